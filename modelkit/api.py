@@ -1,0 +1,60 @@
+"""The library API: read, validate and report on model files without the CLI."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from modelkit.checks import run_rules
+from modelkit.diagnostics import Diagnostic, Severity, sorted_diagnostics
+from modelkit.formats import read_model
+from modelkit.formats.body.reader import BodyOptions
+from modelkit.model import Robot
+
+
+class ModelError(Exception):
+    """Raised by :func:`load` when a file has errors; ``.diagnostics`` says which."""
+
+    def __init__(self, path: str, diagnostics: list[Diagnostic]) -> None:
+        errors = [d for d in diagnostics if d.severity is Severity.ERROR]
+        first = errors[0] if errors else None
+        summary = f"{len(errors)} error(s)" + (f"; first: {first.location}: {first.message}" if first else "")
+        super().__init__(f"{path}: {summary}")
+        self.diagnostics = diagnostics
+
+
+@dataclass
+class Validation:
+    path: str
+    robot: Robot | None
+    diagnostics: list[Diagnostic]
+
+    @property
+    def errors(self) -> list[Diagnostic]:
+        return [d for d in self.diagnostics if d.severity is Severity.ERROR]
+
+    @property
+    def warnings(self) -> list[Diagnostic]:
+        return [d for d in self.diagnostics if d.severity is Severity.WARNING]
+
+
+def validate(path: str | Path, options: BodyOptions | None = None, fmt: str | None = None,
+             display: str | None = None) -> Validation:
+    """Read a file and run every rule over its model."""
+    p = Path(path)
+    result = read_model(p, options, fmt, display or str(path))
+    diagnostics = list(result.diagnostics)
+    if result.robot is not None:
+        diagnostics.extend(run_rules(result.robot))
+    unique: dict[tuple[object, ...], Diagnostic] = {}
+    for d in diagnostics:
+        unique.setdefault((d.code, d.location, d.message), d)
+    return Validation(display or str(path), result.robot, sorted_diagnostics(unique.values()))
+
+
+def load(path: str | Path, options: BodyOptions | None = None, fmt: str | None = None) -> Robot:
+    """Read a file into a :class:`Robot`; raise :class:`ModelError` when it has errors."""
+    v = validate(path, options, fmt)
+    if v.robot is None or v.errors:
+        raise ModelError(str(path), v.diagnostics)
+    return v.robot

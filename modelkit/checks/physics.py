@@ -1,0 +1,118 @@
+"""Rules about mass properties and joint ranges."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+
+from modelkit.checks.registry import rule
+from modelkit.diagnostics import Diagnostic, Severity, diag
+from modelkit.model import JointType, Link, Robot
+from modelkit.spatial import inertia_tolerance, principal_moments
+
+
+def _is_dynamic(robot: Robot) -> bool:
+    return robot.root_joint is JointType.FLOATING or any(j.type.moves for j in robot.joints)
+
+
+def _moving_links(robot: Robot) -> set[str]:
+    """Links that move relative to the world: below a moving joint, or the floating root."""
+    moving: set[str] = set()
+    if robot.root is not None and robot.root_joint is JointType.FLOATING:
+        moving.add(robot.root)
+    children: dict[str, list[tuple[str, bool]]] = {}
+    for j in robot.joints:
+        children.setdefault(j.parent, []).append((j.child, j.type.moves))
+    stack = [(robot.root, robot.root in moving)] if robot.root else []
+    seen: set[str] = set()
+    while stack:
+        name, moves = stack.pop()
+        if name is None or name in seen:
+            continue
+        seen.add(name)
+        if moves:
+            moving.add(name)
+        for child, joint_moves in children.get(name, []):
+            stack.append((child, moves or joint_moves))
+    return moving
+
+
+def _mass_loc(link: Link):  # type: ignore[no-untyped-def]
+    inertial = link.inertial
+    if inertial is None:
+        return link.source
+    return inertial.sources.get("mass", inertial.source or link.source)
+
+
+@rule("mass", "MK300", "MK304", "MK313")
+def mass(robot: Robot) -> Iterator[Diagnostic]:
+    """Masses are positive where it matters; default mass properties are flagged."""
+    moving = _moving_links(robot)
+    dynamic = _is_dynamic(robot)
+    for link in robot.links:
+        inertial = link.inertial
+        if inertial is None:
+            if link.name in moving:
+                yield diag("MK313", f'link "{link.name}" moves but has no mass', link.loc("name"))
+            continue
+        if inertial.defaulted and dynamic:
+            what = "no mass information" if "mass" not in inertial.sources else "no inertia"
+            yield diag("MK304", f'link "{link.name}" has {what}: Choreonoid uses '
+                       f'{"1 kg and " if "mass" not in inertial.sources else ""}an identity inertia (1 kg·m²)',
+                       _mass_loc(link), hint="give mass, center_of_mass and inertia")
+        if inertial.mass < 0:
+            yield diag("MK300", f'link "{link.name}" has a negative mass ({inertial.mass:g} kg)', _mass_loc(link))
+        elif inertial.mass == 0 and link.name in moving:
+            yield diag("MK313", f'link "{link.name}" moves but its mass is zero', _mass_loc(link))
+
+
+@rule("inertia", "MK301", "MK302", "MK303")
+def inertia(robot: Robot) -> Iterator[Diagnostic]:
+    """Inertia tensors are symmetric, positive definite and satisfy the triangle inequality.
+
+    The tolerance is libsdformat's (gz-math ``MassMatrix3::IsValid``): ε = 10 · machine-ε · the
+    largest principal moment.
+    """
+    moving = _moving_links(robot)
+    for link in robot.links:
+        inertial = link.inertial
+        if inertial is None or inertial.mass <= 0:
+            continue
+        # A link welded to the world is never simulated dynamically: its inertia is still wrong, but
+        # harmless, so the finding is a warning there.
+        severity = None if link.name in moving else Severity.WARNING
+        static = "" if link.name in moving else " (the link does not move, so simulators ignore it)"
+        where = inertial.sources.get("inertia", _mass_loc(link))
+        tensor = np.asarray(inertial.inertia, dtype=float)
+        if not np.allclose(tensor, tensor.T, rtol=1e-9, atol=1e-12):
+            yield diag("MK301", f'link "{link.name}": the inertia matrix is not symmetric{static}', where,
+                       severity=severity)
+            continue
+        moments = principal_moments(tensor)
+        eps = inertia_tolerance(moments)
+        if np.all(np.abs(moments) <= eps):
+            yield diag("MK302", f'link "{link.name}" has mass {inertial.mass:g} kg but a zero inertia{static}', where,
+                       severity=severity)
+            continue
+        if moments[0] < -eps:
+            yield diag("MK302", f'link "{link.name}": the inertia is not positive definite (principal moments '
+                       f"{', '.join(f'{m:.6g}' for m in moments)}){static}", where, severity=severity)
+            continue
+        a, b, c = moments
+        if a + b < c - eps:
+            yield diag("MK303", f'link "{link.name}": principal moments {a:.6g}, {b:.6g}, {c:.6g} violate the '
+                       f"triangle inequality ({a:.6g} + {b:.6g} < {c:.6g}){static}", where, severity=severity)
+
+
+@rule("joint-ranges", "MK307", "MK315")
+def joint_ranges(robot: Robot) -> Iterator[Diagnostic]:
+    """Joint position and velocity ranges are ordered."""
+    for joint in robot.joints:
+        limits = joint.limits
+        if limits.lower > limits.upper:
+            yield diag("MK307", f'joint "{joint.name}": lower limit {limits.lower:.6g} is above upper limit '
+                       f"{limits.upper:.6g}", joint.loc("range"))
+        if limits.velocity_lower > limits.velocity_upper:
+            yield diag("MK315", f'joint "{joint.name}": velocity range [{limits.velocity_lower:.6g}, '
+                       f"{limits.velocity_upper:.6g}] is reversed", joint.loc("velocity_range"))

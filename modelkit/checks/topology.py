@@ -1,0 +1,127 @@
+"""Rules about the kinematic tree: names, parents, roots, cycles, joint ids."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+from modelkit.checks.registry import rule
+from modelkit.diagnostics import Diagnostic, diag
+from modelkit.model import Robot
+
+
+@rule("unique-names", "MK204", "MK205")
+def unique_names(robot: Robot) -> Iterator[Diagnostic]:
+    """Link names are unique, and so are joint names."""
+    first_link: dict[str, int] = {}
+    for link in robot.links:
+        if link.name == "":
+            continue
+        if link.name in first_link:
+            where = robot.links[first_link[link.name]].loc("name")
+            line = f" (first at line {where.line})" if where and where.line else ""
+            yield diag("MK204", f'duplicated link name "{link.name}"{line}', link.loc("name"))
+        else:
+            first_link[link.name] = robot.links.index(link)
+    first_joint: dict[str, int] = {}
+    for i, joint in enumerate(robot.joints):
+        if joint.name in first_joint:
+            where = robot.joints[first_joint[joint.name]].loc("name")
+            line = f" (first at line {where.line})" if where and where.line else ""
+            yield diag("MK205", f'duplicated joint name "{joint.name}"{line}', joint.loc("name"))
+        else:
+            first_joint[joint.name] = i
+
+
+@rule("parents-exist", "MK202")
+def parents_exist(robot: Robot) -> Iterator[Diagnostic]:
+    """Every joint's parent link exists."""
+    names = {link.name for link in robot.links}
+    for joint in robot.joints:
+        if joint.parent not in names:
+            yield diag("MK202", f'parent link "{joint.parent}" of "{joint.child}" is not defined',
+                       joint.loc("parent"))
+
+
+@rule("single-root", "MK200", "MK201")
+def single_root(robot: Robot) -> Iterator[Diagnostic]:
+    """Exactly one link has no parent (formats that name their root are checked by the reader)."""
+    if robot.root is not None:
+        return
+    children = {j.child for j in robot.joints}
+    roots = [link for link in robot.links if link.name not in children]
+    if not roots and robot.links:
+        yield diag("MK200", "no root link found: every link has a parent", robot.links[0].loc("name"))
+    elif len(roots) > 1:
+        names = ", ".join(f'"{r.name}"' for r in roots)
+        yield diag("MK201", f"{len(roots)} root links found: {names}", roots[1].loc("name"))
+
+
+@rule("no-cycles", "MK203")
+def no_cycles(robot: Robot) -> Iterator[Diagnostic]:
+    """Following parents from any link ends at the root, never in a loop."""
+    parent_of: dict[str, str] = {}
+    for joint in robot.joints:
+        parent_of.setdefault(joint.child, joint.parent)
+    reported: set[str] = set()
+    for joint in robot.joints:
+        seen: list[str] = []
+        current = joint.child
+        while current in parent_of and current not in seen:
+            seen.append(current)
+            current = parent_of[current]
+        if current in seen:
+            cycle = seen[seen.index(current):]
+            key = min(cycle)
+            if key in reported:
+                continue
+            reported.add(key)
+            path = " -> ".join([*cycle, current])
+            yield diag("MK203", f'adding "{joint.child}" to link "{joint.parent}" results in a cyclic reference '
+                       f"({path})", joint.loc("parent"))
+
+
+@rule("joint-ids", "MK206", "MK207")
+def joint_ids(robot: Robot) -> Iterator[Diagnostic]:
+    """Joint ids are unique and dense from 0 (Choreonoid pads gaps with dummy joints)."""
+    seen: dict[int, str] = {}
+    for joint in robot.joints:
+        if joint.joint_id is None:
+            continue
+        if joint.joint_id in seen:
+            yield diag("MK206", f'joint id {joint.joint_id} of "{joint.child}" is duplicated (also "{seen[joint.joint_id]}")',
+                       joint.loc("id"))
+        else:
+            seen[joint.joint_id] = joint.child
+    if seen:
+        missing = sorted(set(range(max(seen) + 1)) - set(seen))
+        if missing:
+            first = min((j for j in robot.joints if j.joint_id is not None), key=lambda j: j.joint_id or 0)
+            ids = ", ".join(str(i) for i in missing[:10]) + (" ..." if len(missing) > 10 else "")
+            yield diag("MK207", f"joint id(s) {ids} are not specified; Choreonoid fills them with dummy joints",
+                       first.loc("id"))
+
+
+@rule("link-joint-name-collision", "MK211")
+def link_joint_collision(robot: Robot) -> Iterator[Diagnostic]:
+    """A joint named like a link (other than its own implicit name) breaks SDF 1.7+ and Gazebo."""
+    names = {link.name for link in robot.links}
+    for joint in robot.joints:
+        if joint.extras.get("implicit_name"):
+            continue
+        if joint.name in names:
+            yield diag("MK211", f'joint "{joint.name}" has the same name as a link; SDF 1.7+ and Gazebo refuse this',
+                       joint.loc("name"))
+
+
+@rule("special-joints", "MK213", "MK214")
+def special_joints(robot: Robot) -> Iterator[Diagnostic]:
+    """Joint kinds that other formats cannot express exactly."""
+    from modelkit.model import JointType
+
+    for joint in robot.joints:
+        if joint.type is JointType.FLOATING:
+            yield diag("MK213", f'"{joint.child}" has a free joint below the root: its subtree floats as a separate '
+                       "body (no URDF/MJCF equivalent)", joint.loc("type"))
+        elif joint.type is JointType.PSEUDO_CONTINUOUS_TRACK:
+            yield diag("MK214", f'"{joint.child}" is a pseudo continuous track: kinematically fixed, its contact '
+                       "surface moves; URDF/SDF/MJCF have no equivalent", joint.loc("type"))

@@ -1,0 +1,148 @@
+"""The `modelkit` command line. Thin: parse options, call the library, render.
+
+Exit codes: 0 clean; 1 findings at error level (or warnings with --strict); 2 the tool could not
+run (bad usage, unreadable input).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
+
+import click
+
+from modelkit.diagnostics import Diagnostic, Severity, render_github, render_json, render_text
+
+F = TypeVar("F", bound=Callable[..., Any])
+UNREADABLE_CODES = frozenset({"MK001", "MK002"})
+
+
+def _pairs(values: tuple[str, ...], option: str) -> dict[str, Path]:
+    out: dict[str, Path] = {}
+    for item in values:
+        name, sep, folder = item.partition("=")
+        if not sep or not name or not folder:
+            raise click.BadParameter(f"expected NAME=DIR, got {item!r}", param_hint=option)
+        out[name] = Path(folder)
+    return out
+
+
+def reading_options(fn: F) -> F:
+    """Options shared by every command that reads model files."""
+    options = [
+        click.option("--input-format", type=click.Choice(["body"]), default=None,
+                     help="Read files as this format instead of guessing from the extension."),
+        click.option("--package-path", "package_paths", multiple=True, metavar="NAME=DIR",
+                     help="Where package://NAME/... URIs point (repeatable); searched before ROS_PACKAGE_PATH."),
+        click.option("--path-variable", "path_variables", multiple=True, metavar="NAME=DIR",
+                     help="Value of a ${NAME} path variable in URIs (repeatable)."),
+        click.option("--materials", "materials", type=click.Path(dir_okay=False, path_type=Path), default=None,
+                     help="Contact-materials file (default: Choreonoid's share/default/materials.yaml)."),
+        click.option("--vrml-extrusion", is_flag=True,
+                     help="Build Extrusions as VRML97 intends instead of reproducing Choreonoid's quirks."),
+        click.option("--max-bytes", type=click.IntRange(min=1), default=64 * 1024 * 1024, show_default=True,
+                     help="Refuse input files larger than this."),
+    ]
+    for option in reversed(options):
+        fn = option(fn)
+    return fn
+
+
+def _body_options(kwargs: dict[str, Any], check_resources: bool) -> Any:
+    from modelkit.formats.body.reader import BodyOptions
+    from modelkit.resources import Resolver
+
+    resolver = Resolver(package_paths=_pairs(kwargs["package_paths"], "--package-path"),
+                        path_variables=_pairs(kwargs["path_variables"], "--path-variable"))
+    return BodyOptions(resolver=resolver, materials_path=kwargs["materials"],
+                       faithful_extrusion=not kwargs["vrml_extrusion"], check_resources=check_resources,
+                       max_bytes=kwargs["max_bytes"])
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="modelkit")
+def main() -> None:
+    """Validate, convert and verify robot model files (Choreonoid .body, URDF/xacro, SDF, MJCF)."""
+
+
+@main.command()
+@click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.option("--format", "output_format", type=click.Choice(["text", "json", "github"]), default="text",
+              show_default=True, help="How to print findings.")
+@click.option("--strict", is_flag=True, help="Fail (exit 1) on warnings too.")
+@click.option("--show-info", is_flag=True, help="Also print info-level findings.")
+@click.option("--no-resources", is_flag=True, help="Do not open mesh files to check that they load.")
+@click.option("--ignore", "ignored", multiple=True, metavar="CODE",
+              help="Silence a code (MK103) or name (unknown-key); repeatable.")
+@reading_options
+def validate(files: tuple[Path, ...], output_format: str, strict: bool, show_info: bool, no_resources: bool,
+             ignored: tuple[str, ...], **kwargs: Any) -> None:
+    """Check model files and print file:line:col findings with stable codes."""
+    from modelkit.api import validate as validate_file
+    from modelkit.codes import resolve
+
+    silenced: set[str] = set()
+    for item in ignored:
+        info = resolve(item)
+        if info is None:
+            raise click.BadParameter(f"unknown code {item!r}", param_hint="--ignore")
+        silenced.add(info.code)
+    options = _body_options(kwargs, check_resources=not no_resources)
+    findings: list[Diagnostic] = []
+    unreadable = False
+    for path in files:
+        result = validate_file(path, options, kwargs["input_format"], str(path))
+        for d in result.diagnostics:
+            if d.code in silenced:
+                continue
+            if d.code in UNREADABLE_CODES:
+                unreadable = True
+            findings.append(d)
+    shown = [d for d in findings if show_info or d.severity is not Severity.INFO]
+    if output_format == "json":
+        click.echo(render_json(shown, [str(f) for f in files]))
+    else:
+        render = render_github if output_format == "github" else render_text
+        for d in shown:
+            click.echo(render(d))
+    errors = sum(1 for d in findings if d.severity is Severity.ERROR)
+    warnings = sum(1 for d in findings if d.severity is Severity.WARNING)
+    if output_format == "text":
+        click.echo(f"{len(files)} file(s) checked: {errors} error(s), {warnings} warning(s)", err=True)
+    if unreadable:
+        sys.exit(2)
+    sys.exit(1 if errors or (strict and warnings) else 0)
+
+
+@main.command()
+@click.argument("file", type=click.Path(path_type=Path))
+@click.option("--order", type=click.Choice(["joint-name", "document"]), default="joint-name", show_default=True,
+              help="Child order: by joint name as check_urdf prints it, or as written in the file.")
+@click.option("--format", "output_format", type=click.Choice(["text", "json"]), default="text",
+              show_default=True, help="text: the check_urdf report; json: the tree with joint types and origins.")
+@reading_options
+def tree(file: Path, order: str, output_format: str, **kwargs: Any) -> None:
+    """Print the kinematic tree exactly as check_urdf does."""
+    from modelkit.api import validate as validate_file
+    from modelkit.tree import tree_json, tree_report
+
+    options = _body_options(kwargs, check_resources=False)
+    result = validate_file(file, options, kwargs["input_format"], str(file))
+    blocking = [d for d in result.diagnostics if d.severity is Severity.ERROR
+                and (d.code.startswith("MK2") or d.code.startswith("MK0") or result.robot is None)]
+    if result.robot is None or result.robot.root is None or blocking:
+        for d in blocking or [d for d in result.diagnostics if d.severity is Severity.ERROR]:
+            click.echo(render_text(d), err=True)
+        click.echo("ERROR: the kinematic tree cannot be built", err=True)
+        sys.exit(2 if any(d.code in UNREADABLE_CODES for d in result.diagnostics) else 1)
+    render = tree_json if output_format == "json" else tree_report
+    click.echo(render(result.robot, order), nl=False)  # type: ignore[arg-type]
+    errors = len(result.errors)
+    if errors:
+        click.echo(f"note: {file} has {errors} other error(s); run `modelkit validate {file}`", err=True)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,0 +1,184 @@
+"""Typing of `.body` scalars and vectors the way Choreonoid's ValueTree does it.
+
+Every YAML scalar is a string; these helpers turn Y-nodes into floats, ints, booleans, vectors,
+rotations and translations. Type and shape mistakes are the schema's to report
+(:mod:`modelkit.formats.body.schema`); the helpers here return ``None`` for them and report only the
+semantic faults the schema cannot see (a zero rotation axis, an empty vector).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+from modelkit.diagnostics import DiagnosticSink
+from modelkit.spatial import Mat3, Vec3, axis_angle
+from modelkit.yamltree import YMap, YNode, YScalar, YSeq
+
+# C strtod's syntax: decimal with optional exponent, hex floats, inf/infinity, nan.
+_FLOAT_RE = re.compile(
+    r"^\s*[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|0[xX](?:[0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)"
+    r"(?:[pP][+-]?\d+)?|(?i:inf(?:inity)?|nan))\s*$"
+)
+_INT_RE = re.compile(r"^\s*[+-]?\d+\s*$")
+TRUE_WORDS = frozenset("y Y yes Yes YES true True TRUE on On ON".split())
+FALSE_WORDS = frozenset("n N no No NO false False FALSE off Off OFF".split())
+UNLIMITED = "unlimited"
+
+
+def parse_float(text: str) -> float | None:
+    """A number as Choreonoid's "read" accessors accept it (the whole string, blanks allowed)."""
+    if not _FLOAT_RE.match(text):
+        return None
+    s = text.strip()
+    body = s.lstrip("+-")
+    if body[:2] in ("0x", "0X"):
+        value = float.fromhex(body)
+        return -value if s.startswith("-") else value
+    return float(s)
+
+
+def parse_int(text: str) -> int | None:
+    return int(text.strip()) if _INT_RE.match(text) else None
+
+
+def parse_bool(text: str) -> bool | None:
+    if text in TRUE_WORDS:
+        return True
+    if text in FALSE_WORDS:
+        return False
+    return None
+
+
+def scalar_text(node: YNode | None) -> str | None:
+    return node.value if isinstance(node, YScalar) else None
+
+
+def number(node: YNode | None) -> float | None:
+    text = scalar_text(node)
+    return None if text is None else parse_float(text)
+
+
+def integer(node: YNode | None) -> int | None:
+    text = scalar_text(node)
+    return None if text is None else parse_int(text)
+
+
+def boolean(node: YNode | None) -> bool | None:
+    text = scalar_text(node)
+    return None if text is None else parse_bool(text)
+
+
+def get_number(m: YMap, *keys: str, default: float | None = None) -> float | None:
+    value = number(m.get(*keys))
+    return default if value is None else value
+
+
+def get_angle(m: YMap, angle_scale: float, *keys: str, default: float | None = None) -> float | None:
+    value = number(m.get(*keys))
+    return default if value is None else value * angle_scale
+
+
+def get_bool(m: YMap, *keys: str, default: bool) -> bool:
+    value = boolean(m.get(*keys))
+    return default if value is None else value
+
+
+def get_text(m: YMap, *keys: str) -> str | None:
+    return scalar_text(m.get(*keys))
+
+
+def numbers(node: YNode | None) -> list[float] | None:
+    """A flat list of numbers, or None when it is not one."""
+    if not isinstance(node, YSeq):
+        return None
+    out: list[float] = []
+    for item in node.items:
+        value = number(item)
+        if value is None:
+            return None
+        out.append(value)
+    return out
+
+
+def vector(node: YNode | None, size: int) -> Vec3 | None:
+    values = numbers(node)
+    if values is None or len(values) != size:
+        return None
+    return np.array(values, dtype=float)
+
+
+def translation(node: YNode | None, sink: DiagnosticSink) -> Vec3 | None:
+    """``[x, y, z]`` or a list of such vectors (summed), as links and Transforms accept it."""
+    if node is None:
+        return None
+    if isinstance(node, YSeq) and not node.items:
+        sink.emit("MK309", "`translation: []` is empty (undefined behaviour in Choreonoid)", node.loc)
+        return None
+    if isinstance(node, YSeq) and node.items and all(isinstance(i, YSeq) for i in node.items):
+        total = np.zeros(3)
+        for item in node.items:
+            v = vector(item, 3)
+            if v is None:
+                return None
+            total += v
+        return total
+    return vector(node, 3)
+
+
+def rotation(node: YNode | None, angle_scale: float, sink: DiagnosticSink) -> Mat3 | None:
+    """``[ax, ay, az, angle]`` or a list of them composed left to right (R1·R2·…)."""
+    if node is None:
+        return None
+    if isinstance(node, YSeq) and not node.items:
+        sink.emit("MK309", "`rotation: []` is empty (undefined behaviour in Choreonoid)", node.loc)
+        return None
+    parts = node.items if isinstance(node, YSeq) and all(isinstance(i, YSeq) for i in node.items) else [node]
+    result = np.eye(3)
+    for part in parts:
+        aa = vector(part, 4)
+        if aa is None:
+            return None
+        axis = aa[:3]
+        if float(np.linalg.norm(axis)) < 1e-6:
+            sink.emit("MK308", "rotation axis is the zero vector", part.loc)
+            return None
+        result = result @ axis_angle(axis, float(aa[3]) * angle_scale)
+    return result
+
+
+def scale3(node: YNode | None, sink: DiagnosticSink) -> Vec3 | None:
+    if node is None:
+        return None
+    if isinstance(node, YScalar):
+        sink.emit("MK413", f'a scalar `scale: {node.value}` is ignored by Choreonoid', node.loc,
+                  hint=f"write scale: [{node.value}, {node.value}, {node.value}]")
+        return None
+    return vector(node, 3)
+
+
+def finite_or_unlimited(node: YNode | None) -> float | None:
+    """A number, or ±inf for ``unlimited`` (returned as +inf; callers apply the sign)."""
+    text = scalar_text(node)
+    if text is None:
+        return None
+    if text.strip() == UNLIMITED:
+        return math.inf
+    return parse_float(text)
+
+
+def node_transform(m: YMap, angle_scale: float, sink: DiagnosticSink) -> np.ndarray:
+    """The 4×4 affine Trans(p)·Rot(R)·Scale(s) of a node with translation/rotation/scale keys."""
+    t = translation(m.get("translation"), sink)
+    r = rotation(m.get("rotation"), angle_scale, sink)
+    s = scale3(m.get("scale"), sink)
+    out = np.eye(4)
+    linear = np.eye(3) if r is None else r
+    if s is not None:
+        linear = linear @ np.diag(s)
+    out[:3, :3] = linear
+    if t is not None:
+        out[:3, 3] = t
+    return out

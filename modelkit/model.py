@@ -1,0 +1,305 @@
+"""The robot model every reader produces and every writer consumes.
+
+Conventions, settled here and nowhere else:
+
+* SI units (m, kg, s), angles in radians, right-handed frames.
+* A link's frame is its joint frame: a joint's ``origin`` is the child link frame expressed in the
+  parent link frame at q = 0, and the joint axis is expressed in the child link frame.
+* Cylinders, capsules and cones lie along their local **Z** axis (readers of Y-axis formats rotate
+  at the boundary). Cone apex at +length/2.
+* Inertia is about the centre of mass, in link axes, a full 3×3 tensor.
+* Every element keeps its :class:`SourceLocation`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from modelkit.diagnostics import SourceLocation
+from modelkit.spatial import Mat3, Pose, Vec3
+
+
+class JointType(str, Enum):
+    FIXED = "fixed"
+    REVOLUTE = "revolute"  # limited or unlimited (URDF "continuous" = revolute without limits)
+    PRISMATIC = "prismatic"
+    FLOATING = "floating"  # 6 DOF (Choreonoid "free"; a non-root one splits off a floating subtree)
+    PLANAR = "planar"
+    BALL = "ball"
+    PSEUDO_CONTINUOUS_TRACK = "pseudo_continuous_track"  # fixed kinematically, moving contact surface
+
+    @property
+    def moves(self) -> bool:
+        return self not in (JointType.FIXED, JointType.PSEUDO_CONTINUOUS_TRACK)
+
+
+# ---- geometry -------------------------------------------------------------------------------
+
+
+@dataclass(eq=False)
+class Box:
+    size: Vec3  # full edge lengths
+
+
+@dataclass(eq=False)
+class Sphere:
+    radius: float
+
+
+@dataclass(eq=False)
+class Cylinder:
+    radius: float
+    length: float
+
+
+@dataclass(eq=False)
+class Capsule:
+    radius: float
+    length: float  # length of the cylindrical part (hemispheres add 2·radius)
+
+
+@dataclass(eq=False)
+class Cone:
+    radius: float
+    length: float
+
+
+@dataclass(eq=False)
+class Ellipsoid:
+    radii: Vec3
+
+
+@dataclass(eq=False)
+class TriangleMeshData:
+    """Triangles held in memory (generated geometry, or a mesh already loaded)."""
+
+    vertices: NDArray[np.float64]  # (n, 3)
+    faces: NDArray[np.int64]  # (m, 3)
+
+
+@dataclass(eq=False)
+class Mesh:
+    """A mesh: a file reference, triangles in memory, or both.
+
+    ``uri`` is as written in the source; ``path`` is where the resolver found it (None when it could
+    not be resolved). ``fragment`` selects a named part (VRML DEF / COLLADA node). ``generator``
+    names the generated-geometry kind ("Extrusion", "IndexedFaceSet", ...) when the triangles were
+    computed from source data rather than read from a file.
+    """
+
+    uri: str | None = None
+    path: str | None = None
+    fragment: str | None = None
+    scale: Vec3 = field(default_factory=lambda: np.ones(3))
+    data: TriangleMeshData | None = None
+    generator: str | None = None
+    source_params: dict[str, Any] = field(default_factory=dict)
+
+
+Geometry = Box | Sphere | Cylinder | Capsule | Cone | Ellipsoid | Mesh
+
+
+@dataclass(eq=False)
+class VisualMaterial:
+    name: str | None = None
+    diffuse: Vec3 | None = None  # RGB 0..1
+    transparency: float = 0.0
+    ambient: float | None = None
+    specular: Vec3 | None = None
+    emissive: Vec3 | None = None
+    specular_exponent: float | None = None
+    texture: str | None = None
+
+    @property
+    def rgba(self) -> tuple[float, float, float, float] | None:
+        if self.diffuse is None:
+            return None
+        r, g, b = (float(v) for v in self.diffuse)
+        return (r, g, b, 1.0 - self.transparency)
+
+
+@dataclass(eq=False)
+class Geom:
+    """One visual or collision shape, placed in its link frame."""
+
+    geometry: Geometry
+    pose: Pose = field(default_factory=Pose)
+    name: str | None = None
+    material: VisualMaterial | None = None
+    source: SourceLocation | None = None
+
+
+@dataclass(eq=False)
+class Inertial:
+    mass: float
+    com: Vec3 = field(default_factory=lambda: np.zeros(3))
+    inertia: Mat3 = field(default_factory=lambda: np.zeros((3, 3)))  # about the COM, link axes
+    defaulted: bool = False  # True when the source gave no mass information (Choreonoid defaults)
+    source: SourceLocation | None = None
+    sources: dict[str, SourceLocation] = field(default_factory=dict)
+
+
+@dataclass(eq=False)
+class Device:
+    """A sensor, light or other device attached to a link.
+
+    ``kind`` is the source format's device type (``Camera``, ``RangeSensor``, ``SpotLight``...);
+    ``params`` holds its parameters in SI units and radians under snake_case names.
+    """
+
+    kind: str
+    name: str
+    pose: Pose = field(default_factory=Pose)
+    params: dict[str, Any] = field(default_factory=dict)
+    source: SourceLocation | None = None
+
+
+@dataclass(eq=False)
+class Link:
+    name: str
+    inertial: Inertial | None = None
+    visuals: list[Geom] = field(default_factory=list)
+    collisions: list[Geom] = field(default_factory=list)
+    devices: list[Device] = field(default_factory=list)
+    contact_material: str | None = None
+    extras: dict[str, Any] = field(default_factory=dict)  # format-specific data kept as is
+    source: SourceLocation | None = None
+    sources: dict[str, SourceLocation] = field(default_factory=dict)  # per attribute: "name", "mass"...
+
+    def loc(self, attribute: str) -> SourceLocation | None:
+        return self.sources.get(attribute, self.source)
+
+
+@dataclass(eq=False)
+class JointLimits:
+    lower: float = -math.inf
+    upper: float = math.inf
+    velocity: float = math.inf  # symmetric bound |dq| ≤ velocity, when symmetric
+    velocity_lower: float = -math.inf
+    velocity_upper: float = math.inf
+    effort: float = math.inf
+
+    @property
+    def position_limited(self) -> bool:
+        return math.isfinite(self.lower) or math.isfinite(self.upper)
+
+
+@dataclass(eq=False)
+class Joint:
+    name: str
+    type: JointType
+    parent: str
+    child: str
+    origin: Pose = field(default_factory=Pose)  # child frame in parent frame at q = 0
+    axis: Vec3 = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))  # in the child frame
+    limits: JointLimits = field(default_factory=JointLimits)
+    armature: float = 0.0
+    initial_position: float = 0.0
+    joint_id: int | None = None
+    actuation_mode: str | None = None
+    extras: dict[str, Any] = field(default_factory=dict)
+    source: SourceLocation | None = None
+    sources: dict[str, SourceLocation] = field(default_factory=dict)  # per attribute: "parent", "axis"...
+
+    def loc(self, attribute: str) -> SourceLocation | None:
+        return self.sources.get(attribute, self.source)
+
+
+@dataclass(eq=False)
+class LoopConstraint:
+    """A closed-loop joint between two links of the tree (Choreonoid ``extra_joints``)."""
+
+    name: str
+    type: str  # "fixed" | "hinge" | "ball" | "piston"
+    link1: str
+    link2: str
+    pose_in_link1: Pose = field(default_factory=Pose)
+    pose_in_link2: Pose = field(default_factory=Pose)
+    axis: Vec3 = field(default_factory=lambda: np.array([1.0, 0.0, 0.0]))  # in the joint frame
+    source: SourceLocation | None = None
+
+
+@dataclass(eq=False)
+class Robot:
+    """A robot: links joined into a tree by joints, plus how the root meets the world.
+
+    ``links`` and ``joints`` are lists (not dicts) so that a reader can keep duplicate names for the
+    validation rules to report. ``root`` names the root link; ``root_joint`` says whether it floats
+    (``FLOATING``) or is welded to the world (``FIXED``) at ``root_pose``, or is None when the format
+    leaves it open (URDF).
+    """
+
+    name: str
+    links: list[Link] = field(default_factory=list)
+    joints: list[Joint] = field(default_factory=list)
+    root: str | None = None
+    root_joint: JointType | None = None
+    root_pose: Pose = field(default_factory=Pose)
+    loops: list[LoopConstraint] = field(default_factory=list)
+    source_format: str = ""
+    source: SourceLocation | None = None
+    extras: dict[str, Any] = field(default_factory=dict)
+
+    def link(self, name: str) -> Link | None:
+        for link in self.links:
+            if link.name == name:
+                return link
+        return None
+
+    def link_map(self) -> dict[str, Link]:
+        """Links by name (the first of duplicates wins)."""
+        out: dict[str, Link] = {}
+        for link in self.links:
+            out.setdefault(link.name, link)
+        return out
+
+    def parent_joint_map(self) -> dict[str, Joint]:
+        """The joint leading into each child link (the first of several wins)."""
+        out: dict[str, Joint] = {}
+        for joint in self.joints:
+            out.setdefault(joint.child, joint)
+        return out
+
+    def children(self, link_name: str) -> list[Joint]:
+        """Joints whose parent is ``link_name``, in document order."""
+        return [j for j in self.joints if j.parent == link_name]
+
+    def movable_joints(self) -> list[Joint]:
+        return [j for j in self.joints if j.type.moves]
+
+    def world_poses(self, positions: dict[str, float] | None = None) -> dict[str, Pose]:
+        """Forward kinematics: each link's pose in the world (root at ``root_pose``).
+
+        ``positions`` maps joint names to q (default 0). Links unreachable from the root are absent.
+        """
+        from modelkit.spatial import axis_angle
+
+        positions = positions or {}
+        if self.root is None:
+            return {}
+        poses: dict[str, Pose] = {self.root: self.root_pose}
+        children_of: dict[str, list[Joint]] = {}
+        for joint in self.joints:
+            children_of.setdefault(joint.parent, []).append(joint)
+        stack = [self.root]
+        while stack:
+            parent = stack.pop()
+            for joint in children_of.get(parent, []):
+                if joint.child in poses:
+                    continue
+                q = positions.get(joint.name, 0.0)
+                motion = Pose()
+                axis = np.asarray(joint.axis, dtype=float)
+                if joint.type is JointType.REVOLUTE and q != 0.0 and np.linalg.norm(axis) > 0:
+                    motion = Pose(axis_angle(axis, q), np.zeros(3))
+                elif joint.type is JointType.PRISMATIC and q != 0.0:
+                    motion = Pose(np.eye(3), axis * q)
+                poses[joint.child] = poses[parent] @ joint.origin @ motion
+                stack.append(joint.child)
+        return poses

@@ -1,0 +1,136 @@
+"""One resolver for the URIs that model files use to name meshes, textures and other files.
+
+Search order for ``package://NAME/REL`` (see docs/resources.md):
+
+1. ``--package-path NAME=DIR`` given by the user;
+2. each entry E of ``ROS_PACKAGE_PATH``: ``E/NAME/REL`` (and ``E/REL`` when E is the package itself);
+3. each entry E of ``AMENT_PREFIX_PATH``: ``E/share/NAME/REL``;
+4. walking up from the model file: the first folder whose ``package.xml`` names NAME, or which holds
+   ``NAME/package.xml``.
+
+``model://NAME/REL`` looks in ``GZ_SIM_RESOURCE_PATH``, ``IGN_GAZEBO_RESOURCE_PATH`` and
+``SDF_PATH``. ``file://`` and plain paths are relative to the referring file's folder.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+_SCHEME_RE = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*)://(.+)$")
+_PACKAGE_NAME_RE = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
+_VARIABLE_RE = re.compile(r"^\$\{([A-Za-z_][A-Za-z0-9_]*)\}")
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """Where a URI points. ``path`` is None when it cannot be resolved; then ``code`` and
+    ``message`` say why (``path`` may also be set for a file that does not exist: check it)."""
+
+    uri: str
+    path: Path | None
+    scheme: str
+    code: str | None = None
+    message: str | None = None
+    hint: str | None = None
+
+
+@dataclass
+class Resolver:
+    package_paths: dict[str, Path] = field(default_factory=dict)
+    path_variables: dict[str, Path] = field(default_factory=dict)
+    environ: Mapping[str, str] = field(default_factory=lambda: dict(os.environ))
+    _package_cache: dict[tuple[str, str], Path | None] = field(default_factory=dict)
+
+    def resolve(self, uri: str, base_dir: Path, model_file: Path | None = None) -> Resolution:
+        text = uri.strip()
+        variable = _VARIABLE_RE.match(text)
+        if variable:
+            name = variable.group(1)
+            root = self.path_variables.get(name)
+            if root is None and name == "HOME" and "HOME" in self.environ:
+                root = Path(self.environ["HOME"])
+            if root is None:
+                return Resolution(uri, None, "variable", "MK505", f'path variable "${{{name}}}" in "{uri}" is not defined',
+                                  hint=f"define it with --path-variable {name}=DIR")
+            text = str(root) + text[variable.end():]
+        match = _SCHEME_RE.match(text)
+        if match is None:
+            path = Path(text)
+            return Resolution(uri, _normal(path if path.is_absolute() else base_dir / path), "")
+        scheme, rest = match.group(1).lower(), match.group(2)
+        if scheme == "file":
+            path = Path(rest)
+            return Resolution(uri, _normal(path if path.is_absolute() else base_dir / path), "file")
+        if scheme == "package":
+            return self._resolve_package(uri, rest, model_file or base_dir / "_")
+        if scheme == "model":
+            return self._resolve_model(uri, rest)
+        return Resolution(uri, None, scheme, "MK503", f'the "{scheme}" scheme in URI "{uri}" is not supported')
+
+    def _resolve_package(self, uri: str, rest: str, model_file: Path) -> Resolution:
+        package, _, relative = rest.partition("/")
+        root = self.find_package(package, model_file.parent)
+        if root is None:
+            return Resolution(uri, None, "package", "MK504", f'package "{package}" of "{uri}" cannot be found',
+                              hint=f"give its folder with --package-path {package}=DIR, or set ROS_PACKAGE_PATH")
+        return Resolution(uri, _normal(root / relative), "package")
+
+    def find_package(self, package: str, start: Path) -> Path | None:
+        key = (package, str(start))
+        if key in self._package_cache:
+            return self._package_cache[key]
+        found = self._search_package(package, start)
+        self._package_cache[key] = found
+        return found
+
+    def _search_package(self, package: str, start: Path) -> Path | None:
+        if package in self.package_paths:
+            return self.package_paths[package]
+        for entry in _split_paths(self.environ.get("ROS_PACKAGE_PATH", "")):
+            if (entry / package).is_dir():
+                return entry / package
+            if entry.name == package and entry.is_dir():
+                return entry
+        for entry in _split_paths(self.environ.get("AMENT_PREFIX_PATH", "")):
+            if (entry / "share" / package).is_dir():
+                return entry / "share" / package
+        folder = start.resolve()
+        for candidate in (folder, *folder.parents):
+            if _package_name(candidate / "package.xml") == package:
+                return candidate
+            if _package_name(candidate / package / "package.xml") == package:
+                return candidate / package
+        return None
+
+    def _resolve_model(self, uri: str, rest: str) -> Resolution:
+        for var in ("GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH", "SDF_PATH"):
+            for entry in _split_paths(self.environ.get(var, "")):
+                candidate = entry / rest
+                if candidate.exists():
+                    return Resolution(uri, _normal(candidate), "model")
+        model = rest.partition("/")[0]
+        return Resolution(uri, None, "model", "MK504", f'model "{model}" of "{uri}" cannot be found',
+                          hint="add its parent folder to GZ_SIM_RESOURCE_PATH")
+
+
+def _split_paths(value: str) -> list[Path]:
+    return [Path(p) for p in value.split(os.pathsep) if p]
+
+
+def _normal(path: Path) -> Path:
+    return Path(os.path.normpath(path))
+
+
+def _package_name(package_xml: Path) -> str | None:
+    try:
+        if not package_xml.is_file():
+            return None
+        head = package_xml.read_text(encoding="utf-8", errors="replace")[:65536]
+    except OSError:
+        return None
+    match = _PACKAGE_NAME_RE.search(head)
+    return match.group(1) if match else None

@@ -1,0 +1,452 @@
+"""YAML read the way Choreonoid reads it, keeping the source position of every node.
+
+* libyaml (``CSafeLoader``) does the scanning, as in Choreonoid, so tabs in flow sequences work.
+* Every scalar stays a string; typing happens where a value is used (see :mod:`modelkit.scalars`).
+* Anchors and aliases are kept as shared nodes (never copied), so an alias bomb costs nothing to
+  load; :func:`parse_yaml` then measures the expanded size and refuses documents that would
+  explode, and refuses recursive aliases.
+* ``<<`` merge keys follow Choreonoid: explicit keys win, and in a merge list the earlier mapping wins.
+* Duplicate keys, which PyYAML and Choreonoid silently collapse, are reported.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from modelkit.diagnostics import DiagnosticSink, SourceLocation
+
+# The expanded node count above which a document is treated as an alias bomb. Real Choreonoid
+# models stay far below it (the largest sample terrains have a few hundred thousand scalars).
+DEFAULT_EXPANSION_LIMIT = 5_000_000
+DEFAULT_MAX_BYTES = 64 * 1024 * 1024
+
+
+@dataclass(eq=False)
+class YNode:
+    loc: SourceLocation
+    anchor: str | None = field(default=None, kw_only=True)
+
+
+@dataclass(eq=False)
+class YScalar(YNode):
+    value: str
+    plain: bool = True  # False when the scalar was quoted or a block scalar
+
+
+@dataclass(eq=False)
+class YSeq(YNode):
+    items: list[YNode] = field(default_factory=list)
+
+
+@dataclass(eq=False)
+class YMap(YNode):
+    """A mapping after merge resolution: key -> (key node, value node), in document order."""
+
+    entries: dict[str, tuple[YScalar, YNode]] = field(default_factory=dict)
+    merged_keys: set[str] = field(default_factory=set)  # keys that came from a `<<` merge
+
+    def get(self, *spellings: str) -> YNode | None:
+        for key in spellings:
+            entry = self.entries.get(key)
+            if entry is not None:
+                return entry[1]
+        return None
+
+    def find(self, *spellings: str) -> tuple[str, YNode] | None:
+        """The first spelling present, with its value."""
+        for key in spellings:
+            entry = self.entries.get(key)
+            if entry is not None:
+                return key, entry[1]
+        return None
+
+    def key_loc(self, key: str) -> SourceLocation:
+        entry = self.entries.get(key)
+        return entry[0].loc if entry else self.loc
+
+    def __contains__(self, key: object) -> bool:
+        return key in self.entries
+
+    def keys(self) -> Iterator[str]:
+        return iter(self.entries)
+
+    def items(self) -> Iterator[tuple[str, YNode]]:
+        for key, (_, value) in self.entries.items():
+            yield key, value
+
+
+@dataclass
+class YamlDocument:
+    root: YNode | None
+    path: str
+    anchors: dict[str, YNode]
+
+
+def _loc(path: str, mark: yaml.Mark | None) -> SourceLocation:
+    if mark is None:
+        return SourceLocation(path)
+    return SourceLocation(path, mark.line + 1, mark.column + 1)
+
+
+class _Converter:
+    """Turns PyYAML's composed node graph into Y-nodes, sharing aliased nodes."""
+
+    def __init__(self, path: str, sink: DiagnosticSink, anchor_names: dict[int, str]) -> None:
+        self.path = path
+        self.sink = sink
+        self.memo: dict[int, YNode] = {}
+        self.anchor_names = anchor_names
+
+    def convert(self, node: yaml.Node) -> YNode:
+        done = self.memo.get(id(node))
+        if done is not None:
+            return done
+        loc = _loc(self.path, node.start_mark)
+        anchor = self.anchor_names.get(id(node))
+        result: YNode
+        if isinstance(node, yaml.ScalarNode):
+            result = YScalar(loc, node.value, plain=node.style in (None, ""), anchor=anchor)
+            self.memo[id(node)] = result
+        elif isinstance(node, yaml.SequenceNode):
+            seq = YSeq(loc, anchor=anchor)
+            self.memo[id(node)] = seq
+            seq.items = [self.convert(child) for child in node.value]
+            result = seq
+        elif isinstance(node, yaml.MappingNode):
+            mapping = YMap(loc, anchor=anchor)
+            self.memo[id(node)] = mapping
+            self._fill_mapping(mapping, node)
+            result = mapping
+        else:  # pragma: no cover - PyYAML has no other node kinds
+            raise TypeError(node)
+        return result
+
+    def _fill_mapping(self, mapping: YMap, node: yaml.MappingNode) -> None:
+        merges: list[tuple[YScalar, yaml.Node]] = []
+        for key_node, value_node in node.value:
+            if not isinstance(key_node, yaml.ScalarNode):
+                self.sink.emit("MK019", "a mapping key must be a scalar", _loc(self.path, key_node.start_mark))
+                continue
+            key = YScalar(_loc(self.path, key_node.start_mark), key_node.value,
+                          plain=key_node.style in (None, ""))
+            if key_node.tag == "tag:yaml.org,2002:merge" or (key.value == "<<" and key.plain):
+                merges.append((key, value_node))
+                continue
+            if key.value == "":
+                self.sink.emit("MK018", "empty key", key.loc)
+                continue
+            previous = mapping.entries.get(key.value)
+            if previous is not None:
+                self.sink.emit(
+                    "MK011",
+                    f'duplicate key "{key.value}" (first at line {previous[0].loc.line}); '
+                    "Choreonoid silently keeps only this last value",
+                    key.loc,
+                )
+            mapping.entries[key.value] = (key, self.convert(value_node))
+        for key, value_node in merges:
+            self._merge(mapping, key, value_node)
+
+    def _merge(self, mapping: YMap, key: YScalar, value_node: yaml.Node) -> None:
+        value = self.convert(value_node)
+        sources: list[YNode]
+        if isinstance(value, YMap):
+            sources = [value]
+        elif isinstance(value, YSeq):
+            sources = list(value.items)
+        else:
+            self.sink.emit("MK016", 'a value to merge by the "<<" key must be a mapping or a list of mappings',
+                           value.loc)
+            return
+        for source in sources:
+            if not isinstance(source, YMap):
+                self.sink.emit("MK016", 'an element to merge by the "<<" key must be a mapping', source.loc)
+                continue
+            for k, entry in source.entries.items():
+                if k not in mapping.entries:
+                    mapping.entries[k] = entry
+                    mapping.merged_keys.add(k)
+
+
+MAX_NESTING = 128
+
+
+def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], yaml.Mark | None]:
+    """One pass over the event stream (libyaml's parser is iterative, so this is safe on any input).
+
+    Returns the anchor names by (line, column) of the anchored node (PyYAML's composer drops them)
+    and, when the nesting passes :data:`MAX_NESTING`, the mark where it does: the composer and
+    everything after it recurse, so such documents are refused before composing.
+    """
+    names: dict[tuple[int, int], str] = {}
+    depth = 0
+    documents = 0
+    try:
+        for event in yaml.parse(text, Loader=yaml.CSafeLoader):
+            if isinstance(event, yaml.DocumentStartEvent):
+                documents += 1
+                if documents > 1:
+                    break
+            if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
+                depth += 1
+                if depth > MAX_NESTING:
+                    return names, event.start_mark
+            elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
+                depth -= 1
+            anchor = getattr(event, "anchor", None)
+            if anchor and not isinstance(event, yaml.AliasEvent):
+                names[(event.start_mark.line, event.start_mark.column)] = anchor
+    except yaml.YAMLError:
+        pass
+    return names, None
+
+
+def measure_expansion(root: YNode, limit: int) -> tuple[str, YNode] | None:
+    """Check the size the document would have with every alias copied out.
+
+    Returns ``("recursive", node)`` for a node that contains itself, ``("limit", node)`` for the
+    node where the expanded count passes ``limit``, or None when the document is fine. Shared nodes
+    are measured once, so the check is linear in the size of the file.
+    """
+    sizes: dict[int, int] = {}
+    on_stack: set[int] = set()
+    # Iterative post-order walk: a malicious file must not hit Python's recursion limit either.
+    stack: list[tuple[YNode, bool]] = [(root, False)]
+    while stack:
+        node, children_done = stack.pop()
+        key = id(node)
+        if children_done:
+            on_stack.discard(key)
+            total = 1
+            for child in _children(node):
+                total += sizes[id(child)]
+                if total > limit:
+                    return ("limit", node)
+            sizes[key] = total
+            continue
+        if key in sizes:
+            continue
+        if key in on_stack:
+            return ("recursive", node)
+        on_stack.add(key)
+        stack.append((node, True))
+        for child in _children(node):
+            if id(child) in on_stack:
+                return ("recursive", child)
+            if id(child) not in sizes:
+                stack.append((child, False))
+    return None
+
+
+def _children(node: YNode) -> list[YNode]:
+    if isinstance(node, YSeq):
+        return node.items
+    if isinstance(node, YMap):
+        return [value for _, value in node.entries.values()]
+    return []
+
+
+def read_text(path: Path, sink: DiagnosticSink, max_bytes: int = DEFAULT_MAX_BYTES,
+              display: str | None = None) -> str | None:
+    """Read a text file with the checks every input gets: exists, size, text encoding."""
+    name = display or str(path)
+    try:
+        size = path.stat().st_size
+    except OSError as exc:
+        sink.emit("MK001", f"cannot read file: {exc.strerror or exc}", SourceLocation(name))
+        return None
+    if path.is_dir():
+        sink.emit("MK001", "cannot read file: it is a directory", SourceLocation(name))
+        return None
+    if size > max_bytes:
+        sink.emit("MK002", f"file is {size} bytes, over the limit of {max_bytes} bytes",
+                  SourceLocation(name), hint="raise the limit with --max-bytes if the file is genuine")
+        return None
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        sink.emit("MK001", f"cannot read file: {exc.strerror or exc}", SourceLocation(name))
+        return None
+    return decode_text(data, name, sink)
+
+
+def decode_text(data: bytes, name: str, sink: DiagnosticSink) -> str | None:
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError:
+            sink.emit("MK003", "the file starts with a UTF-16 mark but is not valid UTF-16", SourceLocation(name))
+            return None
+    if b"\x00" in data:
+        offset = data.index(b"\x00")
+        line = data.count(b"\n", 0, offset) + 1
+        sink.emit("MK003", "the file contains NUL bytes: it is binary, not text", SourceLocation(name, line, 1))
+        return None
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        col = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
+        sink.emit("MK003", f"the file is not valid UTF-8 (byte 0x{data[exc.start]:02x})",
+                  SourceLocation(name, line, col))
+        return None
+    return text
+
+
+def parse_yaml(text: str, path: str, sink: DiagnosticSink,
+               expansion_limit: int = DEFAULT_EXPANSION_LIMIT) -> YamlDocument:
+    """Compose the first YAML document of ``text`` into Y-nodes, reporting problems into ``sink``."""
+    anchors_by_pos, too_deep = _scan_events(text)
+    if too_deep is not None:
+        sink.emit("MK010", f"YAML nesting deeper than {MAX_NESTING} levels; refusing the document",
+                  _loc(path, too_deep))
+        return YamlDocument(None, path, {})
+    try:
+        loader = yaml.CSafeLoader(text)
+        try:
+            node = _first_document(loader)
+        finally:
+            loader.dispose()
+    except yaml.MarkedYAMLError as exc:
+        _report_yaml_error(exc, path, sink, text)
+        return YamlDocument(None, path, {})
+    except yaml.YAMLError as exc:  # pragma: no cover - libyaml errors are marked
+        sink.emit("MK010", f"YAML error: {exc}", SourceLocation(path))
+        return YamlDocument(None, path, {})
+    if node is None:
+        sink.emit("MK004", "the file contains no YAML document", SourceLocation(path, 1, 1))
+        return YamlDocument(None, path, {})
+    anchor_names = _anchor_ids(node, anchors_by_pos)
+    converter = _Converter(path, sink, anchor_names)
+    root = converter.convert(node)
+    anchors = {name: converter.memo[nid] for nid, name in anchor_names.items() if nid in converter.memo}
+    problem = measure_expansion(root, expansion_limit)
+    if problem is not None:
+        kind, where = problem
+        if kind == "recursive":
+            sink.emit("MK014", "an alias refers to a node that contains it (recursive structure)", where.loc)
+        else:
+            sink.emit("MK015", f"expanding the aliases would produce more than {expansion_limit} nodes "
+                      "(an alias bomb); refusing the document", where.loc)
+        return YamlDocument(None, path, anchors)
+    return YamlDocument(root, path, anchors)
+
+
+def _first_document(loader: yaml.CSafeLoader) -> yaml.Node | None:
+    # Choreonoid uses only the first document; later documents are not even parsed.
+    if loader.check_node():
+        return loader.get_node()
+    return None
+
+
+def _anchor_ids(root: yaml.Node, by_pos: dict[tuple[int, int], str]) -> dict[int, str]:
+    if not by_pos:
+        return {}
+    found: dict[int, str] = {}
+    seen: set[int] = set()
+    stack = [root]
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        name = by_pos.get((node.start_mark.line, node.start_mark.column))
+        if name is not None:
+            found[id(node)] = name
+        if isinstance(node, yaml.SequenceNode):
+            stack.extend(node.value)
+        elif isinstance(node, yaml.MappingNode):
+            for k, v in node.value:
+                stack.append(k)
+                stack.append(v)
+    return found
+
+
+def _token_at(text: str, mark: yaml.Mark | None, sigil: str) -> str:
+    """The anchor or alias name written at ``mark`` (libyaml's messages omit it)."""
+    if mark is None:
+        return "?"
+    lines = text.splitlines()
+    if mark.line >= len(lines):
+        return "?"
+    rest = lines[mark.line][mark.column:]
+    start = rest.find(sigil)
+    if start < 0:
+        return "?"
+    name = []
+    for ch in rest[start + 1:]:
+        if ch.isspace() or ch in ",[]{}":
+            break
+        name.append(ch)
+    return "".join(name) or "?"
+
+
+def _report_yaml_error(exc: yaml.MarkedYAMLError, path: str, sink: DiagnosticSink, text: str) -> None:
+    problem = exc.problem or "malformed YAML"
+    mark = exc.problem_mark or exc.context_mark
+    if "duplicate anchor" in f"{exc.context} {problem}":
+        first = exc.context_mark
+        name = _token_at(text, exc.problem_mark, "&")
+        where = f" (first defined at line {first.line + 1})" if first else ""
+        sink.emit("MK012", f'anchor "{name}" is defined twice{where}; Choreonoid refuses repeated anchor names',
+                  _loc(path, exc.problem_mark))
+        return
+    if "undefined alias" in problem:
+        name = _token_at(text, exc.problem_mark, "*")
+        sink.emit("MK013", f'alias "*{name}" refers to an anchor that is not defined before it',
+                  _loc(path, exc.problem_mark))
+        return
+    message = problem
+    if exc.context:
+        message = f"{exc.context}: {problem}"
+    sink.emit("MK010", f"YAML syntax error: {message}", _loc(path, mark))
+
+
+def to_plain(node: YNode) -> object:
+    """The node as plain Python data (dict/list/str) for JSON-Schema validation.
+
+    Shared nodes stay shared objects. Call only on documents that passed :func:`measure_expansion`.
+    """
+    memo: dict[int, object] = {}
+
+    def conv(n: YNode) -> object:
+        done = memo.get(id(n))
+        if done is not None:
+            return done
+        if isinstance(n, YScalar):
+            return n.value
+        if isinstance(n, YSeq):
+            out_list: list[object] = []
+            memo[id(n)] = out_list
+            out_list.extend(conv(c) for c in n.items)
+            return out_list
+        assert isinstance(n, YMap)
+        out: dict[str, object] = {}
+        memo[id(n)] = out
+        for k, (_, v) in n.entries.items():
+            out[k] = conv(v)
+        return out
+
+    return conv(node)
+
+
+def locate(root: YNode, path: tuple[str | int, ...]) -> tuple[YNode | None, YScalar | None]:
+    """Follow a JSON path (keys and indices) through the tree: (value node, key node of the last step)."""
+    node: YNode | None = root
+    key_node: YScalar | None = None
+    for step in path:
+        if isinstance(node, YMap) and isinstance(step, str):
+            entry = node.entries.get(step)
+            if entry is None:
+                return node, key_node
+            key_node, node = entry
+        elif isinstance(node, YSeq) and isinstance(step, int) and 0 <= step < len(node.items):
+            node = node.items[step]
+            key_node = None
+        else:
+            return node, key_node
+    return node, key_node
