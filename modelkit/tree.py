@@ -44,18 +44,21 @@ def tree_report(robot: Robot, order: Order = "joint-name") -> str:
     ]
     # Iterative depth-first walk (a 10 000-link chain must not hit the recursion limit). A link
     # already on the current path is printed but not entered again, so no model can loop forever.
-    Frame = tuple[Iterator[tuple[int, Joint]], int, frozenset[str]]
-    stack: list[Frame] = [(iter(enumerate(children.get(root, []), 1)), 2, frozenset({root}))]
+    Frame = tuple[Iterator[tuple[int, Joint]], int, str]
+    stack: list[Frame] = [(iter(enumerate(children.get(root, []), 1)), 2, root)]
+    on_path = {root}
     while stack:
-        joints, level, path = stack[-1]
+        joints, level, link = stack[-1]
         item = next(joints, None)
         if item is None:
             stack.pop()
+            on_path.discard(link)
             continue
         index, joint = item
         lines.append(f"{'  ' * level}child({index}):  {joint.child}")
-        if joint.child not in path:
-            stack.append((iter(enumerate(children.get(joint.child, []), 1)), level + 2, path | {joint.child}))
+        if joint.child not in on_path:
+            on_path.add(joint.child)
+            stack.append((iter(enumerate(children.get(joint.child, []), 1)), level + 2, joint.child))
     return "\n".join(lines) + "\n"
 
 
