@@ -38,8 +38,9 @@ class Validation:
         return [d for d in self.diagnostics if d.severity is Severity.WARNING]
 
 
-def validate(path: str | Path, options: BodyOptions | None = None, fmt: str | None = None,
-             display: str | None = None) -> Validation:
+def validate(
+    path: str | Path, options: BodyOptions | None = None, fmt: str | None = None, display: str | None = None
+) -> Validation:
     """Read a file and run every rule over its model."""
     p = Path(path)
     result = read_model(p, options, fmt, display or str(path))

@@ -32,18 +32,45 @@ def _pairs(values: tuple[str, ...], option: str) -> dict[str, Path]:
 def reading_options(fn: F) -> F:
     """Options shared by every command that reads model files."""
     options = [
-        click.option("--input-format", type=click.Choice(["body"]), default=None,
-                     help="Read files as this format instead of guessing from the extension."),
-        click.option("--package-path", "package_paths", multiple=True, metavar="NAME=DIR",
-                     help="Where package://NAME/... URIs point (repeatable); searched before ROS_PACKAGE_PATH."),
-        click.option("--path-variable", "path_variables", multiple=True, metavar="NAME=DIR",
-                     help="Value of a ${NAME} path variable in URIs (repeatable)."),
-        click.option("--materials", "materials", type=click.Path(dir_okay=False, path_type=Path), default=None,
-                     help="Contact-materials file (default: Choreonoid's share/default/materials.yaml)."),
-        click.option("--vrml-extrusion", is_flag=True,
-                     help="Build Extrusions as VRML97 intends instead of reproducing Choreonoid's quirks."),
-        click.option("--max-bytes", type=click.IntRange(min=1), default=64 * 1024 * 1024, show_default=True,
-                     help="Refuse input files larger than this."),
+        click.option(
+            "--input-format",
+            type=click.Choice(["body"]),
+            default=None,
+            help="Read files as this format instead of guessing from the extension.",
+        ),
+        click.option(
+            "--package-path",
+            "package_paths",
+            multiple=True,
+            metavar="NAME=DIR",
+            help="Where package://NAME/... URIs point (repeatable); searched before ROS_PACKAGE_PATH.",
+        ),
+        click.option(
+            "--path-variable",
+            "path_variables",
+            multiple=True,
+            metavar="NAME=DIR",
+            help="Value of a ${NAME} path variable in URIs (repeatable).",
+        ),
+        click.option(
+            "--materials",
+            "materials",
+            type=click.Path(dir_okay=False, path_type=Path),
+            default=None,
+            help="Contact-materials file (default: Choreonoid's share/default/materials.yaml).",
+        ),
+        click.option(
+            "--vrml-extrusion",
+            is_flag=True,
+            help="Build Extrusions as VRML97 intends instead of reproducing Choreonoid's quirks.",
+        ),
+        click.option(
+            "--max-bytes",
+            type=click.IntRange(min=1),
+            default=64 * 1024 * 1024,
+            show_default=True,
+            help="Refuse input files larger than this.",
+        ),
     ]
     for option in reversed(options):
         fn = option(fn)
@@ -54,11 +81,17 @@ def _body_options(kwargs: dict[str, Any], check_resources: bool) -> Any:
     from modelkit.formats.body.reader import BodyOptions
     from modelkit.resources import Resolver
 
-    resolver = Resolver(package_paths=_pairs(kwargs["package_paths"], "--package-path"),
-                        path_variables=_pairs(kwargs["path_variables"], "--path-variable"))
-    return BodyOptions(resolver=resolver, materials_path=kwargs["materials"],
-                       faithful_extrusion=not kwargs["vrml_extrusion"], check_resources=check_resources,
-                       max_bytes=kwargs["max_bytes"])
+    resolver = Resolver(
+        package_paths=_pairs(kwargs["package_paths"], "--package-path"),
+        path_variables=_pairs(kwargs["path_variables"], "--path-variable"),
+    )
+    return BodyOptions(
+        resolver=resolver,
+        materials_path=kwargs["materials"],
+        faithful_extrusion=not kwargs["vrml_extrusion"],
+        check_resources=check_resources,
+        max_bytes=kwargs["max_bytes"],
+    )
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -69,16 +102,34 @@ def main() -> None:
 
 @main.command()
 @click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
-@click.option("--format", "output_format", type=click.Choice(["text", "json", "github"]), default="text",
-              show_default=True, help="How to print findings.")
+@click.option(
+    "--format",
+    "output_format",
+    type=click.Choice(["text", "json", "github"]),
+    default="text",
+    show_default=True,
+    help="How to print findings.",
+)
 @click.option("--strict", is_flag=True, help="Fail (exit 1) on warnings too.")
 @click.option("--show-info", is_flag=True, help="Also print info-level findings.")
 @click.option("--no-resources", is_flag=True, help="Do not open mesh files to check that they load.")
-@click.option("--ignore", "ignored", multiple=True, metavar="CODE",
-              help="Silence a code (MK103) or name (unknown-key); repeatable.")
+@click.option(
+    "--ignore",
+    "ignored",
+    multiple=True,
+    metavar="CODE",
+    help="Silence a code (MK103) or name (unknown-key); repeatable.",
+)
 @reading_options
-def validate(files: tuple[Path, ...], output_format: str, strict: bool, show_info: bool, no_resources: bool,
-             ignored: tuple[str, ...], **kwargs: Any) -> None:
+def validate(
+    files: tuple[Path, ...],
+    output_format: str,
+    strict: bool,
+    show_info: bool,
+    no_resources: bool,
+    ignored: tuple[str, ...],
+    **kwargs: Any,
+) -> None:
     """Check model files and print file:line:col findings with stable codes."""
     from modelkit.api import validate as validate_file
     from modelkit.codes import resolve
@@ -118,10 +169,21 @@ def validate(files: tuple[Path, ...], output_format: str, strict: bool, show_inf
 
 @main.command()
 @click.argument("file", type=click.Path(path_type=Path))
-@click.option("--order", type=click.Choice(["joint-name", "document"]), default="joint-name", show_default=True,
-              help="Child order: by joint name as check_urdf prints it, or as written in the file.")
-@click.option("--format", "output_format", type=click.Choice(["text", "json"]), default="text",
-              show_default=True, help="text: the check_urdf report; json: the tree with joint types and origins.")
+@click.option(
+    "--order",
+    type=click.Choice(["joint-name", "document"]),
+    default="joint-name",
+    show_default=True,
+    help="Child order: by joint name as check_urdf prints it, or as written in the file.",
+)
+@click.option(
+    "--format",
+    "output_format",
+    type=click.Choice(["text", "json"]),
+    default="text",
+    show_default=True,
+    help="text: the check_urdf report; json: the tree with joint types and origins.",
+)
 @reading_options
 def tree(file: Path, order: str, output_format: str, **kwargs: Any) -> None:
     """Print the kinematic tree exactly as check_urdf does."""
@@ -130,8 +192,12 @@ def tree(file: Path, order: str, output_format: str, **kwargs: Any) -> None:
 
     options = _body_options(kwargs, check_resources=False)
     result = validate_file(file, options, kwargs["input_format"], str(file))
-    blocking = [d for d in result.diagnostics if d.severity is Severity.ERROR
-                and (d.code.startswith("MK2") or d.code.startswith("MK0") or result.robot is None)]
+    blocking = [
+        d
+        for d in result.diagnostics
+        if d.severity is Severity.ERROR
+        and (d.code.startswith("MK2") or d.code.startswith("MK0") or result.robot is None)
+    ]
     if result.robot is None or result.robot.root is None or blocking:
         for d in blocking or [d for d in result.diagnostics if d.severity is Severity.ERROR]:
             click.echo(render_text(d), err=True)

@@ -27,17 +27,34 @@ _TABLE: tuple[CodeInfo, ...] = (
     # -- MK0xx: reading the file --------------------------------------------------------------
     CodeInfo("MK001", "file-unreadable", "error", "The file does not exist or cannot be read."),
     CodeInfo("MK002", "file-too-large", "error", "The file is larger than the size limit (`--max-bytes`)."),
-    CodeInfo("MK003", "not-text", "error", "The file is not UTF-8/UTF-16 text (binary data or a bad encoding)."),
+    CodeInfo(
+        "MK003", "not-text", "error", "The file is not UTF-8/UTF-16 text (binary data or a bad encoding)."
+    ),
     CodeInfo("MK004", "empty-document", "error", "The file contains no YAML document."),
     CodeInfo("MK010", "yaml-syntax", "error", "The YAML is malformed."),
-    CodeInfo("MK011", "yaml-duplicate-key", "error",
-             "A mapping repeats a key; Choreonoid silently keeps the last value."),
-    CodeInfo("MK012", "yaml-duplicate-anchor", "error", "An anchor name is defined twice (Choreonoid refuses this)."),
+    CodeInfo(
+        "MK011",
+        "yaml-duplicate-key",
+        "error",
+        "A mapping repeats a key; Choreonoid silently keeps the last value.",
+    ),
+    CodeInfo(
+        "MK012",
+        "yaml-duplicate-anchor",
+        "error",
+        "An anchor name is defined twice (Choreonoid refuses this).",
+    ),
     CodeInfo("MK013", "yaml-undefined-alias", "error", "An alias refers to an anchor that is not defined."),
     CodeInfo("MK014", "yaml-recursive-alias", "error", "An alias refers to a node that contains it."),
-    CodeInfo("MK015", "yaml-expansion-limit", "error",
-             "Expanding aliases would produce too many nodes (an alias bomb)."),
-    CodeInfo("MK016", "yaml-bad-merge", "error", "A `<<` merge value is not a mapping or a list of mappings."),
+    CodeInfo(
+        "MK015",
+        "yaml-expansion-limit",
+        "error",
+        "Expanding aliases would produce too many nodes (an alias bomb).",
+    ),
+    CodeInfo(
+        "MK016", "yaml-bad-merge", "error", "A `<<` merge value is not a mapping or a list of mappings."
+    ),
     CodeInfo("MK017", "yaml-top-not-mapping", "error", "The top-level YAML node is not a mapping."),
     CodeInfo("MK018", "yaml-empty-key", "error", "A mapping has an empty key."),
     CodeInfo("MK019", "yaml-complex-key", "error", "A mapping key is not a scalar."),
@@ -45,24 +62,38 @@ _TABLE: tuple[CodeInfo, ...] = (
     CodeInfo("MK100", "schema-type", "error", "A value has the wrong type or shape."),
     CodeInfo("MK101", "schema-required", "error", "A required key is missing."),
     CodeInfo("MK102", "schema-enum", "error", "A value is not one of the allowed words."),
-    CodeInfo("MK103", "unknown-key", "warning",
-             "A key that the loader ignores (often a typo); a close match is suggested."),
+    CodeInfo(
+        "MK103",
+        "unknown-key",
+        "warning",
+        "A key that the loader ignores (often a typo); a close match is suggested.",
+    ),
     CodeInfo("MK104", "schema-violation", "error", "The value breaks another rule of the schema."),
     CodeInfo("MK110", "body-format", "error", "`format` is missing or is not `ChoreonoidBody`."),
     CodeInfo("MK111", "body-version-missing", "error", "`format_version` is not specified."),
     CodeInfo("MK112", "body-version-unsupported", "error", "`format_version` is 2.1 or later."),
-    CodeInfo("MK113", "body-radian-v2", "error", "`angle_unit: radian` is not allowed with format version 2.0."),
+    CodeInfo(
+        "MK113", "body-radian-v2", "error", "`angle_unit: radian` is not allowed with format version 2.0."
+    ),
     CodeInfo("MK114", "body-no-links", "error", "There is no usable `links` list."),
-    CodeInfo("MK115", "body-wrapper-mode", "warning",
-             "The file has no `format` key and is a wrapper around another model file."),
-    CodeInfo("MK116", "scalar-trailing-text", "warning",
-             "A number has trailing text; Choreonoid reads only the leading number (e.g. `2kg` → 2)."),
-    CodeInfo("MK117", "scalar-ignored", "warning",
-             "A value cannot be read as the type expected here and Choreonoid silently keeps the default."),
-    CodeInfo("MK118", "flat-list-remainder", "warning",
-             "A flat list's length is not a multiple of its tuple size; the extra numbers are dropped."),
-    CodeInfo("MK119", "anchor-holder-key", "info",
-             "A top-level key that only holds YAML anchors; the loader ignores it."),
+    CodeInfo(
+        "MK115",
+        "body-wrapper-mode",
+        "warning",
+        "The file has no `format` key and is a wrapper around another model file.",
+    ),
+    CodeInfo(
+        "MK118",
+        "flat-list-remainder",
+        "warning",
+        "A flat list's length is not a multiple of its tuple size; the extra numbers are dropped.",
+    ),
+    CodeInfo(
+        "MK119",
+        "anchor-holder-key",
+        "info",
+        "A top-level key that only holds YAML anchors; the loader ignores it.",
+    ),
     # -- MK2xx: kinematic tree --------------------------------------------------------------
     CodeInfo("MK200", "no-root", "error", "No root link can be found (every link has a parent, or a cycle)."),
     CodeInfo("MK201", "multiple-roots", "error", "More than one link has no parent."),
@@ -71,100 +102,235 @@ _TABLE: tuple[CodeInfo, ...] = (
     CodeInfo("MK204", "duplicate-link-name", "error", "Two links have the same name."),
     CodeInfo("MK205", "duplicate-joint-name", "error", "Two joints have the same name."),
     CodeInfo("MK206", "duplicate-joint-id", "warning", "Two joints have the same `joint_id`."),
-    CodeInfo("MK207", "joint-id-gap", "warning", "Joint ids are not dense from 0 (Choreonoid adds dummy joints)."),
+    CodeInfo(
+        "MK207", "joint-id-gap", "warning", "Joint ids are not dense from 0 (Choreonoid adds dummy joints)."
+    ),
     CodeInfo("MK208", "root-link-undefined", "error", "`root_link` names a link that does not exist."),
     CodeInfo("MK209", "root-has-parent", "warning", "The root link also names a parent, which is ignored."),
     CodeInfo("MK210", "nameless-link", "warning", "A link has no name and cannot be referenced."),
-    CodeInfo("MK211", "link-joint-name-collision", "warning",
-             "A link and a joint share a name (fatal in SDF 1.7+ and Gazebo)."),
-    CodeInfo("MK212", "link-node-type", "error", "A node in `links` has a type other than Link/SubBody/ContinuousTrack/Skip."),
-    CodeInfo("MK213", "non-root-free-joint", "warning",
-             "A non-root link has a free joint: its subtree floats separately (no URDF/MJCF equivalent)."),
-    CodeInfo("MK214", "pseudo-continuous-track", "info",
-             "A pseudo continuous track is kinematically fixed; other formats cannot model its moving surface."),
-    CodeInfo("MK215", "extra-joint-invalid", "error", "An `extra_joints` entry is incomplete or names a missing link."),
-    CodeInfo("MK216", "subbody-invalid", "error", "A SubBody cannot be loaded (missing uri, recursion, load failure)."),
-    CodeInfo("MK217", "continuous-track-invalid", "error", "A ContinuousTrack node lacks a required key or value."),
+    CodeInfo(
+        "MK211",
+        "link-joint-name-collision",
+        "warning",
+        "A link and a joint share a name (fatal in SDF 1.7+ and Gazebo).",
+    ),
+    CodeInfo(
+        "MK212",
+        "link-node-type",
+        "error",
+        "A node in `links` has a type other than Link/SubBody/ContinuousTrack/Skip.",
+    ),
+    CodeInfo(
+        "MK213",
+        "non-root-free-joint",
+        "warning",
+        "A non-root link has a free joint: its subtree floats separately (no URDF/MJCF equivalent).",
+    ),
+    CodeInfo(
+        "MK214",
+        "pseudo-continuous-track",
+        "info",
+        "A pseudo continuous track is kinematically fixed; other formats cannot model its moving surface.",
+    ),
+    CodeInfo(
+        "MK215",
+        "extra-joint-invalid",
+        "error",
+        "An `extra_joints` entry is incomplete or names a missing link.",
+    ),
+    CodeInfo(
+        "MK216",
+        "subbody-invalid",
+        "error",
+        "A SubBody cannot be loaded (missing uri, recursion, load failure).",
+    ),
+    CodeInfo(
+        "MK217", "continuous-track-invalid", "error", "A ContinuousTrack node lacks a required key or value."
+    ),
     CodeInfo("MK218", "parent-missing", "error", "A link other than the root names no parent."),
-    CodeInfo("MK219", "deprecated-actuation-mode", "warning",
-             "`jointSurfaceVelocity` is deprecated; use `joint_type: pseudo_continuous_track`."),
-    CodeInfo("MK220", "joint-type-illegal", "error", "A joint type is not one the loader knows."),
-    CodeInfo("MK221", "root-fixed-to-world", "info", "The root link is welded to the world (no free joint)."),
+    CodeInfo(
+        "MK219",
+        "deprecated-actuation-mode",
+        "warning",
+        "`jointSurfaceVelocity` is deprecated; use `joint_type: pseudo_continuous_track`.",
+    ),
     # -- MK3xx: mass properties, joints, transforms ---------------------------------------------
     CodeInfo("MK300", "mass-not-positive", "error", "A link's mass is zero or negative."),
     CodeInfo("MK301", "inertia-asymmetric", "error", "A 9-element inertia matrix is not symmetric."),
-    CodeInfo("MK302", "inertia-not-positive-definite", "error", "An inertia tensor is not positive definite."),
-    CodeInfo("MK303", "inertia-triangle-inequality", "error",
-             "Principal moments violate the triangle inequality (physically impossible)."),
-    CodeInfo("MK304", "default-mass-properties", "warning",
-             "A link has no mass information; Choreonoid uses 1 kg and an identity inertia."),
+    CodeInfo(
+        "MK302", "inertia-not-positive-definite", "error", "An inertia tensor is not positive definite."
+    ),
+    CodeInfo(
+        "MK303",
+        "inertia-triangle-inequality",
+        "error",
+        "Principal moments violate the triangle inequality (physically impossible).",
+    ),
+    CodeInfo(
+        "MK304",
+        "default-mass-properties",
+        "warning",
+        "A link has no mass information; Choreonoid uses 1 kg and an identity inertia.",
+    ),
     CodeInfo("MK305", "joint-axis-zero", "error", "A joint axis is the zero vector."),
-    CodeInfo("MK306", "joint-axis-not-unit", "warning", "A joint axis is not a unit vector (Choreonoid uses it as given)."),
-    CodeInfo("MK307", "joint-range-reversed", "error", "A joint range has its lower bound above its upper bound."),
+    CodeInfo(
+        "MK306",
+        "joint-axis-not-unit",
+        "warning",
+        "A joint axis is not a unit vector (Choreonoid uses it as given).",
+    ),
+    CodeInfo(
+        "MK307", "joint-range-reversed", "error", "A joint range has its lower bound above its upper bound."
+    ),
     CodeInfo("MK308", "rotation-axis-zero", "error", "A rotation axis is the zero vector."),
-    CodeInfo("MK309", "empty-vector", "error", "`rotation: []` or `translation: []` (undefined behaviour in Choreonoid)."),
-    CodeInfo("MK310", "joint-angle-on-prismatic", "warning",
-             "`joint_angle` on a prismatic joint is converted as an angle."),
-    CodeInfo("MK311", "joint-keys-on-fixed", "warning", "Joint range/axis keys on a joint that does not move."),
-    CodeInfo("MK312", "crease-angle-small", "warning",
-             "A `crease_angle` below 1 in degree mode is probably meant in radians."),
-    CodeInfo("MK313", "moving-link-massless", "error", "A moving link has no mass (engines cannot simulate it)."),
+    CodeInfo(
+        "MK309",
+        "empty-vector",
+        "error",
+        "`rotation: []` or `translation: []` (undefined behaviour in Choreonoid).",
+    ),
+    CodeInfo(
+        "MK310",
+        "joint-angle-on-prismatic",
+        "warning",
+        "`joint_angle` on a prismatic joint is converted as an angle.",
+    ),
+    CodeInfo(
+        "MK311", "joint-keys-on-fixed", "warning", "Joint range/axis keys on a joint that does not move."
+    ),
+    CodeInfo(
+        "MK312",
+        "crease-angle-small",
+        "warning",
+        "A `crease_angle` below 1 in degree mode is probably meant in radians.",
+    ),
+    CodeInfo(
+        "MK313", "moving-link-massless", "error", "A moving link has no mass (engines cannot simulate it)."
+    ),
     CodeInfo("MK314", "inertia-count", "error", "An inertia list has neither 6 nor 9 elements."),
-    CodeInfo("MK315", "joint-velocity-range-reversed", "warning", "A velocity range has its lower bound above its upper."),
-    CodeInfo("MK316", "inertia-suspicious", "warning",
-             "An inertia is implausible for the mass (e.g. identity inertia on a light part)."),
+    CodeInfo(
+        "MK315",
+        "joint-velocity-range-reversed",
+        "warning",
+        "A velocity range has its lower bound above its upper.",
+    ),
     # -- MK4xx: geometry -------------------------------------------------------------------------
     CodeInfo("MK400", "primitive-invalid", "error", "A primitive's dimensions cannot generate a shape."),
-    CodeInfo("MK401", "extrusion-too-few-points", "error",
-             "An Extrusion has fewer than 2 distinct spine or cross-section points (Choreonoid crashes)."),
-    CodeInfo("MK402", "extrusion-count-mismatch", "error",
-             "Extrusion `scale`/`orientation` count is neither 0, 1 nor ≥ the spine points (out-of-range access)."),
-    CodeInfo("MK403", "extrusion-oblique-spine", "warning",
-             "A straight oblique spine makes Choreonoid shear the cross-section."),
-    CodeInfo("MK404", "extrusion-mirrored-spine", "warning", "A straight −Y spine mirrors the cross-section."),
-    CodeInfo("MK405", "extrusion-snake-begin-cap", "warning", "`begin_cap` is ignored by Choreonoid; use `beginCap`."),
-    CodeInfo("MK406", "extrusion-open-capped", "warning", "An open cross-section with caps gives a non-closed surface."),
-    CodeInfo("MK407", "elevation-grid-count", "error",
-             "ElevationGrid `height` count differs from xDimension·zDimension (Choreonoid crashes)."),
-    CodeInfo("MK408", "face-index-out-of-range", "error", "A face index refers to a vertex that does not exist."),
-    CodeInfo("MK409", "face-unterminated", "warning",
-             "The last IndexedFaceSet polygon lacks its −1 terminator and is dropped."),
+    CodeInfo(
+        "MK401",
+        "extrusion-too-few-points",
+        "error",
+        "An Extrusion has fewer than 2 distinct spine or cross-section points (Choreonoid crashes).",
+    ),
+    CodeInfo(
+        "MK402",
+        "extrusion-count-mismatch",
+        "error",
+        "Extrusion `scale`/`orientation` count is neither 0, 1 nor ≥ the spine points (out-of-range access).",
+    ),
+    CodeInfo(
+        "MK403",
+        "extrusion-oblique-spine",
+        "warning",
+        "A straight oblique spine makes Choreonoid shear the cross-section.",
+    ),
+    CodeInfo(
+        "MK404", "extrusion-mirrored-spine", "warning", "A straight −Y spine mirrors the cross-section."
+    ),
+    CodeInfo(
+        "MK405",
+        "extrusion-snake-begin-cap",
+        "warning",
+        "`begin_cap` is ignored by Choreonoid; use `beginCap`.",
+    ),
+    CodeInfo(
+        "MK406",
+        "extrusion-open-capped",
+        "warning",
+        "An open cross-section with caps gives a non-closed surface.",
+    ),
+    CodeInfo(
+        "MK407",
+        "elevation-grid-count",
+        "error",
+        "ElevationGrid `height` count differs from xDimension·zDimension (Choreonoid crashes).",
+    ),
+    CodeInfo(
+        "MK408", "face-index-out-of-range", "error", "A face index refers to a vertex that does not exist."
+    ),
+    CodeInfo(
+        "MK409",
+        "face-unterminated",
+        "warning",
+        "The last IndexedFaceSet polygon lacks its −1 terminator and is dropped.",
+    ),
     CodeInfo("MK410", "face-set-empty", "error", "An IndexedFaceSet has no valid polygon."),
-    CodeInfo("MK411", "face-attribute-count", "error", "Normals or texture coordinates are fewer than required."),
     CodeInfo("MK412", "geometry-unknown", "error", "A geometry type is not known."),
     CodeInfo("MK413", "scale-ignored", "warning", "A scalar `scale` is ignored; give three numbers."),
-    CodeInfo("MK414", "non-uniform-scale", "info", "A non-uniform scale turns a primitive into a different shape."),
-    CodeInfo("MK415", "extrusion-axis-not-unit", "warning",
-             "An Extrusion orientation axis is not unit length (Choreonoid uses it unnormalised)."),
+    CodeInfo(
+        "MK414", "non-uniform-scale", "info", "A non-uniform scale turns a primitive into a different shape."
+    ),
+    CodeInfo(
+        "MK415",
+        "extrusion-axis-not-unit",
+        "warning",
+        "An Extrusion orientation axis is not unit length (Choreonoid uses it unnormalised).",
+    ),
     # -- MK5xx: resources and materials -----------------------------------------------------------
-    CodeInfo("MK500", "resource-not-found", "error",
-             "A resource file does not exist (a warning when the mesh is visual-only)."),
+    CodeInfo(
+        "MK500",
+        "resource-not-found",
+        "error",
+        "A resource file does not exist (a warning when the mesh is visual-only).",
+    ),
     CodeInfo("MK501", "resource-load-failed", "error", "A resource file exists but cannot be loaded."),
-    CodeInfo("MK502", "resource-fragment-missing", "error", "A resource `node` fragment does not exist in the file."),
+    CodeInfo(
+        "MK502",
+        "resource-fragment-missing",
+        "error",
+        "A resource `node` fragment does not exist in the file.",
+    ),
     CodeInfo("MK503", "uri-scheme-unsupported", "error", "A URI scheme is not supported here."),
-    CodeInfo("MK504", "package-not-found", "error", "A `package://` URI names a package that cannot be found."),
+    CodeInfo(
+        "MK504", "package-not-found", "error", "A `package://` URI names a package that cannot be found."
+    ),
     CodeInfo("MK505", "path-variable-undefined", "error", "A `${VAR}` path variable is not defined."),
     CodeInfo("MK506", "resource-extension", "error", "A resource file type is not supported."),
     CodeInfo("MK507", "texture-unreadable", "warning", "A texture image cannot be found."),
-    CodeInfo("MK508", "contact-material-unknown", "warning",
-             "A contact material name is not in the materials table; Default parameters apply."),
-    CodeInfo("MK509", "resource-not-single-mesh", "error", "A Resource used as a geometry is not a single mesh."),
+    CodeInfo(
+        "MK508",
+        "contact-material-unknown",
+        "warning",
+        "A contact material name is not in the materials table; Default parameters apply.",
+    ),
     CodeInfo("MK510", "package-uri", "info", "A `package://` URI depends on the environment."),
     CodeInfo("MK511", "materials-file-invalid", "error", "The contact materials file cannot be read."),
     # -- MK6xx: devices and scene nodes ----------------------------------------------------------
-    CodeInfo("MK600", "camera-without-format", "warning", "A Camera has no valid `format`, so no device is created."),
-    CodeInfo("MK601", "optical-frame-unknown", "error", "An `optical_frame` value is unknown."),
+    CodeInfo(
+        "MK600",
+        "camera-without-format",
+        "warning",
+        "A Camera has no valid `format`, so no device is created.",
+    ),
     CodeInfo("MK602", "node-type-unknown", "error", "An element node type is not defined."),
     CodeInfo("MK603", "node-type-optional-skipped", "warning", "An optional unknown node type is skipped."),
-    CodeInfo("MK604", "visual-collision-conflict", "error", "A Visual node inside a Collision node, or vice versa."),
-    CodeInfo("MK605", "marker-type-unknown", "error", "A MarkerDevice `marker_type` is unknown."),
+    CodeInfo(
+        "MK604", "visual-collision-conflict", "error", "A Visual node inside a Collision node, or vice versa."
+    ),
     CodeInfo("MK606", "device-scale", "warning", "A device node has `scale`, which corrupts its rotation."),
-    CodeInfo("MK607", "range-sensor-bounds", "warning", "A RangeSensor min angle exceeds its max and is ignored."),
+    CodeInfo(
+        "MK607", "range-sensor-bounds", "warning", "A RangeSensor min angle exceeds its max and is ignored."
+    ),
     CodeInfo("MK608", "elements-invalid", "error", "An `elements` value is not a list or a mapping."),
-    CodeInfo("MK609", "node-type-mismatch", "error", "A node's `type` differs from the key it is placed under."),
-    CodeInfo("MK610", "shape-material-misplaced", "warning",
-             "`material` directly in a Shape is ignored; put it under `appearance`."),
-    CodeInfo("MK611", "device-value-invalid", "error", "A device parameter has an invalid value."),
+    CodeInfo(
+        "MK609", "node-type-mismatch", "error", "A node's `type` differs from the key it is placed under."
+    ),
+    CodeInfo(
+        "MK610",
+        "shape-material-misplaced",
+        "warning",
+        "`material` directly in a Shape is ignored; put it under `appearance`.",
+    ),
 )
 
 CODES: dict[str, CodeInfo] = {c.code: c for c in _TABLE}
@@ -181,7 +347,9 @@ def markdown_table() -> str:
     lines = ["| code | name | default severity | meaning |", "|---|---|---|---|"]
     for c in _TABLE:
         summary = c.summary.replace("|", "\\|")
-        lines.append(f"| {c.code} | `{c.name}` | {c.severity} | {summary}{' (retired)' if c.retired else ''} |")
+        lines.append(
+            f"| {c.code} | `{c.name}` | {c.severity} | {summary}{' (retired)' if c.retired else ''} |"
+        )
     return "\n".join(lines) + "\n"
 
 

@@ -9,12 +9,12 @@ from __future__ import annotations
 import json
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from enum import Enum
+from enum import StrEnum
 
 from modelkit.codes import CODES
 
 
-class Severity(str, Enum):
+class Severity(StrEnum):
     ERROR = "error"
     WARNING = "warning"
     INFO = "info"
@@ -48,7 +48,13 @@ class Diagnostic:
 
     def sort_key(self) -> tuple[str, int, int, str, str]:
         loc = self.location
-        return (loc.file if loc else "", loc.line if loc else 0, loc.col if loc else 0, self.code, self.message)
+        return (
+            loc.file if loc else "",
+            loc.line if loc else 0,
+            loc.col if loc else 0,
+            self.code,
+            self.message,
+        )
 
     def to_json(self) -> dict[str, object]:
         loc = self.location
@@ -64,8 +70,13 @@ class Diagnostic:
         }
 
 
-def diag(code: str, message: str, location: SourceLocation | None = None, hint: str | None = None,
-         severity: Severity | None = None) -> Diagnostic:
+def diag(
+    code: str,
+    message: str,
+    location: SourceLocation | None = None,
+    hint: str | None = None,
+    severity: Severity | None = None,
+) -> Diagnostic:
     """Build a diagnostic whose severity defaults to the one the code catalogue gives."""
     entry = CODES[code]
     return Diagnostic(code, severity or Severity(entry.severity), message, location, hint)
@@ -84,8 +95,14 @@ class DiagnosticSink:
             self._seen.add(key)
             self.items.append(d)
 
-    def emit(self, code: str, message: str, location: SourceLocation | None = None,
-             hint: str | None = None, severity: Severity | None = None) -> None:
+    def emit(
+        self,
+        code: str,
+        message: str,
+        location: SourceLocation | None = None,
+        hint: str | None = None,
+        severity: Severity | None = None,
+    ) -> None:
         self.add(diag(code, message, location, hint, severity))
 
     def extend(self, ds: Iterable[Diagnostic]) -> None:
@@ -137,5 +154,6 @@ def render_json(ds: Iterable[Diagnostic], files: Iterable[str]) -> str:
         "warnings": sum(1 for i in items if i["severity"] == "warning"),
         "infos": sum(1 for i in items if i["severity"] == "info"),
     }
-    return json.dumps({"files": list(files), "diagnostics": items, "summary": summary}, indent=2,
-                      sort_keys=False)
+    return json.dumps(
+        {"files": list(files), "diagnostics": items, "summary": summary}, indent=2, sort_keys=False
+    )

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from enum import Enum
+from enum import StrEnum
 from typing import Any
 
 import numpy as np
@@ -25,7 +25,7 @@ from modelkit.diagnostics import SourceLocation
 from modelkit.spatial import Mat3, Pose, Vec3
 
 
-class JointType(str, Enum):
+class JointType(StrEnum):
     FIXED = "fixed"
     REVOLUTE = "revolute"  # limited or unlimited (URDF "continuous" = revolute without limits)
     PRISMATIC = "prismatic"

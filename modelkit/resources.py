@@ -54,9 +54,15 @@ class Resolver:
             if root is None and name == "HOME" and "HOME" in self.environ:
                 root = Path(self.environ["HOME"])
             if root is None:
-                return Resolution(uri, None, "variable", "MK505", f'path variable "${{{name}}}" in "{uri}" is not defined',
-                                  hint=f"define it with --path-variable {name}=DIR")
-            text = str(root) + text[variable.end():]
+                return Resolution(
+                    uri,
+                    None,
+                    "variable",
+                    "MK505",
+                    f'path variable "${{{name}}}" in "{uri}" is not defined',
+                    hint=f"define it with --path-variable {name}=DIR",
+                )
+            text = str(root) + text[variable.end() :]
         match = _SCHEME_RE.match(text)
         if match is None:
             path = Path(text)
@@ -69,14 +75,22 @@ class Resolver:
             return self._resolve_package(uri, rest, model_file or base_dir / "_")
         if scheme == "model":
             return self._resolve_model(uri, rest)
-        return Resolution(uri, None, scheme, "MK503", f'the "{scheme}" scheme in URI "{uri}" is not supported')
+        return Resolution(
+            uri, None, scheme, "MK503", f'the "{scheme}" scheme in URI "{uri}" is not supported'
+        )
 
     def _resolve_package(self, uri: str, rest: str, model_file: Path) -> Resolution:
         package, _, relative = rest.partition("/")
         root = self.find_package(package, model_file.parent)
         if root is None:
-            return Resolution(uri, None, "package", "MK504", f'package "{package}" of "{uri}" cannot be found',
-                              hint=f"give its folder with --package-path {package}=DIR, or set ROS_PACKAGE_PATH")
+            return Resolution(
+                uri,
+                None,
+                "package",
+                "MK504",
+                f'package "{package}" of "{uri}" cannot be found',
+                hint=f"give its folder with --package-path {package}=DIR, or set ROS_PACKAGE_PATH",
+            )
         return Resolution(uri, _normal(root / relative), "package")
 
     def find_package(self, package: str, start: Path) -> Path | None:
@@ -113,8 +127,14 @@ class Resolver:
                 if candidate.exists():
                     return Resolution(uri, _normal(candidate), "model")
         model = rest.partition("/")[0]
-        return Resolution(uri, None, "model", "MK504", f'model "{model}" of "{uri}" cannot be found',
-                          hint="add its parent folder to GZ_SIM_RESOURCE_PATH")
+        return Resolution(
+            uri,
+            None,
+            "model",
+            "MK504",
+            f'model "{model}" of "{uri}" cannot be found',
+            hint="add its parent folder to GZ_SIM_RESOURCE_PATH",
+        )
 
 
 def _split_paths(value: str) -> list[Path]:

@@ -53,7 +53,9 @@ class Pose:
         return self.rotation @ np.asarray(point, dtype=float) + self.translation
 
     def is_identity(self, tol: float = 1e-12) -> bool:
-        return bool(np.allclose(self.rotation, np.eye(3), atol=tol) and np.allclose(self.translation, 0, atol=tol))
+        return bool(
+            np.allclose(self.rotation, np.eye(3), atol=tol) and np.allclose(self.translation, 0, atol=tol)
+        )
 
     def __repr__(self) -> str:
         return f"Pose(xyz={self.translation.tolist()}, rpy={rpy_from_matrix(self.rotation).tolist()})"
@@ -127,11 +129,13 @@ def quat_wxyz_from_matrix(r: Mat3) -> NDArray[np.float64]:
 
 def matrix_from_quat_wxyz(q: NDArray[np.float64] | list[float]) -> Mat3:
     w, x, y, z = (float(v) for v in np.asarray(q, dtype=float) / np.linalg.norm(q))
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def is_rotation(r: Mat3, tol: float = 1e-9) -> bool:

@@ -72,8 +72,10 @@ def tree_json(robot: Robot, order: Order = "joint-name") -> str:
             entry: dict[str, object] = {
                 "joint": joint.name,
                 "type": joint.type.value,
-                "origin": {"xyz": [round(float(x), 12) for x in joint.origin.translation],
-                           "rotation": [[round(float(x), 12) for x in row] for row in joint.origin.rotation]},
+                "origin": {
+                    "xyz": [round(float(x), 12) for x in joint.origin.translation],
+                    "rotation": [[round(float(x), 12) for x in row] for row in joint.origin.rotation],
+                },
                 "axis": [round(float(x), 12) for x in joint.axis],
             }
             if joint.child not in path:
@@ -84,6 +86,9 @@ def tree_json(robot: Robot, order: Order = "joint-name") -> str:
         return {"link": name, "children": kids}
 
     root = robot.root or ""
-    data = {"robot": robot.name, "root_joint": robot.root_joint.value if robot.root_joint else None,
-            "tree": node(root, frozenset({root}))}
+    data = {
+        "robot": robot.name,
+        "root_joint": robot.root_joint.value if robot.root_joint else None,
+        "tree": node(root, frozenset({root})),
+    }
     return json.dumps(data, indent=2) + "\n"

@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import yaml
 
@@ -129,10 +130,13 @@ class _Converter:
         merges: list[tuple[YScalar, yaml.Node]] = []
         for key_node, value_node in node.value:
             if not isinstance(key_node, yaml.ScalarNode):
-                self.sink.emit("MK019", "a mapping key must be a scalar", _loc(self.path, key_node.start_mark))
+                self.sink.emit(
+                    "MK019", "a mapping key must be a scalar", _loc(self.path, key_node.start_mark)
+                )
                 continue
-            key = YScalar(_loc(self.path, key_node.start_mark), key_node.value,
-                          plain=key_node.style in (None, ""))
+            key = YScalar(
+                _loc(self.path, key_node.start_mark), key_node.value, plain=key_node.style in (None, "")
+            )
             if key_node.tag == "tag:yaml.org,2002:merge" or (key.value == "<<" and key.plain):
                 merges.append((key, value_node))
                 continue
@@ -159,8 +163,9 @@ class _Converter:
         elif isinstance(value, YSeq):
             sources = list(value.items)
         else:
-            self.sink.emit("MK016", 'a value to merge by the "<<" key must be a mapping or a list of mappings',
-                           value.loc)
+            self.sink.emit(
+                "MK016", 'a value to merge by the "<<" key must be a mapping or a list of mappings', value.loc
+            )
             return
         for source in sources:
             if not isinstance(source, YMap):
@@ -175,7 +180,7 @@ class _Converter:
 MAX_NESTING = 128
 
 
-def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], yaml.Mark | None]:
+def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], Any]:
     """One pass over the event stream (libyaml's parser is iterative, so this is safe on any input).
 
     Returns the anchor names by (line, column) of the anchored node (PyYAML's composer drops them)
@@ -198,7 +203,7 @@ def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], yaml.Mark | Non
             elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
                 depth -= 1
             anchor = getattr(event, "anchor", None)
-            if anchor and not isinstance(event, yaml.AliasEvent):
+            if anchor and not isinstance(event, yaml.AliasEvent) and event.start_mark is not None:
                 names[(event.start_mark.line, event.start_mark.column)] = anchor
     except yaml.YAMLError:
         pass
@@ -250,8 +255,9 @@ def _children(node: YNode) -> list[YNode]:
     return []
 
 
-def read_text(path: Path, sink: DiagnosticSink, max_bytes: int = DEFAULT_MAX_BYTES,
-              display: str | None = None) -> str | None:
+def read_text(
+    path: Path, sink: DiagnosticSink, max_bytes: int = DEFAULT_MAX_BYTES, display: str | None = None
+) -> str | None:
     """Read a text file with the checks every input gets: exists, size, text encoding."""
     name = display or str(path)
     try:
@@ -263,8 +269,12 @@ def read_text(path: Path, sink: DiagnosticSink, max_bytes: int = DEFAULT_MAX_BYT
         sink.emit("MK001", "cannot read file: it is a directory", SourceLocation(name))
         return None
     if size > max_bytes:
-        sink.emit("MK002", f"file is {size} bytes, over the limit of {max_bytes} bytes",
-                  SourceLocation(name), hint="raise the limit with --max-bytes if the file is genuine")
+        sink.emit(
+            "MK002",
+            f"file is {size} bytes, over the limit of {max_bytes} bytes",
+            SourceLocation(name),
+            hint="raise the limit with --max-bytes if the file is genuine",
+        )
         return None
     try:
         data = path.read_bytes()
@@ -279,31 +289,42 @@ def decode_text(data: bytes, name: str, sink: DiagnosticSink) -> str | None:
         try:
             return data.decode("utf-16")
         except UnicodeDecodeError:
-            sink.emit("MK003", "the file starts with a UTF-16 mark but is not valid UTF-16", SourceLocation(name))
+            sink.emit(
+                "MK003", "the file starts with a UTF-16 mark but is not valid UTF-16", SourceLocation(name)
+            )
             return None
     if b"\x00" in data:
         offset = data.index(b"\x00")
         line = data.count(b"\n", 0, offset) + 1
-        sink.emit("MK003", "the file contains NUL bytes: it is binary, not text", SourceLocation(name, line, 1))
+        sink.emit(
+            "MK003", "the file contains NUL bytes: it is binary, not text", SourceLocation(name, line, 1)
+        )
         return None
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         line = data.count(b"\n", 0, exc.start) + 1
         col = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
-        sink.emit("MK003", f"the file is not valid UTF-8 (byte 0x{data[exc.start]:02x})",
-                  SourceLocation(name, line, col))
+        sink.emit(
+            "MK003",
+            f"the file is not valid UTF-8 (byte 0x{data[exc.start]:02x})",
+            SourceLocation(name, line, col),
+        )
         return None
     return text
 
 
-def parse_yaml(text: str, path: str, sink: DiagnosticSink,
-               expansion_limit: int = DEFAULT_EXPANSION_LIMIT) -> YamlDocument:
+def parse_yaml(
+    text: str, path: str, sink: DiagnosticSink, expansion_limit: int = DEFAULT_EXPANSION_LIMIT
+) -> YamlDocument:
     """Compose the first YAML document of ``text`` into Y-nodes, reporting problems into ``sink``."""
     anchors_by_pos, too_deep = _scan_events(text)
     if too_deep is not None:
-        sink.emit("MK010", f"YAML nesting deeper than {MAX_NESTING} levels; refusing the document",
-                  _loc(path, too_deep))
+        sink.emit(
+            "MK010",
+            f"YAML nesting deeper than {MAX_NESTING} levels; refusing the document",
+            _loc(path, too_deep),
+        )
         return YamlDocument(None, path, {})
     try:
         loader = yaml.CSafeLoader(text)
@@ -330,8 +351,12 @@ def parse_yaml(text: str, path: str, sink: DiagnosticSink,
         if kind == "recursive":
             sink.emit("MK014", "an alias refers to a node that contains it (recursive structure)", where.loc)
         else:
-            sink.emit("MK015", f"expanding the aliases would produce more than {expansion_limit} nodes "
-                      "(an alias bomb); refusing the document", where.loc)
+            sink.emit(
+                "MK015",
+                f"expanding the aliases would produce more than {expansion_limit} nodes "
+                "(an alias bomb); refusing the document",
+                where.loc,
+            )
         return YamlDocument(None, path, anchors)
     return YamlDocument(root, path, anchors)
 
@@ -373,12 +398,12 @@ def _token_at(text: str, mark: yaml.Mark | None, sigil: str) -> str:
     lines = text.splitlines()
     if mark.line >= len(lines):
         return "?"
-    rest = lines[mark.line][mark.column:]
+    rest = lines[mark.line][mark.column :]
     start = rest.find(sigil)
     if start < 0:
         return "?"
     name = []
-    for ch in rest[start + 1:]:
+    for ch in rest[start + 1 :]:
         if ch.isspace() or ch in ",[]{}":
             break
         name.append(ch)
@@ -392,13 +417,19 @@ def _report_yaml_error(exc: yaml.MarkedYAMLError, path: str, sink: DiagnosticSin
         first = exc.context_mark
         name = _token_at(text, exc.problem_mark, "&")
         where = f" (first defined at line {first.line + 1})" if first else ""
-        sink.emit("MK012", f'anchor "{name}" is defined twice{where}; Choreonoid refuses repeated anchor names',
-                  _loc(path, exc.problem_mark))
+        sink.emit(
+            "MK012",
+            f'anchor "{name}" is defined twice{where}; Choreonoid refuses repeated anchor names',
+            _loc(path, exc.problem_mark),
+        )
         return
     if "undefined alias" in problem:
         name = _token_at(text, exc.problem_mark, "*")
-        sink.emit("MK013", f'alias "*{name}" refers to an anchor that is not defined before it',
-                  _loc(path, exc.problem_mark))
+        sink.emit(
+            "MK013",
+            f'alias "*{name}" refers to an anchor that is not defined before it',
+            _loc(path, exc.problem_mark),
+        )
         return
     message = problem
     if exc.context:

@@ -142,8 +142,14 @@ def test_terrain_primitives_format_1() -> None:
     assert robot.root_joint is JointType.FIXED
     np.testing.assert_allclose(robot.root_pose.translation, [0, 0, -0.1])
     kinds = {link.name: type(link.visuals[0].geometry) for link in robot.links}
-    assert kinds == {"Ground": Box, "object1": Cylinder, "object2": Cylinder, "object3": Sphere,
-                     "object4": Cone, "object5": Capsule}
+    assert kinds == {
+        "Ground": Box,
+        "object1": Cylinder,
+        "object2": Cylinder,
+        "object3": Sphere,
+        "object4": Cone,
+        "object5": Capsule,
+    }
     cone = robot.link("object4")
     assert cone is not None
     # rotation [1,0,0,90] turns Choreonoid's +Y apex to +Z: the model cone (apex +Z) is unrotated.
@@ -154,7 +160,9 @@ def test_terrain_primitives_format_1() -> None:
 
 
 def test_rigid_bodies_combine_with_parallel_axis(tmp_path: Path) -> None:
-    body = write(tmp_path, """
+    body = write(
+        tmp_path,
+        """
 format: ChoreonoidBody
 format_version: 2.0
 links:
@@ -171,7 +179,8 @@ links:
           type: RigidBody
           mass: 3.0
           inertia: [0.01, 0, 0, 0.01, 0, 0.01]
-""")
+""",
+    )
     link = load(body).links[0]
     assert link.inertial is not None
     assert link.inertial.mass == 4.0
@@ -181,7 +190,9 @@ links:
 
 
 def test_rigid_body_rotation_rotates_inertia(tmp_path: Path) -> None:
-    body = write(tmp_path, """
+    body = write(
+        tmp_path,
+        """
 format: ChoreonoidBody
 format_version: 2.0
 links:
@@ -193,7 +204,8 @@ links:
         center_of_mass: [0.2, 0, 0]
         mass: 2.0
         inertia: [0.1, 0, 0, 0, 0.2, 0, 0, 0, 0.3]
-""")
+""",
+    )
     inertial = load(body).links[0].inertial
     assert inertial is not None
     np.testing.assert_allclose(inertial.com, [0, 0.2, 0], atol=1e-12)
@@ -201,13 +213,16 @@ links:
 
 
 def test_missing_mass_gives_choreonoid_defaults_and_a_warning(tmp_path: Path) -> None:
-    body = write(tmp_path, """
+    body = write(
+        tmp_path,
+        """
 format: ChoreonoidBody
 format_version: 2.0
 links:
   - name: base
     joint_type: free
-""")
+""",
+    )
     v = validate(body)
     assert v.robot is not None
     inertial = v.robot.links[0].inertial
@@ -218,7 +233,9 @@ links:
 
 
 def test_radian_mode_and_ranges(tmp_path: Path) -> None:
-    body = write(tmp_path, """
+    body = write(
+        tmp_path,
+        """
 format: ChoreonoidBody
 formatVersion: 1.0
 angleUnit: radian
@@ -239,7 +256,8 @@ links:
     jointRange: 0.2
     mass: 1
     inertia: [0.01, 0, 0, 0.01, 0, 0.01]
-""")
+""",
+    )
     robot = load(body)
     arm, slider = robot.joints
     np.testing.assert_allclose(arm.axis, [-1, 0, 0])
@@ -251,7 +269,9 @@ links:
 
 
 def test_degree_ranges_convert_only_for_revolute(tmp_path: Path) -> None:
-    body = write(tmp_path, """
+    body = write(
+        tmp_path,
+        """
 format: ChoreonoidBody
 format_version: 2.0
 links:
@@ -270,7 +290,8 @@ links:
     joint_range: [-0.5, 0.5]
     mass: 1
     inertia: [0.01, 0, 0, 0.01, 0, 0.01]
-""")
+""",
+    )
     a, b = load(body).joints
     np.testing.assert_allclose([a.limits.lower, a.limits.upper], [-math.pi / 2, math.pi / 4])
     np.testing.assert_allclose(a.limits.velocity, math.pi)
@@ -279,14 +300,17 @@ links:
 
 
 def test_rotation_list_composes_left_to_right(tmp_path: Path) -> None:
-    body = write(tmp_path, """
+    body = write(
+        tmp_path,
+        """
 format: ChoreonoidBody
 format_version: 2.0
 links:
   - name: base
     rotation: [[0, 1, 0, 90], [0, 0, 1, -90]]
     translation: [[1, 0, 0], [0, 2, 0]]
-""")
+""",
+    )
     robot = load(body)
     r = robot.root_pose.rotation
     # Ry(90)·Rz(-90): x ↦ Ry(90)(0,-1,0) = (0,-1,0); z ↦ Ry(90)(0,0,1) = (1,0,0)

@@ -26,24 +26,37 @@ def urdf_of(robot: Robot) -> str:
     parts = [f'<robot name="{robot.name}">']
     parts += [f'  <link name="{link.name}"/>' for link in robot.links]
     for j in robot.joints:
-        parts.append(f'  <joint name="{j.name}" type="fixed"><parent link="{j.parent}"/>'
-                     f'<child link="{j.child}"/></joint>')
+        parts.append(
+            f'  <joint name="{j.name}" type="fixed"><parent link="{j.parent}"/>'
+            f'<child link="{j.child}"/></joint>'
+        )
     parts.append("</robot>")
     return "\n".join(parts) + "\n"
 
 
 CASES = {
     "ordered_by_joint_name": robot_from_edges(
-        "order", ["base", "zeta", "mid", "alpha"],
-        [("b_joint", "base", "zeta"), ("a_joint", "base", "mid"), ("c_joint", "base", "alpha")]),
+        "order",
+        ["base", "zeta", "mid", "alpha"],
+        [("b_joint", "base", "zeta"), ("a_joint", "base", "mid"), ("c_joint", "base", "alpha")],
+    ),
     "deep_and_wide": robot_from_edges(
-        "test_robot", ["base_link", "link1", "link2", "link3", "link4", "link5"],
-        [("j1", "base_link", "link1"), ("j2", "link1", "link2"), ("j3", "base_link", "link3"),
-         ("j4", "link2", "link4"), ("J0", "link1", "link5")]),
+        "test_robot",
+        ["base_link", "link1", "link2", "link3", "link4", "link5"],
+        [
+            ("j1", "base_link", "link1"),
+            ("j2", "link1", "link2"),
+            ("j3", "base_link", "link3"),
+            ("j4", "link2", "link4"),
+            ("J0", "link1", "link5"),
+        ],
+    ),
     "single_link": robot_from_edges("only", ["only"], []),
     "byte_order_names": robot_from_edges(
-        "bytes", ["root", "x1", "x2", "x3", "x4"],
-        [("B", "root", "x1"), ("a", "root", "x2"), ("_", "root", "x3"), ("A10", "root", "x4")]),
+        "bytes",
+        ["root", "x1", "x2", "x3", "x4"],
+        [("B", "root", "x1"), ("a", "root", "x2"), ("_", "root", "x3"), ("A10", "root", "x4")],
+    ),
 }
 
 
@@ -97,18 +110,24 @@ def test_body_tree_cli_and_document_order() -> None:
     assert result.exit_code == 0, result.output
     assert result.stdout == SENSORS_TREE
     doc = runner.invoke(main, ["tree", "--order", "document", str(TUTORIAL / "mobile_robot_sensors.body")])
-    assert doc.stdout.splitlines()[3:] == ["    child(1):  LeftWheel", "    child(2):  RightWheel",
-                                           "    child(3):  PanLink", "        child(1):  TiltLink"]
+    assert doc.stdout.splitlines()[3:] == [
+        "    child(1):  LeftWheel",
+        "    child(2):  RightWheel",
+        "    child(3):  PanLink",
+        "        child(1):  TiltLink",
+    ]
 
 
 def test_body_tree_matches_the_packages_own_urdf_shape() -> None:
     """The tutorial's hand-written URDF of the same robot gives the same tree under check_urdf,
     apart from the two sensor frames that only the URDF has as links."""
     check_urdf = require_tool("check_urdf")
-    expected = subprocess.run([check_urdf, str(TUTORIAL / "mobile_robot_sensors.urdf")], capture_output=True,
-                              check=True, text=True).stdout
-    without_sensor_links = "".join(line for line in expected.splitlines(keepends=True)
-                                   if "LiDAR" not in line and "RealSense" not in line)
+    expected = subprocess.run(
+        [check_urdf, str(TUTORIAL / "mobile_robot_sensors.urdf")], capture_output=True, check=True, text=True
+    ).stdout
+    without_sensor_links = "".join(
+        line for line in expected.splitlines(keepends=True) if "LiDAR" not in line and "RealSense" not in line
+    )
     assert without_sensor_links == SENSORS_TREE
 
 
@@ -128,8 +147,9 @@ def test_tree_json_has_types_and_origins() -> None:
 
 def test_tree_on_broken_file_exits_1_with_message(tmp_path: Path) -> None:
     body = tmp_path / "b.body"
-    body.write_text("format: ChoreonoidBody\nformat_version: 2.0\nlinks:\n  - name: a\n  - name: b\n"
-                    "    parent: nope\n")
+    body.write_text(
+        "format: ChoreonoidBody\nformat_version: 2.0\nlinks:\n  - name: a\n  - name: b\n    parent: nope\n"
+    )
     result = CliRunner().invoke(main, ["tree", str(body)])
     assert result.exit_code == 1
     assert "MK202" in result.stderr and "ERROR: the kinematic tree cannot be built" in result.stderr

@@ -31,7 +31,7 @@ def test_scalars_stay_strings_with_positions() -> None:
 def test_merge_keys_explicit_wins_and_earlier_merge_wins() -> None:
     root, found = parse("A: &A {x: 1, y: 1}\nB: &B {x: 2, z: 2}\nm: {<<: [*A, *B], y: 3}\n")
     assert found == []
-    assert to_plain(root) ["m"] == {"y": "3", "x": "1", "z": "2"}  # type: ignore[index]
+    assert to_plain(root)["m"] == {"y": "3", "x": "1", "z": "2"}  # type: ignore[index]
 
 
 def test_aliases_are_shared_not_copied() -> None:

@@ -58,11 +58,17 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
             continue
         if inertial.defaulted and dynamic:
             what = "no mass information" if "mass" not in inertial.sources else "no inertia"
-            yield diag("MK304", f'link "{link.name}" has {what}: Choreonoid uses '
-                       f'{"1 kg and " if "mass" not in inertial.sources else ""}an identity inertia (1 kg·m²)',
-                       _mass_loc(link), hint="give mass, center_of_mass and inertia")
+            yield diag(
+                "MK304",
+                f'link "{link.name}" has {what}: Choreonoid uses '
+                f"{'1 kg and ' if 'mass' not in inertial.sources else ''}an identity inertia (1 kg·m²)",
+                _mass_loc(link),
+                hint="give mass, center_of_mass and inertia",
+            )
         if inertial.mass < 0:
-            yield diag("MK300", f'link "{link.name}" has a negative mass ({inertial.mass:g} kg)', _mass_loc(link))
+            yield diag(
+                "MK300", f'link "{link.name}" has a negative mass ({inertial.mass:g} kg)', _mass_loc(link)
+            )
         elif inertial.mass == 0 and link.name in moving:
             yield diag("MK313", f'link "{link.name}" moves but its mass is zero', _mass_loc(link))
 
@@ -86,23 +92,41 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
         where = inertial.sources.get("inertia", _mass_loc(link))
         tensor = np.asarray(inertial.inertia, dtype=float)
         if not np.allclose(tensor, tensor.T, rtol=1e-9, atol=1e-12):
-            yield diag("MK301", f'link "{link.name}": the inertia matrix is not symmetric{static}', where,
-                       severity=severity)
+            yield diag(
+                "MK301",
+                f'link "{link.name}": the inertia matrix is not symmetric{static}',
+                where,
+                severity=severity,
+            )
             continue
         moments = principal_moments(tensor)
         eps = inertia_tolerance(moments)
         if np.all(np.abs(moments) <= eps):
-            yield diag("MK302", f'link "{link.name}" has mass {inertial.mass:g} kg but a zero inertia{static}', where,
-                       severity=severity)
+            yield diag(
+                "MK302",
+                f'link "{link.name}" has mass {inertial.mass:g} kg but a zero inertia{static}',
+                where,
+                severity=severity,
+            )
             continue
         if moments[0] < -eps:
-            yield diag("MK302", f'link "{link.name}": the inertia is not positive definite (principal moments '
-                       f"{', '.join(f'{m:.6g}' for m in moments)}){static}", where, severity=severity)
+            yield diag(
+                "MK302",
+                f'link "{link.name}": the inertia is not positive definite (principal moments '
+                f"{', '.join(f'{m:.6g}' for m in moments)}){static}",
+                where,
+                severity=severity,
+            )
             continue
         a, b, c = moments
         if a + b < c - eps:
-            yield diag("MK303", f'link "{link.name}": principal moments {a:.6g}, {b:.6g}, {c:.6g} violate the '
-                       f"triangle inequality ({a:.6g} + {b:.6g} < {c:.6g}){static}", where, severity=severity)
+            yield diag(
+                "MK303",
+                f'link "{link.name}": principal moments {a:.6g}, {b:.6g}, {c:.6g} violate the '
+                f"triangle inequality ({a:.6g} + {b:.6g} < {c:.6g}){static}",
+                where,
+                severity=severity,
+            )
 
 
 @rule("joint-ranges", "MK307", "MK315")
@@ -111,8 +135,16 @@ def joint_ranges(robot: Robot) -> Iterator[Diagnostic]:
     for joint in robot.joints:
         limits = joint.limits
         if limits.lower > limits.upper:
-            yield diag("MK307", f'joint "{joint.name}": lower limit {limits.lower:.6g} is above upper limit '
-                       f"{limits.upper:.6g}", joint.loc("range"))
+            yield diag(
+                "MK307",
+                f'joint "{joint.name}": lower limit {limits.lower:.6g} is above upper limit '
+                f"{limits.upper:.6g}",
+                joint.loc("range"),
+            )
         if limits.velocity_lower > limits.velocity_upper:
-            yield diag("MK315", f'joint "{joint.name}": velocity range [{limits.velocity_lower:.6g}, '
-                       f"{limits.velocity_upper:.6g}] is reversed", joint.loc("velocity_range"))
+            yield diag(
+                "MK315",
+                f'joint "{joint.name}": velocity range [{limits.velocity_lower:.6g}, '
+                f"{limits.velocity_upper:.6g}] is reversed",
+                joint.loc("velocity_range"),
+            )

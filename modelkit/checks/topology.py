@@ -38,8 +38,11 @@ def parents_exist(robot: Robot) -> Iterator[Diagnostic]:
     names = {link.name for link in robot.links}
     for joint in robot.joints:
         if joint.parent not in names:
-            yield diag("MK202", f'parent link "{joint.parent}" of "{joint.child}" is not defined',
-                       joint.loc("parent"))
+            yield diag(
+                "MK202",
+                f'parent link "{joint.parent}" of "{joint.child}" is not defined',
+                joint.loc("parent"),
+            )
 
 
 @rule("single-root", "MK200", "MK201")
@@ -70,14 +73,17 @@ def no_cycles(robot: Robot) -> Iterator[Diagnostic]:
             seen.append(current)
             current = parent_of[current]
         if current in seen:
-            cycle = seen[seen.index(current):]
+            cycle = seen[seen.index(current) :]
             key = min(cycle)
             if key in reported:
                 continue
             reported.add(key)
             path = " -> ".join([*cycle, current])
-            yield diag("MK203", f'adding "{joint.child}" to link "{joint.parent}" results in a cyclic reference '
-                       f"({path})", joint.loc("parent"))
+            yield diag(
+                "MK203",
+                f'adding "{joint.child}" to link "{joint.parent}" results in a cyclic reference ({path})',
+                joint.loc("parent"),
+            )
 
 
 @rule("joint-ids", "MK206", "MK207")
@@ -88,8 +94,11 @@ def joint_ids(robot: Robot) -> Iterator[Diagnostic]:
         if joint.joint_id is None:
             continue
         if joint.joint_id in seen:
-            yield diag("MK206", f'joint id {joint.joint_id} of "{joint.child}" is duplicated (also "{seen[joint.joint_id]}")',
-                       joint.loc("id"))
+            yield diag(
+                "MK206",
+                f'joint id {joint.joint_id} of "{joint.child}" is duplicated (also "{seen[joint.joint_id]}")',
+                joint.loc("id"),
+            )
         else:
             seen[joint.joint_id] = joint.child
     if seen:
@@ -97,8 +106,11 @@ def joint_ids(robot: Robot) -> Iterator[Diagnostic]:
         if missing:
             first = min((j for j in robot.joints if j.joint_id is not None), key=lambda j: j.joint_id or 0)
             ids = ", ".join(str(i) for i in missing[:10]) + (" ..." if len(missing) > 10 else "")
-            yield diag("MK207", f"joint id(s) {ids} are not specified; Choreonoid fills them with dummy joints",
-                       first.loc("id"))
+            yield diag(
+                "MK207",
+                f"joint id(s) {ids} are not specified; Choreonoid fills them with dummy joints",
+                first.loc("id"),
+            )
 
 
 @rule("link-joint-name-collision", "MK211")
@@ -109,8 +121,11 @@ def link_joint_collision(robot: Robot) -> Iterator[Diagnostic]:
         if joint.extras.get("implicit_name"):
             continue
         if joint.name in names:
-            yield diag("MK211", f'joint "{joint.name}" has the same name as a link; SDF 1.7+ and Gazebo refuse this',
-                       joint.loc("name"))
+            yield diag(
+                "MK211",
+                f'joint "{joint.name}" has the same name as a link; SDF 1.7+ and Gazebo refuse this',
+                joint.loc("name"),
+            )
 
 
 @rule("special-joints", "MK213", "MK214")
@@ -120,8 +135,16 @@ def special_joints(robot: Robot) -> Iterator[Diagnostic]:
 
     for joint in robot.joints:
         if joint.type is JointType.FLOATING:
-            yield diag("MK213", f'"{joint.child}" has a free joint below the root: its subtree floats as a separate '
-                       "body (no URDF/MJCF equivalent)", joint.loc("type"))
+            yield diag(
+                "MK213",
+                f'"{joint.child}" has a free joint below the root: its subtree floats as a separate '
+                "body (no URDF/MJCF equivalent)",
+                joint.loc("type"),
+            )
         elif joint.type is JointType.PSEUDO_CONTINUOUS_TRACK:
-            yield diag("MK214", f'"{joint.child}" is a pseudo continuous track: kinematically fixed, its contact '
-                       "surface moves; URDF/SDF/MJCF have no equivalent", joint.loc("type"))
+            yield diag(
+                "MK214",
+                f'"{joint.child}" is a pseudo continuous track: kinematically fixed, its contact '
+                "surface moves; URDF/SDF/MJCF have no equivalent",
+                joint.loc("type"),
+            )

@@ -37,8 +37,9 @@ def detect_format(path: Path, explicit: str | None = None) -> str | None:
     return None
 
 
-def read_model(path: Path, options: BodyOptions | None = None, fmt: str | None = None,
-               display: str | None = None) -> ReadResult:
+def read_model(
+    path: Path, options: BodyOptions | None = None, fmt: str | None = None, display: str | None = None
+) -> ReadResult:
     """Read any supported model file; an unknown format is a diagnostic, not an exception."""
     shown = display or str(path)
     kind = detect_format(path, fmt)
@@ -48,6 +49,9 @@ def read_model(path: Path, options: BodyOptions | None = None, fmt: str | None =
         return read_body(path, options, shown)
     sink = DiagnosticSink()
     known = ", ".join(s for info in FORMATS for s in info.suffixes)
-    sink.emit("MK001", f"cannot tell the format of this file (supported: {known}); "
-              "use --input-format", SourceLocation(shown))
+    sink.emit(
+        "MK001",
+        f"cannot tell the format of this file (supported: {known}); use --input-format",
+        SourceLocation(shown),
+    )
     return ReadResult(None, sink.items)

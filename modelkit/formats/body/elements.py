@@ -38,8 +38,9 @@ from modelkit.yamltree import YamlDocument, YMap, YNode, YScalar, YSeq, parse_ya
 # Choreonoid's cylinders, capsules and cones lie along local Y; the model's along Z.
 Y_TO_Z = rot_x(-math.pi / 2.0)
 
-SCENE_ONLY_NODES = frozenset({"Node", "LineSet", "DirectionalLight", "PerspectiveCamera", "OrthographicCamera",
-                              "Fog", "Text"})
+SCENE_ONLY_NODES = frozenset(
+    {"Node", "LineSet", "DirectionalLight", "PerspectiveCamera", "OrthographicCamera", "Fog", "Text"}
+)
 MESH_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl"})
 YAML_EXTENSIONS = frozenset({".yaml", ".yml"})
 UNSUPPORTED_MESH_EXTENSIONS = frozenset({".blend", ".x", ".dxf", ".scen"})
@@ -106,27 +107,38 @@ def iter_elements(node: YNode | None) -> list[tuple[str, YMap]]:
     return []
 
 
-def walk(elements: YNode | None, transform: np.ndarray, mode: str, out: Collected, ctx: WalkContext,
-         depth: int = 0) -> None:
+def walk(
+    elements: YNode | None, transform: np.ndarray, mode: str, out: Collected, ctx: WalkContext, depth: int = 0
+) -> None:
     if depth > MAX_ELEMENT_DEPTH:
         if elements is not None:
-            ctx.sink.emit("MK608", f"elements are nested more than {MAX_ELEMENT_DEPTH} levels deep; "
-                          "the rest is not read", elements.loc)
+            ctx.sink.emit(
+                "MK608",
+                f"elements are nested more than {MAX_ELEMENT_DEPTH} levels deep; the rest is not read",
+                elements.loc,
+            )
         return
     for node_type, node in iter_elements(elements):
         _walk_node(node_type, node, transform, mode, out, ctx, depth)
 
 
-def _walk_node(node_type: str, node: YMap, transform: np.ndarray, mode: str, out: Collected,
-               ctx: WalkContext, depth: int) -> None:
+def _walk_node(
+    node_type: str, node: YMap, transform: np.ndarray, mode: str, out: Collected, ctx: WalkContext, depth: int
+) -> None:
     sink = ctx.sink
     if node_type == "Skip" or node_type in SCENE_ONLY_NODES:
         return
     if node_type == "Group":
         walk(node.get("elements"), transform, mode, out, ctx, depth + 1)
     elif node_type == "Transform":
-        walk(node.get("elements"), transform @ v.node_transform(node, ctx.angle_scale, sink), mode, out, ctx,
-             depth + 1)
+        walk(
+            node.get("elements"),
+            transform @ v.node_transform(node, ctx.angle_scale, sink),
+            mode,
+            out,
+            ctx,
+            depth + 1,
+        )
     elif node_type in ("Visual", "Collision"):
         new_mode = node_type.lower()
         if mode not in ("both", new_mode):
@@ -185,33 +197,46 @@ def inertia_matrix(node: YNode | None) -> Mat3 | None:
 def _add_device(kind: str, node: YMap, affine: np.ndarray, out: Collected, ctx: WalkContext) -> None:
     name = v.get_text(node, "name") or ""
     if "scale" in node:
-        ctx.sink.emit("MK606", f'{kind} "{name}" has `scale`, which corrupts the device rotation in Choreonoid',
-                      node.key_loc("scale"))
+        ctx.sink.emit(
+            "MK606",
+            f'{kind} "{name}" has `scale`, which corrupts the device rotation in Choreonoid',
+            node.key_loc("scale"),
+        )
     params = dev.read_params(kind, node, ctx.angle_scale, ctx.sink)
     if kind in ("Camera", "CameraDevice"):
         fmt = params.get("format")
         if fmt not in dev.CAMERA_FORMATS:
             where = node.get("format")
-            ctx.sink.emit("MK600", f'camera "{name}" has no valid `format` '
-                          f'({"missing" if fmt is None else repr(fmt)}): Choreonoid creates no device',
-                          where.loc if where is not None else node.loc,
-                          hint="use COLOR, DEPTH, COLOR_DEPTH, POINT_CLOUD or COLOR_POINT_CLOUD")
+            ctx.sink.emit(
+                "MK600",
+                f'camera "{name}" has no valid `format` '
+                f"({'missing' if fmt is None else repr(fmt)}): Choreonoid creates no device",
+                where.loc if where is not None else node.loc,
+                hint="use COLOR, DEPTH, COLOR_DEPTH, POINT_CLOUD or COLOR_POINT_CLOUD",
+            )
             return
         params["camera_kind"] = dev.CAMERA_FORMATS[fmt]
     if kind == "RangeSensor":
         for axis in ("yaw", "pitch"):
             lo, hi = v.number(node.get(f"min_{axis}_angle")), v.number(node.get(f"max_{axis}_angle"))
             if lo is not None and hi is not None and lo > hi:
-                ctx.sink.emit("MK607", f'range sensor "{name}": min_{axis}_angle {lo} exceeds max_{axis}_angle {hi}; '
-                              "Choreonoid ignores both", node.key_loc(f"min_{axis}_angle"))
+                ctx.sink.emit(
+                    "MK607",
+                    f'range sensor "{name}": min_{axis}_angle {lo} exceeds max_{axis}_angle {hi}; '
+                    "Choreonoid ignores both",
+                    node.key_loc(f"min_{axis}_angle"),
+                )
     if kind in dev.PLUGIN_DEVICES:
         params["plugin"] = True
     device_id = v.integer(node.get("id"))
     if device_id is not None:
         params["id"] = device_id
     pose, _ = split_affine(affine)
-    out.devices.append(Device(kind, name, pose if pose is not None else Pose(np.eye(3), affine[:3, 3].copy()),
-                              params, node.loc))
+    out.devices.append(
+        Device(
+            kind, name, pose if pose is not None else Pose(np.eye(3), affine[:3, 3].copy()), params, node.loc
+        )
+    )
 
 
 # ---- shapes ----------------------------------------------------------------------------------
@@ -259,9 +284,12 @@ def _material(shape: YMap, ctx: WalkContext) -> VisualMaterial | None:
         if uri is not None and uri_node is not None:
             res = ctx.resolver.resolve(uri, ctx.base_dir, ctx.path)
             if res.path is None or not res.path.is_file():
-                ctx.sink.emit("MK507", f'texture "{uri}" cannot be found'
-                              + (f" ({res.message})" if res.message else f" at {res.path}"),
-                              uri_node.loc)
+                ctx.sink.emit(
+                    "MK507",
+                    f'texture "{uri}" cannot be found'
+                    + (f" ({res.message})" if res.message else f" at {res.path}"),
+                    uri_node.loc,
+                )
             result.texture = str(res.path) if res.path is not None else uri
     if result.diffuse is None and result.texture is None and not isinstance(m, YMap):
         return None
@@ -279,8 +307,7 @@ def add_shape(shape: YMap, transform: np.ndarray, mode: str, out: Collected, ctx
     material = _material(shape, ctx)
     name = v.get_text(shape, "name")
     if kind == "Resource":
-        _add_mesh_file(geometry_node, affine, mode, out, ctx, material=material, name=name,
-                       single_mesh=True)
+        _add_mesh_file(geometry_node, affine, mode, out, ctx, material=material, name=name, single_mesh=True)
         return
     built = _build_geometry(kind, geometry_node, ctx)
     if built is None:
@@ -329,8 +356,9 @@ def _build_geometry(kind: str, g: YMap, ctx: WalkContext) -> tuple[Geometry, np.
         if r <= 0 or bad_height:
             sink.emit("MK400", f"a {kind.lower()} cannot be generated with radius {r} and height {h}", g.loc)
             return None
-        cls = {"Cylinder": Cylinder, "Capsule": Capsule, "Cone": Cone}[kind]
-        return cls(r, h), local
+        if kind == "Cylinder":
+            return Cylinder(r, h), local
+        return (Capsule(r, h) if kind == "Capsule" else Cone(r, h)), local
     if kind in ("Extrusion", "ElevationGrid", "IndexedFaceSet", "TriangleMesh"):
         mesh = _generated_mesh(kind, g, ctx)
         if mesh is None:
@@ -345,9 +373,12 @@ def _generated_mesh(kind: str, g: YMap, ctx: WalkContext) -> Mesh | None:
     sink = ctx.sink
     crease = v.number(g.get("crease_angle", "creaseAngle"))
     if crease is not None and ctx.angle_scale != 1.0 and 0.0 < crease < 1.0:
-        sink.emit("MK312", f"crease_angle {crease} is in degrees here; {crease} rad would be "
-                  f"{math.degrees(crease):.1f} degrees", g.key_loc("crease_angle" if "crease_angle" in g
-                                                                    else "creaseAngle"))
+        sink.emit(
+            "MK312",
+            f"crease_angle {crease} is in degrees here; {crease} rad would be "
+            f"{math.degrees(crease):.1f} degrees",
+            g.key_loc("crease_angle" if "crease_angle" in g else "creaseAngle"),
+        )
     params: dict[str, Any] = {}
     try:
         if kind == "Extrusion":
@@ -358,11 +389,25 @@ def _generated_mesh(kind: str, g: YMap, ctx: WalkContext) -> Mesh | None:
             scale = v.numbers(g.get("scale")) or []
             begin_cap = v.get_bool(g, "beginCap", default=True)
             end_cap = v.get_bool(g, "end_cap", "endCap", default=True)
-            data, report = gen.extrusion(cs, spine, orientation=orientation, scale=scale, begin_cap=begin_cap,
-                                         end_cap=end_cap, faithful=ctx.faithful_extrusion)
+            data, report = gen.extrusion(
+                cs,
+                spine,
+                orientation=orientation,
+                scale=scale,
+                begin_cap=begin_cap,
+                end_cap=end_cap,
+                faithful=ctx.faithful_extrusion,
+            )
             _extrusion_findings(report, g, ctx)
-            params = {"cross_section": cs, "spine": spine, "orientation": orientation, "scale": scale,
-                      "begin_cap": begin_cap, "end_cap": end_cap, "faithful": ctx.faithful_extrusion}
+            params = {
+                "cross_section": cs,
+                "spine": spine,
+                "orientation": orientation,
+                "scale": scale,
+                "begin_cap": begin_cap,
+                "end_cap": end_cap,
+                "faithful": ctx.faithful_extrusion,
+            }
         elif kind == "ElevationGrid":
             xd = v.integer(g.get("x_dimension", "xDimension")) or 0
             zd = v.integer(g.get("z_dimension", "zDimension")) or 0
@@ -375,8 +420,11 @@ def _generated_mesh(kind: str, g: YMap, ctx: WalkContext) -> Mesh | None:
             faces = [int(x) for x in (v.numbers(g.get("faces", "coordIndex")) or [])]
             data, dropped = gen.indexed_face_set(vertices, faces)
             if dropped:
-                sink.emit("MK409", f"the last polygon ({dropped} indices) lacks its -1 terminator and is dropped",
-                          g.key_loc("faces" if "faces" in g else "coordIndex"))
+                sink.emit(
+                    "MK409",
+                    f"the last polygon ({dropped} indices) lacks its -1 terminator and is dropped",
+                    g.key_loc("faces" if "faces" in g else "coordIndex"),
+                )
         else:
             vertices = v.numbers(g.get("vertices", "coordinate")) or []
             triangles = [int(x) for x in (v.numbers(g.get("faces", "coordIndex", "triangles")) or [])]
@@ -391,27 +439,44 @@ def _extrusion_findings(report: Any, g: YMap, ctx: WalkContext) -> None:
     sink = ctx.sink
     spine_loc = g.key_loc("spine")
     if report.oblique_straight:
-        sink.emit("MK403", "the straight spine is neither along ±Y nor horizontal: Choreonoid shears and shrinks "
-                  "the cross-section (modelkit reproduces it; --vrml-extrusion gives the VRML97 shape)", spine_loc)
+        sink.emit(
+            "MK403",
+            "the straight spine is neither along ±Y nor horizontal: Choreonoid shears and shrinks "
+            "the cross-section (modelkit reproduces it; --vrml-extrusion gives the VRML97 shape)",
+            spine_loc,
+        )
     if report.mirrored:
-        sink.emit("MK404", "the straight spine points along -Y: Choreonoid mirrors the cross-section "
-                  "(a point reflection)", spine_loc)
+        sink.emit(
+            "MK404",
+            "the straight spine points along -Y: Choreonoid mirrors the cross-section (a point reflection)",
+            spine_loc,
+        )
     if report.open_cross_section_with_caps:
-        sink.emit("MK406", "the cross-section is not closed but caps are on: the surface is not closed",
-                  g.key_loc("crossSection" if "crossSection" in g else "cross_section"))
+        sink.emit(
+            "MK406",
+            "the cross-section is not closed but caps are on: the surface is not closed",
+            g.key_loc("crossSection" if "crossSection" in g else "cross_section"),
+        )
     if report.non_unit_orientation_axis:
-        sink.emit("MK415", "an orientation axis is not unit length; Choreonoid uses it unnormalised",
-                  g.key_loc("orientation"))
+        sink.emit(
+            "MK415",
+            "an orientation axis is not unit length; Choreonoid uses it unnormalised",
+            g.key_loc("orientation"),
+        )
     for key, count in sorted(report.dropped_numbers.items()):
         if count:
             spelled = {"cross_section": ("cross_section", "crossSection")}.get(key, (key,))
             where = next((s for s in spelled if s in g), spelled[0])
-            sink.emit("MK118", f"{count} trailing number(s) of `{where}` do not make a whole tuple and are dropped",
-                      g.key_loc(where))
+            sink.emit(
+                "MK118",
+                f"{count} trailing number(s) of `{where}` do not make a whole tuple and are dropped",
+                g.key_loc(where),
+            )
 
 
-def _place(geometry: Geometry, affine: np.ndarray, kind: str, loc: SourceLocation,
-           ctx: WalkContext) -> tuple[Geometry, Pose] | None:
+def _place(
+    geometry: Geometry, affine: np.ndarray, kind: str, loc: SourceLocation, ctx: WalkContext
+) -> tuple[Geometry, Pose] | None:
     """Apply the accumulated transform: scale goes into the geometry, the rest into a pose."""
     pose, scale = split_affine(affine)
     uniform = bool(np.allclose(scale, scale[0], rtol=1e-12))
@@ -422,7 +487,9 @@ def _place(geometry: Geometry, affine: np.ndarray, kind: str, loc: SourceLocatio
             ctx.sink.emit("MK414", f"a sheared {kind} cannot be represented; it is left out", loc)
             return None
         baked = TriangleMeshData(mesh.vertices @ affine[:3, :3].T, mesh.faces.copy())
-        ctx.sink.emit("MK414", f"the transforms above this {kind} shear it; its triangles carry the shear", loc)
+        ctx.sink.emit(
+            "MK414", f"the transforms above this {kind} shear it; its triangles carry the shear", loc
+        )
         return Mesh(data=baked, generator=kind), Pose(np.eye(3), affine[:3, 3].copy())
     if isinstance(geometry, Box):
         return Box(geometry.size * np.abs(scale)), pose
@@ -437,9 +504,12 @@ def _place(geometry: Geometry, affine: np.ndarray, kind: str, loc: SourceLocatio
             rz = Pose(pose.rotation @ Y_TO_Z, pose.translation)
             cls = type(geometry)
             return cls(geometry.radius * abs(scale[0]), geometry.length * abs(scale[1])), rz
-        ctx.sink.emit("MK414", f"a {kind.lower()} scaled non-uniformly is kept as a scaled primitive mesh", loc)
-        return Mesh(generator=kind, scale=scale, source_params={"radius": geometry.radius,
-                                                                 "height": geometry.length}), pose
+        ctx.sink.emit(
+            "MK414", f"a {kind.lower()} scaled non-uniformly is kept as a scaled primitive mesh", loc
+        )
+        return Mesh(
+            generator=kind, scale=scale, source_params={"radius": geometry.radius, "height": geometry.length}
+        ), pose
     if isinstance(geometry, Mesh):
         geometry.scale = scale if not np.allclose(scale, 1.0) else np.ones(3)
         return geometry, pose
@@ -455,8 +525,9 @@ def _as_triangles(geometry: Geometry) -> TriangleMeshData | None:
 # ---- resources -------------------------------------------------------------------------------
 
 
-def add_resource(node: YMap, transform: np.ndarray, mode: str, out: Collected, ctx: WalkContext,
-                 depth: int) -> None:
+def add_resource(
+    node: YMap, transform: np.ndarray, mode: str, out: Collected, ctx: WalkContext, depth: int
+) -> None:
     uri_node = node.get("uri")
     uri = v.scalar_text(uri_node)
     if uri is None or uri_node is None:
@@ -466,11 +537,22 @@ def add_resource(node: YMap, transform: np.ndarray, mode: str, out: Collected, c
     if suffix in YAML_EXTENSIONS:
         _add_yaml_resource(node, uri, uri_node, affine, mode, out, ctx, depth)
         return
-    _add_mesh_file(node, affine, mode, out, ctx, material=None, name=v.get_text(node, "name"), single_mesh=False)
+    _add_mesh_file(
+        node, affine, mode, out, ctx, material=None, name=v.get_text(node, "name"), single_mesh=False
+    )
 
 
-def _add_mesh_file(node: YMap, affine: np.ndarray, mode: str, out: Collected, ctx: WalkContext, *,
-                   material: VisualMaterial | None, name: str | None, single_mesh: bool) -> None:
+def _add_mesh_file(
+    node: YMap,
+    affine: np.ndarray,
+    mode: str,
+    out: Collected,
+    ctx: WalkContext,
+    *,
+    material: VisualMaterial | None,
+    name: str | None,
+    single_mesh: bool,
+) -> None:
     uri_node = node.get("uri")
     uri = v.scalar_text(uri_node)
     if uri is None or uri_node is None:
@@ -482,22 +564,40 @@ def _add_mesh_file(node: YMap, affine: np.ndarray, mode: str, out: Collected, ct
     severity = Severity.WARNING if visual_only else None
     usage = " (visual only)" if visual_only else ""
     if resolution.code is not None:
-        ctx.sink.emit(resolution.code, (resolution.message or uri) + usage, uri_node.loc, hint=resolution.hint,
-                      severity=severity)
+        ctx.sink.emit(
+            resolution.code,
+            (resolution.message or uri) + usage,
+            uri_node.loc,
+            hint=resolution.hint,
+            severity=severity,
+        )
     elif path is not None:
         suffix = path.suffix.lower()
         if resolution.scheme == "package":
-            ctx.sink.emit("MK510", f'"{uri}" depends on the package search path; found at {path}', uri_node.loc)
+            ctx.sink.emit(
+                "MK510", f'"{uri}" depends on the package search path; found at {path}', uri_node.loc
+            )
         if not path.exists():
-            ctx.sink.emit("MK500", f'resource "{uri}" not found at {path}{usage}', uri_node.loc, severity=severity)
+            ctx.sink.emit(
+                "MK500", f'resource "{uri}" not found at {path}{usage}', uri_node.loc, severity=severity
+            )
         elif suffix not in MESH_EXTENSIONS:
-            ctx.sink.emit("MK506", f'resource "{uri}": {suffix or "no extension"} files are not supported '
-                          f"(supported: .stl .obj .dae .wrl .yaml)", uri_node.loc, severity=severity)
+            ctx.sink.emit(
+                "MK506",
+                f'resource "{uri}": {suffix or "no extension"} files are not supported '
+                f"(supported: .stl .obj .dae .wrl .yaml)",
+                uri_node.loc,
+                severity=severity,
+            )
         elif ctx.check_resources:
             _check_mesh_loads(path, fragment, node, uri, ctx, severity, usage)
     metadata = _mesh_metadata(node)
-    mesh = Mesh(uri=uri, path=str(path) if path is not None else None, fragment=fragment,
-                source_params={"metadata": metadata} if metadata else {})
+    mesh = Mesh(
+        uri=uri,
+        path=str(path) if path is not None else None,
+        fragment=fragment,
+        source_params={"metadata": metadata} if metadata else {},
+    )
     placed = _place(mesh, affine, "mesh", node.loc, ctx)
     if placed is None:
         return
@@ -525,16 +625,26 @@ def _mesh_metadata(node: YMap) -> dict[str, str]:
     return out
 
 
-def _check_mesh_loads(path: Path, fragment: str | None, node: YMap, uri: str, ctx: WalkContext,
-                      severity: Severity | None, usage: str) -> None:
+def _check_mesh_loads(
+    path: Path,
+    fragment: str | None,
+    node: YMap,
+    uri: str,
+    ctx: WalkContext,
+    severity: Severity | None,
+    usage: str,
+) -> None:
     key = (str(path), fragment)
     if key not in ctx.mesh_cache:
         from modelkit.geometry import meshfiles
 
         metadata = _mesh_metadata(node)
         try:
-            meshfiles.load_mesh(path, fragment, meshfiles.MeshMetadata(metadata.get("length_unit"),
-                                                                      metadata.get("upper_axis")))
+            meshfiles.load_mesh(
+                path,
+                fragment,
+                meshfiles.MeshMetadata(metadata.get("length_unit"), metadata.get("upper_axis")),
+            )
             ctx.mesh_cache[key] = None
         except meshfiles.MeshLoadError as exc:
             ctx.mesh_cache[key] = f"{exc.code}\t{exc}"
@@ -545,12 +655,24 @@ def _check_mesh_loads(path: Path, fragment: str | None, node: YMap, uri: str, ct
         ctx.sink.emit(code, f'resource "{uri}": {message}{usage}', (where or node).loc, severity=severity)
 
 
-def _add_yaml_resource(node: YMap, uri: str, uri_node: YNode, affine: np.ndarray, mode: str, out: Collected,
-                       ctx: WalkContext, depth: int) -> None:
+def _add_yaml_resource(
+    node: YMap,
+    uri: str,
+    uri_node: YNode,
+    affine: np.ndarray,
+    mode: str,
+    out: Collected,
+    ctx: WalkContext,
+    depth: int,
+) -> None:
     resolution = ctx.resolver.resolve(uri, ctx.base_dir, ctx.path)
     if resolution.code is not None or resolution.path is None:
-        ctx.sink.emit(resolution.code or "MK500", resolution.message or f'resource "{uri}" cannot be resolved',
-                      uri_node.loc, hint=resolution.hint)
+        ctx.sink.emit(
+            resolution.code or "MK500",
+            resolution.message or f'resource "{uri}" cannot be resolved',
+            uri_node.loc,
+            hint=resolution.hint,
+        )
         return
     path = resolution.path
     key = str(path)
@@ -570,9 +692,23 @@ def _add_yaml_resource(node: YMap, uri: str, uri_node: YNode, affine: np.ndarray
         content = doc.anchors.get(fragment) or ctx.main_anchors.get(fragment)
         if content is None:
             where = node.get("node", "fragment") or node
-            ctx.sink.emit("MK502", f'fragment "{fragment}" is not found in "{uri}" (it must be an anchor name)',
-                          where.loc)
+            ctx.sink.emit(
+                "MK502",
+                f'fragment "{fragment}" is not found in "{uri}" (it must be an anchor name)',
+                where.loc,
+            )
             return
-    sub = WalkContext(path, str(path), ctx.angle_scale, ctx.sink, ctx.resolver, ctx.check_resources,
-                      ctx.faithful_extrusion, ctx.main_anchors, ctx.mesh_cache, ctx.yaml_cache, ctx.depth + 1)
+    sub = WalkContext(
+        path,
+        str(path),
+        ctx.angle_scale,
+        ctx.sink,
+        ctx.resolver,
+        ctx.check_resources,
+        ctx.faithful_extrusion,
+        ctx.main_anchors,
+        ctx.mesh_cache,
+        ctx.yaml_cache,
+        ctx.depth + 1,
+    )
     walk(content, affine, mode, out, sub, depth + 1)

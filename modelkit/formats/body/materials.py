@@ -59,8 +59,11 @@ def load_materials(path: Path | None, sink: DiagnosticSink) -> MaterialTable:
     root = doc.root if doc else None
     entries = root.get("materials") if isinstance(root, YMap) else None
     if not isinstance(entries, YSeq):
-        sink.emit("MK511", f"cannot read contact materials from {target}: no `materials` list",
-                  SourceLocation(str(target)))
+        sink.emit(
+            "MK511",
+            f"cannot read contact materials from {target}: no `materials` list",
+            SourceLocation(str(target)),
+        )
         for d in local.items:
             sink.add(d)
         return table
@@ -70,12 +73,17 @@ def load_materials(path: Path | None, sink: DiagnosticSink) -> MaterialTable:
         name = scalar_text(item.get("name"))
         if not name:
             continue
-        extra = {k: v.value for k, v in item.items() if isinstance(v, YScalar) and k not in
-                 ("name", "roughness", "viscosity")}
+        extra = {
+            k: v.value
+            for k, v in item.items()
+            if isinstance(v, YScalar) and k not in ("name", "roughness", "viscosity")
+        }
         table.materials[name] = ContactMaterial(
-            name, number(item.get("roughness")) or 0.5,
+            name,
+            number(item.get("roughness")) or 0.5,
             1.0 if number(item.get("viscosity")) is None else float(number(item.get("viscosity")) or 0.0),
-            extra)
+            extra,
+        )
     pairs = root.get("contact_materials", "contactMaterials") if isinstance(root, YMap) else None
     if isinstance(pairs, YSeq):
         for item in pairs.items:
@@ -91,10 +99,13 @@ def load_materials(path: Path | None, sink: DiagnosticSink) -> MaterialTable:
             restitution = number(item.get("restitution"))
             for i in range(len(texts)):
                 for j in range(i + 1, len(texts)):
-                    table.pairs.append(ContactPair(
-                        (texts[i], texts[j]),
-                        static if static is not None else (friction if friction is not None else 0.5),
-                        dynamic if dynamic is not None else (friction if friction is not None else 0.5),
-                        restitution if restitution is not None else 0.0))
+                    table.pairs.append(
+                        ContactPair(
+                            (texts[i], texts[j]),
+                            static if static is not None else (friction if friction is not None else 0.5),
+                            dynamic if dynamic is not None else (friction if friction is not None else 0.5),
+                            restitution if restitution is not None else 0.0,
+                        )
+                    )
     _CACHE[key] = table
     return table

@@ -42,14 +42,29 @@ JOINT_TYPES: dict[str, JointType] = {
 }
 AXIS_SYMBOLS = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 ACTUATION_MODES = {
-    "joint_effort": "effort", "jointEffort": "effort", "jointTorque": "effort", "jointForce": "effort",
-    "joint_displacement": "displacement", "jointDisplacement": "displacement", "jointAngle": "displacement",
-    "joint_velocity": "velocity", "jointVelocity": "velocity",
-    "link_position": "link_position", "linkPosition": "link_position",
+    "joint_effort": "effort",
+    "jointEffort": "effort",
+    "jointTorque": "effort",
+    "jointForce": "effort",
+    "joint_displacement": "displacement",
+    "jointDisplacement": "displacement",
+    "jointAngle": "displacement",
+    "joint_velocity": "velocity",
+    "jointVelocity": "velocity",
+    "link_position": "link_position",
+    "linkPosition": "link_position",
     "jointSurfaceVelocity": "velocity",
 }
-RANGE_KEYS = ("joint_range", "jointRange", "max_joint_velocity", "maxJointVelocity", "joint_velocity_range",
-              "jointVelocityRange", "joint_axis", "jointAxis")
+RANGE_KEYS = (
+    "joint_range",
+    "jointRange",
+    "max_joint_velocity",
+    "maxJointVelocity",
+    "joint_velocity_range",
+    "jointVelocityRange",
+    "joint_axis",
+    "jointAxis",
+)
 MASS_KEYS = ("mass", "center_of_mass", "centerOfMass", "inertia")
 
 
@@ -88,8 +103,9 @@ def read_body(path: Path, options: BodyOptions | None = None, display: str | Non
 
 
 class _BodyReader:
-    def __init__(self, path: Path, options: BodyOptions, sink: DiagnosticSink, display: str,
-                 stack: tuple[str, ...]) -> None:
+    def __init__(
+        self, path: Path, options: BodyOptions, sink: DiagnosticSink, display: str, stack: tuple[str, ...]
+    ) -> None:
         self.path = path
         self.options = options
         self.sink = sink
@@ -120,8 +136,16 @@ class _BodyReader:
             return None
         name = v.get_text(root, "name") or self.path.stem
         robot = Robot(name=name, source_format="body", source=root.loc)
-        ctx = WalkContext(self.path, self.display, self.angle_scale, self.sink, self.options.resolver,
-                          self.options.check_resources, self.options.faithful_extrusion, doc.anchors)
+        ctx = WalkContext(
+            self.path,
+            self.display,
+            self.angle_scale,
+            self.sink,
+            self.options.resolver,
+            self.options.check_resources,
+            self.options.faithful_extrusion,
+            doc.anchors,
+        )
         records = self._links(links_node, ctx)
         if records is None:
             return None
@@ -130,10 +154,7 @@ class _BodyReader:
         return robot
 
     def _check_schema(self, root: YMap) -> None:
-        try:  # TEMPORARY until the schema lands
-            from modelkit.formats.body.schema import check_schema
-        except ImportError:
-            return
+        from modelkit.formats.body.schema import check_schema
 
         try:
             self.sink.extend(check_schema(root, self.display))
@@ -145,32 +166,55 @@ class _BodyReader:
         if fmt is None:
             model_file = root.get("model_file", "modelFile")
             if model_file is not None:
-                self.sink.emit("MK115", "this file has no `format` key: it is a wrapper around "
-                               f'"{v.scalar_text(model_file)}", which modelkit does not follow yet', model_file.loc)
+                self.sink.emit(
+                    "MK115",
+                    "this file has no `format` key: it is a wrapper around "
+                    f'"{v.scalar_text(model_file)}", which modelkit does not follow yet',
+                    model_file.loc,
+                )
             else:
-                self.sink.emit("MK110", "neither `format: ChoreonoidBody` nor `model_file` is specified", root.loc,
-                               hint="add `format: ChoreonoidBody` at the top")
+                self.sink.emit(
+                    "MK110",
+                    "neither `format: ChoreonoidBody` nor `model_file` is specified",
+                    root.loc,
+                    hint="add `format: ChoreonoidBody` at the top",
+                )
             return False
         if v.scalar_text(fmt) != "ChoreonoidBody":
-            self.sink.emit("MK110", f'`format` is "{v.scalar_text(fmt)}", not "ChoreonoidBody": the file cannot be '
-                           "loaded as a Choreonoid body model", fmt.loc)
+            self.sink.emit(
+                "MK110",
+                f'`format` is "{v.scalar_text(fmt)}", not "ChoreonoidBody": the file cannot be '
+                "loaded as a Choreonoid body model",
+                fmt.loc,
+            )
             return False
         version_node = root.get("format_version", "formatVersion")
         version = v.number(version_node)
         if version_node is None:
-            self.sink.emit("MK111", "the version of the Choreonoid body format is not specified", root.loc,
-                           hint="add `format_version: 2.0`")
+            self.sink.emit(
+                "MK111",
+                "the version of the Choreonoid body format is not specified",
+                root.loc,
+                hint="add `format_version: 2.0`",
+            )
             version = 1.0
         elif version is not None and version >= 2.1:
-            self.sink.emit("MK112", f"version {v.scalar_text(version_node)} of the Choreonoid body format is not "
-                           "supported (2.0 is the latest)", version_node.loc)
+            self.sink.emit(
+                "MK112",
+                f"version {v.scalar_text(version_node)} of the Choreonoid body format is not "
+                "supported (2.0 is the latest)",
+                version_node.loc,
+            )
         unit_node = root.get("angle_unit", "angleUnit")
         unit = v.scalar_text(unit_node)
         if unit == "radian":
             self.angle_scale = 1.0
             if version is not None and version >= 2.0 and unit_node is not None:
-                self.sink.emit("MK113", "`angle_unit: radian` is not supported in format version 2.0; "
-                               "write angles in degrees", unit_node.loc)
+                self.sink.emit(
+                    "MK113",
+                    "`angle_unit: radian` is not supported in format version 2.0; write angles in degrees",
+                    unit_node.loc,
+                )
         return True
 
     # -- links -------------------------------------------------------------------------------
@@ -199,7 +243,9 @@ class _BodyReader:
             elif node_type == "ContinuousTrack":
                 records.extend(self._continuous_track(node, ctx))
             else:
-                self.sink.emit("MK212", f"a {node_type} node cannot be specified in links", node.key_loc("type"))
+                self.sink.emit(
+                    "MK212", f"a {node_type} node cannot be specified in links", node.key_loc("type")
+                )
         if not records:
             self.sink.emit("MK114", "there is no link defined", links_node.loc)
             return None
@@ -224,12 +270,22 @@ class _BodyReader:
         mode_node = node.get("actuation_mode", "actuationMode")
         mode_word = v.scalar_text(mode_node)
         if mode_word == "jointSurfaceVelocity" and mode_node is not None:
-            sink.emit("MK219", "`actuation_mode: jointSurfaceVelocity` is deprecated; it forces a pseudo "
-                      "continuous track", mode_node.loc, hint="use joint_type: pseudo_continuous_track")
+            sink.emit(
+                "MK219",
+                "`actuation_mode: jointSurfaceVelocity` is deprecated; it forces a pseudo continuous track",
+                mode_node.loc,
+                hint="use joint_type: pseudo_continuous_track",
+            )
             joint_type = JointType.PSEUDO_CONTINUOUS_TRACK
         joint_name_node = node.get("joint_name")
-        joint = Joint(name=v.scalar_text(joint_name_node) or name, type=joint_type, parent="", child=name,
-                      origin=offset, source=node.loc)
+        joint = Joint(
+            name=v.scalar_text(joint_name_node) or name,
+            type=joint_type,
+            parent="",
+            child=name,
+            origin=offset,
+            source=node.loc,
+        )
         joint.sources["name"] = (joint_name_node or name_node or node).loc
         if joint_name_node is None:
             joint.extras["implicit_name"] = True
@@ -248,9 +304,15 @@ class _BodyReader:
             self._check_material(link.contact_material, material_node.loc)
         collected = Collected()
         walk(node.get("elements"), np.eye(4), "both", collected, ctx)
-        link.visuals, link.collisions, link.devices = collected.visuals, collected.collisions, collected.devices
+        link.visuals, link.collisions, link.devices = (
+            collected.visuals,
+            collected.collisions,
+            collected.devices,
+        )
         link.inertial = self._mass_properties(node, collected)
-        return _LinkRecord(link, joint, parent, parent_node.loc if parent_node is not None else None, word, offset)
+        return _LinkRecord(
+            link, joint, parent, parent_node.loc if parent_node is not None else None, word, offset
+        )
 
     def _check_material(self, name: str | None, loc: SourceLocation) -> None:
         if name is None:
@@ -258,8 +320,12 @@ class _BodyReader:
         if self.materials is None:
             self.materials = load_materials(self.options.materials_path, self.sink)
         if not self.materials.knows(name):
-            self.sink.emit("MK508", f'contact material "{name}" is not in {Path(self.materials.path).name}; '
-                           "Choreonoid gives it the Default material's parameters", loc)
+            self.sink.emit(
+                "MK508",
+                f'contact material "{name}" is not in {Path(self.materials.path).name}; '
+                "Choreonoid gives it the Default material's parameters",
+                loc,
+            )
 
     def _joint_details(self, node: YMap, joint: Joint, word: str | None) -> None:
         sink = self.sink
@@ -275,8 +341,12 @@ class _BodyReader:
                     sink.emit("MK305", f'joint "{joint.name}": the axis is the zero vector', axis_node.loc)
                 else:
                     if abs(norm - 1.0) > 1e-6:
-                        sink.emit("MK306", f'joint "{joint.name}": the axis {axis.tolist()} has length {norm:.6g}; '
-                                  "Choreonoid uses it unnormalised (modelkit normalises it)", axis_node.loc)
+                        sink.emit(
+                            "MK306",
+                            f'joint "{joint.name}": the axis {axis.tolist()} has length {norm:.6g}; '
+                            "Choreonoid uses it unnormalised (modelkit normalises it)",
+                            axis_node.loc,
+                        )
                     joint.axis = axis / norm
         limits = JointLimits()
         range_node = node.get("joint_range", "jointRange")
@@ -315,19 +385,37 @@ class _BodyReader:
         elif angle is not None and angle_node is not None:
             joint.initial_position = angle * self.angle_scale
             if joint.type is JointType.PRISMATIC:
-                sink.emit("MK310", f'joint "{joint.name}" is prismatic but `joint_angle` is converted as an '
-                          "angle by Choreonoid", angle_node.loc, hint="use joint_displacement")
+                sink.emit(
+                    "MK310",
+                    f'joint "{joint.name}" is prismatic but `joint_angle` is converted as an '
+                    "angle by Choreonoid",
+                    angle_node.loc,
+                    hint="use joint_displacement",
+                )
         id_node = node.get("joint_id", "jointId")
         joint_id = v.integer(id_node)
         if joint_id is not None and id_node is not None and joint_id >= 0:
             joint.joint_id = joint_id
             joint.sources["id"] = id_node.loc
         if not joint.type.moves and word is not None:
-            present = [k for k in ("joint_range", "jointRange", "max_joint_velocity", "maxJointVelocity",
-                                   "joint_velocity_range", "jointVelocityRange") if k in node]
+            present = [
+                k
+                for k in (
+                    "joint_range",
+                    "jointRange",
+                    "max_joint_velocity",
+                    "maxJointVelocity",
+                    "joint_velocity_range",
+                    "jointVelocityRange",
+                )
+                if k in node
+            ]
             if present and joint.type is JointType.FIXED:
-                sink.emit("MK311", f'joint "{joint.name}" is fixed; `{present[0]}` has no effect',
-                          node.key_loc(present[0]))
+                sink.emit(
+                    "MK311",
+                    f'joint "{joint.name}" is fixed; `{present[0]}` has no effect',
+                    node.key_loc(present[0]),
+                )
 
     def _axis(self, node: YNode) -> np.ndarray | None:
         if isinstance(node, YScalar):
@@ -365,12 +453,20 @@ class _BodyReader:
             com = v.vector(com_node, 3)
             inertia = inertia_matrix(inertia_node)
             if isinstance(inertia_node, YSeq) and v.numbers(inertia_node) is not None and inertia is None:
-                self.sink.emit("MK314", f"an inertia must have six or nine numbers, not {len(inertia_node.items)}",
-                               inertia_node.loc)
+                self.sink.emit(
+                    "MK314",
+                    f"an inertia must have six or nine numbers, not {len(inertia_node.items)}",
+                    inertia_node.loc,
+                )
             if inertia is None and not has_rigid:
                 inertial.defaulted = True  # only mass/COM given: identity inertia
-            parts.append((default_mass if mass is None else mass, np.zeros(3) if com is None else com,
-                          default_inertia if inertia is None else inertia))
+            parts.append(
+                (
+                    default_mass if mass is None else mass,
+                    np.zeros(3) if com is None else com,
+                    default_inertia if inertia is None else inertia,
+                )
+            )
             for key, n in (("mass", mass_node), ("com", com_node), ("inertia", inertia_node)):
                 if n is not None:
                     inertial.sources[key] = n.loc
@@ -390,8 +486,11 @@ class _BodyReader:
             return []
         path = (self.path.parent / uri).resolve()
         if str(path) in self.stack:
-            self.sink.emit("MK216", f'SubBody "{uri}" includes a body that is already being loaded '
-                           "(recursive sub-body)", uri_node.loc)
+            self.sink.emit(
+                "MK216",
+                f'SubBody "{uri}" includes a body that is already being loaded (recursive sub-body)',
+                uri_node.loc,
+            )
             return []
         if not path.exists():
             self.sink.emit("MK216", f'SubBody "{uri}" cannot be loaded: not found at {path}', uri_node.loc)
@@ -425,8 +524,16 @@ class _BodyReader:
                 link.devices += override.link.devices
                 if override.link.contact_material:
                     link.contact_material = override.link.contact_material
-                records.append(_LinkRecord(link, joint, override.parent, override.parent_loc,
-                                           override.joint_type_word, joint.origin))
+                records.append(
+                    _LinkRecord(
+                        link,
+                        joint,
+                        override.parent,
+                        override.parent_loc,
+                        override.joint_type_word,
+                        joint.origin,
+                    )
+                )
                 continue
             parent_joint = next(j for j in sub.joints if j.child == old)
             parent_joint.child = link.name
@@ -434,21 +541,37 @@ class _BodyReader:
             parent_joint.name = prefix + parent_joint.name + suffix
             if parent_joint.joint_id is not None:
                 parent_joint.joint_id += offset
-            records.append(_LinkRecord(link, parent_joint, parent_joint.parent, parent_joint.loc("parent"),
-                                       parent_joint.type.value, parent_joint.origin))
+            records.append(
+                _LinkRecord(
+                    link,
+                    parent_joint,
+                    parent_joint.parent,
+                    parent_joint.loc("parent"),
+                    parent_joint.type.value,
+                    parent_joint.origin,
+                )
+            )
         return records
 
     def _continuous_track(self, node: YMap, ctx: WalkContext) -> list[_LinkRecord]:
         name = v.get_text(node, "name") or ""
-        missing = [k for k, present in (("parent", "parent" in node), ("numJoints", "numJoints" in node),
-                                        ("jointOffset", "joint_offset" in node or "jointOffset" in node))
-                   if not present]
+        missing = [
+            k
+            for k, present in (
+                ("parent", "parent" in node),
+                ("numJoints", "numJoints" in node),
+                ("jointOffset", "joint_offset" in node or "jointOffset" in node),
+            )
+            if not present
+        ]
         if missing:
             self.sink.emit("MK217", f'ContinuousTrack "{name}": {missing[0]} must be specified', node.loc)
             return []
         count = v.integer(node.get("numJoints")) or 0
         if count < 3:
-            self.sink.emit("MK217", f'ContinuousTrack "{name}": numJoints must be more than 2', node.key_loc("numJoints"))
+            self.sink.emit(
+                "MK217", f'ContinuousTrack "{name}": numJoints must be more than 2', node.key_loc("numJoints")
+            )
             return []
         joint_offset = v.vector(node.get("joint_offset", "jointOffset"), 3)
         angles = v.numbers(node.get("initialJointAngles")) or []
@@ -462,8 +585,9 @@ class _BodyReader:
             rec.joint.type = JointType.REVOLUTE
             rec.joint.name = f"{name}{i}"
             rec.parent = f"{name}{i - 1}"
-            rec.joint.origin = Pose(rec.joint.origin.rotation.copy(),
-                                    np.zeros(3) if joint_offset is None else joint_offset.copy())
+            rec.joint.origin = Pose(
+                rec.joint.origin.rotation.copy(), np.zeros(3) if joint_offset is None else joint_offset.copy()
+            )
             if i - 1 < len(angles):
                 rec.joint.initial_position = angles[i - 1] * self.angle_scale
             records.append(rec)
@@ -476,7 +600,9 @@ class _BodyReader:
         root_name = v.scalar_text(root_node)
         names = {r.link.name for r in records}
         if root_name is not None and root_node is not None and root_name not in names:
-            self.sink.emit("MK208", f'link "{root_name}" specified in `root_link` is not defined', root_node.loc)
+            self.sink.emit(
+                "MK208", f'link "{root_name}" specified in `root_link` is not defined', root_node.loc
+            )
             root_name = None
         if root_name is None:
             root_name = records[0].link.name
@@ -485,19 +611,25 @@ class _BodyReader:
             link, joint = record.link, record.joint
             robot.links.append(link)
             if not link.name and record.link.source is not None:
-                self.sink.emit("MK210", "a link without a name cannot be referenced as a parent",
-                               link.source)
+                self.sink.emit("MK210", "a link without a name cannot be referenced as a parent", link.source)
             if link.name == root_name and robot.root_joint is None:
                 if record.parent is not None and record.parent_loc is not None:
-                    self.sink.emit("MK209", f'the root link "{link.name}" has a parent "{record.parent}", which '
-                                   "is ignored", record.parent_loc)
+                    self.sink.emit(
+                        "MK209",
+                        f'the root link "{link.name}" has a parent "{record.parent}", which is ignored',
+                        record.parent_loc,
+                    )
                 robot.root_joint = JointType.FLOATING if joint.type is JointType.FLOATING else JointType.FIXED
                 robot.root_pose = record.pose
                 robot.extras["root_joint_source"] = joint.loc("type")
                 continue
             if record.parent is None:
-                self.sink.emit("MK218", f'the parent of "{link.name}" is not specified', link.loc("name"),
-                               hint=f"add `parent:` or make it the root with `root_link: {link.name}`")
+                self.sink.emit(
+                    "MK218",
+                    f'the parent of "{link.name}" is not specified',
+                    link.loc("name"),
+                    hint=f"add `parent:` or make it the root with `root_link: {link.name}`",
+                )
                 continue
             joint.parent = record.parent
             robot.joints.append(joint)
@@ -520,20 +652,28 @@ class _BodyReader:
                 missing = link1 if link1 not in names else link2
                 key = "link1_name" if link1 not in names else "link2_name"
                 where = item.get(key, key.replace("_name", "Name"))
-                self.sink.emit("MK215", f'the link "{missing}" of extra joint {i} is not found',
-                               (where or item).loc)
+                self.sink.emit(
+                    "MK215", f'the link "{missing}" of extra joint {i} is not found', (where or item).loc
+                )
                 continue
             if problem:
                 self.sink.emit("MK215", f"extra joint {i}: {problem}", item.loc)
                 continue
             assert link1 is not None and link2 is not None and kind is not None
             axis = v.vector(item.get("axis", "jointAxis"), 3)
-            loop = LoopConstraint(name=v.get_text(item, "name") or f"extra_joint_{i}", type=kind, link1=link1,
-                                  link2=link2, source=item.loc)
+            loop = LoopConstraint(
+                name=v.get_text(item, "name") or f"extra_joint_{i}",
+                type=kind,
+                link1=link1,
+                link2=link2,
+                source=item.loc,
+            )
             if axis is not None and float(np.linalg.norm(axis)) > 0:
                 loop.axis = axis / np.linalg.norm(axis)
-            for which, t_keys, r_key in ((1, ("translation_in_link1", "link1LocalPos"), "rotation_in_link1"),
-                                         (2, ("translation_in_link2", "link2LocalPos"), "rotation_in_link2")):
+            for which, t_keys, r_key in (
+                (1, ("translation_in_link1", "link1LocalPos"), "rotation_in_link1"),
+                (2, ("translation_in_link2", "link2LocalPos"), "rotation_in_link2"),
+            ):
                 t = v.vector(item.get(*t_keys), 3)
                 r = v.rotation(item.get(r_key), self.angle_scale, self.sink)
                 pose = Pose(np.eye(3) if r is None else r, np.zeros(3) if t is None else t)

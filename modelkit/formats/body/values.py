@@ -153,8 +153,12 @@ def scale3(node: YNode | None, sink: DiagnosticSink) -> Vec3 | None:
     if node is None:
         return None
     if isinstance(node, YScalar):
-        sink.emit("MK413", f'a scalar `scale: {node.value}` is ignored by Choreonoid', node.loc,
-                  hint=f"write scale: [{node.value}, {node.value}, {node.value}]")
+        sink.emit(
+            "MK413",
+            f"a scalar `scale: {node.value}` is ignored by Choreonoid",
+            node.loc,
+            hint=f"write scale: [{node.value}, {node.value}, {node.value}]",
+        )
         return None
     return vector(node, 3)
 
