@@ -180,7 +180,7 @@ class _Converter:
 MAX_NESTING = 128
 
 
-def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], Any]:
+def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], Any, list[tuple[str, int, int]]]:
     """One pass over the event stream (libyaml's parser is iterative, so this is safe on any input).
 
     Returns the anchor names by (line, column) of the anchored node (PyYAML's composer drops them)
@@ -188,6 +188,7 @@ def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], Any]:
     everything after it recurse, so such documents are refused before composing.
     """
     names: dict[tuple[int, int], str] = {}
+    aliases: list[tuple[str, int, int]] = []  # (anchor, line, column) of every alias, 0-based
     depth = 0
     documents = 0
     try:
@@ -199,15 +200,17 @@ def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], Any]:
             if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
                 depth += 1
                 if depth > MAX_NESTING:
-                    return names, event.start_mark
+                    return names, event.start_mark, aliases
             elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
                 depth -= 1
             anchor = getattr(event, "anchor", None)
-            if anchor and not isinstance(event, yaml.AliasEvent) and event.start_mark is not None:
+            if anchor and isinstance(event, yaml.AliasEvent) and event.start_mark is not None:
+                aliases.append((anchor, event.start_mark.line, event.start_mark.column))
+            elif anchor and event.start_mark is not None:
                 names[(event.start_mark.line, event.start_mark.column)] = anchor
     except yaml.YAMLError:
         pass
-    return names, None
+    return names, None, aliases
 
 
 def measure_expansion(root: YNode, limit: int) -> tuple[str, YNode] | None:
@@ -318,7 +321,7 @@ def parse_yaml(
     text: str, path: str, sink: DiagnosticSink, expansion_limit: int = DEFAULT_EXPANSION_LIMIT
 ) -> YamlDocument:
     """Compose the first YAML document of ``text`` into Y-nodes, reporting problems into ``sink``."""
-    anchors_by_pos, too_deep = _scan_events(text)
+    anchors_by_pos, too_deep, alias_marks = _scan_events(text)
     if too_deep is not None:
         sink.emit(
             "MK010",
@@ -349,7 +352,19 @@ def parse_yaml(
     if problem is not None:
         kind, where = problem
         if kind == "recursive":
-            sink.emit("MK014", "an alias refers to a node that contains it (recursive structure)", where.loc)
+            # Point at the alias that closes the loop: the first alias of this anchor after it.
+            loc = where.loc
+            for name, line, col in alias_marks:
+                if name == where.anchor and (line + 1, col + 1) > (where.loc.line, where.loc.col):
+                    loc = SourceLocation(path, line + 1, col + 1)
+                    break
+            sink.emit(
+                "MK014",
+                f'alias "*{where.anchor}" refers to a node that contains it (a recursive structure)'
+                if where.anchor
+                else "an alias refers to a node that contains it (a recursive structure)",
+                loc,
+            )
         else:
             sink.emit(
                 "MK015",
@@ -431,6 +446,8 @@ def _report_yaml_error(exc: yaml.MarkedYAMLError, path: str, sink: DiagnosticSin
             _loc(path, exc.problem_mark),
         )
         return
+    if exc.context and exc.context.startswith("while parsing a flow") and exc.context_mark is not None:
+        mark = exc.context_mark  # the bracket that is never closed, not where the parser noticed
     message = problem
     if exc.context:
         message = f"{exc.context}: {problem}"

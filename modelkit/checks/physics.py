@@ -12,10 +12,6 @@ from modelkit.model import JointType, Link, Robot
 from modelkit.spatial import inertia_tolerance, principal_moments
 
 
-def _is_dynamic(robot: Robot) -> bool:
-    return robot.root_joint is JointType.FLOATING or any(j.type.moves for j in robot.joints)
-
-
 def _moving_links(robot: Robot) -> set[str]:
     """Links that move relative to the world: below a moving joint, or the floating root."""
     moving: set[str] = set()
@@ -49,14 +45,13 @@ def _mass_loc(link: Link):  # type: ignore[no-untyped-def]
 def mass(robot: Robot) -> Iterator[Diagnostic]:
     """Masses are positive where it matters; default mass properties are flagged."""
     moving = _moving_links(robot)
-    dynamic = _is_dynamic(robot)
     for link in robot.links:
         inertial = link.inertial
         if inertial is None:
             if link.name in moving:
                 yield diag("MK313", f'link "{link.name}" moves but has no mass', link.loc("name"))
             continue
-        if inertial.defaulted and dynamic:
+        if inertial.defaulted and link.name in moving:
             what = "no mass information" if "mass" not in inertial.sources else "no inertia"
             yield diag(
                 "MK304",

@@ -24,6 +24,8 @@ def unique_names(robot: Robot) -> Iterator[Diagnostic]:
             first_link[link.name] = robot.links.index(link)
     first_joint: dict[str, int] = {}
     for i, joint in enumerate(robot.joints):
+        if joint.extras.get("implicit_name"):
+            continue  # named after its link: a duplicate is already a duplicate link name
         if joint.name in first_joint:
             where = robot.joints[first_joint[joint.name]].loc("name")
             line = f" (first at line {where.line})" if where and where.line else ""
@@ -61,29 +63,34 @@ def single_root(robot: Robot) -> Iterator[Diagnostic]:
 
 @rule("no-cycles", "MK203")
 def no_cycles(robot: Robot) -> Iterator[Diagnostic]:
-    """Following parents from any link ends at the root, never in a loop."""
-    parent_of: dict[str, str] = {}
+    """Following parents from any link ends at the root, never in a loop.
+
+    Joints are attached in document order, as Choreonoid does, and the joint whose attachment
+    closes a loop is the one reported.
+    """
+    attached: dict[str, str] = {}  # child -> parent, for the joints attached so far
     for joint in robot.joints:
-        parent_of.setdefault(joint.child, joint.parent)
-    reported: set[str] = set()
-    for joint in robot.joints:
-        seen: list[str] = []
-        current = joint.child
-        while current in parent_of and current not in seen:
-            seen.append(current)
-            current = parent_of[current]
-        if current in seen:
-            cycle = seen[seen.index(current) :]
-            key = min(cycle)
-            if key in reported:
-                continue
-            reported.add(key)
-            path = " -> ".join([*cycle, current])
-            yield diag(
-                "MK203",
-                f'adding "{joint.child}" to link "{joint.parent}" results in a cyclic reference ({path})',
-                joint.loc("parent"),
-            )
+        if joint.child in attached:
+            continue  # a second parent: not a cycle by itself
+        ancestor: str | None = joint.parent
+        path = [joint.child]
+        seen: set[str] = set()
+        while ancestor is not None and ancestor not in seen:
+            seen.add(ancestor)
+            path.append(ancestor)
+            if ancestor == joint.child:
+                loop = " -> ".join(reversed(path))
+                yield diag(
+                    "MK203",
+                    f'adding "{joint.child}" to link "{joint.parent}" results in a cyclic reference ({loop})',
+                    joint.loc("parent"),
+                )
+                break
+            ancestor = attached.get(ancestor)
+        else:
+            attached[joint.child] = joint.parent
+            continue
+        # a cycle was found: leave the joint out so later joints are judged on the tree so far
 
 
 @rule("joint-ids", "MK206", "MK207")

@@ -60,10 +60,12 @@ _VECTORISE_ABOVE = 24
 class GeometryError(Exception):
     """Input on which Choreonoid would crash or refuse; ``code`` is a modelkit diagnostic code."""
 
-    def __init__(self, code: str, message: str) -> None:
+    def __init__(self, code: str, message: str, key: str | None = None, index: int | None = None) -> None:
         super().__init__(f"{code}: {message}")
         self.code = code
         self.message = message
+        self.key = key  # the input at fault: "spine", "cross_section", "scale", "orientation", "height", "faces"
+        self.index = index  # the element of that input at fault, when one is
 
 
 @dataclass(frozen=True)
@@ -288,6 +290,7 @@ def extrusion(
             f"An Extrusion needs at least 2 distinct spine points; it has {_distinct_rows(sp)}"
             + (" (after removing the closing point)" if spine_closed else "")
             + ".",
+            key="spine",
         )
     if _distinct_rows(cs) < 2:
         raise GeometryError(
@@ -295,6 +298,7 @@ def extrusion(
             f"An Extrusion needs at least 2 distinct cross-section points; it has {_distinct_rows(cs)}"
             + (" (after removing the closing point)" if cs_closed else "")
             + ".",
+            key="cross_section",
         )
     n, m = len(sp), len(cs)
     for key, rows in (("scale", sc), ("orientation", ori)):
@@ -303,6 +307,7 @@ def extrusion(
                 "MK402",
                 f"Extrusion {key} has {len(rows)} entries; it needs 0, 1 or at least {n} "
                 f"(one per spine point{' without the closing one' if spine_closed else ''}).",
+                key=key,
             )
 
     # Cross-section plane frames.
@@ -397,12 +402,14 @@ def elevation_grid(
     h = np.asarray(height, dtype=np.float64).reshape(-1)
     if xd < 2 or zd < 2:
         raise GeometryError(
-            "MK407", f"An ElevationGrid needs xDimension and zDimension of at least 2 (got {xd} × {zd})."
+            "MK407", f"An ElevationGrid needs xDimension and zDimension of at least 2 (got {xd} × {zd}).",
+            key="x_dimension",
         )
     if len(h) != xd * zd:
         raise GeometryError(
             "MK407",
             f"ElevationGrid height has {len(h)} values; xDimension·zDimension = {xd}·{zd} = {xd * zd}.",
+            key="height",
         )
     zz, xx = np.meshgrid(np.arange(zd), np.arange(xd), indexing="ij")
     vertices = np.stack([xx.reshape(-1) * float(x_spacing), h, zz.reshape(-1) * float(z_spacing)], axis=1)
@@ -462,9 +469,11 @@ def indexed_face_set(vertices: Sequence[float], coord_index: Sequence[int]) -> t
     verts = _vertex_rows(vertices)
     nv = len(verts)
     idx = _indices(coord_index, "Vertex")
-    bad = idx[(idx >= nv) | (idx < -1)]
+    mask = (idx >= nv) | (idx < -1)
+    bad = idx[mask]
     if len(bad):
-        raise GeometryError("MK408", _out_of_range_message(bad, nv, allow_separator=True))
+        raise GeometryError("MK408", _out_of_range_message(bad, nv, allow_separator=True), key="faces",
+                            index=int(np.flatnonzero(mask)[0]))
 
     separators = np.flatnonzero(idx == -1)
     trailing = len(idx) - (int(separators[-1]) + 1 if len(separators) else 0)
@@ -497,7 +506,7 @@ def indexed_face_set(vertices: Sequence[float], coord_index: Sequence[int]) -> t
             parts.append(polygon[local])
             keys.append(np.full(len(local), p, dtype=np.int64))
     if not parts:
-        raise GeometryError("MK410", "There is no valid polygon to triangulate.")
+        raise GeometryError("MK410", "There is no valid polygon to triangulate.", key="faces")
     faces = np.concatenate(parts, axis=0)
     order = np.argsort(np.concatenate(keys), kind="stable")  # polygon order, as Choreonoid emits
     return TriangleMeshData(vertices=verts, faces=faces[order].astype(np.int64)), trailing
@@ -513,9 +522,11 @@ def triangle_mesh(vertices: Sequence[float], triangles: Sequence[int]) -> Triang
     verts = _vertex_rows(vertices)
     idx = _indices(triangles, "Vertex")
     idx = idx[: len(idx) // 3 * 3]
-    bad = idx[(idx >= len(verts)) | (idx < 0)]
+    mask = (idx >= len(verts)) | (idx < 0)
+    bad = idx[mask]
     if len(bad):
-        raise GeometryError("MK408", _out_of_range_message(bad, len(verts), allow_separator=False))
+        raise GeometryError("MK408", _out_of_range_message(bad, len(verts), allow_separator=False), key="faces",
+                            index=int(np.flatnonzero(mask)[0]))
     return TriangleMeshData(vertices=verts, faces=idx.reshape(-1, 3))
 
 

@@ -340,13 +340,19 @@ def _build_geometry(kind: str, g: YMap, ctx: WalkContext) -> tuple[Geometry, np.
         size = v.vector(g.get("size"), 3)
         size = np.ones(3) if size is None else size
         if np.any(size < 0):
-            sink.emit("MK400", f"a box cannot be generated with size {size.tolist()} (negative edge)", g.loc)
+            size_node = g.get("size")
+            where = (
+                size_node.items[int(np.flatnonzero(size < 0)[0])].loc
+                if isinstance(size_node, YSeq)
+                else g.loc
+            )
+            sink.emit("MK400", f"a box cannot be generated with size {size.tolist()} (negative edge)", where)
             return None
         return Box(size), local
     if kind == "Sphere":
         r = _positive(g, "radius", 1.0)
         if r <= 0:
-            sink.emit("MK400", f"a sphere cannot be generated with radius {r}", g.loc)
+            sink.emit("MK400", f"a sphere cannot be generated with radius {r}", (g.get("radius") or g).loc)
             return None
         return Sphere(r), local
     if kind in ("Cylinder", "Capsule", "Cone"):
@@ -354,7 +360,10 @@ def _build_geometry(kind: str, g: YMap, ctx: WalkContext) -> tuple[Geometry, np.
         h = _positive(g, "height", 1.0)
         bad_height = h < 0 if kind == "Capsule" else h <= 0
         if r <= 0 or bad_height:
-            sink.emit("MK400", f"a {kind.lower()} cannot be generated with radius {r} and height {h}", g.loc)
+            where = (g.get("radius") if r <= 0 else g.get("height")) or g
+            sink.emit(
+                "MK400", f"a {kind.lower()} cannot be generated with radius {r} and height {h}", where.loc
+            )
             return None
         if kind == "Cylinder":
             return Cylinder(r, h), local
@@ -423,16 +432,36 @@ def _generated_mesh(kind: str, g: YMap, ctx: WalkContext) -> Mesh | None:
                 sink.emit(
                     "MK409",
                     f"the last polygon ({dropped} indices) lacks its -1 terminator and is dropped",
-                    g.key_loc("faces" if "faces" in g else "coordIndex"),
+                    _fault_location(g, "faces", None),
                 )
         else:
             vertices = v.numbers(g.get("vertices", "coordinate")) or []
             triangles = [int(x) for x in (v.numbers(g.get("faces", "coordIndex", "triangles")) or [])]
             data = gen.triangle_mesh(vertices, triangles)
     except gen.GeometryError as exc:
-        sink.emit(exc.code, f"{kind}: {exc}", g.loc)
+        sink.emit(exc.code, f"{kind}: {exc.message}", _fault_location(g, exc.key, exc.index))
         return None
     return Mesh(data=data, generator=kind, source_params=params)
+
+
+GEOMETRY_KEY_SPELLINGS = {
+    "cross_section": ("cross_section", "crossSection"),
+    "x_dimension": ("x_dimension", "xDimension"),
+    "faces": ("faces", "coordIndex", "triangles"),
+}
+
+
+def _fault_location(g: YMap, key: str | None, index: int | None) -> SourceLocation:
+    """The value (or the list element) of a geometry that a GeometryError blames."""
+    if key is None:
+        return g.loc
+    found = g.find(*GEOMETRY_KEY_SPELLINGS.get(key, (key,)))
+    if found is None:
+        return g.loc
+    _, value = found
+    if index is not None and isinstance(value, YSeq) and 0 <= index < len(value.items):
+        return value.items[index].loc
+    return value.loc
 
 
 def _extrusion_findings(report: Any, g: YMap, ctx: WalkContext) -> None:

@@ -389,7 +389,7 @@ class _BodyReader:
                     "MK310",
                     f'joint "{joint.name}" is prismatic but `joint_angle` is converted as an '
                     "angle by Choreonoid",
-                    angle_node.loc,
+                    node.key_loc("joint_angle" if "joint_angle" in node else "jointAngle"),
                     hint="use joint_displacement",
                 )
         id_node = node.get("joint_id", "jointId")
@@ -397,7 +397,7 @@ class _BodyReader:
         if joint_id is not None and id_node is not None and joint_id >= 0:
             joint.joint_id = joint_id
             joint.sources["id"] = id_node.loc
-        if not joint.type.moves and word is not None:
+        if not joint.type.moves and word in JOINT_TYPES:
             present = [
                 k
                 for k in (
@@ -458,7 +458,7 @@ class _BodyReader:
                     f"an inertia must have six or nine numbers, not {len(inertia_node.items)}",
                     inertia_node.loc,
                 )
-            if inertia is None and not has_rigid:
+            if inertia_node is None and not has_rigid:
                 inertial.defaulted = True  # only mass/COM given: identity inertia
             parts.append(
                 (
@@ -570,7 +570,9 @@ class _BodyReader:
         count = v.integer(node.get("numJoints")) or 0
         if count < 3:
             self.sink.emit(
-                "MK217", f'ContinuousTrack "{name}": numJoints must be more than 2', node.key_loc("numJoints")
+                "MK217",
+                f'ContinuousTrack "{name}": numJoints must be more than 2',
+                (node.get("numJoints") or node).loc,
             )
             return []
         joint_offset = v.vector(node.get("joint_offset", "jointOffset"), 3)
@@ -627,7 +629,7 @@ class _BodyReader:
                 self.sink.emit(
                     "MK218",
                     f'the parent of "{link.name}" is not specified',
-                    link.loc("name"),
+                    link.source,
                     hint=f"add `parent:` or make it the root with `root_link: {link.name}`",
                 )
                 continue

@@ -1,0 +1,255 @@
+"""A corpus of deliberately broken Choreonoid `.body` files, each with one precise diagnostic.
+
+Every ``tests/broken_body/*.body`` file holds exactly one fault on top of the clean pendulum in
+``tests/broken_body/support/clean_pendulum.body``; ``tests/broken_body/EXPECTED.yaml`` says which
+diagnostic the fault must produce (code, severity, line, column, message fragment) and which exit code
+``modelkit validate`` must return. Each case runs through the CLI in-process with ``--format json``.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import threading
+import time
+import traceback
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+from click.testing import CliRunner, Result
+
+from modelkit.cli import main
+
+HERE = Path(__file__).resolve().parent
+CORPUS = HERE / "broken_body"
+EXPECTED_FILE = CORPUS / "EXPECTED.yaml"
+CLEAN_BASE = CORPUS / "support" / "clean_pendulum.body"
+
+# A hang guard, not a timing assertion: an in-process run that takes longer than this is a hang.
+IN_PROCESS_LIMIT_S = 60
+# The alias-bomb and deep-nesting cases must be refused quickly; a subprocess is killed after this.
+SUBPROCESS_LIMIT_S = 30
+
+SEVERITIES = frozenset({"error", "warning", "info"})
+
+
+@dataclass(frozen=True)
+class Case:
+    name: str
+    code: str
+    severity: str
+    line: int
+    column: int
+    message: str
+    exit: int
+    hint: str | None = None
+    args: tuple[str, ...] = ()
+    absent: bool = False
+    hang_guard: bool = False
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def path(self) -> Path:
+        return CORPUS / self.name
+
+
+def _load_cases() -> list[Case]:
+    raw = yaml.safe_load(EXPECTED_FILE.read_text(encoding="utf-8"))
+    assert isinstance(raw, dict), "EXPECTED.yaml must map case file names to expectations"
+    known = {"code", "severity", "line", "column", "message", "exit", "hint", "args", "absent", "hang_guard"}
+    cases = []
+    for name, entry in raw.items():
+        assert isinstance(entry, dict), f"{name}: the expectation must be a mapping"
+        cases.append(Case(
+            name=str(name),
+            code=str(entry["code"]),
+            severity=str(entry["severity"]),
+            line=int(entry["line"]),
+            column=int(entry["column"]),
+            message=str(entry["message"]),
+            exit=int(entry["exit"]),
+            hint=None if entry.get("hint") is None else str(entry["hint"]),
+            args=tuple(str(a) for a in entry.get("args", ())),
+            absent=bool(entry.get("absent", False)),
+            hang_guard=bool(entry.get("hang_guard", False)),
+            extra={k: v for k, v in entry.items() if k not in known},
+        ))
+    return cases
+
+
+CASES = _load_cases()
+
+
+@contextmanager
+def _hang_guard(seconds: int) -> Iterator[None]:
+    """Turn a hang into a test failure (SIGALRM, so only in the main thread; elsewhere no guard)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def expired(signum: int, frame: object) -> None:
+        raise TimeoutError(f"still running after {seconds} s: the tool hangs on this input")
+
+    previous = signal.signal(signal.SIGALRM, expired)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def _invoke(path: Path, *args: str) -> Result:
+    runner = CliRunner()
+    with _hang_guard(IN_PROCESS_LIMIT_S):
+        return runner.invoke(main, ["validate", "--format", "json", *args, str(path)], catch_exceptions=True)
+
+
+def _crash_text(result: Result) -> str | None:
+    """The traceback when the CLI raised anything other than SystemExit."""
+    if result.exception is None or isinstance(result.exception, SystemExit):
+        return None
+    info = result.exc_info
+    if info is None:
+        return repr(result.exception)
+    return "".join(traceback.format_exception(*info))
+
+
+def _diagnostics(result: Result) -> list[dict[str, Any]]:
+    document = json.loads(result.stdout)
+    diagnostics = document["diagnostics"]
+    assert isinstance(diagnostics, list)
+    return diagnostics
+
+
+def _show(diagnostics: list[dict[str, Any]]) -> str:
+    if not diagnostics:
+        return "  (no diagnostics)"
+    return "\n".join(
+        f"  {d.get('line')}:{d.get('column')} {d.get('severity')} {d.get('code')} {d.get('message')}"
+        + (f" (hint: {d['hint']})" if d.get("hint") else "")
+        for d in diagnostics
+    )
+
+
+# ---- the corpus is consistent ------------------------------------------------------------------
+
+
+def test_expected_entries_are_well_formed() -> None:
+    assert len(CASES) >= 40
+    for case in CASES:
+        assert case.name.endswith(".body"), case.name
+        assert case.code.startswith("MK") and len(case.code) == 5, f"{case.name}: code {case.code!r}"
+        assert case.severity in SEVERITIES, f"{case.name}: severity {case.severity!r}"
+        assert case.exit in (0, 1, 2), f"{case.name}: exit {case.exit}"
+        assert case.message, f"{case.name}: empty message fragment"
+        assert not case.extra, f"{case.name}: unknown expectation keys {sorted(case.extra)}"
+        if case.exit != 2:
+            want = 1 if case.severity == "error" else 0
+            assert case.exit == want, f"{case.name}: a {case.severity} case exits {want}, not {case.exit}"
+
+
+def test_expected_codes_are_catalogued() -> None:
+    from modelkit.codes import CODES
+
+    for case in CASES:
+        assert case.code in CODES, f"{case.name}: {case.code} is not in modelkit/codes.py"
+
+
+def test_every_case_file_is_listed_and_vice_versa() -> None:
+    on_disk = {p.name for p in CORPUS.glob("*.body")}
+    listed = {c.name for c in CASES if not c.absent}
+    absent = {c.name for c in CASES if c.absent}
+    assert sorted(on_disk - listed - absent) == [], "case files missing from EXPECTED.yaml"
+    assert sorted(listed - on_disk) == [], "EXPECTED.yaml entries without a case file"
+    assert sorted(absent & on_disk) == [], "entries marked `absent: true` must not exist"
+
+
+def test_clean_base_has_no_findings() -> None:
+    from modelkit.api import validate
+
+    result = _invoke(CLEAN_BASE, "--strict")
+    assert _crash_text(result) is None, _crash_text(result)
+    diagnostics = _diagnostics(result)
+    assert diagnostics == [], "the clean base must validate without findings:\n" + _show(diagnostics)
+    assert result.exit_code == 0
+    library = validate(CLEAN_BASE)
+    assert library.robot is not None
+    assert [d for d in library.diagnostics if d.severity.value != "info"] == []
+    assert [link.name for link in library.robot.links] == ["base", "arm"]
+
+
+# ---- one precise diagnostic per case -----------------------------------------------------------
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
+def test_broken_body(case: Case) -> None:
+    result = _invoke(case.path, *case.args)
+    crash = _crash_text(result)
+    assert crash is None, f"{case.name}: the CLI raised instead of reporting:\n{crash}"
+    try:
+        diagnostics = _diagnostics(result)
+    except (ValueError, KeyError) as exc:
+        pytest.fail(f"{case.name}: --format json printed no diagnostics document ({exc}):\n{result.output}")
+
+    problems: list[str] = []
+    if result.exit_code != case.exit:
+        problems.append(f"exit code {result.exit_code}, expected {case.exit}")
+    same_code = [d for d in diagnostics if d.get("code") == case.code]
+    if len(same_code) != 1:
+        problems.append(f"{len(same_code)} diagnostic(s) with code {case.code}, expected exactly 1")
+    if same_code:
+        found = min(same_code, key=lambda d: (d.get("line") != case.line, d.get("column") != case.column))
+        want_file = str(case.path)
+        if found.get("file") != want_file:
+            problems.append(f"file {found.get('file')!r}, expected {want_file!r}")
+        if (found.get("line"), found.get("column")) != (case.line, case.column):
+            where = f"{found.get('line')}:{found.get('column')}"
+            problems.append(f"position {where}, expected {case.line}:{case.column}")
+        if found.get("severity") != case.severity:
+            problems.append(f"severity {found.get('severity')}, expected {case.severity}")
+        message = str(found.get("message", ""))
+        if case.message.lower() not in message.lower():
+            problems.append(f"message {message!r} lacks {case.message!r}")
+        if case.code in message:
+            problems.append(f"message {message!r} repeats its own code (the renderers already print it)")
+        if case.hint is not None and case.hint.lower() not in str(found.get("hint") or "").lower():
+            problems.append(f"hint {found.get('hint')!r} lacks {case.hint!r}")
+    others = [d for d in diagnostics if d.get("severity") == "error" and d.get("code") != case.code]
+    if others:
+        problems.append("other error-level diagnostics: " + ", ".join(
+            f"{d.get('code')} at {d.get('line')}:{d.get('column')}" for d in others))
+    wanted = f"{case.severity} {case.code} at {case.line}:{case.column}"
+    assert not problems, (f"{case.name}: expected {wanted}\n  - " + "\n  - ".join(problems)
+                          + "\nall diagnostics:\n" + _show(diagnostics))
+
+
+# ---- hostile YAML is refused quickly ---------------------------------------------------------------
+
+
+HOSTILE = [c for c in CASES if c.hang_guard]
+
+
+@pytest.mark.parametrize("case", HOSTILE, ids=[c.name for c in HOSTILE])
+def test_hostile_yaml_is_refused_quickly(case: Case) -> None:
+    command = [sys.executable, "-m", "modelkit.cli", "validate", "--format", "json", *case.args,
+               str(case.path)]
+    started = time.monotonic()
+    try:
+        done = subprocess.run(command, capture_output=True, text=True, timeout=SUBPROCESS_LIMIT_S,
+                              check=False)
+    except subprocess.TimeoutExpired:
+        pytest.fail(f"{case.name}: still running after {SUBPROCESS_LIMIT_S} s (the document must be refused, "
+                    "not expanded)")
+    elapsed = time.monotonic() - started
+    assert "Traceback" not in done.stderr, done.stderr
+    assert done.returncode == case.exit, f"exit {done.returncode} after {elapsed:.1f} s\n{done.stderr}"
+    codes = [d["code"] for d in json.loads(done.stdout)["diagnostics"]]
+    assert case.code in codes, codes
