@@ -1,0 +1,845 @@
+"""Load mesh files (STL, OBJ, COLLADA, VRML97) into triangles, the way Choreonoid reads them.
+
+One entry point, :func:`load_mesh`, returns every triangle of a file (or of one named part of it) in
+metres, in the file's root frame. The rules follow ``docs/body-format.md`` §3.6 / §4.9:
+
+* **Units.** Meshes are metres. ``metadata.length_unit`` (millimeter ×0.001, inch ×0.0254) and
+  ``metadata.upper_axis: Y`` (the cyclic permutation (x, y, z) → (z, x, y)) are honoured for STL, OBJ
+  and COLLADA, **not** for VRML (as Choreonoid).
+* **COLLADA.** The root ``<asset><unit meter>`` is applied; ``<up_axis>`` is **ignored** (Choreonoid,
+  RViz and Gazebo all ignore it; trimesh ignores ``<unit>`` as well, so it is not used for DAE).
+* **Fragments** (VRML ``DEF`` names, COLLADA node ``name`` attributes): the first node with that name in a
+  depth-first search is *detached*: the translations of its ancestors and its own translation are
+  dropped, the accumulated linear part (rotation, scale) is kept.
+
+Third-party parsers (trimesh, pycollada) are imported lazily inside the loaders so that importing this
+module stays cheap (the ``validate`` command must start fast).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from modelkit.model import TriangleMeshData
+
+__all__ = [
+    "SUPPORTED_EXTENSIONS",
+    "LoadedMesh",
+    "MeshLoadError",
+    "MeshMetadata",
+    "load_mesh",
+]
+
+SUPPORTED_EXTENSIONS: frozenset[str] = frozenset({".stl", ".obj", ".dae", ".wrl"})
+
+#: Extensions Choreonoid reads through Assimp that modelkit does not read.
+_ASSIMP_ONLY_EXTENSIONS = frozenset({".blend", ".x", ".dxf"})
+
+#: Limits that keep hostile files (deep nesting, exponential DEF/USE or instance_node sharing) from
+#: exhausting the stack, the memory or the time.
+MAX_NESTING_DEPTH = 256
+MAX_NODE_VISITS = 1_000_000
+MAX_TRIANGLES = 5_000_000
+
+_LENGTH_UNITS = {"millimeter": 0.001, "inch": 0.0254, "meter": 1.0}
+
+#: ``metadata.upper_axis: Y``: mesh (x, y, z) → (z, x, y), §3.6 (a cyclic permutation, not Rx(90°)).
+UPPER_AXIS_Y_ROTATION: NDArray[np.float64] = np.array(
+    [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], dtype=np.float64
+)
+
+Mesh = tuple[NDArray[np.float64], NDArray[np.int64]]  # (vertices (n,3), faces (m,3))
+
+
+# ---- public types ---------------------------------------------------------------------------
+
+
+class MeshLoadError(Exception):
+    """A mesh file cannot be used.
+
+    ``code`` is a diagnostic code: ``MK501`` cannot parse/load, ``MK502`` fragment not found, ``MK506``
+    unsupported extension. ``line`` is the 1-based line in the mesh file when known (text formats);
+    ``parts`` lists the named parts of the file (for "did you mean" hints on MK502).
+    """
+
+    def __init__(self, code: str, message: str, *, line: int | None = None,
+                 parts: Sequence[str] = ()) -> None:
+        super().__init__(message)
+        self.code = code
+        self.message = message
+        self.line = line
+        self.parts = list(parts)
+
+
+@dataclass(frozen=True)
+class MeshMetadata:
+    """The ``metadata`` of a Choreonoid ``Resource`` node (§3.6)."""
+
+    length_unit: str | None = None  # "millimeter" | "inch" | None
+    upper_axis: str | None = None  # "Y" | None
+
+
+@dataclass
+class LoadedMesh:
+    mesh: TriangleMeshData  # all triangles of the file (or fragment), metres, file root frame
+    parts: list[str]  # named nodes found (VRML DEF names / COLLADA node names), sorted
+    unit_scale: float  # scale applied (COLLADA <unit meter> × metadata length unit)
+    source_format: str  # "stl" | "obj" | "dae" | "wrl"
+    notes: list[str] = field(default_factory=list)  # facts worth telling a user
+
+
+# ---- entry point ----------------------------------------------------------------------------
+
+
+def load_mesh(path: Path, fragment: str | None = None, metadata: MeshMetadata | None = None) -> LoadedMesh:
+    """Load the triangles of a mesh file as Choreonoid would (§3.6).
+
+    Raises :class:`MeshLoadError` (and nothing else) for any input that cannot be used: an unsupported
+    extension (MK506), a file that cannot be read or parsed (MK501), an unknown ``fragment`` (MK502).
+    """
+    path = Path(path)
+    ext = path.suffix.lower()
+    if ext not in SUPPORTED_EXTENSIONS:
+        shown = ext or "(no extension)"
+        extra = " (Choreonoid reads it through Assimp)" if ext in _ASSIMP_ONLY_EXTENSIONS else ""
+        raise MeshLoadError(
+            "MK506",
+            f"mesh file type {shown}{extra} is not supported; supported: "
+            + ", ".join(sorted(SUPPORTED_EXTENSIONS)),
+        )
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        raise MeshLoadError("MK501", f"cannot read {path.name}: {e.strerror or e}") from e
+    if not data.strip():
+        raise MeshLoadError("MK501", f"{path.name} is empty")
+    try:
+        # overflow/invalid values in hostile files end up as non-finite vertices, reported below
+        with np.errstate(all="ignore"):
+            if ext == ".stl":
+                return _finish(_load_stl(data, path.name), path.name, fragment, metadata)
+            if ext == ".obj":
+                return _finish(_load_obj(data, path.name), path.name, fragment, metadata)
+            if ext == ".dae":
+                return _load_dae(data, path.name, fragment, metadata)
+            return _load_wrl(data, path.name, fragment, metadata)
+    except MeshLoadError:
+        raise
+    except RecursionError as e:
+        raise MeshLoadError("MK501", f"cannot load {path.name}: nesting too deep") from e
+    except MemoryError as e:
+        raise MeshLoadError("MK501", f"cannot load {path.name}: out of memory") from e
+    except Exception as e:  # a parser library failed in a way we did not foresee
+        raise MeshLoadError("MK501", f"cannot load {path.name}: {type(e).__name__}: {e}") from e
+
+
+# ---- shared scene graph ---------------------------------------------------------------------
+
+
+@dataclass(eq=False)
+class MeshSceneNode:
+    """A node of a loaded scene: a local 4×4 transform, meshes in the node frame, child nodes.
+
+    Children may be shared (VRML ``USE``, COLLADA ``instance_node``), so the graph is a DAG.
+    """
+
+    name: str | None = None
+    matrix: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    meshes: list[Mesh] = field(default_factory=list)
+    children: list[MeshSceneNode] = field(default_factory=list)
+
+
+@dataclass
+class _Flattened:
+    vertices: NDArray[np.float64]
+    faces: NDArray[np.int64]
+    parts: list[str]
+    notes: list[str]
+
+
+def _scene_names(roots: Sequence[MeshSceneNode]) -> list[str]:
+    """All node names, each node visited once (shared nodes are not expanded)."""
+    seen: set[int] = set()
+    names: set[str] = set()
+    stack = list(roots)
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if node.name:
+            names.add(node.name)
+        stack.extend(node.children)
+    return sorted(names)
+
+
+def _find_fragment(
+    roots: Sequence[MeshSceneNode], name: str, file_name: str
+) -> tuple[MeshSceneNode, NDArray[np.float64]] | None:
+    """First node called ``name`` in depth-first pre-order, with its accumulated transform
+    (ancestors × own)."""
+    stack: list[tuple[MeshSceneNode, NDArray[np.float64]]] = [(r, r.matrix) for r in reversed(roots)]
+    visits = 0
+    while stack:
+        node, acc = stack.pop()
+        visits += 1
+        if visits > MAX_NODE_VISITS:
+            raise MeshLoadError(
+                "MK501", f"{file_name}: scene graph too large (more than {MAX_NODE_VISITS} node visits)"
+            )
+        if node.name == name:
+            return node, acc
+        for child in reversed(node.children):
+            stack.append((child, acc @ child.matrix))
+    return None
+
+
+def flatten_scene(roots: Sequence[MeshSceneNode], fragment: str | None, file_name: str) -> _Flattened:
+    """Bake every mesh instance of the scene (or of the fragment, detached per §3.6) into one
+    triangle list. Triangles under a mirroring transform (negative determinant) have their winding
+    reversed so that outward faces stay outward."""
+    parts = _scene_names(roots)
+    notes: list[str] = []
+    starts: list[tuple[MeshSceneNode, NDArray[np.float64]]]
+    if fragment is not None:
+        found = _find_fragment(roots, fragment, file_name)
+        if found is None:
+            hint = ("; named parts: " + ", ".join(parts)) if parts else "; the file has no named parts"
+            message = f'fragment "{fragment}" is not found in {file_name}{hint}'
+            raise MeshLoadError("MK502", message, parts=parts)
+        node, acc = found
+        detached = np.eye(4)
+        detached[:3, :3] = acc[:3, :3]  # keep the accumulated linear part, drop every translation
+        starts = [(node, detached)]
+        if np.any(np.abs(acc[:3, 3]) > 0.0):
+            t = acc[:3, 3]
+            notes.append(
+                f'fragment "{fragment}" detached: its accumulated translation '
+                f"({t[0]:.6g}, {t[1]:.6g}, {t[2]:.6g}) is dropped, its orientation is kept (as Choreonoid)"
+            )
+    else:
+        starts = [(r, r.matrix) for r in roots]
+
+    instances: list[tuple[Mesh, NDArray[np.float64]]] = []
+    n_tri = 0
+    visits = 0
+    stack = list(reversed(starts))
+    while stack:
+        node, acc = stack.pop()
+        visits += 1
+        if visits > MAX_NODE_VISITS:
+            raise MeshLoadError(
+                "MK501", f"{file_name}: scene graph too large (more than {MAX_NODE_VISITS} node visits)"
+            )
+        for mesh in node.meshes:
+            n_tri += len(mesh[1])
+            if n_tri > MAX_TRIANGLES:
+                raise MeshLoadError("MK501", f"{file_name} expands to more than {MAX_TRIANGLES} triangles")
+            instances.append((mesh, acc))
+        for child in reversed(node.children):
+            stack.append((child, acc @ child.matrix))
+
+    verts: list[NDArray[np.float64]] = []
+    faces: list[NDArray[np.int64]] = []
+    offset = 0
+    mirrored = 0
+    for (v, f), acc in instances:
+        if len(f) == 0:
+            continue
+        lin = acc[:3, :3]
+        verts.append(v @ lin.T + acc[:3, 3])
+        ff = f + offset
+        if np.linalg.det(lin) < 0.0:
+            ff = ff[:, [0, 2, 1]]
+            mirrored += 1
+        faces.append(ff)
+        offset += len(v)
+    if mirrored:
+        notes.append(f"{mirrored} mesh instance(s) under a mirroring transform: triangle winding reversed")
+    if verts:
+        return _Flattened(np.concatenate(verts), np.concatenate(faces).astype(np.int64), parts, notes)
+    return _Flattened(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), parts, notes)
+
+
+# ---- polygon triangulation ------------------------------------------------------------------
+
+
+def _polygon_normal(p: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Newell's normal of a (possibly non-planar) polygon, not normalised."""
+    q = np.roll(p, -1, axis=0)
+    return np.array(
+        [
+            np.sum((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])),
+            np.sum((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])),
+            np.sum((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1])),
+        ]
+    )
+
+
+def _ear_clip(points: NDArray[np.float64]) -> list[tuple[int, int, int]]:
+    """Triangulate one simple polygon (k ≥ 3 points, 3-D, roughly planar) by ear clipping.
+
+    Returns index triples into ``points`` with the polygon's orientation. Falls back to a fan for the
+    remaining vertices if no ear can be found (self-intersecting or degenerate input).
+    """
+    k = len(points)
+    if k == 3:
+        return [(0, 1, 2)]
+    n = _polygon_normal(points)
+    norm = float(np.linalg.norm(n))
+    if norm <= 0.0 or not math.isfinite(norm):
+        return [(0, i, i + 1) for i in range(1, k - 1)]
+    n = n / norm
+    # 2-D coordinates in the polygon plane, oriented so that the polygon is counter-clockwise
+    ref = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = np.cross(n, ref)
+    u /= np.linalg.norm(u)
+    w = np.cross(n, u)
+    xy = np.stack([points @ u, points @ w], axis=1)
+    idx = list(range(k))
+    tris: list[tuple[int, int, int]] = []
+
+    def cross2(o: int, p: int, q: int) -> float:
+        ox, oy = xy[o]
+        return float((xy[p, 0] - ox) * (xy[q, 1] - oy) - (xy[p, 1] - oy) * (xy[q, 0] - ox))
+
+    def is_ear(a: int, b: int, c: int) -> bool:
+        if cross2(a, b, c) <= 0.0:  # reflex or degenerate corner
+            return False
+        return not any(
+            j not in (a, b, c)
+            and cross2(a, b, j) >= 0.0
+            and cross2(b, c, j) >= 0.0
+            and cross2(c, a, j) >= 0.0
+            for j in idx
+        )
+
+    i = 0
+    fails = 0
+    while len(idx) > 3 and fails < len(idx):
+        m = len(idx)
+        i0, i1, i2 = idx[(i - 1) % m], idx[i % m], idx[(i + 1) % m]
+        if is_ear(i0, i1, i2):
+            tris.append((i0, i1, i2))
+            del idx[i % m]
+            i %= len(idx)
+            fails = 0
+        else:
+            i = (i + 1) % m
+            fails += 1
+    if len(idx) >= 3:  # three left, or ear search failed: fan the rest
+        tris.extend((idx[0], idx[j], idx[j + 1]) for j in range(1, len(idx) - 1))
+    return tris
+
+
+def triangulate_polygons(
+    vertices: NDArray[np.float64], counts: NDArray[np.int64], flat: NDArray[np.int64]
+) -> tuple[NDArray[np.int64], int]:
+    """Triangulate polygons given as vertex counts and a flat index list, keeping their orientation.
+
+    Triangles pass through; quads are split at a concave corner if there is one; larger polygons are
+    ear-clipped. Polygons with fewer than 3 vertices or with an index outside ``vertices`` are skipped;
+    their number is returned with the (m, 3) faces, in polygon order.
+    """
+    counts = np.asarray(counts, dtype=np.int64)
+    flat = np.asarray(flat, dtype=np.int64)
+    nv = len(vertices)
+    if len(counts) == 0:
+        return np.zeros((0, 3), dtype=np.int64), 0
+    if np.any(counts < 0) or int(counts.sum()) != len(flat):
+        raise MeshLoadError("MK501", "polygon vertex counts do not match the index list")
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    bad_index = (flat < 0) | (flat >= nv)
+    cum_bad = np.concatenate([[0], np.cumsum(bad_index)])
+    bad_poly = (cum_bad[starts + counts] - cum_bad[starts] > 0) | (counts < 3)
+    skipped = int(np.count_nonzero(bad_poly))
+
+    out_faces: list[NDArray[np.int64]] = []
+    out_poly: list[NDArray[np.int64]] = []
+    poly_ids = np.arange(len(counts))
+
+    tri = (counts == 3) & ~bad_poly
+    if np.any(tri):
+        s = starts[tri]
+        out_faces.append(flat[s[:, None] + np.arange(3)])
+        out_poly.append(poly_ids[tri])
+
+    quad = (counts == 4) & ~bad_poly
+    if np.any(quad):
+        s = starts[quad]
+        q = flat[s[:, None] + np.arange(4)]  # (k, 4)
+        p = vertices[q]  # (k, 4, 3)
+        nrm = np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1])  # quad normal (diagonal cross product)
+        prev = np.roll(p, 1, axis=1)
+        nxt = np.roll(p, -1, axis=1)
+        turn = np.einsum("kij,kj->ki", np.cross(p - prev, nxt - p), nrm)  # < 0 at a concave corner
+        start = np.where(np.any(turn < 0, axis=1), np.argmin(turn, axis=1), 0)
+        order = (start[:, None] + np.arange(4)) % 4
+        qq = np.take_along_axis(q, order, axis=1)
+        t1 = qq[:, [0, 1, 2]]
+        t2 = qq[:, [0, 2, 3]]
+        out_faces.append(np.stack([t1, t2], axis=1).reshape(-1, 3))
+        out_poly.append(np.repeat(poly_ids[quad], 2))
+
+    big = np.nonzero((counts > 4) & ~bad_poly)[0]
+    for pi in big:
+        s = int(starts[pi])
+        ids = flat[s : s + int(counts[pi])]
+        local = _ear_clip(np.asarray(vertices[ids], dtype=np.float64))
+        if local:
+            out_faces.append(ids[np.array(local, dtype=np.int64)])
+            out_poly.append(np.full(len(local), pi, dtype=np.int64))
+
+    if not out_faces:
+        return np.zeros((0, 3), dtype=np.int64), skipped
+    faces = np.concatenate(out_faces)
+    order_idx = np.argsort(np.concatenate(out_poly), kind="stable")
+    return faces[order_idx].astype(np.int64), skipped
+
+
+def compact_mesh(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> Mesh:
+    """Drop vertices no face refers to (keeps the order of the others)."""
+    if len(faces) == 0:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+    used = np.unique(faces)
+    if len(used) == len(vertices):
+        return np.asarray(vertices, dtype=np.float64), faces.astype(np.int64)
+    remap = np.full(len(vertices), -1, dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    return np.asarray(vertices[used], dtype=np.float64), remap[faces]
+
+
+def _merge_identical_vertices(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> Mesh:
+    """Merge exactly equal vertices (STL is a triangle soup), keeping first-occurrence order."""
+    if len(vertices) == 0:
+        return vertices, faces
+    _, first, inverse = np.unique(vertices, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    order = np.argsort(first, kind="stable")  # unique rows in order of first occurrence
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return np.asarray(vertices[np.sort(first)], dtype=np.float64), rank[inverse][faces]
+
+
+# ---- STL / OBJ (trimesh) ----------------------------------------------------------------------
+
+
+@dataclass
+class _Raw:
+    """Triangles of a file before metadata is applied."""
+
+    fmt: str
+    vertices: NDArray[np.float64]
+    faces: NDArray[np.int64]
+    notes: list[str] = field(default_factory=list)
+
+
+def _load_stl(data: bytes, name: str) -> _Raw:
+    """STL, binary or ASCII. Like Choreonoid the kind is decided by the size: a file of exactly
+    84 + 50·n bytes (n = the header's triangle count) is binary, anything else must be ASCII."""
+    from trimesh.exchange import stl as trimesh_stl
+
+    header_count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
+    if header_count >= 0 and len(data) == 84 + 50 * header_count:
+        loaded = trimesh_stl.load_stl_binary(io.BytesIO(data))
+        kwargs = [loaded]
+        kind = "binary"
+    else:
+        text = data.decode("latin-1")
+        if not text.lstrip().lower().startswith("solid"):
+            expected = f"; its header announces {header_count} triangles = {84 + 50 * header_count} bytes" \
+                if header_count >= 0 else ""
+            raise MeshLoadError(
+                "MK501",
+                f"{name} is neither a binary STL (size {len(data)} bytes{expected}) "
+                "nor an ASCII STL (it does not start with 'solid'); truncated or not an STL file",
+            )
+        if "\x00" in text:
+            raise MeshLoadError("MK501", f"{name}: ASCII STL contains NUL bytes (truncated binary STL?)")
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")  # numpy warns (instead of failing) on unparsable numbers
+                loaded = trimesh_stl.load_stl_ascii(io.StringIO(text))
+        except (ValueError, Warning) as e:
+            raise MeshLoadError("MK501", f"{name}: malformed ASCII STL ({e})") from e
+        kwargs = list(loaded["geometry"].values()) if "geometry" in loaded else [loaded]
+        n_facets = len(re.findall(r"\bendfacet\b", text.lower()))
+        n_parsed = sum(len(k["faces"]) for k in kwargs)
+        if n_parsed != n_facets:
+            raise MeshLoadError(
+                "MK501", f"{name}: malformed ASCII STL ({n_facets} facets but {n_parsed} vertex triples read)"
+            )
+        kind = "ASCII"
+    verts = [np.asarray(k["vertices"], dtype=np.float64).reshape(-1, 3) for k in kwargs]
+    faces = [np.asarray(k["faces"], dtype=np.int64).reshape(-1, 3) for k in kwargs]
+    offsets = np.cumsum([0] + [len(v) for v in verts])
+    v_all = np.concatenate(verts) if verts else np.zeros((0, 3))
+    f_all = (np.concatenate([f + o for f, o in zip(faces, offsets, strict=False)])
+             if faces else np.zeros((0, 3), dtype=np.int64))
+    v_all, f_all = _merge_identical_vertices(v_all, f_all)
+    return _Raw("stl", v_all, f_all, ["ASCII STL (some tools, e.g. MuJoCo, read only binary STL)"]
+                if kind == "ASCII" else [])
+
+
+def _load_obj(data: bytes, name: str) -> _Raw:
+    """Wavefront OBJ through trimesh (materials are not read; only the triangles matter)."""
+    from trimesh.exchange.obj import load_obj
+
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        text = data.decode("latin-1")
+    if "\x00" in text:
+        raise MeshLoadError("MK501", f"{name} contains NUL bytes: not a text OBJ file")
+    try:
+        loaded = load_obj(io.StringIO(text), group_material=False, skip_materials=True, maintain_order=True)
+    except IndexError as e:
+        raise MeshLoadError("MK501", f"{name}: a face refers to a vertex that does not exist") from e
+    except ValueError as e:
+        raise MeshLoadError("MK501", f"{name}: malformed OBJ ({e})") from e
+    kwargs: list[dict[str, Any]] = list(loaded["geometry"].values()) if "geometry" in loaded else [loaded]
+    verts: list[NDArray[np.float64]] = []
+    faces: list[NDArray[np.int64]] = []
+    offset = 0
+    for k in kwargs:
+        if "vertices" not in k or "faces" not in k:
+            continue
+        v = np.asarray(k["vertices"], dtype=np.float64).reshape(-1, 3)
+        f = np.asarray(k["faces"], dtype=np.int64)
+        if f.ndim != 2 or len(f) == 0:
+            continue
+        if f.shape[1] != 3:  # trimesh keeps all-quad (or all-k-gon) objects as polygons
+            f, _ = triangulate_polygons(v, np.full(len(f), f.shape[1], dtype=np.int64), f.reshape(-1))
+        verts.append(v)
+        faces.append(f + offset)
+        offset += len(v)
+    if not faces:
+        raise MeshLoadError("MK501", f"{name} contains no faces: not a usable OBJ file")
+    v_all = np.concatenate(verts)
+    f_all = np.concatenate(faces)
+    if np.any(f_all < 0) or np.any(f_all >= len(v_all)):
+        raise MeshLoadError("MK501", f"{name}: face index out of range")
+    return _Raw("obj", v_all, f_all, [])
+
+
+def _metadata_transform(metadata: MeshMetadata | None, notes: list[str]) -> tuple[float, NDArray[np.float64]]:
+    """(length scale, rotation) requested by a Resource's ``metadata``."""
+    scale = 1.0
+    rot = np.eye(3)
+    if metadata is None:
+        return scale, rot
+    if metadata.length_unit is not None:
+        unit = metadata.length_unit.strip().lower()
+        if unit in _LENGTH_UNITS:
+            scale = _LENGTH_UNITS[unit]
+        else:
+            notes.append(
+                f'metadata length_unit "{metadata.length_unit}" is not known (millimeter, inch); ignored'
+            )
+    if metadata.upper_axis is not None:
+        axis = metadata.upper_axis.strip().upper()
+        if axis == "Y":
+            rot = UPPER_AXIS_Y_ROTATION.copy()
+            notes.append("metadata upper_axis Y applied: mesh (x, y, z) -> (z, x, y)")
+        elif axis != "Z":
+            notes.append(f'metadata upper_axis "{metadata.upper_axis}" is not known (Y); ignored')
+    return scale, rot
+
+
+def _finish(raw: _Raw, name: str, fragment: str | None, metadata: MeshMetadata | None) -> LoadedMesh:
+    """STL/OBJ: no named parts; apply metadata; check the numbers."""
+    if fragment is not None:
+        raise MeshLoadError(
+            "MK502",
+            f'fragment "{fragment}" is not found in {name}; {raw.fmt.upper()} files have no named parts',
+        )
+    if len(raw.faces) == 0:
+        raise MeshLoadError("MK501", f"{name} contains no triangles")
+    notes = list(raw.notes)
+    scale, rot = _metadata_transform(metadata, notes)
+    verts = raw.vertices @ (scale * rot).T
+    _check_finite(verts, name)
+    return LoadedMesh(TriangleMeshData(verts, raw.faces.astype(np.int64)), [], scale, raw.fmt, notes)
+
+
+def _check_finite(vertices: NDArray[np.float64], name: str) -> None:
+    """Reject NaN/infinite coordinates; turn -0.0 into 0.0 (in place) so output files stay clean."""
+    if not np.all(np.isfinite(vertices)):
+        raise MeshLoadError("MK501", f"{name} has non-finite vertex coordinates (NaN or infinity)")
+    vertices += 0.0
+
+
+# ---- COLLADA (pycollada) ----------------------------------------------------------------------
+
+
+def _local(tag: object) -> str:
+    return str(tag).rsplit("}", 1)[-1]
+
+
+def _axis_angle4(axis: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
+    m = np.eye(4)
+    n = float(np.linalg.norm(axis))
+    if n == 0.0:
+        return m
+    a = axis / n
+    c, s = math.cos(angle), math.sin(angle)
+    k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+    m[:3, :3] = c * np.eye(3) + (1.0 - c) * np.outer(a, a) + s * k
+    return m
+
+
+def _dae_transform(t: Any) -> NDArray[np.float64]:
+    """One COLLADA transform element as a float64 4×4 matrix (pycollada's own are float32)."""
+    node = getattr(t, "xmlnode", None)
+    tag = _local(node.tag) if node is not None else ""
+    try:
+        vals = np.array((node.text or "").split(), dtype=np.float64) if node is not None else np.zeros(0)
+    except ValueError:
+        vals = np.zeros(0)
+    m = np.eye(4)
+    if tag == "translate" and len(vals) == 3:
+        m[:3, 3] = vals
+    elif tag == "rotate" and len(vals) == 4:
+        m = _axis_angle4(vals[:3], math.radians(vals[3]))
+    elif tag == "scale" and len(vals) == 3:
+        m[0, 0], m[1, 1], m[2, 2] = vals
+    elif tag == "matrix" and len(vals) == 16:
+        m = vals.reshape(4, 4)
+    else:
+        m = np.asarray(t.matrix, dtype=np.float64).reshape(4, 4)
+    return m
+
+
+class _DaeConverter:
+    """pycollada scene → :class:`MeshSceneNode` graph (node names, float64 transforms)."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.notes: list[str] = []
+        self._nodes: dict[int, MeshSceneNode | None] = {}
+        self._geoms: dict[int, list[Mesh]] = {}
+        self._skipped_polys = 0
+        self._line_prims = 0
+        self._other: set[str] = set()
+
+    def geometry(self, geom: Any) -> list[Mesh]:
+        key = id(geom)
+        if key in self._geoms:
+            return self._geoms[key]
+        from collada.lineset import LineSet
+        from collada.polylist import Polylist
+        from collada.triangleset import TriangleSet
+
+        groups: dict[int, tuple[NDArray[np.float64], list[NDArray[np.int64]]]] = {}
+        for prim in geom.primitives:
+            if isinstance(prim, LineSet):
+                self._line_prims += 1
+                continue
+            vsrc = prim.vertex
+            vidx = prim.vertex_index
+            if vsrc is None or vidx is None or len(vidx) == 0:
+                continue
+            verts = np.asarray(vsrc, dtype=np.float64).reshape(-1, 3)
+            if isinstance(prim, TriangleSet):
+                faces = np.asarray(vidx, dtype=np.int64).reshape(-1, 3)
+                bad = np.any((faces < 0) | (faces >= len(verts)), axis=1)
+                if np.any(bad):
+                    self._skipped_polys += int(bad.sum())
+                    faces = faces[~bad]
+            elif isinstance(prim, Polylist):  # also <polygons> (a Polylist subclass)
+                counts = np.asarray(prim.vcounts)
+                faces, skipped = triangulate_polygons(verts, counts, np.asarray(vidx).reshape(-1))
+                self._skipped_polys += skipped
+            else:
+                self._other.add(type(prim).__name__)
+                continue
+            entry = groups.setdefault(id(vsrc), (verts, []))
+            entry[1].append(faces)
+        meshes = [compact_mesh(v, np.concatenate(fs)) for v, fs in groups.values()]
+        meshes = [m for m in meshes if len(m[1])]
+        self._geoms[key] = meshes
+        return meshes
+
+    def node(self, node: Any, depth: int) -> MeshSceneNode | None:
+        """Convert a <node>; None when nothing below it has a mesh (Choreonoid drops such nodes, so
+        camera and light nodes are not selectable parts)."""
+        from collada.scene import ControllerNode, GeometryNode, Node, NodeNode
+
+        if depth > MAX_NESTING_DEPTH:
+            raise MeshLoadError("MK501", f"{self.name}: node nesting deeper than {MAX_NESTING_DEPTH} "
+                                         "(or a cyclic <instance_node>)")
+        if isinstance(node, NodeNode):
+            node = node.node
+        key = id(node)
+        if key in self._nodes:
+            return self._nodes[key]
+        out = MeshSceneNode(name=node.xmlnode.get("name") or None)
+        mat = np.eye(4)
+        for t in node.transforms:
+            mat = mat @ _dae_transform(t)
+        out.matrix = mat
+        real: list[Any] = []
+        instanced: list[Any] = []
+        for child in node.children:
+            if isinstance(child, NodeNode):
+                instanced.append(child)
+            elif isinstance(child, Node):
+                real.append(child)
+            elif isinstance(child, GeometryNode):
+                out.meshes.extend(self.geometry(child.geometry))
+            elif isinstance(child, ControllerNode):
+                self._controller(child, out)
+        # Assimp lists a node's own <node> children before its <instance_node>s
+        for c in real + instanced:  # a plain loop: one stack frame per level
+            converted = self.node(c, depth + 1)
+            if converted is not None:
+                out.children.append(converted)
+        result = out if (out.meshes or out.children) else None
+        self._nodes[key] = result
+        return result
+
+    def _controller(self, child: Any, out: MeshSceneNode) -> None:
+        ctrl = child.controller
+        geom = getattr(ctrl, "geometry", None)
+        bind = getattr(ctrl, "bind_shape_matrix", None)
+        if geom is None or bind is None:
+            self._other.add(type(ctrl).__name__)
+            return
+        b = np.asarray(bind, dtype=np.float64).reshape(4, 4)
+        for v, f in self.geometry(geom):
+            out.meshes.append((v @ b[:3, :3].T + b[:3, 3], f))
+        self.notes.append("skinned mesh (<instance_controller>) taken in its bind pose")
+
+    def finish_notes(self) -> list[str]:
+        notes = list(self.notes)
+        if self._skipped_polys:
+            notes.append(
+                f"{self._skipped_polys} polygon(s) with fewer than 3 vertices or bad indices skipped"
+            )
+        if self._line_prims:
+            notes.append(f"{self._line_prims} <lines> primitive(s) ignored (no triangles)")
+        for kind in sorted(self._other):
+            notes.append(f"{kind} not supported; skipped")
+        return notes
+
+
+_ENTITY_RE = re.compile(rb"<!ENTITY", re.IGNORECASE)
+
+
+def _float_or_nan(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        return float("nan")
+
+
+def _load_dae(data: bytes, name: str, fragment: str | None, metadata: MeshMetadata | None) -> LoadedMesh:
+    root_at = data.find(b"<COLLADA")
+    prolog = data if root_at < 0 else data[:root_at]
+    if _ENTITY_RE.search(prolog):
+        raise MeshLoadError("MK501", f"{name}: XML entity declarations are not accepted in COLLADA files")
+
+    import collada
+    from collada.common import DaeBrokenRefError, DaeError, DaeUnsupportedError
+
+    try:
+        dae = collada.Collada(io.BytesIO(data), ignore=[DaeUnsupportedError, DaeBrokenRefError])
+    except DaeError as e:
+        msg = str(getattr(e, "msg", "") or e)
+        at = re.search(r"line (\d+), column", msg)
+        line = int(at.group(1)) if at else None
+        raise MeshLoadError("MK501", f"{name}: not a readable COLLADA file: {msg}", line=line) from e
+    except (ValueError, TypeError, KeyError, IndexError, AttributeError) as e:
+        raise MeshLoadError("MK501", f"{name}: inconsistent COLLADA content ({type(e).__name__}: {e})") from e
+    root = dae.xmlnode.getroot()
+    if _local(root.tag) != "COLLADA":
+        raise MeshLoadError("MK501", f"{name}: root element is <{_local(root.tag)}>, not <COLLADA>")
+
+    notes: list[str] = []
+    # units: only the document's <asset> counts (Assimp reads no nested <asset>)
+    unit = 1.0
+    asset = dae.assetInfo
+    if asset is not None and getattr(asset, "unitmeter", None) is not None:
+        unit = float(asset.unitmeter)
+    if not math.isfinite(unit) or unit <= 0.0:
+        raise MeshLoadError("MK501", f"{name}: invalid <unit meter> value {unit}")
+    if unit != 1.0:
+        notes.append(f"COLLADA <unit meter=\"{unit:g}\"> applied (x{unit:g})")
+    up: str | None = None
+    for asset_el in root.iter("{*}asset"):
+        owner = asset_el.getparent()
+        for child in asset_el:
+            tag = _local(child.tag)
+            if owner is root and tag == "up_axis":
+                up = (child.text or "").strip().upper() or None
+            elif owner is not root and tag == "unit" and _float_or_nan(child.get("meter", "1")) != unit:
+                notes.append(
+                    f'nested <unit meter="{child.get("meter")}"> in <{_local(owner.tag)}> not applied '
+                    "(Assimp/Choreonoid use only the document unit)"
+                )
+    if up != "Z_UP":
+        shown = up if up else "absent (COLLADA default Y_UP)"
+        notes.append(
+            f"COLLADA up_axis {shown} ignored, as Choreonoid does (RViz and Gazebo also ignore it; "
+            "viewers that honour it show this mesh rotated)"
+        )
+    if dae.errors:
+        shown_errors = "; ".join(str(getattr(e, "msg", e)) for e in dae.errors[:3])
+        more = f" (+{len(dae.errors) - 3} more)" if len(dae.errors) > 3 else ""
+        notes.append(f"COLLADA content ignored: {shown_errors}{more}")
+
+    scene = dae.scene
+    if scene is None and len(dae.scenes):
+        scene = dae.scenes[0]
+        notes.append("no <scene><instance_visual_scene>: the first visual scene is used")
+    conv = _DaeConverter(name)
+    roots: list[MeshSceneNode] = []
+    for top in scene.nodes if scene is not None else []:
+        converted = conv.node(top, 1)
+        if converted is not None:
+            roots.append(converted)
+    if scene is None:
+        notes.append("no visual scene: no geometry is instanced")
+    notes.extend(conv.finish_notes())
+
+    flat = flatten_scene(roots, fragment, name)
+    notes.extend(flat.notes)
+    mscale, rot = _metadata_transform(metadata, notes)
+    total = unit * mscale
+    verts = flat.vertices @ (total * rot).T
+    _check_finite(verts, name)
+    if len(flat.faces) == 0:
+        notes.append("no triangles")
+    return LoadedMesh(TriangleMeshData(verts, flat.faces), flat.parts, total, "dae", notes)
+
+
+# ---- VRML97 ---------------------------------------------------------------------------------
+
+
+def _load_wrl(data: bytes, name: str, fragment: str | None, metadata: MeshMetadata | None) -> LoadedMesh:
+    from modelkit.geometry.vrml import VrmlError, read_vrml
+
+    try:
+        scene = read_vrml(data)
+    except VrmlError as e:
+        where = f" (line {e.line})" if e.line else ""
+        raise MeshLoadError("MK501", f"{name}{where}: {e.message}", line=e.line) from e
+    notes = list(scene.notes)
+    if metadata is not None and (metadata.length_unit or metadata.upper_axis):
+        notes.append("metadata length_unit/upper_axis ignored for VRML, as Choreonoid does")
+    flat = flatten_scene(scene.roots, fragment, name)
+    notes.extend(flat.notes)
+    _check_finite(flat.vertices, name)
+    if len(flat.faces) == 0:
+        notes.append("no triangles")
+    return LoadedMesh(TriangleMeshData(flat.vertices, flat.faces), flat.parts, 1.0, "wrl", notes)
