@@ -360,9 +360,9 @@ def _build_geometry(kind: str, g: YMap, ctx: WalkContext) -> tuple[Geometry, np.
         h = _positive(g, "height", 1.0)
         bad_height = h < 0 if kind == "Capsule" else h <= 0
         if r <= 0 or bad_height:
-            where = (g.get("radius") if r <= 0 else g.get("height")) or g
+            culprit: YNode = (g.get("radius") if r <= 0 else g.get("height")) or g
             sink.emit(
-                "MK400", f"a {kind.lower()} cannot be generated with radius {r} and height {h}", where.loc
+                "MK400", f"a {kind.lower()} cannot be generated with radius {r} and height {h}", culprit.loc
             )
             return None
         if kind == "Cylinder":
