@@ -346,3 +346,20 @@ def test_every_corpus_body_loads(path: Path) -> None:
     result = read_body(path)
     assert result.robot is not None
     assert result.robot.root is not None
+
+
+def test_list_numbers_use_strtod_prefix_like_choreonoid(tmp_path: Path) -> None:
+    """GR001.body has `specularColor: [ 0.2, 0.2, 0.t ]`, which Choreonoid reads as (0.2, 0.2, 0)."""
+    body = write(tmp_path, """
+format: ChoreonoidBody
+format_version: 2.0
+links:
+  - name: base
+    elements:
+      - type: Shape
+        geometry: {type: Box, size: [1, 1, 1]}
+        appearance: {material: {diffuse: [0.5, 0.5, 0.5], specularColor: [0.2, 0.2, 0.t]}}
+""")
+    material = load(body).links[0].visuals[0].material
+    assert material is not None and material.specular is not None
+    np.testing.assert_allclose(material.specular, [0.2, 0.2, 0.0])

@@ -449,7 +449,7 @@ class _BodyReader:
             com_node = node.get("center_of_mass", "centerOfMass")
             inertia_node = node.get("inertia")
             default_mass, default_inertia = (0.0, np.zeros((3, 3))) if has_rigid else (1.0, np.eye(3))
-            mass = v.number(mass_node)
+            mass = v.number_prefix(mass_node)
             com = v.vector(com_node, 3)
             inertia = inertia_matrix(inertia_node)
             if isinstance(inertia_node, YSeq) and v.numbers(inertia_node) is not None and inertia is None:

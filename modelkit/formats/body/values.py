@@ -22,6 +22,12 @@ _FLOAT_RE = re.compile(
     r"^\s*[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|0[xX](?:[0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)"
     r"(?:[pP][+-]?\d+)?|(?i:inf(?:inity)?|nan))\s*$"
 )
+# The leading number that C strtod consumes (Choreonoid's "to" accessors: list elements, mass,
+# joint_id) when text follows it: "0.5m" -> 0.5, "0.t" -> 0.
+_FLOAT_PREFIX_RE = re.compile(
+    r"^\s*[+-]?(?:0[xX](?:[0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)(?:[pP][+-]?\d+)?"
+    r"|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|(?i:inf(?:inity)?|nan))"
+)
 _INT_RE = re.compile(r"^\s*[+-]?\d+\s*$")
 TRUE_WORDS = frozenset("y Y yes Yes YES true True TRUE on On ON".split())
 FALSE_WORDS = frozenset("n N no No NO false False FALSE off Off OFF".split())
@@ -38,6 +44,15 @@ def parse_float(text: str) -> float | None:
         value = float.fromhex(body)
         return -value if s.startswith("-") else value
     return float(s)
+
+
+def parse_float_prefix(text: str) -> float | None:
+    """The number a "to" accessor reads: the whole text if it is a number, else its leading number."""
+    whole = parse_float(text)
+    if whole is not None:
+        return whole
+    match = _FLOAT_PREFIX_RE.match(text)
+    return None if match is None else parse_float(match.group(0))
 
 
 def parse_int(text: str) -> int | None:
@@ -59,6 +74,11 @@ def scalar_text(node: YNode | None) -> str | None:
 def number(node: YNode | None) -> float | None:
     text = scalar_text(node)
     return None if text is None else parse_float(text)
+
+
+def number_prefix(node: YNode | None) -> float | None:
+    text = scalar_text(node)
+    return None if text is None else parse_float_prefix(text)
 
 
 def integer(node: YNode | None) -> int | None:
@@ -96,7 +116,7 @@ def numbers(node: YNode | None) -> list[float] | None:
         return None
     out: list[float] = []
     for item in node.items:
-        value = number(item)
+        value = number_prefix(item)  # list elements are read with strtod's prefix rule
         if value is None:
             return None
         out.append(value)
