@@ -64,7 +64,8 @@ class GeometryError(Exception):
         super().__init__(f"{code}: {message}")
         self.code = code
         self.message = message
-        self.key = key  # the input at fault: "spine", "cross_section", "scale", "orientation", "height", "faces"
+        # The input at fault ("spine", "cross_section", "scale", "orientation", "height", "faces").
+        self.key = key
         self.index = index  # the element of that input at fault, when one is
 
 
@@ -402,7 +403,8 @@ def elevation_grid(
     h = np.asarray(height, dtype=np.float64).reshape(-1)
     if xd < 2 or zd < 2:
         raise GeometryError(
-            "MK407", f"An ElevationGrid needs xDimension and zDimension of at least 2 (got {xd} × {zd}).",
+            "MK407",
+            f"An ElevationGrid needs xDimension and zDimension of at least 2 (got {xd} × {zd}).",
             key="x_dimension",
         )
     if len(h) != xd * zd:
@@ -472,8 +474,12 @@ def indexed_face_set(vertices: Sequence[float], coord_index: Sequence[int]) -> t
     mask = (idx >= nv) | (idx < -1)
     bad = idx[mask]
     if len(bad):
-        raise GeometryError("MK408", _out_of_range_message(bad, nv, allow_separator=True), key="faces",
-                            index=int(np.flatnonzero(mask)[0]))
+        raise GeometryError(
+            "MK408",
+            _out_of_range_message(bad, nv, allow_separator=True),
+            key="faces",
+            index=int(np.flatnonzero(mask)[0]),
+        )
 
     separators = np.flatnonzero(idx == -1)
     trailing = len(idx) - (int(separators[-1]) + 1 if len(separators) else 0)
@@ -525,8 +531,12 @@ def triangle_mesh(vertices: Sequence[float], triangles: Sequence[int]) -> Triang
     mask = (idx >= len(verts)) | (idx < 0)
     bad = idx[mask]
     if len(bad):
-        raise GeometryError("MK408", _out_of_range_message(bad, len(verts), allow_separator=False), key="faces",
-                            index=int(np.flatnonzero(mask)[0]))
+        raise GeometryError(
+            "MK408",
+            _out_of_range_message(bad, len(verts), allow_separator=False),
+            key="faces",
+            index=int(np.flatnonzero(mask)[0]),
+        )
     return TriangleMeshData(vertices=verts, faces=idx.reshape(-1, 3))
 
 
