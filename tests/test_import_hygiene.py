@@ -1,0 +1,137 @@
+"""`modelkit validate` and `modelkit tree` must not import the simulators (mujoco, pybullet), nor
+the mesh stack (trimesh) for a model that has no mesh files.
+
+Each command runs in a fresh interpreter (the test process has imported who knows what). The
+child puts a recording finder first on ``sys.meta_path`` before importing modelkit, so an import
+*attempt* is caught even where the package is not installed (as in CI, where a guarded
+``try: import mujoco`` would otherwise leave no trace in ``sys.modules``); it then runs the
+command through ``click.testing.CliRunner`` and reports the exit code, the output, the modules
+loaded and the attempts as JSON.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+PROJECT_ROOT = Path(__file__).resolve().parents[1]
+CORPUS = PROJECT_ROOT.parent / "shared" / "corpus"
+PENDULUM = CORPUS / "choreonoid" / "share" / "model" / "misc" / "pendulum.body"
+
+SIMULATORS = ("mujoco", "pybullet")
+MESH_STACK = ("trimesh",)
+
+# Used when the shared corpus is not next to the checkout (CI): no mesh files.
+FALLBACK_BODY = """\
+format: ChoreonoidBody
+format_version: 2.0
+angle_unit: degree
+name: Pendulum
+root_link: BASE
+links:
+  -
+    name: BASE
+    joint_type: fixed
+    center_of_mass: [ 0, 0, 0.1 ]
+    mass: 10.0
+    inertia: [ 0.06667, 0, 0, 0, 0.06667, 0, 0, 0, 0.06667 ]
+    elements:
+      - { type: Shape, translation: [ 0, 0, 0.1 ], geometry: { type: Box, size: [ 0.2, 0.2, 0.2 ] } }
+  -
+    name: ARM
+    parent: BASE
+    translation: [ 0.125, 0, 0.1 ]
+    joint_type: revolute
+    joint_id: 0
+    joint_axis: [ 1, 0, 0 ]
+    center_of_mass: [ 0, 0, 0.5 ]
+    mass: 1.0
+    inertia: [ 0.0835417, 0, 0, 0, 0.0835417, 0, 0, 0, 0.000416667 ]
+    elements:
+      - { type: Shape, translation: [ 0, 0, 0.5 ], geometry: { type: Box, size: [ 0.05, 0.05, 1.0 ] } }
+"""
+
+CHILD = textwrap.dedent("""\
+    import json
+    import sys
+
+    WATCHED = set(sys.argv[1].split(","))
+    attempted = []
+
+
+    class Recorder:
+        @staticmethod
+        def find_spec(fullname, path=None, target=None):
+            if fullname.partition(".")[0] in WATCHED:
+                attempted.append(fullname)
+            return None  # let the real finders decide
+
+
+    sys.meta_path.insert(0, Recorder)
+
+    from click.testing import CliRunner
+
+    from modelkit.cli import main
+
+    result = CliRunner().invoke(main, sys.argv[2:], catch_exceptions=True)
+    json.dump({
+        "exit_code": result.exit_code,
+        "output": result.output,
+        "exception": None if result.exception is None or isinstance(result.exception, SystemExit)
+        else repr(result.exception),
+        "modules": sorted(sys.modules),
+        "attempted": sorted(set(attempted)),
+    }, sys.stdout)
+""")
+
+
+def _run(args: list[str], watched: tuple[str, ...]) -> dict[str, Any]:
+    done = subprocess.run([sys.executable, "-c", CHILD, ",".join(watched), *args],
+                          cwd=PROJECT_ROOT, stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                          check=False, timeout=300)
+    assert done.returncode == 0, f"child failed:\n{done.stdout}\n{done.stderr}"
+    report: dict[str, Any] = json.loads(done.stdout)
+    assert report["exception"] is None, report["exception"]
+    return report
+
+
+@pytest.fixture(scope="module")
+def small_model(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """pendulum.body from the corpus: two links, box shapes, no mesh files."""
+    if PENDULUM.is_file():
+        return PENDULUM
+    path = tmp_path_factory.mktemp("hygiene") / "pendulum.body"
+    path.write_text(FALLBACK_BODY)
+    return path
+
+
+@pytest.mark.parametrize("command", [["validate"], ["validate", "--no-resources"], ["tree"]],
+                         ids=["validate", "validate-no-resources", "tree"])
+def test_no_simulator_or_mesh_stack_for_a_model_without_meshes(command: list[str], small_model: Path) -> None:
+    watched = SIMULATORS + MESH_STACK
+    report = _run([*command, str(small_model)], watched)
+    assert report["exit_code"] == 0, report["output"]
+    # The check itself works: modelkit ran in this interpreter.
+    assert "modelkit.cli" in report["modules"]
+    assert any(m.startswith("modelkit.formats.body") for m in report["modules"])
+    loaded = [m for m in report["modules"] if m.partition(".")[0] in watched]
+    assert loaded == [], f"`modelkit {' '.join(command)}` imported {loaded}"
+    assert report["attempted"] == [], f"`modelkit {' '.join(command)}` tried to import {report['attempted']}"
+
+
+def test_no_simulator_for_the_whole_corpus() -> None:
+    """Models with meshes may load trimesh, never a simulator."""
+    files = sorted(str(p) for p in CORPUS.rglob("*.body")) if CORPUS.is_dir() else []
+    if not files:
+        pytest.skip(f"no .body files under {CORPUS}")
+    report = _run(["validate", *files], SIMULATORS)
+    assert report["exit_code"] in (0, 1), report["output"]
+    loaded = [m for m in report["modules"] if m.partition(".")[0] in SIMULATORS]
+    assert loaded == [], f"`modelkit validate` imported {loaded}"
+    assert report["attempted"] == [], f"`modelkit validate` tried to import {report['attempted']}"
