@@ -13,6 +13,37 @@ CORPUS = REPO.parent / "shared" / "corpus"
 SAMPLES = REPO / "samples"
 TUTORIAL = SAMPLES / "choreonoid_ros2_mobile_robot_tutorial" / "model"
 
+# A clean two-link pendulum (a copy of Choreonoid's misc/pendulum.body) for tests that must run
+# without the shared corpus.
+PENDULUM_BODY = """\
+format: ChoreonoidBody
+format_version: 2.0
+angle_unit: degree
+name: Pendulum
+root_link: BASE
+links:
+  -
+    name: BASE
+    joint_type: fixed
+    center_of_mass: [ 0, 0, 0.1 ]
+    mass: 10.0
+    inertia: [ 0.06667, 0, 0, 0, 0.06667, 0, 0, 0, 0.06667 ]
+    elements:
+      - { type: Shape, translation: [ 0, 0, 0.1 ], geometry: { type: Box, size: [ 0.2, 0.2, 0.2 ] } }
+  -
+    name: ARM
+    parent: BASE
+    translation: [ 0.125, 0, 0.1 ]
+    joint_type: revolute
+    joint_id: 0
+    joint_axis: [ 1, 0, 0 ]
+    center_of_mass: [ 0, 0, 0.5 ]
+    mass: 1.0
+    inertia: [ 0.0835417, 0, 0, 0, 0.0835417, 0, 0, 0, 0.000416667 ]
+    elements:
+      - { type: Shape, translation: [ 0, 0, 0.5 ], geometry: { type: Box, size: [ 0.05, 0.05, 1.0 ] } }
+"""
+
 
 def corpus_bodies() -> list[Path]:
     return sorted(CORPUS.rglob("*.body")) if CORPUS.is_dir() else []

@@ -20,6 +20,8 @@ from typing import Any
 
 import pytest
 
+from .conftest import PENDULUM_BODY
+
 PROJECT_ROOT = Path(__file__).resolve().parents[1]
 CORPUS = PROJECT_ROOT.parent / "shared" / "corpus"
 PENDULUM = CORPUS / "choreonoid" / "share" / "model" / "misc" / "pendulum.body"
@@ -28,34 +30,7 @@ SIMULATORS = ("mujoco", "pybullet")
 MESH_STACK = ("trimesh",)
 
 # Used when the shared corpus is not next to the checkout (CI): no mesh files.
-FALLBACK_BODY = """\
-format: ChoreonoidBody
-format_version: 2.0
-angle_unit: degree
-name: Pendulum
-root_link: BASE
-links:
-  -
-    name: BASE
-    joint_type: fixed
-    center_of_mass: [ 0, 0, 0.1 ]
-    mass: 10.0
-    inertia: [ 0.06667, 0, 0, 0, 0.06667, 0, 0, 0, 0.06667 ]
-    elements:
-      - { type: Shape, translation: [ 0, 0, 0.1 ], geometry: { type: Box, size: [ 0.2, 0.2, 0.2 ] } }
-  -
-    name: ARM
-    parent: BASE
-    translation: [ 0.125, 0, 0.1 ]
-    joint_type: revolute
-    joint_id: 0
-    joint_axis: [ 1, 0, 0 ]
-    center_of_mass: [ 0, 0, 0.5 ]
-    mass: 1.0
-    inertia: [ 0.0835417, 0, 0, 0, 0.0835417, 0, 0, 0, 0.000416667 ]
-    elements:
-      - { type: Shape, translation: [ 0, 0, 0.5 ], geometry: { type: Box, size: [ 0.05, 0.05, 1.0 ] } }
-"""
+FALLBACK_BODY = PENDULUM_BODY
 
 CHILD = textwrap.dedent("""\
     import json

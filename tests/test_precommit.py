@@ -28,6 +28,8 @@ from pathlib import Path
 
 import pytest
 
+from .conftest import PENDULUM_BODY
+
 pytest.importorskip("pre_commit")
 
 pytestmark = pytest.mark.slow
@@ -37,35 +39,7 @@ CORPUS = PROJECT_ROOT.parent / "shared" / "corpus"
 CORPUS_PENDULUM = CORPUS / "choreonoid" / "share" / "model" / "misc" / "pendulum.body"
 HOOK_ID = "modelkit-validate"
 
-# Used when the shared corpus is not next to the checkout (CI).
-CLEAN_BODY = """\
-format: ChoreonoidBody
-format_version: 2.0
-angle_unit: degree
-name: Pendulum
-root_link: BASE
-links:
-  -
-    name: BASE
-    joint_type: fixed
-    center_of_mass: [ 0, 0, 0.1 ]
-    mass: 10.0
-    inertia: [ 0.06667, 0, 0, 0, 0.06667, 0, 0, 0, 0.06667 ]
-    elements:
-      - { type: Shape, translation: [ 0, 0, 0.1 ], geometry: { type: Box, size: [ 0.2, 0.2, 0.2 ] } }
-  -
-    name: ARM
-    parent: BASE
-    translation: [ 0.125, 0, 0.1 ]
-    joint_type: revolute
-    joint_id: 0
-    joint_axis: [ 1, 0, 0 ]
-    center_of_mass: [ 0, 0, 0.5 ]
-    mass: 1.0
-    inertia: [ 0.0835417, 0, 0, 0, 0.0835417, 0, 0, 0, 0.000416667 ]
-    elements:
-      - { type: Shape, translation: [ 0, 0, 0.5 ], geometry: { type: Box, size: [ 0.05, 0.05, 1.0 ] } }
-"""
+CLEAN_BODY = PENDULUM_BODY  # used when the shared corpus is not next to the checkout (CI)
 
 # ARM's parent names a link that does not exist: an error on line 20 (the value of `parent`).
 BROKEN_BODY = """\

@@ -55,15 +55,14 @@ ACTUATION_MODES = {
     "linkPosition": "link_position",
     "jointSurfaceVelocity": "velocity",
 }
-RANGE_KEYS = (
+# Keys that limit a joint's motion: meaningless on a fixed joint.
+LIMIT_KEYS = (
     "joint_range",
     "jointRange",
     "max_joint_velocity",
     "maxJointVelocity",
     "joint_velocity_range",
     "jointVelocityRange",
-    "joint_axis",
-    "jointAxis",
 )
 MASS_KEYS = ("mass", "center_of_mass", "centerOfMass", "inertia")
 
@@ -398,18 +397,7 @@ class _BodyReader:
             joint.joint_id = joint_id
             joint.sources["id"] = id_node.loc
         if not joint.type.moves and word in JOINT_TYPES:
-            present = [
-                k
-                for k in (
-                    "joint_range",
-                    "jointRange",
-                    "max_joint_velocity",
-                    "maxJointVelocity",
-                    "joint_velocity_range",
-                    "jointVelocityRange",
-                )
-                if k in node
-            ]
+            present = [k for k in LIMIT_KEYS if k in node]
             if present and joint.type is JointType.FIXED:
                 sink.emit(
                     "MK311",
