@@ -109,9 +109,6 @@ class DiagnosticSink:
         for d in ds:
             self.add(d)
 
-    @property
-    def has_errors(self) -> bool:
-        return any(d.severity is Severity.ERROR for d in self.items)
 
 
 def sorted_diagnostics(ds: Iterable[Diagnostic]) -> list[Diagnostic]:

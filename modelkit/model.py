@@ -252,27 +252,6 @@ class Robot:
                 return link
         return None
 
-    def link_map(self) -> dict[str, Link]:
-        """Links by name (the first of duplicates wins)."""
-        out: dict[str, Link] = {}
-        for link in self.links:
-            out.setdefault(link.name, link)
-        return out
-
-    def parent_joint_map(self) -> dict[str, Joint]:
-        """The joint leading into each child link (the first of several wins)."""
-        out: dict[str, Joint] = {}
-        for joint in self.joints:
-            out.setdefault(joint.child, joint)
-        return out
-
-    def children(self, link_name: str) -> list[Joint]:
-        """Joints whose parent is ``link_name``, in document order."""
-        return [j for j in self.joints if j.parent == link_name]
-
-    def movable_joints(self) -> list[Joint]:
-        return [j for j in self.joints if j.type.moves]
-
     def world_poses(self, positions: dict[str, float] | None = None) -> dict[str, Pose]:
         """Forward kinematics: each link's pose in the world (root at ``root_pose``).
 

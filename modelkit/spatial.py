@@ -28,34 +28,8 @@ class Pose:
     rotation: Mat3 = field(default_factory=_identity3)
     translation: Vec3 = field(default_factory=_zero3)
 
-    @staticmethod
-    def identity() -> Pose:
-        return Pose()
-
-    @staticmethod
-    def from_matrix(m: Mat4) -> Pose:
-        return Pose(np.array(m[:3, :3], dtype=float), np.array(m[:3, 3], dtype=float))
-
-    def matrix(self) -> Mat4:
-        m = np.eye(4)
-        m[:3, :3] = self.rotation
-        m[:3, 3] = self.translation
-        return m
-
     def __matmul__(self, other: Pose) -> Pose:
         return Pose(self.rotation @ other.rotation, self.rotation @ other.translation + self.translation)
-
-    def inverse(self) -> Pose:
-        rt = self.rotation.T
-        return Pose(rt, -rt @ self.translation)
-
-    def apply(self, point: Vec3) -> Vec3:
-        return self.rotation @ np.asarray(point, dtype=float) + self.translation
-
-    def is_identity(self, tol: float = 1e-12) -> bool:
-        return bool(
-            np.allclose(self.rotation, np.eye(3), atol=tol) and np.allclose(self.translation, 0, atol=tol)
-        )
 
     def __repr__(self) -> str:
         return f"Pose(xyz={self.translation.tolist()}, rpy={rpy_from_matrix(self.rotation).tolist()})"
@@ -79,21 +53,8 @@ def rot_x(angle: float) -> Mat3:
     return axis_angle([1.0, 0.0, 0.0], angle)
 
 
-def rot_y(angle: float) -> Mat3:
-    return axis_angle([0.0, 1.0, 0.0], angle)
-
-
-def rot_z(angle: float) -> Mat3:
-    return axis_angle([0.0, 0.0, 1.0], angle)
-
-
-def matrix_from_rpy(roll: float, pitch: float, yaw: float) -> Mat3:
-    """URDF/SDF fixed-axis roll-pitch-yaw: R = Rz(yaw) · Ry(pitch) · Rx(roll)."""
-    return rot_z(yaw) @ rot_y(pitch) @ rot_x(roll)
-
-
 def rpy_from_matrix(r: Mat3) -> Vec3:
-    """Inverse of :func:`matrix_from_rpy` (pitch in [-π/2, π/2])."""
+    """URDF/SDF fixed-axis roll-pitch-yaw of R = Rz(yaw)·Ry(pitch)·Rx(roll), pitch in [-π/2, π/2]."""
     sy = -float(r[2, 0])
     sy = max(-1.0, min(1.0, sy))
     pitch = math.asin(sy)
@@ -104,47 +65,6 @@ def rpy_from_matrix(r: Mat3) -> Vec3:
         roll = 0.0
         yaw = math.atan2(-float(r[0, 1]), float(r[1, 1]))
     return np.array([roll, pitch, yaw])
-
-
-def quat_wxyz_from_matrix(r: Mat3) -> NDArray[np.float64]:
-    """Unit quaternion (w, x, y, z) with w ≥ 0."""
-    m = np.asarray(r, dtype=float)
-    tr = float(np.trace(m))
-    if tr > 0:
-        s = math.sqrt(tr + 1.0) * 2
-        q = [0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s]
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
-        q = [(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s]
-    elif m[1, 1] > m[2, 2]:
-        s = math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
-        q = [(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s]
-    else:
-        s = math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
-        q = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s]
-    qa = np.array(q, dtype=float)
-    qa /= np.linalg.norm(qa)
-    return -qa if qa[0] < 0 else qa
-
-
-def matrix_from_quat_wxyz(q: NDArray[np.float64] | list[float]) -> Mat3:
-    w, x, y, z = (float(v) for v in np.asarray(q, dtype=float) / np.linalg.norm(q))
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
-def is_rotation(r: Mat3, tol: float = 1e-9) -> bool:
-    return bool(np.allclose(r.T @ r, np.eye(3), atol=tol) and abs(np.linalg.det(r) - 1.0) < tol)
-
-
-def inertia_rotated(inertia: Mat3, r: Mat3) -> Mat3:
-    """Express an inertia tensor in a rotated frame: R · I · Rᵀ."""
-    return r @ inertia @ r.T
 
 
 def parallel_axis(mass: float, offset: Vec3) -> Mat3:

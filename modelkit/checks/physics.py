@@ -7,7 +7,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from modelkit.checks.registry import rule
-from modelkit.diagnostics import Diagnostic, Severity, diag
+from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
 from modelkit.model import JointType, Link, Robot
 from modelkit.spatial import inertia_tolerance, principal_moments
 
@@ -34,7 +34,7 @@ def _moving_links(robot: Robot) -> set[str]:
     return moving
 
 
-def _mass_loc(link: Link):  # type: ignore[no-untyped-def]
+def _mass_loc(link: Link) -> SourceLocation | None:
     inertial = link.inertial
     if inertial is None:
         return link.source

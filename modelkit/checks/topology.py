@@ -87,10 +87,8 @@ def no_cycles(robot: Robot) -> Iterator[Diagnostic]:
                 )
                 break
             ancestor = attached.get(ancestor)
-        else:
+        else:  # no cycle: attach it (a joint that closes a cycle stays out)
             attached[joint.child] = joint.parent
-            continue
-        # a cycle was found: leave the joint out so later joints are judged on the tree so far
 
 
 @rule("joint-ids", "MK206", "MK207")

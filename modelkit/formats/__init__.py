@@ -5,14 +5,11 @@ Readers are imported lazily so that `validate` and `tree` load only what the inp
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
 from modelkit.formats.body.reader import BodyOptions, ReadResult
-
-Reader = Callable[[Path, BodyOptions, str], ReadResult]
 
 
 @dataclass(frozen=True)

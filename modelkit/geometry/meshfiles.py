@@ -183,6 +183,15 @@ def _scene_names(roots: Sequence[MeshSceneNode]) -> list[str]:
     return sorted(names)
 
 
+def _count_visit(visits: int, file_name: str) -> int:
+    """One more scene-node visit; refuse scene graphs that explode through shared instances."""
+    if visits >= MAX_NODE_VISITS:
+        raise MeshLoadError(
+            "MK501", f"{file_name}: scene graph too large (more than {MAX_NODE_VISITS} node visits)"
+        )
+    return visits + 1
+
+
 def _find_fragment(
     roots: Sequence[MeshSceneNode], name: str, file_name: str
 ) -> tuple[MeshSceneNode, NDArray[np.float64]] | None:
@@ -192,11 +201,7 @@ def _find_fragment(
     visits = 0
     while stack:
         node, acc = stack.pop()
-        visits += 1
-        if visits > MAX_NODE_VISITS:
-            raise MeshLoadError(
-                "MK501", f"{file_name}: scene graph too large (more than {MAX_NODE_VISITS} node visits)"
-            )
+        visits = _count_visit(visits, file_name)
         if node.name == name:
             return node, acc
         for child in reversed(node.children):
@@ -236,11 +241,7 @@ def flatten_scene(roots: Sequence[MeshSceneNode], fragment: str | None, file_nam
     stack = list(reversed(starts))
     while stack:
         node, acc = stack.pop()
-        visits += 1
-        if visits > MAX_NODE_VISITS:
-            raise MeshLoadError(
-                "MK501", f"{file_name}: scene graph too large (more than {MAX_NODE_VISITS} node visits)"
-            )
+        visits = _count_visit(visits, file_name)
         for mesh in node.meshes:
             n_tri += len(mesh[1])
             if n_tri > MAX_TRIANGLES:

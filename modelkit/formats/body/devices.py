@@ -9,8 +9,6 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
-
 from modelkit.diagnostics import DiagnosticSink
 from modelkit.formats.body import values as v
 from modelkit.yamltree import YMap, to_plain
@@ -202,11 +200,3 @@ def _range_sensor(node: YMap, angle_scale: float, params: dict[str, Any]) -> set
         params[f"{axis}_step"] = step
         params[f"{axis}_samples"] = samples
     return used
-
-
-# Rotation from a device frame to the GL camera frame (looks −Z, up +Y), per `optical_frame`.
-OPTICAL_FRAMES: dict[str, np.ndarray] = {
-    "gl": np.eye(3),
-    "cv": np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]),
-    "robotics": np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
-}

@@ -43,7 +43,6 @@ SCENE_ONLY_NODES = frozenset(
 )
 MESH_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl"})
 YAML_EXTENSIONS = frozenset({".yaml", ".yml"})
-UNSUPPORTED_MESH_EXTENSIONS = frozenset({".blend", ".x", ".dxf", ".scen"})
 
 
 @dataclass
@@ -307,7 +306,7 @@ def add_shape(shape: YMap, transform: np.ndarray, mode: str, out: Collected, ctx
     material = _material(shape, ctx)
     name = v.get_text(shape, "name")
     if kind == "Resource":
-        _add_mesh_file(geometry_node, affine, mode, out, ctx, material=material, name=name, single_mesh=True)
+        _add_mesh_file(geometry_node, affine, mode, out, ctx, material=material, name=name)
         return
     built = _build_geometry(kind, geometry_node, ctx)
     if built is None:
@@ -567,7 +566,7 @@ def add_resource(
         _add_yaml_resource(node, uri, uri_node, affine, mode, out, ctx, depth)
         return
     _add_mesh_file(
-        node, affine, mode, out, ctx, material=None, name=v.get_text(node, "name"), single_mesh=False
+        node, affine, mode, out, ctx, material=None, name=v.get_text(node, "name")
     )
 
 
@@ -580,7 +579,6 @@ def _add_mesh_file(
     *,
     material: VisualMaterial | None,
     name: str | None,
-    single_mesh: bool,
 ) -> None:
     uri_node = node.get("uri")
     uri = v.scalar_text(uri_node)

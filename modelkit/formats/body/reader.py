@@ -17,7 +17,7 @@ from modelkit.diagnostics import Diagnostic, DiagnosticSink, SourceLocation, sor
 from modelkit.formats.body import values as v
 from modelkit.formats.body.elements import Collected, WalkContext, inertia_matrix, walk
 from modelkit.formats.body.materials import MaterialTable, load_materials
-from modelkit.model import Device, Geom, Inertial, Joint, JointLimits, JointType, Link, LoopConstraint, Robot
+from modelkit.model import Inertial, Joint, JointLimits, JointType, Link, LoopConstraint, Robot
 from modelkit.resources import Resolver
 from modelkit.spatial import Pose, combine_mass_properties
 from modelkit.yamltree import (
@@ -672,18 +672,3 @@ class _BodyReader:
                 else:
                     loop.pose_in_link2 = pose
             robot.loops.append(loop)
-
-
-def link_geoms(link: Link) -> list[Geom]:
-    """Visual and collision geoms of a link without repeats (a shape may be both)."""
-    seen: set[int] = set()
-    out = []
-    for g in [*link.visuals, *link.collisions]:
-        if id(g) not in seen:
-            seen.add(id(g))
-            out.append(g)
-    return out
-
-
-def link_devices(robot: Robot) -> list[tuple[str, Device]]:
-    return [(link.name, d) for link in robot.links for d in link.devices]
