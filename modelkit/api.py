@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from modelkit.checks import run_rules
 from modelkit.diagnostics import Diagnostic, Severity, sorted_diagnostics
 from modelkit.formats import read_model
-from modelkit.formats.body.reader import BodyOptions
+from modelkit.formats.common import ReadOptions
 from modelkit.model import Robot
 
 
@@ -25,9 +25,13 @@ class ModelError(Exception):
 
 @dataclass
 class Validation:
+    """What validating one file found. ``robot`` is the first robot; ``robots`` all of them (an SDF
+    world holds several models)."""
+
     path: str
     robot: Robot | None
     diagnostics: list[Diagnostic]
+    robots: list[Robot] = field(default_factory=list)
 
     @property
     def errors(self) -> list[Diagnostic]:
@@ -39,21 +43,21 @@ class Validation:
 
 
 def validate(
-    path: str | Path, options: BodyOptions | None = None, fmt: str | None = None, display: str | None = None
+    path: str | Path, options: ReadOptions | None = None, fmt: str | None = None, display: str | None = None
 ) -> Validation:
     """Read a file and run every rule over its model."""
     p = Path(path)
     result = read_model(p, options, fmt, display or str(path))
     diagnostics = list(result.diagnostics)
-    if result.robot is not None:
-        diagnostics.extend(run_rules(result.robot))
+    for robot in result.robots:
+        diagnostics.extend(run_rules(robot))
     unique: dict[tuple[object, ...], Diagnostic] = {}
     for d in diagnostics:
         unique.setdefault((d.code, d.location, d.message), d)
-    return Validation(display or str(path), result.robot, sorted_diagnostics(unique.values()))
+    return Validation(display or str(path), result.robot, sorted_diagnostics(unique.values()), result.robots)
 
 
-def load(path: str | Path, options: BodyOptions | None = None, fmt: str | None = None) -> Robot:
+def load(path: str | Path, options: ReadOptions | None = None, fmt: str | None = None) -> Robot:
     """Read a file into a :class:`Robot`; raise :class:`ModelError` when it has errors."""
     v = validate(path, options, fmt)
     if v.robot is None or v.errors:

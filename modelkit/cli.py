@@ -34,7 +34,7 @@ def reading_options(fn: F) -> F:
     options = [
         click.option(
             "--input-format",
-            type=click.Choice(["body"]),
+            type=click.Choice(["body", "urdf", "xacro", "sdf", "mjcf"]),
             default=None,
             help="Read files as this format instead of guessing from the extension.",
         ),
@@ -65,6 +65,13 @@ def reading_options(fn: F) -> F:
             help="Build Extrusions as VRML97 intends instead of reproducing Choreonoid's quirks.",
         ),
         click.option(
+            "--legacy/--no-legacy",
+            "legacy_xacro",
+            default=None,
+            help="xacro: expand pre-Jade constructs (<property>, <include>, unprefixed macro calls) "
+            "[default: detect them, expand them and warn; --no-legacy expands as current xacro does].",
+        ),
+        click.option(
             "--max-bytes",
             type=click.IntRange(min=1),
             default=64 * 1024 * 1024,
@@ -77,16 +84,31 @@ def reading_options(fn: F) -> F:
     return fn
 
 
-def _body_options(kwargs: dict[str, Any], check_resources: bool) -> Any:
-    from modelkit.formats.body.reader import BodyOptions
+def split_xacro_args(items: tuple[str, ...]) -> tuple[tuple[Path, ...], dict[str, str]]:
+    """Split command-line words into files and xacro ``key:=value`` arguments (as xacro takes them)."""
+    files: list[Path] = []
+    args: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition(":=")
+        if sep and key and "/" not in key:
+            args[key] = value
+        else:
+            files.append(Path(item))
+    return tuple(files), args
+
+
+def _read_options(kwargs: dict[str, Any], check_resources: bool, xacro_args: dict[str, str]) -> Any:
+    from modelkit.formats.common import ReadOptions
     from modelkit.resources import Resolver
 
     resolver = Resolver(
         package_paths=_pairs(kwargs["package_paths"], "--package-path"),
         path_variables=_pairs(kwargs["path_variables"], "--path-variable"),
     )
-    return BodyOptions(
+    return ReadOptions(
         resolver=resolver,
+        xacro_args=xacro_args,
+        legacy_xacro=kwargs["legacy_xacro"],
         materials_path=kwargs["materials"],
         faithful_extrusion=not kwargs["vrml_extrusion"],
         check_resources=check_resources,
@@ -101,7 +123,7 @@ def main() -> None:
 
 
 @main.command()
-@click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.argument("words", nargs=-1, required=True, metavar="FILES... [KEY:=VALUE]...")
 @click.option(
     "--format",
     "output_format",
@@ -122,7 +144,7 @@ def main() -> None:
 )
 @reading_options
 def validate(
-    files: tuple[Path, ...],
+    words: tuple[str, ...],
     output_format: str,
     strict: bool,
     show_info: bool,
@@ -130,7 +152,11 @@ def validate(
     ignored: tuple[str, ...],
     **kwargs: Any,
 ) -> None:
-    """Check model files and print file:line:col findings with stable codes."""
+    """Check model files and print file:line:col findings with stable codes.
+
+    FILES may be .body, .urdf, .xacro, .sdf/.world or MJCF (.xml/.mjcf); KEY:=VALUE words are
+    passed to xacro as arguments.
+    """
     from modelkit.api import validate as validate_file
     from modelkit.codes import resolve
 
@@ -140,7 +166,10 @@ def validate(
         if info is None:
             raise click.BadParameter(f"unknown code {item!r}", param_hint="--ignore")
         silenced.add(info.code)
-    options = _body_options(kwargs, check_resources=not no_resources)
+    files, xacro_args = split_xacro_args(words)
+    if not files:
+        raise click.UsageError("no model file given")
+    options = _read_options(kwargs, not no_resources, xacro_args)
     findings: list[Diagnostic] = []
     unreadable = False
     for path in files:
@@ -169,6 +198,7 @@ def validate(
 
 @main.command()
 @click.argument("file", type=click.Path(path_type=Path))
+@click.argument("xacro_words", nargs=-1, metavar="[KEY:=VALUE]...")
 @click.option(
     "--order",
     type=click.Choice(["joint-name", "document"]),
@@ -185,12 +215,20 @@ def validate(
     help="text: the check_urdf report; json: the tree with joint types and origins.",
 )
 @reading_options
-def tree(file: Path, order: str, output_format: str, **kwargs: Any) -> None:
-    """Print the kinematic tree exactly as check_urdf does."""
+def tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: str, **kwargs: Any) -> None:
+    """Print the kinematic tree exactly as check_urdf does.
+
+    Works for every format. An SDF world prints one report per model, in document order.
+    """
     from modelkit.api import validate as validate_file
     from modelkit.tree import tree_json, tree_report
 
-    options = _body_options(kwargs, check_resources=False)
+    extra_files, xacro_args = split_xacro_args(xacro_words)
+    if extra_files:
+        raise click.UsageError(
+            f"tree takes one file; unexpected {extra_files[0]} (xacro arguments are KEY:=VALUE)"
+        )
+    options = _read_options(kwargs, False, xacro_args)
     result = validate_file(file, options, kwargs["input_format"], str(file))
     blocking = [
         d
@@ -198,13 +236,14 @@ def tree(file: Path, order: str, output_format: str, **kwargs: Any) -> None:
         if d.severity is Severity.ERROR
         and (d.code.startswith("MK2") or d.code.startswith("MK0") or result.robot is None)
     ]
-    if result.robot is None or result.robot.root is None or blocking:
+    if not result.robots or any(r.root is None for r in result.robots) or blocking:
         for d in blocking or [d for d in result.diagnostics if d.severity is Severity.ERROR]:
             click.echo(render_text(d), err=True)
         click.echo("ERROR: the kinematic tree cannot be built", err=True)
         sys.exit(2 if any(d.code in UNREADABLE_CODES for d in result.diagnostics) else 1)
     render = tree_json if output_format == "json" else tree_report
-    click.echo(render(result.robot, order), nl=False)  # type: ignore[arg-type]
+    for robot in result.robots:
+        click.echo(render(robot, order), nl=False)  # type: ignore[arg-type]
     errors = len(result.errors)
     if errors:
         click.echo(f"note: {file} has {errors} other error(s); run `modelkit validate {file}`", err=True)

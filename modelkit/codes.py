@@ -6,7 +6,7 @@ renumbered; retired codes stay in the table marked ``retired``.
 
 Ranges: MK0xx file and YAML layer; MK1xx schema and document header; MK2xx kinematic tree;
 MK3xx mass properties, joints and transforms; MK4xx geometry; MK5xx resources and materials;
-MK6xx devices and scene nodes.
+MK6xx devices and scene nodes; MK7xx xacro expansion.
 """
 
 from __future__ import annotations
@@ -58,7 +58,17 @@ _TABLE: tuple[CodeInfo, ...] = (
     CodeInfo("MK017", "yaml-top-not-mapping", "error", "The top-level YAML node is not a mapping."),
     CodeInfo("MK018", "yaml-empty-key", "error", "A mapping has an empty key."),
     CodeInfo("MK019", "yaml-complex-key", "error", "A mapping key is not a scalar."),
+    CodeInfo("MK020", "xml-syntax", "error", "The XML is malformed."),
+    CodeInfo(
+        "MK021",
+        "xml-entity-refused",
+        "error",
+        "The XML declares entities (`<!ENTITY>`); they are refused (entity bombs, file reads).",
+    ),
+    CodeInfo("MK022", "xml-root-unexpected", "error", "The top XML element is not the one the format needs."),
     # -- MK1xx: schema and header ----------------------------------------------------------
+    # MK100-MK119: .body schema and header; MK120-MK129: XML elements and attributes (all XML
+    # formats); MK130-MK149: URDF; MK150-MK169: SDF; MK170-MK179: MJCF.
     CodeInfo("MK100", "schema-type", "error", "A value has the wrong type or shape."),
     CodeInfo("MK101", "schema-required", "error", "A required key is missing."),
     CodeInfo("MK102", "schema-enum", "error", "A value is not one of the allowed words."),
@@ -94,6 +104,20 @@ _TABLE: tuple[CodeInfo, ...] = (
         "info",
         "A top-level key that only holds YAML anchors; the loader ignores it.",
     ),
+    # -- MK12x: XML elements and attributes (URDF, SDF, MJCF) ----------------------------------
+    CodeInfo("MK120", "xml-attribute-missing", "error", "A required XML attribute is missing."),
+    CodeInfo("MK121", "xml-value-invalid", "error", "An XML attribute or text is not a valid value."),
+    CodeInfo("MK122", "xml-element-missing", "error", "A required XML element is missing."),
+    CodeInfo(
+        "MK123", "xml-element-unknown", "warning", "An XML element or attribute is not part of the format."
+    ),
+    CodeInfo("MK124", "xml-element-repeated", "warning", "An element that may appear once appears again."),
+    # -- MK13x/MK14x: URDF ------------------------------------------------------------------
+    # (urdf section)
+    # -- MK15x/MK16x: SDF -------------------------------------------------------------------
+    # (sdf section)
+    # -- MK17x: MJCF ------------------------------------------------------------------------
+    # (mjcf section)
     # -- MK2xx: kinematic tree --------------------------------------------------------------
     CodeInfo("MK200", "no-root", "error", "No root link can be found (every link has a parent, or a cycle)."),
     CodeInfo("MK201", "multiple-roots", "error", "More than one link has no parent."),
@@ -154,6 +178,7 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "`jointSurfaceVelocity` is deprecated; use `joint_type: pseudo_continuous_track`.",
     ),
+    # (urdf tree MK220-MK229) (sdf frames and poses MK230-MK249)
     # -- MK3xx: mass properties, joints, transforms ---------------------------------------------
     CodeInfo("MK300", "mass-not-positive", "error", "A link's mass is zero or negative."),
     CodeInfo("MK301", "inertia-asymmetric", "error", "A 9-element inertia matrix is not symmetric."),
@@ -214,6 +239,7 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "A velocity range has its lower bound above its upper.",
     ),
+    # (urdf joints and mass MK320-MK339) (sdf joints and inertials MK340-MK359)
     # -- MK4xx: geometry -------------------------------------------------------------------------
     CodeInfo("MK400", "primitive-invalid", "error", "A primitive's dimensions cannot generate a shape."),
     CodeInfo(
@@ -276,6 +302,7 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "An Extrusion orientation axis is not unit length (Choreonoid uses it unnormalised).",
     ),
+    # (urdf/sdf/mjcf geometry MK420-MK439)
     # -- MK5xx: resources and materials -----------------------------------------------------------
     CodeInfo(
         "MK500",
@@ -305,6 +332,7 @@ _TABLE: tuple[CodeInfo, ...] = (
     ),
     CodeInfo("MK510", "package-uri", "info", "A `package://` URI depends on the environment."),
     CodeInfo("MK511", "materials-file-invalid", "error", "The contact materials file cannot be read."),
+    # (urdf materials and resources MK512-MK529) (sdf resources MK530-MK549)
     # -- MK6xx: devices and scene nodes ----------------------------------------------------------
     CodeInfo(
         "MK600",
@@ -331,6 +359,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "`material` directly in a Shape is ignored; put it under `appearance`.",
     ),
+    # (urdf gazebo extensions MK620-MK629) (sdf sensors, lights, plugins MK630-MK649)
+    # -- MK7xx: xacro -----------------------------------------------------------------------
+    # (xacro MK700-MK719)
 )
 
 CODES: dict[str, CodeInfo] = {c.code: c for c in _TABLE}
@@ -353,5 +384,20 @@ def markdown_table() -> str:
     return "\n".join(lines) + "\n"
 
 
+def write_docs(path: str = "docs/codes.md") -> None:
+    """Replace the generated table in ``docs/codes.md`` (everything after the marker)."""
+    from pathlib import Path
+
+    marker = "<!-- generated: codes table -->\n"
+    doc = Path(path)
+    head = doc.read_text(encoding="utf-8").split(marker, 1)[0]
+    doc.write_text(head + marker + markdown_table(), encoding="utf-8")
+
+
 if __name__ == "__main__":  # pragma: no cover - documentation generator
-    print(markdown_table(), end="")
+    import sys
+
+    if "--write" in sys.argv:
+        write_docs()
+    else:
+        print(markdown_table(), end="")

@@ -191,6 +191,16 @@ class JointLimits:
 
 
 @dataclass(eq=False)
+class Mimic:
+    """This joint follows another: q = multiplier · q_leader + offset (URDF/SDF mimic, MJCF equality)."""
+
+    joint: str
+    multiplier: float = 1.0
+    offset: float = 0.0
+    source: SourceLocation | None = None
+
+
+@dataclass(eq=False)
 class Joint:
     name: str
     type: JointType
@@ -200,6 +210,9 @@ class Joint:
     axis: Vec3 = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))  # in the child frame
     limits: JointLimits = field(default_factory=JointLimits)
     armature: float = 0.0
+    damping: float = 0.0  # viscous, N·m·s/rad or N·s/m
+    friction: float = 0.0  # Coulomb (dry) friction, N·m or N
+    mimic: Mimic | None = None
     initial_position: float = 0.0
     joint_id: int | None = None
     actuation_mode: str | None = None

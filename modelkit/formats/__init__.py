@@ -1,15 +1,17 @@
 """The format registry: which reader handles which file.
 
-Readers are imported lazily so that `validate` and `tree` load only what the input needs.
+Readers are imported lazily so that `validate` and `tree` load only what the input needs (mujoco
+only for MJCF input, which it reads).
 """
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass
 from pathlib import Path
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
-from modelkit.formats.body.reader import BodyOptions, ReadResult
+from modelkit.formats.common import ReadOptions, ReadResult
 
 
 @dataclass(frozen=True)
@@ -17,38 +19,76 @@ class FormatInfo:
     name: str
     suffixes: tuple[str, ...]
     description: str
+    reader: str  # "module:function", imported on first use
+    root_tags: tuple[str, ...] = ()  # the top XML element that identifies the format
 
 
 FORMATS: tuple[FormatInfo, ...] = (
-    FormatInfo("body", (".body",), "Choreonoid body file (YAML), format 1.0 and 2.0"),
+    FormatInfo(
+        "body",
+        (".body",),
+        "Choreonoid body file (YAML), format 1.0 and 2.0",
+        "modelkit.formats.body.reader:read_body",
+    ),
+    FormatInfo(
+        "xacro",
+        (".xacro",),
+        "xacro macro file, expanded to URDF (legacy xacro detected)",
+        "modelkit.formats.xacro.reader:read_xacro",
+    ),
+    FormatInfo(
+        "urdf", (".urdf",), "URDF 1.0-1.2", "modelkit.formats.urdf.reader:read_urdf", root_tags=("robot",)
+    ),
+    FormatInfo(
+        "sdf",
+        (".sdf", ".world"),
+        "SDFormat 1.4-1.11 (models and worlds)",
+        "modelkit.formats.sdf.reader:read_sdf",
+        root_tags=("sdf",),
+    ),
+    FormatInfo(
+        "mjcf",
+        (".mjcf",),
+        "MuJoCo MJCF (read through mujoco)",
+        "modelkit.formats.mjcf.reader:read_mjcf",
+        root_tags=("mujoco",),
+    ),
 )
+FORMAT_NAMES: tuple[str, ...] = tuple(info.name for info in FORMATS)
 
 
 def detect_format(path: Path, explicit: str | None = None) -> str | None:
+    """The format of ``path``: by extension, else by its top XML element (``.xml`` files)."""
     if explicit:
         return explicit
     name = path.name.lower()
     for info in FORMATS:
         if any(name.endswith(s) for s in info.suffixes):
             return info.name
+    from modelkit.xmlsource import sniff_root_tag
+
+    tag = sniff_root_tag(path)
+    for info in FORMATS:
+        if tag is not None and tag in info.root_tags:
+            return info.name
     return None
 
 
 def read_model(
-    path: Path, options: BodyOptions | None = None, fmt: str | None = None, display: str | None = None
+    path: Path, options: ReadOptions | None = None, fmt: str | None = None, display: str | None = None
 ) -> ReadResult:
     """Read any supported model file; an unknown format is a diagnostic, not an exception."""
     shown = display or str(path)
     kind = detect_format(path, fmt)
-    if kind == "body":
-        from modelkit.formats.body.reader import read_body
-
-        return read_body(path, options, shown)
+    for info in FORMATS:
+        if info.name == kind:
+            module_name, _, function = info.reader.partition(":")
+            reader = getattr(importlib.import_module(module_name), function)
+            result: ReadResult = reader(path, options or ReadOptions(), shown)
+            return result
     sink = DiagnosticSink()
     known = ", ".join(s for info in FORMATS for s in info.suffixes)
-    sink.emit(
-        "MK001",
-        f"cannot tell the format of this file (supported: {known}); use --input-format",
-        SourceLocation(shown),
-    )
+    message = f"cannot tell the format of this file (supported: {known}, or .xml with a <robot>, "
+    message += "<sdf> or <mujoco> top element); use --input-format"
+    sink.emit("MK001", message, SourceLocation(shown))
     return ReadResult(None, sink.items)

@@ -8,21 +8,19 @@ shared docs) is the specification; section numbers below refer to it.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from modelkit.diagnostics import Diagnostic, DiagnosticSink, SourceLocation, sorted_diagnostics
+from modelkit.diagnostics import DiagnosticSink, SourceLocation, sorted_diagnostics
 from modelkit.formats.body import values as v
 from modelkit.formats.body.elements import Collected, WalkContext, inertia_matrix, walk
 from modelkit.formats.body.materials import MaterialTable, load_materials
+from modelkit.formats.common import ReadOptions, ReadResult
 from modelkit.model import Inertial, Joint, JointLimits, JointType, Link, LoopConstraint, Robot
-from modelkit.resources import Resolver
 from modelkit.spatial import Pose, combine_mass_properties
 from modelkit.yamltree import (
-    DEFAULT_EXPANSION_LIMIT,
-    DEFAULT_MAX_BYTES,
     YMap,
     YNode,
     YScalar,
@@ -67,20 +65,8 @@ LIMIT_KEYS = (
 MASS_KEYS = ("mass", "center_of_mass", "centerOfMass", "inertia")
 
 
-@dataclass
-class BodyOptions:
-    resolver: Resolver = field(default_factory=Resolver)
-    materials_path: Path | None = None
-    faithful_extrusion: bool = True
-    check_resources: bool = True
-    max_bytes: int = DEFAULT_MAX_BYTES
-    expansion_limit: int = DEFAULT_EXPANSION_LIMIT
-
-
-@dataclass
-class ReadResult:
-    robot: Robot | None
-    diagnostics: list[Diagnostic]
+# The .body reader takes the shared reading options; the old name stays for callers.
+BodyOptions = ReadOptions
 
 
 @dataclass

@@ -1,0 +1,94 @@
+"""Mesh references in XML formats (URDF, SDF): resolve the URI and check the file, with diagnostics.
+
+The `.body` reader has its own variant (Choreonoid's resource nodes carry fragments and metadata);
+this one serves formats whose meshes are plain ``uri`` + ``scale``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
+from modelkit.model import Mesh
+from modelkit.resources import Resolver
+
+MESH_FILE_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl"})
+
+
+@dataclass
+class MeshChecker:
+    """Resolves mesh URIs for one model file and loads each mesh file at most once."""
+
+    resolver: Resolver
+    base_dir: Path
+    model_file: Path | None
+    sink: DiagnosticSink
+    check_resources: bool = True
+    _loaded: dict[str, str | None] = field(default_factory=dict)
+
+    def mesh(
+        self,
+        uri: str,
+        loc: SourceLocation,
+        scale: tuple[float, float, float] = (1.0, 1.0, 1.0),
+        visual_only: bool = False,
+        submesh: str | None = None,
+    ) -> Mesh:
+        """A :class:`Mesh` for ``uri``; unresolvable or unloadable files are reported at ``loc``.
+
+        A problem with a mesh used only for display is a warning; for collision it is an error.
+        """
+        resolution = self.resolver.resolve(uri, self.base_dir, self.model_file)
+        severity = Severity.WARNING if visual_only else None
+        usage = " (visual only)" if visual_only else ""
+        path = resolution.path
+        if resolution.code is not None:
+            self.sink.emit(
+                resolution.code,
+                (resolution.message or uri) + usage,
+                loc,
+                hint=resolution.hint,
+                severity=severity,
+            )
+        elif path is not None:
+            if resolution.scheme == "package":
+                self.sink.emit("MK510", f'"{uri}" depends on the package search path; found at {path}', loc)
+            suffix = path.suffix.lower()
+            if not path.exists():
+                self.sink.emit(
+                    "MK500", f'resource "{uri}" not found at {path}{usage}', loc, severity=severity
+                )
+            elif suffix not in MESH_FILE_EXTENSIONS:
+                self.sink.emit(
+                    "MK506",
+                    f'resource "{uri}": {suffix or "no extension"} files are not supported '
+                    "(supported: .stl .obj .dae .wrl)",
+                    loc,
+                    severity=severity,
+                )
+            elif self.check_resources:
+                problem = self._load(path, submesh)
+                if problem:
+                    code, message = problem.split("\t", 1)
+                    self.sink.emit(code, f'resource "{uri}": {message}{usage}', loc, severity=severity)
+        return Mesh(
+            uri=uri,
+            path=str(path) if path is not None else None,
+            fragment=submesh,
+            scale=np.asarray(scale, dtype=float),
+        )
+
+    def _load(self, path: Path, fragment: str | None) -> str | None:
+        key = f"{path}\t{fragment or ''}"
+        if key not in self._loaded:
+            from modelkit.geometry import meshfiles
+
+            try:
+                meshfiles.load_mesh(path, fragment)
+                self._loaded[key] = None
+            except meshfiles.MeshLoadError as exc:
+                self._loaded[key] = f"{exc.code}\t{exc}"
+        return self._loaded[key]
