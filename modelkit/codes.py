@@ -178,7 +178,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "`jointSurfaceVelocity` is deprecated; use `joint_type: pseudo_continuous_track`.",
     ),
-    # (urdf tree MK220-MK229) (sdf frames and poses MK230-MK249)
+    CodeInfo(
+        "MK220",
+        "link-multiple-parents",
+        "error",
+        "A link is the child of two joints (check_urdf misses it when both parents share a root).",
+    ),
+    # (urdf tree MK221-MK229) (sdf frames and poses MK230-MK249)
     # -- MK3xx: mass properties, joints, transforms ---------------------------------------------
     CodeInfo("MK300", "mass-not-positive", "error", "A link's mass is zero or negative."),
     CodeInfo("MK301", "inertia-asymmetric", "error", "A 9-element inertia matrix is not symmetric."),
@@ -239,7 +245,20 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "A velocity range has its lower bound above its upper.",
     ),
-    # (urdf joints and mass MK320-MK339) (sdf joints and inertials MK340-MK359)
+    CodeInfo("MK320", "mimic-target-undefined", "error", "A mimic joint follows a joint that does not exist."),
+    CodeInfo(
+        "MK321",
+        "mimic-target-invalid",
+        "error",
+        "A mimic joint follows itself, a joint that is not 1-DOF, or a loop of mimic joints.",
+    ),
+    CodeInfo(
+        "MK322",
+        "massless-link-dropped",
+        "warning",
+        "libsdformat (Gazebo) would silently drop this massless URDF link and its subtree.",
+    ),
+    # (urdf joints and mass MK323-MK339) (sdf joints and inertials MK340-MK359)
     # -- MK4xx: geometry -------------------------------------------------------------------------
     CodeInfo("MK400", "primitive-invalid", "error", "A primitive's dimensions cannot generate a shape."),
     CodeInfo(
@@ -332,7 +351,13 @@ _TABLE: tuple[CodeInfo, ...] = (
     ),
     CodeInfo("MK510", "package-uri", "info", "A `package://` URI depends on the environment."),
     CodeInfo("MK511", "materials-file-invalid", "error", "The contact materials file cannot be read."),
-    # (urdf materials and resources MK512-MK529) (sdf resources MK530-MK549)
+    CodeInfo(
+        "MK512",
+        "mesh-collada-mujoco",
+        "warning",
+        "A URDF mesh is COLLADA (.dae), which MuJoCo cannot load.",
+    ),
+    # (urdf materials and resources MK513-MK529) (sdf resources MK530-MK549)
     # -- MK6xx: devices and scene nodes ----------------------------------------------------------
     CodeInfo(
         "MK600",

@@ -1,0 +1,203 @@
+"""Rules about what other tools will do with a model: findings a user wants before converting.
+
+Each rule names the tool whose behaviour it predicts (libsdformat's URDF→SDF conversion, MuJoCo's
+URDF loader, PyBullet) so a user knows why a file that passes ``check_urdf`` still fails elsewhere.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import PurePosixPath
+
+from modelkit.checks.registry import rule
+from modelkit.diagnostics import Diagnostic, diag
+from modelkit.model import Joint, JointType, Robot
+
+URDF_FORMATS = frozenset({"urdf", "xacro"})
+ONE_DOF = frozenset({JointType.REVOLUTE, JointType.PRISMATIC})
+
+
+@rule("link-multiple-parents", "MK220")
+def multiple_parents(robot: Robot) -> Iterator[Diagnostic]:
+    """A link is the child of one joint only (check_urdf misses this when both parents share a root).
+
+    MuJoCo refuses such a file, libsdformat drops a joint, PyBullet crashes and yourdfpy raises.
+    """
+    defined: dict[str, int] = {}
+    for link in robot.links:
+        defined[link.name] = defined.get(link.name, 0) + 1
+    first: dict[str, Joint] = {}
+    for joint in robot.joints:
+        if defined.get(joint.child, 0) > 1:
+            continue  # two links of that name: the duplicate name is the fault (MK204)
+        earlier = first.get(joint.child)
+        if earlier is None:
+            first[joint.child] = joint
+            continue
+        where = earlier.loc("child")
+        line = f" at line {where.line}" if where and where.line else ""
+        yield diag(
+            "MK220",
+            f'link "{joint.child}" has a second parent: joint "{joint.name}" attaches it to '
+            f'"{joint.parent}", but joint "{earlier.name}"{line} already attaches it to "{earlier.parent}"',
+            joint.loc("child"),
+            hint="a kinematic tree gives each link one parent joint; model a closed loop another way",
+        )
+
+
+@rule("mimic-targets", "MK320", "MK321")
+def mimic_targets(robot: Robot) -> Iterator[Diagnostic]:
+    """A mimic joint follows an existing one-degree-of-freedom joint other than itself, without a loop."""
+    by_name: dict[str, Joint] = {}
+    for joint in robot.joints:
+        by_name.setdefault(joint.name, joint)
+    for joint in robot.joints:
+        mimic = joint.mimic
+        if mimic is None:
+            continue
+        where = mimic.source or joint.loc("mimic")
+        leader = by_name.get(mimic.joint)
+        if leader is None:
+            yield diag(
+                "MK320",
+                f'joint "{joint.name}" mimics "{mimic.joint}", which is not a joint of this robot',
+                where,
+                hint=_closest(mimic.joint, by_name),
+            )
+        elif leader is joint:
+            yield diag("MK321", f'joint "{joint.name}" mimics itself', where)
+        elif leader.type not in ONE_DOF:
+            yield diag(
+                "MK321",
+                f'joint "{joint.name}" mimics "{leader.name}", a {leader.type.value} joint; only '
+                "revolute, continuous and prismatic joints can be followed",
+                where,
+            )
+        elif _mimic_loop(joint, by_name):
+            yield diag("MK321", f'joint "{joint.name}" is part of a loop of mimic joints', where)
+
+
+def _mimic_loop(start: Joint, by_name: dict[str, Joint]) -> bool:
+    seen = {start.name}
+    current: Joint | None = start
+    while current is not None and current.mimic is not None:
+        current = by_name.get(current.mimic.joint)
+        if current is None:
+            return False
+        if current.name in seen:
+            return current.name == start.name
+        seen.add(current.name)
+    return False
+
+
+def _closest(name: str, candidates: dict[str, Joint]) -> str | None:
+    import difflib
+
+    match = difflib.get_close_matches(name, list(candidates), n=1)
+    return f'did you mean "{match[0]}"?' if match else None
+
+
+@rule("massless-links-dropped", "MK322")
+def massless_links_dropped(robot: Robot) -> Iterator[Diagnostic]:
+    """Links libsdformat's URDF→SDF conversion (Gazebo) would drop, with their whole subtree.
+
+    libsdformat first merges every link hung on a fixed joint into its parent (fixed-joint lumping),
+    then leaves out any remaining link without ``<inertial>`` or with zero mass, and everything below
+    it, with no message on the console. A link named ``world`` is exempt.
+    """
+    if robot.source_format not in URDF_FORMATS or robot.root is None:
+        return
+    children: dict[str, list[Joint]] = {}
+    for joint in robot.joints:
+        children.setdefault(joint.parent, []).append(joint)
+    links = {link.name: link for link in robot.links}
+    lumped_mass = _lumped_masses(robot, children)
+    if robot.root != "world" and lumped_mass.get(robot.root, 0.0) <= 0.0 and robot.root in links:
+        yield diag(
+            "MK322",
+            f'the root link "{robot.root}" has no mass, even after merging the links fixed to it: '
+            "libsdformat/Gazebo would silently leave out the whole robot",
+            links[robot.root].loc("name"),
+            hint="give the root an <inertial>, or add a \"world\" root link with a fixed joint",
+        )
+        return
+    stack = [robot.root]
+    seen: set[str] = set()
+    while stack:
+        name = stack.pop()
+        if name in seen:
+            continue
+        seen.add(name)
+        for joint in children.get(name, []):
+            child = joint.child
+            if joint.type is JointType.FIXED and name != "world":
+                stack.append(child)  # merged into its parent: judged with it
+                continue
+            if child != "world" and lumped_mass.get(child, 0.0) <= 0.0 and child in links:
+                lost = _subtree_size(child, children)
+                below = f" and the {lost - 1} link(s) below it" if lost > 1 else ""
+                yield diag(
+                    "MK322",
+                    f'link "{child}" has no mass (no <inertial>, or mass 0, after merging the links '
+                    f"fixed to it): libsdformat/Gazebo would silently leave it out{below}",
+                    links[child].loc("name"),
+                    hint="give the link an <inertial> with a small positive mass, or attach it with a "
+                    "fixed joint so it is merged into its parent",
+                )
+                continue
+            stack.append(child)
+
+
+def _lumped_masses(robot: Robot, children: dict[str, list[Joint]]) -> dict[str, float]:
+    """Each link's mass after fixed-joint lumping (a lumped child adds its mass to its parent)."""
+    own = {link.name: (link.inertial.mass if link.inertial is not None else 0.0) for link in robot.links}
+    total: dict[str, float] = {}
+    order: list[str] = []
+    stack = [robot.root] if robot.root else []
+    seen: set[str] = set()
+    while stack:
+        name = stack.pop()
+        if name in seen:
+            continue
+        seen.add(name)
+        order.append(name)
+        stack.extend(j.child for j in children.get(name, []))
+    for name in reversed(order):
+        mass = max(own.get(name, 0.0), 0.0)
+        for joint in children.get(name, []):
+            if joint.type is JointType.FIXED and name != "world":
+                mass += total.get(joint.child, 0.0)
+        total[name] = mass
+    return total
+
+
+def _subtree_size(name: str, children: dict[str, list[Joint]]) -> int:
+    seen: set[str] = set()
+    stack = [name]
+    while stack:
+        current = stack.pop()
+        if current in seen:
+            continue
+        seen.add(current)
+        stack.extend(j.child for j in children.get(current, []))
+    return len(seen)
+
+
+@rule("collada-for-mujoco", "MK512")
+def collada_for_mujoco(robot: Robot) -> Iterator[Diagnostic]:
+    """COLLADA meshes in a URDF: MuJoCo cannot load them ("no decoder found for mesh file")."""
+    if robot.source_format not in URDF_FORMATS:
+        return
+    seen: set[str] = set()
+    for link in robot.links:
+        for geom in [*link.visuals, *link.collisions]:
+            uri = getattr(geom.geometry, "uri", None)
+            if not uri or PurePosixPath(uri.split("?")[0]).suffix.lower() != ".dae" or uri in seen:
+                continue
+            seen.add(uri)
+            yield diag(
+                "MK512",
+                f'mesh "{uri}" is COLLADA: MuJoCo cannot load it from this URDF',
+                geom.source or link.loc("name"),
+                hint="`modelkit convert` writes it as STL/OBJ for MuJoCo; or use an STL/OBJ copy in the URDF",
+            )
