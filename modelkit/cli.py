@@ -17,6 +17,9 @@ from modelkit.diagnostics import Diagnostic, Severity, render_github, render_jso
 
 F = TypeVar("F", bound=Callable[..., Any])
 UNREADABLE_CODES = frozenset({"MK001", "MK002"})
+# Tree errors after which the tree can still be printed as check_urdf prints it: a joint named like a
+# link (legal URDF), a link with two parents under one root (check_urdf prints it twice).
+TREE_PRINTABLE_CODES = frozenset({"MK211", "MK220"})
 
 
 def _pairs(values: tuple[str, ...], option: str) -> dict[str, Path]:
@@ -234,10 +237,11 @@ def tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: st
         d
         for d in result.diagnostics
         if d.severity is Severity.ERROR
+        and d.code not in TREE_PRINTABLE_CODES
         and (d.code.startswith("MK2") or d.code.startswith("MK0") or result.robot is None)
     ]
     if not result.robots or any(r.root is None for r in result.robots) or blocking:
-        for d in blocking or [d for d in result.diagnostics if d.severity is Severity.ERROR]:
+        for d in blocking or result.errors or result.diagnostics:
             click.echo(render_text(d), err=True)
         click.echo("ERROR: the kinematic tree cannot be built", err=True)
         sys.exit(2 if any(d.code in UNREADABLE_CODES for d in result.diagnostics) else 1)

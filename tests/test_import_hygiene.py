@@ -1,6 +1,10 @@
 """`modelkit validate` and `modelkit tree` must not import the simulators (mujoco, pybullet), nor
 the mesh stack (trimesh) for a model that has no mesh files.
 
+MJCF input is the only exception: an MJCF file is read through MuJoCo, so reading one imports
+mujoco (inside ``modelkit.formats.mjcf``, when the file is read). pybullet is never imported, and
+other XML files (a URDF named ``.xml``, told apart by its top element) do not import mujoco.
+
 Each command runs in a fresh interpreter (the test process has imported who knows what). The
 child puts a recording finder first on ``sys.meta_path`` before importing modelkit, so an import
 *attempt* is caught even where the package is not installed (as in CI, where a guarded
@@ -110,3 +114,35 @@ def test_no_simulator_for_the_whole_corpus() -> None:
     loaded = [m for m in report["modules"] if m.partition(".")[0] in SIMULATORS]
     assert loaded == [], f"`modelkit validate` imported {loaded}"
     assert report["attempted"] == [], f"`modelkit validate` tried to import {report['attempted']}"
+
+
+MJCF_MODEL = PROJECT_ROOT / "tests" / "mjcf" / "pendulum.xml"
+URDF_AS_XML = """\
+<robot name="r">
+  <link name="a"/>
+  <link name="b"/>
+  <joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>
+</robot>
+"""
+
+
+@pytest.mark.parametrize("command", [["validate"], ["tree"]], ids=["validate", "tree"])
+def test_mjcf_input_is_the_only_exception(command: list[str]) -> None:
+    """An MJCF file is read through MuJoCo: mujoco is imported for it; pybullet still never."""
+    report = _run([*command, str(MJCF_MODEL)], SIMULATORS)
+    assert report["exit_code"] == 0, report["output"]
+    assert "mujoco" in report["modules"]
+    assert "modelkit.formats.mjcf.reader" in report["modules"]
+    assert [m for m in report["modules"] if m.partition(".")[0] == "pybullet"] == []
+    assert [m for m in report["attempted"] if m.partition(".")[0] == "pybullet"] == []
+
+
+def test_other_xml_input_does_not_import_mujoco(tmp_path: Path) -> None:
+    """Telling MJCF from URDF in a ``.xml`` file reads its top element, not mujoco."""
+    path = tmp_path / "robot.xml"
+    path.write_text(URDF_AS_XML)
+    report = _run(["tree", str(path)], SIMULATORS)
+    assert "modelkit.cli" in report["modules"]
+    assert not any(m.startswith("modelkit.formats.mjcf") for m in report["modules"])
+    loaded = [m for m in report["modules"] if m.partition(".")[0] in SIMULATORS]
+    assert loaded == [] and report["attempted"] == []

@@ -34,6 +34,33 @@ def _moving_links(robot: Robot) -> set[str]:
     return moving
 
 
+def _merged_masses(robot: Robot) -> dict[str, float]:
+    """Mass of each rigid body, keyed by its top link; a link on a fixed joint counts as massive.
+
+    Links joined by fixed joints form one rigid body. The top link gets the body's total mass; a
+    link attached by a fixed joint gets +inf, since its own mass does not matter on its own.
+    """
+    fixed_children: dict[str, list[str]] = {}
+    for joint in robot.joints:
+        if joint.type is JointType.FIXED:
+            fixed_children.setdefault(joint.parent, []).append(joint.child)
+    own = {link.name: max(link.inertial.mass, 0.0) if link.inertial else 0.0 for link in robot.links}
+    out = {child: float("inf") for children in fixed_children.values() for child in children}
+    for link in robot.links:
+        if link.name in out:
+            continue
+        total, stack, seen = 0.0, [link.name], set()
+        while stack:
+            name = stack.pop()
+            if name in seen:
+                continue
+            seen.add(name)
+            total += own.get(name, 0.0)
+            stack.extend(fixed_children.get(name, []))
+        out[link.name] = total
+    return out
+
+
 def _mass_loc(link: Link) -> SourceLocation | None:
     inertial = link.inertial
     if inertial is None:
@@ -45,10 +72,15 @@ def _mass_loc(link: Link) -> SourceLocation | None:
 def mass(robot: Robot) -> Iterator[Diagnostic]:
     """Masses are positive where it matters; default mass properties are flagged."""
     moving = _moving_links(robot)
+    merged = _merged_masses(robot)
     for link in robot.links:
         inertial = link.inertial
+        if link.extras.get("synthesised"):
+            continue  # a link the reader made up (an MJCF multi-joint body's intermediate frames)
         if inertial is None:
-            if link.name in moving:
+            # A link without mass information (URDF/SDF) hung on a fixed joint is part of its
+            # parent's rigid body, and engines merge it; the body as a whole needs mass.
+            if link.name in moving and merged.get(link.name, 0.0) <= 0.0:
                 yield diag("MK313", f'link "{link.name}" moves but has no mass', link.loc("name"))
             continue
         if inertial.defaulted and link.name in moving:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Iterator
 
 from modelkit.checks.registry import rule
@@ -39,11 +40,28 @@ def parents_exist(robot: Robot) -> Iterator[Diagnostic]:
     """Every joint's parent link exists."""
     names = {link.name for link in robot.links}
     for joint in robot.joints:
-        if joint.parent not in names:
+        if joint.parent in names:
+            continue
+        if joint.extras.get("implicit_name"):  # .body: the joint is its link
             yield diag(
                 "MK202",
                 f'parent link "{joint.parent}" of "{joint.child}" is not defined',
                 joint.loc("parent"),
+            )
+        elif joint.parent == "":
+            yield diag(
+                "MK202",
+                f'joint "{joint.name}" names no parent link',
+                joint.loc("parent"),
+                hint='add <parent link="..."/>',
+            )
+        else:
+            close = difflib.get_close_matches(joint.parent, sorted(names), n=1)
+            yield diag(
+                "MK202",
+                f'parent link "{joint.parent}" of joint "{joint.name}" is not defined',
+                joint.loc("parent"),
+                hint=f'did you mean "{close[0]}"?' if close else None,
             )
 
 
@@ -55,6 +73,8 @@ def single_root(robot: Robot) -> Iterator[Diagnostic]:
     children = {j.child for j in robot.joints}
     roots = [link for link in robot.links if link.name not in children]
     if not roots and robot.links:
+        if any(True for _ in no_cycles(robot)):
+            return  # every link has a parent because of a cycle: no-cycles reports it, with its path
         yield diag("MK200", "no root link found: every link has a parent", robot.links[0].loc("name"))
     elif len(roots) > 1:
         names = ", ".join(f'"{r.name}"' for r in roots)

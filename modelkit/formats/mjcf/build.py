@@ -1,0 +1,470 @@
+"""MuJoCo bodies → robots of the model.
+
+The mapping (``docs/mjcf.md`` says it for users):
+
+* each MuJoCo body is a link; the world body is not one;
+* the model's link frame is its joint frame, so a body whose joint sits at ``pos`` ≠ 0 gets a link
+  frame moved to that point (``extras["mjcf_body_offset"]``), and its inertia, geoms and children
+  are re-expressed there;
+* the model has one joint per link: a body with n joints becomes a chain of n links, the first
+  n − 1 of them massless and named ``<body>__<joint>``; a body with no joint hangs from its
+  parent on a synthesised fixed joint ``<parent>_to_<body>``;
+* a joint's q is MuJoCo's qpos: a joint ``ref`` is folded into the joint origin;
+* each top-level body starts a robot: free joint → floating root, no joint → fixed root at its
+  pose, other joints → a synthesised fixed ``world`` link they hang from.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from modelkit.diagnostics import DiagnosticSink, SourceLocation
+from modelkit.formats.mjcf.bodies import MjBody, MjGeom, MjJoint, MjSite, inverse, translation
+from modelkit.formats.mjcf.source import Locator
+from modelkit.model import (
+    Box,
+    Capsule,
+    Cylinder,
+    Ellipsoid,
+    Geom,
+    Geometry,
+    Inertial,
+    Joint,
+    JointLimits,
+    JointType,
+    Link,
+    Mesh,
+    Mimic,
+    Robot,
+    Sphere,
+    VisualMaterial,
+)
+from modelkit.spatial import Pose, axis_angle
+
+JOINT_TYPES = {
+    "hinge": JointType.REVOLUTE,
+    "slide": JointType.PRISMATIC,
+    "ball": JointType.BALL,
+    "free": JointType.FLOATING,
+}
+UNSUPPORTED_GEOMS = ("plane", "hfield", "sdf")
+WORLD_LINK = "world"
+
+
+@dataclass
+class Names:
+    """Deterministic, unique names for links and joints (generated names never shadow real ones)."""
+
+    links: set[str] = field(default_factory=set)
+    joints: set[str] = field(default_factory=set)
+
+    @staticmethod
+    def unique(wanted: str, taken: set[str]) -> str:
+        name, n = wanted, 1
+        while name in taken:
+            n += 1
+            name = f"{wanted}_{n}"
+        taken.add(name)
+        return name
+
+
+@dataclass
+class Built:
+    """The robots of one file and what the build learnt on the way."""
+
+    robots: list[Robot]  # the main robot (the largest tree) first, then the others in file order
+    joints: dict[int, Joint]  # MuJoCo joint index → model joint
+    robot_of_body: dict[int, Robot]
+
+
+class RobotBuilder:
+    """Turns the records of :mod:`.bodies` into robots, one per top-level body tree."""
+
+    def __init__(self, bodies: list[MjBody], locator: Locator, sink: DiagnosticSink, model_name: str) -> None:
+        self.bodies = {b.index: b for b in bodies}
+        self.order = [b.index for b in bodies]
+        self.loc = locator
+        self.sink = sink
+        self.model_name = model_name
+        self.names = Names()
+        self.link_name: dict[int, str] = {}
+        self.joint_name: dict[int, str] = {}
+        self.offset: dict[int, Pose] = {}
+        self.joints: dict[int, Joint] = {}
+
+    # -- names ---------------------------------------------------------------------------------
+
+    def _name_everything(self) -> None:
+        """Real names first (so generated ones cannot take them), then the generated ones."""
+        for b in self.order:
+            body = self.bodies[b]
+            if body.name:
+                self.link_name[b] = self.names.unique(body.name, self.names.links)
+            for joint in body.joints:
+                if joint.name:
+                    self.joint_name[joint.index] = self.names.unique(joint.name, self.names.joints)
+        for b in self.order:
+            body = self.bodies[b]
+            if not body.name:
+                self.link_name[b] = self.names.unique(f"body{b}", self.names.links)
+                self.sink.emit(
+                    "MK173", f'body {b} has no name; it is called "{self.link_name[b]}"', self.loc.body(b)
+                )
+            for k, joint in enumerate(body.joints):
+                if joint.name:
+                    continue
+                name = self.names.unique(f"joint{joint.index}", self.names.joints)
+                self.joint_name[joint.index] = name
+                if not (k == 0 and joint.kind == "free" and body.parent == 0):  # the root's: no Joint
+                    self.sink.emit(
+                        "MK173",
+                        f'a joint of body "{self.link_name[b]}" has no name; it is called "{name}"',
+                        self.loc.joint(joint.index),
+                    )
+
+    # -- robots --------------------------------------------------------------------------------
+
+    def build(self) -> Built:
+        self._name_everything()
+        tops = [b for b in self.order if self.bodies[b].parent == 0]
+        trees: dict[int, list[int]] = {t: [] for t in tops}
+        top_of: dict[int, int] = {}
+        for b in self.order:
+            parent = self.bodies[b].parent
+            top_of[b] = b if parent == 0 else top_of[parent]
+            trees[top_of[b]].append(b)
+        position = {t: i for i, t in enumerate(tops)}
+        main = max(tops, key=lambda t: (*self._size(trees[t]), -position[t])) if tops else None
+        robots: list[Robot] = []
+        robot_of_body: dict[int, Robot] = {}
+        for top in tops:
+            name = self.model_name if top == main else self.link_name[top]
+            robot = Robot(name=name, source_format="mjcf", source=self.loc.body(top))
+            for b in trees[top]:
+                self._body(robot, self.bodies[b])
+                robot_of_body[b] = robot
+            robots.append(robot)
+        if main is not None and len(tops) > 1:
+            others = ", ".join(f'"{self.link_name[t]}"' for t in tops if t != main)
+            self.sink.emit(
+                "MK176",
+                f"the worldbody holds {len(tops)} body trees; the robot is the largest one, "
+                f'"{self.link_name[main]}", and each other tree is a robot of its own: {others}',
+                self.loc.body(next(t for t in tops if t != main)),
+            )
+        ordered = []
+        if main is not None:
+            ordered = [robot_of_body[main], *(r for r in robots if r is not robot_of_body[main])]
+        return Built(ordered, self.joints, robot_of_body)
+
+    def _size(self, tree: list[int]) -> tuple[int, int]:
+        """How big a tree is: its bodies, then its joints (a jointed tree beats a static one)."""
+        return len(tree), sum(len(self.bodies[b].joints) for b in tree)
+
+    def _body(self, robot: Robot, body: MjBody) -> None:
+        joints = body.joints
+        movable = [j for j in joints if j.kind != "free"]
+        offset = translation(movable[-1].pos) if movable else Pose()
+        self.offset[body.index] = offset
+        link = self._link(body, offset)
+        if body.parent == 0:
+            start, pose = self._root(robot, body, joints)
+        else:
+            parent_offset = self.offset[body.parent]
+            start, pose = self.link_name[body.parent], inverse(parent_offset) @ body.pose
+        chain = joints[1:] if body.parent == 0 and joints and joints[0].kind == "free" else joints
+        self._chain(robot, body, start, pose, chain, link)
+        robot.links.append(link)
+
+    def _root(self, robot: Robot, body: MjBody, joints: list[MjJoint]) -> tuple[str, Pose]:
+        """Set the robot's root for a top-level body; return the link and pose its chain starts at."""
+        if not joints:
+            robot.root, robot.root_joint, robot.root_pose = (
+                self.link_name[body.index],
+                JointType.FIXED,
+                body.pose,
+            )
+            return "", Pose()
+        if joints[0].kind == "free":
+            robot.root_joint, robot.root_pose = JointType.FLOATING, body.pose
+            if len(joints) == 1:
+                robot.root = self.link_name[body.index]
+                return "", Pose()
+            # A free joint followed by others: the free body is a massless link of its own.
+            free = joints[0]
+            name = self.names.unique(
+                f"{self.link_name[body.index]}__{self.joint_name[free.index]}", self.names.links
+            )
+            robot.root = name
+            robot.links.append(self._intermediate(name, body, free))
+            return name, Pose()
+        world = Link(WORLD_LINK, source=self.loc.body(body.index), extras={"synthesised": True})
+        world.sources["name"] = self.loc.body(body.index)
+        if robot.link(WORLD_LINK) is None:
+            robot.links.append(world)
+        robot.root, robot.root_joint, robot.root_pose = WORLD_LINK, JointType.FIXED, Pose()
+        return WORLD_LINK, body.pose
+
+    def _chain(
+        self, robot: Robot, body: MjBody, start: str, pose: Pose, joints: list[MjJoint], link: Link
+    ) -> None:
+        """Hang ``link`` (the body) from ``start`` through its joints: one link per joint."""
+        if not start:
+            return
+        if not joints:
+            name = self.names.unique(f"{start}_to_{link.name}", self.names.joints)
+            joint = Joint(
+                name, JointType.FIXED, start, link.name, origin=pose, source=self.loc.body(body.index)
+            )
+            joint.extras["synthesised"] = True
+            joint.sources["name"] = joint.sources["parent"] = self.loc.body(body.index)
+            robot.joints.append(joint)
+            return
+        parent, previous = start, np.zeros(3)
+        links: list[str] = []
+        for k, mj in enumerate(joints):
+            last = k == len(joints) - 1
+            anchor = np.zeros(3) if mj.kind == "free" else mj.pos
+            step = pose @ translation(anchor) if k == 0 else translation(anchor - previous)
+            origin = step @ self._ref(mj)
+            if last:
+                child = link.name
+            else:
+                child = self.names.unique(
+                    f"{self.link_name[body.index]}__{self.joint_name[mj.index]}", self.names.links
+                )
+                robot.links.append(self._intermediate(child, body, mj))
+            robot.joints.append(self._joint(mj, parent, child, origin))
+            parent, previous = child, anchor
+            links.append(child)
+        if len(joints) > 1:
+            self._report_chain(body, joints, links)
+
+    def _report_chain(self, body: MjBody, joints: list[MjJoint], links: list[str]) -> None:
+        names = ", ".join(self.joint_name[j.index] for j in joints)
+        chain = " → ".join(f'"{name}"' for name in links)
+        self.sink.emit(
+            "MK171",
+            f'body "{self.link_name[body.index]}" has {len(joints)} joints ({names}); the model holds one '
+            f"joint per link, so it becomes a chain of {len(joints)} links, massless but the last: {chain}",
+            self.loc.body(body.index),
+        )
+
+    @staticmethod
+    def _ref(mj: MjJoint) -> Pose:
+        """The motion of the joint to q = 0 from its reference position (MuJoCo's body pose is
+        the pose at qpos = ref)."""
+        if mj.ref == 0.0 or float(np.linalg.norm(mj.axis)) == 0.0:
+            return Pose()
+        if mj.kind == "hinge":
+            return Pose(axis_angle(mj.axis, -mj.ref), np.zeros(3))
+        if mj.kind == "slide":
+            return translation(-mj.ref * np.asarray(mj.axis) / float(np.linalg.norm(mj.axis)))
+        return Pose()
+
+    def _intermediate(self, name: str, body: MjBody, mj: MjJoint) -> Link:
+        link = Link(name, source=self.loc.joint(mj.index))
+        link.sources["name"] = self.loc.joint(mj.index, "name")
+        link.extras.update({"synthesised": True, "mjcf_intermediate_of": self.link_name[body.index]})
+        return link
+
+    # -- joints --------------------------------------------------------------------------------
+
+    def _joint(self, mj: MjJoint, parent: str, child: str, origin: Pose) -> Joint:
+        loc = self.loc
+        norm = float(np.linalg.norm(mj.axis))
+        joint = Joint(
+            self.joint_name[mj.index],
+            JOINT_TYPES[mj.kind],
+            parent,
+            child,
+            origin=origin,
+            axis=np.asarray(mj.axis, dtype=float) / norm if norm > 0 else np.asarray(mj.axis, dtype=float),
+            armature=mj.armature,
+            damping=mj.damping,
+            friction=mj.frictionloss,
+            source=loc.joint(mj.index),
+        )
+        joint.limits = self._limits(mj, joint)
+        for attribute in ("name", "type", "axis", "range", "pos", "ref"):
+            joint.sources[attribute] = loc.joint(mj.index, attribute)
+        joint.sources["parent"] = loc.joint(mj.index)
+        if mj.kind in ("hinge", "slide"):
+            joint.initial_position = mj.ref
+        extras = {"mjcf_joint_id": mj.index, "mjcf_type": mj.kind}
+        if mj.ref:
+            extras["mjcf_ref"] = mj.ref
+        if mj.stiffness:
+            extras["mjcf_stiffness"] = mj.stiffness
+            extras["mjcf_springref"] = mj.springref
+        joint.extras.update(extras)
+        self.joints[mj.index] = joint
+        return joint
+
+    @staticmethod
+    def _limits(mj: MjJoint, joint: Joint) -> JointLimits:
+        limits = JointLimits()
+        if mj.limited and mj.kind in ("hinge", "slide"):
+            limits.lower, limits.upper = mj.range
+        elif mj.limited and mj.kind == "ball":
+            joint.extras["mjcf_ball_range"] = list(mj.range)
+        if mj.actfrc is not None:
+            low, high = mj.actfrc
+            joint.extras["mjcf_actfrcrange"] = [low, high]
+            if low == -high:
+                limits.effort = high
+        return limits
+
+    # -- links ---------------------------------------------------------------------------------
+
+    def _link(self, body: MjBody, offset: Pose) -> Link:
+        b = body.index
+        link = Link(self.link_name[b], source=self.loc.body(b))
+        link.sources["name"] = self.loc.body(b, "name")
+        link.extras["mjcf_body_id"] = b
+        if np.any(offset.translation != 0.0):
+            link.extras["mjcf_body_offset"] = [float(x) for x in offset.translation]
+        if body.mocap:
+            link.extras["mjcf_mocap"] = True
+        back = inverse(offset)
+        inertial = body.inertial
+        if inertial is not None:
+            link.inertial = Inertial(
+                inertial.mass,
+                com=back.translation + np.asarray(inertial.ipos, dtype=float),
+                inertia=inertial.tensor(),
+                defaulted=not inertial.explicit,
+                source=self.loc.inertial(b),
+            )
+            link.inertial.sources["mass"] = self.loc.inertial(b, "mass")
+            written = "fullinertia" if "fullinertia" in self._inertial_attributes(b) else "diaginertia"
+            link.inertial.sources["inertia"] = self.loc.inertial(b, written)
+        self._geoms(link, body, back)
+        return link
+
+    def _inertial_attributes(self, body: int) -> Iterable[str]:
+        placed = self.loc.inertials.get(body)
+        return [str(k) for k in placed.el.attrib] if placed is not None else []
+
+    def _geoms(self, link: Link, body: MjBody, back: Pose) -> None:
+        visuals: list[Geom] = []
+        collisions: list[Geom] = []
+        for mg in body.geoms:
+            geom = self.geom(mg, back)
+            if geom is None:
+                continue
+            (visuals if mg.visual_only else collisions).append(geom)
+        link.visuals = visuals if visuals else [self._copy(g) for g in collisions]
+        link.collisions = collisions
+
+    @staticmethod
+    def _copy(geom: Geom) -> Geom:
+        return Geom(geom.geometry, geom.pose, geom.name, geom.material, geom.source)
+
+    def geom(self, mg: MjGeom, back: Pose) -> Geom | None:
+        """The model geom of a MuJoCo geom (``back`` re-expresses it in the link frame)."""
+        geometry = self.geometry(mg)
+        where = self.loc.geom(mg.index)
+        if geometry is None:
+            self.sink.emit(
+                "MK172",
+                f"{mg.kind} geom{_named(mg.name)} cannot be held by the model; it is skipped",
+                where,
+            )
+            return None
+        material = None
+        if mg.rgba is not None:
+            r, g, b, a = mg.rgba
+            material = VisualMaterial(name=mg.material, diffuse=np.array([r, g, b]), transparency=1.0 - a)
+        return Geom(geometry, back @ mg.pose, mg.name, material, where)
+
+    @staticmethod
+    def geometry(mg: MjGeom) -> Geometry | None:
+        s = mg.size
+        kind = mg.kind
+        if kind == "box":
+            return Box(2.0 * np.asarray(s[:3], dtype=float))
+        if kind == "sphere":
+            return Sphere(float(s[0]))
+        if kind == "capsule":
+            return Capsule(float(s[0]), 2.0 * float(s[1]))
+        if kind == "cylinder":
+            return Cylinder(float(s[0]), 2.0 * float(s[1]))
+        if kind == "ellipsoid":
+            return Ellipsoid(np.asarray(s[:3], dtype=float).copy())
+        if kind == "mesh" and (mg.mesh_file or mg.mesh_name):
+            return Mesh(uri=mg.mesh_file, path=mg.mesh_path, scale=np.asarray(mg.mesh_scale, dtype=float))
+        return None
+
+    # -- data kept on the robots ---------------------------------------------------------------
+
+    def attached(self, body: int, name: str | None, pose: Pose, **params: Any) -> dict[str, Any]:
+        """A site, camera or light of ``body`` as data: its link, and its pose in the link frame."""
+        placed = inverse(self.offset.get(body, Pose())) @ pose
+        return {
+            "name": name,
+            "link": self.link_name.get(body),
+            "xyz": [float(x) for x in placed.translation],
+            "rotation": [[float(x) for x in row] for row in placed.rotation],
+            **params,
+        }
+
+    def sites(self, sites: Iterable[MjSite], body: int) -> list[dict[str, Any]]:
+        return [
+            self.attached(
+                body,
+                site.name,
+                site.pose,
+                type=site.kind,
+                size=[float(x) for x in site.size],
+                source=str(self.loc.site(site.index)),
+            )
+            for site in sites
+        ]
+
+
+def apply_joint_equalities(
+    equalities: list[dict[str, Any]],
+    joints: dict[int, Joint],
+    refs: dict[int, float],
+    sink: DiagnosticSink,
+    where: dict[int, SourceLocation],
+) -> None:
+    """Joint-joint equalities become mimics: MuJoCo's ``q1 − ref1 = Σ cᵢ (q2 − ref2)ⁱ`` is the model's
+    ``q1 = m·q2 + o`` when only c₀ and c₁ are non-zero. Anything else is reported."""
+    for eq in equalities:
+        if eq["type"] != "joint" or not eq["active"]:
+            continue
+        follower, leader = joints.get(eq["obj1id"]), joints.get(eq["obj2id"])
+        loc = where.get(eq["index"])
+        coef = eq["data"][:5]
+        if follower is None:
+            continue
+        if leader is None:
+            held = coef[0] + refs.get(eq["obj1id"], 0.0)
+            sink.emit(
+                "MK172",
+                f'joint "{follower.name}" is held at {held:.6g} by an equality with no second joint; '
+                "the model cannot hold this (kept as data)",
+                loc,
+            )
+            continue
+        if any(abs(c) > 0.0 for c in coef[2:]):
+            sink.emit(
+                "MK172",
+                f'joint "{follower.name}" follows "{leader.name}" through a polynomial of degree '
+                f"{max(i for i, c in enumerate(coef) if c)}; a mimic is linear, so it is kept as data",
+                loc,
+            )
+            continue
+        ref1, ref2 = refs.get(eq["obj1id"], 0.0), refs.get(eq["obj2id"], 0.0)
+        multiplier = coef[1]
+        follower.mimic = Mimic(leader.name, multiplier, coef[0] + ref1 - multiplier * ref2, source=loc)
+
+
+def _named(name: str | None) -> str:
+    return f' "{name}"' if name else ""

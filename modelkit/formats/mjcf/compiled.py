@@ -1,0 +1,296 @@
+"""Bodies, joints, geoms and the rest read from MuJoCo's compiled model (``MjModel``).
+
+Compilation resolves everything MJCF leaves implicit: defaults and classes, ``childclass``,
+``<include>``, ``<frame>``, angle units and Euler sequences, ``fromto``, inertia from geoms. Reading
+the compiled arrays therefore gives exactly what MuJoCo simulates.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from modelkit.formats.mjcf.bodies import (
+    MjBody,
+    MjGeom,
+    MjInertial,
+    MjJoint,
+    MjSite,
+    inverse,
+    pose_of,
+    translation,
+)
+from modelkit.spatial import Pose
+
+JOINT_KINDS = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
+DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)
+
+
+def enum_word(enum_value: Any, prefix: str) -> str:
+    """``mjGEOM_CAPSULE`` → ``capsule``."""
+    name = str(getattr(enum_value, "name", enum_value))
+    return name[len(prefix) :].lower() if name.startswith(prefix) else name.lower()
+
+
+class CompiledModel:
+    """Reads one ``MjModel`` (with the ``MjSpec`` it came from, for mesh file names)."""
+
+    def __init__(self, mujoco: Any, model: Any, spec: Any, model_dir: Path) -> None:
+        self.mj = mujoco
+        self.m = model
+        self.spec = spec
+        self.model_dir = model_dir
+
+    def name(self, kind: str, index: int) -> str | None:
+        obj = getattr(self.mj.mjtObj, f"mjOBJ_{kind.upper()}")
+        name = self.mj.mj_id2name(self.m, obj, int(index))
+        return str(name) if name else None
+
+    # -- bodies ------------------------------------------------------------------------------
+
+    def bodies(self) -> list[MjBody]:
+        m = self.m
+        out = [
+            MjBody(
+                index=b,
+                name=self.name("body", b),
+                parent=int(m.body_parentid[b]),
+                pose=pose_of(m.body_pos[b], m.body_quat[b]),
+                inertial=MjInertial(
+                    float(m.body_mass[b]),
+                    np.array(m.body_ipos[b], dtype=float),
+                    np.array(m.body_iquat[b], dtype=float),
+                    np.array(m.body_inertia[b], dtype=float),
+                ),
+                mocap=int(m.body_mocapid[b]) >= 0,
+            )
+            for b in range(1, m.nbody)
+        ]
+        for j in range(m.njnt):
+            out[int(m.jnt_bodyid[j]) - 1].joints.append(self.joint(j))
+        for g in range(m.ngeom):
+            body = int(m.geom_bodyid[g])
+            if body > 0:
+                out[body - 1].geoms.append(self.geom(g))
+        for s in range(m.nsite):
+            body = int(m.site_bodyid[s])
+            if body > 0:
+                out[body - 1].sites.append(self.site(s))
+        return out
+
+    def world_geoms(self) -> list[MjGeom]:
+        return [self.geom(g) for g in range(self.m.ngeom) if int(self.m.geom_bodyid[g]) == 0]
+
+    def world_sites(self) -> list[MjSite]:
+        return [self.site(s) for s in range(self.m.nsite) if int(self.m.site_bodyid[s]) == 0]
+
+    def joint(self, j: int) -> MjJoint:
+        m = self.m
+        kind = JOINT_KINDS.get(int(m.jnt_type[j]), "hinge")
+        qadr, dadr = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
+        scalar = kind in ("hinge", "slide")
+        return MjJoint(
+            index=j,
+            name=self.name("joint", j),
+            kind=kind,
+            pos=np.array(m.jnt_pos[j], dtype=float),
+            axis=np.array(m.jnt_axis[j], dtype=float),
+            limited=bool(m.jnt_limited[j]),
+            range=(float(m.jnt_range[j][0]), float(m.jnt_range[j][1])),
+            ref=float(m.qpos0[qadr]) if scalar else 0.0,
+            damping=float(m.dof_damping[dadr]),
+            frictionloss=float(m.dof_frictionloss[dadr]),
+            armature=float(m.dof_armature[dadr]),
+            stiffness=float(m.jnt_stiffness[j]),
+            springref=float(m.qpos_spring[qadr]) if scalar else 0.0,
+            actfrc=(float(m.jnt_actfrcrange[j][0]), float(m.jnt_actfrcrange[j][1]))
+            if bool(m.jnt_actfrclimited[j])
+            else None,
+        )
+
+    def geom(self, g: int) -> MjGeom:
+        m = self.m
+        kind = enum_word(self.mj.mjtGeom(int(m.geom_type[g])), "mjGEOM_")
+        pose = pose_of(m.geom_pos[g], m.geom_quat[g])
+        rgba = tuple(float(x) for x in m.geom_rgba[g])
+        material = None
+        matid = int(m.geom_matid[g])
+        if matid >= 0:
+            material = self.name("material", matid)
+            if np.allclose(rgba, DEFAULT_RGBA):
+                rgba = tuple(float(x) for x in m.mat_rgba[matid])
+        geom = MjGeom(
+            index=g,
+            name=self.name("geom", g),
+            kind=kind,
+            size=np.array(m.geom_size[g], dtype=float),
+            pose=pose,
+            contype=int(m.geom_contype[g]),
+            conaffinity=int(m.geom_conaffinity[g]),
+            group=int(m.geom_group[g]),
+            rgba=(rgba[0], rgba[1], rgba[2], rgba[3]),
+            material=material,
+        )
+        mesh = int(m.geom_dataid[g])
+        if kind == "mesh" and mesh >= 0:
+            self._mesh(geom, mesh)
+        return geom
+
+    def _mesh(self, geom: MjGeom, mesh: int) -> None:
+        """Name the mesh file and undo MuJoCo's re-centring: the compiled geom frame sits at the
+        mesh's centre of mass, on its principal axes; the file's frame is that pose times the
+        inverse of (mesh_pos, mesh_quat)."""
+        m = self.m
+        geom.mesh_name = self.name("mesh", mesh)
+        geom.pose = geom.pose @ inverse(pose_of(m.mesh_pos[mesh], m.mesh_quat[mesh]))
+        geom.mesh_scale = np.array(m.mesh_scale[mesh], dtype=float)
+        meshes = list(self.spec.meshes)
+        if mesh < len(meshes):
+            written = str(meshes[mesh].file or "")
+            geom.mesh_file = written or None
+            if written:
+                geom.mesh_path = str(mesh_path(self.model_dir, str(self.spec.meshdir or ""), written))
+
+    def site(self, s: int) -> MjSite:
+        m = self.m
+        return MjSite(
+            index=s,
+            name=self.name("site", s),
+            kind=enum_word(self.mj.mjtGeom(int(m.site_type[s])), "mjGEOM_"),
+            pose=pose_of(m.site_pos[s], m.site_quat[s]),
+            size=np.array(m.site_size[s], dtype=float),
+        )
+
+    # -- what the model keeps as data ---------------------------------------------------------
+
+    def cameras_and_lights(self) -> list[tuple[int, str, str | None, Pose, dict[str, Any]]]:
+        """(body, kind, name, pose in the body frame, parameters) of every camera and light."""
+        m = self.m
+        out: list[tuple[int, str, str | None, Pose, dict[str, Any]]] = []
+        for c in range(m.ncam):
+            pose = pose_of(m.cam_pos[c], m.cam_quat[c])
+            out.append(
+                (int(m.cam_bodyid[c]), "camera", self.name("camera", c), pose, {"fovy": float(m.cam_fovy[c])})
+            )
+        for lt in range(m.nlight):
+            pose = translation(m.light_pos[lt])
+            params = {
+                "dir": [float(x) for x in m.light_dir[lt]],
+                "diffuse": [float(x) for x in m.light_diffuse[lt]],
+            }
+            out.append((int(m.light_bodyid[lt]), "light", self.name("light", lt), pose, params))
+        return out
+
+    def equalities(self) -> list[dict[str, Any]]:
+        m = self.m
+        out = []
+        for e in range(m.neq):
+            kind = enum_word(self.mj.mjtEq(int(m.eq_type[e])), "mjEQ_")
+            objtype = enum_word(self.mj.mjtObj(int(m.eq_objtype[e])), "mjOBJ_")
+            obj1, obj2 = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+            out.append(
+                {
+                    "index": e,
+                    "name": self.name("equality", e),
+                    "type": kind,
+                    "objtype": objtype,
+                    "obj1": self._object_name(objtype, obj1),
+                    "obj2": self._object_name(objtype, obj2),
+                    "obj1id": obj1,
+                    "obj2id": obj2,
+                    "data": [float(x) for x in m.eq_data[e]],
+                    "active": bool(m.eq_active0[e]),
+                }
+            )
+        return out
+
+    def _object_name(self, objtype: str, index: int) -> str | None:
+        if index < 0 or objtype in ("unknown", ""):
+            return None
+        try:
+            return self.name(objtype, index) or f"{objtype}{index}"
+        except AttributeError:
+            return f"{objtype}{index}"
+
+    def actuators(self) -> list[dict[str, Any]]:
+        m = self.m
+        out = []
+        for a in range(m.nu):
+            trn = enum_word(self.mj.mjtTrn(int(m.actuator_trntype[a])), "mjTRN_")
+            target_kind = {"jointinparent": "joint", "slidercrank": "site"}.get(trn, trn)
+            entry: dict[str, Any] = {
+                "name": self.name("actuator", a),
+                "transmission": trn,
+                "target": self._object_name(target_kind, int(m.actuator_trnid[a][0])),
+                "gear": float(m.actuator_gear[a][0]),
+                "gain": enum_word(self.mj.mjtGain(int(m.actuator_gaintype[a])), "mjGAIN_"),
+                "bias": enum_word(self.mj.mjtBias(int(m.actuator_biastype[a])), "mjBIAS_"),
+            }
+            if bool(m.actuator_ctrllimited[a]):
+                entry["ctrlrange"] = [float(x) for x in m.actuator_ctrlrange[a]]
+            if bool(m.actuator_forcelimited[a]):
+                entry["forcerange"] = [float(x) for x in m.actuator_forcerange[a]]
+            out.append(entry)
+        return out
+
+    def sensors(self) -> list[dict[str, Any]]:
+        m = self.m
+        out = []
+        for s in range(m.nsensor):
+            objtype = enum_word(self.mj.mjtObj(int(m.sensor_objtype[s])), "mjOBJ_")
+            out.append(
+                {
+                    "name": self.name("sensor", s),
+                    "type": enum_word(self.mj.mjtSensor(int(m.sensor_type[s])), "mjSENS_"),
+                    "objtype": objtype,
+                    "object": self._object_name(objtype, int(m.sensor_objid[s])),
+                }
+            )
+        return out
+
+    def tendons(self) -> list[dict[str, Any]]:
+        m = self.m
+        out = []
+        for t in range(m.ntendon):
+            start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
+            wraps = []
+            for w in range(start, start + count):
+                wtype = enum_word(self.mj.mjtWrap(int(m.wrap_type[w])), "mjWRAP_")
+                objtype = {"joint": "joint", "site": "site", "sphere": "geom", "cylinder": "geom"}.get(wtype)
+                wraps.append(
+                    {
+                        "type": wtype,
+                        "object": self._object_name(objtype, int(m.wrap_objid[w])) if objtype else None,
+                        "coef": float(m.wrap_prm[w]),
+                    }
+                )
+            fixed = all(w["type"] == "joint" for w in wraps)
+            out.append(
+                {"name": self.name("tendon", t), "kind": "fixed" if fixed else "spatial", "wraps": wraps}
+            )
+        return out
+
+    def keyframes(self) -> list[dict[str, Any]]:
+        m = self.m
+        return [
+            {
+                "name": self.name("key", k),
+                "time": float(m.key_time[k]),
+                "qpos": [float(x) for x in m.key_qpos[k]],
+            }
+            for k in range(m.nkey)
+        ]
+
+
+def mesh_path(model_dir: Path, meshdir: str, written: str) -> Path:
+    """Where MuJoCo opens a mesh file: absolute as written, else under ``meshdir``, itself relative
+    to the main model file's folder unless absolute."""
+    path = Path(written)
+    if path.is_absolute():
+        return path
+    base = Path(meshdir) if meshdir else Path()
+    if not base.is_absolute():
+        base = model_dir / base
+    return (base / path).absolute()

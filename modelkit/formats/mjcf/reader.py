@@ -1,0 +1,316 @@
+"""The MJCF reader: MuJoCo parses and compiles the file, modelkit maps the result to its model.
+
+Steps:
+
+1. modelkit parses the file itself (:mod:`modelkit.xmlsource`): malformed XML (MK020) and entity
+   declarations (MK021) are refused before MuJoCo sees the file, and every element gets a line
+   and column;
+2. ``mujoco.MjSpec.from_file`` parses it (schema errors → MK170 at MuJoCo's line);
+3. the spec is compiled with static-body fusion and visual discarding switched off, so every body
+   and geom survives; the compiled ``MjModel`` is read (:mod:`.compiled`);
+4. if compilation fails (a missing mesh, a bad inertia...), the error is reported (MK170) and the
+   tree is read from the uncompiled spec instead (:mod:`.uncompiled`, MK174);
+5. the bodies become robots (:mod:`.build`), paired with their XML elements for source
+   locations (:mod:`.source`).
+
+``mujoco`` is imported here only, when an MJCF file is read.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from modelkit.diagnostics import DiagnosticSink, SourceLocation, sorted_diagnostics
+from modelkit.formats.common import ReadOptions, ReadResult
+from modelkit.formats.mjcf.bodies import MjBody, MjGeom
+from modelkit.formats.mjcf.build import Built, RobotBuilder, apply_joint_equalities
+from modelkit.formats.mjcf.compiled import CompiledModel, mesh_path
+from modelkit.formats.mjcf.errors import error_location, error_text
+from modelkit.formats.mjcf.source import SourceIndex, TreeShape, locate, pair
+from modelkit.formats.mjcf.uncompiled import SpecReader
+from modelkit.model import Robot
+from modelkit.xmlsource import read_xml
+
+MUJOCO_DEFAULT_NAME = "MuJoCo Model"
+
+
+def read_mjcf(path: Path, options: ReadOptions, display: str, compiled: bool = True) -> ReadResult:
+    """Read an MJCF file through MuJoCo into robots (one per top-level body tree).
+
+    ``compiled=False`` skips compilation and reads the uncompiled spec, as the fallback after a
+    compile error does (the tests compare the two).
+    """
+    sink = DiagnosticSink()
+    robots = _MjcfReader(path, options, display, sink).read(compiled)
+    main = robots[0] if robots else None
+    return ReadResult(main, sorted_diagnostics(sink.items), robots[1:])
+
+
+def _import_mujoco() -> Any:
+    import mujoco
+
+    return mujoco
+
+
+class _MjcfReader:
+    def __init__(self, path: Path, options: ReadOptions, display: str, sink: DiagnosticSink) -> None:
+        self.path = path
+        self.options = options
+        self.display = display
+        self.sink = sink
+
+    def read(self, compiled: bool = True) -> list[Robot]:
+        doc = read_xml(self.path, self.sink, self.options.max_bytes, self.display)
+        if doc is None:
+            return []
+        if doc.root.tag != "mujoco":
+            self.sink.emit("MK022", f"the top element is <{doc.root.tag}>, not <mujoco>", doc.loc(doc.root))
+            return []
+        index = SourceIndex(doc, self.path.parent, self.sink, self.options.max_bytes)
+        list(index.iter_all())  # reads the included files: their XML problems stop here too
+        if any(d.code in ("MK020", "MK021", "MK002", "MK003") for d in self.sink.items):
+            return []
+        try:
+            mujoco = _import_mujoco()
+        except ImportError as exc:  # pragma: no cover - mujoco is a dependency
+            self.sink.emit("MK170", f"cannot read MJCF: mujoco is not installed ({exc})", doc.loc(doc.root))
+            return []
+        spec = self._spec(mujoco, index)
+        if spec is None:
+            return []
+        name = self._model_name(index)
+        model = self._compile(spec, index) if compiled else None
+        if model is not None:
+            return self._from_compiled(mujoco, model, spec, index, name)
+        return self._from_spec(mujoco, index, name)
+
+    # -- MuJoCo ------------------------------------------------------------------------------
+
+    def _spec(self, mujoco: Any, index: SourceIndex) -> Any:
+        try:
+            spec = mujoco.MjSpec.from_file(str(self.path))
+        except Exception as exc:  # MuJoCo raises ValueError; nothing it raises may escape
+            self._mujoco_error(exc, index)
+            return None
+        spec.compiler.fusestatic = False  # keep every body (and its name)
+        spec.compiler.discardvisual = False  # keep visual-only geoms
+        spec.compiler.alignfree = False  # keep free bodies' frames as written
+        return spec
+
+    def _compile(self, spec: Any, index: SourceIndex) -> Any:
+        try:
+            return spec.compile()
+        except Exception as exc:
+            self._mujoco_error(exc, index)
+            return None
+
+    def _mujoco_error(self, exc: BaseException, index: SourceIndex) -> None:
+        text = error_text(exc)
+        self.sink.emit("MK170", f"MuJoCo: {text}", error_location(str(exc), index))
+
+    def _model_name(self, index: SourceIndex) -> str:
+        root = index.main.root
+        written = root.get("model")
+        if written:
+            return written
+        self.sink.emit(
+            "MK173",
+            f'the model has no name (<mujoco model="...">); it is called "{self.path.stem}" '
+            f'after the file (MuJoCo calls it "{MUJOCO_DEFAULT_NAME}")',
+            index.main.loc(root),
+        )
+        return self.path.stem
+
+    # -- the compiled model ---------------------------------------------------------------------
+
+    def _from_compiled(
+        self, mujoco: Any, model: Any, spec: Any, index: SourceIndex, name: str
+    ) -> list[Robot]:
+        reader = CompiledModel(mujoco, model, spec, self.path.parent)
+        bodies = reader.bodies()
+        world_geoms = reader.world_geoms()
+        locator = locate(index, _shapes(bodies), [(g.index, g.name) for g in world_geoms])
+        builder = RobotBuilder(bodies, locator, self.sink, name)
+        built = builder.build()
+        equalities = reader.equalities()
+        where = self._item_locations(index, "equality", [e["name"] for e in equalities])
+        refs = {j.index: j.ref for b in bodies for j in b.joints}
+        apply_joint_equalities(equalities, built.joints, refs, self.sink, where)
+        tendons = reader.tendons()
+        self._report_unsupported(equalities, tendons, index, where)
+        data: dict[str, list[dict[str, Any]]] = {
+            "mjcf_actuators": reader.actuators(),
+            "mjcf_sensors": reader.sensors(),
+            "mjcf_keyframes": reader.keyframes(),
+            "mjcf_tendons": tendons,
+            "mjcf_equalities": equalities,
+            "mjcf_world_geoms": [self._world_geom(builder, g) for g in world_geoms],
+            "mjcf_world_sites": builder.sites(reader.world_sites(), 0),
+        }
+        self._tag_actuators(index, data["mjcf_actuators"])
+        self._keep(reader, built, builder, bodies, data)
+        if model.nflex:
+            self.sink.emit(
+                "MK172",
+                f"{model.nflex} flex object(s) (deformable bodies): the model cannot hold them",
+                index.top().loc(),
+            )
+        return built.robots
+
+    def _item_locations(
+        self, index: SourceIndex, section: str, names: list[str | None]
+    ) -> dict[int, SourceLocation]:
+        items = index.section_items(section)
+        named = {p.el.get("name", ""): p for p in items if p.el.get("name")}
+        paired = pair(names, items, named)
+        return {i: p.loc() for i, p in enumerate(paired) if p is not None}
+
+    def _report_unsupported(
+        self,
+        equalities: list[dict[str, Any]],
+        tendons: list[dict[str, Any]],
+        index: SourceIndex,
+        eq_where: dict[int, SourceLocation],
+    ) -> None:
+        top = index.top().loc()
+        for eq in equalities:
+            if eq["type"] == "joint":
+                continue
+            objects = {"body": "bodies", "xbody": "bodies"}.get(eq["objtype"], f"{eq['objtype']}s")
+            what = f"{eq['type']} equality{_quoted(eq['name'])} between {objects} "
+            what += f'"{eq["obj1"]}" and "{eq["obj2"] or "world"}"'
+            self.sink.emit(
+                "MK172", f"{what}: the model cannot hold it (kept as data)", eq_where.get(eq["index"], top)
+            )
+        where = self._item_locations(index, "tendon", [t["name"] for t in tendons])
+        for i, tendon in enumerate(tendons):
+            self.sink.emit(
+                "MK172",
+                f"{tendon['kind']} tendon{_quoted(tendon['name'])}: the model cannot hold tendons "
+                "(kept as data)",
+                where.get(i, top),
+            )
+
+    def _tag_actuators(self, index: SourceIndex, actuators: list[dict[str, Any]]) -> None:
+        """Add the written element (``motor``, ``position``...) to each actuator when it is known."""
+        items = index.section_items("actuator")
+        named = {p.el.get("name", ""): p for p in items if p.el.get("name")}
+        for entry, placed in zip(actuators, pair([a["name"] for a in actuators], items, named), strict=True):
+            if placed is not None:
+                entry["element"] = placed.tag
+                entry["source"] = str(placed.loc())
+
+    @staticmethod
+    def _world_geom(builder: RobotBuilder, geom: MjGeom) -> dict[str, Any]:
+        return {
+            "name": geom.name,
+            "type": geom.kind,
+            "size": [float(x) for x in geom.size],
+            "xyz": [float(x) for x in geom.pose.translation],
+            "rotation": [[float(x) for x in row] for row in geom.pose.rotation],
+            "source": str(builder.loc.geom(geom.index)),
+        }
+
+    def _keep(
+        self,
+        reader: CompiledModel,
+        built: Built,
+        builder: RobotBuilder,
+        bodies: list[MjBody],
+        data: dict[str, list[dict[str, Any]]],
+    ) -> None:
+        """Store what the model does not hold as data on the robots, and say so once.
+
+        Sites, cameras and lights go with the robot of their body (the world's with the main
+        robot), in link frames; the rest goes on the main robot.
+        """
+        if built.robots:
+            main = built.robots[0]
+            for robot in built.robots:
+                robot.extras.update(
+                    {"mjcf_compiled": True, "mjcf_sites": [], "mjcf_cameras": [], "mjcf_lights": []}
+                )
+            for body in bodies:
+                built.robot_of_body[body.index].extras["mjcf_sites"].extend(
+                    builder.sites(body.sites, body.index)
+                )
+            for body_id, kind, name, pose, params in reader.cameras_and_lights():
+                robot = built.robot_of_body.get(body_id, main)
+                robot.extras[f"mjcf_{kind}s"].append(builder.attached(body_id, name, pose, **params))
+            main.extras.update(data)
+
+        def attached(key: str) -> int:
+            return sum(len(r.extras.get(key, [])) for r in built.robots)
+
+        counts = {
+            "actuator": len(data["mjcf_actuators"]),
+            "sensor": len(data["mjcf_sensors"]),
+            "site": attached("mjcf_sites") + len(data["mjcf_world_sites"]),
+            "camera": attached("mjcf_cameras"),
+            "light": attached("mjcf_lights"),
+            "keyframe": len(data["mjcf_keyframes"]),
+            "world geom": len(data["mjcf_world_geoms"]),
+        }
+        kept = [f"{n} {word}{'s' if n != 1 else ''}" for word, n in counts.items() if n]
+        if kept:
+            self.sink.emit(
+                "MK175",
+                f"{', '.join(kept)} kept as data in the robot's extras (not part of the model)",
+                builder.loc.index.top().loc(),
+            )
+
+    # -- the fallback ---------------------------------------------------------------------------
+
+    def _from_spec(self, mujoco: Any, index: SourceIndex, name: str) -> list[Robot]:
+        """The tree from a fresh, uncompiled spec (a spec whose compilation failed keeps raising
+        the compile error on every access)."""
+        try:
+            spec = mujoco.MjSpec.from_file(str(self.path))
+            bodies = SpecReader(mujoco, spec).bodies()
+        except Exception:  # already reported by the first attempt
+            return []
+        self._missing_meshes(spec, index)
+        locator = locate(index, _shapes(bodies), [])
+        built = RobotBuilder(bodies, locator, self.sink, name).build()
+        for robot in built.robots:
+            robot.extras["mjcf_compiled"] = False
+        self.sink.emit(
+            "MK174",
+            "the kinematic tree was read from the uncompiled model: links have no geometry and only "
+            "explicitly written inertials; equalities, actuators and sensors are not read",
+            index.top().loc(),
+        )
+        return built.robots
+
+    def _missing_meshes(self, spec: Any, index: SourceIndex) -> None:
+        """Point at each ``<mesh file>`` that does not exist (the usual reason compilation fails)."""
+        assets = [p for p in index.section_items("asset") if p.tag == "mesh"]
+        by_file = {p.el.get("file", ""): p for p in assets}
+        for mesh in spec.meshes:
+            written = str(mesh.file or "")
+            if not written:
+                continue
+            path = mesh_path(self.path.parent, str(spec.meshdir or ""), written)
+            if not path.exists():
+                placed = by_file.get(written)
+                loc = placed.loc("file") if placed is not None else index.top().loc()
+                self.sink.emit("MK500", f'mesh file "{written}" not found at {path}', loc)
+
+
+def _shapes(bodies: list[MjBody]) -> list[TreeShape]:
+    return [
+        TreeShape(
+            b.index,
+            b.name,
+            b.parent,
+            [(j.index, j.name) for j in b.joints],
+            [(g.index, g.name) for g in b.geoms],
+            [(s.index, s.name) for s in b.sites],
+        )
+        for b in bodies
+    ]
+
+
+def _quoted(name: str | None) -> str:
+    return f' "{name}"' if name else ""

@@ -1,0 +1,125 @@
+"""The fallback: the kinematic tree read from an ``MjSpec`` that MuJoCo could not compile.
+
+MuJoCo's parser has applied defaults and classes and spliced ``<include>`` files, so names, joint
+types, anchors, axes and ranges are right; this module resolves what compilation would have:
+``<frame>`` nesting, alternative orientations (``euler``, ``axisangle``, ``xyaxes``, ``zaxis``) and
+degrees. It does **not** compute inertia from geoms, ``fromto`` placements or mesh geometry: links
+carry only an explicitly written ``<inertial>``, and no geoms.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from modelkit.formats.mjcf.bodies import MjBody, MjInertial, MjJoint, pose_of
+from modelkit.spatial import Pose
+
+JOINT_KINDS = {"mjJNT_FREE": "free", "mjJNT_BALL": "ball", "mjJNT_SLIDE": "slide", "mjJNT_HINGE": "hinge"}
+
+
+class SpecReader:
+    """Reads bodies and joints from an uncompiled spec, numbering them as MuJoCo would (depth first)."""
+
+    def __init__(self, mujoco: Any, spec: Any) -> None:
+        self.mj = mujoco
+        self.spec = spec
+        self.degree = bool(spec.compiler.degree)
+        self.autolimits = bool(spec.compiler.autolimits)
+        self._joint_count = 0
+
+    def bodies(self) -> list[MjBody]:
+        out: list[MjBody] = []
+        stack: list[tuple[Any, int]] = [(b, 0) for b in reversed(list(self.spec.worldbody.bodies))]
+        while stack:
+            body, parent = stack.pop()
+            record = self._body(body, len(out) + 1, parent)
+            out.append(record)
+            stack.extend((child, record.index) for child in reversed(list(body.bodies)))
+        return out
+
+    def _body(self, body: Any, index: int, parent: int) -> MjBody:
+        pose = self._frames(body.frame) @ pose_of(body.pos, self._quat(body.quat, body.alt))
+        record = MjBody(index, str(body.name) or None, parent, pose, mocap=bool(body.mocap))
+        for joint in body.joints:
+            record.joints.append(self._joint(joint))
+        if bool(body.explicitinertial):
+            record.inertial = self._inertial(body)
+        return record
+
+    def _frames(self, frame: Any) -> Pose:
+        """The pose of a chain of ``<frame>`` elements, outermost first."""
+        pose = Pose()
+        depth = 0
+        while frame is not None and depth < 1000:
+            pose = pose_of(frame.pos, self._quat(frame.quat, frame.alt)) @ pose
+            frame = frame.frame
+            depth += 1
+        return pose
+
+    def _quat(self, quat: Any, alt: Any) -> Any:
+        if alt is None or getattr(alt.type, "name", "") == "mjORIENTATION_QUAT":
+            return quat
+        return self.mj.MjSpec.resolve_orientation(self.degree, self.spec.compiler.eulerseq, alt)
+
+    def _joint(self, joint: Any) -> MjJoint:
+        kind = JOINT_KINDS.get(getattr(joint.type, "name", ""), "hinge")
+        angular = kind in ("hinge", "ball")
+        scale = math.pi / 180.0 if self.degree and angular else 1.0
+        low, high = (float(x) for x in joint.range)
+        limited_word = getattr(joint.limited, "name", "")
+        limited = limited_word == "mjLIMITED_TRUE" or (
+            limited_word == "mjLIMITED_AUTO" and self.autolimits and low < high
+        )
+        axis = np.array(joint.axis, dtype=float)
+        norm = float(np.linalg.norm(axis))
+        index = self._joint_count
+        self._joint_count += 1
+        return MjJoint(
+            index=index,
+            name=str(joint.name) or None,
+            kind=kind,
+            pos=np.array(joint.pos, dtype=float),
+            axis=axis / norm if norm > 0 else axis,
+            limited=limited and kind != "free",
+            range=(low * scale, high * scale),
+            ref=float(joint.ref) * (scale if kind == "hinge" else 1.0),
+            damping=float(np.asarray(joint.damping).ravel()[0]),
+            frictionloss=float(joint.frictionloss),
+            armature=float(joint.armature),
+            stiffness=float(np.asarray(joint.stiffness).ravel()[0]),
+            springref=float(joint.springref),
+        )
+
+    def _inertial(self, body: Any) -> MjInertial:
+        full = np.array(body.fullinertia, dtype=float)
+        iquat = self._quat(body.iquat, body.ialt)
+        diag = np.array(body.inertia, dtype=float)
+        if math.isfinite(full[0]):
+            xx, yy, zz, xy, xz, yz = full
+            tensor = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+            moments, axes = np.linalg.eigh(tensor)
+            if np.linalg.det(axes) < 0:
+                axes[:, 0] = -axes[:, 0]
+            diag, iquat = moments, _matrix_quat(axes)
+        return MjInertial(float(body.mass), np.array(body.ipos, dtype=float), iquat, diag)
+
+
+def _matrix_quat(r: Any) -> Any:
+    """A unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method)."""
+    m = np.asarray(r, dtype=float)
+    trace = float(np.trace(m))
+    if trace > 0:
+        s = 2.0 * math.sqrt(trace + 1.0)
+        return np.array([0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s])
+    i = int(np.argmax(np.diag(m)))
+    j, k = (i + 1) % 3, (i + 2) % 3
+    s = 2.0 * math.sqrt(max(1.0 + m[i, i] - m[j, j] - m[k, k], 0.0))
+    q = np.zeros(4)
+    q[0] = (m[k, j] - m[j, k]) / s
+    q[1 + i] = 0.25 * s
+    q[1 + j] = (m[j, i] + m[i, j]) / s
+    q[1 + k] = (m[k, i] + m[i, k]) / s
+    return q

@@ -1,0 +1,172 @@
+"""Extensions kept as data: ``<gazebo>``, ``<transmission>``, ``<ros2_control>``, ``<mujoco>``.
+
+None of them changes the kinematic model, but writers and conversion reports need them:
+
+* ``<gazebo reference="X">`` goes to link X, or joint X, or the robot (no reference) as a dict in
+  ``extras["gazebo"]``: the reference, the block as canonical XML, its location, and the simple
+  values libsdformat understands (``mu1``, ``mu2``, ``kp``, ``kd``, ``material``, ``selfCollide``...).
+  A ``<sensor>`` inside becomes a :class:`Device` of that link.
+* ``<transmission>`` → ``robot.extras["transmissions"]`` (name, type, joints, actuators, location).
+* ``<ros2_control>`` and ``<mujoco>`` → ``robot.extras`` as canonical XML.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from lxml import etree
+from lxml.etree import _Element as Element
+
+from modelkit.formats.urdf.values import Context, did_you_mean, rpy_matrix
+from modelkit.model import Device, Robot
+from modelkit.spatial import Pose
+from modelkit.xmlsource import parse_number, parse_numbers
+
+# Simple values of a <gazebo> block that libsdformat maps onto the model (peers.md §2.1).
+GAZEBO_KEYS = (
+    "material",
+    "mu1",
+    "mu2",
+    "kp",
+    "kd",
+    "fdir1",
+    "selfCollide",
+    "static",
+    "turnGravityOff",
+    "gravity",
+    "maxContacts",
+    "minDepth",
+    "maxVel",
+    "dampingFactor",
+    "laserRetro",
+    "stopCfm",
+    "stopErp",
+    "fudgeFactor",
+    "springReference",
+    "springStiffness",
+    "provideFeedback",
+    "implicitSpringDamper",
+    "preserveFixedJoint",
+    "disableFixedJointLumping",
+)
+
+
+def canonical_xml(element: Element) -> str:
+    """The element (without its tail text) as canonical XML."""
+    copy = etree.fromstring(etree.tostring(element, with_tail=False))
+    return etree.tostring(copy, method="c14n").decode("utf-8")
+
+
+def _value(text: str | None) -> Any:
+    """A simple value: a number when it is one, true/false words as bools, else the stripped text."""
+    if text is None:
+        return None
+    stripped = text.strip()
+    number = parse_number(stripped)
+    if number is not None:
+        return number
+    if stripped.lower() in ("true", "false"):
+        return stripped.lower() == "true"
+    numbers = parse_numbers(stripped)
+    if numbers:
+        return numbers
+    return stripped
+
+
+def read_gazebo(ctx: Context, element: Element, robot: Robot) -> None:
+    """File one ``<gazebo>`` block under its link, joint or the robot."""
+    reference = element.get("reference")
+    entry: dict[str, Any] = {
+        "reference": reference,
+        "xml": canonical_xml(element),
+        "source": ctx.loc(element),
+    }
+    for child in element:
+        tag = ctx.tag(child)
+        if tag in GAZEBO_KEYS and len(child) == 0:
+            entry[tag] = _value(child.text)
+    link = robot.link(reference) if reference else None
+    joint = next((j for j in robot.joints if j.name == reference), None) if reference else None
+    if link is not None:
+        link.extras.setdefault("gazebo", []).append(entry)
+        for sensor in ctx.children(element, "sensor"):
+            device = _sensor(ctx, sensor)
+            if device is not None:
+                link.devices.append(device)
+    elif joint is not None:
+        joint.extras.setdefault("gazebo", []).append(entry)
+    else:
+        robot.extras.setdefault("gazebo", []).append(entry)
+        if reference:
+            names = {lk.name for lk in robot.links} | {j.name for j in robot.joints}
+            ctx.emit(
+                "MK138",
+                f'<gazebo reference="{reference}"> names neither a link nor a joint; libsdformat ignores '
+                "the block",
+                ctx.loc(element, "reference"),
+                hint=did_you_mean(reference, names),
+            )
+
+
+def _sensor(ctx: Context, element: Element) -> Device | None:
+    """A Gazebo ``<sensor name type>`` as a device; its SDF content is kept as raw XML."""
+    name = element.get("name")
+    kind = element.get("type")
+    if not name or not kind:
+        missing = " and ".join(k for k, v in (("name", name), ("type", kind)) if not v)
+        ctx.emit(
+            "MK620",
+            f"<sensor> in a <gazebo> block has no {missing}; SDF needs both, so Gazebo refuses it",
+            ctx.loc(element),
+        )
+        return None
+    device = Device(kind=kind, name=name, source=ctx.loc(element))
+    device.params["xml"] = canonical_xml(element)
+    for key in ("update_rate", "always_on", "visualize", "topic"):
+        child = ctx.first(element, key)
+        if child is not None:
+            device.params[key] = _value(child.text)
+    pose_el = ctx.first(element, "pose")
+    if pose_el is not None:
+        values = parse_numbers(pose_el.text or "")
+        if values is None or len(values) != 6 or not all(math.isfinite(v) for v in values):
+            ctx.emit(
+                "MK620",
+                f'sensor "{name}": <pose> "{(pose_el.text or "").strip()}" is not six numbers '
+                "(x y z roll pitch yaw); the sensor is placed at the link origin",
+                ctx.text_loc(pose_el),
+            )
+        else:
+            device.pose = Pose(rpy_matrix(*values[3:]), np.array(values[:3]))
+    return device
+
+
+def read_transmission(ctx: Context, element: Element, joint_names: set[str]) -> dict[str, Any]:
+    """A ROS transmission: both the current form (``<type>`` element) and the old PR2 attribute."""
+    type_el = ctx.first(element, "type")
+    entry: dict[str, Any] = {
+        "name": element.get("name"),
+        "type": (type_el.text or "").strip() if type_el is not None else element.get("type"),
+        "joints": [],
+        "actuators": [],
+        "source": ctx.loc(element),
+        "xml": canonical_xml(element),
+    }
+    for joint_el in ctx.children(element, "joint"):
+        name = joint_el.get("name")
+        if name is None:
+            continue
+        entry["joints"].append(name)
+        if name not in joint_names:
+            ctx.emit(
+                "MK139",
+                f'transmission "{entry["name"]}" drives joint "{name}", which is not a joint of this robot',
+                ctx.loc(joint_el, "name"),
+                hint=did_you_mean(name, joint_names),
+            )
+    for actuator in ctx.children(element, "actuator"):
+        if actuator.get("name") is not None:
+            entry["actuators"].append(actuator.get("name"))
+    return entry

@@ -1,0 +1,218 @@
+"""Reading URDF attribute values with diagnostics: numbers, vectors, origins.
+
+Every helper reports what is wrong at the exact attribute (``file:line:col``) and returns None, so
+the caller can carry on with a default. Number syntax is urdfdom's (see :mod:`modelkit.xmlsource`).
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from lxml import etree
+from lxml.etree import _Element as Element
+
+from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
+from modelkit.spatial import Mat3, Pose
+from modelkit.xmlsource import XmlDocument, parse_number, parse_numbers
+
+# URDF versions modelkit reads, and the version that introduced each later feature.
+VERSIONS = ("1.0", "1.1", "1.2")
+
+
+@dataclass
+class Context:
+    """What every part of the URDF reader shares: the document, the sink and the declared version."""
+
+    doc: XmlDocument
+    sink: DiagnosticSink
+    version: str = "1.0"
+    version_declared: bool = False
+    namespace: str | None = None  # the <robot> element's own namespace (a default xmlns), if any
+    newer_features: list[tuple[str, str, SourceLocation]] = field(default_factory=list)
+    xacro_reported: bool = False
+
+    def loc(self, element: Element, attribute: str | None = None) -> SourceLocation:
+        return self.doc.loc(element, attribute)
+
+    def text_loc(self, element: Element) -> SourceLocation:
+        return self.doc.text_loc(element)
+
+    def emit(
+        self,
+        code: str,
+        message: str,
+        loc: SourceLocation | None,
+        hint: str | None = None,
+        severity: Severity | None = None,
+    ) -> None:
+        self.sink.emit(code, message, loc, hint=hint, severity=severity)
+
+    def tag(self, element: Element) -> str | None:
+        """The element's URDF name, or None for comments, processing instructions and foreign elements.
+
+        An element in the ``<robot>`` element's own namespace (a default ``xmlns``) counts as URDF;
+        an element of any other namespace (``xmlns:drake``...) is an extension and is skipped.
+        """
+        if not isinstance(element.tag, str):
+            return None
+        qname = etree.QName(element)
+        if qname.namespace is None or qname.namespace == self.namespace:
+            return qname.localname
+        return None
+
+    def children(self, element: Element, name: str | None = None) -> list[Element]:
+        """URDF child elements of ``element`` (all, or those called ``name``), in document order."""
+        out = []
+        for child in element:
+            tag = self.tag(child)
+            if tag is not None and (name is None or tag == name):
+                out.append(child)
+        return out
+
+    def first(self, element: Element, name: str) -> Element | None:
+        """The first child called ``name`` (urdfdom reads only the first; repeats are reported apart)."""
+        found = self.children(element, name)
+        return found[0] if found else None
+
+    def uses_feature(self, feature: str, needs: str, loc: SourceLocation) -> None:
+        """Note a URDF 1.1/1.2 feature; reported when the document declares an older version."""
+        self.newer_features.append((feature, needs, loc))
+
+
+def did_you_mean(word: str, candidates: list[str] | tuple[str, ...] | set[str]) -> str | None:
+    """A "did you mean" hint when ``word`` is close to one of ``candidates``."""
+    match = difflib.get_close_matches(word, sorted(candidates), n=1, cutoff=0.6)
+    return f'did you mean "{match[0]}"?' if match else None
+
+
+def number(
+    ctx: Context,
+    element: Element,
+    attribute: str,
+    what: str,
+    default: float | None = None,
+    required: bool = False,
+) -> float | None:
+    """The attribute as a number; a missing required one or a malformed one is reported (None back)."""
+    text = element.get(attribute)
+    if text is None:
+        if required:
+            ctx.emit(
+                "MK120",
+                f"<{ctx.tag(element)}> has no `{attribute}` attribute ({what})",
+                ctx.loc(element),
+            )
+        return default
+    value = parse_number(text)
+    if value is None:
+        ctx.emit(
+            "MK121",
+            f'{what}: `{attribute}="{text}"` is not a number',
+            ctx.loc(element, attribute),
+        )
+        return None
+    if not math.isfinite(value):
+        ctx.emit("MK121", f'{what}: `{attribute}="{text}"` is not finite', ctx.loc(element, attribute))
+        return None
+    return value
+
+
+def vector(ctx: Context, element: Element, attribute: str, what: str, count: int = 3) -> list[float] | None:
+    """The attribute as exactly ``count`` blank-separated numbers; None (reported) otherwise."""
+    text = element.get(attribute)
+    if text is None:
+        return None
+    values = parse_numbers(text)
+    loc = ctx.loc(element, attribute)
+    if values is None:
+        bad = next((item for item in text.split() if parse_number(item) is None), text)
+        ctx.emit("MK121", f'{what}: `{attribute}="{text}"`: "{bad}" is not a number', loc)
+        return None
+    if len(values) != count:
+        ctx.emit(
+            "MK121",
+            f'{what}: `{attribute}="{text}"`: expected {count} numbers, found {len(values)}',
+            loc,
+        )
+        return None
+    if not all(math.isfinite(v) for v in values):
+        ctx.emit("MK121", f'{what}: `{attribute}="{text}"` has a value that is not finite', loc)
+        return None
+    return values
+
+
+def rpy_matrix(roll: float, pitch: float, yaw: float) -> Mat3:
+    """URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) · Ry(pitch) · Rx(roll)."""
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def quaternion_matrix(x: float, y: float, z: float, w: float) -> Mat3:
+    """The rotation of a unit quaternion given as x, y, z, w."""
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def origin(ctx: Context, element: Element | None, what: str) -> Pose | None:
+    """The pose of an ``<origin xyz rpy quat_xyzw>`` element (identity when absent).
+
+    None when the origin is malformed (already reported); callers fall back to identity.
+    """
+    if element is None:
+        return Pose()
+    ok = True
+    pose = Pose()
+    xyz = vector(ctx, element, "xyz", f"{what} origin")
+    if xyz is not None:
+        pose.translation = np.array(xyz)
+    elif element.get("xyz") is not None:
+        ok = False
+    has_rpy = element.get("rpy") is not None
+    has_quat = element.get("quat_xyzw") is not None
+    if has_rpy and has_quat:
+        ctx.emit(
+            "MK137",
+            f"{what} origin gives both `rpy` and `quat_xyzw`; give one orientation only",
+            ctx.loc(element, "quat_xyzw"),
+            hint="URDF 1.1 forbids both; tools disagree on which one wins",
+        )
+        return None
+    if has_rpy:
+        rpy = vector(ctx, element, "rpy", f"{what} origin")
+        if rpy is None:
+            ok = False
+        else:
+            pose.rotation = rpy_matrix(*rpy)
+    elif has_quat:
+        ctx.uses_feature("`quat_xyzw`", "1.1", ctx.loc(element, "quat_xyzw"))
+        quat = vector(ctx, element, "quat_xyzw", f"{what} origin", count=4)
+        if quat is None:
+            ok = False
+        else:
+            norm = math.sqrt(sum(q * q for q in quat))
+            if norm == 0.0:
+                ctx.emit(
+                    "MK121",
+                    f"{what} origin: `quat_xyzw` is the zero quaternion, which is no rotation",
+                    ctx.loc(element, "quat_xyzw"),
+                )
+                ok = False
+            else:
+                pose.rotation = quaternion_matrix(*(q / norm for q in quat))
+    return pose if ok else None

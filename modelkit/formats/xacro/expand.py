@@ -1,0 +1,351 @@
+"""Running the ``xacro`` package in-process, without ROS, with every failure as a diagnostic.
+
+xacro is a module full of global state (file and macro stacks, substitution arguments, the global
+symbol table, a shared text node), prints its warnings to stderr and finds packages through
+``ament_index_python``. One expansion therefore happens under a lock, with that state reset, a few
+of xacro's module functions wrapped or replaced for the duration, and the originals put back:
+
+* ``parse`` reads every file (the top one and each include) through :mod:`modelkit.xmlsource`
+  first (size limit, entity refusal, exact syntax errors), records element origins
+  (:mod:`.origins`) and, unless ``--no-legacy``, rewrites legacy constructs to their prefixed form;
+* ``$(find PKG)`` uses modelkit's resolver, ``$(env)``/``$(optenv)`` its environment;
+* ``warning``/``message``/``error`` become diagnostics, nothing reaches the terminal;
+* ``eval_all``, ``handle_macro_call`` and friends record where xacro is, so that an exception can be
+  placed on a line (:mod:`.errors`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import io
+import os
+import threading
+import xml.dom.minidom as minidom
+import xml.parsers.expat
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from modelkit.diagnostics import Diagnostic, DiagnosticSink, Severity, SourceLocation, diag
+from modelkit.formats.common import ReadOptions
+from modelkit.formats.xacro.errors import (
+    FailureContext,
+    PackageNotFound,
+    Reported,
+    ValueTooLarge,
+    diagnose,
+)
+from modelkit.formats.xacro.legacy import (
+    FileSet,
+    LegacyConstruct,
+    file_key,
+    find_legacy,
+    find_package,
+    macro_names,
+    scan_file_set,
+)
+from modelkit.formats.xacro.origins import OriginMap, dom_elements
+from modelkit.xmlsource import XmlDocument, read_xml
+
+# Elements that macro and block expansion may create (a macro bomb stops here); a lower
+# ``ReadOptions.expansion_limit`` lowers it. xacro's own cost grows with the square of the number
+# of sibling elements (minidom's insertBefore), so a bomb of siblings takes a while to reach it.
+CLONE_BUDGET = 100_000
+
+_LOCK = threading.Lock()
+
+
+@dataclass
+class Expanded:
+    """The URDF text xacro produced and, per element in document order, where it comes from."""
+
+    text: str
+    origins: list[SourceLocation]
+
+
+def legacy_diagnostic(construct: LegacyConstruct, mode: bool | None) -> Diagnostic:
+    """MK701 for one legacy construct: a warning (auto), info (--legacy) or error (--no-legacy)."""
+    hint = f"use {construct.modern()}"
+    if mode is False:
+        hint += "; without --no-legacy modelkit expands it as pre-Jade xacro did"
+    severity = {None: Severity.WARNING, True: Severity.INFO, False: Severity.ERROR}[mode]
+    return diag("MK701", construct.message(), construct.origin.loc(), hint=hint, severity=severity)
+
+
+class _Run:
+    """One expansion: what xacro's hooks share while it runs."""
+
+    def __init__(self, path: Path, display: str, options: ReadOptions, sink: DiagnosticSink) -> None:
+        self.path = path
+        self.display = display
+        self.options = options
+        self.sink = sink
+        self.files = FileSet()
+        self.origins = OriginMap(min(CLONE_BUDGET, options.expansion_limit))
+        self.stack: list[minidom.Element] = []
+        self.failed_node: minidom.Element | None = None
+        self.failed_call: minidom.Element | None = None
+        self.failed_text: str | None = None
+        self.last_directive: minidom.Element | None = None
+        self.xacro: Any = None
+
+    # -- files ---------------------------------------------------------------------------------
+
+    def display_for(self, path: Path) -> str:
+        """How an included file is named in diagnostics: like the top file, relative or absolute."""
+        key = file_key(path)
+        if key == file_key(self.path):
+            return self.display
+        if os.path.isabs(self.display):
+            return key
+        relative = os.path.relpath(key)
+        return key if relative.startswith("..") else relative
+
+    def load(self, path: Path, sink: DiagnosticSink | None = None) -> XmlDocument | None:
+        return read_xml(path, sink or DiagnosticSink(), self.options.max_bytes, self.display_for(path))
+
+    def report_legacy(self, constructs: list[LegacyConstruct]) -> None:
+        for construct in constructs:
+            self.sink.add(legacy_diagnostic(construct, self.options.legacy_xacro))
+
+    def parse(self, filename: str) -> minidom.Document:
+        """xacro's ``parse`` of a file: our checks, origins and legacy rewriting, then a minidom tree."""
+        xacro = self.xacro
+        path = Path(filename)
+        if not path.is_file():
+            xacro.filestack.pop()  # as xacro does: the missing file is not "the current file"
+            code = errno.EISDIR if path.is_dir() else errno.ENOENT
+            error = OSError(code, os.strerror(code), filename)
+            raise xacro.XacroException(f"{error.strerror}: {filename}", exc=error)
+        key = file_key(path)
+        doc = self.files.docs.get(key)
+        if doc is None:
+            doc = self.load(path, self.sink)
+            if doc is None:
+                raise Reported()
+            self.files.docs[key] = doc
+            self.files.macro_names |= macro_names(doc)
+            self.report_legacy(self.files.add_constructs(find_legacy(doc, self.files.macro_names)))
+        try:
+            dom = minidom.parseString(doc.text)
+        except xml.parsers.expat.ExpatError as exc:
+            where = SourceLocation(doc.display, exc.lineno or 0, (exc.offset or 0) + 1)
+            self.sink.emit("MK020", f"malformed XML: {xml.parsers.expat.ErrorString(exc.code)}", where)
+            raise Reported() from exc
+        root = dom.documentElement
+        assert root is not None  # parseString of a document that lxml accepted
+        pairs = self.origins.adopt(root, doc)
+        if self.options.legacy_xacro is not False:
+            for node, element in pairs:
+                if element in self.files.legacy_elements:
+                    node.tagName = node.nodeName = "xacro:" + node.tagName
+        return dom
+
+    # -- hooks ---------------------------------------------------------------------------------
+
+    def tracked(self, function: Callable[..., Any], call: bool = False) -> Callable[..., Any]:
+        """Wrap a function of xacro's that takes the element it works on first."""
+
+        def wrapper(node: minidom.Element, *args: Any, **kwargs: Any) -> Any:
+            self.stack.append(node)
+            self.last_directive = None  # a directive is "current" only until xacro moves on
+            try:
+                return function(node, *args, **kwargs)
+            except BaseException:
+                if self.failed_node is None:
+                    self.failed_node = node
+                if call and self.failed_call is None:
+                    self.failed_call = node
+                raise
+            finally:
+                self.stack.pop()
+                if self.failed_node is None:
+                    self.last_directive = None
+
+        wrapper.__wrapped__ = function  # type: ignore[attr-defined]
+        return wrapper
+
+    def eval_text(self, function: Callable[..., Any]) -> Callable[..., Any]:
+        limit = self.options.max_bytes
+
+        def wrapper(text: Any, symbols: Any) -> Any:
+            try:
+                result = function(text, symbols)
+            except BaseException:
+                if self.failed_text is None and isinstance(text, str):
+                    self.failed_text = text
+                raise
+            if isinstance(result, str) and len(result) > limit:
+                self.failed_text = text if isinstance(text, str) else None
+                raise ValueTooLarge()
+            return result
+
+        return wrapper
+
+    def check_attrs(self, function: Callable[..., Any]) -> Callable[..., Any]:
+        def wrapper(tag: minidom.Element, *args: Any) -> Any:
+            self.last_directive = tag
+            return function(tag, *args)
+
+        return wrapper
+
+    def here(self) -> SourceLocation:
+        """Where xacro is now: the element it works on, else the file."""
+        origin = self.origins.get(self.stack[-1]) if self.stack else None
+        if origin is not None:
+            return origin.loc()
+        current = (self.xacro.filestack or [None])[-1] if self.xacro else None
+        return SourceLocation(self.display_for(Path(current)) if current else self.display)
+
+    def say(self, severity: Severity, args: tuple[object, ...]) -> None:
+        text = " ".join(str(a) for a in args).strip()
+        if not text:
+            return
+        code = "MK700" if severity is Severity.ERROR else "MK703"
+        self.sink.emit(code, f"xacro: {' '.join(text.split())}", self.here(), severity=severity)
+
+    def substitutions(self) -> dict[str, Callable[..., str]]:
+        import xacro.substitution_args as sa
+
+        environ = self.options.resolver.environ
+
+        def find(package: str) -> str:
+            current = (self.xacro.filestack or [None])[-1]
+            found = find_package(self.options, package, Path(current or self.path), self.path)
+            if found is None:
+                raise PackageNotFound(package)
+            return str(found)
+
+        def env(name: str) -> str:
+            if name not in environ:
+                raise sa.SubstitutionException(f"environment variable '{name}' is not set")
+            return environ[name]
+
+        def optenv(name: str, default: str = "") -> str:
+            return environ.get(name, default)
+
+        return {"find": find, "env": env, "optenv": optenv}
+
+    # -- running -------------------------------------------------------------------------------
+
+    def messages(self) -> dict[str, Callable[..., Any]]:
+        def warning(*args: object, **kwargs: object) -> None:
+            self.say(Severity.WARNING, args)
+
+        def message(*args: object, **kwargs: object) -> None:
+            self.say(Severity.INFO, args)
+
+        def error(*args: object, **kwargs: object) -> None:
+            self.say(Severity.ERROR, args)
+
+        def print_location(*args: object, **kwargs: object) -> None:
+            return None
+
+        return {"warning": warning, "message": message, "error": error, "print_location": print_location}
+
+    @contextlib.contextmanager
+    def patched(self) -> Iterator[None]:
+        """xacro with our hooks and fresh state; everything restored afterwards."""
+        import xacro
+        import xacro.substitution_args as sa
+
+        self.xacro = xacro
+        saved: list[tuple[Any, str, Any]] = []
+
+        def put(target: Any, name: str, value: Any) -> None:
+            saved.append((target, name, getattr(target, name)))
+            setattr(target, name, value)
+
+        try:
+            put(xacro, "parse", _with_original(self.parse, xacro.parse))
+            for name in ("eval_all", "process_include", "grab_property", "grab_macro"):
+                put(xacro, name, self.tracked(getattr(xacro, name)))
+            put(xacro, "handle_macro_call", self.tracked(xacro.handle_macro_call, call=True))
+            put(xacro, "eval_text", self.eval_text(xacro.eval_text))
+            put(xacro, "check_attrs", self.check_attrs(xacro.check_attrs))
+            for name, function in self.messages().items():
+                put(xacro, name, function)
+            substitutions = self.substitutions()
+            for name, function in substitutions.items():
+                put(sa, f"_eval_{name}", function)
+            saved.append((sa, "_eval_dict", sa._eval_dict))
+            sa._eval_dict = {**sa._eval_dict, **substitutions}
+            put(xacro, "all_includes", [])
+            put(xacro, "substitution_args_context", {})
+            put(xacro, "filestack", None)
+            put(xacro, "macrostack", None)
+            put(xacro, "root_dir", os.curdir)
+            put(xacro, "verbosity", 1)
+            dummy = minidom.getDOMImplementation().createDocument(None, "dummy", None)
+            put(xacro, "_empty_text_node", dummy.createTextNode("\n\n"))
+            put(xacro, "_global_symbols", xacro.create_global_symbols())
+            yield
+        finally:
+            for target, name, value in reversed(saved):
+                setattr(target, name, value)
+
+    def context(self) -> FailureContext:
+        current = (self.xacro.filestack or [None])[-1]
+        docs = list(self.files.docs.values())
+        if current:
+            first = self.files.docs.get(file_key(current))
+            if first is not None:
+                docs = [first] + [d for d in docs if d is not first]
+        macros = [m.body.getAttribute("name") for m in (self.xacro.macrostack or [])]
+        return FailureContext(
+            origins=self.origins,
+            docs=docs,
+            fallback=SourceLocation(self.display_for(Path(current)) if current else self.display),
+            failed_node=self.failed_node,
+            failed_call=self.failed_call,
+            last_directive=self.last_directive,
+            failed_text=self.failed_text,
+            macros=macros,
+        )
+
+    def run(self, top: XmlDocument) -> Expanded | None:
+        self.files = scan_file_set(top, self.path, self.options, self.load)
+        self.report_legacy(self.files.constructs)
+        stray = io.StringIO()
+        with _LOCK, self.patched(), contextlib.redirect_stdout(stray), contextlib.redirect_stderr(stray):
+            try:
+                doc = self.xacro.process_file(
+                    str(self.path), mappings=dict(self.options.xacro_args), verbosity=1
+                )
+            except Exception as exc:
+                found = diagnose(exc, self.context())
+                if found is not None:
+                    self.sink.add(found)
+                return None
+            finally:
+                for line in stray.getvalue().splitlines():
+                    self.say(Severity.WARNING, (line,))
+            fallback = self.origins.get(doc.documentElement)
+            top_loc = fallback.loc() if fallback else SourceLocation(self.display)
+            origins = []
+            for node in dom_elements(doc.documentElement):
+                origin = self.origins.get(node)
+                origins.append(origin.loc() if origin else top_loc)
+            return Expanded(doc.toprettyxml(indent="  "), origins)
+
+
+def _with_original(hook: Callable[..., Any], original: Callable[..., Any]) -> Callable[..., Any]:
+    def parse(inp: Any, filename: str | None = None) -> Any:
+        if inp is not None or filename is None:
+            return original(inp, filename)
+        return hook(filename)
+
+    return parse
+
+
+def expand(path: Path, options: ReadOptions, display: str, sink: DiagnosticSink) -> Expanded | None:
+    """Expand an xacro file; diagnostics go to ``sink``; None when it cannot be expanded."""
+    top = read_xml(path, sink, options.max_bytes, display)
+    if top is None:
+        return None
+    return _Run(path, display, options, sink).run(top)
+
+
+__all__ = ["Expanded", "expand", "legacy_diagnostic"]
