@@ -114,10 +114,146 @@ _TABLE: tuple[CodeInfo, ...] = (
     CodeInfo("MK124", "xml-element-repeated", "warning", "An element that may appear once appears again."),
     # -- MK13x/MK14x: URDF ------------------------------------------------------------------
     # (urdf section)
+    CodeInfo(
+        "MK130",
+        "urdf-version-unsupported",
+        "error",
+        "The `<robot version>` is not 1.0, 1.1 or 1.2.",
+    ),
+    CodeInfo(
+        "MK131", "urdf-robot-name-missing", "error", "`<robot>` has no `name` (urdfdom refuses the file)."
+    ),
+    CodeInfo("MK132", "urdf-no-links", "error", "The robot has no `<link>` element."),
+    CodeInfo("MK133", "urdf-joint-type-unknown", "error", "A joint `type` is not a URDF joint type."),
+    CodeInfo(
+        "MK134",
+        "urdf-joint-limit-missing",
+        "error",
+        "A revolute or prismatic joint has no `<limit>` (urdfdom refuses the file).",
+    ),
+    CodeInfo(
+        "MK135",
+        "urdf-material-undefined",
+        "warning",
+        "A visual refers to a material name that is not defined before it; the visual gets no colour.",
+    ),
+    CodeInfo(
+        "MK136",
+        "urdf-material-unnamed",
+        "error",
+        "A `<material>` in a visual has no `name` (urdfdom drops the visual; PyBullet refuses the file).",
+    ),
+    CodeInfo(
+        "MK137",
+        "urdf-origin-rpy-and-quat",
+        "error",
+        "An `<origin>` gives both `rpy` and `quat_xyzw`.",
+    ),
+    CodeInfo(
+        "MK138",
+        "urdf-gazebo-reference-unknown",
+        "warning",
+        "A `<gazebo reference>` names neither a link nor a joint; libsdformat ignores the block.",
+    ),
+    CodeInfo(
+        "MK139",
+        "urdf-transmission-joint-unknown",
+        "warning",
+        "A `<transmission>` drives a joint that does not exist.",
+    ),
+    CodeInfo(
+        "MK140",
+        "urdf-material-duplicate",
+        "error",
+        "Two top-level materials have the same name (urdfdom refuses the file).",
+    ),
+    CodeInfo(
+        "MK141",
+        "urdf-material-empty",
+        "warning",
+        "A top-level material has neither a colour nor a texture.",
+    ),
+    CodeInfo(
+        "MK142",
+        "urdf-feature-newer-than-version",
+        "warning",
+        "A URDF 1.1/1.2 feature (`quat_xyzw`, `<capsule>`, `<limit acceleration>`...) in a document that "
+        "declares an older version; older parsers silently misread it.",
+    ),
     # -- MK15x/MK16x: SDF -------------------------------------------------------------------
     # (sdf section)
+    CodeInfo("MK150", "sdf-version-missing", "error", "`<sdf>` has no `version` attribute."),
+    CodeInfo(
+        "MK151",
+        "sdf-version-unsupported",
+        "error",
+        "The SDFormat version is not one modelkit reads (1.4 to 1.11).",
+    ),
+    CodeInfo(
+        "MK152", "sdf-model-without-link", "error", "A model has no link (SDFormat requires at least one)."
+    ),
+    CodeInfo(
+        "MK153",
+        "sdf-root-multiple",
+        "error",
+        "`<sdf>` holds more than one model, light or actor outside a world; only the first is read.",
+    ),
+    CodeInfo(
+        "MK154",
+        "sdf-nothing-to-read",
+        "warning",
+        "The file holds no model (a world without models, or only a light or an actor).",
+    ),
+    CodeInfo(
+        "MK155",
+        "sdf-not-modelled",
+        "warning",
+        "Valid SDF that the robot model cannot hold (actor, world joint, nested static model ...); skipped.",
+    ),
     # -- MK17x: MJCF ------------------------------------------------------------------------
     # (mjcf section)
+    CodeInfo(
+        "MK170",
+        "mjcf-compile-error",
+        "error",
+        "MuJoCo refused the MJCF file; its message is given, at the line it names when it names one.",
+    ),
+    CodeInfo(
+        "MK171",
+        "mjcf-multi-joint-body",
+        "info",
+        "A body with several joints becomes a chain of links (one joint each, massless in between).",
+    ),
+    CodeInfo(
+        "MK172",
+        "mjcf-element-unsupported",
+        "warning",
+        "An MJCF element the model cannot hold (tendon, non-joint equality, plane/hfield/sdf geom...).",
+    ),
+    CodeInfo(
+        "MK173",
+        "mjcf-unnamed",
+        "info",
+        "A body or joint (or the model) has no name; a deterministic name is generated.",
+    ),
+    CodeInfo(
+        "MK174",
+        "mjcf-uncompiled-fallback",
+        "warning",
+        "MuJoCo could not compile the file; the tree was read from the uncompiled spec (no geometry).",
+    ),
+    CodeInfo(
+        "MK175",
+        "mjcf-kept-as-data",
+        "info",
+        "Actuators, sensors, sites, cameras, lights, keyframes, world geoms: kept as data, not in the model.",
+    ),
+    CodeInfo(
+        "MK176",
+        "mjcf-several-trees",
+        "info",
+        "The worldbody holds several body trees; each becomes a robot of its own.",
+    ),
     # -- MK2xx: kinematic tree --------------------------------------------------------------
     CodeInfo("MK200", "no-root", "error", "No root link can be found (every link has a parent, or a cycle)."),
     CodeInfo("MK201", "multiple-roots", "error", "More than one link has no parent."),
@@ -135,7 +271,7 @@ _TABLE: tuple[CodeInfo, ...] = (
     CodeInfo(
         "MK211",
         "link-joint-name-collision",
-        "warning",
+        "error",
         "A link and a joint share a name (fatal in SDF 1.7+ and Gazebo).",
     ),
     CodeInfo(
@@ -184,7 +320,75 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "A link is the child of two joints (check_urdf misses it when both parents share a root).",
     ),
-    # (urdf tree MK221-MK229) (sdf frames and poses MK230-MK249)
+    CodeInfo("MK221", "child-undefined", "error", "A joint names a child link that does not exist."),
+    # (urdf tree MK222-MK229) (sdf frames and poses MK230-MK249)
+    CodeInfo(
+        "MK230",
+        "sdf-relative-to-undefined",
+        "error",
+        "A pose's `relative_to` names no frame of its scope (libsdformat error 25).",
+    ),
+    CodeInfo(
+        "MK231", "sdf-pose-cycle", "error", "`relative_to` attributes form a cycle (libsdformat error 26)."
+    ),
+    CodeInfo(
+        "MK232",
+        "sdf-attached-to-undefined",
+        "error",
+        "A frame's `attached_to` names no frame of its scope (libsdformat error 22).",
+    ),
+    CodeInfo(
+        "MK233",
+        "sdf-attached-to-cycle",
+        "error",
+        "Frames' `attached_to` attributes form a cycle (libsdformat error 23).",
+    ),
+    CodeInfo(
+        "MK234",
+        "sdf-joint-link-undefined",
+        "error",
+        "A joint's parent or child names no link or frame, or the child is `world` (errors 19, 20).",
+    ),
+    CodeInfo(
+        "MK235",
+        "sdf-joint-parent-is-child",
+        "error",
+        "A joint's parent and child are, or are attached to, the same link (libsdformat error 21).",
+    ),
+    CodeInfo(
+        "MK236",
+        "sdf-canonical-link-invalid",
+        "error",
+        "`canonical_link` names no link of the model (libsdformat error 15).",
+    ),
+    CodeInfo(
+        "MK237",
+        "sdf-name-not-unique",
+        "error",
+        "Two siblings share a name: links/joints/frames/models of a model (SDF 1.7+), visuals, "
+        "collisions, sensors of a link, models of a world.",
+    ),
+    CodeInfo(
+        "MK238", "sdf-reserved-name", "error", "A name is reserved (`world`, `__...__`, or contains `::`)."
+    ),
+    CodeInfo(
+        "MK239",
+        "sdf-expressed-in-undefined",
+        "error",
+        "A joint axis's `expressed_in` names no frame of the model.",
+    ),
+    CodeInfo(
+        "MK240",
+        "sdf-placement-frame-undefined",
+        "error",
+        "A `placement_frame` names no frame of the placed model (libsdformat error 29).",
+    ),
+    CodeInfo(
+        "MK241",
+        "sdf-closed-loop",
+        "warning",
+        "A link is the child of several joints; the extra joints are kept as loop constraints.",
+    ),
     # -- MK3xx: mass properties, joints, transforms ---------------------------------------------
     CodeInfo("MK300", "mass-not-positive", "error", "A link's mass is zero or negative."),
     CodeInfo("MK301", "inertia-asymmetric", "error", "A 9-element inertia matrix is not symmetric."),
@@ -245,7 +449,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "A velocity range has its lower bound above its upper.",
     ),
-    CodeInfo("MK320", "mimic-target-undefined", "error", "A mimic joint follows a joint that does not exist."),
+    CodeInfo(
+        "MK320", "mimic-target-undefined", "error", "A mimic joint follows a joint that does not exist."
+    ),
     CodeInfo(
         "MK321",
         "mimic-target-invalid",
@@ -258,7 +464,31 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "libsdformat (Gazebo) would silently drop this massless URDF link and its subtree.",
     ),
-    # (urdf joints and mass MK323-MK339) (sdf joints and inertials MK340-MK359)
+    CodeInfo(
+        "MK323",
+        "joint-limit-negative",
+        "warning",
+        "A URDF `<limit>` effort or velocity is negative (they are magnitudes; Choreonoid refuses them).",
+    ),
+    # (urdf joints and mass MK324-MK339) (sdf joints and inertials MK340-MK359)
+    CodeInfo(
+        "MK340",
+        "sdf-joint-type-unsupported",
+        "warning",
+        "A universal, revolute2, screw or gearbox joint: the model keeps it as a fixed placeholder.",
+    ),
+    CodeInfo(
+        "MK342",
+        "sdf-auto-inertial-computed",
+        "info",
+        "`<inertial auto=\"true\">`: mass properties computed from the collision shapes.",
+    ),
+    CodeInfo(
+        "MK343",
+        "sdf-auto-inertial-unsupported",
+        "warning",
+        "`<inertial auto=\"true\">` with collisions modelkit cannot integrate (meshes); written values kept.",
+    ),
     # -- MK4xx: geometry -------------------------------------------------------------------------
     CodeInfo("MK400", "primitive-invalid", "error", "A primitive's dimensions cannot generate a shape."),
     CodeInfo(
@@ -321,7 +551,21 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "An Extrusion orientation axis is not unit length (Choreonoid uses it unnormalised).",
     ),
-    # (urdf/sdf/mjcf geometry MK420-MK439)
+    # (urdf/sdf/mjcf geometry MK420-MK439: urdf MK420-MK429)
+    CodeInfo(
+        "MK420",
+        "mesh-scale-single-number",
+        "warning",
+        "A URDF mesh `scale` has one number; URDF needs three (urdfdom drops the shape).",
+    ),
+    # (urdf geometry MK421-MK429)
+    # (sdf geometry MK430-MK439)
+    CodeInfo(
+        "MK430",
+        "sdf-geometry-not-modelled",
+        "warning",
+        "A plane, heightmap, image or polyline geometry: the model has no such shape; kept as data.",
+    ),
     # -- MK5xx: resources and materials -----------------------------------------------------------
     CodeInfo(
         "MK500",
@@ -357,7 +601,34 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "A URDF mesh is COLLADA (.dae), which MuJoCo cannot load.",
     ),
-    # (urdf materials and resources MK513-MK529) (sdf resources MK530-MK549)
+    CodeInfo(
+        "MK513",
+        "color-out-of-range",
+        "warning",
+        "A URDF colour `rgba` has values outside 0..1 (they are clamped).",
+    ),
+    # (urdf materials and resources MK514-MK529) (sdf resources MK530-MK549)
+    CodeInfo(
+        "MK530",
+        "sdf-include-invalid",
+        "error",
+        "An `<include>` target cannot be used (no model.config or SDF file, no model in it).",
+    ),
+    CodeInfo(
+        "MK531", "sdf-include-cycle", "error", "An `<include>` includes a file that is already being read."
+    ),
+    CodeInfo(
+        "MK532",
+        "sdf-model-uri-local",
+        "info",
+        "A `model://` URI is found beside the model, not on the resource path (GZ_SIM_RESOURCE_PATH).",
+    ),
+    CodeInfo(
+        "MK533",
+        "sdf-material-script",
+        "info",
+        "A visual's colour comes from an OGRE material script; only the script name is kept.",
+    ),
     # -- MK6xx: devices and scene nodes ----------------------------------------------------------
     CodeInfo(
         "MK600",
@@ -384,9 +655,70 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "`material` directly in a Shape is ignored; put it under `appearance`.",
     ),
-    # (urdf gazebo extensions MK620-MK629) (sdf sensors, lights, plugins MK630-MK649)
+    CodeInfo(
+        "MK620",
+        "gazebo-sensor-invalid",
+        "warning",
+        "A `<sensor>` in a URDF `<gazebo>` block lacks its name or type, or has a malformed `<pose>`.",
+    ),
+    # (urdf gazebo extensions MK621-MK629) (sdf sensors, lights, plugins MK630-MK649)
+    CodeInfo(
+        "MK630",
+        "sdf-device-type-invalid",
+        "error",
+        "A sensor or light type is missing or not an SDFormat type (libsdformat refuses it).",
+    ),
+    CodeInfo("MK631", "sdf-plugin-kept", "info", "A `<plugin>` is simulator code; it is kept only as data."),
     # -- MK7xx: xacro -----------------------------------------------------------------------
     # (xacro MK700-MK719)
+    CodeInfo(
+        "MK700", "xacro-error", "error", "xacro could not expand the file (a bad expression, attribute, tag)."
+    ),
+    CodeInfo(
+        "MK701",
+        "xacro-legacy-construct",
+        "warning",
+        "Pre-Jade xacro without the `xacro:` prefix (`<property>`, `<include>`, an unprefixed macro call); "
+        "expanded with a warning, an error with `--no-legacy`.",
+    ),
+    CodeInfo(
+        "MK702", "xacro-package-not-found", "error", "`$(find PKG)` names a package that cannot be found."
+    ),
+    CodeInfo(
+        "MK703", "xacro-warning", "warning", "xacro warned while expanding (or the file printed a message)."
+    ),
+    CodeInfo(
+        "MK704",
+        "xacro-arg-undefined",
+        "error",
+        "`$(arg NAME)` has no value: no `NAME:=VALUE` argument and no `<xacro:arg>` default.",
+    ),
+    CodeInfo(
+        "MK705", "xacro-file-missing", "error", "A file to include (or a YAML file to load) does not exist."
+    ),
+    CodeInfo("MK706", "xacro-recursion", "error", "Macro expansion recurses without end."),
+    CodeInfo(
+        "MK707", "xacro-name-undefined", "error", "A `${...}` expression uses a name that is not defined."
+    ),
+    CodeInfo(
+        "MK708",
+        "xacro-macro-call",
+        "error",
+        "A macro call does not match the macro: a missing or unknown parameter, a missing block, "
+        "or no such macro.",
+    ),
+    CodeInfo(
+        "MK709",
+        "xacro-expansion-limit",
+        "error",
+        "Expansion produces too many elements or too long a value (a macro or property bomb).",
+    ),
+    CodeInfo(
+        "MK710",
+        "xacro-library",
+        "info",
+        "An xacro file expands to no robot content: a macro library, checked for xacro errors only.",
+    ),
 )
 
 CODES: dict[str, CodeInfo] = {c.code: c for c in _TABLE}
