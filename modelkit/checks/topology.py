@@ -7,7 +7,7 @@ from collections.abc import Iterator
 
 from modelkit.checks.registry import rule
 from modelkit.diagnostics import Diagnostic, diag
-from modelkit.model import Robot
+from modelkit.model import Link, Robot
 
 
 @rule("unique-names", "MK204", "MK205")
@@ -141,15 +141,22 @@ def joint_ids(robot: Robot) -> Iterator[Diagnostic]:
 @rule("link-joint-name-collision", "MK211")
 def link_joint_collision(robot: Robot) -> Iterator[Diagnostic]:
     """A joint named like a link (other than its own implicit name) breaks SDF 1.7+ and Gazebo."""
-    names = {link.name for link in robot.links}
+    links: dict[str, Link] = {}
+    for link in robot.links:
+        links.setdefault(link.name, link)
     for joint in robot.joints:
         if joint.extras.get("implicit_name"):
             continue
-        if joint.name in names:
+        same = links.get(joint.name)
+        if same is not None:
+            where = same.loc("name")
+            line = f" (the link is at line {where.line})" if where and where.line else ""
             yield diag(
                 "MK211",
-                f'joint "{joint.name}" has the same name as a link; SDF 1.7+ and Gazebo refuse this',
+                f'joint "{joint.name}" has the same name as a link{line}; SDF 1.7+ (libsdformat) and '
+                "Gazebo refuse this",
                 joint.loc("name"),
+                hint=f'rename the joint, e.g. "{joint.name}_joint"',
             )
 
 
