@@ -105,18 +105,14 @@ class XmlDocument:
         return SourceLocation(self.display, *self._position(offset))
 
 
+_TAG_TOKEN = re.compile(r"\"[^\"]*\"|'[^']*'|>")
+
+
 def _tag_end(text: str, start: int) -> int:
     """Offset of the ``>`` that closes the start tag beginning at ``start`` (quotes respected)."""
-    quote = ""
-    for i in range(start, len(text)):
-        c = text[i]
-        if quote:
-            if c == quote:
-                quote = ""
-        elif c in "\"'":
-            quote = c
-        elif c == ">":
-            return i
+    for match in _TAG_TOKEN.finditer(text, start):
+        if match.group(0) == ">":
+            return match.start()
     return len(text)
 
 

@@ -88,27 +88,35 @@ def no_cycles(robot: Robot) -> Iterator[Diagnostic]:
     Joints are attached in document order, as Choreonoid does, and the joint whose attachment
     closes a loop is the one reported.
     """
-    attached: dict[str, str] = {}  # child -> parent, for the joints attached so far
+    attached: dict[str, str] = {}  # child -> parent, for the joints attached so far (a forest)
+    top: dict[str, str] = {}  # union-find towards the topmost ancestor, with path compression
+
+    def topmost(name: str) -> str:
+        chain = []
+        while name in top:
+            chain.append(name)
+            name = top[name]
+        for item in chain:
+            top[item] = name
+        return name
+
     for joint in robot.joints:
         if joint.child in attached:
             continue  # a second parent: not a cycle by itself
-        ancestor: str | None = joint.parent
-        path = [joint.child]
-        seen: set[str] = set()
-        while ancestor is not None and ancestor not in seen:
-            seen.add(ancestor)
-            path.append(ancestor)
-            if ancestor == joint.child:
-                loop = " -> ".join(reversed(path))
-                yield diag(
-                    "MK203",
-                    f'adding "{joint.child}" to link "{joint.parent}" results in a cyclic reference ({loop})',
-                    joint.loc("parent"),
-                )
-                break
-            ancestor = attached.get(ancestor)
-        else:  # no cycle: attach it (a joint that closes a cycle stays out)
+        if topmost(joint.parent) != joint.child:
             attached[joint.child] = joint.parent
+            top[joint.child] = joint.parent
+            continue
+        # The child is an ancestor of the parent: this joint would close a loop (it stays out).
+        path = [joint.child, joint.parent]
+        while path[-1] != joint.child:
+            path.append(attached[path[-1]])
+        loop = " -> ".join(reversed(path))
+        yield diag(
+            "MK203",
+            f'adding "{joint.child}" to link "{joint.parent}" results in a cyclic reference ({loop})',
+            joint.loc("parent"),
+        )
 
 
 @rule("joint-ids", "MK206", "MK207")
