@@ -11,6 +11,13 @@ from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
 from modelkit.model import JointType, Link, Robot
 from modelkit.spatial import inertia_tolerance, principal_moments
 
+# Who fills in missing mass properties, per source format (the wording of MK304).
+DEFAULTS_APPLIED_BY = {"body": "Choreonoid uses", "sdf": "SDFormat's defaults apply"}
+DEFAULTS_HINT = {
+    "body": "give mass, center_of_mass and inertia",
+    "sdf": "give <inertial> a <mass> and an <inertia>",
+}
+
 
 def _moving_links(robot: Robot) -> set[str]:
     """Links that move relative to the world: below a moving joint, or the floating root."""
@@ -85,12 +92,13 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
             continue
         if inertial.defaulted and link.name in moving:
             what = "no mass information" if "mass" not in inertial.sources else "no inertia"
+            who = DEFAULTS_APPLIED_BY.get(robot.source_format, "the format's defaults apply")
             yield diag(
                 "MK304",
-                f'link "{link.name}" has {what}: Choreonoid uses '
+                f'link "{link.name}" has {what}: {who}: '
                 f"{'1 kg and ' if 'mass' not in inertial.sources else ''}an identity inertia (1 kg·m²)",
                 _mass_loc(link),
-                hint="give mass, center_of_mass and inertia",
+                hint=DEFAULTS_HINT.get(robot.source_format, "give the mass and the inertia"),
             )
         if inertial.mass < 0:
             yield diag(

@@ -1,0 +1,165 @@
+"""What the SDF reader shares while it reads one file and the files it includes.
+
+* URI resolution with one SDF convenience: ``model://NAME/...`` that the resource path
+  (``GZ_SIM_RESOURCE_PATH``, ``IGN_GAZEBO_RESOURCE_PATH``, ``SDF_PATH``) does not resolve is looked
+  up beside the referring file's own model folders (a folder holding ``NAME/`` among the file's
+  ancestors), and reported as info (MK532) because it depends on the layout;
+* ``<include>`` targets: a directory is a model folder whose ``model.config`` names the SDF file;
+  each file is parsed and checked once, however often it is included;
+* mesh checking through :class:`~modelkit.formats.meshref.MeshChecker`.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from modelkit.diagnostics import DiagnosticSink, SourceLocation
+from modelkit.formats.common import ReadOptions
+from modelkit.formats.meshref import MeshChecker
+from modelkit.formats.sdf.document import MAX_VERSION, SdfDocument, load_document, parse_version
+from modelkit.formats.sdf.spec import check_elements
+from modelkit.model import Mesh
+from modelkit.resources import Resolution
+from modelkit.xmlsource import read_xml
+
+
+@dataclass
+class Context:
+    options: ReadOptions
+    sink: DiagnosticSink
+    _meshes: dict[str, MeshChecker] = field(default_factory=dict)
+    _documents: dict[str, SdfDocument | None] = field(default_factory=dict)
+
+    # -- documents ---------------------------------------------------------------------------
+
+    def document(self, path: Path, display: str | None = None) -> SdfDocument | None:
+        """Load (once) and check an SDF file."""
+        key = os.path.normpath(os.path.abspath(path))
+        if key not in self._documents:
+            src = load_document(
+                path, display or os.path.normpath(str(path)), self.sink, self.options.max_bytes
+            )
+            if src is not None:
+                check_elements(src.doc, self.sink, src.version)
+            self._documents[key] = src
+        return self._documents[key]
+
+    # -- URIs ----------------------------------------------------------------------------------
+
+    def resolve(self, uri: str, src: SdfDocument, loc: SourceLocation) -> Resolution:
+        """Resolve ``uri`` as written in ``src``; unresolved ``model://`` URIs get the local look-up."""
+        resolution = self.options.resolver.resolve(uri, src.base_dir, src.path)
+        if resolution.scheme != "model" or resolution.path is not None:
+            return resolution
+        local = self._local_model(uri, src.path)
+        if local is None:
+            return resolution
+        folder = local[1]
+        self.sink.emit(
+            "MK532",
+            f'"{uri}" is not on the model resource path; found beside this model at {local[0]}',
+            loc,
+            hint=f"add {folder} to GZ_SIM_RESOURCE_PATH so that Gazebo finds it too",
+        )
+        return Resolution(uri, local[0], "model")
+
+    @staticmethod
+    def _local_model(uri: str, model_file: Path) -> tuple[Path, Path] | None:
+        rest = uri.strip()[len("model://") :]
+        name = rest.partition("/")[0]
+        if not name:
+            return None
+        relative = model_file.is_absolute() is False
+        for folder in Path(os.path.abspath(model_file)).parents:
+            if (folder / name).is_dir():
+                found = folder / rest
+                if relative:
+                    found = Path(os.path.relpath(found))
+                    folder = Path(os.path.relpath(folder))
+                return Path(os.path.normpath(found)), folder
+        return None
+
+    def mesh(
+        self,
+        uri: str,
+        src: SdfDocument,
+        loc: SourceLocation,
+        scale: tuple[float, float, float],
+        visual_only: bool,
+        submesh: str | None,
+    ) -> Mesh:
+        key = str(src.path)
+        checker = self._meshes.get(key)
+        if checker is None:
+            checker = MeshChecker(
+                self.options.resolver, src.base_dir, src.path, self.sink, self.options.check_resources
+            )
+            self._meshes[key] = checker
+        target = uri
+        if uri.strip().lower().startswith("model://"):
+            resolution = self.resolve(uri, src, loc)
+            if resolution.path is not None:
+                target = os.path.abspath(resolution.path)
+        mesh = checker.mesh(target, loc, scale, visual_only=visual_only, submesh=submesh)
+        mesh.uri = uri
+        return mesh
+
+    # -- includes ------------------------------------------------------------------------------
+
+    def include_file(self, uri: str, src: SdfDocument, loc: SourceLocation) -> Path | None:
+        """The SDF file an ``<include><uri>`` names; faults are reported at ``loc``."""
+        resolution = self.resolve(uri, src, loc)
+        if resolution.code is not None or resolution.path is None:
+            self.sink.emit(
+                resolution.code or "MK504",
+                resolution.message or f'cannot resolve "{uri}"',
+                loc,
+                hint=resolution.hint,
+            )
+            return None
+        path = resolution.path
+        if not path.exists():
+            self.sink.emit("MK500", f'included model "{uri}" not found at {path}', loc)
+            return None
+        if path.is_dir():
+            return self._model_folder(uri, path, loc)
+        return path
+
+    def _model_folder(self, uri: str, folder: Path, loc: SourceLocation) -> Path | None:
+        config = folder / "model.config"
+        if not config.is_file():
+            fallback = folder / "model.sdf"
+            if fallback.is_file():
+                return fallback
+            self.sink.emit(
+                "MK530",
+                f'included model "{uri}": {folder} has no model.config (and no model.sdf)',
+                loc,
+            )
+            return None
+        scratch = DiagnosticSink()
+        doc = read_xml(config, scratch, self.options.max_bytes)
+        if doc is None:
+            self.sink.emit("MK530", f'included model "{uri}": {config} cannot be read', loc)
+            return None
+        choices: list[tuple[tuple[int, int] | None, str]] = []
+        for el in doc.root.iter("sdf"):
+            name = (el.text or "").strip()
+            if name:
+                choices.append((parse_version(el.get("version")), name))
+        if not choices:
+            self.sink.emit("MK530", f'included model "{uri}": {config} names no <sdf> file', loc)
+            return None
+        usable = [c for c in choices if c[0] is not None and c[0] <= MAX_VERSION]
+        version_name = max(usable, key=lambda c: c[0] or (0, 0))[1] if usable else choices[0][1]
+        target = folder / version_name
+        if not target.is_file():
+            self.sink.emit(
+                "MK530",
+                f'included model "{uri}": {config} names "{version_name}", which does not exist',
+                loc,
+            )
+            return None
+        return target

@@ -1,0 +1,154 @@
+"""Loading one SDF file: XML with positions, the ``<sdf>`` root and its version.
+
+SDF files often use namespaced custom elements (``<gz:...>``, ``<ignition:...>``) without
+declaring the prefix: libsdformat's XML parser (tinyxml2) ignores namespaces, lxml refuses the
+document. When that is the only problem, the undeclared prefixes are declared on the root element
+(at the end of its start tag, so line numbers and the columns of every other line are unchanged)
+and the document is parsed again.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from modelkit.diagnostics import DiagnosticSink
+from modelkit.formats.sdf.values import Values, local_name
+from modelkit.xmlsource import XmlDocument, parse_xml_bytes, read_xml
+
+MIN_VERSION = (1, 4)
+MAX_VERSION = (1, 11)
+SUPPORTED = "1.4-1.11"
+_VERSION = re.compile(r"\s*(\d+)\.(\d+)\s*")
+_MASKED = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<!DOCTYPE(?:[^\[>]|\[.*?\])*>", re.DOTALL)
+_PREFIXED = re.compile(r"(?:<|\s)([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*")
+_DECLARED = re.compile(r"xmlns:([A-Za-z_][\w.-]*)\s*=")
+_ENCODING = re.compile(r"<\?xml[^>]*encoding\s*=\s*[\"']([^\"']+)", re.IGNORECASE)
+
+
+@dataclass
+class SdfDocument:
+    """A parsed SDF file and the version its semantics follow."""
+
+    doc: XmlDocument
+    path: Path
+    version: tuple[int, int]
+    values: Values
+
+    @property
+    def display(self) -> str:
+        return self.doc.display
+
+    @property
+    def base_dir(self) -> Path:
+        return self.path.parent
+
+    def at_least(self, major: int, minor: int) -> bool:
+        return self.version >= (major, minor)
+
+
+def parse_version(text: str | None) -> tuple[int, int] | None:
+    match = _VERSION.fullmatch(text or "")
+    return (int(match.group(1)), int(match.group(2))) if match else None
+
+
+def version_text(version: tuple[int, int]) -> str:
+    return f"{version[0]}.{version[1]}"
+
+
+def load_document(path: Path, display: str, sink: DiagnosticSink, max_bytes: int) -> SdfDocument | None:
+    """Read ``path`` as SDF; faults become diagnostics and the result is None when unusable.
+
+    An unsupported or missing version is reported, and reading goes on with the nearest version
+    modelkit knows, so that the rest of the file is still checked.
+    """
+    doc = _read(path, display, sink, max_bytes)
+    if doc is None:
+        return None
+    root = doc.root
+    values = Values(doc, sink)
+    if local_name(root) != "sdf":
+        hint = "this looks like URDF; read it as URDF" if local_name(root) == "robot" else None
+        sink.emit("MK022", f"the top element is <{local_name(root)}>, not <sdf>", doc.loc(root), hint=hint)
+        return None
+    raw = root.get("version")
+    version = parse_version(raw)
+    if raw is None:
+        sink.emit(
+            "MK150",
+            "<sdf> has no version attribute; libsdformat refuses the file",
+            doc.loc(root),
+            hint='add version="1.11" (or the version the file was written for)',
+        )
+        version = MAX_VERSION
+    elif version is None or not MIN_VERSION <= version <= MAX_VERSION:
+        sink.emit(
+            "MK151",
+            f'SDFormat version "{raw}" is not supported (modelkit reads {SUPPORTED})',
+            doc.loc(root, "version"),
+            hint="convert older files with `gz sdf -p`" if version and version < MIN_VERSION else None,
+        )
+        version = MIN_VERSION if version is not None and version < MIN_VERSION else MAX_VERSION
+    return SdfDocument(doc, path, version, values)
+
+
+def _read(path: Path, display: str, sink: DiagnosticSink, max_bytes: int) -> XmlDocument | None:
+    first = DiagnosticSink()
+    doc = read_xml(path, first, max_bytes, display)
+    if doc is not None:
+        sink.extend(first.items)
+        return doc
+    if not any(d.code == "MK020" and "Namespace prefix" in d.message for d in first.items):
+        sink.extend(first.items)
+        return None
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        sink.extend(first.items)
+        return None
+    declared = _declare_prefixes(text)
+    if declared is None:
+        sink.extend(first.items)
+        return None
+    second = DiagnosticSink()
+    doc = parse_xml_bytes(declared.encode("utf-8"), display, second, path)
+    sink.extend(second.items)
+    return doc
+
+
+def _declare_prefixes(text: str) -> str | None:
+    """``text`` with every undeclared namespace prefix declared on the root element."""
+    encoding = _ENCODING.search(text)
+    if encoding and encoding.group(1).lower().replace("_", "-") not in ("utf-8", "utf8"):
+        return None
+    masked = _MASKED.sub(lambda m: " " * len(m.group(0)), text)
+    start = masked.find("<")
+    while start >= 0 and masked[start + 1 : start + 2] in ("!", "?", ""):
+        start = masked.find("<", start + 1)
+    if start < 0:
+        return None
+    end = _tag_end(masked, start)
+    if end >= len(masked):
+        return None
+    prefixes = {m.group(1) for m in _PREFIXED.finditer(masked)} - {"xml", "xmlns", "http", "https"}
+    prefixes -= set(_DECLARED.findall(masked))
+    if not prefixes:
+        return None
+    insert = "".join(f' xmlns:{p}="urn:modelkit:undeclared:{p}"' for p in sorted(prefixes))
+    at = end - 1 if masked[end - 1] == "/" else end
+    return text[:at] + insert + text[at:]
+
+
+def _tag_end(text: str, start: int) -> int:
+    quote = ""
+    for i in range(start, len(text)):
+        c = text[i]
+        if quote:
+            if c == quote:
+                quote = ""
+        elif c in "\"'":
+            quote = c
+        elif c == ">":
+            return i
+    return len(text)

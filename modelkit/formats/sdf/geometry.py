@@ -1,0 +1,249 @@
+"""``<geometry>`` and ``<material>``: SDF shapes and colours as the robot model holds them.
+
+Box, sphere, cylinder, capsule, ellipsoid, cone and mesh map one to one (SDF cylinders, capsules
+and cones already lie along Z). Plane, heightmap, image and polyline have no counterpart in the
+model: they are reported (MK430) and kept as data for writers that can use them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from lxml.etree import _Element as Element
+
+from modelkit.diagnostics import DiagnosticSink
+from modelkit.formats.sdf.context import Context
+from modelkit.formats.sdf.document import SdfDocument
+from modelkit.formats.sdf.values import child, local_name
+from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geometry, Mesh, Sphere, VisualMaterial
+
+SHAPES = ("box", "sphere", "cylinder", "capsule", "ellipsoid", "cone", "mesh")
+UNMODELLED = ("plane", "heightmap", "image", "polyline")
+
+
+@dataclass
+class ShapeResult:
+    """What a ``<geometry>`` gave: a model shape, or data about a shape the model cannot hold."""
+
+    geometry: Geometry | None = None
+    unmodelled: dict[str, Any] | None = None
+    empty: bool = False
+
+
+def element_data(element: Element) -> Any:
+    """An element's content as plain data: numbers where the text is numbers, dicts for children
+    (repeated children become lists, attributes are ``@name`` keys)."""
+    kids = [c for c in element if isinstance(c.tag, str)]
+    if not kids and not element.attrib:
+        return _scalar((element.text or "").strip())
+    out: dict[str, Any] = {"@" + str(k): str(v) for k, v in element.attrib.items()}
+    groups: dict[str, list[Any]] = {}
+    for c in kids:
+        key = local_name(c)
+        groups.setdefault(key, []).append(element_data(c))
+    for key, items in groups.items():
+        out[key] = items[0] if len(items) == 1 else items
+    text = (element.text or "").strip()
+    if text:
+        out["#text"] = _scalar(text)
+    return out
+
+
+def _scalar(text: str) -> Any:
+    parts = text.split()
+    try:
+        numbers = [float(p) for p in parts]
+    except ValueError:
+        return text
+    if not numbers:
+        return text
+    return numbers[0] if len(numbers) == 1 else numbers
+
+
+def read_geometry(
+    ctx: Context, src: SdfDocument, geometry: Element | None, owner: str, visual_only: bool
+) -> ShapeResult:
+    """The shape in a ``<geometry>`` element; ``owner`` names the visual/collision for messages."""
+    sink = ctx.sink
+    values = src.values
+    if geometry is None:
+        return ShapeResult(empty=True)  # a missing <geometry> is reported by the caller
+    shapes = [c for c in geometry if isinstance(c.tag, str) and not c.tag.startswith("{")]
+    known = [c for c in shapes if c.tag in (*SHAPES, *UNMODELLED, "empty")]
+    if not known:
+        sink.emit("MK122", f"the <geometry> of {owner} holds no shape", values.loc(geometry))
+        return ShapeResult(empty=True)
+    if len(known) > 1:
+        sink.emit(
+            "MK124",
+            f"the <geometry> of {owner} holds {len(known)} shapes; only the first (<{known[0].tag}>) is used",
+            values.loc(known[1]),
+        )
+    shape = known[0]
+    kind = str(shape.tag)
+    if kind == "empty":
+        return ShapeResult(empty=True)
+    if kind in UNMODELLED:
+        sink.emit(
+            "MK430",
+            f"{owner} has a <{kind}> geometry, which the robot model cannot hold; it is kept only as data",
+            values.loc(shape),
+        )
+        return ShapeResult(unmodelled={"kind": kind, "params": element_data(shape)})
+    return ShapeResult(geometry=_shape(ctx, src, shape, owner, visual_only))
+
+
+def _positive(sink: DiagnosticSink, src: SdfDocument, el: Element | None, value: float, what: str) -> float:
+    if value <= 0.0 and el is not None:
+        sink.emit("MK400", f"{what} must be positive, not {value:g}", src.values.text_loc(el))
+    return value
+
+
+def _shape(ctx: Context, src: SdfDocument, shape: Element, owner: str, visual_only: bool) -> Geometry | None:
+    values = src.values
+    sink = ctx.sink
+    kind = shape.tag
+
+    def number(name: str, default: float) -> float:
+        el = child(shape, name)
+        value = values.number(el, default)
+        value = default if value is None else value
+        return _positive(sink, src, el, value, f"<{kind}> {name} of {owner}")
+
+    if kind == "box":
+        el = child(shape, "size")
+        size = values.vector(el, 3) if el is not None else np.ones(3)
+        size = np.ones(3) if size is None else size
+        if el is not None and np.any(size <= 0.0):
+            sink.emit(
+                "MK400", f"<box> size of {owner} must be positive: {size.tolist()}", values.text_loc(el)
+            )
+        return Box(size)
+    if kind == "sphere":
+        return Sphere(number("radius", 1.0))
+    if kind == "cylinder":
+        return Cylinder(number("radius", 1.0), number("length", 1.0))
+    if kind == "capsule":
+        return Capsule(number("radius", 0.5), number("length", 1.0))
+    if kind == "cone":
+        return Cone(number("radius", 0.5), number("length", 1.0))
+    if kind == "ellipsoid":
+        el = child(shape, "radii")
+        radii = values.vector(el, 3) if el is not None else np.ones(3)
+        radii = np.ones(3) if radii is None else radii
+        if el is not None and np.any(radii <= 0.0):
+            sink.emit(
+                "MK400",
+                f"<ellipsoid> radii of {owner} must be positive: {radii.tolist()}",
+                values.text_loc(el),
+            )
+        return Ellipsoid(radii)
+    return _mesh(ctx, src, shape, owner, visual_only)
+
+
+def _mesh(ctx: Context, src: SdfDocument, shape: Element, owner: str, visual_only: bool) -> Mesh | None:
+    values = src.values
+    uri_el = child(shape, "uri")
+    uri = values.text(uri_el)
+    if not uri or uri_el is None:
+        ctx.sink.emit("MK122", f"the <mesh> of {owner} has no <uri>", values.loc(shape))
+        return None
+    scale_el = child(shape, "scale")
+    scale = values.vector(scale_el, 3) if scale_el is not None else None
+    if scale is None:
+        scale = np.ones(3)
+    submesh_el = child(shape, "submesh")
+    submesh = values.text(child(submesh_el, "name")) if submesh_el is not None else None
+    mesh = ctx.mesh(
+        uri,
+        src,
+        values.text_loc(uri_el),
+        (float(scale[0]), float(scale[1]), float(scale[2])),
+        visual_only,
+        submesh or None,
+    )
+    if submesh_el is not None and values.boolean(child(submesh_el, "center")):
+        mesh.source_params["center_submesh"] = True
+    optimization = shape.get("optimization")
+    if optimization:
+        mesh.source_params["optimization"] = optimization
+    return mesh
+
+
+@dataclass
+class MaterialResult:
+    material: VisualMaterial | None
+    extras: dict[str, Any] = field(default_factory=dict)  # what VisualMaterial cannot hold
+
+
+def read_material(
+    ctx: Context, src: SdfDocument, material: Element | None, transparency: Element | None, owner: str
+) -> MaterialResult:
+    """A visual's ``<material>`` (and ``<transparency>``) as a :class:`VisualMaterial`."""
+    values = src.values
+    visual_transparency = values.number(transparency) if transparency is not None else None
+    if material is None:
+        if visual_transparency:
+            return MaterialResult(VisualMaterial(transparency=visual_transparency))
+        return MaterialResult(None)
+    result = VisualMaterial()
+    extras: dict[str, Any] = {}
+    diffuse = values.color(child(material, "diffuse"))
+    ambient = values.color(child(material, "ambient"))
+    specular = values.color(child(material, "specular"))
+    emissive = values.color(child(material, "emissive"))
+    if diffuse is not None:
+        result.diffuse = np.array(diffuse[:3])
+        result.transparency = 1.0 - diffuse[3]
+    if visual_transparency is not None:
+        result.transparency = visual_transparency
+    if specular is not None:
+        result.specular = np.array(specular[:3])
+    if emissive is not None:
+        result.emissive = np.array(emissive[:3])
+    if ambient is not None:
+        extras["ambient"] = list(ambient)
+        result.ambient = _ambient_intensity(ambient, diffuse)
+    script = child(material, "script")
+    if script is not None:
+        name = values.text(child(script, "name"))
+        uris = [values.text(u) for u in script if isinstance(u.tag, str) and u.tag == "uri"]
+        result.name = name or None
+        extras["script"] = {"name": name, "uri": [u for u in uris if u]}
+        if diffuse is None:
+            ctx.sink.emit(
+                "MK533",
+                f'the colour of {owner} comes from the OGRE material script "{name}"; only its name is kept',
+                values.loc(script),
+                hint="add a <diffuse> colour for tools that do not read Gazebo material scripts",
+            )
+    for key in ("pbr", "shader", "lighting", "double_sided", "render_order"):
+        el = child(material, key)
+        if el is not None:
+            extras[key] = element_data(el)
+    pbr = child(material, "pbr")
+    if pbr is not None:
+        for workflow in pbr:
+            albedo = child(workflow, "albedo_map") if isinstance(workflow.tag, str) else None
+            if albedo is not None and values.text(albedo):
+                result.texture = values.text(albedo)
+                break
+    return MaterialResult(result, extras)
+
+
+def _ambient_intensity(
+    ambient: tuple[float, float, float, float], diffuse: tuple[float, float, float, float] | None
+) -> float | None:
+    """VRML's ambientIntensity when the ambient colour is a multiple of the diffuse colour."""
+    if diffuse is None:
+        return None
+    a = np.array(ambient[:3])
+    d = np.array(diffuse[:3])
+    if float(np.max(d)) <= 0.0:
+        return None
+    k = float(a @ d) / float(d @ d)
+    if np.allclose(a, k * d, atol=1e-6) and 0.0 <= k <= 1.0:
+        return k
+    return None

@@ -1,0 +1,317 @@
+"""The SDFormat element catalogue: which elements and attributes each element may hold.
+
+The table (``modelkit/data/sdf_spec.json``) is generated from libsdformat's own description files
+(``/usr/share/sdformat12/1.4`` … ``1.9``, Debian package ``sdformat-sdf``), merged over the versions,
+plus the elements that SDFormat 1.10 and 1.11 added (:data:`LATER_ADDITIONS`, transcribed from the
+gazebosim/sdformat ``sdf/1.10`` and ``sdf/1.11`` descriptions). Regenerate with::
+
+    python -m modelkit.formats.sdf.spec /usr/share/sdformat12
+
+An element is known by an id: the description file's stem for a file's top element (``link``,
+``box_shape``), and ``PARENT/NAME`` for an element declared inline (``joint/axis/limit``).
+"""
+
+from __future__ import annotations
+
+import difflib
+import json
+import sys
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+
+from lxml.etree import _Element as Element
+
+from modelkit.diagnostics import DiagnosticSink
+from modelkit.xmlsource import XmlDocument
+
+SPEC_FILE = Path(__file__).resolve().parents[2] / "data" / "sdf_spec.json"
+
+# Elements and attributes of SDFormat 1.10/1.11 that the 1.9 descriptions lack:
+# id -> (attributes, {child name: (child id, may repeat)}, accepts any content).
+LATER_ADDITIONS: dict[str, tuple[list[str], dict[str, tuple[str, bool]], bool]] = {
+    "joint": ([], {"screw_thread_pitch": ("joint/screw_thread_pitch", False)}, False),
+    "joint/screw_thread_pitch": ([], {}, False),
+    "joint/axis": ([], {"mimic": ("mimic", False)}, False),
+    "joint/axis2": ([], {"mimic": ("mimic", False)}, False),
+    "mimic": (
+        ["joint", "axis"],
+        {
+            "multiplier": ("mimic/multiplier", False),
+            "offset": ("mimic/offset", False),
+            "reference": ("mimic/reference", False),
+        },
+        False,
+    ),
+    "mimic/multiplier": ([], {}, False),
+    "mimic/offset": ([], {}, False),
+    "mimic/reference": ([], {}, False),
+    "inertial": (
+        ["auto"],
+        {
+            "density": ("inertial/density", False),
+            "auto_inertia_params": ("auto_inertia_params", False),
+        },
+        False,
+    ),
+    "inertial/density": ([], {}, False),
+    "auto_inertia_params": ([], {}, True),
+    "collision": (
+        [],
+        {
+            "density": ("collision/density", False),
+            "material_density": ("collision/density", False),
+            "auto_inertia_params": ("auto_inertia_params", False),
+        },
+        False,
+    ),
+    "collision/density": ([], {}, False),
+    "geometry": ([], {"cone": ("cone_shape", False)}, False),
+    "cone_shape": (
+        [],
+        {"radius": ("cone_shape/radius", False), "length": ("cone_shape/length", False)},
+        False,
+    ),
+    "cone_shape/radius": ([], {}, False),
+    "cone_shape/length": ([], {}, False),
+    "mesh_shape": (
+        ["optimization"],
+        {"convex_decomposition": ("mesh_shape/convex_decomposition", False)},
+        False,
+    ),
+    "mesh_shape/convex_decomposition": (
+        [],
+        {
+            "max_convex_hulls": ("mesh_shape/convex_decomposition/max_convex_hulls", False),
+            "voxel_resolution": ("mesh_shape/convex_decomposition/voxel_resolution", False),
+        },
+        False,
+    ),
+    "mesh_shape/convex_decomposition/max_convex_hulls": ([], {}, False),
+    "mesh_shape/convex_decomposition/voxel_resolution": ([], {}, False),
+    "model": (["namespace"], {}, False),
+    "model/include": (["merge"], {"namespace": ("model/include/namespace", False)}, False),
+    "model/include/namespace": ([], {}, False),
+    "sensor": (
+        [],
+        {
+            "air_speed": ("air_speed", False),
+            "air_flow": ("air_flow", False),
+            "frame_id": ("sensor/frame_id", False),
+        },
+        False,
+    ),
+    "sensor/frame_id": ([], {}, False),
+    "air_speed": ([], {}, True),
+    "air_flow": ([], {}, True),
+    "camera": (
+        [],
+        {
+            "optical_frame_id": ("camera/optical_frame_id", False),
+            "camera_info_topic": ("camera/camera_info_topic", False),
+            "triggered": ("camera/triggered", False),
+            "trigger_topic": ("camera/trigger_topic", False),
+        },
+        False,
+    ),
+    "camera/optical_frame_id": ([], {}, False),
+    "camera/camera_info_topic": ([], {}, False),
+    "camera/triggered": ([], {}, False),
+    "camera/trigger_topic": ([], {}, False),
+    "light": ([], {"visualize": ("light/visualize", False)}, False),
+    "light/visualize": ([], {}, False),
+}
+
+
+@dataclass
+class ElementSpec:
+    """What one SDF element may contain."""
+
+    name: str
+    attributes: set[str] = field(default_factory=set)
+    children: dict[str, tuple[str, bool]] = field(default_factory=dict)  # name -> (id, may repeat)
+    any_content: bool = False  # copy_data: arbitrary content (plugins)
+
+
+@lru_cache(maxsize=1)
+def catalogue() -> dict[str, ElementSpec]:
+    """The element table, loaded once."""
+    raw = json.loads(SPEC_FILE.read_text(encoding="utf-8"))
+    out: dict[str, ElementSpec] = {}
+    for ident, entry in raw["elements"].items():
+        out[ident] = ElementSpec(
+            name=entry["name"],
+            attributes=set(entry.get("attributes", [])),
+            children={k: (v[0], bool(v[1])) for k, v in entry.get("children", {}).items()},
+            any_content=bool(entry.get("any", False)),
+        )
+    return out
+
+
+@lru_cache(maxsize=1)
+def _homes() -> dict[str, list[str]]:
+    """Element name -> the names of the elements that may hold it (for "belongs in" hints)."""
+    table = catalogue()
+    out: dict[str, set[str]] = {}
+    for spec in table.values():
+        for name in spec.children:
+            out.setdefault(name, set()).add(spec.name)
+    return {k: sorted(v) for k, v in out.items()}
+
+
+def check_elements(doc: XmlDocument, sink: DiagnosticSink, version: tuple[int, int] = (1, 11)) -> None:
+    """Report elements and attributes that SDFormat does not define where they are written (MK123),
+    and elements written twice where the specification allows one (MK124).
+
+    Namespaced elements and attributes (``<gz:...>``) are legal custom content and are skipped, as
+    is everything inside ``<plugin>`` and other elements whose content is free.
+    """
+    table = catalogue()
+    stack: list[tuple[Element, str]] = [(doc.root, "root")]
+    while stack:
+        element, ident = stack.pop()
+        spec = table.get(ident)
+        if spec is None or spec.any_content:
+            continue
+        _check_attributes(doc, sink, element, spec)
+        if ident == "pose" and version >= (1, 7) and element.get("frame") is not None:
+            sink.emit(
+                "MK123",
+                "attribute frame of <pose> was replaced by relative_to in SDFormat 1.7; it is ignored",
+                doc.loc(element, "frame"),
+                hint="write relative_to",
+            )
+        seen: set[str] = set()
+        pending: list[tuple[Element, str]] = []
+        for child in element:
+            tag = child.tag
+            if not isinstance(tag, str) or tag.startswith("{"):
+                continue
+            entry = spec.children.get(tag)
+            if entry is None:
+                sink.emit(
+                    "MK123",
+                    f"<{tag}> is not an SDFormat element of <{spec.name}>; libsdformat ignores it",
+                    doc.loc(child),
+                    hint=_hint(tag, spec),
+                )
+                continue
+            child_id, may_repeat = entry
+            if tag in seen and not may_repeat and ident != "root":  # root: MK153 says more
+                sink.emit(
+                    "MK124",
+                    f"<{tag}> appears more than once in <{spec.name}>; only the first is read",
+                    doc.loc(child),
+                )
+            seen.add(tag)
+            pending.append((child, child_id))
+        stack.extend(reversed(pending))
+
+
+def _check_attributes(doc: XmlDocument, sink: DiagnosticSink, element: Element, spec: ElementSpec) -> None:
+    for name in element.attrib:
+        key = str(name)
+        if key.startswith("{") or key in spec.attributes:
+            continue
+        close = difflib.get_close_matches(key, sorted(spec.attributes), n=1, cutoff=0.6)
+        sink.emit(
+            "MK123",
+            f'attribute "{key}" is not defined for <{spec.name}>; libsdformat ignores it',
+            doc.loc(element, key),
+            hint=f'did you mean "{close[0]}"?' if close else None,
+        )
+
+
+def _hint(tag: str, spec: ElementSpec) -> str | None:
+    close = difflib.get_close_matches(tag, sorted(spec.children), n=1, cutoff=0.6)
+    if close:
+        return f"did you mean <{close[0]}>?"
+    homes = _homes().get(tag)
+    if homes:
+        shown = ", ".join(f"<{h}>" for h in homes[:3]) + (" ..." if len(homes) > 3 else "")
+        return f"<{tag}> belongs in {shown}"
+    if spec.children:
+        return "known here: " + ", ".join(f"<{c}>" for c in sorted(spec.children)[:12])
+    return None
+
+
+# ---- generator ----------------------------------------------------------------------------------
+
+
+def _generate(spec_root: Path) -> dict[str, dict[str, object]]:
+    table: dict[str, ElementSpec] = {}
+
+    def entry(ident: str, name: str) -> ElementSpec:
+        return table.setdefault(ident, ElementSpec(name))
+
+    def many(required: str | None) -> bool:
+        return required not in ("0", "1")
+
+    def walk(el: Element, ident: str, folder: Path) -> None:
+        item = entry(ident, str(el.get("name")))
+        for child in el:
+            if not isinstance(child.tag, str):
+                continue
+            if child.tag == "attribute":
+                item.attributes.add(str(child.get("name")))
+            elif child.tag == "include":
+                stem = Path(str(child.get("filename"))).stem
+                top = _top(folder / f"{stem}.sdf")
+                if top is not None:
+                    item.children[str(top.get("name"))] = (stem, many(child.get("required")))
+            elif child.tag == "element":
+                if child.get("copy_data") == "true":
+                    item.any_content = True
+                    continue
+                name = str(child.get("name"))
+                ref = child.get("ref")
+                child_id = ref if ref else f"{ident}/{name}"
+                item.children[name] = (child_id, many(child.get("required")))
+                walk(child, child_id, folder)
+
+    for folder in sorted(p for p in spec_root.iterdir() if p.is_dir() and p.name in _VERSIONS):
+        for path in sorted(folder.glob("*.sdf")):
+            top = _top(path)
+            if top is not None:
+                walk(top, path.stem, folder)
+    for ident, (attributes, children, any_content) in LATER_ADDITIONS.items():
+        item = entry(ident, ident.rsplit("/", 1)[-1].removesuffix("_shape"))
+        item.attributes.update(attributes)
+        item.children.update(children)
+        item.any_content = item.any_content or any_content
+    return {
+        ident: {
+            "name": spec.name,
+            "attributes": sorted(spec.attributes),
+            "children": {k: list(v) for k, v in sorted(spec.children.items())},
+            "any": spec.any_content,
+        }
+        for ident, spec in sorted(table.items())
+    }
+
+
+_VERSIONS = ("1.4", "1.5", "1.6", "1.7", "1.8", "1.9")
+
+
+def _top(path: Path) -> Element | None:
+    from lxml import etree
+
+    if not path.is_file():
+        return None
+    root = etree.parse(str(path)).getroot()
+    return root if root.tag == "element" else None
+
+
+def main(argv: list[str]) -> int:  # pragma: no cover - regenerates the data file
+    if len(argv) != 1:
+        print("usage: python -m modelkit.formats.sdf.spec SPEC_ROOT (e.g. /usr/share/sdformat12)")
+        return 2
+    source = "libsdformat 1.4-1.9 descriptions + SDFormat 1.10/1.11 additions"
+    data = {"source": source, "elements": _generate(Path(argv[0]))}
+    SPEC_FILE.write_text(json.dumps(data, indent=0, sort_keys=False) + "\n", encoding="utf-8")
+    print(f"wrote {SPEC_FILE} ({len(data['elements'])} elements)")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main(sys.argv[1:]))
