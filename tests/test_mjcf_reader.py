@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from modelkit.api import validate
 from modelkit.cli import main
 from modelkit.formats import detect_format, read_model
 from modelkit.formats.common import ReadOptions, ReadResult
@@ -815,3 +816,15 @@ def test_ball_joints_cameras_and_keyframes(tmp_path: Path) -> None:
     assert robot.extras["mjcf_keyframes"] == [{"name": "home", "time": 0.0, "qpos": [1.0, 0.0, 0.0, 0.0]}]
     link = target.link("target")
     assert link is not None and link.extras["mjcf_mocap"] is True
+
+
+def test_uncompiled_fallback_does_not_guess_missing_masses(tmp_path: Path) -> None:
+    """When MuJoCo cannot compile the file, masses it would infer from geoms are unknown: no MK313."""
+    path = tmp_path / "missing_mesh.xml"
+    path.write_text(
+        '<mujoco model="m"><asset><mesh name="m" file="nope.stl"/></asset><worldbody>'
+        '<body name="b"><joint type="hinge"/><geom type="mesh" mesh="m"/></body></worldbody></mujoco>'
+    )
+    codes = sorted(d.code for d in validate(path).diagnostics)
+    assert "MK313" not in codes
+    assert {"MK170", "MK174", "MK500"} <= set(codes)

@@ -78,6 +78,8 @@ def _mass_loc(link: Link) -> SourceLocation | None:
 @rule("mass", "MK300", "MK304", "MK313")
 def mass(robot: Robot) -> Iterator[Diagnostic]:
     """Masses are positive where it matters; default mass properties are flagged."""
+    if robot.extras.get("mjcf_compiled") is False:
+        return  # MuJoCo could not compile the file: masses it would infer from geoms are unknown
     moving = _moving_links(robot)
     merged = _merged_masses(robot)
     for link in robot.links:
