@@ -14,6 +14,7 @@ from typing import Any, TypeVar
 import click
 
 from modelkit.diagnostics import Diagnostic, Severity, render_github, render_json, render_text
+from modelkit.format_names import FORMAT_NAMES
 
 F = TypeVar("F", bound=Callable[..., Any])
 UNREADABLE_CODES = frozenset({"MK001", "MK002"})
@@ -37,7 +38,7 @@ def reading_options(fn: F) -> F:
     options = [
         click.option(
             "--input-format",
-            type=click.Choice(["body", "urdf", "xacro", "sdf", "mjcf"]),
+            type=click.Choice(FORMAT_NAMES),
             default=None,
             help="Read files as this format instead of guessing from the extension.",
         ),

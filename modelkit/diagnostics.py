@@ -110,6 +110,20 @@ class DiagnosticSink:
             self.add(d)
 
 
+def closest(word: str, candidates: Iterable[str]) -> str | None:
+    """The candidate most like ``word`` (difflib's ratio, at least 0.6), or None."""
+    import difflib
+
+    match = difflib.get_close_matches(word, list(candidates), n=1)
+    return match[0] if match else None
+
+
+def did_you_mean(word: str, candidates: Iterable[str]) -> str | None:
+    """The hint ``did you mean "X"?`` when ``word`` is close to one of ``candidates``; else None."""
+    match = closest(word, candidates)
+    return None if match is None else f'did you mean "{match}"?'
+
+
 
 def sorted_diagnostics(ds: Iterable[Diagnostic]) -> list[Diagnostic]:
     return sorted(ds, key=Diagnostic.sort_key)

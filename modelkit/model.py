@@ -24,6 +24,13 @@ from numpy.typing import NDArray
 from modelkit.diagnostics import SourceLocation
 from modelkit.spatial import Mat3, Pose, Vec3
 
+WORLD_LINK = "world"
+"""The name of the link that stands for the world itself (every format's convention)."""
+
+SYNTHESISED = "synthesised"
+"""The ``extras`` key (value True) of a link or joint the reader made up: not written in the source
+(an MJCF multi-joint body's intermediate frames, the world link a reader adds to hang joints from)."""
+
 
 class JointType(StrEnum):
     FIXED = "fixed"
@@ -246,6 +253,9 @@ class Robot:
     validation rules to report. ``root`` names the root link; ``root_joint`` says whether it floats
     (``FLOATING``) or is welded to the world (``FIXED``) at ``root_pose``, or is None when the format
     leaves it open (URDF).
+
+    ``extras["masses_unknown"]`` is True when the reader could not tell the masses (an MJCF file
+    MuJoCo could not compile: the masses it would infer from geoms); mass rules then say nothing.
     """
 
     name: str
@@ -265,6 +275,13 @@ class Robot:
                 return link
         return None
 
+    def children_of(self) -> dict[str, list[Joint]]:
+        """Parent link name → the joints that hang from it, in document order (a new dict each call)."""
+        out: dict[str, list[Joint]] = {}
+        for joint in self.joints:
+            out.setdefault(joint.parent, []).append(joint)
+        return out
+
     def world_poses(self, positions: dict[str, float] | None = None) -> dict[str, Pose]:
         """Forward kinematics: each link's pose in the world (root at ``root_pose``).
 
@@ -276,9 +293,7 @@ class Robot:
         if self.root is None:
             return {}
         poses: dict[str, Pose] = {self.root: self.root_pose}
-        children_of: dict[str, list[Joint]] = {}
-        for joint in self.joints:
-            children_of.setdefault(joint.parent, []).append(joint)
+        children_of = self.children_of()
         stack = [self.root]
         while stack:
             parent = stack.pop()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -31,6 +32,18 @@ class Pose:
     def __matmul__(self, other: Pose) -> Pose:
         return Pose(self.rotation @ other.rotation, self.rotation @ other.translation + self.translation)
 
+    def inverse(self) -> Pose:
+        """The inverse transform: ``p_child = rotationᵀ @ (p_parent - translation)``."""
+        rt = self.rotation.T
+        return Pose(rt, -(rt @ self.translation))
+
+    def is_identity(self, tol: float = 1e-12) -> bool:
+        """Every entry within ``tol`` (absolute; no relative tolerance) of the identity transform's."""
+        return bool(
+            np.allclose(self.rotation, np.eye(3), atol=tol, rtol=0.0)
+            and np.allclose(self.translation, 0.0, atol=tol, rtol=0.0)
+        )
+
     def __repr__(self) -> str:
         return f"Pose(xyz={self.translation.tolist()}, rpy={rpy_from_matrix(self.rotation).tolist()})"
 
@@ -53,6 +66,40 @@ def rot_x(angle: float) -> Mat3:
     return axis_angle([1.0, 0.0, 0.0], angle)
 
 
+def matrix_from_rpy(roll: float, pitch: float, yaw: float) -> Mat3:
+    """URDF/SDF fixed-axis roll-pitch-yaw: R = Rz(yaw)·Ry(pitch)·Rx(roll)."""
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def matrix_from_quat_wxyz(quat: Sequence[float] | NDArray[np.float64]) -> Mat3:
+    """The rotation of the quaternion (w, x, y, z), normalised first.
+
+    A zero or non-finite quaternion gives the identity, as MuJoCo does; readers of formats where
+    that is an error report it before calling. URDF/SDF write x, y, z, w: pass ``(w, x, y, z)``.
+    """
+    q = np.asarray(quat, dtype=float)
+    n = float(np.linalg.norm(q))
+    if n == 0.0 or not math.isfinite(n):
+        return np.eye(3)
+    w, x, y, z = q / n
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
 def rpy_from_matrix(r: Mat3) -> Vec3:
     """URDF/SDF fixed-axis roll-pitch-yaw of R = Rz(yaw)·Ry(pitch)·Rx(roll), pitch in [-π/2, π/2]."""
     sy = -float(r[2, 0])
@@ -65,6 +112,17 @@ def rpy_from_matrix(r: Mat3) -> Vec3:
         roll = 0.0
         yaw = math.atan2(-float(r[0, 1]), float(r[1, 1]))
     return np.array([roll, pitch, yaw])
+
+
+def inertia_from_moments(ixx: float, ixy: float, ixz: float, iyy: float, iyz: float, izz: float) -> Mat3:
+    """The symmetric inertia tensor of its six moments (URDF/SDF order: ixx ixy ixz iyy iyz izz)."""
+    return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], dtype=float)
+
+
+def rotate_inertia(inertia: Mat3, rotation: Mat3) -> Mat3:
+    """R·I·Rᵀ: an inertia tensor given in rotated axes, re-expressed in the outer axes."""
+    r = np.asarray(rotation, dtype=float)
+    return r @ np.asarray(inertia, dtype=float) @ r.T
 
 
 def parallel_axis(mass: float, offset: Vec3) -> Mat3:

@@ -24,9 +24,7 @@ Order = Literal["joint-name", "document"]
 
 
 def _children(robot: Robot, order: Order) -> dict[str, list[Joint]]:
-    out: dict[str, list[Joint]] = {}
-    for joint in robot.joints:
-        out.setdefault(joint.parent, []).append(joint)
+    out = robot.children_of()
     if order == "joint-name":
         for joints in out.values():
             joints.sort(key=lambda j: j.name.encode("utf-8"))

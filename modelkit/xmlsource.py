@@ -22,14 +22,30 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
-from modelkit.yamltree import DEFAULT_MAX_BYTES, decode_text
+from modelkit.textio import DEFAULT_MAX_BYTES, decode_text, read_bytes
 
 _SKIPPED = re.compile(
     r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<!DOCTYPE(?:[^\[>]|\[.*?\])*>", re.DOTALL | re.IGNORECASE
 )
 _START_TAG = re.compile(r"<([^\s/>!?][^\s/>]*)")
+# One attribute of a start tag: its name as written and its quoted value (skipped whole, so that
+# text inside a value is never taken for another attribute).
+_ATTRIBUTE = re.compile(r"""([^\s=/>"']+)\s*=\s*(?:"[^"]*"|'[^']*')""")
 _ENTITY_DECL = re.compile(r"<!ENTITY", re.IGNORECASE)
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+def mask_markup(text: str) -> str:
+    """``text`` with comments, CDATA sections, processing instructions and the DOCTYPE blanked out
+    (replaced by as many spaces), so that a ``<`` in them is not taken for a tag; offsets are kept."""
+    return _SKIPPED.sub(lambda m: " " * len(m.group(0)), text)
+
+
+def location_at(text: str, display: str, offset: int) -> SourceLocation:
+    """The 1-based line and column of ``offset`` in ``text``."""
+    line = text.count("\n", 0, offset) + 1
+    col = offset - (text.rfind("\n", 0, offset) + 1) + 1
+    return SourceLocation(display, line, col)
 
 
 def parse_number(text: str | None) -> float | None:
@@ -74,7 +90,9 @@ class XmlDocument:
         return line, offset - self._line_offsets[line - 1] + 1
 
     def loc(self, element: Element, attribute: str | None = None) -> SourceLocation:
-        """Where ``element`` starts, or where its ``attribute`` is written (1-based line and col)."""
+        """Where ``element`` starts, or where its ``attribute`` is written (1-based line and col).
+
+        An attribute the element does not have is placed at the element."""
         origin = self.origins.get(element)
         if origin is not None:
             return origin
@@ -82,12 +100,12 @@ class XmlDocument:
         if start is None:
             line = element.sourceline if isinstance(element.sourceline, int) else 0
             return SourceLocation(self.display, line, 1 if line else 0)
-        if attribute is not None:
-            end = _tag_end(self.text, start)
-            name = re.escape(attribute)
-            match = re.compile(rf"(?<![\w:.-]){name}\s*=").search(self.text, start, end)
-            if match:
-                return SourceLocation(self.display, *self._position(match.start()))
+        if attribute and element.get(attribute) is not None:
+            name = _START_TAG.match(self.text, start)
+            end = tag_end(self.text, start)
+            for match in _ATTRIBUTE.finditer(self.text, name.end() if name else start, end):
+                if match.group(1) == attribute:
+                    return SourceLocation(self.display, *self._position(match.start()))
         return SourceLocation(self.display, *self._position(start))
 
     def text_loc(self, element: Element) -> SourceLocation:
@@ -98,7 +116,7 @@ class XmlDocument:
         start = self._starts.get(element)
         if start is None:
             return self.loc(element)
-        end = _tag_end(self.text, start)
+        end = tag_end(self.text, start)
         offset = min(end + 1, len(self.text))
         while offset < len(self.text) and self.text[offset] in " \t\r\n":
             offset += 1
@@ -108,7 +126,7 @@ class XmlDocument:
 _TAG_TOKEN = re.compile(r"\"[^\"]*\"|'[^']*'|>")
 
 
-def _tag_end(text: str, start: int) -> int:
+def tag_end(text: str, start: int) -> int:
     """Offset of the ``>`` that closes the start tag beginning at ``start`` (quotes respected)."""
     for match in _TAG_TOKEN.finditer(text, start):
         if match.group(0) == ">":
@@ -119,8 +137,7 @@ def _tag_end(text: str, start: int) -> int:
 def _index_positions(doc: XmlDocument) -> None:
     text = doc.text
     doc._line_offsets = [0] + [m.end() for m in re.finditer(r"\n", text)]
-    masked = _SKIPPED.sub(lambda m: " " * len(m.group(0)), text)
-    starts = [m.start() for m in _START_TAG.finditer(masked)]
+    starts = [m.start() for m in _START_TAG.finditer(mask_markup(text))]
     elements = [e for e in doc.root.iter() if isinstance(e.tag, str)]
     if len(starts) != len(elements):  # cannot pair them safely: fall back to lxml's lines
         return
@@ -136,13 +153,11 @@ def parse_xml_bytes(
         return None
     entity = _ENTITY_DECL.search(text)
     if entity:
-        line = text.count("\n", 0, entity.start()) + 1
-        col = entity.start() - (text.rfind("\n", 0, entity.start()) + 1) + 1
         sink.emit(
             "MK021",
             "the document declares XML entities; modelkit refuses them (they can expand without bound "
             "or read other files)",
-            SourceLocation(display, line, col),
+            location_at(text, display, entity.start()),
             hint="replace the entities with their text, or generate the file with xacro",
         )
         return None
@@ -176,28 +191,8 @@ def read_xml(
 ) -> XmlDocument | None:
     """Read and parse an XML file with the checks every input gets: exists, size, encoding, syntax."""
     name = display or str(path)
-    try:
-        if path.is_dir():
-            sink.emit("MK001", "cannot read file: it is a directory", SourceLocation(name))
-            return None
-        size = path.stat().st_size
-    except OSError as exc:
-        sink.emit("MK001", f"cannot read file: {exc.strerror or exc}", SourceLocation(name))
-        return None
-    if size > max_bytes:
-        sink.emit(
-            "MK002",
-            f"file is {size} bytes, over the limit of {max_bytes} bytes",
-            SourceLocation(name),
-            hint="raise the limit with --max-bytes if the file is genuine",
-        )
-        return None
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        sink.emit("MK001", f"cannot read file: {exc.strerror or exc}", SourceLocation(name))
-        return None
-    return parse_xml_bytes(data, name, sink, path)
+    data = read_bytes(path, sink, max_bytes, name)
+    return None if data is None else parse_xml_bytes(data, name, sink, path)
 
 
 def sniff_root_tag(path: Path, limit: int = 65536) -> str | None:
@@ -207,8 +202,7 @@ def sniff_root_tag(path: Path, limit: int = 65536) -> str | None:
             head = handle.read(limit).decode("utf-8", errors="replace")
     except OSError:
         return None
-    masked = _SKIPPED.sub(lambda m: " " * len(m.group(0)), head)
-    match = _START_TAG.search(masked)
+    match = _START_TAG.search(mask_markup(head))
     if match is None:
         return None
     return match.group(1).split(":")[-1]

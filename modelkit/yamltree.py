@@ -19,11 +19,12 @@ from typing import Any
 import yaml
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
-
-# The expanded node count above which a document is treated as an alias bomb. Real Choreonoid
-# models stay far below it (the largest sample terrains have a few hundred thousand scalars).
-DEFAULT_EXPANSION_LIMIT = 5_000_000
-DEFAULT_MAX_BYTES = 64 * 1024 * 1024
+from modelkit.textio import (  # re-exported: the file checks are shared with the XML readers
+    DEFAULT_EXPANSION_LIMIT,
+    DEFAULT_MAX_BYTES,
+    decode_text,
+    read_bytes,
+)
 
 
 @dataclass(eq=False)
@@ -263,58 +264,8 @@ def read_text(
 ) -> str | None:
     """Read a text file with the checks every input gets: exists, size, text encoding."""
     name = display or str(path)
-    try:
-        size = path.stat().st_size
-    except OSError as exc:
-        sink.emit("MK001", f"cannot read file: {exc.strerror or exc}", SourceLocation(name))
-        return None
-    if path.is_dir():
-        sink.emit("MK001", "cannot read file: it is a directory", SourceLocation(name))
-        return None
-    if size > max_bytes:
-        sink.emit(
-            "MK002",
-            f"file is {size} bytes, over the limit of {max_bytes} bytes",
-            SourceLocation(name),
-            hint="raise the limit with --max-bytes if the file is genuine",
-        )
-        return None
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        sink.emit("MK001", f"cannot read file: {exc.strerror or exc}", SourceLocation(name))
-        return None
-    return decode_text(data, name, sink)
-
-
-def decode_text(data: bytes, name: str, sink: DiagnosticSink) -> str | None:
-    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        try:
-            return data.decode("utf-16")
-        except UnicodeDecodeError:
-            sink.emit(
-                "MK003", "the file starts with a UTF-16 mark but is not valid UTF-16", SourceLocation(name)
-            )
-            return None
-    if b"\x00" in data:
-        offset = data.index(b"\x00")
-        line = data.count(b"\n", 0, offset) + 1
-        sink.emit(
-            "MK003", "the file contains NUL bytes: it is binary, not text", SourceLocation(name, line, 1)
-        )
-        return None
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = data.count(b"\n", 0, exc.start) + 1
-        col = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
-        sink.emit(
-            "MK003",
-            f"the file is not valid UTF-8 (byte 0x{data[exc.start]:02x})",
-            SourceLocation(name, line, col),
-        )
-        return None
-    return text
+    data = read_bytes(path, sink, max_bytes, name)
+    return None if data is None else decode_text(data, name, sink)
 
 
 def parse_yaml(

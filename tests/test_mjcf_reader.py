@@ -828,3 +828,32 @@ def test_uncompiled_fallback_does_not_guess_missing_masses(tmp_path: Path) -> No
     codes = sorted(d.code for d in validate(path).diagnostics)
     assert "MK313" not in codes
     assert {"MK170", "MK174", "MK500"} <= set(codes)
+
+
+def test_uncompiled_fallback_keeps_full_and_rotated_inertias(tmp_path: Path) -> None:
+    """``fullinertia`` is the written tensor; ``diaginertia`` with an orientation is R·diag·Rᵀ; both
+    agree with what MuJoCo compiles (principal moments and ``body_iquat``)."""
+    path = tmp_path / "inertia.xml"
+    path.write_text(
+        '<mujoco model="m"><worldbody><body name="a"><joint type="hinge"/><geom size="0.1"/>'
+        '<body name="b" euler="10 20 30">'
+        '<joint type="hinge" axis="1 2 2"/><inertial pos="0.1 0.2 0.3" mass="2" '
+        'fullinertia="0.3 0.4 0.5 0.01 -0.02 0.03"/></body><body name="c"><joint type="slide"/>'
+        '<inertial pos="0 0 0" mass="1" diaginertia="0.1 0.2 0.3" euler="30 40 50"/></body>'
+        "</body></worldbody></mujoco>"
+    )
+    model = mujoco.MjModel.from_xml_path(str(path))
+    robot = read(path, compiled=False).robot
+    assert robot is not None
+    for name in ("b", "c"):
+        link = robot.link(name)
+        assert link is not None and link.inertial is not None
+        body = link.extras["mjcf_body_id"]
+        r = np.zeros(9)
+        mujoco.mju_quat2Mat(r, model.body_iquat[body])
+        compiled = r.reshape(3, 3) @ np.diag(model.body_inertia[body]) @ r.reshape(3, 3).T
+        assert np.allclose(link.inertial.inertia, compiled, atol=1e-12, rtol=0.0)
+    b = robot.link("b")
+    assert b is not None and b.inertial is not None
+    written = [[0.3, 0.01, -0.02], [0.01, 0.4, 0.03], [-0.02, 0.03, 0.5]]
+    assert np.array_equal(b.inertial.inertia, written)

@@ -528,6 +528,30 @@ def test_materials_and_unmodelled_geometry(tmp_path: Path) -> None:
     assert codes(result) == ["MK430"]
 
 
+def test_pbr_albedo_map_is_checked_once_per_uri(tmp_path: Path) -> None:
+    pbr = "<material><pbr><metal><albedo_map>{}</albedo_map></metal></pbr></material>"
+    visual = '<visual name="{}"><geometry><box><size>1 1 1</size></box></geometry>{}</visual>'
+    body = (
+        '<link name="a"><inertial><mass>1</mass></inertial>'
+        + visual.format("v1", pbr.format("textures/missing.png"))
+        + visual.format("v2", pbr.format("textures/missing.png"))
+        + visual.format("v3", pbr.format("textures/here.png"))
+        + "</link>"
+    )
+    (tmp_path / "textures").mkdir()
+    (tmp_path / "textures" / "here.png").write_bytes(b"")
+    result = read_text(tmp_path, model("1.7", body))
+    link = robot_of(result).links[0]
+    assert [g.material.texture for g in link.visuals if g.material] == [
+        "textures/missing.png",
+        "textures/missing.png",
+        "textures/here.png",
+    ]
+    found = [d for d in result.diagnostics if d.code == "MK507"]
+    assert len(found) == 1 and '"textures/missing.png"' in found[0].message
+    assert found[0].location is not None and found[0].location.line == 4
+
+
 def test_namespaced_custom_elements_are_legal(tmp_path: Path) -> None:
     body = """<link name="a"><inertial><mass>1</mass></inertial><gz:extra value="1"/>
       <visual name="v" gz:flag="x"><geometry><box><size>1 1 1</size></box></geometry></visual></link>

@@ -6,9 +6,10 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from modelkit.checks.masses import lumped_masses
 from modelkit.checks.registry import rule
 from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
-from modelkit.model import JointType, Link, Robot
+from modelkit.model import SYNTHESISED, JointType, Link, Robot
 from modelkit.spatial import inertia_tolerance, principal_moments
 
 # Who fills in missing mass properties, per source format (the wording of MK304).
@@ -24,9 +25,7 @@ def _moving_links(robot: Robot) -> set[str]:
     moving: set[str] = set()
     if robot.root is not None and robot.root_joint is JointType.FLOATING:
         moving.add(robot.root)
-    children: dict[str, list[tuple[str, bool]]] = {}
-    for j in robot.joints:
-        children.setdefault(j.parent, []).append((j.child, j.type.moves))
+    children = robot.children_of()
     stack = [(robot.root, robot.root in moving)] if robot.root else []
     seen: set[str] = set()
     while stack:
@@ -36,8 +35,8 @@ def _moving_links(robot: Robot) -> set[str]:
         seen.add(name)
         if moves:
             moving.add(name)
-        for child, joint_moves in children.get(name, []):
-            stack.append((child, moves or joint_moves))
+        for joint in children.get(name, []):
+            stack.append((joint.child, moves or joint.type.moves))
     return moving
 
 
@@ -47,24 +46,8 @@ def _merged_masses(robot: Robot) -> dict[str, float]:
     Links joined by fixed joints form one rigid body. The top link gets the body's total mass; a
     link attached by a fixed joint gets +inf, since its own mass does not matter on its own.
     """
-    fixed_children: dict[str, list[str]] = {}
-    for joint in robot.joints:
-        if joint.type is JointType.FIXED:
-            fixed_children.setdefault(joint.parent, []).append(joint.child)
-    own = {link.name: max(link.inertial.mass, 0.0) if link.inertial else 0.0 for link in robot.links}
-    out = {child: float("inf") for children in fixed_children.values() for child in children}
-    for link in robot.links:
-        if link.name in out:
-            continue
-        total, stack, seen = 0.0, [link.name], set()
-        while stack:
-            name = stack.pop()
-            if name in seen:
-                continue
-            seen.add(name)
-            total += own.get(name, 0.0)
-            stack.extend(fixed_children.get(name, []))
-        out[link.name] = total
+    out = lumped_masses(robot)
+    out.update({j.child: float("inf") for j in robot.joints if j.type is JointType.FIXED})
     return out
 
 
@@ -78,14 +61,14 @@ def _mass_loc(link: Link) -> SourceLocation | None:
 @rule("mass", "MK300", "MK304", "MK313")
 def mass(robot: Robot) -> Iterator[Diagnostic]:
     """Masses are positive where it matters; default mass properties are flagged."""
-    if robot.extras.get("mjcf_compiled") is False:
-        return  # MuJoCo could not compile the file: masses it would infer from geoms are unknown
+    if robot.extras.get("masses_unknown"):
+        return  # e.g. MuJoCo could not compile the file: masses it would infer from geoms are unknown
     moving = _moving_links(robot)
     merged = _merged_masses(robot)
     for link in robot.links:
         inertial = link.inertial
-        if link.extras.get("synthesised"):
-            continue  # a link the reader made up (an MJCF multi-joint body's intermediate frames)
+        if link.extras.get(SYNTHESISED):
+            continue  # a link the reader made up (MJCF intermediate frames, a world link to hang from)
         if inertial is None:
             # A link without mass information (URDF/SDF) hung on a fixed joint is part of its
             # parent's rigid body, and engines merge it; the body as a whole needs mass.

@@ -9,9 +9,10 @@ from __future__ import annotations
 from collections.abc import Iterator
 from pathlib import PurePosixPath
 
+from modelkit.checks.masses import lumped_masses, subtree
 from modelkit.checks.registry import rule
-from modelkit.diagnostics import Diagnostic, diag
-from modelkit.model import Joint, JointType, Robot
+from modelkit.diagnostics import Diagnostic, diag, did_you_mean
+from modelkit.model import WORLD_LINK, Joint, JointType, Robot
 
 URDF_FORMATS = frozenset({"urdf", "xacro"})
 ONE_DOF = frozenset({JointType.REVOLUTE, JointType.PRISMATIC})
@@ -62,7 +63,7 @@ def mimic_targets(robot: Robot) -> Iterator[Diagnostic]:
                 "MK320",
                 f'joint "{joint.name}" mimics "{mimic.joint}", which is not a joint of this robot',
                 where,
-                hint=_closest(mimic.joint, by_name),
+                hint=did_you_mean(mimic.joint, by_name),
             )
         elif leader is joint:
             yield diag("MK321", f'joint "{joint.name}" mimics itself', where)
@@ -90,13 +91,6 @@ def _mimic_loop(start: Joint, by_name: dict[str, Joint]) -> bool:
     return False
 
 
-def _closest(name: str, candidates: dict[str, Joint]) -> str | None:
-    import difflib
-
-    match = difflib.get_close_matches(name, list(candidates), n=1)
-    return f'did you mean "{match[0]}"?' if match else None
-
-
 @rule("massless-links-dropped", "MK322")
 def massless_links_dropped(robot: Robot) -> Iterator[Diagnostic]:
     """Links libsdformat's URDF→SDF conversion (Gazebo) would drop, with their whole subtree.
@@ -107,12 +101,10 @@ def massless_links_dropped(robot: Robot) -> Iterator[Diagnostic]:
     """
     if robot.source_format not in URDF_FORMATS or robot.root is None:
         return
-    children: dict[str, list[Joint]] = {}
-    for joint in robot.joints:
-        children.setdefault(joint.parent, []).append(joint)
+    children = robot.children_of()
     links = {link.name: link for link in robot.links}
-    lumped_mass = _lumped_masses(robot, children)
-    if robot.root != "world" and lumped_mass.get(robot.root, 0.0) <= 0.0 and robot.root in links:
+    lumped_mass = lumped_masses(robot, lump_into_world=False)
+    if robot.root != WORLD_LINK and lumped_mass.get(robot.root, 0.0) <= 0.0 and robot.root in links:
         yield diag(
             "MK322",
             f'the root link "{robot.root}" has no mass, even after merging the links fixed to it: '
@@ -130,11 +122,11 @@ def massless_links_dropped(robot: Robot) -> Iterator[Diagnostic]:
         seen.add(name)
         for joint in children.get(name, []):
             child = joint.child
-            if joint.type is JointType.FIXED and name != "world":
+            if joint.type is JointType.FIXED and name != WORLD_LINK:
                 stack.append(child)  # merged into its parent: judged with it
                 continue
-            if child != "world" and lumped_mass.get(child, 0.0) <= 0.0 and child in links:
-                lost = _subtree_size(child, children)
+            if child != WORLD_LINK and lumped_mass.get(child, 0.0) <= 0.0 and child in links:
+                lost = len(subtree(children, child))
                 below = f" and the {lost - 1} link(s) below it" if lost > 1 else ""
                 yield diag(
                     "MK322",
@@ -146,41 +138,6 @@ def massless_links_dropped(robot: Robot) -> Iterator[Diagnostic]:
                 )
                 continue
             stack.append(child)
-
-
-def _lumped_masses(robot: Robot, children: dict[str, list[Joint]]) -> dict[str, float]:
-    """Each link's mass after fixed-joint lumping (a lumped child adds its mass to its parent)."""
-    own = {link.name: (link.inertial.mass if link.inertial is not None else 0.0) for link in robot.links}
-    total: dict[str, float] = {}
-    order: list[str] = []
-    stack = [robot.root] if robot.root else []
-    seen: set[str] = set()
-    while stack:
-        name = stack.pop()
-        if name in seen:
-            continue
-        seen.add(name)
-        order.append(name)
-        stack.extend(j.child for j in children.get(name, []))
-    for name in reversed(order):
-        mass = max(own.get(name, 0.0), 0.0)
-        for joint in children.get(name, []):
-            if joint.type is JointType.FIXED and name != "world":
-                mass += total.get(joint.child, 0.0)
-        total[name] = mass
-    return total
-
-
-def _subtree_size(name: str, children: dict[str, list[Joint]]) -> int:
-    seen: set[str] = set()
-    stack = [name]
-    while stack:
-        current = stack.pop()
-        if current in seen:
-            continue
-        seen.add(current)
-        stack.extend(j.child for j in children.get(current, []))
-    return len(seen)
 
 
 @rule("collada-for-mujoco", "MK512")

@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Iterator
 
 from modelkit.checks.registry import rule
-from modelkit.diagnostics import Diagnostic, diag
+from modelkit.diagnostics import Diagnostic, diag, did_you_mean
 from modelkit.model import Link, Robot
 
 
@@ -56,12 +55,11 @@ def parents_exist(robot: Robot) -> Iterator[Diagnostic]:
                 hint='add <parent link="..."/>',
             )
         else:
-            close = difflib.get_close_matches(joint.parent, sorted(names), n=1)
             yield diag(
                 "MK202",
                 f'parent link "{joint.parent}" of joint "{joint.name}" is not defined',
                 joint.loc("parent"),
-                hint=f'did you mean "{close[0]}"?' if close else None,
+                hint=did_you_mean(joint.parent, names),
             )
 
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
+from modelkit.format_names import FORMAT_NAMES
 from modelkit.formats.common import ReadOptions, ReadResult
 
 
@@ -54,7 +55,7 @@ FORMATS: tuple[FormatInfo, ...] = (
         root_tags=("mujoco",),
     ),
 )
-FORMAT_NAMES: tuple[str, ...] = tuple(info.name for info in FORMATS)
+assert sorted(FORMAT_NAMES) == sorted(info.name for info in FORMATS), "modelkit.format_names is stale"
 
 
 def detect_format(path: Path, explicit: str | None = None) -> str | None:

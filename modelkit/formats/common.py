@@ -8,7 +8,7 @@ from pathlib import Path
 from modelkit.diagnostics import Diagnostic
 from modelkit.model import Robot
 from modelkit.resources import Resolver
-from modelkit.yamltree import DEFAULT_EXPANSION_LIMIT, DEFAULT_MAX_BYTES
+from modelkit.textio import DEFAULT_EXPANSION_LIMIT, DEFAULT_MAX_BYTES
 
 
 @dataclass

@@ -1,4 +1,5 @@
-"""Mesh references in XML formats (URDF, SDF): resolve the URI and check the file, with diagnostics.
+"""Mesh and texture references in XML formats (URDF, SDF): resolve the URI and check the file, with
+diagnostics.
 
 The `.body` reader has its own variant (Choreonoid's resource nodes carry fragments and metadata);
 this one serves formats whose meshes are plain ``uri`` + ``scale``.
@@ -6,6 +7,7 @@ this one serves formats whose meshes are plain ``uri`` + ``scale``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -13,21 +15,48 @@ import numpy as np
 
 from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
 from modelkit.model import Mesh
-from modelkit.resources import Resolver
+from modelkit.resources import Resolution, Resolver
 
 MESH_FILE_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl"})
 
 
+def not_found(uri: str, path: Path | str, usage: str = "") -> str:
+    """The MK500 message for a resource file that does not exist."""
+    return f'resource "{uri}" not found at {path}{usage}'
+
+
 @dataclass
 class MeshChecker:
-    """Resolves mesh URIs for one model file and loads each mesh file at most once."""
+    """Resolves mesh and texture URIs for one model file and loads each mesh file at most once.
+
+    ``resolve`` replaces the resolver's look-up (relative to ``base_dir``) for a format with
+    conventions of its own: it gets the URI and where it is written, and may report there.
+    """
 
     resolver: Resolver
     base_dir: Path
     model_file: Path | None
     sink: DiagnosticSink
     check_resources: bool = True
+    resolve: Callable[[str, SourceLocation], Resolution] | None = None
     _loaded: dict[str, str | None] = field(default_factory=dict)
+    _textures: set[str] = field(default_factory=set)
+
+    def resolution(self, uri: str, loc: SourceLocation) -> Resolution:
+        """Where ``uri`` points."""
+        if self.resolve is not None:
+            return self.resolve(uri, loc)
+        return self.resolver.resolve(uri, self.base_dir, self.model_file)
+
+    def texture(self, uri: str, loc: SourceLocation) -> None:
+        """Report a texture file that cannot be found (MK507), once per URI."""
+        if not self.check_resources or uri in self._textures:
+            return
+        self._textures.add(uri)
+        resolution = self.resolution(uri, loc)
+        if resolution.path is None or not resolution.path.exists():
+            why = resolution.message or f"not found at {resolution.path}"
+            self.sink.emit("MK507", f'texture "{uri}" cannot be found ({why})', loc, hint=resolution.hint)
 
     def mesh(
         self,
@@ -41,7 +70,7 @@ class MeshChecker:
 
         A problem with a mesh used only for display is a warning; for collision it is an error.
         """
-        resolution = self.resolver.resolve(uri, self.base_dir, self.model_file)
+        resolution = self.resolution(uri, loc)
         severity = Severity.WARNING if visual_only else None
         usage = " (visual only)" if visual_only else ""
         path = resolution.path
@@ -58,9 +87,7 @@ class MeshChecker:
                 self.sink.emit("MK510", f'"{uri}" depends on the package search path; found at {path}', loc)
             suffix = path.suffix.lower()
             if not path.exists():
-                self.sink.emit(
-                    "MK500", f'resource "{uri}" not found at {path}{usage}', loc, severity=severity
-                )
+                self.sink.emit("MK500", not_found(uri, path, usage), loc, severity=severity)
             elif suffix not in MESH_FILE_EXTENSIONS:
                 self.sink.emit(
                     "MK506",

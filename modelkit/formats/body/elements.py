@@ -32,7 +32,7 @@ from modelkit.model import (
     VisualMaterial,
 )
 from modelkit.resources import Resolver
-from modelkit.spatial import Mat3, Pose, Vec3, rot_x
+from modelkit.spatial import Mat3, Pose, Vec3, inertia_from_moments, rot_x
 from modelkit.yamltree import YamlDocument, YMap, YNode, YScalar, YSeq, parse_yaml, read_text
 
 # Choreonoid's cylinders, capsules and cones lie along local Y; the model's along Z.
@@ -185,8 +185,7 @@ def inertia_matrix(node: YNode | None) -> Mat3 | None:
     if len(values) == 9:
         return np.array(values, dtype=float).reshape(3, 3)
     if len(values) == 6:
-        xx, xy, xz, yy, yz, zz = values
-        return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], dtype=float)
+        return inertia_from_moments(*values)
     return None
 
 

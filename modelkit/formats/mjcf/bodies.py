@@ -8,42 +8,21 @@ in radians.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from modelkit.spatial import Mat3, Pose, Vec3
-
-
-def quat_matrix(quat: Any) -> Mat3:
-    """The rotation matrix of a MuJoCo quaternion (w, x, y, z); normalised first."""
-    q = np.asarray(quat, dtype=float)
-    n = float(np.linalg.norm(q))
-    if n == 0.0 or not math.isfinite(n):
-        return np.eye(3)
-    w, x, y, z = q / n
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
+from modelkit.spatial import Mat3, Pose, Vec3, matrix_from_quat_wxyz
 
 
 def pose_of(pos: Any, quat: Any) -> Pose:
-    return Pose(quat_matrix(quat), np.asarray(pos, dtype=float).copy())
+    """A MuJoCo position and quaternion (w, x, y, z; a zero one is no rotation, as in MuJoCo)."""
+    return Pose(matrix_from_quat_wxyz(quat), np.asarray(pos, dtype=float).copy())
 
 
 def translation(vector: Any) -> Pose:
     return Pose(np.eye(3), np.asarray(vector, dtype=float).copy())
-
-
-def inverse(pose: Pose) -> Pose:
-    r = pose.rotation.T
-    return Pose(r, -r @ pose.translation)
 
 
 @dataclass
@@ -54,7 +33,7 @@ class MjJoint:
     name: str | None
     kind: str
     pos: Vec3
-    axis: Vec3
+    axis: Vec3  # unit once compiled; as written from a bare spec (the builder normalises)
     limited: bool = False
     range: tuple[float, float] = (0.0, 0.0)
     ref: float = 0.0
@@ -94,18 +73,12 @@ class MjGeom:
 
 @dataclass
 class MjInertial:
-    """Mass, centre of mass, principal moments and the principal axes' orientation (body frame)."""
+    """Mass, centre of mass and the full inertia tensor about it, in body axes."""
 
     mass: float
     ipos: Vec3
-    iquat: Any
-    diag: Vec3
+    inertia: Mat3
     explicit: bool = True
-
-    def tensor(self) -> Mat3:
-        """The full inertia tensor about the centre of mass, in body axes."""
-        r = quat_matrix(self.iquat)
-        return r @ np.diag(np.asarray(self.diag, dtype=float)) @ r.T
 
 
 @dataclass

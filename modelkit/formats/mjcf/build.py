@@ -23,9 +23,11 @@ from typing import Any
 import numpy as np
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
-from modelkit.formats.mjcf.bodies import MjBody, MjGeom, MjJoint, MjSite, inverse, translation
+from modelkit.formats.mjcf.bodies import MjBody, MjGeom, MjJoint, MjSite, translation
 from modelkit.formats.mjcf.source import Locator
 from modelkit.model import (
+    SYNTHESISED,
+    WORLD_LINK,
     Box,
     Capsule,
     Cylinder,
@@ -51,8 +53,6 @@ JOINT_TYPES = {
     "ball": JointType.BALL,
     "free": JointType.FLOATING,
 }
-UNSUPPORTED_GEOMS = ("plane", "hfield", "sdf")
-WORLD_LINK = "world"
 
 
 @dataclass
@@ -175,7 +175,7 @@ class RobotBuilder:
             start, pose = self._root(robot, body, joints)
         else:
             parent_offset = self.offset[body.parent]
-            start, pose = self.link_name[body.parent], inverse(parent_offset) @ body.pose
+            start, pose = self.link_name[body.parent], parent_offset.inverse() @ body.pose
         chain = joints[1:] if body.parent == 0 and joints and joints[0].kind == "free" else joints
         self._chain(robot, body, start, pose, chain, link)
         robot.links.append(link)
@@ -202,7 +202,7 @@ class RobotBuilder:
             robot.root = name
             robot.links.append(self._intermediate(name, body, free))
             return name, Pose()
-        world = Link(WORLD_LINK, source=self.loc.body(body.index), extras={"synthesised": True})
+        world = Link(WORLD_LINK, source=self.loc.body(body.index), extras={SYNTHESISED: True})
         world.sources["name"] = self.loc.body(body.index)
         if robot.link(WORLD_LINK) is None:
             robot.links.append(world)
@@ -220,7 +220,7 @@ class RobotBuilder:
             joint = Joint(
                 name, JointType.FIXED, start, link.name, origin=pose, source=self.loc.body(body.index)
             )
-            joint.extras["synthesised"] = True
+            joint.extras[SYNTHESISED] = True
             joint.sources["name"] = joint.sources["parent"] = self.loc.body(body.index)
             robot.joints.append(joint)
             return
@@ -269,7 +269,7 @@ class RobotBuilder:
     def _intermediate(self, name: str, body: MjBody, mj: MjJoint) -> Link:
         link = Link(name, source=self.loc.joint(mj.index))
         link.sources["name"] = self.loc.joint(mj.index, "name")
-        link.extras.update({"synthesised": True, "mjcf_intermediate_of": self.link_name[body.index]})
+        link.extras.update({SYNTHESISED: True, "mjcf_intermediate_of": self.link_name[body.index]})
         return link
 
     # -- joints --------------------------------------------------------------------------------
@@ -330,13 +330,13 @@ class RobotBuilder:
             link.extras["mjcf_body_offset"] = [float(x) for x in offset.translation]
         if body.mocap:
             link.extras["mjcf_mocap"] = True
-        back = inverse(offset)
+        back = offset.inverse()
         inertial = body.inertial
         if inertial is not None:
             link.inertial = Inertial(
                 inertial.mass,
                 com=back.translation + np.asarray(inertial.ipos, dtype=float),
-                inertia=inertial.tensor(),
+                inertia=inertial.inertia,
                 defaulted=not inertial.explicit,
                 source=self.loc.inertial(b),
             )
@@ -372,7 +372,7 @@ class RobotBuilder:
         if geometry is None:
             self.sink.emit(
                 "MK172",
-                f"{mg.kind} geom{_named(mg.name)} cannot be held by the model; it is skipped",
+                f"{mg.kind} geom{quoted(mg.name)} cannot be held by the model; it is skipped",
                 where,
             )
             return None
@@ -404,7 +404,7 @@ class RobotBuilder:
 
     def attached(self, body: int, name: str | None, pose: Pose, **params: Any) -> dict[str, Any]:
         """A site, camera or light of ``body`` as data: its link, and its pose in the link frame."""
-        placed = inverse(self.offset.get(body, Pose())) @ pose
+        placed = self.offset.get(body, Pose()).inverse() @ pose
         return {
             "name": name,
             "link": self.link_name.get(body),
@@ -466,5 +466,6 @@ def apply_joint_equalities(
         follower.mimic = Mimic(leader.name, multiplier, coef[0] + ref1 - multiplier * ref2, source=loc)
 
 
-def _named(name: str | None) -> str:
+def quoted(name: str | None) -> str:
+    """`` "name"`` with a leading blank, or "" when there is no name (for messages)."""
     return f' "{name}"' if name else ""

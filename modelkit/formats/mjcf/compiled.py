@@ -18,11 +18,10 @@ from modelkit.formats.mjcf.bodies import (
     MjInertial,
     MjJoint,
     MjSite,
-    inverse,
     pose_of,
     translation,
 )
-from modelkit.spatial import Pose
+from modelkit.spatial import Pose, matrix_from_quat_wxyz, rotate_inertia
 
 JOINT_KINDS = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
 DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)
@@ -61,8 +60,7 @@ class CompiledModel:
                 inertial=MjInertial(
                     float(m.body_mass[b]),
                     np.array(m.body_ipos[b], dtype=float),
-                    np.array(m.body_iquat[b], dtype=float),
-                    np.array(m.body_inertia[b], dtype=float),
+                    rotate_inertia(np.diag(m.body_inertia[b]), matrix_from_quat_wxyz(m.body_iquat[b])),
                 ),
                 mocap=int(m.body_mocapid[b]) >= 0,
             )
@@ -144,7 +142,7 @@ class CompiledModel:
         inverse of (mesh_pos, mesh_quat)."""
         m = self.m
         geom.mesh_name = self.name("mesh", mesh)
-        geom.pose = geom.pose @ inverse(pose_of(m.mesh_pos[mesh], m.mesh_quat[mesh]))
+        geom.pose = geom.pose @ pose_of(m.mesh_pos[mesh], m.mesh_quat[mesh]).inverse()
         geom.mesh_scale = np.array(m.mesh_scale[mesh], dtype=float)
         meshes = list(self.spec.meshes)
         if mesh < len(meshes):

@@ -59,10 +59,10 @@ def error_location(message: str, index: SourceIndex) -> SourceLocation:
         on_line = [p for p in elements if p.loc().line == line]
         chosen = _best(on_line, name, tag, attribute, index, loose=True)
         if chosen is not None:
-            return _at(chosen, attribute)
+            return chosen.loc(attribute)
         return SourceLocation(index.main.display, line, 1)
     chosen = _best(elements, name, tag, attribute, index, loose=False)
-    return _at(chosen, attribute) if chosen is not None else index.top().loc()
+    return chosen.loc(attribute) if chosen is not None else index.top().loc()
 
 
 def _best(
@@ -88,12 +88,6 @@ def _best(
         refers = [p for p in pool if name in p.el.attrib.values()] if loose else []
         pool = own or refers or (pool if loose else [])
     return pool[0] if pool else None
-
-
-def _at(placed: Placed, attribute: str | None) -> SourceLocation:
-    if attribute is not None and placed.el.get(attribute) is not None:
-        return placed.loc(attribute)
-    return placed.loc()
 
 
 def _by_file(index: SourceIndex, written: str) -> Placed | None:

@@ -23,8 +23,9 @@ from typing import Any
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation, sorted_diagnostics
 from modelkit.formats.common import ReadOptions, ReadResult
+from modelkit.formats.meshref import not_found
 from modelkit.formats.mjcf.bodies import MjBody, MjGeom
-from modelkit.formats.mjcf.build import Built, RobotBuilder, apply_joint_equalities
+from modelkit.formats.mjcf.build import Built, RobotBuilder, apply_joint_equalities, quoted
 from modelkit.formats.mjcf.compiled import CompiledModel, mesh_path
 from modelkit.formats.mjcf.errors import error_location, error_text
 from modelkit.formats.mjcf.source import SourceIndex, TreeShape, locate, pair
@@ -178,7 +179,7 @@ class _MjcfReader:
             if eq["type"] == "joint":
                 continue
             objects = {"body": "bodies", "xbody": "bodies"}.get(eq["objtype"], f"{eq['objtype']}s")
-            what = f"{eq['type']} equality{_quoted(eq['name'])} between {objects} "
+            what = f"{eq['type']} equality{quoted(eq['name'])} between {objects} "
             what += f'"{eq["obj1"]}" and "{eq["obj2"] or "world"}"'
             self.sink.emit(
                 "MK172", f"{what}: the model cannot hold it (kept as data)", eq_where.get(eq["index"], top)
@@ -187,7 +188,7 @@ class _MjcfReader:
         for i, tendon in enumerate(tendons):
             self.sink.emit(
                 "MK172",
-                f"{tendon['kind']} tendon{_quoted(tendon['name'])}: the model cannot hold tendons "
+                f"{tendon['kind']} tendon{quoted(tendon['name'])}: the model cannot hold tendons "
                 "(kept as data)",
                 where.get(i, top),
             )
@@ -275,6 +276,7 @@ class _MjcfReader:
         built = RobotBuilder(bodies, locator, self.sink, name).build()
         for robot in built.robots:
             robot.extras["mjcf_compiled"] = False
+            robot.extras["masses_unknown"] = True
         self.sink.emit(
             "MK174",
             "the kinematic tree was read from the uncompiled model: links have no geometry and only "
@@ -295,7 +297,7 @@ class _MjcfReader:
             if not path.exists():
                 placed = by_file.get(written)
                 loc = placed.loc("file") if placed is not None else index.top().loc()
-                self.sink.emit("MK500", f'mesh file "{written}" not found at {path}', loc)
+                self.sink.emit("MK500", not_found(written, path), loc)
 
 
 def _shapes(bodies: list[MjBody]) -> list[TreeShape]:
@@ -311,6 +313,3 @@ def _shapes(bodies: list[MjBody]) -> list[TreeShape]:
         for b in bodies
     ]
 
-
-def _quoted(name: str | None) -> str:
-    return f' "{name}"' if name else ""

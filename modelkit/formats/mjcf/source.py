@@ -183,14 +183,14 @@ class Locator:
     def body(self, index: int, attribute: str | None = None) -> SourceLocation:
         placed = self.bodies.get(index)
         if placed is not None:
-            return self._at(placed, attribute)
+            return placed.loc(attribute)
         fallback = self.body_fallback.get(index)
         return fallback.loc() if fallback is not None else self.index.top().loc()
 
     def joint(self, index: int, attribute: str | None = None) -> SourceLocation:
         placed = self.joints.get(index)
         if placed is not None:
-            return self._at(placed, attribute)
+            return placed.loc(attribute)
         return self.body(self.joint_body.get(index, -1))
 
     def geom(self, index: int) -> SourceLocation:
@@ -203,14 +203,7 @@ class Locator:
 
     def inertial(self, body: int, attribute: str | None = None) -> SourceLocation:
         placed = self.inertials.get(body)
-        return self._at(placed, attribute) if placed is not None else self.body(body)
-
-    @staticmethod
-    def _at(placed: Placed, attribute: str | None) -> SourceLocation:
-        """The attribute's position when it is written, else the element's."""
-        if attribute is not None and placed.el.get(attribute) is not None:
-            return placed.loc(attribute)
-        return placed.loc()
+        return placed.loc(attribute) if placed is not None else self.body(body)
 
 
 @dataclass

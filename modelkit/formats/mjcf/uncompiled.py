@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from modelkit.formats.mjcf.bodies import MjBody, MjInertial, MjJoint, pose_of
-from modelkit.spatial import Pose
+from modelkit.spatial import Pose, inertia_from_moments, matrix_from_quat_wxyz, rotate_inertia
 
 JOINT_KINDS = {"mjJNT_FREE": "free", "mjJNT_BALL": "ball", "mjJNT_SLIDE": "slide", "mjJNT_HINGE": "hinge"}
 
@@ -73,8 +73,6 @@ class SpecReader:
         limited = limited_word == "mjLIMITED_TRUE" or (
             limited_word == "mjLIMITED_AUTO" and self.autolimits and low < high
         )
-        axis = np.array(joint.axis, dtype=float)
-        norm = float(np.linalg.norm(axis))
         index = self._joint_count
         self._joint_count += 1
         return MjJoint(
@@ -82,7 +80,7 @@ class SpecReader:
             name=str(joint.name) or None,
             kind=kind,
             pos=np.array(joint.pos, dtype=float),
-            axis=axis / norm if norm > 0 else axis,
+            axis=np.array(joint.axis, dtype=float),  # as written; the builder normalises it
             limited=limited and kind != "free",
             range=(low * scale, high * scale),
             ref=float(joint.ref) * (scale if kind == "hinge" else 1.0),
@@ -95,31 +93,10 @@ class SpecReader:
 
     def _inertial(self, body: Any) -> MjInertial:
         full = np.array(body.fullinertia, dtype=float)
-        iquat = self._quat(body.iquat, body.ialt)
-        diag = np.array(body.inertia, dtype=float)
         if math.isfinite(full[0]):
-            xx, yy, zz, xy, xz, yz = full
-            tensor = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
-            moments, axes = np.linalg.eigh(tensor)
-            if np.linalg.det(axes) < 0:
-                axes[:, 0] = -axes[:, 0]
-            diag, iquat = moments, _matrix_quat(axes)
-        return MjInertial(float(body.mass), np.array(body.ipos, dtype=float), iquat, diag)
-
-
-def _matrix_quat(r: Any) -> Any:
-    """A unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method)."""
-    m = np.asarray(r, dtype=float)
-    trace = float(np.trace(m))
-    if trace > 0:
-        s = 2.0 * math.sqrt(trace + 1.0)
-        return np.array([0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s])
-    i = int(np.argmax(np.diag(m)))
-    j, k = (i + 1) % 3, (i + 2) % 3
-    s = 2.0 * math.sqrt(max(1.0 + m[i, i] - m[j, j] - m[k, k], 0.0))
-    q = np.zeros(4)
-    q[0] = (m[k, j] - m[j, k]) / s
-    q[1 + i] = 0.25 * s
-    q[1 + j] = (m[j, i] + m[i, j]) / s
-    q[1 + k] = (m[k, i] + m[i, k]) / s
-    return q
+            xx, yy, zz, xy, xz, yz = full  # MuJoCo's order
+            tensor = inertia_from_moments(xx, xy, xz, yy, yz, zz)
+        else:
+            rotation = matrix_from_quat_wxyz(self._quat(body.iquat, body.ialt))
+            tensor = rotate_inertia(np.diag(np.array(body.inertia, dtype=float)), rotation)
+        return MjInertial(float(body.mass), np.array(body.ipos, dtype=float), tensor)

@@ -23,12 +23,11 @@ import numpy as np
 
 from modelkit.diagnostics import DiagnosticSink, Severity
 from modelkit.formats.sdf.collect import ModelTree
-from modelkit.formats.sdf.joints import WORLD, AxisSpec, JointData
+from modelkit.formats.sdf.joints import AxisSpec, JointData
 from modelkit.formats.sdf.links import LinkData
 from modelkit.formats.sdf.poses import FrameGraph
-from modelkit.formats.sdf.values import inverse, is_identity
-from modelkit.model import Inertial, Joint, JointType, Link, LoopConstraint, Robot
-from modelkit.spatial import Pose, Vec3
+from modelkit.model import SYNTHESISED, WORLD_LINK, Inertial, Joint, JointType, Link, LoopConstraint, Robot
+from modelkit.spatial import Pose, Vec3, rotate_inertia
 
 LOOP_TYPES = {
     JointType.FIXED: "fixed",
@@ -89,7 +88,7 @@ class Assembler:
             if tree_joints.get(jd.child_link or "") is jd:
                 robot.joints.append(self._joint(jd))
         if synthetic:
-            robot.links.insert(0, Link(WORLD, extras={"sdf_synthetic_world": True}))
+            robot.links.insert(0, Link(WORLD_LINK, extras={"sdf_synthetic_world": True, SYNTHESISED: True}))
             for jd in world_joints:
                 robot.joints.append(self._world_joint(jd))
         for jd in loops:
@@ -111,8 +110,8 @@ class Assembler:
         close loops. A cycle of such joints is cut at the link written first, which becomes a top.
         """
         static = self.placement.static
-        world = [j for j in self.joints if j.parent_link == WORLD and j.child_link is not None]
-        links = [j for j in self.joints if j.valid and j.parent_link != WORLD]
+        world = [j for j in self.joints if j.parent_link == WORLD_LINK and j.child_link is not None]
+        links = [j for j in self.joints if j.valid and j.parent_link != WORLD_LINK]
         incoming: dict[str, JointData] = {}
         loops: list[JointData] = []
         for j in links:
@@ -188,8 +187,8 @@ class Assembler:
     def _reframe(self, data: LinkData) -> None:
         link = data.link
         new = self.frames.get(link.name, data.pose)
-        offset = inverse(new) @ data.pose
-        if is_identity(offset, 1e-12):
+        offset = new.inverse() @ data.pose
+        if offset.is_identity(1e-12):
             return
         link.extras["sdf_link_pose"] = offset
         for geom in (*link.visuals, *link.collisions):
@@ -204,7 +203,7 @@ class Assembler:
             link.inertial = Inertial(
                 inertial.mass,
                 r @ inertial.com + offset.translation,
-                r @ inertial.inertia @ r.T,
+                rotate_inertia(inertial.inertia, r),
                 inertial.defaulted,
                 inertial.source,
                 inertial.sources,
@@ -224,14 +223,14 @@ class Assembler:
         joint = data.joint
         pose = self.graph.pose(data.item.name)
         parent = self.frames.get(data.parent_link or "", Pose())
-        joint.origin = inverse(parent) @ pose
+        joint.origin = parent.inverse() @ pose
         joint.axis = self._axis_in_joint(pose, data.axis)
         return joint
 
     def _world_joint(self, data: JointData) -> Joint:
         joint = data.joint
         pose = self.graph.pose(data.item.name)
-        joint.parent = WORLD
+        joint.parent = WORLD_LINK
         joint.origin = self.placement.model_pose @ pose
         joint.axis = self._axis_in_joint(pose, data.axis)
         return joint
@@ -245,8 +244,8 @@ class Assembler:
             type=LOOP_TYPES.get(data.joint.type, "fixed"),
             link1=data.parent_link or "",
             link2=data.child_link or "",
-            pose_in_link1=inverse(p) @ pose,
-            pose_in_link2=inverse(c) @ pose,
+            pose_in_link1=p.inverse() @ pose,
+            pose_in_link2=c.inverse() @ pose,
             axis=self._axis_in_joint(pose, data.axis),
             source=data.joint.source,
         )
@@ -258,7 +257,7 @@ class Assembler:
                 continue
             frame = self.frames.get(target.link.name, target.pose)
             for device, pose in data.sensors:
-                device.pose = inverse(frame) @ pose
+                device.pose = frame.inverse() @ pose
                 target.link.devices.append(device)
 
     def _frames_on_links(self) -> None:
@@ -269,7 +268,7 @@ class Assembler:
             if data is None:
                 continue
             frame = self.frames.get(data.link.name, data.pose)
-            data.link.extras.setdefault("sdf_frames", {})[item.name] = inverse(frame) @ self.graph.pose(
+            data.link.extras.setdefault("sdf_frames", {})[item.name] = frame.inverse() @ self.graph.pose(
                 item.name
             )
 
@@ -290,7 +289,7 @@ class Assembler:
         if canonical is not None:
             robot.extras["sdf_canonical_link"] = canonical
         if synthetic:
-            robot.root, robot.root_joint, robot.root_pose = WORLD, JointType.FIXED, Pose()
+            robot.root, robot.root_joint, robot.root_pose = WORLD_LINK, JointType.FIXED, Pose()
         elif root is not None:
             robot.root = root
             robot.root_pose = placement.model_pose @ self.frames.get(root, Pose())
@@ -300,10 +299,10 @@ class Assembler:
                 data = world[0]
                 robot.extras["sdf_world_joint"] = {
                     "name": data.joint.name,
-                    "pose": inverse(self.frames.get(root, Pose())) @ self.graph.pose(data.item.name),
+                    "pose": self.frames.get(root, Pose()).inverse() @ self.graph.pose(data.item.name),
                 }
         if placement.static:
-            for data in (j for j in self.joints if j.parent_link == WORLD):
+            for data in (j for j in self.joints if j.parent_link == WORLD_LINK):
                 self.sink.emit(
                     "MK155",
                     f'joint "{data.item.local}" attaches a static model to the world; the model is '

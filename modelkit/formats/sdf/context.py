@@ -6,13 +6,14 @@
   ancestors), and reported as info (MK532) because it depends on the layout;
 * ``<include>`` targets: a directory is a model folder whose ``model.config`` names the SDF file;
   each file is parsed and checked once, however often it is included;
-* mesh checking through :class:`~modelkit.formats.meshref.MeshChecker`.
+* mesh and texture checking through :class:`~modelkit.formats.meshref.MeshChecker`, with the
+  ``model://`` look-up above.
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
@@ -90,21 +91,36 @@ class Context:
         visual_only: bool,
         submesh: str | None,
     ) -> Mesh:
+        return self._files(src).mesh(uri, loc, scale, visual_only=visual_only, submesh=submesh)
+
+    def texture(self, uri: str, src: SdfDocument, loc: SourceLocation) -> None:
+        """Report a texture file written in ``src`` that cannot be found (MK507, once per URI)."""
+        self._files(src).texture(uri, loc)
+
+    def _files(self, src: SdfDocument) -> MeshChecker:
+        """The mesh and texture checker of one file (each mesh file is loaded once per file)."""
         key = str(src.path)
         checker = self._meshes.get(key)
         if checker is None:
             checker = MeshChecker(
-                self.options.resolver, src.base_dir, src.path, self.sink, self.options.check_resources
+                self.options.resolver,
+                src.base_dir,
+                src.path,
+                self.sink,
+                self.options.check_resources,
+                resolve=lambda uri, loc: self._file_resolution(uri, src, loc),
             )
             self._meshes[key] = checker
-        target = uri
-        if uri.strip().lower().startswith("model://"):
-            resolution = self.resolve(uri, src, loc)
-            if resolution.path is not None:
-                target = os.path.abspath(resolution.path)
-        mesh = checker.mesh(target, loc, scale, visual_only=visual_only, submesh=submesh)
-        mesh.uri = uri
-        return mesh
+        return checker
+
+    def _file_resolution(self, uri: str, src: SdfDocument, loc: SourceLocation) -> Resolution:
+        """Where a mesh or texture URI of ``src`` points; a ``model://`` one as an absolute path."""
+        if not uri.strip().lower().startswith("model://"):
+            return self.options.resolver.resolve(uri, src.base_dir, src.path)
+        resolution = self.resolve(uri, src, loc)
+        if resolution.path is None:
+            return resolution
+        return replace(resolution, path=Path(os.path.abspath(resolution.path)))
 
     # -- includes ------------------------------------------------------------------------------
 

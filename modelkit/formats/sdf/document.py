@@ -15,13 +15,12 @@ from pathlib import Path
 
 from modelkit.diagnostics import DiagnosticSink
 from modelkit.formats.sdf.values import Values, local_name
-from modelkit.xmlsource import XmlDocument, parse_xml_bytes, read_xml
+from modelkit.xmlsource import XmlDocument, mask_markup, parse_xml_bytes, read_xml, tag_end
 
 MIN_VERSION = (1, 4)
 MAX_VERSION = (1, 11)
 SUPPORTED = "1.4-1.11"
 _VERSION = re.compile(r"\s*(\d+)\.(\d+)\s*")
-_MASKED = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<!DOCTYPE(?:[^\[>]|\[.*?\])*>", re.DOTALL)
 _PREFIXED = re.compile(r"(?:<|\s)([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*")
 _DECLARED = re.compile(r"xmlns:([A-Za-z_][\w.-]*)\s*=")
 _ENCODING = re.compile(r"<\?xml[^>]*encoding\s*=\s*[\"']([^\"']+)", re.IGNORECASE)
@@ -122,13 +121,13 @@ def _declare_prefixes(text: str) -> str | None:
     encoding = _ENCODING.search(text)
     if encoding and encoding.group(1).lower().replace("_", "-") not in ("utf-8", "utf8"):
         return None
-    masked = _MASKED.sub(lambda m: " " * len(m.group(0)), text)
+    masked = mask_markup(text)
     start = masked.find("<")
     while start >= 0 and masked[start + 1 : start + 2] in ("!", "?", ""):
         start = masked.find("<", start + 1)
     if start < 0:
         return None
-    end = _tag_end(masked, start)
+    end = tag_end(masked, start)
     if end >= len(masked):
         return None
     prefixes = {m.group(1) for m in _PREFIXED.finditer(masked)} - {"xml", "xmlns", "http", "https"}
@@ -138,17 +137,3 @@ def _declare_prefixes(text: str) -> str | None:
     insert = "".join(f' xmlns:{p}="urn:modelkit:undeclared:{p}"' for p in sorted(prefixes))
     at = end - 1 if masked[end - 1] == "/" else end
     return text[:at] + insert + text[at:]
-
-
-def _tag_end(text: str, start: int) -> int:
-    quote = ""
-    for i in range(start, len(text)):
-        c = text[i]
-        if quote:
-            if c == quote:
-                quote = ""
-        elif c in "\"'":
-            quote = c
-        elif c == ">":
-            return i
-    return len(text)

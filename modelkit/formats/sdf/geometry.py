@@ -16,7 +16,7 @@ from lxml.etree import _Element as Element
 from modelkit.diagnostics import DiagnosticSink
 from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.document import SdfDocument
-from modelkit.formats.sdf.values import child, local_name
+from modelkit.formats.sdf.values import child, is_custom, local_name
 from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geometry, Mesh, Sphere, VisualMaterial
 
 SHAPES = ("box", "sphere", "cylinder", "capsule", "ellipsoid", "cone", "mesh")
@@ -29,7 +29,6 @@ class ShapeResult:
 
     geometry: Geometry | None = None
     unmodelled: dict[str, Any] | None = None
-    empty: bool = False
 
 
 def element_data(element: Element) -> Any:
@@ -69,12 +68,12 @@ def read_geometry(
     sink = ctx.sink
     values = src.values
     if geometry is None:
-        return ShapeResult(empty=True)  # a missing <geometry> is reported by the caller
-    shapes = [c for c in geometry if isinstance(c.tag, str) and not c.tag.startswith("{")]
+        return ShapeResult()  # a missing <geometry> is reported by the caller
+    shapes = [c for c in geometry if isinstance(c.tag, str) and not is_custom(c)]
     known = [c for c in shapes if c.tag in (*SHAPES, *UNMODELLED, "empty")]
     if not known:
         sink.emit("MK122", f"the <geometry> of {owner} holds no shape", values.loc(geometry))
-        return ShapeResult(empty=True)
+        return ShapeResult()
     if len(known) > 1:
         sink.emit(
             "MK124",
@@ -84,7 +83,7 @@ def read_geometry(
     shape = known[0]
     kind = str(shape.tag)
     if kind == "empty":
-        return ShapeResult(empty=True)
+        return ShapeResult()
     if kind in UNMODELLED:
         sink.emit(
             "MK430",
@@ -227,8 +226,10 @@ def read_material(
     if pbr is not None:
         for workflow in pbr:
             albedo = child(workflow, "albedo_map") if isinstance(workflow.tag, str) else None
-            if albedo is not None and values.text(albedo):
-                result.texture = values.text(albedo)
+            texture = values.text(albedo)
+            if albedo is not None and texture:
+                result.texture = texture
+                ctx.texture(texture, src, values.text_loc(albedo))
                 break
     return MaterialResult(result, extras)
 

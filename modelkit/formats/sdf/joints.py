@@ -13,20 +13,19 @@ it in the joint frame.
 
 from __future__ import annotations
 
-import difflib
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from lxml.etree import _Element as Element
 
-from modelkit.diagnostics import SourceLocation
+from modelkit.diagnostics import SourceLocation, did_you_mean
 from modelkit.formats.sdf.collect import Item
 from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import sensor_device
 from modelkit.formats.sdf.values import child, children
-from modelkit.model import Device, Joint, JointLimits, JointType, Mimic
+from modelkit.model import WORLD_LINK, Device, Joint, JointLimits, JointType, Mimic
 from modelkit.spatial import Pose, Vec3
 
 TYPES = {
@@ -38,7 +37,6 @@ TYPES = {
 }
 UNSUPPORTED = ("universal", "revolute2", "screw", "gearbox")
 UNLIMITED = 1e16
-WORLD = "world"
 
 
 @dataclass
@@ -72,7 +70,7 @@ def read_joint(ctx: Context, graph: FrameGraph, item: Item) -> JointData:
     el = item.element
     word = (el.get("type") or "").strip()
     joint = Joint(name=item.name, type=JointType.FIXED, parent="", child="", source=values.loc(el))
-    joint.sources["name"] = values.loc(el, "name") if el.get("name") is not None else values.loc(el)
+    joint.sources["name"] = values.loc(el, "name")
     data = JointData(item, joint, word)
     what = f'joint "{item.local}"'
     if el.get("type") is None:
@@ -119,12 +117,12 @@ def _type(ctx: Context, data: JointData, what: str) -> None:
             loc,
         )
         return
-    close = difflib.get_close_matches(word, [*TYPES, *UNSUPPORTED], n=1)
+    known = [*TYPES, *UNSUPPORTED]
     ctx.sink.emit(
         "MK121",
         f'{what} has type "{word}", which is not an SDFormat joint type',
         loc,
-        hint=f'did you mean "{close[0]}"?' if close else "types: " + ", ".join([*TYPES, *UNSUPPORTED]),
+        hint=did_you_mean(word, known) or "types: " + ", ".join(known),
     )
 
 
@@ -141,12 +139,12 @@ def _ends(ctx: Context, graph: FrameGraph, data: JointData, what: str) -> None:
         loc = values.text_loc(el)
         joint.sources[end] = loc
         names[end] = text
-        if text == WORLD:
+        if text == WORLD_LINK:
             if end == "child":
                 ctx.sink.emit("MK234", f'the child of {what} is "world"; a child must be a link', loc)
                 continue
-            data.parent_link = WORLD
-            joint.parent = WORLD
+            data.parent_link = WORLD_LINK
+            joint.parent = WORLD_LINK
             continue
         vertex = graph.lookup(item.scope, text)
         link = graph.link_of(vertex) if vertex is not None else None
@@ -254,7 +252,7 @@ def _axis_details(ctx: Context, data: JointData, axis_el: Element) -> None:
             joint=item.scope.scoped(leader) if leader else "",
             multiplier=multiplier,
             offset=offset - multiplier * reference,
-            source=values.loc(mimic, "joint") if mimic.get("joint") is not None else values.loc(mimic),
+            source=values.loc(mimic, "joint"),
         )
         if mimic.get("axis", "axis") != "axis":
             joint.extras["sdf_mimic_axis"] = mimic.get("axis")

@@ -25,9 +25,9 @@ from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.geometry import element_data, read_geometry, read_material
 from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import light_device, plugin_data, sensor_device
-from modelkit.formats.sdf.values import child, children, inverse
+from modelkit.formats.sdf.values import child, children
 from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Inertial, Link, Sphere
-from modelkit.spatial import Mat3, Pose, Vec3, combine_mass_properties
+from modelkit.spatial import Mat3, Pose, Vec3, combine_mass_properties, inertia_from_moments, rotate_inertia
 
 DEFAULT_DENSITY = 1000.0
 LINK_FLAGS = ("gravity", "kinematic", "self_collide", "enable_wind", "must_be_base_link")
@@ -47,9 +47,9 @@ def read_link(ctx: Context, graph: FrameGraph, item: Item) -> LinkData:
     values = src.values
     el = item.element
     link = Link(name=item.name, source=values.loc(el))
-    link.sources["name"] = values.loc(el, "name") if el.get("name") is not None else values.loc(el)
+    link.sources["name"] = values.loc(el, "name")
     pose = graph.pose(item.name)
-    to_link = inverse(pose)
+    to_link = pose.inverse()
     data = LinkData(item, link, pose)
     what = f'link "{item.local}"'
 
@@ -164,16 +164,9 @@ def _inertial(ctx: Context, graph: FrameGraph, item: Item, to_link: Pose, data: 
         inertial.sources["inertia"] = values.loc(inertia_el)
         get = {k: values.child_number(inertia_el, k, d) for k, d in _INERTIA_DEFAULTS.items()}
         v = {k: (d if get[k] is None else float(get[k] or 0.0)) for k, d in _INERTIA_DEFAULTS.items()}
-        tensor = np.array(
-            [
-                [v["ixx"], v["ixy"], v["ixz"]],
-                [v["ixy"], v["iyy"], v["iyz"]],
-                [v["ixz"], v["iyz"], v["izz"]],
-            ]
-        )
-    rotation = frame.rotation
+        tensor = inertia_from_moments(**v)
     inertial.com = frame.translation.copy()
-    inertial.inertia = rotation @ tensor @ rotation.T
+    inertial.inertia = rotate_inertia(tensor, frame.rotation)
     if values.attribute_bool(el, "auto"):
         _auto(ctx, item, el, inertial, data)
     return inertial
@@ -195,7 +188,7 @@ def _auto(ctx: Context, item: Item, el: Element, inertial: Inertial, data: LinkD
             continue
         mass, com, tensor = solid
         r = geom.pose.rotation
-        parts.append((mass, geom.pose.rotation @ com + geom.pose.translation, r @ tensor @ r.T))
+        parts.append((mass, r @ com + geom.pose.translation, rotate_inertia(tensor, r)))
     where = values.loc(el, "auto")
     if skipped or not parts:
         why = ", ".join(skipped) if skipped else "it has no collision"

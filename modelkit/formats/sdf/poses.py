@@ -22,10 +22,10 @@ from dataclasses import dataclass
 
 from lxml.etree import _Element as Element
 
-from modelkit.diagnostics import DiagnosticSink, SourceLocation
+from modelkit.diagnostics import DiagnosticSink, SourceLocation, did_you_mean
 from modelkit.formats.sdf.collect import MODEL_FRAME, Item, ModelTree, Scope
 from modelkit.formats.sdf.document import SdfDocument
-from modelkit.formats.sdf.values import child, inverse
+from modelkit.formats.sdf.values import child
 from modelkit.spatial import Pose
 
 _RESERVED = re.compile(r"^__.*__$")
@@ -39,7 +39,6 @@ class Vertex:
     scope: Scope  # the scope whose names this vertex's attributes use
     default_relative: str | None  # None only for the top-level model frame
     attached_to: str | None = None  # flattened, unresolved; None for links
-    attached_explicit: bool = False
 
 
 class FrameGraph:
@@ -87,7 +86,7 @@ class FrameGraph:
             return Vertex(item.name, "joint", item, scope, target, target)
         attached = item.element.get("attached_to")
         target = scope.scoped(attached) if attached else scope.frame
-        return Vertex(item.name, "frame", item, scope, target, target, bool(attached))
+        return Vertex(item.name, "frame", item, scope, target, target)
 
     def _check_names(self) -> None:
         """Sibling names must be unique (SDF 1.7+: links, joints, frames and nested models share one
@@ -185,8 +184,6 @@ class FrameGraph:
         self, scope: Scope, name: str, kinds: tuple[str, ...] = ("link", "joint", "frame", "model")
     ) -> str | None:
         """A "did you mean" hint: the closest name of the given kinds in ``scope``."""
-        import difflib
-
         local = [
             v.name[len(scope.prefix) :]
             for v in self.vertices.values()
@@ -194,8 +191,7 @@ class FrameGraph:
         ]
         if "model" in kinds:
             local.append(MODEL_FRAME)
-        close = difflib.get_close_matches(name, local, n=1)
-        return f'did you mean "{close[0]}"?' if close else None
+        return did_you_mean(name, local)
 
     # -- the pose graph ----------------------------------------------------------------------
 
@@ -241,7 +237,7 @@ class FrameGraph:
                 )
             else:
                 inside = self._resolve(placement, stop=item.inner.frame)
-                pose = pose @ inverse(inside)
+                pose = pose @ inside.inverse()
         return pose
 
     def pose(self, name: str) -> Pose:

@@ -22,7 +22,7 @@ from modelkit.formats.common import ReadOptions, ReadResult
 from modelkit.formats.sdf.assemble import Assembler, Placement
 from modelkit.formats.sdf.collect import Collector, ModelTree, Scope
 from modelkit.formats.sdf.context import Context
-from modelkit.formats.sdf.document import SdfDocument
+from modelkit.formats.sdf.document import SdfDocument, version_text
 from modelkit.formats.sdf.joints import read_joint
 from modelkit.formats.sdf.links import read_link
 from modelkit.formats.sdf.poses import FrameGraph
@@ -162,7 +162,7 @@ class _Reader:
                 )
         if model.world is not None:
             robot.extras["sdf_world"] = model.world
-        robot.extras["sdf_version"] = f"{tree.scope.src.version[0]}.{tree.scope.src.version[1]}"
+        robot.extras["sdf_version"] = version_text(tree.scope.src.version)
         return robot
 
     def _not_modelled(self, src: SdfDocument, el: Element, message: str) -> None:
@@ -210,7 +210,7 @@ class _Reader:
                 self.sink.emit(
                     "MK237",
                     f'world "{world_name}" has two models named "{name}" (the first at line {names[name]})',
-                    values.loc(el, "name") if el.get("name") is not None else values.loc(el),
+                    values.loc(el, "name"),
                 )
             else:
                 names[name] = values.loc(el).line

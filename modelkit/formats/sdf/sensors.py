@@ -14,6 +14,7 @@ from typing import Any
 from lxml import etree
 from lxml.etree import _Element as Element
 
+from modelkit.diagnostics import did_you_mean
 from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.document import SdfDocument
 from modelkit.formats.sdf.geometry import element_data
@@ -113,14 +114,11 @@ def sensor_device(ctx: Context, src: SdfDocument, el: Element, owner: str) -> De
         ctx.sink.emit("MK120", f'sensor "{name}" of {owner} has no type attribute', values.loc(el))
         return None
     if kind not in SENSOR_TYPES:
-        import difflib
-
-        close = difflib.get_close_matches(kind, sorted(SENSOR_TYPES), n=1)
         ctx.sink.emit(
             "MK630",
             f'sensor "{name}" of {owner} has type "{kind}", which is not an SDFormat sensor type',
             values.loc(el, "type"),
-            hint=f'did you mean "{close[0]}"?' if close else None,
+            hint=did_you_mean(kind, SENSOR_TYPES),
         )
         return None
     params: dict[str, Any] = {}

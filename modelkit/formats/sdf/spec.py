@@ -13,7 +13,6 @@ An element is known by an id: the description file's stem for a file's top eleme
 
 from __future__ import annotations
 
-import difflib
 import json
 import sys
 from dataclasses import dataclass, field
@@ -22,7 +21,8 @@ from pathlib import Path
 
 from lxml.etree import _Element as Element
 
-from modelkit.diagnostics import DiagnosticSink
+from modelkit.diagnostics import DiagnosticSink, closest, did_you_mean
+from modelkit.formats.sdf.values import is_custom
 from modelkit.xmlsource import XmlDocument
 
 SPEC_FILE = Path(__file__).resolve().parents[2] / "data" / "sdf_spec.json"
@@ -185,7 +185,7 @@ def check_elements(doc: XmlDocument, sink: DiagnosticSink, version: tuple[int, i
         pending: list[tuple[Element, str]] = []
         for child in element:
             tag = child.tag
-            if not isinstance(tag, str) or tag.startswith("{"):
+            if not isinstance(tag, str) or is_custom(child):
                 continue
             entry = spec.children.get(tag)
             if entry is None:
@@ -213,19 +213,18 @@ def _check_attributes(doc: XmlDocument, sink: DiagnosticSink, element: Element, 
         key = str(name)
         if key.startswith("{") or key in spec.attributes:
             continue
-        close = difflib.get_close_matches(key, sorted(spec.attributes), n=1, cutoff=0.6)
         sink.emit(
             "MK123",
             f'attribute "{key}" is not defined for <{spec.name}>; libsdformat ignores it',
             doc.loc(element, key),
-            hint=f'did you mean "{close[0]}"?' if close else None,
+            hint=did_you_mean(key, spec.attributes),
         )
 
 
 def _hint(tag: str, spec: ElementSpec) -> str | None:
-    close = difflib.get_close_matches(tag, sorted(spec.children), n=1, cutoff=0.6)
-    if close:
-        return f"did you mean <{close[0]}>?"
+    close = closest(tag, spec.children)
+    if close is not None:
+        return f"did you mean <{close}>?"
     homes = _homes().get(tag)
     if homes:
         shown = ", ".join(f"<{h}>" for h in homes[:3]) + (" ..." if len(homes) > 3 else "")

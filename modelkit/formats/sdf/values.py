@@ -15,7 +15,7 @@ import numpy as np
 from lxml.etree import _Element as Element
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
-from modelkit.spatial import Mat3, Pose, Vec3
+from modelkit.spatial import Pose, Vec3, matrix_from_quat_wxyz, matrix_from_rpy
 from modelkit.xmlsource import XmlDocument, parse_number
 
 _INF = re.compile(r"[+-]?inf(inity)?", re.IGNORECASE)
@@ -26,45 +26,6 @@ POSE_COUNTS = {"euler_rpy": 6, "quat_xyzw": 7}
 
 def _finite(value: float | None) -> float | None:
     return value if value is not None and math.isfinite(value) else None
-
-
-def rpy_matrix(roll: float, pitch: float, yaw: float) -> Mat3:
-    """R = Rz(yaw)·Ry(pitch)·Rx(roll): SDF's (and URDF's) fixed-axis roll-pitch-yaw."""
-    cr, sr = math.cos(roll), math.sin(roll)
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
-def quaternion_matrix(x: float, y: float, z: float, w: float) -> Mat3:
-    """Rotation of the unit quaternion (x, y, z, w) (normalised here)."""
-    n = math.sqrt(x * x + y * y + z * z + w * w)
-    x, y, z, w = x / n, y / n, z / n, w / n
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
-def inverse(pose: Pose) -> Pose:
-    rt = pose.rotation.T
-    return Pose(rt, -(rt @ pose.translation))
-
-
-def is_identity(pose: Pose, tol: float = 1e-12) -> bool:
-    return bool(
-        np.allclose(pose.rotation, np.eye(3), atol=tol, rtol=0.0)
-        and np.allclose(pose.translation, 0.0, atol=tol, rtol=0.0)
-    )
 
 
 def local_name(element: Element) -> str:
@@ -228,6 +189,7 @@ class Values:
             if math.sqrt(sum(q * q for q in nums[3:])) == 0.0:
                 self.invalid(element, "<pose> quaternion is zero")
                 return None
-            return Pose(quaternion_matrix(*nums[3:]), translation)
+            x, y, z, w = nums[3:]
+            return Pose(matrix_from_quat_wxyz((w, x, y, z)), translation)
         angles = [math.radians(a) for a in nums[3:]] if degrees else nums[3:]
-        return Pose(rpy_matrix(*angles), translation)
+        return Pose(matrix_from_rpy(*angles), translation)

@@ -15,10 +15,9 @@ from modelkit.diagnostics import DiagnosticSink
 from modelkit.formats.sdf.collect import MODEL_FRAME
 from modelkit.formats.sdf.document import SdfDocument
 from modelkit.formats.sdf.poses import FrameGraph
-from modelkit.formats.sdf.values import child, inverse
+from modelkit.formats.sdf.values import child
+from modelkit.model import WORLD_LINK
 from modelkit.spatial import Pose
-
-WORLD = "world"
 
 
 @dataclass(eq=False)
@@ -29,7 +28,7 @@ class Placed:
     src: SdfDocument
     pose_src: SdfDocument
     pose_element: Element | None
-    default: str = WORLD
+    default: str = WORLD_LINK
     graph: FrameGraph | None = None
     placement: str | None = None
     placement_loc: tuple[SdfDocument, Element, str | None] | None = None
@@ -49,7 +48,7 @@ class WorldFrames:
     def pose(self, name: str, path: list[str] | None = None) -> Pose:
         """The world pose of a world-level frame or model (identity when unresolvable)."""
         path = [] if path is None else path
-        if name == WORLD:
+        if name == WORLD_LINK:
             return Pose()
         if name in self._pose:
             return self._pose[name]
@@ -74,7 +73,7 @@ class WorldFrames:
                         src.values.loc(el, attr) if attr else src.values.text_loc(el),
                     )
             else:
-                own = own @ inverse(entry.graph.pose(target))
+                own = own @ entry.graph.pose(target).inverse()
         result = base @ own
         self._pose[name] = result
         return result
@@ -89,7 +88,7 @@ class WorldFrames:
         return self.pose(model, path) @ inner
 
     def _exists(self, name: str) -> bool:
-        if name == WORLD or name in self.entries:
+        if name == WORLD_LINK or name in self.entries:
             return True
         model, sep, rest = name.partition("::")
         entry = self.entries.get(model)
@@ -141,7 +140,12 @@ def world_frame_entries(src: SdfDocument, world: Element) -> list[Placed]:
             attached = (el.get("attached_to") or "").strip()
             out.append(
                 Placed(
-                    el.get("name") or "", src, src, child(el, "pose"), default=attached or WORLD, kind="frame"
+                    el.get("name") or "",
+                    src,
+                    src,
+                    child(el, "pose"),
+                    default=attached or WORLD_LINK,
+                    kind="frame",
                 )
             )
     return out

@@ -19,9 +19,10 @@ import numpy as np
 from lxml import etree
 from lxml.etree import _Element as Element
 
-from modelkit.formats.urdf.values import Context, did_you_mean, rpy_matrix
+from modelkit.diagnostics import did_you_mean
+from modelkit.formats.urdf.values import Context
 from modelkit.model import Device, Robot
-from modelkit.spatial import Pose
+from modelkit.spatial import Pose, matrix_from_rpy
 from modelkit.xmlsource import parse_number, parse_numbers
 
 # Simple values of a <gazebo> block that libsdformat maps onto the model (peers.md §2.1).
@@ -139,7 +140,7 @@ def _sensor(ctx: Context, element: Element) -> Device | None:
                 ctx.text_loc(pose_el),
             )
         else:
-            device.pose = Pose(rpy_matrix(*values[3:]), np.array(values[:3]))
+            device.pose = Pose(matrix_from_rpy(*values[3:]), np.array(values[:3]))
     return device
 
 

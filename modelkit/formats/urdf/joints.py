@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 from lxml.etree import _Element as Element
 
-from modelkit.formats.urdf.values import Context, did_you_mean, number, origin, vector
+from modelkit.diagnostics import did_you_mean
+from modelkit.formats.urdf.values import Context, number, origin, vector
 from modelkit.model import Joint, JointLimits, JointType, Mimic
 
 JOINT_TYPES: dict[str, JointType] = {
@@ -34,8 +35,8 @@ def read_joint(ctx: Context, element: Element) -> Joint:
     word = element.get("type")
     joint = Joint(name=name or "", type=JointType.FIXED, parent="", child="", source=ctx.loc(element))
     joint.axis = np.array([1.0, 0.0, 0.0])
-    joint.sources["name"] = ctx.loc(element, "name" if name is not None else None)
-    joint.sources["type"] = ctx.loc(element, "type" if word is not None else None)
+    joint.sources["name"] = ctx.loc(element, "name")
+    joint.sources["type"] = ctx.loc(element, "type")
     label = f'joint "{joint.name}"'
     if word is None:
         ctx.emit("MK120", f"{label} has no `type` attribute", ctx.loc(element))
@@ -76,7 +77,7 @@ def _links(ctx: Context, element: Element, joint: Joint) -> None:
         if el is None:
             continue
         value = el.get("link")
-        joint.sources[role] = ctx.loc(el, "link" if value is not None else None)
+        joint.sources[role] = ctx.loc(el, "link")
         if value is not None:
             setattr(joint, role, value)
 
@@ -86,7 +87,7 @@ def _axis(ctx: Context, element: Element, joint: Joint, label: str) -> None:
     axis_el = ctx.first(element, "axis")
     if axis_el is None or joint.type in (JointType.FIXED, JointType.FLOATING):
         return
-    joint.sources["axis"] = ctx.loc(axis_el, "xyz" if axis_el.get("xyz") is not None else None)
+    joint.sources["axis"] = ctx.loc(axis_el, "xyz")
     if axis_el.get("xyz") is None:
         ctx.emit(
             "MK120", f"<axis> of {label} has no `xyz` attribute (urdfdom then uses 0 0 0)", ctx.loc(axis_el)

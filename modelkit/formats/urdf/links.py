@@ -8,15 +8,15 @@ stops reading the link at the first bad part (and check_urdf still exits 0).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 from lxml.etree import _Element as Element
 
+from modelkit.diagnostics import did_you_mean
 from modelkit.formats.meshref import MeshChecker
-from modelkit.formats.urdf.values import Context, did_you_mean, number, origin, vector
+from modelkit.formats.urdf.values import Context, number, origin, vector
 from modelkit.model import Box, Capsule, Cylinder, Geom, Geometry, Inertial, Link, Sphere, VisualMaterial
-from modelkit.resources import Resolver
+from modelkit.spatial import inertia_from_moments, rotate_inertia
 
 INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
@@ -29,12 +29,8 @@ class Materials:
     inside a visual becomes known to the links that follow it in the document.
     """
 
-    resolver: Resolver
-    base_dir: Path
-    model_file: Path | None
-    check_resources: bool
+    files: MeshChecker  # resolves and checks texture files
     table: dict[str, VisualMaterial] = field(default_factory=dict)
-    _textures: set[str] = field(default_factory=set)
 
     def parse(self, ctx: Context, element: Element, name: str | None) -> VisualMaterial | None:
         """The material defined by ``element`` (None when it has neither color nor texture)."""
@@ -65,22 +61,8 @@ class Materials:
             else:
                 found = True
                 material.texture = filename
-                self._check_texture(ctx, filename, texture)
+                self.files.texture(filename, ctx.loc(texture, "filename"))
         return material if found else None
-
-    def _check_texture(self, ctx: Context, uri: str, element: Element) -> None:
-        if not self.check_resources or uri in self._textures:
-            return
-        self._textures.add(uri)
-        resolution = self.resolver.resolve(uri, self.base_dir, self.model_file)
-        if resolution.path is None or not resolution.path.exists():
-            why = resolution.message or f"not found at {resolution.path}"
-            ctx.emit(
-                "MK507",
-                f'texture "{uri}" cannot be found ({why})',
-                ctx.loc(element, "filename"),
-                hint=resolution.hint,
-            )
 
     def define(self, ctx: Context, element: Element) -> None:
         """A top-level ``<material name>`` (its name must be unique; it needs a colour or texture)."""
@@ -180,7 +162,7 @@ def read_inertial(ctx: Context, element: Element, link: str) -> Inertial | None:
     inertial = Inertial(
         mass=mass,
         com=pose.translation.copy(),
-        inertia=pose.rotation @ tensor @ pose.rotation.T,
+        inertia=rotate_inertia(tensor, pose.rotation),
         source=ctx.loc(element),
     )
     inertial.sources["mass"] = ctx.loc(mass_el, "value")
@@ -203,8 +185,7 @@ def _inertia(ctx: Context, element: Element, link: str) -> np.ndarray | None:
     values = [number(ctx, element, k, f'inertia of link "{link}"') for k in INERTIA_KEYS]
     if any(v is None for v in values):
         return None
-    ixx, ixy, ixz, iyy, iyz, izz = (float(v or 0.0) for v in values)
-    return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    return inertia_from_moments(*(float(v or 0.0) for v in values))
 
 
 def _read_geom(

@@ -16,18 +16,16 @@ from pathlib import Path
 from lxml import etree
 from lxml.etree import _Element as Element
 
-from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation, sorted_diagnostics
+from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation, did_you_mean, sorted_diagnostics
 from modelkit.formats.common import ReadOptions, ReadResult
 from modelkit.formats.meshref import MeshChecker
 from modelkit.formats.urdf.extensions import canonical_xml, read_gazebo, read_transmission
 from modelkit.formats.urdf.joints import read_joint
 from modelkit.formats.urdf.links import Materials, read_link
 from modelkit.formats.urdf.schema import check_structure
-from modelkit.formats.urdf.values import VERSIONS, Context, did_you_mean
-from modelkit.model import JointType, Robot
-from modelkit.xmlsource import XmlDocument, read_xml
-
-WORLD = "world"
+from modelkit.formats.urdf.values import VERSIONS, Context
+from modelkit.model import WORLD_LINK, JointType, Robot
+from modelkit.xmlsource import XmlDocument, location_at, read_xml
 
 
 def read_urdf(path: Path, options: ReadOptions, display: str) -> ReadResult:
@@ -63,10 +61,10 @@ def read_urdf_document(
     robot = Robot(name=root.get("name", ""), source_format="urdf", source=doc.loc(root))
     _header(ctx, root, robot)
     check_structure(ctx, root)
-    materials = Materials(options.resolver, base_dir, model_file, options.check_resources)
+    meshes = MeshChecker(options.resolver, base_dir, model_file, sink, options.check_resources)
+    materials = Materials(meshes)
     for element in ctx.children(root, "material"):
         materials.define(ctx, element)
-    meshes = MeshChecker(options.resolver, base_dir, model_file, sink, options.check_resources)
     for element in ctx.children(root, "link"):
         robot.links.append(read_link(ctx, element, meshes, materials))
     if not robot.links:
@@ -88,13 +86,11 @@ def _external_dtd(doc: XmlDocument, sink: DiagnosticSink) -> None:
     if not url:
         return
     offset = doc.text.find("<!DOCTYPE")
-    line = doc.text.count("\n", 0, offset) + 1 if offset >= 0 else 0
-    col = offset - (doc.text.rfind("\n", 0, offset) + 1) + 1 if offset >= 0 else 0
     sink.emit(
         "MK021",
         f'the document type declaration names an external DTD "{url}"; modelkit does not load it '
         "(nor do URDF parsers)",
-        SourceLocation(doc.display, line, col),
+        location_at(doc.text, doc.display, offset) if offset >= 0 else SourceLocation(doc.display),
         severity=Severity.WARNING,
         hint="remove the <!DOCTYPE> line",
     )
@@ -156,11 +152,11 @@ def _root(robot: Robot) -> None:
         robot.root = None
         return
     robot.root = roots[0]
-    if robot.root == WORLD:
+    if robot.root == WORLD_LINK:
         # A root named "world" is the world itself (ROS, Gazebo, MuJoCo): the robot is welded to it
         # through the joints below it.
         robot.root_joint = JointType.FIXED
-        robot.extras["world_link"] = WORLD
+        robot.extras["world_link"] = WORLD_LINK
 
 
 def _extensions(ctx: Context, root: Element, robot: Robot) -> None:

@@ -15,7 +15,8 @@ from __future__ import annotations
 from lxml import etree
 from lxml.etree import _Element as Element
 
-from modelkit.formats.urdf.values import Context, did_you_mean
+from modelkit.diagnostics import did_you_mean
+from modelkit.formats.urdf.values import Context
 
 EXTENSIONS = frozenset({"gazebo", "transmission", "ros2_control", "mujoco", "sensor"})
 XINCLUDE = "http://www.w3.org/2001/XInclude"

@@ -6,7 +6,6 @@ the caller can carry on with a default. Number syntax is urdfdom's (see :mod:`mo
 
 from __future__ import annotations
 
-import difflib
 import math
 from dataclasses import dataclass, field
 
@@ -15,7 +14,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
-from modelkit.spatial import Mat3, Pose
+from modelkit.spatial import Pose, matrix_from_quat_wxyz, matrix_from_rpy
 from modelkit.xmlsource import XmlDocument, parse_number, parse_numbers
 
 # URDF versions modelkit reads, and the version that introduced each later feature.
@@ -82,12 +81,6 @@ class Context:
         self.newer_features.append((feature, needs, loc))
 
 
-def did_you_mean(word: str, candidates: list[str] | tuple[str, ...] | set[str]) -> str | None:
-    """A "did you mean" hint when ``word`` is close to one of ``candidates``."""
-    match = difflib.get_close_matches(word, sorted(candidates), n=1, cutoff=0.6)
-    return f'did you mean "{match[0]}"?' if match else None
-
-
 def number(
     ctx: Context,
     element: Element,
@@ -144,31 +137,6 @@ def vector(ctx: Context, element: Element, attribute: str, what: str, count: int
     return values
 
 
-def rpy_matrix(roll: float, pitch: float, yaw: float) -> Mat3:
-    """URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) · Ry(pitch) · Rx(roll)."""
-    cr, sr = math.cos(roll), math.sin(roll)
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
-def quaternion_matrix(x: float, y: float, z: float, w: float) -> Mat3:
-    """The rotation of a unit quaternion given as x, y, z, w."""
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
 def origin(ctx: Context, element: Element | None, what: str) -> Pose | None:
     """The pose of an ``<origin xyz rpy quat_xyzw>`` element (identity when absent).
 
@@ -198,7 +166,7 @@ def origin(ctx: Context, element: Element | None, what: str) -> Pose | None:
         if rpy is None:
             ok = False
         else:
-            pose.rotation = rpy_matrix(*rpy)
+            pose.rotation = matrix_from_rpy(*rpy)
     elif has_quat:
         ctx.uses_feature("`quat_xyzw`", "1.1", ctx.loc(element, "quat_xyzw"))
         quat = vector(ctx, element, "quat_xyzw", f"{what} origin", count=4)
@@ -214,5 +182,6 @@ def origin(ctx: Context, element: Element | None, what: str) -> Pose | None:
                 )
                 ok = False
             else:
-                pose.rotation = quaternion_matrix(*(q / norm for q in quat))
+                x, y, z, w = quat
+                pose.rotation = matrix_from_quat_wxyz((w, x, y, z))
     return pose if ok else None
