@@ -14,7 +14,6 @@ import subprocess
 import sys
 import threading
 import time
-import traceback
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -27,6 +26,8 @@ from click.testing import CliRunner, Result
 
 from modelkit.cli import main
 
+from .broken_support import SEVERITIES, Expected, crash_text, json_diagnostics, problems, show
+
 HERE = Path(__file__).resolve().parent
 CORPUS = HERE / "broken_body"
 EXPECTED_FILE = CORPUS / "EXPECTED.yaml"
@@ -37,7 +38,6 @@ IN_PROCESS_LIMIT_S = 60
 # The alias-bomb and deep-nesting cases must be refused quickly; a subprocess is killed after this.
 SUBPROCESS_LIMIT_S = 30
 
-SEVERITIES = frozenset({"error", "warning", "info"})
 
 
 @dataclass(frozen=True)
@@ -112,33 +112,6 @@ def _invoke(path: Path, *args: str) -> Result:
         return runner.invoke(main, ["validate", "--format", "json", *args, str(path)], catch_exceptions=True)
 
 
-def _crash_text(result: Result) -> str | None:
-    """The traceback when the CLI raised anything other than SystemExit."""
-    if result.exception is None or isinstance(result.exception, SystemExit):
-        return None
-    info = result.exc_info
-    if info is None:
-        return repr(result.exception)
-    return "".join(traceback.format_exception(*info))
-
-
-def _diagnostics(result: Result) -> list[dict[str, Any]]:
-    document = json.loads(result.stdout)
-    diagnostics = document["diagnostics"]
-    assert isinstance(diagnostics, list)
-    return diagnostics
-
-
-def _show(diagnostics: list[dict[str, Any]]) -> str:
-    if not diagnostics:
-        return "  (no diagnostics)"
-    return "\n".join(
-        f"  {d.get('line')}:{d.get('column')} {d.get('severity')} {d.get('code')} {d.get('message')}"
-        + (f" (hint: {d['hint']})" if d.get("hint") else "")
-        for d in diagnostics
-    )
-
-
 # ---- the corpus is consistent ------------------------------------------------------------------
 
 
@@ -176,9 +149,9 @@ def test_clean_base_has_no_findings() -> None:
     from modelkit.api import validate
 
     result = _invoke(CLEAN_BASE, "--strict")
-    assert _crash_text(result) is None, _crash_text(result)
-    diagnostics = _diagnostics(result)
-    assert diagnostics == [], "the clean base must validate without findings:\n" + _show(diagnostics)
+    assert crash_text(result) is None, crash_text(result)
+    diagnostics = json_diagnostics(result)
+    assert diagnostics == [], "the clean base must validate without findings:\n" + show(diagnostics)
     assert result.exit_code == 0
     library = validate(CLEAN_BASE)
     assert library.robot is not None
@@ -192,43 +165,19 @@ def test_clean_base_has_no_findings() -> None:
 @pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
 def test_broken_body(case: Case) -> None:
     result = _invoke(case.path, *case.args)
-    crash = _crash_text(result)
+    crash = crash_text(result)
     assert crash is None, f"{case.name}: the CLI raised instead of reporting:\n{crash}"
     try:
-        diagnostics = _diagnostics(result)
+        diagnostics = json_diagnostics(result)
     except (ValueError, KeyError) as exc:
         pytest.fail(f"{case.name}: --format json printed no diagnostics document ({exc}):\n{result.output}")
 
-    problems: list[str] = []
-    if result.exit_code != case.exit:
-        problems.append(f"exit code {result.exit_code}, expected {case.exit}")
-    same_code = [d for d in diagnostics if d.get("code") == case.code]
-    if len(same_code) != 1:
-        problems.append(f"{len(same_code)} diagnostic(s) with code {case.code}, expected exactly 1")
-    if same_code:
-        found = min(same_code, key=lambda d: (d.get("line") != case.line, d.get("column") != case.column))
-        want_file = str(case.path)
-        if found.get("file") != want_file:
-            problems.append(f"file {found.get('file')!r}, expected {want_file!r}")
-        if (found.get("line"), found.get("column")) != (case.line, case.column):
-            where = f"{found.get('line')}:{found.get('column')}"
-            problems.append(f"position {where}, expected {case.line}:{case.column}")
-        if found.get("severity") != case.severity:
-            problems.append(f"severity {found.get('severity')}, expected {case.severity}")
-        message = str(found.get("message", ""))
-        if case.message.lower() not in message.lower():
-            problems.append(f"message {message!r} lacks {case.message!r}")
-        if case.code in message:
-            problems.append(f"message {message!r} repeats its own code (the renderers already print it)")
-        if case.hint is not None and case.hint.lower() not in str(found.get("hint") or "").lower():
-            problems.append(f"hint {found.get('hint')!r} lacks {case.hint!r}")
-    others = [d for d in diagnostics if d.get("severity") == "error" and d.get("code") != case.code]
-    if others:
-        problems.append("other error-level diagnostics: " + ", ".join(
-            f"{d.get('code')} at {d.get('line')}:{d.get('column')}" for d in others))
+    expected = Expected(str(case.path), case.code, case.severity, case.line, case.column, case.message,
+                        case.exit, case.hint)
+    found = problems(expected, result.exit_code, diagnostics)
     wanted = f"{case.severity} {case.code} at {case.line}:{case.column}"
-    assert not problems, (f"{case.name}: expected {wanted}\n  - " + "\n  - ".join(problems)
-                          + "\nall diagnostics:\n" + _show(diagnostics))
+    assert not found, (f"{case.name}: expected {wanted}\n  - " + "\n  - ".join(found)
+                          + "\nall diagnostics:\n" + show(diagnostics))
 
 
 # ---- hostile YAML is refused quickly ---------------------------------------------------------------

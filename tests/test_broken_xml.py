@@ -9,8 +9,6 @@ raise.
 
 from __future__ import annotations
 
-import json
-import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -21,10 +19,11 @@ from click.testing import CliRunner, Result
 
 from modelkit.cli import main
 
+from .broken_support import SEVERITIES, Expected, crash_text, json_diagnostics, problems, show
+
 HERE = Path(__file__).resolve().parent
 FOLDERS = {"urdf": HERE / "broken_urdf", "xacro": HERE / "broken_xacro", "sdf": HERE / "broken_sdf"}
 SUFFIXES = {"urdf": (".urdf",), "xacro": (".xacro",), "sdf": (".sdf", ".world")}
-SEVERITIES = frozenset({"error", "warning", "info"})
 KNOWN_KEYS = {"code", "severity", "line", "column", "message", "exit", "hint", "args", "absent", "file"}
 
 
@@ -88,32 +87,6 @@ def _invoke(path: Path, *args: str) -> Result:
     return CliRunner().invoke(main, ["validate", "--format", "json", *args, str(path)], catch_exceptions=True)
 
 
-def _crash_text(result: Result) -> str | None:
-    """The traceback when the CLI raised anything other than SystemExit."""
-    if result.exception is None or isinstance(result.exception, SystemExit):
-        return None
-    info = result.exc_info
-    if info is None:
-        return repr(result.exception)
-    return "".join(traceback.format_exception(*info))
-
-
-def _diagnostics(result: Result) -> list[dict[str, Any]]:
-    diagnostics = json.loads(result.stdout)["diagnostics"]
-    assert isinstance(diagnostics, list)
-    return diagnostics
-
-
-def _show(diagnostics: list[dict[str, Any]]) -> str:
-    if not diagnostics:
-        return "  (no diagnostics)"
-    return "\n".join(
-        f"  {d.get('file')}:{d.get('line')}:{d.get('column')} {d.get('severity')} {d.get('code')} "
-        f"{d.get('message')}" + (f" (hint: {d['hint']})" if d.get("hint") else "")
-        for d in diagnostics
-    )
-
-
 # ---- the corpora are consistent ----------------------------------------------------------------
 
 
@@ -160,9 +133,9 @@ def test_clean_bases_have_no_findings(folder: str) -> None:
         pytest.skip(f"no clean base for {folder} yet")
     for base in bases:
         result = _invoke(base, "--strict")
-        assert _crash_text(result) is None, _crash_text(result)
-        diagnostics = _diagnostics(result)
-        assert diagnostics == [], f"{base.name} must validate without findings:\n" + _show(diagnostics)
+        assert crash_text(result) is None, crash_text(result)
+        diagnostics = json_diagnostics(result)
+        assert diagnostics == [], f"{base.name} must validate without findings:\n" + show(diagnostics)
         assert result.exit_code == 0
 
 
@@ -172,38 +145,17 @@ def test_clean_bases_have_no_findings(folder: str) -> None:
 @pytest.mark.parametrize("case", CASES, ids=[c.ident for c in CASES])
 def test_broken_case(case: Case) -> None:
     result = _invoke(case.path, *case.args)
-    crash = _crash_text(result)
+    crash = crash_text(result)
     assert crash is None, f"{case.ident}: the CLI raised instead of reporting:\n{crash}"
     try:
-        diagnostics = _diagnostics(result)
+        diagnostics = json_diagnostics(result)
     except (ValueError, KeyError) as exc:
         pytest.fail(f"{case.ident}: --format json printed no diagnostics document ({exc}):\n{result.output}")
 
-    problems: list[str] = []
-    if result.exit_code != case.exit:
-        problems.append(f"exit code {result.exit_code}, expected {case.exit}")
-    same_code = [d for d in diagnostics if d.get("code") == case.code]
-    if len(same_code) != 1:
-        problems.append(f"{len(same_code)} diagnostic(s) with code {case.code}, expected exactly 1")
-    if same_code:
-        found = same_code[0]
-        want_file = str(case.path if case.file is None else FOLDERS[case.folder] / case.file)
-        if found.get("file") != want_file:
-            problems.append(f"file {found.get('file')!r}, expected {want_file!r}")
-        if (found.get("line"), found.get("column")) != (case.line, case.column):
-            where = f"{found.get('line')}:{found.get('column')}"
-            problems.append(f"position {where}, expected {case.line}:{case.column}")
-        if found.get("severity") != case.severity:
-            problems.append(f"severity {found.get('severity')}, expected {case.severity}")
-        message = str(found.get("message", ""))
-        if case.message.lower() not in message.lower():
-            problems.append(f"message {message!r} lacks {case.message!r}")
-        if case.hint is not None and case.hint.lower() not in str(found.get("hint") or "").lower():
-            problems.append(f"hint {found.get('hint')!r} lacks {case.hint!r}")
-    others = [d for d in diagnostics if d.get("severity") == "error" and d.get("code") != case.code]
-    if others:
-        problems.append("other error-level diagnostics: " + ", ".join(
-            f"{d.get('code')} at {d.get('line')}:{d.get('column')}" for d in others))
+    want_file = str(case.path if case.file is None else FOLDERS[case.folder] / case.file)
+    expected = Expected(want_file, case.code, case.severity, case.line, case.column, case.message, case.exit,
+                        case.hint)
+    found = problems(expected, result.exit_code, diagnostics)
     wanted = f"{case.severity} {case.code} at {case.line}:{case.column}"
-    assert not problems, (f"{case.ident}: expected {wanted}\n  - " + "\n  - ".join(problems)
-                          + "\nall diagnostics:\n" + _show(diagnostics))
+    assert not found, (f"{case.ident}: expected {wanted}\n  - " + "\n  - ".join(found)
+                          + "\nall diagnostics:\n" + show(diagnostics))
