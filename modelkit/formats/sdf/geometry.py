@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 from lxml.etree import _Element as Element
+from numpy.typing import NDArray
 
 from modelkit.diagnostics import DiagnosticSink
 from modelkit.formats.sdf.context import Context
@@ -111,15 +112,18 @@ def _shape(ctx: Context, src: SdfDocument, shape: Element, owner: str, visual_on
         value = default if value is None else value
         return _positive(sink, src, el, value, f"<{kind}> {name} of {owner}")
 
+    def positive_vector(name: str) -> NDArray[np.float64]:
+        """A three-number child (ones when absent or unreadable); non-positive entries reported."""
+        el = child(shape, name)
+        vector = values.vector(el, 3) if el is not None else None
+        vector = np.ones(3) if vector is None else vector
+        if el is not None and np.any(vector <= 0.0):
+            message = f"<{kind}> {name} of {owner} must be positive: {vector.tolist()}"
+            sink.emit("MK400", message, values.text_loc(el))
+        return vector
+
     if kind == "box":
-        el = child(shape, "size")
-        size = values.vector(el, 3) if el is not None else np.ones(3)
-        size = np.ones(3) if size is None else size
-        if el is not None and np.any(size <= 0.0):
-            sink.emit(
-                "MK400", f"<box> size of {owner} must be positive: {size.tolist()}", values.text_loc(el)
-            )
-        return Box(size)
+        return Box(positive_vector("size"))
     if kind == "sphere":
         return Sphere(number("radius", 1.0))
     if kind == "cylinder":
@@ -129,16 +133,7 @@ def _shape(ctx: Context, src: SdfDocument, shape: Element, owner: str, visual_on
     if kind == "cone":
         return Cone(number("radius", 0.5), number("length", 1.0))
     if kind == "ellipsoid":
-        el = child(shape, "radii")
-        radii = values.vector(el, 3) if el is not None else np.ones(3)
-        radii = np.ones(3) if radii is None else radii
-        if el is not None and np.any(radii <= 0.0):
-            sink.emit(
-                "MK400",
-                f"<ellipsoid> radii of {owner} must be positive: {radii.tolist()}",
-                values.text_loc(el),
-            )
-        return Ellipsoid(radii)
+        return Ellipsoid(positive_vector("radii"))
     return _mesh(ctx, src, shape, owner, visual_only)
 
 

@@ -89,20 +89,14 @@ def read_link(ctx: Context, graph: FrameGraph, item: Item) -> LinkData:
                 data.collision_densities.append(values.number(child(geom_el, "density")))
             for plugin in children(geom_el, "plugin"):
                 link.extras.setdefault("sdf_plugins", []).append(plugin_data(ctx, src, plugin, label))
-    for sensor_el in children(el, "sensor"):
-        device = sensor_device(ctx, src, sensor_el, what)
-        if device is None:
-            continue
-        _unique(ctx, src, names.setdefault("sensor", {}), sensor_el, "sensor", device.name, what)
-        device.pose = place(child(sensor_el, "pose"), src, item.name, f'sensor "{device.name}"')
-        link.devices.append(device)
-    for light_el in children(el, "light"):
-        device = light_device(ctx, src, light_el, what)
-        if device is None:
-            continue
-        _unique(ctx, src, names.setdefault("light", {}), light_el, "light", device.name, what)
-        device.pose = place(child(light_el, "pose"), src, item.name, f'light "{device.name}"')
-        link.devices.append(device)
+    for tag, make_device in (("sensor", sensor_device), ("light", light_device)):
+        for device_el in children(el, tag):
+            device = make_device(ctx, src, device_el, what)
+            if device is None:
+                continue
+            _unique(ctx, src, names.setdefault(tag, {}), device_el, tag, device.name, what)
+            device.pose = place(child(device_el, "pose"), src, item.name, f'{tag} "{device.name}"')
+            link.devices.append(device)
     link.inertial = _inertial(ctx, graph, item, to_link, data)
     flags: dict[str, Any] = {}
     for key in LINK_FLAGS:
