@@ -78,7 +78,6 @@ class MjInertial:
     mass: float
     ipos: Vec3
     inertia: Mat3
-    explicit: bool = True
 
 
 @dataclass

@@ -336,8 +336,7 @@ class RobotBuilder:
             link.inertial = Inertial(
                 inertial.mass,
                 com=back.translation + np.asarray(inertial.ipos, dtype=float),
-                inertia=inertial.inertia,
-                defaulted=not inertial.explicit,
+                inertia=inertial.inertia,  # written, or computed by MuJoCo from the geoms: never a default
                 source=self.loc.inertial(b),
             )
             link.inertial.sources["mass"] = self.loc.inertial(b, "mass")
