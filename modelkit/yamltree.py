@@ -187,13 +187,32 @@ def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], Any, list[tuple
     Returns the anchor names by (line, column) of the anchored node (PyYAML's composer drops them)
     and, when the nesting passes :data:`MAX_NESTING`, the mark where it does: the composer and
     everything after it recurse, so such documents are refused before composing.
+
+    Some libyaml builds (the one in PyYAML 6.0.4's wheels) refuse deep flow nesting with a limit of
+    their own while scanning ahead, before any event at our limit is produced. The nesting verdict
+    must not depend on a library's internal limit, so such a refusal is re-scanned with PyYAML's
+    pure-Python parser (iterative too, and without a nesting limit) to find our own mark.
     """
+    names, too_deep, aliases, error = _scan_events_with(text, yaml.CSafeLoader)
+    if too_deep is None and error is not None and _is_nesting_refusal(error):
+        names, too_deep, aliases, _ = _scan_events_with(text, yaml.SafeLoader)
+    return names, too_deep, aliases
+
+
+def _is_nesting_refusal(error: yaml.YAMLError) -> bool:
+    problem = str(getattr(error, "problem", "") or "") + " " + str(getattr(error, "context", "") or "")
+    return "nesting" in problem or "depth" in problem or "flow level" in problem
+
+
+def _scan_events_with(
+    text: str, loader: Any
+) -> tuple[dict[tuple[int, int], str], Any, list[tuple[str, int, int]], yaml.YAMLError | None]:
     names: dict[tuple[int, int], str] = {}
     aliases: list[tuple[str, int, int]] = []  # (anchor, line, column) of every alias, 0-based
     depth = 0
     documents = 0
     try:
-        for event in yaml.parse(text, Loader=yaml.CSafeLoader):
+        for event in yaml.parse(text, Loader=loader):
             if isinstance(event, yaml.DocumentStartEvent):
                 documents += 1
                 if documents > 1:
@@ -201,7 +220,7 @@ def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], Any, list[tuple
             if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
                 depth += 1
                 if depth > MAX_NESTING:
-                    return names, event.start_mark, aliases
+                    return names, event.start_mark, aliases, None
             elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
                 depth -= 1
             anchor = getattr(event, "anchor", None)
@@ -209,9 +228,9 @@ def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], Any, list[tuple
                 aliases.append((anchor, event.start_mark.line, event.start_mark.column))
             elif anchor and event.start_mark is not None:
                 names[(event.start_mark.line, event.start_mark.column)] = anchor
-    except yaml.YAMLError:
-        pass
-    return names, None, aliases
+    except yaml.YAMLError as exc:
+        return names, None, aliases, exc
+    return names, None, aliases, None
 
 
 def measure_expansion(root: YNode, limit: int) -> tuple[str, YNode] | None:

@@ -71,6 +71,17 @@ def test_deep_nesting_refused_without_recursion_error() -> None:
     assert root is None and found[0][0] == "MK010"
 
 
+def test_deep_nesting_mark_is_ours_not_libyamls() -> None:
+    # The refusal points at the bracket that opens level 129 (top mapping = level 1), whatever
+    # nesting limit the installed libyaml has of its own (PyYAML 6.0.4's stops at 1000, ahead).
+    for depth in (200, 1000, 5000):
+        _, found = parse("a: " + "[" * depth + "]" * depth + "\n")
+        assert found[0] == ("MK010", 1, 3 + 128), depth
+    block = "".join(" " * i + "k:\n" for i in range(140))
+    _, found = parse(block)
+    assert found[0] == ("MK010", 129, 129)
+
+
 def test_syntax_error_has_position() -> None:
     _, found = parse("a: [1, 2\nb: 3\n")
     assert found[0] == ("MK010", 1, 4)  # the bracket that is never closed
