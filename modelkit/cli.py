@@ -254,5 +254,90 @@ def tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: st
         click.echo(f"note: {file} has {errors} other error(s); run `modelkit validate {file}`", err=True)
 
 
+@main.command()
+@click.argument("words", nargs=-1, required=True, metavar="INPUTS... [KEY:=VALUE]...")
+@click.option("-o", "--output", type=click.Path(path_type=Path), required=True,
+              help="Output file (its suffix picks the target: .urdf .sdf .xml .body) or folder (with --to).")
+@click.option("--to", "target", type=click.Choice(["urdf", "sdf", "mjcf", "body"]), default=None,
+              help="Target format (default: from the output file's suffix).")
+@click.option("--report", "report_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Write every conversion note and reading finding to this JSON file.")
+@click.option("--strict", is_flag=True, help="Exit 1 when a note at --strict-level or above was made.")
+@click.option("--strict-level", type=click.Choice(["info", "warning"]), default="warning", show_default=True,
+              help="The note severity --strict fails on.")
+@click.option("--force", is_flag=True, help="Replace output files that exist.")
+@click.option("--quiet", "-q", is_flag=True, help="Print only warnings and errors, no info notes.")
+@click.option("--sdf-version", type=click.Choice(["1.6", "1.7", "1.8", "1.9", "1.10", "1.11"]),
+              default="1.9", show_default=True, help="SDFormat version to write (1.6 for libsdformat 9 users).")
+@click.option("--mesh-format", type=click.Choice(["stl", "obj"]), default="stl", show_default=True,
+              help="File format for meshes modelkit writes (generated geometry, converted COLLADA/VRML).")
+@click.option("--keep-collada", is_flag=True, help="URDF/SDF: copy COLLADA meshes as they are (MJCF always converts).")
+@click.option("--keep-package-uris", is_flag=True,
+              help="Keep package:// and model:// mesh references instead of copying the meshes.")
+@click.option("--merge-fixed", is_flag=True, help="Fuse links on fixed joints into their parents.")
+@click.option("--urdf-world-link", is_flag=True,
+              help="URDF: add a `world` link and the root's fixed or floating joint to it.")
+@reading_options
+def convert(
+    words: tuple[str, ...],
+    output: Path,
+    target: str | None,
+    report_path: Path | None,
+    strict: bool,
+    strict_level: str,
+    force: bool,
+    quiet: bool,
+    sdf_version: str,
+    mesh_format: str,
+    keep_collada: bool,
+    keep_package_uris: bool,
+    merge_fixed: bool,
+    urdf_world_link: bool,
+    **kwargs: Any,
+) -> None:
+    """Convert model files to URDF, SDF, MJCF or .body; every approximation is reported.
+
+    The output folder gets the model file(s) and every mesh they need (in meshes/), referenced by
+    relative paths. Exit 0 written; 1 an input has errors (or --strict notes); 2 could not run.
+    """
+    from modelkit.convert import WriteOptions
+    from modelkit.convert import convert as run_convert
+    from modelkit.convert.report import render_summary, report_json
+
+    files, xacro_args = split_xacro_args(words)
+    if not files:
+        raise click.UsageError("no input file given")
+    options = WriteOptions(
+        sdf_version=sdf_version,
+        mesh_format=mesh_format,
+        keep_collada=keep_collada,
+        keep_package_uris=keep_package_uris,
+        merge_fixed=merge_fixed,
+        urdf_world_link=urdf_world_link,
+    )
+    result = run_convert(
+        files, output, target, _read_options(kwargs, True, xacro_args), options, force, kwargs["input_format"]
+    )
+    for d in result.diagnostics:
+        click.echo(render_text(d), err=True)
+    click.echo(render_summary(result, quiet), err=True, nl=False)
+    if report_path is not None:
+        from modelkit.convert.output import OutputPlan
+
+        plan = OutputPlan(report_path.parent, {Path(f) for f in files}, True)
+        plan.add(report_path.name, report_json(result, [str(f) for f in files]).encode("utf-8"), "report")
+        problems = plan.problems()
+        if problems:
+            for d in problems:
+                click.echo(render_text(d), err=True)
+            sys.exit(2)
+        plan.commit()
+    if result.status:
+        sys.exit(result.status)
+    threshold = Severity(strict_level).rank
+    if strict and any(n.severity.rank >= threshold for n in result.notes):
+        sys.exit(1)
+
+
 if __name__ == "__main__":  # pragma: no cover
     main()

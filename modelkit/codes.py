@@ -6,7 +6,9 @@ renumbered; retired codes stay in the table marked ``retired``.
 
 Ranges: MK0xx file and YAML layer; MK1xx schema and document header; MK2xx kinematic tree;
 MK3xx mass properties, joints and transforms; MK4xx geometry; MK5xx resources and materials;
-MK6xx devices and scene nodes; MK7xx xacro expansion.
+MK6xx devices and scene nodes; MK7xx xacro expansion; MK8xx conversion notes (what a writer
+approximated, renamed, dropped or synthesised; MK850-MK889 one block per writer, MK89x the convert
+command's own refusals).
 """
 
 from __future__ import annotations
@@ -718,6 +720,181 @@ _TABLE: tuple[CodeInfo, ...] = (
         "xacro-library",
         "info",
         "An xacro file expands to no robot content: a macro library, checked for xacro errors only.",
+    ),
+    # -- MK8xx: conversion notes ------------------------------------------------------------
+    # MK800-MK849 shared by every writer; MK850-859 URDF, MK860-869 SDF, MK870-879 MJCF,
+    # MK880-889 .body; MK890-899 the convert command (outputs refused, targets that cannot hold).
+    CodeInfo("MK800", "renamed", "info", "A name the target forbids or reserves was changed; the note names both."),
+    CodeInfo(
+        "MK801",
+        "default-mass-written",
+        "warning",
+        "The source gave no mass information; Choreonoid's default (1 kg, identity inertia) is written "
+        "explicitly.",
+    ),
+    CodeInfo(
+        "MK802",
+        "primitive-as-mesh",
+        "info",
+        "A primitive the target lacks (cone, capsule, ellipsoid) is written as a triangle mesh file.",
+    ),
+    CodeInfo(
+        "MK803",
+        "generated-geometry-as-mesh",
+        "info",
+        "Generated geometry (Extrusion, ElevationGrid, IndexedFaceSet, TriangleMesh) is written as a "
+        "mesh file.",
+    ),
+    CodeInfo(
+        "MK804",
+        "mesh-converted",
+        "info",
+        "A mesh file is converted to a format the target reads (COLLADA, VRML → STL/OBJ), unit scale "
+        "applied.",
+    ),
+    CodeInfo(
+        "MK805",
+        "mesh-missing",
+        "warning",
+        "A mesh file could not be found or read; the shape is left out and the rest is written.",
+    ),
+    CodeInfo(
+        "MK806",
+        "device-dropped",
+        "warning",
+        "A sensor or light the target cannot hold is left out.",
+    ),
+    CodeInfo(
+        "MK807",
+        "device-approximated",
+        "warning",
+        "A sensor or light is written as the nearest thing the target has; the note says what differs.",
+    ),
+    CodeInfo(
+        "MK808",
+        "plugin-dropped",
+        "warning",
+        "Simulator plugin code or extension data (Gazebo plugins, transmissions) is not carried over.",
+    ),
+    CodeInfo(
+        "MK809",
+        "track-approximated",
+        "warning",
+        "A pseudo continuous track (no target has one) is written as a row of driven rollers.",
+    ),
+    CodeInfo(
+        "MK810",
+        "loop-dropped",
+        "warning",
+        "A closed-loop joint (Choreonoid `extra_joints`) the target cannot hold is left out.",
+    ),
+    CodeInfo(
+        "MK811",
+        "loop-approximated",
+        "info",
+        "A closed-loop joint is written as an equality constraint (hinge: two ball connects on the axis).",
+    ),
+    CodeInfo("MK812", "mimic-dropped", "warning", "A mimic relation the target cannot hold is left out."),
+    CodeInfo(
+        "MK813",
+        "joint-approximated",
+        "warning",
+        "A joint type the target lacks (planar, ball, floating inside the tree) is written as the "
+        "nearest one.",
+    ),
+    CodeInfo(
+        "MK814",
+        "root-convention",
+        "info",
+        "How the root meets the world follows the target's convention (URDF: floating unless welded "
+        "to `world`).",
+    ),
+    CodeInfo(
+        "MK815",
+        "fixed-joint-merged",
+        "info",
+        "`--merge-fixed`: a link on a fixed joint is fused into its parent, mass properties combined.",
+    ),
+    CodeInfo(
+        "MK816",
+        "massless-link-frame",
+        "info",
+        "A link without mass is written as a frame (SDF `<frame>`, MJCF massless body) so no consumer "
+        "drops it.",
+    ),
+    CodeInfo(
+        "MK817",
+        "friction-approximated",
+        "info",
+        "Contact friction from material pairs is written as the target's per-shape or pair value.",
+    ),
+    CodeInfo(
+        "MK818",
+        "appearance-approximated",
+        "info",
+        "Appearance the target cannot hold (texture, specular, emissive, transparency) is simplified.",
+    ),
+    CodeInfo(
+        "MK819",
+        "value-synthesised",
+        "info",
+        "The target requires a value the source does not give (URDF effort/velocity limits); a "
+        "documented value is written.",
+    ),
+    CodeInfo(
+        "MK820",
+        "value-dropped",
+        "info",
+        "A joint or link property the target has no field for (armature, initial position, joint id, "
+        "velocity ranges) is left out.",
+    ),
+    CodeInfo(
+        "MK821",
+        "scale-baked",
+        "info",
+        "A scale the target cannot express (non-uniform on a primitive) is baked into mesh vertices.",
+    ),
+    CodeInfo(
+        "MK822",
+        "world-content-dropped",
+        "info",
+        "World content that is not the robot (lights, ground, physics settings) is not written.",
+    ),
+    CodeInfo(
+        "MK823",
+        "root-pose-dropped",
+        "warning",
+        "The robot's placement in the world cannot be written in the target (URDF has no root pose).",
+    ),
+    CodeInfo(
+        "MK890",
+        "output-exists",
+        "error",
+        "The output file exists; `--force` replaces it.",
+    ),
+    CodeInfo(
+        "MK891",
+        "output-is-input",
+        "error",
+        "The output would overwrite an input file; nothing is written.",
+    ),
+    CodeInfo(
+        "MK892",
+        "output-unsafe",
+        "error",
+        "An output path would leave the output folder or is not a regular file; nothing is written.",
+    ),
+    CodeInfo(
+        "MK893",
+        "target-holds-one-robot",
+        "info",
+        "The input holds several robots; each is written to its own file, named after the model.",
+    ),
+    CodeInfo(
+        "MK894",
+        "write-failed",
+        "error",
+        "Writing an output failed (disk full, permissions); nothing partial is left behind.",
     ),
 )
 

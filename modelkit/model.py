@@ -152,12 +152,62 @@ class Inertial:
     sources: dict[str, SourceLocation] = field(default_factory=dict)
 
 
+class DeviceKind(StrEnum):
+    """The one device vocabulary every reader maps to and every writer maps from.
+
+    Frame convention (settled at each format's boundary): a device's ``pose`` is its sensor frame
+    in the link frame, robotics style: **+X is the viewing / scanning / forward direction, +Y left,
+    +Z up** (SDF's sensor frame). A camera image's top edge is towards +Z. Lights shine along their
+    ``direction`` parameter, a vector in the device frame (default (0, 0, -1), as SDF, MJCF and
+    Choreonoid default).
+
+    Canonical parameters (SI units, radians; absent = not given by the source):
+
+    * cameras (``camera``, ``depth_camera``, ``rgbd_camera``): ``width``, ``height`` (pixels),
+      ``horizontal_fov``, ``near``, ``far``, ``update_rate`` (Hz), ``noise_stddev``;
+    * ``lidar``: ``horizontal_samples``, ``horizontal_min_angle``, ``horizontal_max_angle``,
+      ``vertical_samples`` (1 for a planar scanner), ``vertical_min_angle``,
+      ``vertical_max_angle``, ``range_min``, ``range_max``, ``range_resolution``, ``update_rate``,
+      ``noise_stddev``, ``detection_rate``;
+    * ``imu``, ``accelerometer``, ``gyro``: ``update_rate``, ``max_acceleration`` and
+      ``max_angular_velocity`` (vec3), ``noise_stddev``;
+    * ``force_torque``: ``update_rate``, ``max_force``, ``max_torque`` (vec3);
+    * ``contact``: ``update_rate``;
+    * lights (``spot_light``, ``point_light``, ``directional_light``): ``color`` (RGB 0..1),
+      ``intensity``, ``attenuation_constant``, ``attenuation_linear``,
+      ``attenuation_quadratic``, ``range``, ``direction``, ``spot_inner_angle``,
+      ``spot_outer_angle`` (half-angles), ``spot_falloff``, ``on``;
+    * every kind: anything else the source said under its own snake_case name, kept for a writer
+      of the same format.
+    """
+
+    CAMERA = "camera"
+    DEPTH_CAMERA = "depth_camera"
+    RGBD_CAMERA = "rgbd_camera"
+    LIDAR = "lidar"
+    IMU = "imu"
+    ACCELEROMETER = "accelerometer"
+    GYRO = "gyro"
+    FORCE_TORQUE = "force_torque"
+    CONTACT = "contact"
+    SPOT_LIGHT = "spot_light"
+    POINT_LIGHT = "point_light"
+    DIRECTIONAL_LIGHT = "directional_light"
+    OTHER = "other"  # no canonical meaning (plugins, GPS, altimeter ...): ``source_kind`` says what
+
+
+CAMERA_KINDS = frozenset({DeviceKind.CAMERA, DeviceKind.DEPTH_CAMERA, DeviceKind.RGBD_CAMERA})
+LIGHT_KINDS = frozenset({DeviceKind.SPOT_LIGHT, DeviceKind.POINT_LIGHT, DeviceKind.DIRECTIONAL_LIGHT})
+
+
 @dataclass(eq=False)
 class Device:
     """A sensor, light or other device attached to a link.
 
     ``kind`` is the source format's device type (``Camera``, ``RangeSensor``, ``SpotLight``...);
     ``params`` holds its parameters in SI units and radians under snake_case names.
+    ``canonical`` is the kind in the shared vocabulary (:class:`DeviceKind`) with its parameters in
+    ``canonical_params``; readers fill both so that any writer can map the device.
     """
 
     kind: str
@@ -165,6 +215,8 @@ class Device:
     pose: Pose = field(default_factory=Pose)
     params: dict[str, Any] = field(default_factory=dict)
     source: SourceLocation | None = None
+    canonical: DeviceKind = DeviceKind.OTHER
+    canonical_params: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass(eq=False)

@@ -80,7 +80,7 @@ def load_materials(path: Path | None, sink: DiagnosticSink) -> MaterialTable:
         }
         table.materials[name] = ContactMaterial(
             name,
-            number(item.get("roughness")) or 0.5,
+            0.5 if number(item.get("roughness")) is None else float(number(item.get("roughness")) or 0.0),
             1.0 if number(item.get("viscosity")) is None else float(number(item.get("viscosity")) or 0.0),
             extra,
         )

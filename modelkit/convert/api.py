@@ -1,0 +1,183 @@
+"""The conversion pipeline: read each input, refuse what cannot be converted, prepare the model
+for the target, run the writer, stage every file, check the plan, write it atomically."""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from modelkit.convert.context import WriteContext
+from modelkit.convert.meshes import MeshExporter
+from modelkit.convert.notes import ConversionNote, NoteSink
+from modelkit.convert.options import WriteOptions
+from modelkit.convert.output import OutputPlan, safe_file_name
+from modelkit.convert.registry import TargetInfo, load_writer, target_for_path, target_info
+from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
+from modelkit.formats.common import ReadOptions
+from modelkit.model import Robot
+
+# Reader errors that do not stop a conversion: the writer deals with them and says so in a note
+# (a link and a joint sharing a name are renamed; a missing or unreadable mesh is left out).
+CONVERTIBLE_ERRORS = frozenset({"MK211", "MK500", "MK501", "MK502", "MK504", "MK506"})
+UNREADABLE = frozenset({"MK001", "MK002"})
+COMPOUND_SUFFIXES = (".urdf.xacro", ".xacro", ".urdf", ".body", ".sdf", ".world", ".mjcf", ".xml")
+
+
+@dataclass
+class ConversionResult:
+    """What a conversion did: files written (relative to the output folder's parent as given),
+    the notes of every writer, and the reading diagnostics that stopped an input."""
+
+    outputs: list[str] = field(default_factory=list)
+    notes: list[ConversionNote] = field(default_factory=list)
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    status: int = 0  # 0 written; 1 an input had errors; 2 could not run (unreadable, output refused)
+
+
+def output_stem(path: Path) -> str:
+    name = path.name
+    for suffix in COMPOUND_SUFFIXES:
+        if name.lower().endswith(suffix):
+            return name[: -len(suffix)] or name
+    return path.stem
+
+
+def input_files(robot: Robot, model_path: Path) -> set[Path]:
+    """The files a robot was read from: its model file and every mesh it references."""
+    found = {model_path}
+    for link in robot.links:
+        for geom in [*link.visuals, *link.collisions]:
+            path = getattr(geom.geometry, "path", None)
+            if path:
+                found.add(Path(path))
+    return found
+
+
+def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: NoteSink) -> Robot:
+    """A copy of ``robot`` shaped for the target: tracks approximated where the target has none,
+    fixed joints merged on request. The source model is never changed."""
+    from modelkit.convert.merge import merge_fixed_joints
+    from modelkit.convert.tracks import approximate_tracks
+
+    out = copy.deepcopy(robot)
+    if not target.tracks_native:
+        approximate_tracks(out, notes)
+    if options.merge_fixed:
+        merge_fixed_joints(out, notes)
+    return out
+
+
+def render_model(robot: Robot, target: str, plan: OutputPlan, relpath: str,
+                 options: WriteOptions) -> list[ConversionNote]:
+    """Run the writer for one robot, staging its model file at ``relpath`` and its meshes."""
+    info = target_info(target)
+    notes = NoteSink()
+    prepared = prepare(robot, info, options, notes)
+    ctx = WriteContext(options, notes, MeshExporter(plan, relpath, options, notes), relpath)
+    data = load_writer(target)(prepared, ctx)
+    plan.add(relpath, data, "model")
+    return notes.items
+
+
+def write(robot: Robot, path: str | Path, fmt: str | None = None, options: WriteOptions | None = None,
+          force: bool = False) -> list[ConversionNote]:
+    """Write one robot to ``path`` (format from ``fmt`` or the suffix), meshes beside it in
+    ``meshes/``; return the conversion notes. Raises ``FileExistsError``/``PermissionError``
+    when the output is refused (see :class:`OutputPlan`)."""
+    out = Path(path)
+    info = target_info(fmt) if fmt else target_for_path(out)
+    if info is None:
+        raise ValueError(f"cannot tell the target format of {out}; pass fmt=")
+    plan = OutputPlan(out.parent, set(), force)
+    if robot.source is not None and robot.source.file:
+        plan.inputs = input_files(robot, Path(robot.source.file))
+    notes = render_model(robot, info.name, plan, out.name, options or WriteOptions())
+    problems = plan.problems()
+    if problems:
+        exc = FileExistsError if all(p.code == "MK890" for p in problems) else PermissionError
+        raise exc("; ".join(p.message for p in problems))
+    plan.commit()
+    return notes
+
+
+def _outputs_for(source: Path, robots: list[Robot], output: Path, target: TargetInfo,
+                 folder_mode: bool) -> list[str]:
+    """File names (relative to the output folder) for the robots of one input."""
+    if not folder_mode and len(robots) == 1:
+        return [output.name]
+    stem = output_stem(source) if folder_mode else output_stem(output)
+    if len(robots) == 1:
+        return [f"{safe_file_name(stem, 'robot')}{target.suffix}"]
+    names = []
+    for robot in robots:
+        names.append(f"{safe_file_name(stem, 'robot')}_{safe_file_name(robot.name, 'model')}{target.suffix}")
+    return names
+
+
+def convert(
+    inputs: Sequence[str | Path],
+    output: str | Path,
+    to: str | None = None,
+    read_options: ReadOptions | None = None,
+    options: WriteOptions | None = None,
+    force: bool = False,
+    input_format: str | None = None,
+) -> ConversionResult:
+    """Convert every robot of every input into ``output`` (a file, or a folder with ``to``)."""
+    from modelkit.api import validate
+
+    result = ConversionResult()
+    options = options or WriteOptions()
+    out = Path(output)
+    by_suffix = target_for_path(out)
+    folder_mode = by_suffix is None or len(inputs) > 1 or out.is_dir()
+    target = target_info(to) if to else by_suffix
+    if target is None:
+        result.diagnostics.append(diag("MK892", f"cannot tell the target format of {out}: name a file "
+                                       "ending in .urdf, .sdf, .xml or .body, or pass --to",
+                                       SourceLocation(str(out))))
+        result.status = 2
+        return result
+    folder = out if folder_mode else out.parent
+    plan = OutputPlan(folder, set(), force)
+    for item in inputs:
+        source = Path(item)
+        checked = validate(source, read_options, input_format, str(source))
+        blocking = [d for d in checked.errors if d.code not in CONVERTIBLE_ERRORS]
+        result.diagnostics.extend(d for d in checked.diagnostics if d.severity is not Severity.INFO)
+        if any(d.code in UNREADABLE for d in checked.diagnostics):
+            result.status = 2
+            continue
+        robots = [r for r in checked.robots if r.root is not None]
+        if blocking or not robots:
+            result.status = max(result.status, 1)
+            continue
+        plan.inputs |= {p for r in robots for p in input_files(r, source)}
+        names = _outputs_for(source, robots, out, target, folder_mode)
+        if len(robots) > 1:
+            result.notes.append(ConversionNote(
+                "MK893", Severity.INFO,
+                f"{source} holds {len(robots)} models; each is written to its own file: " + ", ".join(names),
+                SourceLocation(str(source)), None))
+        for robot, name in zip(robots, names, strict=True):
+            result.notes.extend(render_model(robot, target.name, plan, name, options))
+            result.outputs.append(str(folder / name))
+    if result.status:
+        result.outputs = []
+        return result
+    problems = plan.problems()
+    if problems:
+        result.diagnostics.extend(problems)
+        result.outputs = []
+        result.status = 2
+        return result
+    try:
+        plan.commit()
+    except OSError as exc:
+        result.diagnostics.append(diag("MK894", f"writing into {folder} failed: {exc}; nothing was written",
+                                       SourceLocation(str(folder))))
+        result.outputs = []
+        result.status = 2
+    return result

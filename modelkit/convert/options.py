@@ -1,0 +1,18 @@
+"""What a writer can be asked to do differently (every option has the safe default)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+SDF_VERSIONS = ("1.6", "1.7", "1.8", "1.9", "1.10", "1.11")
+MESH_FORMATS = ("stl", "obj")
+
+
+@dataclass(frozen=True)
+class WriteOptions:
+    sdf_version: str = "1.9"
+    mesh_format: str = "stl"  # for meshes the writer generates or converts
+    keep_collada: bool = False  # URDF/SDF: copy COLLADA files as they are instead of converting
+    keep_package_uris: bool = False  # keep package:// and model:// references instead of copying
+    merge_fixed: bool = False  # fuse links on fixed joints into their parents
+    urdf_world_link: bool = False  # URDF: write a `world` link and the root's fixed/floating joint
