@@ -721,6 +721,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "info",
         "An xacro file expands to no robot content: a macro library, checked for xacro errors only.",
     ),
+    CodeInfo(
+        "MK711",
+        "xacro-read-outside",
+        "error",
+        "`include`, `load_yaml` or a `$(find)` path would read a file outside the model's folder tree "
+        "and the package paths given; refused unread.",
+    ),
     # -- MK8xx: conversion notes ------------------------------------------------------------
     # MK800-MK849 shared by every writer; MK850-859 URDF, MK860-869 SDF, MK870-879 MJCF,
     # MK880-889 .body; MK890-899 the convert command (outputs refused, targets that cannot hold).
@@ -849,12 +856,6 @@ _TABLE: tuple[CodeInfo, ...] = (
         "velocity ranges) is left out.",
     ),
     CodeInfo(
-        "MK821",
-        "scale-baked",
-        "info",
-        "A scale the target cannot express (non-uniform on a primitive) is baked into mesh vertices.",
-    ),
-    CodeInfo(
         "MK822",
         "world-content-dropped",
         "info",
@@ -865,6 +866,20 @@ _TABLE: tuple[CodeInfo, ...] = (
         "root-pose-dropped",
         "warning",
         "The robot's placement in the world cannot be written in the target (URDF has no root pose).",
+    ),
+    CodeInfo(
+        "MK860",
+        "sdf-inertia-adjusted",
+        "warning",
+        "An inertia libsdformat refuses (principal moments violating A + B ≥ C, its whole file then fails to "
+        "load) is written as the nearest one it accepts; the note gives the change.",
+    ),
+    CodeInfo(
+        "MK870",
+        "mjcf-inertia-adjusted",
+        "warning",
+        "An inertia MuJoCo refuses (principal moments violating A + B ≥ C, or singular on a moving body) "
+        "is written as the nearest one it accepts; the note gives the change.",
     ),
     CodeInfo(
         "MK890",

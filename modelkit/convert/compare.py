@@ -69,8 +69,11 @@ def compare_robots(
 
     Links of ``b`` marked synthesised (``extras["synthesised"]``) are not required in ``a``.
     """
-    renames = renames or {}
-    name = lambda n: renames.get(n, n)  # noqa: E731
+    mapping = renames or {}
+
+    def name(n: str) -> str:
+        return mapping.get(n, n)
+
     out: list[Difference] = []
     a_links = {name(lk.name): lk for lk in a.links}
     b_links = {lk.name: lk for lk in b.links}

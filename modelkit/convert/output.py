@@ -94,11 +94,11 @@ class OutputPlan:
                 staged = self.files[relpath]
                 target = self.folder / relpath
                 target.parent.mkdir(parents=True, exist_ok=True)
-                fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-                temps.append((Path(tmp), target))
+                fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+                temps.append((Path(tmp_name), target))
                 with os.fdopen(fd, "wb") as out:
                     out.write(staged.data)
-                os.chmod(tmp, 0o644)
+                os.chmod(tmp_name, 0o644)
             for tmp, target in temps:
                 os.replace(tmp, target)
         except OSError:
