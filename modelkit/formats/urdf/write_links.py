@@ -1,0 +1,207 @@
+"""URDF writer, links: ``<inertial>``, ``<visual>``/``<collision>`` geometry and robot-level materials.
+
+URDF 1.0 has box, sphere, cylinder and mesh; capsules, cones and ellipsoids are written as mesh
+files (MK802). Colours become robot-level ``<material name>`` entries, shared by identical
+materials; URDF holds only ``<color rgba>`` and ``<texture filename>``, so specular, emissive,
+ambient and shininess are dropped with one MK818 note per robot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from lxml import etree
+from lxml.etree import _Element as Element
+
+from modelkit.convert.context import WriteContext
+from modelkit.convert.meshes import MeshRef
+from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.output import safe_file_name
+from modelkit.diagnostics import SourceLocation
+from modelkit.model import (
+    Box,
+    Capsule,
+    Cone,
+    Cylinder,
+    Ellipsoid,
+    Geom,
+    Link,
+    Mesh,
+    Robot,
+    Sphere,
+    VisualMaterial,
+)
+from modelkit.spatial import Pose, rpy_from_matrix
+
+TEXTURE_FOLDER = "textures"
+
+
+def origin_element(parent: Element, pose: Pose, always: bool = False) -> None:
+    """``<origin xyz rpy>`` for ``pose`` (left out when it is the identity, unless ``always``)."""
+    xyz = fmt_vec(pose.translation)
+    rpy = fmt_vec(rpy_from_matrix(pose.rotation))
+    if always or xyz != "0 0 0" or rpy != "0 0 0":
+        etree.SubElement(parent, "origin", xyz=xyz, rpy=rpy)
+
+
+def inertial_element(parent: Element, link: Link, ctx: WriteContext, target: str) -> None:
+    """The link's ``<inertial>``: COM as origin (rpy 0), the full tensor about the COM in link axes."""
+    inertial = link.inertial
+    if inertial is None or inertial.mass <= 0.0:
+        return  # a massless link is a frame; URDF allows a link without <inertial>
+    if inertial.defaulted:
+        ctx.note(
+            "MK801",
+            f'link "{link.name}" has no mass information; the default the source format '
+            f"implies (mass {fmt(inertial.mass)} kg and its inertia) is written explicitly",
+            link.loc("mass"),
+            f"{target}/inertial",
+        )
+    el = etree.SubElement(parent, "inertial")
+    etree.SubElement(el, "origin", xyz=fmt_vec(inertial.com), rpy="0 0 0")
+    etree.SubElement(el, "mass", value=fmt(inertial.mass))
+    i = np.asarray(inertial.inertia, dtype=float)
+    etree.SubElement(
+        el,
+        "inertia",
+        ixx=fmt(i[0, 0]),
+        ixy=fmt(i[0, 1]),
+        ixz=fmt(i[0, 2]),
+        iyy=fmt(i[1, 1]),
+        iyz=fmt(i[1, 2]),
+        izz=fmt(i[2, 2]),
+    )
+
+
+@dataclass
+class MaterialTable:
+    """Robot-level materials: one entry per distinct (name, rgba, texture), with unique names."""
+
+    entries: list[tuple[str, tuple[float, float, float, float] | None, str | None]] = field(
+        default_factory=list
+    )
+    _by_key: dict[tuple[object, ...], str] = field(default_factory=dict)
+    _names: set[str] = field(default_factory=set)
+    appearance_dropped: list[str] = field(default_factory=list)
+
+    def add(self, material: VisualMaterial, fallback: str, texture: str | None) -> str | None:
+        rgba = material.rgba
+        if rgba is None and texture is None:
+            return None
+        key = (material.name, rgba, texture)
+        known = self._by_key.get(key)
+        if known is not None:
+            return known
+        base = material.name or fallback
+        name, n = base, 1
+        while name in self._names:
+            n += 1
+            name = f"{base}_{n}"
+        self._names.add(name)
+        self._by_key[key] = name
+        self.entries.append((name, rgba, texture))
+        return name
+
+    def write(self, robot_el: Element) -> None:
+        for name, rgba, texture in self.entries:
+            el = etree.SubElement(robot_el, "material", name=name)
+            if rgba is not None:
+                etree.SubElement(el, "color", rgba=fmt_vec(rgba))
+            if texture is not None:
+                etree.SubElement(el, "texture", filename=texture)
+
+
+def _texture(
+    material: VisualMaterial, robot: Robot, ctx: WriteContext, target: str, source: SourceLocation | None
+) -> str | None:
+    """The texture copied into the output (a relative reference), or None with an MK818 note."""
+    uri = material.texture
+    if not uri:
+        return None
+    from modelkit.resources import Resolver
+
+    path = Path(uri)
+    if not path.is_absolute():
+        base = Path(robot.source.file).parent if robot.source and robot.source.file else Path.cwd()
+        resolution = Resolver().resolve(uri, base, Path(robot.source.file) if robot.source else None)
+        path = resolution.path if resolution.path is not None else path
+    try:
+        data = path.read_bytes()
+    except OSError:
+        ctx.note("MK818", f'texture "{uri}" cannot be read; the visual keeps its colour only', source, target)
+        return None
+    relpath = ctx.meshes.plan.add(f"{TEXTURE_FOLDER}/{safe_file_name(path.name, 'texture')}", data, "texture")
+    return ctx.meshes.prefix + relpath
+
+
+def _mesh_element(parent: Element, ref: MeshRef) -> None:
+    el = etree.SubElement(parent, "mesh", filename=ref.uri)
+    scale = np.asarray(ref.scale, dtype=float)
+    if not np.all(scale == 1.0):
+        el.set("scale", fmt_vec(scale))
+
+
+def geometry_element(parent: Element, geom: Geom, ctx: WriteContext, target: str, mesh_name: str) -> bool:
+    """``<geometry>`` for the geom; False (nothing written) when its mesh is missing."""
+    shape = geom.geometry
+    if isinstance(shape, Mesh):
+        ref = ctx.meshes.mesh(shape, mesh_name, target, geom.source, readable=("stl", "obj", "dae"))
+        if ref is None:
+            return False
+        _mesh_element(etree.SubElement(parent, "geometry"), ref)
+        return True
+    if isinstance(shape, Capsule | Cone | Ellipsoid):
+        ref = ctx.meshes.primitive(shape, mesh_name, target, geom.source)
+        _mesh_element(etree.SubElement(parent, "geometry"), ref)
+        return True
+    el = etree.SubElement(parent, "geometry")
+    if isinstance(shape, Box):
+        etree.SubElement(el, "box", size=fmt_vec(shape.size))
+    elif isinstance(shape, Sphere):
+        etree.SubElement(el, "sphere", radius=fmt(shape.radius))
+    elif isinstance(shape, Cylinder):
+        etree.SubElement(el, "cylinder", radius=fmt(shape.radius), length=fmt(shape.length))
+    return True
+
+
+def _dropped_appearance(material: VisualMaterial) -> list[str]:
+    out = []
+    if material.specular is not None and np.any(np.asarray(material.specular) != 0.0):
+        out.append("specular")
+    if material.emissive is not None and np.any(np.asarray(material.emissive) != 0.0):
+        out.append("emissive")
+    if material.ambient is not None:
+        out.append("ambient")
+    if material.specular_exponent is not None:
+        out.append("shininess")
+    return out
+
+
+def link_element(
+    robot_el: Element, link: Link, name: str, robot: Robot, ctx: WriteContext, materials: MaterialTable
+) -> Element:
+    """The ``<link>`` element with its inertial, visuals and collisions."""
+    el = etree.SubElement(robot_el, "link", name=name)
+    target = f"link[{name}]"
+    inertial_element(el, link, ctx, target)
+    for kind, geoms in (("visual", link.visuals), ("collision", link.collisions)):
+        for i, geom in enumerate(geoms):
+            where = f"{target}/{kind}[{i}]"
+            item = etree.Element(kind)
+            if geom.name:
+                item.set("name", geom.name)
+            origin_element(item, geom.pose)
+            if not geometry_element(item, geom, ctx, where, f"{name}_{kind}{i}"):
+                continue
+            if kind == "visual" and geom.material is not None:
+                texture = _texture(geom.material, robot, ctx, where, geom.source)
+                mat_name = materials.add(geom.material, f"{name}_visual{i}", texture)
+                if mat_name is not None:
+                    etree.SubElement(item, "material", name=mat_name)
+                for what in _dropped_appearance(geom.material):
+                    if what not in materials.appearance_dropped:
+                        materials.appearance_dropped.append(what)
+            el.append(item)
+    return el

@@ -1,0 +1,271 @@
+"""The URDF writer: a robot model → URDF 1.0 bytes, with a conversion note for every loss.
+
+Element order: robot-level materials, links (model order, then links the writer adds), joints
+(model order, then joints the writer adds), ``<gazebo>`` blocks, transmissions and other kept
+extensions. Pretty-printed with two-space indentation, numbers through
+:func:`modelkit.convert.numbers.fmt`. The parts live in ``write_names`` (unique names, MK800),
+``write_links`` (inertials, geometry, materials), ``write_joints`` (joint types, synthesised limits)
+and ``write_gazebo`` (sensors, friction, kept extension blocks).
+
+How the root meets the world: URDF has no root pose and its consumers float the root unless it
+hangs from a link named ``world``. With ``WriteOptions.urdf_world_link`` a ``world`` link is written
+with a fixed (or floating) joint to the root at ``root_pose``; otherwise a welded root is an MK814
+note and a placement an MK823 note. Links the tree does not reach (an SDF model's free links) hang
+from the root by ``floating`` joints (MK813), since a URDF has exactly one root.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from lxml import etree
+from lxml.etree import _Element as Element
+
+from modelkit.convert.context import WriteContext
+from modelkit.convert.notes import ConversionNote
+from modelkit.formats.urdf.write_gazebo import write_extensions
+from modelkit.formats.urdf.write_joints import joint_elements
+from modelkit.formats.urdf.write_links import MaterialTable, link_element, origin_element
+from modelkit.formats.urdf.write_names import NameTable, renames_from_notes
+from modelkit.model import WORLD_LINK, JointType, Robot
+from modelkit.spatial import Pose
+
+__all__ = ["urdf_renames", "write_urdf"]
+
+# Robot extras that carry no model information (or that this writer writes elsewhere).
+SILENT_EXTRAS = frozenset(
+    {
+        "materials",
+        "urdf_version",
+        "world_link",
+        "root_joint_source",
+        "materials_path",
+        "masses_unknown",
+        "sdf_canonical_link",
+        "sdf_version",
+        "sdf_model_pose",
+        "sdf_free_links",
+        "sdf_world_joint",
+        "mjcf_compiled",
+        "gazebo",
+        "transmissions",
+        "ros2_control",
+        "mujoco",
+        "sensor",
+    }
+)
+# Robot extras that do: the note that says they are left out.
+DROPPED_EXTRAS = {
+    "mjcf_actuators": ("MK808", "MJCF actuators"),
+    "mjcf_tendons": ("MK808", "MJCF tendons"),
+    "mjcf_equalities": ("MK808", "MJCF equality constraints"),
+    "mjcf_sensors": ("MK806", "MJCF sensors"),
+    "mjcf_cameras": ("MK806", "MJCF cameras"),
+    "mjcf_lights": ("MK806", "MJCF lights"),
+    "mjcf_sites": ("MK808", "MJCF sites (named frames)"),
+    "mjcf_keyframes": ("MK820", "MJCF keyframes (stored joint positions)"),
+    "mjcf_world_geoms": ("MK822", "MJCF world geoms"),
+    "mjcf_world_sites": ("MK822", "MJCF world sites"),
+    "sdf_plugins": ("MK808", "SDF model plugins"),
+    "sdf_world": ("MK822", "the SDF world around the model"),
+}
+SILENT_LINK_EXTRAS = frozenset(
+    {
+        "gazebo",
+        "synthesised",
+        "is_continuous_track",
+        "track",
+        "mjcf_body_id",
+        "mjcf_body_offset",
+        "mjcf_intermediate_of",
+        "sdf_link_pose",
+    }
+)
+SDF_LINK_DEFAULTS = {
+    "gravity": True,
+    "kinematic": False,
+    "self_collide": False,
+    "enable_wind": False,
+    "must_be_base_link": False,
+}
+
+
+def urdf_renames(notes: Iterable[ConversionNote]) -> dict[str, str]:
+    """Source link name → written link name, from a conversion's MK800 notes (for compare_robots)."""
+    return renames_from_notes(notes, "link")
+
+
+def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
+    """The URDF file of ``robot``; meshes and textures are staged through ``ctx``."""
+    add_world = (
+        ctx.options.urdf_world_link
+        and robot.root not in (None, WORLD_LINK)
+        and robot.root_joint in (JointType.FIXED, JointType.FLOATING)
+    )
+    names = NameTable(robot, ctx, reserved=(WORLD_LINK,) if add_world else ())
+    materials = MaterialTable()
+    links = etree.Element("links")
+    if add_world:
+        etree.SubElement(links, "link", name=WORLD_LINK)
+    for index, link in enumerate(robot.links):
+        link_element(links, link, names.links[index], robot, ctx, materials)
+        _link_extras(link.extras, link.name, names.links[index], ctx)
+    joints: list[Element] = []
+    extra_links: list[str] = []
+    for index, joint in enumerate(robot.joints):
+        joints.extend(joint_elements(joint, index, names, ctx, extra_links))
+    joints.extend(_root(robot, names, ctx, add_world))
+    joints.extend(_free_links(robot, names, ctx))
+    for name in extra_links:
+        etree.SubElement(links, "link", name=name)
+
+    out = etree.Element("robot", name=robot.name or "robot")
+    materials.write(out)
+    if materials.appearance_dropped:
+        ctx.note(
+            "MK818",
+            "URDF materials hold only a colour and a texture; "
+            + ", ".join(materials.appearance_dropped)
+            + " left out",
+            robot.source,
+            "material",
+        )
+    for el in list(links):
+        out.append(el)
+    for el in joints:
+        out.append(el)
+    write_extensions(out, robot, names, ctx)
+    _massless(robot, names, ctx)
+    _notes(robot, ctx)
+    etree.indent(out, space="  ")
+    text = etree.tostring(out, encoding="unicode")
+    return ('<?xml version="1.0"?>\n' + text + "\n").encode("utf-8")
+
+
+def _root(robot: Robot, names: NameTable, ctx: WriteContext, add_world: bool) -> list[Element]:
+    """The joint to ``world`` (with the option), or the notes on what URDF cannot say about the root."""
+    if robot.root is None or robot.root == WORLD_LINK:
+        return []
+    root = names.link(robot.root)
+    out: list[Element] = []
+    where = robot.extras.get("root_joint_source") or robot.source
+    if add_world:
+        word = "fixed" if robot.root_joint is JointType.FIXED else "floating"
+        el = etree.Element("joint", name=names.fresh(f"{WORLD_LINK}_to_{root}"), type=word)
+        origin_element(el, robot.root_pose)
+        etree.SubElement(el, "parent", link=WORLD_LINK)
+        etree.SubElement(el, "child", link=root)
+        out.append(el)
+        ctx.note(
+            "MK814",
+            f'the root "{root}" hangs from a "{WORLD_LINK}" link by the {word} joint '
+            f'"{el.get("name")}" at the robot\'s placement',
+            where,
+            f"joint[{el.get('name')}]",
+        )
+        return out
+    if robot.root_joint is JointType.FIXED:
+        ctx.note(
+            "MK814",
+            f'the root "{root}" is welded to the world in the source; URDF consumers float '
+            f'the root unless it hangs from a "{WORLD_LINK}" link (option urdf_world_link)',
+            where,
+            f"link[{root}]",
+        )
+    if not robot.root_pose.is_identity():
+        ctx.note(
+            "MK823",
+            f'the robot\'s placement in the world (root "{root}") cannot be written in URDF; '
+            "it is left out (option urdf_world_link writes it as the world joint's origin)",
+            where,
+            f"link[{root}]",
+        )
+    return out
+
+
+def _free_links(robot: Robot, names: NameTable, ctx: WriteContext) -> list[Element]:
+    """Floating joints from the root to links the tree does not reach (URDF has one root)."""
+    if robot.root is None:
+        return []
+    children = {j.child for j in robot.joints}
+    reached = set(robot.world_poses())
+    free_poses = robot.extras.get("sdf_free_links") or {}
+    out: list[Element] = []
+    for index, link in enumerate(robot.links):
+        if link.name in reached or link.name in children or link.name == robot.root:
+            continue
+        name = names.links[index]
+        placed = free_poses.get(link.name) if isinstance(free_poses, dict) else None
+        origin = robot.root_pose.inverse() @ placed if isinstance(placed, Pose) else Pose()
+        el = etree.Element("joint", name=names.fresh(f"{name}_free"), type="floating")
+        origin_element(el, origin)
+        etree.SubElement(el, "parent", link=names.link(robot.root))
+        etree.SubElement(el, "child", link=name)
+        out.append(el)
+        ctx.note(
+            "MK813",
+            f'link "{link.name}" is not connected to the root; URDF has one root, so it hangs '
+            f'from "{names.link(robot.root)}" by the floating joint "{el.get("name")}"',
+            link.source,
+            f"joint[{el.get('name')}]",
+        )
+    return out
+
+
+def _massless(robot: Robot, names: NameTable, ctx: WriteContext) -> None:
+    """One note for the links written without ``<inertial>`` (frames), with what peers do to them."""
+    massless = [
+        names.links[i]
+        for i, link in enumerate(robot.links)
+        if (link.inertial is None or link.inertial.mass <= 0.0) and link.name != WORLD_LINK
+    ]
+    if not massless:
+        return
+    shown = ", ".join(f'"{n}"' for n in massless[:8]) + (
+        f" and {len(massless) - 8} more" if len(massless) > 8 else ""
+    )
+    ctx.note(
+        "MK816",
+        f"{len(massless)} massless link(s) written without <inertial>, as URDF frames: {shown}; "
+        "PyBullet gives such a link 1 kg and a unit inertia, and libsdformat's URDF to SDF conversion drops "
+        "it (with its subtree) unless its joint is fixed",
+        robot.source,
+        "link",
+    )
+
+
+def _link_extras(extras: dict[str, object], source_name: str, name: str, ctx: WriteContext) -> None:
+    for key, value in sorted(extras.items()):
+        if key == "sdf_link" and isinstance(value, dict):
+            value = {k: v for k, v in value.items() if SDF_LINK_DEFAULTS.get(k, not v) != v}
+        if key in SILENT_LINK_EXTRAS or not value:
+            continue
+        ctx.note(
+            "MK808",
+            f'link "{source_name}": {key} ({_short(value)}) has no URDF equivalent; left out',
+            None,
+            f"link[{name}]",
+        )
+
+
+def _short(value: object) -> str:
+    text = str(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _notes(robot: Robot, ctx: WriteContext) -> None:
+    """Closed loops and robot-level data of other formats that URDF cannot hold."""
+    for loop in robot.loops:
+        ctx.note(
+            "MK810",
+            f'closed-loop joint "{loop.name}" ({loop.type}) between "{loop.link1}" and '
+            f'"{loop.link2}": URDF holds a tree only; it is left out',
+            loop.source,
+            "robot",
+        )
+    for key, value in sorted(robot.extras.items()):
+        if key in SILENT_EXTRAS or not value:
+            continue
+        code, what = DROPPED_EXTRAS.get(key, ("MK808", f"extension data {key}"))
+        count = f"{len(value)} " if isinstance(value, list) else ""
+        ctx.note(code, f"{count}{what}: URDF has no equivalent; left out", robot.source, "robot")
