@@ -1,0 +1,427 @@
+"""The body tree of the MJCF writer: bodies, inertials and joints.
+
+* One ``<body>`` per link, nested as the tree, named after the link; ``pos``/``quat`` (w x y z) =
+  the joint origin. Fixed joints (and any pseudo continuous track left, MK813) write no joint: the
+  body is welded to its parent and kept, never lumped.
+* The root body sits at ``root_pose``: ``FLOATING`` → ``<freejoint/>``; ``FIXED`` → no joint;
+  None (URDF leaves it open) → ``<freejoint/>`` with an MK814 note. A root link named ``world``
+  is MuJoCo's world body itself: its children become top-level bodies (MK814).
+* revolute → ``hinge``, prismatic → ``slide`` (``axis`` in the body frame, anchored at the body
+  origin; ``range`` only when both limits are finite, ``autolimits`` makes it limited), ball →
+  ``ball``, planar → two slides and a hinge named ``<joint>_tx``, ``<joint>_ty``, ``<joint>_rz``
+  (MK813). MuJoCo allows a free joint on top-level bodies only, so a floating joint inside the tree
+  makes its subtree a top-level body with ``<freejoint/>`` at its pose in the world at q = 0 (as
+  Choreonoid's own MuJoCo plugin does; MK813).
+* ``damping``, ``frictionloss``, ``armature`` as given; a finite effort limit → ``actuatorfrcrange``.
+* Inertials: ``<inertial pos mass diaginertia>`` when the tensor is diagonal, else ``fullinertia="Ixx
+  Iyy Izz Ixy Ixz Iyz"``; MuJoCo never recomputes them (``inertiafromgeom="false"``). A massless
+  link on a fixed joint is a body without ``<inertial>`` (MK816). MuJoCo refuses a moving body
+  whose weld group (the body and what is welded to it) has no mass or a singular inertia; such a body
+  gets ``MIN_MASS`` kg and/or ``MIN_INERTIA`` kg·m² on each principal axis at its origin (MK816 /
+  MK819, the note says the value).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from modelkit.convert.context import WriteContext
+from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.formats.mjcf.write_devices import DeviceWriter
+from modelkit.formats.mjcf.write_geoms import GeomWriter
+from modelkit.formats.mjcf.write_names import NameTable
+from modelkit.formats.mjcf.write_xml import Element, set_pose, sub
+from modelkit.model import WORLD_LINK, Inertial, Joint, JointType, Link, Robot
+from modelkit.spatial import Pose, combine_mass_properties, principal_moments, rotate_inertia
+
+MIN_MASS = 1e-6  # kg, given to a moving body whose weld group has no mass
+MIN_INERTIA = 1e-9  # kg·m², added on each axis when the weld group's inertia is singular
+PLATE_MARGIN = 1e-10  # relative: how far above a + b = c a full tensor is raised (see _triangle)
+SINGULAR = 1e-12  # below this a mass or principal moment counts as zero (MuJoCo's mjMINVAL is 1e-15)
+MOVING = (JointType.REVOLUTE, JointType.PRISMATIC, JointType.BALL, JointType.PLANAR, JointType.FLOATING)
+
+
+@dataclass
+class BodyTree:
+    robot: Robot
+    ctx: WriteContext
+    names: NameTable
+    geoms: GeomWriter
+    devices: DeviceWriter
+    body_name: dict[str, str] = field(default_factory=dict)
+    joint_names: dict[str, list[str]] = field(default_factory=dict)  # model joint → written joint(s)
+    scalar_joints: list[str] = field(default_factory=list)  # written hinge/slide names, tree order
+    bodies: dict[str, Element] = field(default_factory=dict)
+    locked: list[tuple[str, float]] = field(default_factory=list)  # written joint, value it is held at
+
+    def __post_init__(self) -> None:
+        self.children = self.robot.children_of()
+        self.links = {lk.name: lk for lk in self.robot.links}
+        self.parent_joint = {j.child: j for j in self.robot.joints}
+
+    # -- the tree ------------------------------------------------------------------------------
+
+    def write(self, worldbody: Element) -> None:
+        robot = self.robot
+        root = robot.root
+        if root is None or root not in self.links:
+            return
+        self._claim_names()
+        split: list[tuple[Joint, Pose]] = []
+        if root == WORLD_LINK:
+            world = self.links[root]
+            self.ctx.note(
+                "MK814",
+                'the root link "world" is MuJoCo\'s world body: its children are top-level '
+                "bodies, its geoms and devices are written in <worldbody>",
+                world.source,
+                "worldbody",
+            )
+            self.body_name[root] = "world"
+            self._contents(worldbody, world, "world", static=True)
+            for joint in self.children.get(root, []):
+                self._body(worldbody, joint.child, robot.root_pose @ joint.origin, joint, split)
+        else:
+            self._body(worldbody, root, robot.root_pose, None, split)
+        for link in self.robot.links:
+            incoming = self.parent_joint.get(link.name)
+            if (
+                link.name in self.bodies
+                or link.name == root
+                or (incoming is not None and incoming.parent in self.links)
+            ):
+                continue
+            free = self.robot.extras.get("sdf_free_links") or {}
+            pose = free.get(link.name, robot.root_pose)
+            static = robot.root_joint is JointType.FIXED
+            how = "welded to the world, as the root is" if static else "with <freejoint/>"
+            self._claim_subtree(link.name)
+            self.ctx.note(
+                "MK813",
+                f"link {link.name} is not connected to the root; written as a top-level body {how}",
+                link.source,
+                f"body[{self.body_name[link.name]}]",
+            )
+            self._body(worldbody, link.name, pose, None, split, free_top=not static, detached=static)
+        poses: dict[str, Pose] | None = None
+        while split:
+            joint, _ = split.pop(0)
+            poses = poses if poses is not None else robot.world_poses()
+            pose = poses.get(joint.child, Pose())
+            self.ctx.note(
+                "MK813",
+                f"floating joint {joint.name} inside the tree: MuJoCo allows free joints on "
+                f"top-level bodies only, so body {self.body_name[joint.child]} and its subtree are a "
+                "top-level body with <freejoint/> at its pose at q = 0",
+                joint.source,
+                f"body[{self.body_name[joint.child]}]",
+            )
+            self._body(worldbody, joint.child, pose, joint, split, free_top=True)
+
+    def _claim_subtree(self, start: str) -> None:
+        for name in self._subtree(start):
+            if name not in self.body_name:
+                link = self.links[name]
+                self.body_name[name] = self.names.claim("body", name, link.loc("name"), f"body[{name}]")
+
+    def _subtree(self, start: str) -> list[str]:
+        order = [start]
+        seen = set(order)
+        i = 0
+        while i < len(order):
+            for joint in self.children.get(order[i], []):
+                if joint.child not in seen and joint.child in self.links:
+                    seen.add(joint.child)
+                    order.append(joint.child)
+            i += 1
+        return order
+
+    def _claim_names(self) -> None:
+        """Body names in tree order, so that renames are deterministic."""
+        for name in self._subtree(self.robot.root) if self.robot.root else []:
+            if name == WORLD_LINK and name == self.robot.root:
+                continue
+            link = self.links[name]
+            self.body_name[name] = self.names.claim("body", name, link.loc("name"), f"body[{name}]")
+
+    def _body(
+        self,
+        parent: Element,
+        link_name: str,
+        pose: Pose,
+        joint: Joint | None,
+        split: list[tuple[Joint, Pose]],
+        free_top: bool = False,
+        detached: bool = False,
+    ) -> None:
+        link = self.links.get(link_name)
+        if link is None:
+            return
+        name = self.body_name[link_name]
+        el = sub(parent, "body", name=name)
+        set_pose(el, pose)
+        self.bodies[link_name] = el
+        if free_top and joint is None:
+            sub(el, "freejoint")
+            moving = True
+        elif detached:
+            moving = False
+        elif joint is None:
+            moving = self._root_joint(el, link, name)
+        elif free_top:
+            el_joint = sub(
+                el,
+                "freejoint",
+                name=self.names.claim("joint", joint.name, joint.loc("name"), f"body[{name}]/freejoint"),
+            )
+            self.joint_names[joint.name] = [el_joint.get("name", "")]
+            moving = True
+        else:
+            moving = self._joint(el, joint, name)
+        self._inertial(el, link, name, moving)
+        self._contents(el, link, name, static=False)
+        for child in self.children.get(link_name, []):
+            if child.type is JointType.FLOATING:
+                split.append((child, Pose()))
+                continue
+            self._body(el, child.child, child.origin, child, split)
+
+    def _contents(self, el: Element, link: Link, name: str, static: bool) -> None:
+        self.geoms.link_geoms(el, link, name)
+        self.devices.link_devices(el, link, name)
+
+    def _root_joint(self, el: Element, link: Link, name: str) -> bool:
+        kind = self.robot.root_joint
+        if kind is JointType.FIXED:
+            return False
+        if kind is None:
+            self.ctx.note(
+                "MK814",
+                "the source leaves the root open (URDF): written floating, with <freejoint/>",
+                link.source,
+                f"body[{name}]/freejoint",
+            )
+        sub(el, "freejoint")
+        return True
+
+    # -- joints --------------------------------------------------------------------------------
+
+    def _joint(self, body: Element, joint: Joint, body_name: str) -> bool:
+        target = f"body[{body_name}]/joint[{joint.name}]"
+        kind = joint.type
+        if kind is JointType.PSEUDO_CONTINUOUS_TRACK:
+            self.ctx.note(
+                "MK813",
+                f"pseudo continuous track {joint.name} written as a weld (MuJoCo has no moving "
+                "contact surface)",
+                joint.source,
+                f"body[{body_name}]",
+            )
+            return False
+        if kind is JointType.FIXED:
+            return False
+        if kind is JointType.PLANAR:
+            self._planar(body, joint, body_name)
+            return True
+        name = self.names.claim("joint", joint.name, joint.loc("name"), target)
+        self.joint_names[joint.name] = [name]
+        if kind is JointType.BALL:
+            el = sub(body, "joint", name=name, type="ball")
+            self._dynamics(el, joint, target)
+            return True
+        el = sub(
+            body,
+            "joint",
+            name=name,
+            type="hinge" if kind is JointType.REVOLUTE else "slide",
+            axis=fmt_vec(joint.axis),
+        )
+        self.scalar_joints.append(name)
+        limits = joint.limits
+        if math.isfinite(limits.lower) and math.isfinite(limits.upper) and limits.lower < limits.upper:
+            el.set("range", f"{fmt(limits.lower)} {fmt(limits.upper)}")
+        elif math.isfinite(limits.lower) and limits.lower == limits.upper:
+            self.locked.append((name, limits.lower))
+            self.ctx.note(
+                "MK820",
+                f"joint {joint.name} is locked (both limits {fmt(limits.lower)}); MuJoCo needs "
+                "range[0] < range[1], so it is written unlimited and held at that value by a joint "
+                "equality",
+                joint.loc("limits"),
+                target,
+            )
+        elif limits.position_limited:
+            self.ctx.note(
+                "MK820",
+                f"joint {joint.name} is limited on one side only ({limits.lower}, "
+                f"{limits.upper}); MuJoCo needs both, so it is written unlimited",
+                joint.loc("limits"),
+                target,
+            )
+        self._dynamics(el, joint, target)
+        return True
+
+    def _planar(self, body: Element, joint: Joint, body_name: str) -> None:
+        normal = np.asarray(joint.axis, dtype=float)
+        normal = normal / float(np.linalg.norm(normal))
+        helper = np.array([1.0, 0.0, 0.0]) if abs(normal[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        u = np.cross(helper, normal)
+        u = u / float(np.linalg.norm(u))
+        v = np.cross(normal, u)
+        written = []
+        for suffix, kind, axis in (("_tx", "slide", u), ("_ty", "slide", v), ("_rz", "hinge", normal)):
+            target = f"body[{body_name}]/joint[{joint.name}{suffix}]"
+            name = self.names.claim("joint", joint.name + suffix, joint.loc("name"), target, note=False)
+            el = sub(body, "joint", name=name, type=kind, axis=fmt_vec(axis))
+            self._dynamics(el, joint, target)
+            written.append(name)
+        self.joint_names[joint.name] = written
+        self.ctx.note(
+            "MK813",
+            f"planar joint {joint.name} written as two slides and a hinge ({', '.join(written)})",
+            joint.source,
+            f"body[{body_name}]",
+        )
+
+    def _dynamics(self, el: Element, joint: Joint, target: str) -> None:
+        if joint.damping:
+            el.set("damping", fmt(joint.damping))
+        if joint.friction:
+            el.set("frictionloss", fmt(joint.friction))
+        if joint.armature:
+            el.set("armature", fmt(joint.armature))
+        effort = joint.limits.effort
+        if math.isfinite(effort) and effort > 0.0 and joint.type is not JointType.BALL:
+            el.set("actuatorfrcrange", f"{fmt(-effort)} {fmt(effort)}")
+        elif math.isfinite(effort) and effort <= 0.0:
+            self.ctx.note(
+                "MK820",
+                f"joint {joint.name}: effort limit {fmt(effort)} not written (it would forbid "
+                "any actuator force)",
+                joint.loc("limits"),
+                target,
+            )
+        lost = []
+        if math.isfinite(joint.limits.velocity) or math.isfinite(joint.limits.velocity_upper):
+            lost.append("velocity limit")
+        if joint.initial_position:
+            lost.append(f"initial position {fmt(joint.initial_position)}")
+        if lost:
+            self.ctx.note(
+                "MK820",
+                f"joint {joint.name}: {' and '.join(lost)} not written (MJCF joints have no such field)",
+                joint.source,
+                target,
+            )
+
+    # -- inertials -----------------------------------------------------------------------------
+
+    def _inertial(self, body: Element, link: Link, name: str, moving: bool) -> None:
+        inertial = link.inertial
+        target = f"body[{name}]/inertial"
+        if inertial is not None and inertial.defaulted:
+            self.ctx.note(
+                "MK801",
+                f"link {link.name} has no mass information; Choreonoid's default "
+                f"{fmt(inertial.mass)} kg is written",
+                link.loc("mass"),
+                target,
+            )
+        mass = inertial.mass if inertial is not None else 0.0
+        com = np.asarray(inertial.com, dtype=float) if inertial is not None else np.zeros(3)
+        tensor = np.asarray(inertial.inertia, dtype=float) if inertial is not None else np.zeros((3, 3))
+        if moving:
+            group_mass, moments = self._weld_group(link)
+            if group_mass < SINGULAR:
+                self.ctx.note(
+                    "MK816",
+                    f"link {link.name} moves but has no mass (nor anything welded to it); "
+                    f"MuJoCo refuses that, so it gets {fmt(MIN_MASS)} kg and {fmt(MIN_INERTIA)} kg·m² "
+                    "on each axis",
+                    link.loc("mass"),
+                    target,
+                )
+                mass, com = mass + MIN_MASS, com if mass > 0.0 else np.zeros(3)
+                tensor = tensor + MIN_INERTIA * np.eye(3)
+            elif float(np.min(moments)) < SINGULAR:
+                self.ctx.note(
+                    "MK870",
+                    f"link {link.name} moves but its inertia (with what is welded to it) is "
+                    f"singular; MuJoCo refuses that, so {fmt(MIN_INERTIA)} kg·m² is added on each axis",
+                    link.loc("inertia"),
+                    target,
+                )
+                tensor = tensor + MIN_INERTIA * np.eye(3)
+        if mass > 0.0:
+            tensor = self._triangle(tensor, link, target)
+        if mass <= 0.0:
+            if inertial is None or inertial.mass == 0.0:
+                self.ctx.note(
+                    "MK816",
+                    f"link {link.name} has no mass: written as a massless body (a frame)",
+                    link.source,
+                    f"body[{name}]",
+                )
+            return
+        el = sub(body, "inertial", pos=fmt_vec(com), mass=fmt(mass))
+        off = (tensor[0, 1], tensor[0, 2], tensor[1, 2])
+        if any(v != 0.0 for v in off):
+            el.set("fullinertia", fmt_vec([tensor[0, 0], tensor[1, 1], tensor[2, 2], *off]))
+        else:
+            el.set("diaginertia", fmt_vec([tensor[0, 0], tensor[1, 1], tensor[2, 2]]))
+
+    def _triangle(self, tensor: np.ndarray, link: Link, target: str) -> np.ndarray:
+        """The tensor, or the nearest one with principal moments a + b ≥ c (MuJoCo refuses others):
+        the two smaller moments are raised equally, the axes and the largest moment kept."""
+        sym = 0.5 * (tensor + tensor.T)
+        values, vectors = np.linalg.eigh(sym)
+        a, b, c = (float(v) for v in values)
+        diagonal = not np.any(sym - np.diag(np.diag(sym)))
+        # MuJoCo checks a full tensor after its own eigen-decomposition, without tolerance: a flat
+        # plate (a + b = c exactly) fails on rounding, so a full tensor needs a small margin.
+        need = c if diagonal else c * (1.0 + PLATE_MARGIN)
+        if a + b >= need:
+            return tensor
+        delta = (need - a - b) / 2.0
+        fixed: np.ndarray = vectors @ np.diag([a + delta, b + delta, c]) @ vectors.T
+        why = (
+            "no rigid body has them; MuJoCo refuses them"
+            if a + b < c * (1.0 - PLATE_MARGIN)
+            else "a flat plate: MuJoCo's eigen-decomposition rounds it below the limit and refuses it"
+        )
+        self.ctx.note(
+            "MK870",
+            f"link {link.name}: principal moments {fmt(a)}, {fmt(b)}, {fmt(c)} violate "
+            f"a + b ≥ c ({why}); the two smaller are raised by {fmt(delta)} kg·m², the principal axes "
+            "kept",
+            link.loc("inertia"),
+            target,
+        )
+        return fixed
+
+    def _weld_group(self, link: Link) -> tuple[float, np.ndarray]:
+        """Mass and principal moments of ``link`` and every link welded to it (fixed joints down)."""
+        parts: list[tuple[float, np.ndarray, np.ndarray]] = []
+        stack: list[tuple[str, Pose]] = [(link.name, Pose())]
+        while stack:
+            name, pose = stack.pop()
+            lk = self.links.get(name)
+            if lk is None:
+                continue
+            inertial: Inertial | None = lk.inertial
+            if inertial is not None and inertial.mass > 0.0:
+                parts.append(
+                    (
+                        inertial.mass,
+                        pose.rotation @ np.asarray(inertial.com, dtype=float) + pose.translation,
+                        rotate_inertia(inertial.inertia, pose.rotation),
+                    )
+                )
+            for joint in self.children.get(name, []):
+                if joint.type not in MOVING:
+                    stack.append((joint.child, pose @ joint.origin))
+        mass, _, inertia = combine_mass_properties(parts)
+        return mass, principal_moments(inertia)

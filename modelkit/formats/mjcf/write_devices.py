@@ -1,0 +1,172 @@
+"""Sensors and lights of the MJCF writer (from ``device.canonical`` / ``canonical_params``).
+
+The model's device frame has +X forward (viewing / scanning direction), +Y left, +Z up.
+
+* Cameras (``camera``; ``depth_camera`` and ``rgbd_camera`` with MK807: MuJoCo renders depth
+  from any camera but has no depth sensor) → ``<camera>``. A MuJoCo camera looks along its −Z
+  with +Y up, so its frame is the device frame turned by R = [x: −Y, y: +Z, z: −X]. ``fovy`` is
+  the vertical field of view in degrees, 2·atan(tan(hfov/2)·height/width); ``resolution="w h"``.
+  Clip distances, frame rate and noise have no per-camera field (MK807).
+* ``lidar`` → a ``<site>`` and a ``<rangefinder>`` sensor (``cutoff`` = range_max). A rangefinder
+  casts one ray along the site's +Z, so the site is turned to put +Z on the device's +X (MK807: one
+  ray, not a scan).
+* ``imu`` → site + ``accelerometer`` + ``gyro``; ``accelerometer``/``gyro`` → site + that sensor;
+  ``force_torque`` → site + ``force`` + ``torque`` (MuJoCo measures the force between the body and
+  its parent, expressed in the site frame, as Choreonoid's force sensor does).
+* ``contact`` → left out (MK806): MuJoCo's ``touch`` needs a sensing volume the model does not
+  give.
+* Lights → ``<light type="spot|point|directional">`` at the device position, ``dir`` = the
+  device's ``direction`` in the body frame, ``diffuse`` = colour, ``intensity`` as given,
+  ``cutoff`` = outer half-angle in degrees, ``exponent`` = falloff, ``attenuation`` = (constant,
+  linear, quadratic), ``range``, ``active="false"`` when off.
+* ``other`` → left out (MK806).
+
+Sensor names are ``<device>`` (one sensor) or ``<device>_acc``/``_gyro``/``_force``/``_torque``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from modelkit.convert.context import WriteContext
+from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.formats.mjcf.write_names import NameTable
+from modelkit.formats.mjcf.write_xml import Element, set_pose, sub
+from modelkit.model import CAMERA_KINDS, LIGHT_KINDS, Device, DeviceKind, Link
+from modelkit.spatial import Pose
+
+# Columns: the MuJoCo camera's x, y, z axes in the device frame.
+CAMERA_FROM_DEVICE = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+# The rangefinder site's x, y, z axes in the device frame (its +Z is the device's +X).
+RAY_FROM_DEVICE = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+SITE_SIZE = "0.005"
+SENSORS: dict[DeviceKind, tuple[tuple[str, str], ...]] = {
+    DeviceKind.IMU: (("accelerometer", "_acc"), ("gyro", "_gyro")),
+    DeviceKind.ACCELEROMETER: (("accelerometer", ""),),
+    DeviceKind.GYRO: (("gyro", ""),),
+    DeviceKind.FORCE_TORQUE: (("force", "_force"), ("torque", "_torque")),
+    DeviceKind.LIDAR: (("rangefinder", ""),),
+}
+
+
+def vertical_fov(hfov: float, width: float | None, height: float | None) -> float:
+    if width and height:
+        return 2.0 * math.atan(math.tan(hfov / 2.0) * float(height) / float(width))
+    return hfov
+
+
+@dataclass
+class DeviceWriter:
+    ctx: WriteContext
+    names: NameTable
+    sensor: Element
+
+    def link_devices(self, body: Element, link: Link, body_name: str) -> None:
+        for device in link.devices:
+            target = f"body[{body_name}]/device[{device.name}]"
+            kind = device.canonical
+            if kind in CAMERA_KINDS:
+                self.camera(body, device, target)
+            elif kind in LIGHT_KINDS:
+                self.light(body, device, target)
+            elif kind in SENSORS:
+                self.sensors(body, device, target)
+            else:
+                what = device.kind if kind is DeviceKind.OTHER else kind.value
+                why = (
+                    "MuJoCo's touch sensor needs a sensing volume the model does not give"
+                    if kind is DeviceKind.CONTACT
+                    else "MJCF has no equivalent"
+                )
+                self.ctx.note("MK806", f"{what} device {device.name} left out: {why}", device.source, target)
+
+    def camera(self, body: Element, device: Device, target: str) -> None:
+        p = device.canonical_params
+        el = sub(body, "camera", name=self.names.claim("camera", device.name, device.source, target))
+        set_pose(el, Pose(device.pose.rotation @ CAMERA_FROM_DEVICE, device.pose.translation))
+        hfov = p.get("horizontal_fov")
+        width, height = p.get("width"), p.get("height")
+        if hfov is not None:
+            el.set("fovy", fmt(math.degrees(vertical_fov(float(hfov), width, height))))
+        if width and height:
+            el.set("resolution", f"{int(width)} {int(height)}")
+        lost = [k for k in ("near", "far", "update_rate", "noise_stddev") if p.get(k) is not None]
+        if device.canonical is not DeviceKind.CAMERA:
+            lost.insert(0, "depth image (MuJoCo renders depth from any camera, but has no depth sensor)")
+        if hfov is None:
+            lost.append("field of view not given: MuJoCo's 45° applies")
+        if lost:
+            self.ctx.note(
+                "MK807",
+                f"{device.canonical.value} {device.name} written as a <camera>; not held: " + ", ".join(lost),
+                device.source,
+                target,
+            )
+
+    def light(self, body: Element, device: Device, target: str) -> None:
+        p = device.canonical_params
+        kind = {
+            DeviceKind.SPOT_LIGHT: "spot",
+            DeviceKind.POINT_LIGHT: "point",
+            DeviceKind.DIRECTIONAL_LIGHT: "directional",
+        }[device.canonical]
+        el = sub(body, "light", name=self.names.claim("light", device.name, device.source, target), type=kind)
+        el.set("pos", fmt_vec(device.pose.translation))
+        direction = np.asarray(p.get("direction", (0.0, 0.0, -1.0)), dtype=float)
+        el.set("dir", fmt_vec(device.pose.rotation @ direction))
+        if p.get("color") is not None:
+            el.set("diffuse", fmt_vec(np.asarray(p["color"], dtype=float)[:3]))
+        if p.get("intensity") is not None:
+            el.set("intensity", fmt(float(p["intensity"])))
+        if kind == "spot" and p.get("spot_outer_angle") is not None:
+            el.set("cutoff", fmt(math.degrees(float(p["spot_outer_angle"]))))
+        if kind == "spot" and p.get("spot_falloff") is not None:
+            el.set("exponent", fmt(float(p["spot_falloff"])))
+        att = [p.get(f"attenuation_{k}") for k in ("constant", "linear", "quadratic")]
+        if any(a is not None for a in att):
+            el.set("attenuation", fmt_vec([1.0 if att[0] is None else att[0], att[1] or 0.0, att[2] or 0.0]))
+        if p.get("range") is not None and math.isfinite(float(p["range"])):
+            el.set("range", fmt(float(p["range"])))
+        if p.get("on") is False:
+            el.set("active", "false")
+        if kind == "spot" and p.get("spot_inner_angle") is not None:
+            self.ctx.note(
+                "MK807",
+                f"spot light {device.name}: the inner cone angle is not held (MuJoCo has an "
+                "outer cutoff and an exponent)",
+                device.source,
+                target,
+            )
+
+    def sensors(self, body: Element, device: Device, target: str) -> None:
+        p = device.canonical_params
+        turn = RAY_FROM_DEVICE if device.canonical is DeviceKind.LIDAR else np.eye(3)
+        site_name = self.names.claim("site", device.name, device.source, target)
+        site = sub(body, "site", name=site_name, size=SITE_SIZE)
+        set_pose(site, Pose(device.pose.rotation @ turn, device.pose.translation))
+        for element, suffix in SENSORS[device.canonical]:
+            name = self.names.claim("sensor", device.name + suffix, device.source, target)
+            el = sub(self.sensor, element, name=name, site=site_name)
+            if element == "rangefinder" and p.get("range_max") is not None:
+                el.set("cutoff", fmt(float(p["range_max"])))
+            self._noise(el, p)
+        if device.canonical is DeviceKind.LIDAR:
+            samples = p.get("horizontal_samples")
+            scan = f"; the scan had {samples} samples" if samples else ""
+            self.ctx.note(
+                "MK807",
+                f"lidar {device.name} written as one MuJoCo rangefinder ray along its forward "
+                f"axis (MuJoCo has no scanning sensor{scan})",
+                device.source,
+                target,
+            )
+
+    @staticmethod
+    def _noise(el: Element, p: dict[str, Any]) -> None:
+        noise = p.get("noise_stddev")
+        if noise is not None and float(noise) > 0.0:
+            el.set("noise", fmt(float(noise)))

@@ -1,0 +1,161 @@
+"""Geoms and mesh assets of the MJCF writer.
+
+* Collision geoms keep MuJoCo's default ``contype="1" conaffinity="1"`` (not written) and go in
+  ``group="3"``; visual geoms get ``contype="0" conaffinity="0" group="1"`` (MuJoCo's own URDF
+  importer uses group 1 for visuals). The viewer shows groups 0–2 by default, so a converted robot
+  looks like its visual model; MuJoCo collides geoms whatever their group.
+* Geoms never add mass: the compiler is told ``inertiafromgeom="false"`` and every body's mass
+  comes from its ``<inertial>`` (or is zero), so ``body_mass`` is the model's mass exactly.
+* Box ``size`` = half extents; sphere ``r``; cylinder and capsule ``r h/2`` (the model's capsule
+  length is the cylindrical part, as MuJoCo's); ellipsoid ``rx ry rz``; cones and generated
+  geometry become mesh files (MK802/MK803); COLLADA/VRML meshes are converted to STL/OBJ (MK804).
+* A mesh asset is named after its file (``wheel``), made unique with ``_2``... (MK800); one asset
+  per (file, scale). Each ``file`` is a path relative to the model file (no ``meshdir``), so the
+  output folder can be moved as a whole.
+* Colour: ``rgba`` = (diffuse, 1 − transparency); specular, emissive and textures are not written
+  (MK818).
+* Friction: a link with a contact material gets, on each collision geom, its friction against
+  Choreonoid's floor material ``Ground`` (the pair table's dynamic friction, or Choreonoid's
+  √roughness rule) with MuJoCo's default torsional and rolling values, ``friction="mu 0.005
+  0.0001"``, and an MK817 note: MuJoCo combines the two geoms of a contact by max(), so the value
+  holds against a floor whose friction is ≤ mu (set the floor's friction to 0, or add a
+  ``<contact><pair>``, to reproduce Choreonoid's pair table exactly). The robot file holds no
+  floor, so no ``<pair>`` is written.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import PurePosixPath
+
+import numpy as np
+
+from modelkit.convert.context import WriteContext
+from modelkit.convert.friction import FLOOR_MATERIAL, PairFriction
+from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.formats.mjcf.write_names import NameTable
+from modelkit.formats.mjcf.write_xml import Element, set_pose, sub
+from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere
+
+MESH_READABLE = ("stl", "obj")
+COLLISION_GROUP = "3"
+VISUAL_GROUP = "1"
+TORSIONAL, ROLLING = 0.005, 0.0001  # MuJoCo's defaults, written out with the sliding friction
+
+
+@dataclass
+class GeomWriter:
+    ctx: WriteContext
+    names: NameTable
+    asset: Element
+    friction: dict[str, PairFriction]
+    mesh_assets: dict[tuple[str, tuple[float, ...]], str] = field(default_factory=dict)
+
+    def link_geoms(self, body: Element, link: Link, body_name: str) -> None:
+        for i, geom in enumerate(link.collisions):
+            self.geom(body, geom, f"body[{body_name}]/collision[{i}]", link, collision=True)
+        for i, geom in enumerate(link.visuals):
+            self.geom(body, geom, f"body[{body_name}]/visual[{i}]", link, collision=False)
+
+    def geom(self, body: Element, geom: Geom, target: str, link: Link, collision: bool) -> None:
+        shape = self.shape(
+            geom, target, f"{link.name}_{target.rsplit('/', 1)[1].replace('[', '').rstrip(']')}"
+        )
+        if shape is None:
+            return
+        el = sub(body, "geom")
+        if geom.name:
+            el.set("name", self.names.claim("geom", geom.name, geom.source, target))
+        for key, value in shape.items():
+            el.set(key, value)
+        set_pose(el, geom.pose)
+        if collision:
+            el.set("group", COLLISION_GROUP)
+        else:
+            el.set("contype", "0")
+            el.set("conaffinity", "0")
+            el.set("group", VISUAL_GROUP)
+        self.appearance(el, geom, target)
+        if collision and link.name in self.friction:
+            self.set_friction(el, link, target)
+
+    def shape(self, geom: Geom, target: str, file_stem: str) -> dict[str, str] | None:
+        g = geom.geometry
+        if isinstance(g, Box):
+            return {"type": "box", "size": fmt_vec(np.asarray(g.size, dtype=float) / 2.0)}
+        if isinstance(g, Sphere):
+            return {"type": "sphere", "size": fmt(g.radius)}
+        if isinstance(g, Cylinder):
+            return {"type": "cylinder", "size": f"{fmt(g.radius)} {fmt(g.length / 2.0)}"}
+        if isinstance(g, Capsule):
+            return {"type": "capsule", "size": f"{fmt(g.radius)} {fmt(g.length / 2.0)}"}
+        if isinstance(g, Ellipsoid):
+            return {"type": "ellipsoid", "size": fmt_vec(g.radii)}
+        if isinstance(g, Cone):
+            ref = self.ctx.meshes.primitive(g, file_stem, target, geom.source)
+        elif isinstance(g, Mesh):
+            found = self.ctx.meshes.mesh(g, file_stem, target, geom.source, readable=MESH_READABLE)
+            if found is None:
+                return None
+            ref = found
+        else:  # pragma: no cover - the model has no other geometry
+            return None
+        return {"type": "mesh", "mesh": self.mesh_asset(ref.uri, np.asarray(ref.scale, dtype=float), target)}
+
+    def mesh_asset(self, uri: str, scale: np.ndarray, target: str) -> str:
+        key = (uri, tuple(float(x) for x in scale))
+        known = self.mesh_assets.get(key)
+        if known is not None:
+            return known
+        stem = PurePosixPath(uri).stem or "mesh"
+        name = self.names.claim("mesh", stem, None, f"asset/mesh[{stem}] (for {target})")
+        el = sub(self.asset, "mesh", name=name, file=uri)
+        if np.any(scale != 1.0):
+            el.set("scale", fmt_vec(scale))
+        self.mesh_assets[key] = name
+        return name
+
+    def appearance(self, el: Element, geom: Geom, target: str) -> None:
+        material = geom.material
+        if material is None:
+            return
+        rgba = material.rgba
+        if rgba is not None:
+            el.set("rgba", fmt_vec(rgba))
+        dropped = [
+            word
+            for word, value in (
+                ("texture", material.texture),
+                ("specular colour", material.specular),
+                ("emissive colour", material.emissive),
+                ("specular exponent", material.specular_exponent),
+            )
+            if value is not None
+        ]
+        if dropped:
+            self.ctx.note(
+                "MK818",
+                f"{', '.join(dropped)} of material {material.name or '(unnamed)'} not "
+                "written; the geom has only its rgba",
+                geom.source,
+                target,
+            )
+
+    def set_friction(self, el: Element, link: Link, target: str) -> None:
+        pair = self.friction[link.name]
+        el.set("friction", f"{fmt(pair.dynamic)} {fmt(TORSIONAL)} {fmt(ROLLING)}")
+        how = "Choreonoid's pair table" if pair.from_table else "Choreonoid's √(roughness·roughness) rule"
+        static = (
+            f" (static {fmt(pair.static)} not held: MuJoCo has one coefficient)"
+            if pair.static != pair.dynamic
+            else ""
+        )
+        self.ctx.note(
+            "MK817",
+            f"material {pair.material} against {FLOOR_MATERIAL}: sliding friction {fmt(pair.dynamic)} from "
+            f"{how}{static}; MuJoCo takes the max of both geoms' values, so it holds against a floor with "
+            f"friction ≤ {fmt(pair.dynamic)} (friction 0 on the floor reproduces the pair value; restitution "
+            f"{fmt(pair.restitution)} is not written)",
+            link.loc("material"),
+            f"body[{target.split('[', 1)[1].split(']', 1)[0]}]",
+        )

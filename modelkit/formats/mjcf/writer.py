@@ -1,0 +1,218 @@
+"""The MJCF (MuJoCo XML) writer: ``write_mjcf(robot, ctx) -> bytes``.
+
+The file is built with lxml, 2-space indented, sections in a fixed order (``compiler``,
+``asset``, ``worldbody``, ``equality``, ``actuator``, ``sensor``; empty ones left out); numbers
+through :func:`modelkit.convert.numbers.fmt`. MuJoCo is not imported here.
+
+* ``<compiler angle="radian" autolimits="true" inertiafromgeom="false"/>``: angles in radians,
+  a ``range`` makes a joint limited, and inertia comes from the ``<inertial>`` elements only (geoms
+  never add mass). No ``meshdir``: each mesh ``file`` is relative to the model file. No
+  ``<option>``: the timestep, integrator and gravity are MuJoCo's defaults.
+* The body tree, joints and inertials: :mod:`.write_bodies`; geoms, meshes, colours and friction:
+  :mod:`.write_geoms`; sensors and lights: :mod:`.write_devices`.
+* Mimic joints → ``<equality><joint joint1=follower joint2=leader polycoef="offset multiplier 0 0
+  0"/>`` (MK812 when the leader is not a written hinge/slide).
+* Closed loops (``robot.loops``) → equality constraints between sites placed at the loop joint's
+  frame in each link (``<link>_<loop>``): fixed → ``weld``, ball → ``connect``, hinge → two
+  ``connect`` at ±``HINGE_HALF_SPAN`` m along the axis (as Choreonoid's MuJoCo plugin; MK811),
+  piston → left out (MK810).
+* Actuators: a ``<motor>`` (gear 1: the control is the joint torque or force) on every hinge and slide
+  that is not a mimic follower, named after the joint, ``ctrlrange`` = ±effort when the effort limit
+  is finite. With zero control a motor applies no force, so the passive model is unchanged.
+* Self-collision follows MuJoCo's defaults (parent–child and welded pairs never collide).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from lxml import etree
+
+from modelkit.convert.context import WriteContext
+from modelkit.convert.friction import floor_friction
+from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.formats.mjcf.write_bodies import BodyTree
+from modelkit.formats.mjcf.write_devices import DeviceWriter
+from modelkit.formats.mjcf.write_geoms import GeomWriter
+from modelkit.formats.mjcf.write_names import NameTable
+from modelkit.formats.mjcf.write_xml import set_pose, sub
+from modelkit.model import WORLD_LINK, JointType, LoopConstraint, Robot
+from modelkit.spatial import Pose
+
+SECTIONS = ("compiler", "asset", "worldbody", "equality", "actuator", "sensor")
+HINGE_HALF_SPAN = 0.05  # m: the two connects of a hinge loop sit this far either side of the joint
+
+
+def write_mjcf(robot: Robot, ctx: WriteContext) -> bytes:
+    return MjcfWriter(robot, ctx).write()
+
+
+class MjcfWriter:
+    def __init__(self, robot: Robot, ctx: WriteContext) -> None:
+        self.robot = robot
+        self.ctx = ctx
+        self.names = NameTable(ctx)
+        self.root = etree.Element("mujoco", model=robot.name)
+        self.sections = {tag: sub(self.root, tag) for tag in SECTIONS}
+        compiler = self.sections["compiler"]
+        compiler.set("angle", "radian")
+        compiler.set("autolimits", "true")
+        compiler.set("inertiafromgeom", "false")
+        self.geoms = GeomWriter(ctx, self.names, self.sections["asset"], floor_friction(robot))
+        self.devices = DeviceWriter(ctx, self.names, self.sections["sensor"])
+        self.tree = BodyTree(robot, ctx, self.names, self.geoms, self.devices)
+
+    def write(self) -> bytes:
+        self.tree.write(self.sections["worldbody"])
+        self._joint_ids()
+        self._mimics()
+        for joint, value in self.tree.locked:
+            sub(
+                self.sections["equality"],
+                "joint",
+                name=self.names.claim("equality", f"{joint}_locked"),
+                joint1=joint,
+                polycoef=f"{fmt(value)} 0 0 0 0",
+            )
+        for loop in self.robot.loops:
+            self._loop(loop)
+        self._actuators()
+        for tag in SECTIONS:
+            el = self.sections[tag]
+            if tag not in ("compiler", "worldbody") and len(el) == 0:
+                self.root.remove(el)
+        etree.indent(self.root, space="  ")
+        text: bytes = etree.tostring(self.root, xml_declaration=False, encoding="utf-8", pretty_print=True)
+        return text
+
+    # -- joints across the tree ----------------------------------------------------------------
+
+    def _joint_ids(self) -> None:
+        ids = [j for j in self.robot.joints if j.joint_id is not None]
+        if ids:
+            self.ctx.note(
+                "MK820",
+                f"joint ids of {len(ids)} joint(s) not written (MuJoCo numbers joints in tree order)",
+                ids[0].loc("joint_id"),
+                "worldbody",
+            )
+
+    def _mimics(self) -> None:
+        written = set(self.tree.scalar_joints)
+        for joint in self.robot.joints:
+            mimic = joint.mimic
+            if mimic is None:
+                continue
+            follower = self.tree.joint_names.get(joint.name, [])
+            leader = self.tree.joint_names.get(mimic.joint, [])
+            target = f"equality/joint[{joint.name}]"
+            if (
+                len(follower) != 1
+                or len(leader) != 1
+                or follower[0] not in written
+                or leader[0] not in written
+            ):
+                self.ctx.note(
+                    "MK812",
+                    f"joint {joint.name} mimics {mimic.joint}, but MuJoCo's joint equality needs "
+                    "two hinge or slide joints; left out",
+                    mimic.source or joint.source,
+                    target,
+                )
+                continue
+            sub(
+                self.sections["equality"],
+                "joint",
+                name=self.names.claim("equality", f"{joint.name}_mimic"),
+                joint1=follower[0],
+                joint2=leader[0],
+                polycoef=f"{fmt(mimic.offset)} {fmt(mimic.multiplier)} 0 0 0",
+            )
+
+    def _loop(self, loop: LoopConstraint) -> None:
+        target = f"equality/{loop.name}"
+        bodies = self.tree.bodies
+        missing = [n for n in (loop.link1, loop.link2) if n not in bodies and n != WORLD_LINK]
+        if missing:
+            self.ctx.note(
+                "MK810",
+                f"closed loop {loop.name}: link {missing[0]} is not written; left out",
+                loop.source,
+                target,
+            )
+            return
+        if loop.type == "piston":
+            self.ctx.note(
+                "MK810",
+                f"closed loop {loop.name} is a piston joint; MuJoCo has no equality for it, left out",
+                loop.source,
+                target,
+            )
+            return
+        equality = self.sections["equality"]
+        if loop.type in ("fixed", "ball"):
+            s1 = self._site(loop.link1, loop.pose_in_link1, f"{loop.name}_1", loop)
+            s2 = self._site(loop.link2, loop.pose_in_link2, f"{loop.name}_2", loop)
+            tag = "weld" if loop.type == "fixed" else "connect"
+            sub(
+                equality,
+                tag,
+                name=self.names.claim("equality", loop.name, loop.source, target),
+                site1=s1,
+                site2=s2,
+            )
+            return
+        if loop.type != "hinge":
+            self.ctx.note(
+                "MK810",
+                f"closed loop {loop.name} of type {loop.type}: no MuJoCo equality; left out",
+                loop.source,
+                target,
+            )
+            return
+        axis = np.asarray(loop.axis, dtype=float)
+        axis = axis / float(np.linalg.norm(axis))
+        for sign, suffix in ((1.0, "a"), (-1.0, "b")):
+            shift = Pose(np.eye(3), sign * HINGE_HALF_SPAN * axis)
+            s1 = self._site(loop.link1, loop.pose_in_link1 @ shift, f"{loop.name}_{suffix}1", loop)
+            s2 = self._site(loop.link2, loop.pose_in_link2 @ shift, f"{loop.name}_{suffix}2", loop)
+            sub(
+                equality,
+                "connect",
+                name=self.names.claim("equality", f"{loop.name}_{suffix}", loop.source, target),
+                site1=s1,
+                site2=s2,
+            )
+        self.ctx.note(
+            "MK811",
+            f"closed hinge loop {loop.name} written as two connect constraints "
+            f"{fmt(HINGE_HALF_SPAN)} m either side of the joint on its axis",
+            loop.source,
+            target,
+        )
+
+    def _site(self, link: str, pose: Pose, wanted: str, loop: LoopConstraint) -> str:
+        parent = self.tree.bodies.get(link, self.sections["worldbody"])
+        name = self.names.claim("site", wanted, loop.source, f"site[{wanted}]")
+        el = sub(parent, "site", name=name, size="0.005")
+        set_pose(el, pose)
+        return name
+
+    def _actuators(self) -> None:
+        followers = {j.name for j in self.robot.joints if j.mimic is not None}
+        followers |= {j.name for j in self.robot.joints if j.limits.lower == j.limits.upper}
+        by_name = {j.name: j for j in self.robot.joints}
+        for model_name, written in self.tree.joint_names.items():
+            joint = by_name.get(model_name)
+            if joint is None or joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
+                continue
+            if model_name in followers:
+                continue
+            el = sub(
+                self.sections["actuator"],
+                "motor",
+                name=self.names.claim("actuator", written[0], joint.source, f"actuator[{written[0]}]"),
+                joint=written[0],
+            )
+            effort = joint.limits.effort
+            if np.isfinite(effort) and effort > 0.0:
+                el.set("ctrlrange", fmt_vec([-effort, effort]))
