@@ -129,7 +129,9 @@ def test_devices_camera_range_sensor_light() -> None:
     assert (camera.params["width"], camera.params["height"]) == (320, 240)
     np.testing.assert_allclose(camera.params["field_of_view"], 62 * DEG)
     # rotation [[0,1,0,90],[0,0,1,-90]] with the cv optical frame: the camera looks along link +X.
-    np.testing.assert_allclose(camera.pose.rotation @ [0, 0, 1], [1, 0, 0], atol=1e-12)
+    # The device pose is the canonical robotics sensor frame (+X viewing, +Z image up; model.DeviceKind).
+    np.testing.assert_allclose(camera.pose.rotation @ [1, 0, 0], [1, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(camera.pose.rotation @ [0, 0, 1], [0, 0, 1], atol=1e-12)
     np.testing.assert_allclose(camera.pose.translation, [0.06, 0.0, -0.02])
     light = devices["Light"]
     assert light.kind == "SpotLight"

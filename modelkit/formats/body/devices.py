@@ -1,4 +1,5 @@
-"""Device parameters of `.body` files, as data: canonical name, accepted spellings, kind, default.
+"""Device parameters of `.body` files, as data: canonical name, accepted spellings, kind, default;
+and their mapping to the shared device model (:class:`~modelkit.model.DeviceKind`, robotics frame).
 
 Kinds: ``number``, ``angle`` (converted by the angle unit), ``int``, ``bool``, ``text``,
 ``vec3``, ``angle_rotation`` (axis-angle, angle converted). Parameters not listed are kept raw.
@@ -9,8 +10,13 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
+
 from modelkit.diagnostics import DiagnosticSink
 from modelkit.formats.body import values as v
+from modelkit.formats.devices import GL_IN_ROBOTICS, canonical_from_gl, horizontal_fov
+from modelkit.model import DeviceKind
+from modelkit.spatial import Mat3
 from modelkit.yamltree import YMap, to_plain
 
 INF3 = (math.inf, math.inf, math.inf)
@@ -200,3 +206,129 @@ def _range_sensor(node: YMap, angle_scale: float, params: dict[str, Any]) -> set
         params[f"{axis}_step"] = step
         params[f"{axis}_samples"] = samples
     return used
+
+
+# ---- the canonical device model (DeviceKind) -------------------------------------------------
+
+# R_opt of each `optical_frame` (body-format.md §3.7): columns are the GL camera frame's axes in
+# the device frame, T_glcam = T_device · R_opt · Rot(optical_frame_rotation).
+OPTICAL_FRAMES: dict[str, Mat3] = {
+    "gl": np.eye(3),
+    "cv": np.diag([1.0, -1.0, -1.0]),
+    "robotics": GL_IN_ROBOTICS,
+}
+OPTICAL_DEVICES = frozenset({"Camera", "CameraDevice", "RangeSensor"})
+CANONICAL_CAMERAS = {
+    "COLOR": DeviceKind.CAMERA,
+    "DEPTH": DeviceKind.DEPTH_CAMERA,
+    "POINT_CLOUD": DeviceKind.DEPTH_CAMERA,
+    "COLOR_DEPTH": DeviceKind.RGBD_CAMERA,
+    "COLOR_POINT_CLOUD": DeviceKind.RGBD_CAMERA,
+}
+CANONICAL_KINDS = {
+    "RangeSensor": DeviceKind.LIDAR,
+    "IMU": DeviceKind.IMU,
+    "AccelerationSensor": DeviceKind.ACCELEROMETER,
+    "RateGyroSensor": DeviceKind.GYRO,
+    "ForceSensor": DeviceKind.FORCE_TORQUE,
+    "SpotLight": DeviceKind.SPOT_LIGHT,
+    "PointLight": DeviceKind.POINT_LIGHT,
+}
+
+
+def canonical_rotation(kind: str, params: dict[str, Any], rotation: Mat3) -> Mat3:
+    """The canonical (robotics) sensor frame of a device whose node frame has ``rotation``.
+
+    Cameras and range sensors look through their optical frame: the GL camera frame is
+    R·R_opt·R_ofr, and the canonical frame is that times GL_IN_ROBOTICSᵀ (§8.7). Other devices'
+    frames are their node frames.
+    """
+    if kind not in OPTICAL_DEVICES:
+        return rotation
+    r_opt = OPTICAL_FRAMES.get(str(params.get("optical_frame", "gl")), np.eye(3))
+    extra = params.get("optical_frame_rotation")
+    if extra is not None:
+        r_opt = r_opt @ np.asarray(extra, dtype=float)
+    return canonical_from_gl(rotation @ r_opt)
+
+
+def node_rotation(kind: str, params: dict[str, Any], canonical: Mat3) -> Mat3:
+    """The inverse of :func:`canonical_rotation`: the node rotation a `.body` writer writes back,
+    given the device's ``optical_frame`` / ``optical_frame_rotation`` words in ``params``."""
+    identity = np.eye(3)
+    return np.asarray(canonical, dtype=float) @ canonical_rotation(kind, params, identity).T
+
+
+def canonical_device(kind: str, params: dict[str, Any]) -> tuple[DeviceKind, dict[str, Any]]:
+    """The device in the shared vocabulary: canonical kind and parameters (SI, radians).
+
+    Values that mean "no effect" in Choreonoid (infinite limits, zero noise, detection rate 1)
+    are left out; everything else Choreonoid defines by default is filled in.
+    """
+    if kind in ("Camera", "CameraDevice"):
+        canonical = CANONICAL_CAMERAS.get(str(params.get("format")), DeviceKind.OTHER)
+        return canonical, (_camera(params, canonical) if canonical is not DeviceKind.OTHER else {})
+    canonical = CANONICAL_KINDS.get(kind, DeviceKind.OTHER)
+    out: dict[str, Any] = {}
+    if canonical is DeviceKind.LIDAR:
+        out = {
+            "horizontal_samples": params["yaw_samples"],
+            "horizontal_min_angle": params["min_yaw_angle"] + 0.0,
+            "horizontal_max_angle": params["max_yaw_angle"],
+            "vertical_samples": params["pitch_samples"],
+            "vertical_min_angle": params["min_pitch_angle"] + 0.0,  # no -0.0 from -range/2
+            "vertical_max_angle": params["max_pitch_angle"],
+            "range_min": params["min_distance"],
+            "range_max": params["max_distance"],
+            "update_rate": params["scan_rate"],
+        }
+        _noise(params, out)
+    elif canonical in (DeviceKind.IMU, DeviceKind.ACCELEROMETER, DeviceKind.GYRO, DeviceKind.FORCE_TORQUE):
+        for key in ("max_acceleration", "max_angular_velocity", "max_force", "max_torque"):
+            value = params.get(key)
+            if value is not None and all(math.isfinite(x) for x in value):
+                out[key] = tuple(value)
+    elif canonical in (DeviceKind.SPOT_LIGHT, DeviceKind.POINT_LIGHT):
+        constant, linear, quadratic = params["attenuation"]
+        out = {
+            "color": tuple(params["color"]),
+            "intensity": params["intensity"],
+            "attenuation_constant": constant,
+            "attenuation_linear": linear,
+            "attenuation_quadratic": quadratic,
+            "on": params["on"],
+        }
+        if canonical is DeviceKind.SPOT_LIGHT:
+            # VRML/Choreonoid: beam_width is the full-intensity inner half-angle, cut_off_angle the
+            # outer one, both from the beam axis; a beam wider than the cut-off acts as the cut-off.
+            out["direction"] = tuple(params["direction"])
+            out["spot_inner_angle"] = min(params["beam_width"], params["cut_off_angle"])
+            out["spot_outer_angle"] = params["cut_off_angle"]
+            out["spot_falloff"] = params["cut_off_exponent"]
+    return canonical, out
+
+
+def _camera(params: dict[str, Any], canonical: DeviceKind) -> dict[str, Any]:
+    width, height, fov = params["width"], params["height"], params["field_of_view"]
+    # field_of_view is the shorter side's (§3.7): the vertical one unless the image is taller than wide.
+    hfov = fov if width < height else horizontal_fov(fov, width, height)
+    out: dict[str, Any] = {
+        "width": width,
+        "height": height,
+        "horizontal_fov": hfov,
+        "near": params["near_clip_distance"],
+        "far": params["far_clip_distance"],
+        "update_rate": params["frame_rate"],
+    }
+    if canonical is not DeviceKind.CAMERA:  # a RangeCamera: depth range and noise
+        out["range_min"] = params["min_distance"]
+        out["range_max"] = params["max_distance"]
+        _noise(params, out)
+    return out
+
+
+def _noise(params: dict[str, Any], out: dict[str, Any]) -> None:
+    if params.get("error_deviation"):
+        out["noise_stddev"] = params["error_deviation"]
+    if params.get("detection_rate", 1.0) != 1.0:
+        out["detection_rate"] = params["detection_rate"]

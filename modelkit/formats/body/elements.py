@@ -230,11 +230,13 @@ def _add_device(kind: str, node: YMap, affine: np.ndarray, out: Collected, ctx: 
     if device_id is not None:
         params["id"] = device_id
     pose, _ = split_affine(affine)
-    out.devices.append(
-        Device(
-            kind, name, pose if pose is not None else Pose(np.eye(3), affine[:3, 3].copy()), params, node.loc
-        )
-    )
+    if pose is None:
+        pose = Pose(np.eye(3), affine[:3, 3].copy())
+    # The canonical device model: the pose becomes the robotics sensor frame (§8.7); the source's
+    # optical_frame words stay in params for the .body writer.
+    pose = Pose(dev.canonical_rotation(kind, params, pose.rotation), pose.translation)
+    canonical, canonical_params = dev.canonical_device(kind, params)
+    out.devices.append(Device(kind, name, pose, params, node.loc, canonical, canonical_params))
 
 
 # ---- shapes ----------------------------------------------------------------------------------

@@ -27,6 +27,7 @@ from modelkit.formats.meshref import not_found
 from modelkit.formats.mjcf.bodies import MjBody, MjGeom
 from modelkit.formats.mjcf.build import Built, RobotBuilder, apply_joint_equalities, quoted
 from modelkit.formats.mjcf.compiled import CompiledModel, mesh_path
+from modelkit.formats.mjcf.devices import add_devices
 from modelkit.formats.mjcf.errors import error_location, error_text
 from modelkit.formats.mjcf.source import SourceIndex, TreeShape, locate, pair
 from modelkit.formats.mjcf.uncompiled import SpecReader
@@ -242,6 +243,7 @@ class _MjcfReader:
             main.extras.update(data)
 
         def attached(key: str) -> int:
+            add_devices(reader.mj, reader.m, builder, built)  # the same, as canonical devices on links
             return sum(len(r.extras.get(key, [])) for r in built.robots)
 
         counts = {

@@ -4,7 +4,9 @@ A sensor becomes ``Device(kind=<its type as written>)``; cameras and range senso
 main parameters under flat snake_case names (``width``, ``horizontal_fov``, ``range_max`` ...),
 and every sensor keeps its whole type-specific element as ``params["config"]``. A light becomes
 ``Device(kind="light:<type>")``. Plugins are simulator code: they are kept verbatim as data.
-The caller places devices (their pose is set when the link frame is known).
+Every device also gets its canonical kind and parameters (:mod:`modelkit.formats.devices`; SDF's
+sensor frame is the canonical one). The caller places devices (their pose is set when the link
+frame is known).
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.diagnostics import did_you_mean
+from modelkit.formats.devices import sdf_light_canonical, sdf_sensor_canonical
 from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.document import SdfDocument
 from modelkit.formats.sdf.geometry import element_data
@@ -150,7 +153,15 @@ def sensor_device(ctx: Context, src: SdfDocument, el: Element, owner: str) -> De
     plugins = [plugin_data(ctx, src, p, f'sensor "{name}"') for p in children(el, "plugin")]
     if plugins:
         params["plugins"] = plugins
-    return Device(kind=kind, name=name, params=params, source=values.loc(el))
+    canonical, canonical_params = sdf_sensor_canonical(el)
+    return Device(
+        kind,
+        name,
+        params=params,
+        source=values.loc(el),
+        canonical=canonical,
+        canonical_params=canonical_params,
+    )
 
 
 def _camera(src: SdfDocument, camera: Element) -> dict[str, Any]:
@@ -238,4 +249,12 @@ def light_device(ctx: Context, src: SdfDocument, el: Element, owner: str) -> Dev
             value = values.number(child(spot, key))
             if value is not None:
                 params[f"spot_{key}"] = value
-    return Device(kind=f"light:{kind}", name=name, params=params, source=values.loc(el))
+    canonical, canonical_params = sdf_light_canonical(el)
+    return Device(
+        f"light:{kind}",
+        name,
+        params=params,
+        source=values.loc(el),
+        canonical=canonical,
+        canonical_params=canonical_params,
+    )

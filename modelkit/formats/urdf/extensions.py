@@ -20,6 +20,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.diagnostics import did_you_mean
+from modelkit.formats.devices import sdf_sensor_canonical
 from modelkit.formats.urdf.values import Context
 from modelkit.model import Device, Robot
 from modelkit.spatial import Pose, matrix_from_rpy
@@ -123,7 +124,10 @@ def _sensor(ctx: Context, element: Element) -> Device | None:
             ctx.loc(element),
         )
         return None
-    device = Device(kind=kind, name=name, source=ctx.loc(element))
+    canonical, canonical_params = sdf_sensor_canonical(element)  # the same content as an SDF <sensor>
+    device = Device(
+        kind, name, source=ctx.loc(element), canonical=canonical, canonical_params=canonical_params
+    )
     device.params["xml"] = canonical_xml(element)
     for key in ("update_rate", "always_on", "visualize", "topic"):
         child = ctx.first(element, key)
