@@ -89,7 +89,7 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
             yield diag(
                 "MK300", f'link "{link.name}" has a negative mass ({inertial.mass:g} kg)', _mass_loc(link)
             )
-        elif inertial.mass == 0 and link.name in moving:
+        elif inertial.mass == 0 and link.name in moving and merged.get(link.name, 0.0) <= 0.0:
             yield diag("MK313", f'link "{link.name}" moves but its mass is zero', _mass_loc(link))
 
 
