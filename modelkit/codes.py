@@ -33,6 +33,18 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK003", "not-text", "error", "The file is not UTF-8/UTF-16 text (binary data or a bad encoding)."
     ),
     CodeInfo("MK004", "empty-document", "error", "The file contains no YAML document."),
+    CodeInfo(
+        "MK005",
+        "model-too-large",
+        "error",
+        "A model has more links or joints than the limit (`--max-links`); it is not read further.",
+    ),
+    CodeInfo(
+        "MK006",
+        "list-too-long",
+        "error",
+        "A YAML list has more items than the limit (`--max-list-items`); the document is refused.",
+    ),
     CodeInfo("MK010", "yaml-syntax", "error", "The YAML is malformed."),
     CodeInfo(
         "MK011",
@@ -256,6 +268,12 @@ _TABLE: tuple[CodeInfo, ...] = (
         "info",
         "The worldbody holds several body trees; each becomes a robot of its own.",
     ),
+    CodeInfo(
+        "MK177",
+        "mjcf-warning",
+        "warning",
+        "MuJoCo warned while reading the file (its message is given; nothing goes to MUJOCO_LOG.TXT).",
+    ),
     # -- MK2xx: kinematic tree --------------------------------------------------------------
     CodeInfo("MK200", "no-root", "error", "No root link can be found (every link has a parent, or a cycle)."),
     CodeInfo("MK201", "multiple-roots", "error", "More than one link has no parent."),
@@ -274,7 +292,10 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK211",
         "link-joint-name-collision",
         "error",
-        "A link and a joint share a name (fatal in SDF 1.7+ and Gazebo).",
+        "A link and a joint share a name. Reference: libsdformat refuses it in SDFormat 1.7+ (an error "
+        "there); URDF (check_urdf, PyBullet), SDFormat < 1.7 and .body load it (a warning naming "
+        "libsdformat's URDF conversion, an error under `--target sdf`); MuJoCo keeps bodies and joints "
+        "apart (info).",
     ),
     CodeInfo(
         "MK212",
@@ -393,15 +414,24 @@ _TABLE: tuple[CodeInfo, ...] = (
     ),
     # -- MK3xx: mass properties, joints, transforms ---------------------------------------------
     CodeInfo("MK300", "mass-not-positive", "error", "A link's mass is zero or negative."),
-    CodeInfo("MK301", "inertia-asymmetric", "error", "A 9-element inertia matrix is not symmetric."),
+    CodeInfo(
+        "MK301",
+        "inertia-asymmetric",
+        "error",
+        "A 9-element inertia matrix is not symmetric: an off-diagonal pair differs by more than 1e-4 of "
+        "the largest diagonal moment (less is rounding, ignored). Reference: only .body has 9 elements; "
+        "Choreonoid uses the matrix as given, which no rigid body has.",
+    ),
     CodeInfo(
         "MK302", "inertia-not-positive-definite", "error", "An inertia tensor is not positive definite."
     ),
     CodeInfo(
         "MK303",
         "inertia-triangle-inequality",
-        "error",
-        "Principal moments violate the triangle inequality (physically impossible).",
+        "warning",
+        "Principal moments violate the triangle inequality (physically impossible). Reference: "
+        "Choreonoid, check_urdf and PyBullet load it (a warning); MuJoCo and libsdformat refuse it (an "
+        "error in MJCF and SDF files, and under `--target mjcf|sdf`).",
     ),
     CodeInfo(
         "MK304",
@@ -582,7 +612,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "A resource `node` fragment does not exist in the file.",
     ),
-    CodeInfo("MK503", "uri-scheme-unsupported", "error", "A URI scheme is not supported here."),
+    CodeInfo(
+        "MK503",
+        "uri-scheme-unsupported",
+        "error",
+        "A URI scheme is not supported here. An SDF `<include>` of an `https://` (Gazebo Fuel) URI is an "
+        "info: Gazebo downloads it when it loads the world, modelkit does not fetch or check it.",
+    ),
     CodeInfo(
         "MK504", "package-not-found", "error", "A `package://` URI names a package that cannot be found."
     ),

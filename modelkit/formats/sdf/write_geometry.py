@@ -1,0 +1,145 @@
+"""Visuals and collisions of the SDF writer: shapes, meshes, materials and contact friction.
+
+Box, sphere and cylinder are native in every SDF version, capsule and ellipsoid from SDFormat 1.8;
+a cone (never native) and, before 1.8, a capsule or ellipsoid are written as meshes (MK802).
+"""
+
+from __future__ import annotations
+
+from lxml.etree import _Element as Element
+
+from modelkit.convert.context import WriteContext
+from modelkit.convert.friction import PairFriction
+from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.formats.sdf.write_xml import add_pose, num, rgba, sub
+from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere
+from modelkit.spatial import Pose
+
+MESH_READABLE = ("stl", "obj", "dae")
+
+
+class GeomWriter:
+    def __init__(self, ctx: WriteContext, version: tuple[int, int]) -> None:
+        self.ctx = ctx
+        self.version = version
+
+    def link_geoms(
+        self,
+        el: Element,
+        link: Link,
+        written: str,
+        offset: Pose,
+        relative_to: str | None,
+        friction: PairFriction | None,
+    ) -> None:
+        """Write the link's visuals and collisions under ``el``; ``offset`` maps link-frame poses to
+        the frame the pose is written in (identity when the link frame is the written frame)."""
+        for kind, geoms in (("visual", link.visuals), ("collision", link.collisions)):
+            used: set[str] = set()
+            for index, geom in enumerate(geoms):
+                name = _unique(geom.name or f"{kind}_{index}", used)
+                target = f"link[{written}]/{kind}[{name}]"
+                shape = sub(el, kind, name=name)
+                add_pose(shape, offset @ geom.pose, relative_to)
+                if not self._geometry(shape, geom, f"{written}_{kind}_{name}", target):
+                    el.remove(shape)
+                    continue
+                if kind == "visual":
+                    self._material(shape, geom, target)
+                elif friction is not None:
+                    self._friction(shape, friction, link, target)
+
+    def _geometry(self, parent: Element, geom: Geom, mesh_name: str, target: str) -> bool:
+        g = geom.geometry
+        el = sub(parent, "geometry")
+        native_18 = self.version >= (1, 8)
+        if isinstance(g, Box):
+            sub(sub(el, "box"), "size", fmt_vec(g.size))
+        elif isinstance(g, Sphere):
+            num(sub(el, "sphere"), "radius", g.radius)
+        elif isinstance(g, Cylinder):
+            shape = sub(el, "cylinder")
+            num(shape, "radius", g.radius)
+            num(shape, "length", g.length)
+        elif isinstance(g, Capsule) and native_18:
+            shape = sub(el, "capsule")
+            num(shape, "radius", g.radius)
+            num(shape, "length", g.length)
+        elif isinstance(g, Ellipsoid) and native_18:
+            sub(sub(el, "ellipsoid"), "radii", fmt_vec(g.radii))
+        elif isinstance(g, Capsule | Ellipsoid | Cone):
+            ref = self.ctx.meshes.primitive(g, mesh_name, target, geom.source)
+            mesh = sub(el, "mesh")
+            sub(mesh, "uri", ref.uri)
+        elif isinstance(g, Mesh):
+            found = self.ctx.meshes.mesh(g, mesh_name, target, geom.source, readable=MESH_READABLE)
+            if found is None:
+                return False
+            mesh = sub(el, "mesh")
+            sub(mesh, "uri", found.uri)
+            if any(abs(float(s) - 1.0) > 0.0 for s in found.scale):
+                sub(mesh, "scale", fmt_vec(found.scale))
+        else:  # pragma: no cover - the model has no other geometry
+            return False
+        return True
+
+    def _material(self, visual: Element, geom: Geom, target: str) -> None:
+        material = geom.material
+        if material is None:
+            return
+        if material.transparency:
+            num(visual, "transparency", material.transparency)
+        if material.diffuse is None and material.specular is None and material.emissive is None:
+            return
+        el = sub(visual, "material")
+        if material.diffuse is not None:
+            ambient = material.ambient if material.ambient is not None else 1.0
+            sub(
+                el,
+                "ambient",
+                rgba([ambient * float(c) for c in material.diffuse], 1.0 - material.transparency),
+            )
+            sub(el, "diffuse", rgba(material.diffuse, 1.0 - material.transparency))
+        if material.specular is not None:
+            sub(el, "specular", rgba(material.specular))
+        if material.emissive is not None:
+            sub(el, "emissive", rgba(material.emissive))
+        if material.texture:
+            self.ctx.note(
+                "MK818",
+                f"texture {material.texture} is not carried over; the colours are",
+                geom.source,
+                target,
+            )
+
+    def _friction(self, collision: Element, friction: PairFriction, link: Link, target: str) -> None:
+        surface = sub(collision, "surface")
+        if friction.restitution > 0.0:
+            num(sub(surface, "bounce"), "restitution_coefficient", friction.restitution)
+        ode = sub(sub(surface, "friction"), "ode")
+        num(ode, "mu", friction.static)
+        num(ode, "mu2", friction.static)
+        how = "from Choreonoid's material table" if friction.from_table else "by Choreonoid's √ rule"
+        self.ctx.note(
+            "MK817",
+            f'link "{link.name}" (material {friction.material}): friction against {friction.against} '
+            f"({how}) is written as this collision's <mu>/<mu2> = {fmt(friction.static)}"
+            + (
+                f" (dynamic {fmt(friction.dynamic)} has no field)"
+                if friction.dynamic != friction.static
+                else ""
+            )
+            + "; Gazebo combines the two surfaces of a contact (ODE: the smaller mu; other engines may "
+            "multiply), so the pair value holds only against a surface with a larger coefficient",
+            link.loc("material"),
+            target,
+        )
+
+
+def _unique(name: str, used: set[str]) -> str:
+    new, count = name, 2
+    while new in used:
+        new = f"{name}_{count}"
+        count += 1
+    used.add(new)
+    return new

@@ -1,0 +1,105 @@
+"""Small XML helpers of the SDF writer: elements with text, poses, colours, data back to elements."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from lxml import etree
+from lxml.etree import _Element as Element
+
+from modelkit.convert.numbers import clean, fmt, fmt_vec
+from modelkit.spatial import Mat3, Pose
+
+
+def sub(parent: Element, tag: str, text: str | None = None, **attrib: str) -> Element:
+    """A child element (attributes in the given order) with optional text."""
+    el = etree.SubElement(parent, tag)
+    for key, value in attrib.items():
+        el.set(key, value)
+    if text is not None:
+        el.text = text
+    return el
+
+
+def num(parent: Element, tag: str, value: float) -> Element:
+    return sub(parent, tag, fmt(value))
+
+
+def rpy(rotation: Mat3) -> tuple[float, float, float]:
+    """Fixed-axis roll, pitch, yaw of R = Rz·Ry·Rx, accurate near pitch = ±90° (atan2, not asin)."""
+    r = np.asarray(rotation, dtype=float)
+    pitch = math.atan2(-float(r[2, 0]), math.hypot(float(r[0, 0]), float(r[1, 0])))
+    if math.hypot(float(r[0, 0]), float(r[1, 0])) > 1e-12:
+        roll = math.atan2(float(r[2, 1]), float(r[2, 2]))
+        yaw = math.atan2(float(r[1, 0]), float(r[0, 0]))
+    else:  # gimbal lock: everything into yaw
+        roll = 0.0
+        yaw = math.atan2(-float(r[0, 1]), float(r[1, 1]))
+    return clean(roll), clean(pitch), clean(yaw)
+
+
+def pose_text(pose: Pose) -> str:
+    t = [clean(float(v)) for v in pose.translation]
+    return fmt_vec([*t, *rpy(pose.rotation)])
+
+
+def add_pose(parent: Element, pose: Pose, relative_to: str | None = None, always: bool = False) -> None:
+    """A ``<pose>`` child; left out when it is the identity in the default frame (unless ``always``)."""
+    if relative_to is None and not always and pose.is_identity(0.0):
+        return
+    el = sub(parent, "pose", pose_text(pose))
+    if relative_to is not None:
+        el.set("relative_to", relative_to)
+
+
+def rgba(values: Any, alpha: float = 1.0) -> str:
+    v = [float(x) for x in values]
+    if len(v) == 3:
+        v.append(alpha)
+    return fmt_vec(v)
+
+
+def data_to_element(parent: Element, tag: str, data: Any) -> Element:
+    """The inverse of the reader's ``element_data``: dicts are children (``@x`` attributes,
+    ``#text`` text), lists are repeated children, numbers are printed with ``fmt``."""
+    el = etree.SubElement(parent, tag)
+    if isinstance(data, dict):
+        for key, value in data.items():
+            if key.startswith("@"):
+                el.set(key[1:], str(value))
+        text = data.get("#text")
+        if text is not None:
+            el.text = _scalar_text(text)
+        for key, value in data.items():
+            if key.startswith(("@", "#")):
+                continue
+            for item in value if isinstance(value, list) and _is_repeat(value) else [value]:
+                data_to_element(el, key, item)
+    else:
+        el.text = _scalar_text(data)
+    return el
+
+
+def _is_repeat(value: list[Any]) -> bool:
+    """A list of children (dicts or strings), not the numbers of one vector element."""
+    return any(isinstance(v, dict | str) for v in value)
+
+
+def _scalar_text(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return fmt(float(value)) if math.isfinite(float(value)) else str(value)
+    if isinstance(value, list):
+        return " ".join(_scalar_text(v) for v in value)
+    return str(value)
+
+
+def parse_fragment(xml: str) -> Element | None:
+    """A verbatim element kept by a reader (a plugin), or None when it does not parse on its own."""
+    try:
+        return etree.fromstring(xml)
+    except etree.XMLSyntaxError:
+        return None
