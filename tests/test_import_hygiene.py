@@ -146,3 +146,18 @@ def test_other_xml_input_does_not_import_mujoco(tmp_path: Path) -> None:
     assert not any(m.startswith("modelkit.formats.mjcf") for m in report["modules"])
     loaded = [m for m in report["modules"] if m.partition(".")[0] in SIMULATORS]
     assert loaded == [] and report["attempted"] == []
+
+
+@pytest.mark.parametrize("suffix", [".urdf", ".sdf", ".body", ".xml"])
+def test_convert_imports_no_simulator_but_mujoco_for_mjcf(suffix: str, tmp_path: Path) -> None:
+    """`convert` never imports pybullet (nor pinocchio or drake); mujoco only for MJCF in or out."""
+    source = tmp_path / "pendulum.body"
+    source.write_text(FALLBACK_BODY)
+    watched = (*SIMULATORS, "pinocchio", "pydrake")
+    report = _run(["convert", str(source), "-o", str(tmp_path / "out" / f"pendulum{suffix}")], watched)
+    assert report["exit_code"] == 0, report["output"]
+    assert "modelkit.convert.api" in report["modules"]
+    allowed = {"mujoco"} if suffix == ".xml" else set()
+    loaded = {m.partition(".")[0] for m in report["modules"]} & set(watched)
+    attempted = {m.partition(".")[0] for m in report["attempted"]}
+    assert loaded <= allowed and attempted <= allowed, (loaded, attempted)

@@ -20,3 +20,8 @@ class WriteContext:
     def note(self, code: str, message: str, source: SourceLocation | None = None,
              target: str | None = None) -> None:
         self.notes.note(code, message, source, target)
+
+    def rename(self, kind: str, old: str, new: str, why: str, source: SourceLocation | None = None,
+               target: str | None = None) -> None:
+        """A deterministic rename the target forced (MK800), kept as data for round-trip checks."""
+        self.notes.rename(kind, old, new, why, source, target)

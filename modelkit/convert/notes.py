@@ -21,6 +21,7 @@ class ConversionNote:
     message: str
     source: SourceLocation | None = None  # where the converted thing came from
     target: str | None = None  # the element written for it (``link[wheel]/collision[0]``, a file)
+    renamed: tuple[str, str, str] | None = None  # MK800: (kind, source name, written name)
 
     def to_json(self) -> dict[str, object]:
         loc = self.source
@@ -33,6 +34,8 @@ class ConversionNote:
             "line": loc.line if loc and loc.line else None,
             "column": loc.col if loc and loc.col else None,
             "target": self.target,
+            **({"renamed": dict(zip(("kind", "from", "to"), self.renamed, strict=True))}
+               if self.renamed else {}),
         }
 
     def render(self) -> str:
@@ -63,9 +66,29 @@ class NoteSink:
             self._seen.add(key)
             self.items.append(item)
 
+    def rename(self, kind: str, old: str, new: str, why: str, source: SourceLocation | None = None,
+               target: str | None = None) -> None:
+        """Record that ``kind`` ("link", "joint", "mesh" ...) ``old`` is written as ``new`` (MK800)."""
+        item = ConversionNote("MK800", Severity(CODES["MK800"].severity),
+                              f'{kind} "{old}" is written as "{new}": {why}', source,
+                              target or f"{kind}[{new}]", (kind, old, new))
+        key = (item.code, item.message, item.source, item.target)
+        if key not in self._seen:
+            self._seen.add(key)
+            self.items.append(item)
+
     def extend(self, notes: Iterable[ConversionNote]) -> None:
         for n in notes:
             key = (n.code, n.message, n.source, n.target)
             if key not in self._seen:
                 self._seen.add(key)
                 self.items.append(n)
+
+
+def renames(notes: Iterable[ConversionNote], kind: str = "link") -> dict[str, str]:
+    """Source name → written name for one kind of element, from the MK800 notes of a conversion."""
+    out: dict[str, str] = {}
+    for n in notes:
+        if n.renamed is not None and n.renamed[0] == kind:
+            out.setdefault(n.renamed[1], n.renamed[2])
+    return out

@@ -130,14 +130,13 @@ def write_body(robot: Robot, ctx: WriteContext) -> bytes:
     names = _names(robot)
     for link in robot.links:
         if names.links[id(link)] != link.name:
-            ctx.note("MK800", f'link "{link.name}" is written as "{names.links[id(link)]}" (link names '
-                     "must be unique and not empty)", link.source, f"link[{names.links[id(link)]}]")
+            ctx.rename("link", link.name, names.links[id(link)], "link names must be unique and not empty",
+                       link.source)
     for joint in robot.joints:
         wanted = joint.name or joint.child
         written = names.joints[id(joint)]
         if not joint.extras.get("implicit_name") and written != wanted:
-            ctx.note("MK800", f'joint "{wanted}" is written as "{written}" (joint names must be unique)',
-                     joint.source, f"joint[{written}]")
+            ctx.rename("joint", wanted, written, "joint names must be unique", joint.source)
     order, parent_joint = _tree_order(robot)
     from_body = robot.source_format == "body"
     root_name = names.by_name.get(robot.root or "", robot.root or "")

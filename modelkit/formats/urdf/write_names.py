@@ -8,14 +8,10 @@ Empty and duplicate names are renamed too. Each rename is an MK800 note whose me
 
 from __future__ import annotations
 
-import re
 from collections.abc import Iterable
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.notes import ConversionNote
 from modelkit.model import Robot
-
-_RENAME = re.compile(r'^(link|joint) "(.*)" is written as "(.*)"')
 
 
 class NameTable:
@@ -80,25 +76,4 @@ class NameTable:
     def _note(self, kind: str, old: str, new: str, why: str, source: object) -> None:
         from modelkit.diagnostics import SourceLocation
 
-        self.ctx.note(
-            "MK800",
-            f'{kind} "{old}" is written as "{new}": {why}',
-            source if isinstance(source, SourceLocation) else None,
-            f"{kind}[{new}]",
-        )
-
-
-def renames_from_notes(notes: Iterable[ConversionNote], kind: str = "link") -> dict[str, str]:
-    """Source name → written name of every ``kind`` ("link" or "joint") the MK800 notes rename.
-
-    Link renames are what :func:`modelkit.convert.compare.compare_robots` needs (it matches joints
-    by their child link).
-    """
-    out: dict[str, str] = {}
-    for note in notes:
-        if note.code != "MK800":
-            continue
-        match = _RENAME.match(note.message)
-        if match and match.group(1) == kind:
-            out.setdefault(match.group(2), match.group(3))
-    return out
+        self.ctx.rename(kind, old, new, why, source if isinstance(source, SourceLocation) else None)

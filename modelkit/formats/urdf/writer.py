@@ -22,11 +22,11 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.notes import ConversionNote
+from modelkit.convert.notes import ConversionNote, renames
 from modelkit.formats.urdf.write_gazebo import write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
 from modelkit.formats.urdf.write_links import MaterialTable, link_element, origin_element
-from modelkit.formats.urdf.write_names import NameTable, renames_from_notes
+from modelkit.formats.urdf.write_names import NameTable
 from modelkit.model import WORLD_LINK, JointType, Robot
 from modelkit.spatial import Pose
 
@@ -92,7 +92,7 @@ SDF_LINK_DEFAULTS = {
 
 def urdf_renames(notes: Iterable[ConversionNote]) -> dict[str, str]:
     """Source link name → written link name, from a conversion's MK800 notes (for compare_robots)."""
-    return renames_from_notes(notes, "link")
+    return renames(notes, "link")
 
 
 def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:

@@ -1,0 +1,231 @@
+"""Conversions keep the robot: X → Y → X for every pair of formats, compared as models.
+
+For each source model of format X and each other target Y, the source is written as Y, read
+back, written as X again and read back; the final model must equal the source
+(:func:`modelkit.convert.compare.compare_robots`: links, joints matched by child link, types,
+axes, limits, masses, COMs, inertia tensors, link poses at random configurations; 1e-9), names
+mapped through the writers' MK800 renames. Known, documented losses are listed with their reason
+in ``EXPECTED_LOSSES`` and nowhere else: any other difference fails.
+
+Also here: the issue's acceptance checks on the tutorial robots (loads in MuJoCo and PyBullet with
+the right joint count, total mass and wheel geometry; the Extrusion tracks written as meshes of the
+reader's volume), and that outputs carry no absolute path and do not depend on the output folder.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+import textwrap
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from modelkit.api import validate
+from modelkit.convert import convert, write
+from modelkit.convert.compare import Difference, compare_robots
+from modelkit.convert.notes import ConversionNote, renames
+from modelkit.convert.registry import target_info
+from modelkit.model import Cylinder, JointType, Robot
+
+from .conftest import CORPUS, SAMPLES, TUTORIAL
+
+CHOREONOID = CORPUS / "choreonoid" / "share" / "model"
+SDF_MODELS = CORPUS / "sdformat_urdf" / "sdformat_test_files" / "models"
+SOURCES = {
+    "body": [TUTORIAL / f"{n}.body" for n in ("mobile_robot_primitive", "mobile_robot_pantilt",
+                                             "mobile_robot_sensors", "mobile_robot")]
+    + [CHOREONOID / p for p in ("misc/pendulum.body", "PA10/PA10.body", "GR001/GR001.body", "SR1/SR1.body")],
+    "urdf": [CORPUS / "urdf_tutorial" / "urdf" / f for f in ("01-myfirst.urdf", "05-visual.urdf",
+                                                             "06-flexible.urdf", "07-physics.urdf")]
+    + [CORPUS / "kuka_experimental" / "kuka_kr16_support" / "urdf" / "kr16_2.urdf",
+       CORPUS / "urdf_tutorial" / "urdf" / "08-macroed.urdf.xacro",
+       SAMPLES / "smartcar" / "urdf" / "myrobot.urdf.xacro"],
+    "sdf": [SDF_MODELS / n / f"{n}.sdf" for n in ("graph_tree", "joint_revolute_axis", "link_inertia",
+                                                   "joint_prismatic", "geometry_cylinder")]
+    + [SAMPLES / "gazebo_unicycle" / "unicycle.sdf"],
+    "mjcf": [CORPUS / "dm_control_suite" / "dm_control" / "suite" / f
+             for f in ("cartpole.xml", "acrobot.xml", "pendulum.xml", "reacher.xml")]
+    + [CORPUS / "mujoco_model" / "humanoid" / "humanoid.xml"],
+}
+FAMILY_TARGET = {"body": "body", "urdf": "urdf", "sdf": "sdf", "mjcf": "mjcf"}
+
+
+
+def _tiny_mass(d: Difference) -> bool:
+    """SDF and MJCF cannot hold a massless link that moves or floats (SDF defaults it to 1 kg,
+    MuJoCo refuses it): the writers give it 1e-6 kg with an MK816 note."""
+    return d.quantity == "mass" and d.detail == "0.0 became 1e-06"
+
+
+def _frame(*links: str) -> Callable[[Difference], bool]:
+    """SDF holds a massless leaf link on a fixed joint as a <frame> (MK816), which reads back as a
+    frame, not a link."""
+    return lambda d: d.quantity == "link-set" and d.where in links and "missing" in d.detail
+
+
+KINEMATIC_ONLY = "the URDF has no inertials at all (a kinematic model): its links are massless"
+MULTI_JOINT = ("MuJoCo's multi-joint bodies read as chains of massless links; a format with one "
+               "joint per link keeps them, and coming back to MJCF they need a mass")
+# (source file name, through) → (why the model legitimately changes, which differences that allows).
+# Every other difference fails the test.
+EXPECTED_LOSSES: dict[tuple[str, str], tuple[str, Callable[[Difference], bool]]] = {
+    **{(f, t): (KINEMATIC_ONLY, _tiny_mass) for f in ("01-myfirst.urdf", "05-visual.urdf", "06-flexible.urdf")
+       for t in ("sdf", "mjcf")},
+    ("kr16_2.urdf", "sdf"): ("massless base and tool0 frames", _frame("base", "tool0")),
+    **{("humanoid.xml", t): (MULTI_JOINT, _tiny_mass) for t in ("urdf", "sdf", "body")},
+}
+
+CASES = [(fam, path, through) for fam, paths in SOURCES.items() for path in paths
+         for through in ("urdf", "sdf", "mjcf", "body") if through != FAMILY_TARGET[fam]]
+
+
+def _read(path: Path) -> Robot:
+    checked = validate(path)
+    robots = [r for r in checked.robots if r.root is not None]
+    assert robots, [str(d) for d in checked.diagnostics]
+    return robots[0]
+
+
+def _trip(source: Robot, through: str, back: str, folder: Path) -> tuple[Robot, list[ConversionNote]]:
+    mid = folder / "mid" / f"model{target_info(through).suffix}"
+    notes = write(source, mid, through)
+    middle = _read(mid)
+    end = folder / "end" / f"model{target_info(back).suffix}"
+    notes_back = write(middle, end, back)
+    return _read(end), [*notes, *notes_back]
+
+
+@pytest.mark.parametrize(("family", "path", "through"), CASES,
+                         ids=[f"{p.name}-via-{t}" for _, p, t in CASES])
+def test_x_to_y_to_x_keeps_the_robot(family: str, path: Path, through: str, tmp_path: Path) -> None:
+    if not path.is_file():
+        pytest.skip(f"{path} not available")
+    source = _read(path)
+    final, notes = _trip(source, through, FAMILY_TARGET[family], tmp_path)
+    differences: list[Difference] = compare_robots(source, final, renames(notes, "link"))
+    expected = EXPECTED_LOSSES.get((path.name, through))
+    if expected is not None:
+        why, allowed = expected
+        assert differences, f"expected a loss ({why}) but the round trip was exact: update EXPECTED_LOSSES"
+        differences = [d for d in differences if not allowed(d)]
+    assert differences == [], "\n".join(str(d) for d in differences[:20])
+
+
+# ---- the issue's acceptance checks on the tutorial robots ------------------------------------
+
+PYBULLET_CHILD = textwrap.dedent("""\
+    import json, sys
+    import pybullet as p
+    p.connect(p.DIRECT)
+    body = p.loadURDF(sys.argv[1], flags=p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER)
+    n = p.getNumJoints(body)
+    masses = [p.getDynamicsInfo(body, i)[0] for i in range(-1, n)]
+    moving = [p.getJointInfo(body, i)[1].decode() for i in range(n)
+              if p.getJointInfo(body, i)[2] != p.JOINT_FIXED]
+    shapes = {}
+    for i in range(-1, n):
+        name = p.getBodyInfo(body)[0].decode() if i == -1 else p.getJointInfo(body, i)[12].decode()
+        shapes[name] = [[s[2], list(s[3])] for s in p.getCollisionShapeData(body, i)]
+    print(json.dumps({"mass": sum(masses), "moving": moving, "shapes": shapes}))
+""")
+
+
+def _wheel_cylinders(robot: Robot) -> dict[str, tuple[float, float]]:
+    out = {}
+    for link in robot.links:
+        for geom in link.collisions:
+            if isinstance(geom.geometry, Cylinder) and "Wheel" in link.name:
+                out[link.name] = (geom.geometry.radius, geom.geometry.length)
+    return out
+
+
+def _total_mass(robot: Robot) -> float:
+    return sum(lk.inertial.mass for lk in robot.links if lk.inertial)
+
+
+def _moving(robot: Robot) -> list[str]:
+    return [j.name for j in robot.joints if j.type.moves]
+
+
+@pytest.mark.parametrize("name", ["mobile_robot_primitive", "mobile_robot_pantilt", "mobile_robot_sensors"])
+def test_tutorial_robot_loads_in_pybullet_and_mujoco(name: str, tmp_path: Path) -> None:
+    import mujoco
+
+    source = _read(TUTORIAL / f"{name}.body")
+    wheels = _wheel_cylinders(source)
+    assert len(wheels) == 2
+    result = convert([TUTORIAL / f"{name}.body"], tmp_path / f"{name}.urdf")
+    assert result.status == 0
+    run = subprocess.run([sys.executable, "-c", PYBULLET_CHILD, str(tmp_path / f"{name}.urdf")],
+                         capture_output=True, text=True, timeout=120, check=False)
+    assert run.returncode == 0, run.stderr
+    loaded = json.loads(run.stdout.strip().splitlines()[-1])
+    assert math.isclose(loaded["mass"], _total_mass(source), rel_tol=1e-9)
+    joint_names = renames(result.notes, "joint")  # the wheel joints share their links' names
+    assert sorted(loaded["moving"]) == sorted(joint_names.get(j, j) for j in _moving(source))
+    for link, (radius, length) in wheels.items():
+        (geom_type, dims), = loaded["shapes"][link]
+        assert geom_type == 4  # GEOM_CYLINDER: PyBullet reports (length, radius, 0)
+        assert np.allclose(dims[:2], [length, radius], rtol=1e-6)
+
+    result = convert([TUTORIAL / f"{name}.body"], tmp_path / f"{name}.xml")
+    assert result.status == 0
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / f"{name}.xml"))
+    assert math.isclose(float(model.body_mass.sum()), _total_mass(source), rel_tol=1e-9)
+    hinge_names = {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(model.njnt)
+                   if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE}
+    assert hinge_names == set(_moving(source))
+    assert int(np.sum(model.jnt_type == mujoco.mjtJoint.mjJNT_FREE)) == 1
+    for link, (radius, length) in wheels.items():
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, link)
+        cylinders = [g for g in range(model.ngeom) if model.geom_bodyid[g] == body
+                     and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_CYLINDER and model.geom_contype[g]]
+        assert len(cylinders) == 1
+        assert np.allclose(model.geom_size[cylinders[0]][:2], [radius, length / 2], rtol=1e-12)
+
+
+def test_tracks_become_meshes_of_the_readers_volume(tmp_path: Path) -> None:
+    import trimesh
+
+    from modelkit.geometry.generated import signed_volume
+    from modelkit.model import Mesh
+
+    source = _read(TUTORIAL / "mobile_robot_tracks.body")
+    volumes = sorted(abs(signed_volume(g.geometry.data)) for lk in source.links for g in lk.collisions
+                     if isinstance(g.geometry, Mesh) and g.geometry.generator == "Extrusion"
+                     and g.geometry.data is not None)
+    assert len(volumes) == 2 and volumes[0] > 0
+    result = convert([TUTORIAL / "mobile_robot_tracks.body"], tmp_path / "tracks.urdf")
+    assert result.status == 0
+    codes = [n.code for n in result.notes]
+    assert codes.count("MK809") == 2 and "MK803" in codes
+    written = sorted(trimesh.load(p, force="mesh").volume for p in (tmp_path / "meshes").glob("*.stl"))
+    track_meshes = [v for v in written if any(math.isclose(v, w, rel_tol=1e-6) for w in volumes)]
+    assert len(track_meshes) >= 1, (written, volumes)
+    tracks = _read(tmp_path / "tracks.urdf")
+    assert not any(j.type is JointType.PSEUDO_CONTINUOUS_TRACK for j in tracks.joints)
+    assert math.isclose(_total_mass(tracks), _total_mass(source), rel_tol=1e-12)
+
+
+@pytest.mark.parametrize("target", ["urdf", "sdf", "mjcf", "body"])
+def test_outputs_do_not_depend_on_the_folder(target: str, tmp_path: Path) -> None:
+    """Two machines, two folders: the same bytes, and no absolute path in any file."""
+    suffix = target_info(target).suffix
+    outputs = []
+    for folder in ("first/deeper", "second"):
+        out = tmp_path / folder
+        result = convert([TUTORIAL / "mobile_robot_sensors.body", TUTORIAL / "mobile_robot_tracks.body"],
+                         out, target)
+        assert result.status == 0
+        files = {str(p.relative_to(out)): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+        for name, data in files.items():
+            for needle in (str(tmp_path), str(SAMPLES), str(Path.home()), "/tmp/"):
+                assert needle.encode() not in data, f"{name} contains {needle}"
+        outputs.append(files)
+    assert outputs[0] == outputs[1]
+    assert any(name.endswith(suffix) for name in outputs[0])
