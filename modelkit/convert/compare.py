@@ -124,8 +124,8 @@ def compare_robots(
             continue
         err = float(np.max(np.abs(np.asarray(la.inertial.com) - np.asarray(lb.inertial.com))))
         if err > tol:
-            out.append(Difference("com", lname, f"{la.inertial.com.tolist()} became {lb.inertial.com.tolist()}",
-                                  err))
+            detail = f"{la.inertial.com.tolist()} became {lb.inertial.com.tolist()}"
+            out.append(Difference("com", lname, detail, err))
         ia, ib = np.asarray(la.inertial.inertia), np.asarray(lb.inertial.inertia)
         err = float(np.max(np.abs(ia - ib))) / max(1.0, float(np.max(np.abs(ia))))
         if err > tol:
@@ -164,6 +164,6 @@ def compare_poses(a: Robot, b: Robot, renames: dict[str, str] | None = None, tol
             err = max(float(np.max(np.abs(pose_a.rotation - pose_b.rotation))),
                       float(np.max(np.abs(pose_a.translation - pose_b.translation))))
             if err > tol and (lname not in worst or err > worst[lname].error):
-                worst[lname] = Difference("pose", lname, f"link pose differs by {err:.3g} at configuration {i}",
-                                          err)
+                detail = f"link pose differs by {err:.3g} at configuration {i}"
+                worst[lname] = Difference("pose", lname, detail, err)
     return [worst[k] for k in sorted(worst)]

@@ -40,8 +40,7 @@ def pair_friction(a: str, b: str, materials_path: Path | None = None) -> PairFri
     table = load_materials(materials_path, DiagnosticSink())
     a, b = _canonical(a), _canonical(b)
     for pair in table.pairs:
-        if {_canonical(pair.names[0]), _canonical(pair.names[1])} == {a, b} and (a != b or
-                                                                                 pair.names[0] == pair.names[1]):
+        if {_canonical(pair.names[0]), _canonical(pair.names[1])} == {a, b}:
             return PairFriction(a, b, pair.static_friction, pair.dynamic_friction, pair.restitution, True)
     default = table.materials.get("Default", ContactMaterial("Default", 1.0, 1.0))
     ma, mb = table.materials.get(a, default), table.materials.get(b, default)
