@@ -15,30 +15,11 @@ from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.numbers import fmt_vec
+from modelkit.formats.sdf.sensors import CONFIG_ELEMENT
 from modelkit.formats.sdf.write_xml import add_pose, data_to_element, num, parse_fragment, rgba, sub
 from modelkit.model import CAMERA_KINDS, LIGHT_KINDS, Device, DeviceKind
 from modelkit.spatial import Pose
 
-SENSOR_CONFIG = {  # SDF sensor type -> its configuration element, where not named like the type
-    "depth_camera": "camera",
-    "depth": "camera",
-    "rgbd_camera": "camera",
-    "rgbd": "camera",
-    "thermal_camera": "camera",
-    "thermal": "camera",
-    "segmentation_camera": "camera",
-    "segmentation": "camera",
-    "boundingbox_camera": "camera",
-    "boundingbox": "camera",
-    "wideanglecamera": "camera",
-    "wide_angle_camera": "camera",
-    "multicamera": "camera",
-    "gpu_ray": "ray",
-    "gpu_lidar": "lidar",
-    "gps": "navsat",
-    "wireless_receiver": "transceiver",
-    "wireless_transmitter": "transceiver",
-}
 CANONICAL_SENSOR = {
     DeviceKind.CAMERA: "camera",
     DeviceKind.DEPTH_CAMERA: "depth_camera",
@@ -249,7 +230,7 @@ class DeviceWriter:
         if isinstance(config, dict) and self.version <= (1, 9):
             config = self._image_format(config, device, f"{owner}/sensor[{name}]")
         if config is not None:
-            data_to_element(sensor, SENSOR_CONFIG.get(device.kind, device.kind), config)
+            data_to_element(sensor, CONFIG_ELEMENT.get(device.kind, device.kind), config)
         for plugin in p.get("plugins", []):
             self.plugin(sensor, plugin, f"{owner}/sensor[{name}]")
 

@@ -18,23 +18,14 @@ from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
-from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.numbers import fmt
 from modelkit.diagnostics import SourceLocation
 from modelkit.formats.urdf.write_names import NameTable
-from modelkit.model import CAMERA_KINDS, Device, DeviceKind, Link, Robot
-from modelkit.spatial import rpy_from_matrix
+from modelkit.model import Device, DeviceKind, Link, Robot
 
-SENSOR_TYPES = {
-    DeviceKind.CAMERA: "camera",
-    DeviceKind.DEPTH_CAMERA: "depth_camera",
-    DeviceKind.RGBD_CAMERA: "rgbd_camera",
-    DeviceKind.LIDAR: "gpu_lidar",
-    DeviceKind.IMU: "imu",
-    DeviceKind.ACCELEROMETER: "imu",
-    DeviceKind.GYRO: "imu",
-    DeviceKind.FORCE_TORQUE: "force_torque",
-    DeviceKind.CONTACT: "contact",
-}
+# Gazebo reads the SDF inside a URDF's <gazebo> blocks; sensors are written as SDF 1.6 describes them
+# (`<ray>` for lidars), which Gazebo classic and Gazebo Sim both read.
+GAZEBO_SDF_VERSION = (1, 6)
 
 
 def parse_block(xml: str) -> Element | None:
@@ -53,106 +44,16 @@ def parse_block(xml: str) -> Element | None:
     return element
 
 
-def _sub(parent: Element, tag: str, text: str | None = None) -> Element:
-    el = etree.SubElement(parent, tag)
-    if text is not None:
-        el.text = text
-    return el
+def sensor_element(device: Device, ctx: WriteContext, owner: str) -> Element | None:
+    """An SDF ``<sensor>`` for a device of the shared vocabulary, written by the SDF writer's own
+    device code (None: the kind has no sensor)."""
+    from modelkit.formats.sdf.write_devices import CANONICAL_SENSOR, DeviceWriter
 
-
-def _number(params: dict[str, Any], key: str) -> str | None:
-    value = params.get(key)
-    if isinstance(value, bool) or not isinstance(value, int | float):
+    if device.canonical not in CANONICAL_SENSOR:
         return None
-    return fmt(value)
-
-
-def _noise(parent: Element, params: dict[str, Any]) -> None:
-    stddev = _number(params, "noise_stddev")
-    if stddev is not None:
-        noise = _sub(parent, "noise")
-        _sub(noise, "type", "gaussian")
-        _sub(noise, "mean", "0")
-        _sub(noise, "stddev", stddev)
-
-
-def _camera(sensor: Element, params: dict[str, Any]) -> None:
-    camera = _sub(sensor, "camera")
-    fov = _number(params, "horizontal_fov")
-    if fov is not None:
-        _sub(camera, "horizontal_fov", fov)
-    width, height = _number(params, "width"), _number(params, "height")
-    if width is not None or height is not None:
-        image = _sub(camera, "image")
-        if width is not None:
-            _sub(image, "width", width)
-        if height is not None:
-            _sub(image, "height", height)
-    near, far = _number(params, "near"), _number(params, "far")
-    if near is not None or far is not None:
-        clip = _sub(camera, "clip")
-        if near is not None:
-            _sub(clip, "near", near)
-        if far is not None:
-            _sub(clip, "far", far)
-    _noise(camera, params)
-
-
-def _lidar(sensor: Element, params: dict[str, Any]) -> None:
-    ray = _sub(sensor, "ray")
-    scan = _sub(ray, "scan")
-    for axis in ("horizontal", "vertical"):
-        values = {k: _number(params, f"{axis}_{k}") for k in ("samples", "min_angle", "max_angle")}
-        if all(v is None for v in values.values()):
-            continue
-        el = _sub(scan, axis)
-        for key, value in values.items():
-            if value is not None:
-                _sub(el, key, value)
-    rng = _sub(ray, "range")
-    for key in ("min", "max", "resolution"):
-        value = _number(params, f"range_{key}")
-        if value is not None:
-            _sub(rng, key, value)
-    _noise(ray, params)
-
-
-def sensor_element(device: Device, link_name: str, ctx: WriteContext, target: str) -> Element | None:
-    """An SDF ``<sensor>`` for a device of the shared vocabulary (None: the kind has no sensor)."""
-    kind = SENSOR_TYPES.get(device.canonical)
-    if kind is None:
-        return None
-    params = device.canonical_params
-    sensor = etree.Element("sensor", name=device.name, type=kind)
-    pose = device.pose
-    _sub(sensor, "pose", f"{fmt_vec(pose.translation)} {fmt_vec(rpy_from_matrix(pose.rotation))}")
-    rate = _number(params, "update_rate")
-    if rate is not None:
-        _sub(sensor, "update_rate", rate)
-    if device.canonical in CAMERA_KINDS:
-        _camera(sensor, params)
-    elif device.canonical is DeviceKind.LIDAR:
-        _lidar(sensor, params)
-    elif device.canonical in (DeviceKind.ACCELEROMETER, DeviceKind.GYRO):
-        ctx.note(
-            "MK807",
-            f'{device.canonical.value} "{device.name}" is written as a Gazebo imu sensor (which '
-            "measures both rates and accelerations)",
-            device.source,
-            target,
-        )
-    elif device.canonical is DeviceKind.FORCE_TORQUE:
-        ctx.note(
-            "MK807",
-            f'force sensor "{device.name}" is written as a Gazebo force_torque sensor, which '
-            "measures at the link's parent joint, not at the sensor's own frame",
-            device.source,
-            target,
-        )
-    elif device.canonical is DeviceKind.CONTACT:
-        contact = _sub(sensor, "contact")
-        _sub(contact, "collision", f"{link_name}_collision")
-    return sensor
+    holder = etree.Element("gazebo")
+    DeviceWriter(ctx, GAZEBO_SDF_VERSION, "urdf").device(holder, device, device.pose, None, owner, set())
+    return holder[0] if len(holder) else None
 
 
 def _gazebo(robot_el: Element, reference: str | None) -> Element:
@@ -190,14 +91,13 @@ def _kept_blocks(
 
 
 def _device(robot_el: Element, link: Link, name: str, device: Device, ctx: WriteContext) -> None:
-    target = f"gazebo[{name}]/sensor[{device.name}]"
     xml = device.params.get("xml")
     if isinstance(xml, str):
         block = parse_block(xml)
         if block is not None and block.tag == "sensor":
             _gazebo(robot_el, name).append(block)
             return
-    sensor = sensor_element(device, name, ctx, target)
+    sensor = sensor_element(device, ctx, f"gazebo[{name}]")
     if sensor is None:
         what = device.canonical.value if device.canonical is not DeviceKind.OTHER else device.kind
         ctx.note(
@@ -220,8 +120,8 @@ def write_extensions(robot_el: Element, robot: Robot, names: NameTable, ctx: Wri
         pair = friction.get(link.name)
         if pair is not None:
             friction_block = _gazebo(robot_el, name)
-            _sub(friction_block, "mu1", fmt(pair.dynamic))
-            _sub(friction_block, "mu2", fmt(pair.dynamic))
+            etree.SubElement(friction_block, "mu1").text = fmt(pair.dynamic)
+            etree.SubElement(friction_block, "mu2").text = fmt(pair.dynamic)
             how = "from the material table" if pair.from_table else "by Choreonoid's √(roughness) rule"
             ctx.note(
                 "MK817",
