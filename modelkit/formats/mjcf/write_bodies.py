@@ -19,6 +19,8 @@
   whose weld group (the body and what is welded to it) has no mass or a singular inertia; such a body
   gets ``MIN_MASS`` kg and/or ``MIN_INERTIA`` kg·m² on each principal axis at its origin (MK816 /
   MK819, the note says the value).
+* A chain the MJCF reader made from a multi-joint MuJoCo body is written back as that one body with
+  its joints (:mod:`.write_chains`): no massless moving bodies, so no made-up mass.
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ import numpy as np
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.formats.mjcf.write_chains import Chain, ChainFinder, shifted
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_geoms import GeomWriter
 from modelkit.formats.mjcf.write_names import NameTable
@@ -56,11 +59,22 @@ class BodyTree:
     scalar_joints: list[str] = field(default_factory=list)  # written hinge/slide names, tree order
     bodies: dict[str, Element] = field(default_factory=dict)
     locked: list[tuple[str, float]] = field(default_factory=list)  # written joint, value it is held at
+    frames: dict[str, Pose] = field(default_factory=dict)  # link frame in its body's frame, when not equal
 
     def __post_init__(self) -> None:
         self.children = self.robot.children_of()
         self.links = {lk.name: lk for lk in self.robot.links}
         self.parent_joint = {j.child: j for j in self.robot.joints}
+        self.chains = ChainFinder(self.robot, self.children)
+        self.absorbed: set[str] = set()  # intermediate links written as joints of their chain's body
+        for joint in self.robot.joints:
+            chain = self.chains.below(joint)
+            if chain is not None:
+                self.absorbed.update(chain.links)
+
+    def frame(self, link: str) -> Pose:
+        """The link's frame in the frame of the body it is written in (identity but for chain ends)."""
+        return self.frames.get(link, Pose())
 
     # -- the tree ------------------------------------------------------------------------------
 
@@ -90,6 +104,7 @@ class BodyTree:
             incoming = self.parent_joint.get(link.name)
             if (
                 link.name in self.bodies
+                or link.name in self.absorbed
                 or link.name == root
                 or (incoming is not None and incoming.parent in self.links)
             ):
@@ -123,7 +138,7 @@ class BodyTree:
 
     def _claim_subtree(self, start: str) -> None:
         for name in self._subtree(start):
-            if name not in self.body_name:
+            if name not in self.body_name and name not in self.absorbed:
                 link = self.links[name]
                 self.body_name[name] = self.names.claim("body", name, link.loc("name"), f"body[{name}]")
 
@@ -142,7 +157,7 @@ class BodyTree:
     def _claim_names(self) -> None:
         """Body names in tree order, so that renames are deterministic."""
         for name in self._subtree(self.robot.root) if self.robot.root else []:
-            if name == WORLD_LINK and name == self.robot.root:
+            if (name == WORLD_LINK and name == self.robot.root) or name in self.absorbed:
                 continue
             link = self.links[name]
             self.body_name[name] = self.names.claim("body", name, link.loc("name"), f"body[{name}]")
@@ -159,6 +174,10 @@ class BodyTree:
     ) -> None:
         link = self.links.get(link_name)
         if link is None:
+            return
+        chain = self.chains.below(joint) if joint is not None and not (free_top or detached) else None
+        if chain is not None:
+            self._chain_body(parent, chain, pose @ chain.entry.inverse(), split)
             return
         name = self.body_name[link_name]
         el = sub(parent, "body", name=name)
@@ -181,13 +200,38 @@ class BodyTree:
             moving = True
         else:
             moving = self._joint(el, joint, name)
+        self._fill(el, link, name, moving, split)
+
+    def _chain_body(self, parent: Element, chain: Chain, pose: Pose, split: list[tuple[Joint, Pose]]) -> None:
+        """One body for a multi-joint MuJoCo body the reader made a chain of (:mod:`.write_chains`)."""
+        link = self.links[chain.end]
+        name = self.body_name[chain.end]
+        el = sub(parent, "body", name=name)
+        set_pose(el, pose)
+        self.bodies[chain.end] = el
+        if not chain.shift.is_identity(tol=0.0):
+            self.frames[chain.end] = chain.shift
+        for joint, anchor in zip(chain.joints, chain.positions, strict=True):
+            self._joint(el, joint, name, anchor)
+        self._fill(el, shifted(link, chain.shift), name, True, split, chain.shift)
+
+    def _fill(
+        self,
+        el: Element,
+        link: Link,
+        name: str,
+        moving: bool,
+        split: list[tuple[Joint, Pose]],
+        frame: Pose | None = None,
+    ) -> None:
+        """A body's inertial, geoms, devices and child bodies (``frame``: the link's frame in the body's)."""
         self._inertial(el, link, name, moving)
         self._contents(el, link, name, static=False)
-        for child in self.children.get(link_name, []):
+        for child in self.children.get(link.name, []):
             if child.type is JointType.FLOATING:
                 split.append((child, Pose()))
                 continue
-            self._body(el, child.child, child.origin, child, split)
+            self._body(el, child.child, child.origin if frame is None else frame @ child.origin, child, split)
 
     def _contents(self, el: Element, link: Link, name: str, static: bool) -> None:
         self.geoms.link_geoms(el, link, name)
@@ -209,7 +253,8 @@ class BodyTree:
 
     # -- joints --------------------------------------------------------------------------------
 
-    def _joint(self, body: Element, joint: Joint, body_name: str) -> bool:
+    def _joint(self, body: Element, joint: Joint, body_name: str, anchor: np.ndarray | None = None) -> bool:
+        """Write the joint (``anchor``: its ``pos`` in the body frame; None: the body origin)."""
         target = f"body[{body_name}]/joint[{joint.name}]"
         kind = joint.type
         if kind is JointType.PSEUDO_CONTINUOUS_TRACK:
@@ -230,15 +275,12 @@ class BodyTree:
         self.joint_names[joint.name] = [name]
         if kind is JointType.BALL:
             el = sub(body, "joint", name=name, type="ball")
+            self._anchor(el, anchor)
             self._dynamics(el, joint, target)
             return True
-        el = sub(
-            body,
-            "joint",
-            name=name,
-            type="hinge" if kind is JointType.REVOLUTE else "slide",
-            axis=fmt_vec(joint.axis),
-        )
+        el = sub(body, "joint", name=name, type="hinge" if kind is JointType.REVOLUTE else "slide")
+        self._anchor(el, anchor)
+        el.set("axis", fmt_vec(joint.axis))
         self.scalar_joints.append(name)
         limits = joint.limits
         if math.isfinite(limits.lower) and math.isfinite(limits.upper) and limits.lower < limits.upper:
@@ -263,6 +305,11 @@ class BodyTree:
             )
         self._dynamics(el, joint, target)
         return True
+
+    @staticmethod
+    def _anchor(el: Element, anchor: np.ndarray | None) -> None:
+        if anchor is not None and np.any(anchor != 0.0):
+            el.set("pos", fmt_vec(anchor))
 
     def _planar(self, body: Element, joint: Joint, body_name: str) -> None:
         normal = np.asarray(joint.axis, dtype=float)

@@ -19,6 +19,8 @@ through :func:`modelkit.convert.numbers.fmt`. MuJoCo is not imported here.
 * Actuators: a ``<motor>`` (gear 1: the control is the joint torque or force) on every hinge and slide
   that is not a mimic follower, named after the joint, ``ctrlrange`` = ±effort when the effort limit
   is finite. With zero control a motor applies no force, so the passive model is unchanged.
+* A multi-joint MuJoCo body that the MJCF reader made a chain of links is written back as one body
+  with its joints (:mod:`.write_chains`).
 * Self-collision follows MuJoCo's defaults (parent–child and welded pairs never collide).
 """
 
@@ -194,7 +196,7 @@ class MjcfWriter:
         parent = self.tree.bodies.get(link, self.sections["worldbody"])
         name = self.names.claim("site", wanted, loop.source, f"site[{wanted}]")
         el = sub(parent, "site", name=name, size="0.005")
-        set_pose(el, pose)
+        set_pose(el, self.tree.frame(link) @ pose)
         return name
 
     def _actuators(self) -> None:
