@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import shutil
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -66,3 +67,21 @@ def corpus() -> Path:
             pytest.fail(f"corpus not found at {CORPUS}")
         pytest.skip("shared corpus not available")
     return CORPUS
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _mujoco_warnings_without_log_file() -> Iterator[list[str]]:
+    """Tests that compile models with MuJoCo directly (oracles, writer outputs) must not leave
+    MuJoCo's ``MUJOCO_LOG.TXT`` in the working directory: its warnings are collected instead."""
+    try:
+        import mujoco
+    except ImportError:
+        yield []
+        return
+    collected: list[str] = []
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: collected.append(str(message)))
+    try:
+        yield collected
+    finally:
+        mujoco.set_mju_user_warning(previous)
