@@ -47,7 +47,7 @@ int main(int argc, char **argv) {
   for (uint64_t i = 0; i < model->JointCount(); ++i) {
     const sdf::Joint *j = model->JointByIndex(i);
     std::cout << "joint " << j->Name() << " " << static_cast<int>(j->Type()) << " "
-              << j->ParentName() << "\n";
+              << j->ParentLinkName() << "\n";
   }
   return 0;
 }
@@ -182,7 +182,7 @@ def main() -> int:
                 mujoco.mj_saveLastXML(str(saved), peer["model"])
             row["mujoco_import"] = compare_mjcf(src, peer)
             row["mujoco_import_ok"] = bool(peer.get("loads")) and not peer.get("warnings")
-            ours_xml = Path(tmp) / f"ours{i}" / "robot.xml"
+            ours_xml = Path(tmp) / f"mjcf{i}" / "robot.xml"
             result = convert([urdf], ours_xml)
             failed = {"loads": False, "error": "convert failed"}
             ours = mujoco_facts(ours_xml) if not result.status else failed
@@ -192,7 +192,7 @@ def main() -> int:
                 peer_sdf = run_probe(probe, urdf)
                 row["libsdformat"] = compare_sdf(src, peer_sdf)
                 row["libsdformat_ok"] = not peer_sdf["errors"]
-                ours_sdf = Path(tmp) / f"ours{i}" / "robot.sdf"
+                ours_sdf = Path(tmp) / f"sdf{i}" / "robot.sdf"
                 result = convert([urdf], ours_sdf)
                 refused = {"errors": 1, "messages": ["convert failed"]}
                 facts = run_probe(probe, ours_sdf) if not result.status else refused

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from modelkit.checks import run_rules
@@ -10,6 +10,17 @@ from modelkit.diagnostics import Diagnostic, Severity, sorted_diagnostics
 from modelkit.formats import read_model
 from modelkit.formats.common import ReadOptions
 from modelkit.model import Robot
+
+# Consumers a file may be meant for (``validate --target``), and the findings each refuses although the
+# file's own loader accepts them: under that target they are errors, since that consumer (and
+# ``convert --to`` it) will meet them. Everywhere else they stay warnings that name the consumers.
+TARGET_REFUSALS: dict[str, frozenset[str]] = {
+    "mjcf": frozenset({"MK303"}),  # MuJoCo: inertia violating A + B >= C
+    "sdf": frozenset({"MK303", "MK211"}),  # libsdformat: the same, and links and joints sharing a name
+    "urdf": frozenset(),
+    "pybullet": frozenset(),
+}
+TARGETS = tuple(TARGET_REFUSALS)
 
 
 class ModelError(Exception):
@@ -43,18 +54,34 @@ class Validation:
 
 
 def validate(
-    path: str | Path, options: ReadOptions | None = None, fmt: str | None = None, display: str | None = None
+    path: str | Path,
+    options: ReadOptions | None = None,
+    fmt: str | None = None,
+    display: str | None = None,
+    target: str | None = None,
 ) -> Validation:
-    """Read a file and run every rule over its model."""
+    """Read a file and run every rule over its model.
+
+    ``target`` (one of :data:`TARGETS`) judges the file as that consumer would: what it refuses is an
+    error even where the file's own loader accepts it.
+    """
     p = Path(path)
     result = read_model(p, options, fmt, display or str(path))
     diagnostics = list(result.diagnostics)
     for robot in result.robots:
         diagnostics.extend(run_rules(robot))
+    if target is not None:
+        diagnostics = [_for_target(d, target) for d in diagnostics]
     unique: dict[tuple[object, ...], Diagnostic] = {}
     for d in diagnostics:
         unique.setdefault((d.code, d.location, d.message), d)
     return Validation(display or str(path), result.robot, sorted_diagnostics(unique.values()), result.robots)
+
+
+def _for_target(d: Diagnostic, target: str) -> Diagnostic:
+    if d.code not in TARGET_REFUSALS[target] or d.severity is Severity.ERROR:
+        return d
+    return replace(d, severity=Severity.ERROR, message=f"{d.message} [an error for --target {target}]")
 
 
 def load(path: str | Path, options: ReadOptions | None = None, fmt: str | None = None) -> Robot:

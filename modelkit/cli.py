@@ -50,6 +50,15 @@ def reading_options(fn: F) -> F:
             help="Where package://NAME/... URIs point (repeatable); searched before ROS_PACKAGE_PATH.",
         ),
         click.option(
+            "--resource-path",
+            "resource_paths",
+            multiple=True,
+            type=click.Path(file_okay=False, path_type=Path),
+            metavar="DIR",
+            help="A folder of SDF model folders for <include> and model:// URIs (repeatable); searched "
+            "before SDF_PATH, GZ_SIM_RESOURCE_PATH, IGN_GAZEBO_RESOURCE_PATH and GAZEBO_MODEL_PATH.",
+        ),
+        click.option(
             "--path-variable",
             "path_variables",
             multiple=True,
@@ -82,6 +91,20 @@ def reading_options(fn: F) -> F:
             show_default=True,
             help="Refuse input files larger than this.",
         ),
+        click.option(
+            "--max-links",
+            type=click.IntRange(min=1),
+            default=10_000,
+            show_default=True,
+            help="Refuse models with more links (or joints, MJCF bodies) than this (MK005).",
+        ),
+        click.option(
+            "--max-list-items",
+            type=click.IntRange(min=1),
+            default=250_000,
+            show_default=True,
+            help="Refuse YAML lists (.body) with more items than this (MK006).",
+        ),
     ]
     for option in reversed(options):
         fn = option(fn)
@@ -108,6 +131,7 @@ def _read_options(kwargs: dict[str, Any], check_resources: bool, xacro_args: dic
     resolver = Resolver(
         package_paths=_pairs(kwargs["package_paths"], "--package-path"),
         path_variables=_pairs(kwargs["path_variables"], "--path-variable"),
+        resource_paths=list(kwargs.get("resource_paths") or ()),
     )
     return ReadOptions(
         resolver=resolver,
@@ -117,6 +141,8 @@ def _read_options(kwargs: dict[str, Any], check_resources: bool, xacro_args: dic
         faithful_extrusion=not kwargs["vrml_extrusion"],
         check_resources=check_resources,
         max_bytes=kwargs["max_bytes"],
+        max_links=kwargs["max_links"],
+        max_list_items=kwargs["max_list_items"],
     )
 
 
@@ -140,6 +166,13 @@ def main() -> None:
 @click.option("--show-info", is_flag=True, help="Also print info-level findings.")
 @click.option("--no-resources", is_flag=True, help="Do not open mesh files to check that they load.")
 @click.option(
+    "--target",
+    type=click.Choice(["mjcf", "sdf", "urdf", "pybullet"]),
+    default=None,
+    help="Judge the files as this consumer would: what it refuses (e.g. an inertia breaking A + B >= C "
+    "for mjcf and sdf) is an error even where the file's own loader accepts it.",
+)
+@click.option(
     "--ignore",
     "ignored",
     multiple=True,
@@ -153,6 +186,7 @@ def validate(
     strict: bool,
     show_info: bool,
     no_resources: bool,
+    target: str | None,
     ignored: tuple[str, ...],
     **kwargs: Any,
 ) -> None:
@@ -177,7 +211,7 @@ def validate(
     findings: list[Diagnostic] = []
     unreadable = False
     for path in files:
-        result = validate_file(path, options, kwargs["input_format"], str(path))
+        result = validate_file(path, options, kwargs["input_format"], str(path), target)
         for d in result.diagnostics:
             if d.code in silenced:
                 continue
@@ -268,10 +302,12 @@ def tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: st
 @click.option("--force", is_flag=True, help="Replace output files that exist.")
 @click.option("--quiet", "-q", is_flag=True, help="Print only warnings and errors, no info notes.")
 @click.option("--sdf-version", type=click.Choice(["1.6", "1.7", "1.8", "1.9", "1.10", "1.11"]),
-              default="1.9", show_default=True, help="SDFormat version to write (1.6 for libsdformat 9 users).")
+              default="1.9", show_default=True,
+              help="SDFormat version to write (1.6 for Gazebo 9 / libsdformat 6 users).")
 @click.option("--mesh-format", type=click.Choice(["stl", "obj"]), default="stl", show_default=True,
-              help="File format for meshes modelkit writes (generated geometry, converted COLLADA/VRML).")
-@click.option("--keep-collada", is_flag=True, help="URDF/SDF: copy COLLADA meshes as they are (MJCF always converts).")
+              help="File format of meshes modelkit writes (generated geometry, converted COLLADA/VRML).")
+@click.option("--keep-collada", is_flag=True,
+              help="URDF/SDF/.body: copy COLLADA meshes as they are (MJCF always converts).")
 @click.option("--keep-package-uris", is_flag=True,
               help="Keep package:// and model:// mesh references instead of copying the meshes.")
 @click.option("--merge-fixed", is_flag=True, help="Fuse links on fixed joints into their parents.")

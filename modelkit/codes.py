@@ -49,8 +49,9 @@ _TABLE: tuple[CodeInfo, ...] = (
     CodeInfo(
         "MK011",
         "yaml-duplicate-key",
-        "error",
-        "A mapping repeats a key; Choreonoid silently keeps the last value.",
+        "warning",
+        "A mapping repeats a key. Reference: Choreonoid silently keeps the last value and loads the model "
+        "(so does modelkit; the message names both lines).",
     ),
     CodeInfo(
         "MK012",
@@ -376,7 +377,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK235",
         "sdf-joint-parent-is-child",
         "error",
-        "A joint's parent and child are, or are attached to, the same link (libsdformat error 21).",
+        "A joint's parent and child are the same link or frame: libsdformat refuses it (error 21). Two "
+        "different frames attached to one link: libsdformat loads it (a warning: the joint moves nothing).",
     ),
     CodeInfo(
         "MK236",
@@ -767,7 +769,9 @@ _TABLE: tuple[CodeInfo, ...] = (
     # -- MK8xx: conversion notes ------------------------------------------------------------
     # MK800-MK849 shared by every writer; MK850-859 URDF, MK860-869 SDF, MK870-879 MJCF,
     # MK880-889 .body; MK890-899 the convert command (outputs refused, targets that cannot hold).
-    CodeInfo("MK800", "renamed", "info", "A name the target forbids or reserves was changed; the note names both."),
+    CodeInfo(
+        "MK800", "renamed", "info", "A name the target forbids or reserves was changed; the note names both."
+    ),
     CodeInfo(
         "MK801",
         "default-mass-written",

@@ -8,8 +8,10 @@ Search order for ``package://NAME/REL`` (see docs/resources.md):
 4. walking up from the model file: the first folder whose ``package.xml`` names NAME, or which holds
    ``NAME/package.xml``.
 
-``model://NAME/REL`` looks in ``GZ_SIM_RESOURCE_PATH``, ``IGN_GAZEBO_RESOURCE_PATH`` and
-``SDF_PATH``. ``file://`` and plain paths are relative to the referring file's folder.
+``model://NAME/REL`` looks in the ``--resource-path`` folders, then ``GZ_SIM_RESOURCE_PATH``,
+``IGN_GAZEBO_RESOURCE_PATH``, ``SDF_PATH`` and ``GAZEBO_MODEL_PATH`` (:data:`MODEL_PATH_VARIABLES`); an SDF
+``<include>`` looks a bare name or a relative path up there too when it is not beside the file.
+``file://`` and plain paths are relative to the referring file's folder.
 """
 
 from __future__ import annotations
@@ -20,9 +22,14 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from modelkit.textio import read_head
+
 _SCHEME_RE = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*)://(.+)$")
 _PACKAGE_NAME_RE = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
 _VARIABLE_RE = re.compile(r"^\$\{([A-Za-z_][A-Za-z0-9_]*)\}")
+# Where SDF model folders are looked up, in this order (Gazebo's, then libsdformat's, then Gazebo
+# classic's variable), after the folders given with ``--resource-path``.
+MODEL_PATH_VARIABLES = ("GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH", "SDF_PATH", "GAZEBO_MODEL_PATH")
 
 
 @dataclass(frozen=True)
@@ -43,6 +50,7 @@ class Resolver:
     package_paths: dict[str, Path] = field(default_factory=dict)
     path_variables: dict[str, Path] = field(default_factory=dict)
     environ: Mapping[str, str] = field(default_factory=lambda: dict(os.environ))
+    resource_paths: list[Path] = field(default_factory=list)
     _package_cache: dict[tuple[str, str], Path | None] = field(default_factory=dict)
 
     def resolve(self, uri: str, base_dir: Path, model_file: Path | None = None) -> Resolution:
@@ -112,7 +120,7 @@ class Resolver:
         for entry in _split_paths(self.environ.get("AMENT_PREFIX_PATH", "")):
             if (entry / "share" / package).is_dir():
                 return entry / "share" / package
-        folder = start.resolve()
+        folder = Path(os.path.realpath(start))  # never raises on a symlink loop
         for candidate in (folder, *folder.parents):
             if _package_name(candidate / "package.xml") == package:
                 return candidate
@@ -120,12 +128,28 @@ class Resolver:
                 return candidate / package
         return None
 
+    def model_path(self) -> list[Path]:
+        """The folders holding SDF model folders: ``--resource-path``, then :data:`MODEL_PATH_VARIABLES`."""
+        folders = list(self.resource_paths)
+        for var in MODEL_PATH_VARIABLES:
+            folders.extend(_split_paths(self.environ.get(var, "")))
+        return folders
+
+    def find_on_model_path(self, relative: str) -> Path | None:
+        """``relative`` (a model name, maybe with a path inside the model) under the first model folder
+        that has it, or None."""
+        if not relative or Path(relative).is_absolute():
+            return None
+        for entry in self.model_path():
+            candidate = entry / relative
+            if candidate.exists():
+                return _normal(candidate)
+        return None
+
     def _resolve_model(self, uri: str, rest: str) -> Resolution:
-        for var in ("GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH", "SDF_PATH"):
-            for entry in _split_paths(self.environ.get(var, "")):
-                candidate = entry / rest
-                if candidate.exists():
-                    return Resolution(uri, _normal(candidate), "model")
+        found = self.find_on_model_path(rest)
+        if found is not None:
+            return Resolution(uri, found, "model")
         model = rest.partition("/")[0]
         return Resolution(
             uri,
@@ -133,7 +157,7 @@ class Resolver:
             "model",
             "MK504",
             f'model "{model}" of "{uri}" cannot be found',
-            hint="add its parent folder to GZ_SIM_RESOURCE_PATH",
+            hint="add its parent folder to GZ_SIM_RESOURCE_PATH or give it with --resource-path",
         )
 
 
@@ -146,11 +170,9 @@ def _normal(path: Path) -> Path:
 
 
 def _package_name(package_xml: Path) -> str | None:
-    try:
-        if not package_xml.is_file():
-            return None
-        head = package_xml.read_text(encoding="utf-8", errors="replace")[:65536]
-    except OSError:
+    data = read_head(package_xml, 65536)
+    if data is None:
         return None
+    head = data.decode("utf-8", errors="replace")
     match = _PACKAGE_NAME_RE.search(head)
     return match.group(1) if match else None

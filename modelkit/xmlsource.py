@@ -21,8 +21,8 @@ from pathlib import Path
 from lxml import etree
 from lxml.etree import _Element as Element
 
-from modelkit.diagnostics import DiagnosticSink, SourceLocation
-from modelkit.textio import DEFAULT_MAX_BYTES, decode_text, read_bytes
+from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
+from modelkit.textio import DEFAULT_MAX_BYTES, decode_text, read_bytes, read_head
 
 _SKIPPED = re.compile(
     r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<!DOCTYPE(?:[^\[>]|\[.*?\])*>", re.DOTALL | re.IGNORECASE
@@ -176,14 +176,46 @@ def parse_xml_bytes(
     except etree.XMLSyntaxError as exc:
         line, col = exc.position if exc.position else (exc.lineno or 0, 0)
         message = str(exc.msg or exc).split(", line ")[0]
-        sink.emit("MK020", f"malformed XML: {message}", SourceLocation(display, line or 0, max(col, 1)))
-        return None
+        where = SourceLocation(display, line or 0, max(col, 1))
+        root = _lenient_comments(data, parser) if "hyphen within comment" in message else None
+        if root is None:
+            sink.emit("MK020", f"malformed XML: {message}", where)
+            return None
+        sink.emit(
+            "MK020",
+            'a comment contains "--", which XML forbids: libsdformat, urdfdom and MuJoCo (TinyXML2) '
+            "accept it, strict XML tools (xacro, lxml, ROS launch) refuse it",
+            where,
+            hint='write "- -" or "-" inside comments',
+            severity=Severity.WARNING,
+        )
     except ValueError as exc:  # e.g. an encoding declaration lxml cannot honour
         sink.emit("MK020", f"malformed XML: {exc}", SourceLocation(display))
         return None
     doc = XmlDocument(root=root, display=display, text=text, path=path)
     _index_positions(doc)
     return doc
+
+
+_COMMENT = re.compile(rb"<!--(.*?)-->", re.DOTALL)
+
+
+def _lenient_comments(data: bytes, parser: etree.XMLParser) -> etree._Element | None:
+    """Parse ``data`` as TinyXML2 does, which takes ``--`` inside comments: each such pair (and a ``-``
+    before ``-->``) becomes a space, so every offset stays where it was. None if it still fails."""
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        return None
+
+    def blank(match: re.Match[bytes]) -> bytes:
+        inner = match.group(1).replace(b"--", b"- ")
+        if inner.endswith(b"-"):
+            inner = inner[:-1] + b" "
+        return b"<!--" + inner + b"-->"
+
+    try:
+        return etree.fromstring(_COMMENT.sub(blank, data), parser)
+    except (etree.XMLSyntaxError, ValueError):
+        return None
 
 
 def read_xml(
@@ -197,11 +229,10 @@ def read_xml(
 
 def sniff_root_tag(path: Path, limit: int = 65536) -> str | None:
     """The name of the first element of an XML file (``robot``, ``sdf``, ``mujoco``), or None."""
-    try:
-        with path.open("rb") as handle:
-            head = handle.read(limit).decode("utf-8", errors="replace")
-    except OSError:
+    data = read_head(path, limit)
+    if data is None:
         return None
+    head = data.decode("utf-8", errors="replace")
     match = _START_TAG.search(mask_markup(head))
     if match is None:
         return None

@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,6 +23,7 @@ from modelkit.diagnostics import DiagnosticSink, SourceLocation
 from modelkit.textio import (  # re-exported: the file checks are shared with the XML readers
     DEFAULT_EXPANSION_LIMIT,
     DEFAULT_MAX_BYTES,
+    DEFAULT_MAX_LIST_ITEMS,
     decode_text,
     read_bytes,
 )
@@ -97,16 +99,28 @@ def _loc(path: str, mark: yaml.Mark | None) -> SourceLocation:
 class _Converter:
     """Turns PyYAML's composed node graph into Y-nodes, sharing aliased nodes."""
 
-    def __init__(self, path: str, sink: DiagnosticSink, anchor_names: dict[int, str]) -> None:
+    def __init__(
+        self,
+        path: str,
+        sink: DiagnosticSink,
+        anchor_names: dict[int, str],
+        imported: dict[tuple[int, int], YNode] | None = None,
+    ) -> None:
         self.path = path
         self.sink = sink
         self.memo: dict[int, YNode] = {}
         self.anchor_names = anchor_names
+        # Aliases of another file's anchors, by the 0-based (line, column) of their stand-in scalar.
+        self.imported = imported or {}
 
     def convert(self, node: yaml.Node) -> YNode:
         done = self.memo.get(id(node))
         if done is not None:
             return done
+        if self.imported and isinstance(node, yaml.ScalarNode) and node.start_mark is not None:
+            found = self.imported.get((node.start_mark.line, node.start_mark.column))
+            if found is not None:
+                return found
         loc = _loc(self.path, node.start_mark)
         anchor = self.anchor_names.get(id(node))
         result: YNode
@@ -148,8 +162,8 @@ class _Converter:
             if previous is not None:
                 self.sink.emit(
                     "MK011",
-                    f'duplicate key "{key.value}" (first at line {previous[0].loc.line}); '
-                    "Choreonoid silently keeps only this last value",
+                    f'duplicate key "{key.value}" at line {key.loc.line} (first at line '
+                    f"{previous[0].loc.line}); Choreonoid silently keeps only this last value",
                     key.loc,
                 )
             mapping.entries[key.value] = (key, self.convert(value_node))
@@ -181,7 +195,22 @@ class _Converter:
 MAX_NESTING = 128
 
 
-def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], Any, list[tuple[str, int, int]]]:
+class ListTooLong(Exception):
+    """A YAML sequence has more items than the limit; ``mark`` is where it starts."""
+
+    def __init__(self, mark: Any, limit: int, key: str = "") -> None:
+        super().__init__(mark)
+        self.mark = mark
+        self.limit = limit
+        self.key = key  # the top-level key whose value the list is ("" for any other list)
+
+
+_ITEM_EVENTS = (yaml.ScalarEvent, yaml.AliasEvent, yaml.SequenceStartEvent, yaml.MappingStartEvent)
+
+
+def _scan_events(
+    text: str, max_list_items: int = DEFAULT_MAX_LIST_ITEMS, top_limits: dict[str, int] | None = None
+) -> tuple[dict[tuple[int, int], str], Any, list[tuple[str, int, int]]]:
     """One pass over the event stream (libyaml's parser is iterative, so this is safe on any input).
 
     Returns the anchor names by (line, column) of the anchored node (PyYAML's composer drops them)
@@ -193,9 +222,9 @@ def _scan_events(text: str) -> tuple[dict[tuple[int, int], str], Any, list[tuple
     must not depend on a library's internal limit, so such a refusal is re-scanned with PyYAML's
     pure-Python parser (iterative too, and without a nesting limit) to find our own mark.
     """
-    names, too_deep, aliases, error = _scan_events_with(text, yaml.CSafeLoader)
+    names, too_deep, aliases, error = _scan_events_with(text, yaml.CSafeLoader, max_list_items, top_limits)
     if too_deep is None and error is not None and _is_nesting_refusal(error):
-        names, too_deep, aliases, _ = _scan_events_with(text, yaml.SafeLoader)
+        names, too_deep, aliases, _ = _scan_events_with(text, yaml.SafeLoader, max_list_items, top_limits)
     return names, too_deep, aliases
 
 
@@ -205,18 +234,39 @@ def _is_nesting_refusal(error: yaml.YAMLError) -> bool:
 
 
 def _scan_events_with(
-    text: str, loader: Any
+    text: str,
+    loader: Any,
+    max_list_items: int = DEFAULT_MAX_LIST_ITEMS,
+    top_limits: dict[str, int] | None = None,
 ) -> tuple[dict[tuple[int, int], str], Any, list[tuple[str, int, int]], yaml.YAMLError | None]:
     names: dict[tuple[int, int], str] = {}
     aliases: list[tuple[str, int, int]] = []  # (anchor, line, column) of every alias, 0-based
     depth = 0
     documents = 0
+    # Items counted so far in each open sequence (None for a mapping), innermost last: a long list
+    # costs far more to compose and check than its bytes suggest, so it is refused here, early.
+    counts: list[list[Any]] = []
     try:
         for event in yaml.parse(text, Loader=loader):
             if isinstance(event, yaml.DocumentStartEvent):
                 documents += 1
                 if documents > 1:
                     break
+            if counts and isinstance(event, _ITEM_EVENTS):
+                entry = counts[-1]  # [items, start mark, limit, last key (mappings) or None, own key]
+                entry[0] += 1
+                if entry[3] is None and entry[0] > entry[2]:
+                    raise ListTooLong(entry[1], entry[2], entry[4])
+                if entry[3] is not None and entry[0] % 2 == 1:  # a mapping's key
+                    entry[3] = event.value if isinstance(event, yaml.ScalarEvent) else ""
+            if isinstance(event, yaml.SequenceStartEvent):
+                key = counts[0][3] if len(counts) == 1 and counts[0][3] is not None else ""
+                limit = (top_limits or {}).get(key, max_list_items)
+                counts.append([0, event.start_mark, limit, None, key])
+            elif isinstance(event, yaml.MappingStartEvent):
+                counts.append([0, event.start_mark, 0, "", ""])
+            elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)) and counts:
+                counts.pop()
             if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
                 depth += 1
                 if depth > MAX_NESTING:
@@ -288,10 +338,38 @@ def read_text(
 
 
 def parse_yaml(
-    text: str, path: str, sink: DiagnosticSink, expansion_limit: int = DEFAULT_EXPANSION_LIMIT
+    text: str,
+    path: str,
+    sink: DiagnosticSink,
+    expansion_limit: int = DEFAULT_EXPANSION_LIMIT,
+    max_list_items: int = DEFAULT_MAX_LIST_ITEMS,
+    top_limits: dict[str, int] | None = None,
+    imported_anchors: dict[str, YNode] | None = None,
 ) -> YamlDocument:
-    """Compose the first YAML document of ``text`` into Y-nodes, reporting problems into ``sink``."""
-    anchors_by_pos, too_deep, alias_marks = _scan_events(text)
+    """Compose the first YAML document of ``text`` into Y-nodes, reporting problems into ``sink``.
+
+    ``top_limits`` bounds the list under a top-level key more tightly (the ``links`` of a body:
+    MK005) than any other list (``max_list_items``: MK006); both are checked before composing.
+    ``imported_anchors`` are another document's anchors that aliases here may use when no anchor of
+    that name precedes them in this text (Choreonoid's YAML resources see the main .body's anchors)."""
+    try:
+        anchors_by_pos, too_deep, alias_marks = _scan_events(text, max_list_items, top_limits)
+    except ListTooLong as exc:
+        if exc.key:
+            sink.emit(
+                "MK005",
+                f'"{exc.key}" has more than {exc.limit} items, over the limit; refusing the document',
+                _loc(path, exc.mark),
+                hint="raise the limit with --max-links if the model is genuine",
+            )
+            return YamlDocument(None, path, {})
+        sink.emit(
+            "MK006",
+            f"a list has more than {exc.limit} items; refusing the document",
+            _loc(path, exc.mark),
+            hint="raise the limit with --max-list-items if the file is genuine",
+        )
+        return YamlDocument(None, path, {})
     if too_deep is not None:
         sink.emit(
             "MK010",
@@ -299,6 +377,9 @@ def parse_yaml(
             _loc(path, too_deep),
         )
         return YamlDocument(None, path, {})
+    stand_ins: dict[tuple[int, int], YNode] = {}
+    if imported_anchors:
+        text, stand_ins = _stand_in_imported_aliases(text, anchors_by_pos, alias_marks, imported_anchors)
     try:
         loader = yaml.CSafeLoader(text)
         try:
@@ -315,7 +396,7 @@ def parse_yaml(
         sink.emit("MK004", "the file contains no YAML document", SourceLocation(path, 1, 1))
         return YamlDocument(None, path, {})
     anchor_names = _anchor_ids(node, anchors_by_pos)
-    converter = _Converter(path, sink, anchor_names)
+    converter = _Converter(path, sink, anchor_names, stand_ins)
     root = converter.convert(node)
     anchors = {name: converter.memo[nid] for nid, name in anchor_names.items() if nid in converter.memo}
     problem = measure_expansion(root, expansion_limit)
@@ -344,6 +425,33 @@ def parse_yaml(
             )
         return YamlDocument(None, path, anchors)
     return YamlDocument(root, path, anchors)
+
+
+_YAML_LINE_BREAK = re.compile("\r\n|[\r\n\x85\u2028\u2029]")
+
+
+def _stand_in_imported_aliases(
+    text: str,
+    local: dict[tuple[int, int], str],
+    aliases: list[tuple[str, int, int]],
+    imported: dict[str, YNode],
+) -> tuple[str, dict[tuple[int, int], YNode]]:
+    """``text`` with each alias of an imported anchor turned into a plain scalar of the same length
+    (``*NAME`` -> ``~NAME``, so every mark stays put), and the imported node for each such scalar.
+
+    An alias uses the imported anchor only when no local anchor of its name comes before it, as in
+    Choreonoid (local anchors take precedence)."""
+    starts = [0] + [m.end() for m in _YAML_LINE_BREAK.finditer(text)]  # libyaml's line breaks
+    chars = list(text)
+    stand_ins: dict[tuple[int, int], YNode] = {}
+    for name, line, col in aliases:
+        if name not in imported or any(n == name and pos < (line, col) for pos, n in local.items()):
+            continue
+        offset = starts[line] + col if line < len(starts) else -1
+        if 0 <= offset < len(chars) and chars[offset] == "*":
+            chars[offset] = "~"
+            stand_ins[(line, col)] = imported[name]
+    return "".join(chars), stand_ins
 
 
 def _first_document(loader: yaml.CSafeLoader) -> yaml.Node | None:

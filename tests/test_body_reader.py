@@ -365,3 +365,108 @@ links:
     material = load(body).links[0].visuals[0].material
     assert material is not None and material.specular is not None
     np.testing.assert_allclose(material.specular, [0.2, 0.2, 0.0])
+
+
+# ---- issue 9 §1: what Choreonoid accepts is not an error ------------------------------------------
+
+_HEADER = "format: ChoreonoidBody\nformat_version: 2.0\nname: T\n"
+_MASS = "    mass: 1.0\n    inertia: [ 0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01 ]\n"
+
+
+def test_yaml_resources_use_the_main_files_anchors(tmp_path: Path) -> None:
+    """Choreonoid's YAML resource reader imports the main .body's anchors; local anchors win."""
+    (tmp_path / "parts.yaml").write_text(  # the whole document is an `elements` value (body-format §3.6)
+        "- { type: Shape, geometry: *BOX, appearance: *APP }\n"
+        "- { type: Shape, geometry: &SPH { type: Sphere, radius: 0.3 } }\n"
+        "- { type: Shape, geometry: *SPH }\n"
+    )
+    main = write(
+        tmp_path,
+        _HEADER + "APP: &APP { material: { diffuse: [ 1, 0, 0 ] } }\n"
+        "BOX: &BOX { type: Box, size: [ 0.1, 0.2, 0.3 ] }\n"
+        "SPH: &SPH { type: Sphere, radius: 9.0 }\n"
+        "links:\n  -\n    name: BASE\n    joint_type: fixed\n" + _MASS
+        + "    elements:\n      - { type: Resource, uri: parts.yaml }\n",
+    )
+    v = validate(main)
+    # MK119 (info): the top-level keys APP, BOX and SPH only hold anchors
+    assert [d for d in v.diagnostics if d.code != "MK119"] == [] and v.robot is not None
+    (link,) = v.robot.links
+    shapes = [c.geometry for c in link.collisions]
+    assert isinstance(shapes[0], Box) and list(shapes[0].size) == [0.1, 0.2, 0.3]
+    assert [s.radius for s in shapes[1:] if isinstance(s, Sphere)] == [0.3, 0.3]  # the local &SPH
+    # an anchor defined nowhere is still MK013, located in the resource file
+    (tmp_path / "parts.yaml").write_text("- { type: Shape, geometry: *NOPE }\n")
+    (d,) = validate(main).errors
+    assert d.code == "MK013" and d.location is not None
+    assert d.location.file.endswith("parts.yaml") and (d.location.line, d.location.col) == (1, 28)
+
+
+def test_duplicate_key_is_a_warning_naming_both_lines_and_tree_and_convert_proceed(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from modelkit.cli import main
+
+    path = write(
+        tmp_path,
+        _HEADER + "links:\n  -\n    name: BASE\n    joint_type: free\n    mass: 1.0\n    mass: 2.0\n"
+        "    inertia: [ 0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01 ]\n",
+    )
+    v = validate(path)
+    (d,) = v.diagnostics
+    assert (d.code, d.severity.value) == ("MK011", "warning")
+    assert d.location is not None and (d.location.line, d.location.col) == (9, 5)
+    assert "line 9" in d.message and "first at line 8" in d.message
+    assert v.robot is not None and v.robot.links[0].inertial is not None
+    assert v.robot.links[0].inertial.mass == 2.0  # Choreonoid keeps the last value
+    runner = CliRunner()
+    assert runner.invoke(main, ["tree", str(path)]).exit_code == 0
+    assert runner.invoke(main, ["validate", str(path)]).exit_code == 0
+    assert runner.invoke(main, ["validate", "--strict", str(path)]).exit_code == 1
+    out = tmp_path / "out.urdf"
+    converted = runner.invoke(main, ["convert", str(path), "-o", str(out)])
+    assert converted.exit_code == 0, converted.output
+    assert out.is_file()
+
+
+def test_unlimited_ranges_in_every_spelling(tmp_path: Path) -> None:
+    path = write(
+        tmp_path,
+        _HEADER + "links:\n  -\n    name: BASE\n    joint_type: fixed\n" + _MASS
+        + "  -\n    name: A\n    parent: BASE\n    joint_type: revolute\n    joint_axis: Y\n"
+        "    joint_range: unlimited\n    joint_velocity_range: [ -unlimited, unlimited ]\n" + _MASS
+        + "  -\n    name: B\n    parent: A\n    joint_type: revolute\n"
+        "    joint_range: [ -unlimited, 90 ]\n    max_joint_velocity: unlimited\n" + _MASS
+        + "  -\n    name: C\n    parent: B\n    joint_type: prismatic\n"
+        "    joint_range: [ -0.5, unlimited ]\n    max_joint_effort: unlimited\n" + _MASS,
+    )
+    v = validate(path)
+    assert v.errors == [], v.errors
+    assert v.robot is not None
+    joints = {j.name: j.limits for j in v.robot.joints}
+    assert (joints["A"].lower, joints["A"].upper) == (-math.inf, math.inf)
+    assert (joints["A"].velocity_lower, joints["A"].velocity_upper) == (-math.inf, math.inf)
+    assert joints["B"].lower == -math.inf and joints["B"].upper == pytest.approx(math.pi / 2)
+    assert joints["B"].velocity == math.inf
+    assert (joints["C"].lower, joints["C"].upper) == (-0.5, math.inf)
+    # a word that is not "unlimited" is still refused, as Choreonoid does ("Unknown symbol")
+    bad = write(tmp_path, path.read_text().replace("[ -unlimited, 90 ]", "[ -infinite, 90 ]"), "bad.body")
+    assert [d.code for d in validate(bad).errors] == ["MK100"]
+
+
+def test_nested_rotation_and_translation_lists_with_aliases(tmp_path: Path) -> None:
+    """`rotation: [[...], [...]]` is R1·R2 (about the already rotated axes); translations add up."""
+    path = write(
+        tmp_path,
+        _HEADER + "R1: &R1 [ 0, 1, 0, 90 ]\nT1: &T1 [ 0.1, 0, 0 ]\n"
+        "links:\n  -\n    name: BASE\n    joint_type: fixed\n" + _MASS
+        + "  -\n    name: A\n    parent: BASE\n    joint_type: fixed\n"
+        "    rotation: [ *R1, [ 0, 0, 1, -90 ] ]\n    translation: [ *T1, [ 0, 0.2, 0 ] ]\n" + _MASS,
+    )
+    v = validate(path)
+    assert v.errors == [] and v.robot is not None
+    (joint,) = v.robot.joints
+    ry = np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0]], dtype=float)
+    rz = np.array([[0, 1, 0], [-1, 0, 0], [0, 0, 1]], dtype=float)
+    np.testing.assert_allclose(joint.origin.rotation, ry @ rz, atol=1e-12)
+    np.testing.assert_allclose(joint.origin.translation, [0.1, 0.2, 0.0])

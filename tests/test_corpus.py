@@ -12,15 +12,16 @@ from modelkit.tree import tree_report
 
 from .conftest import CORPUS, corpus_bodies
 
-# The only error-level findings in the corpus, each a real fault:
-# - ellipsoid1.body: its free-floating BASE has principal moments 0.004, 0.015, 0.1 (0.004 + 0.015 < 0.1),
-#   an inertia no rigid body can have (MuJoCo refuses it);
+# The only error-level finding in the corpus, a real fault:
 # - mobile_robot_mesh.body: the chassis mesh vmega_body.dae is absent from the snapshot, and this model
 #   uses it as collision geometry too (the other tutorial models use it as visual only: a warning).
 EXPECTED_ERRORS = {
-    ("choreonoid/share/model/misc/ellipsoid1.body", "MK303", 11, 14),
     ("choreonoid_ros2_mobile_robot_tutorial/model/mobile_robot_mesh.body", "MK500", 20, 14),
 }
+# ellipsoid1.body: its free-floating BASE has principal moments 0.004, 0.015, 0.1 (0.004 + 0.015 < 0.1), an
+# inertia no rigid body can have. Choreonoid loads it, MuJoCo and libsdformat refuse it: a warning naming
+# them, an error when the file is judged for MuJoCo (--target mjcf).
+IMPOSSIBLE_INERTIA = ("choreonoid/share/model/misc/ellipsoid1.body", "MK303", 11, 14)
 
 
 def test_corpus_errors_are_exactly_the_true_ones(corpus: Path) -> None:
@@ -30,6 +31,19 @@ def test_corpus_errors_are_exactly_the_true_ones(corpus: Path) -> None:
             assert d.location is not None
             found.add((str(path.relative_to(corpus)), d.code, d.location.line, d.location.col))
     assert found == EXPECTED_ERRORS
+
+
+def test_impossible_inertia_is_a_warning_unless_judged_for_mujoco(corpus: Path) -> None:
+    name, code, line, col = IMPOSSIBLE_INERTIA
+    for target, severity in ((None, "warning"), ("urdf", "warning"), ("mjcf", "error"), ("sdf", "error")):
+        found = [
+            (d.severity.value, d.location.line, d.location.col)
+            for d in validate(corpus / name, target=target).diagnostics
+            if d.code == code and d.location is not None
+        ]
+        assert found == [(severity, line, col)], target
+    (d,) = [d for d in validate(corpus / name).diagnostics if d.code == code]
+    assert "MuJoCo and libsdformat" in d.message and "Choreonoid" in d.message
 
 
 def test_missing_visual_meshes_are_warnings_at_the_uri_line(corpus: Path) -> None:

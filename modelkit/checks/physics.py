@@ -93,6 +93,22 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
             yield diag("MK313", f'link "{link.name}" moves but its mass is zero', _mass_loc(link))
 
 
+# MK301: an inertia matrix is asymmetric when an off-diagonal pair differs by more than this fraction of
+# the largest diagonal moment (smaller differences are rounding in the source and are ignored).
+ASYMMETRY_TOLERANCE = 1e-4
+# Who loads an inertia that breaks the triangle inequality (MK303), and who refuses it.
+IMPOSSIBLE_INERTIA_CONSUMERS = (
+    "Choreonoid, check_urdf and PyBullet load it, MuJoCo and libsdformat (Gazebo) refuse it"
+)
+# Source formats whose own loader refuses such an inertia: there MK303 is an error.
+IMPOSSIBLE_INERTIA_REFUSED_BY = frozenset({"mjcf", "sdf"})
+
+
+def _impossible_inertia_severity(robot: Robot) -> Severity:
+    """MK303: an error where the file's own loader refuses it, else a warning (``--target`` raises it)."""
+    return Severity.ERROR if robot.source_format in IMPOSSIBLE_INERTIA_REFUSED_BY else Severity.WARNING
+
+
 @rule("inertia", "MK301", "MK302", "MK303")
 def inertia(robot: Robot) -> Iterator[Diagnostic]:
     """Inertia tensors are symmetric, positive definite and satisfy the triangle inequality.
@@ -111,15 +127,20 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
         static = "" if link.name in moving else " (the link does not move, so simulators ignore it)"
         where = inertial.sources.get("inertia", _mass_loc(link))
         tensor = np.asarray(inertial.inertia, dtype=float)
-        if not np.allclose(tensor, tensor.T, rtol=1e-9, atol=1e-12):
+        if not (np.all(np.isfinite(tensor)) and np.isfinite(inertial.mass)):  # e.g. 1e400 in the file
+            yield diag("MK302", f'link "{link.name}": the mass or inertia is not a finite number', where)
+            continue
+        skew = float(np.max(np.abs(tensor - tensor.T)))
+        if skew > ASYMMETRY_TOLERANCE * float(np.max(np.abs(np.diag(tensor)))):
             yield diag(
                 "MK301",
-                f'link "{link.name}": the inertia matrix is not symmetric{static}',
+                f'link "{link.name}": the inertia matrix is not symmetric (off-diagonal pairs differ by up '
+                f"to {skew:.6g}){static}",
                 where,
                 severity=severity,
             )
             continue
-        moments = principal_moments(tensor)
+        moments = principal_moments((tensor + tensor.T) / 2)  # a rounding-level asymmetry is ignored
         eps = inertia_tolerance(moments)
         if np.all(np.abs(moments) <= eps):
             yield diag(
@@ -143,9 +164,10 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
             yield diag(
                 "MK303",
                 f'link "{link.name}": principal moments {a:.6g}, {b:.6g}, {c:.6g} violate the '
-                f"triangle inequality ({a:.6g} + {b:.6g} < {c:.6g}){static}",
+                f"triangle inequality ({a:.6g} + {b:.6g} < {c:.6g}){static}; "
+                f"{IMPOSSIBLE_INERTIA_CONSUMERS}",
                 where,
-                severity=severity,
+                severity=_impossible_inertia_severity(robot),
             )
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 from modelkit.checks.registry import rule
-from modelkit.diagnostics import Diagnostic, diag, did_you_mean
+from modelkit.diagnostics import Diagnostic, Severity, diag, did_you_mean
 from modelkit.model import Link, Robot
 
 
@@ -13,7 +13,7 @@ from modelkit.model import Link, Robot
 def unique_names(robot: Robot) -> Iterator[Diagnostic]:
     """Link names are unique, and so are joint names."""
     first_link: dict[str, int] = {}
-    for link in robot.links:
+    for index, link in enumerate(robot.links):  # not links.index(link): quadratic in links
         if link.name == "":
             continue
         if link.name in first_link:
@@ -21,7 +21,7 @@ def unique_names(robot: Robot) -> Iterator[Diagnostic]:
             line = f" (first at line {where.line})" if where and where.line else ""
             yield diag("MK204", f'duplicated link name "{link.name}"{line}', link.loc("name"))
         else:
-            first_link[link.name] = robot.links.index(link)
+            first_link[link.name] = index
     first_joint: dict[str, int] = {}
     for i, joint in enumerate(robot.joints):
         if joint.extras.get("implicit_name"):
@@ -144,12 +144,40 @@ def joint_ids(robot: Robot) -> Iterator[Diagnostic]:
             )
 
 
+def _name_collision_verdict(robot: Robot) -> tuple[Severity, str]:
+    """How bad a link/joint name collision is for this file's own format, and who breaks on it.
+
+    Only SDFormat 1.7+ makes links and joints share one namespace (libsdformat refuses the file); URDF,
+    older SDFormat, MJCF and .body keep them apart, so there the collision is a portability problem.
+    """
+    fmt = robot.source_format
+    if fmt == "sdf":
+        version = str(robot.extras.get("sdf_version", ""))
+        major, _, minor = version.partition(".")
+        if major.isdigit() and minor.isdigit() and (int(major), int(minor)) < (1, 7):
+            return Severity.WARNING, (
+                f"legal in SDFormat {version}, but libsdformat refuses it once the file is SDFormat 1.7+"
+            )
+        return Severity.ERROR, "SDFormat 1.7+ (libsdformat, Gazebo) refuses this"
+    if fmt == "mjcf":
+        return Severity.INFO, (
+            "legal MJCF (MuJoCo names bodies and joints apart); SDFormat 1.7+ would refuse it"
+        )
+    if fmt in ("urdf", "xacro"):
+        return Severity.WARNING, (
+            "legal URDF (check_urdf, ROS and PyBullet load it), but libsdformat's URDF conversion "
+            "(Gazebo) refuses it"
+        )
+    return Severity.WARNING, "SDFormat 1.7+ (libsdformat, Gazebo) would refuse it after conversion"
+
+
 @rule("link-joint-name-collision", "MK211")
 def link_joint_collision(robot: Robot) -> Iterator[Diagnostic]:
-    """A joint named like a link (other than its own implicit name) breaks SDF 1.7+ and Gazebo."""
+    """A joint named like a link (other than its own implicit name): fatal only in SDFormat 1.7+."""
     links: dict[str, Link] = {}
     for link in robot.links:
         links.setdefault(link.name, link)
+    severity, consumers = _name_collision_verdict(robot)
     for joint in robot.joints:
         if joint.extras.get("implicit_name"):
             continue
@@ -159,10 +187,10 @@ def link_joint_collision(robot: Robot) -> Iterator[Diagnostic]:
             line = f" (the link is at line {where.line})" if where and where.line else ""
             yield diag(
                 "MK211",
-                f'joint "{joint.name}" has the same name as a link{line}; SDF 1.7+ (libsdformat) and '
-                "Gazebo refuse this",
+                f'joint "{joint.name}" has the same name as a link{line}; {consumers}',
                 joint.loc("name"),
                 hint=f'rename the joint, e.g. "{joint.name}_joint"',
+                severity=severity,
             )
 
 

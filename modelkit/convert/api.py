@@ -19,8 +19,9 @@ from modelkit.formats.common import ReadOptions
 from modelkit.model import Robot
 
 # Reader errors that do not stop a conversion: the writer deals with them and says so in a note
-# (a link and a joint sharing a name are renamed; a missing or unreadable mesh is left out).
-CONVERTIBLE_ERRORS = frozenset({"MK211", "MK500", "MK501", "MK502", "MK504", "MK506"})
+# (a link and a joint sharing a name are renamed; a missing or unreadable mesh is left out; a
+# massless moving link, legal in URDF kinematic models, gets the target's smallest mass, MK816).
+CONVERTIBLE_ERRORS = frozenset({"MK211", "MK313", "MK500", "MK501", "MK502", "MK504", "MK506"})
 UNREADABLE = frozenset({"MK001", "MK002"})
 COMPOUND_SUFFIXES = (".urdf.xacro", ".xacro", ".urdf", ".body", ".sdf", ".world", ".mjcf", ".xml")
 

@@ -13,6 +13,7 @@ from pathlib import Path
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
 from modelkit.format_names import FORMAT_NAMES
 from modelkit.formats.common import ReadOptions, ReadResult
+from modelkit.textio import UnreadableFile, check_regular
 
 
 @dataclass(frozen=True)
@@ -80,6 +81,12 @@ def read_model(
 ) -> ReadResult:
     """Read any supported model file; an unknown format is a diagnostic, not an exception."""
     shown = display or str(path)
+    sink = DiagnosticSink()
+    try:  # before any reader (or MuJoCo) opens it: only a regular file within the size limit
+        check_regular(path, (options or ReadOptions()).max_bytes)
+    except UnreadableFile as exc:
+        sink.emit(exc.code, exc.message, SourceLocation(shown), hint=exc.hint)
+        return ReadResult(None, sink.items)
     kind = detect_format(path, fmt)
     for info in FORMATS:
         if info.name == kind:
@@ -87,7 +94,6 @@ def read_model(
             reader = getattr(importlib.import_module(module_name), function)
             result: ReadResult = reader(path, options or ReadOptions(), shown)
             return result
-    sink = DiagnosticSink()
     known = ", ".join(s for info in FORMATS for s in info.suffixes)
     message = f"cannot tell the format of this file (supported: {known}, or .xml with a <robot>, "
     message += "<sdf> or <mujoco> top element); use --input-format"

@@ -8,7 +8,12 @@ from pathlib import Path
 from modelkit.diagnostics import Diagnostic
 from modelkit.model import Robot
 from modelkit.resources import Resolver
-from modelkit.textio import DEFAULT_EXPANSION_LIMIT, DEFAULT_MAX_BYTES
+from modelkit.textio import (
+    DEFAULT_EXPANSION_LIMIT,
+    DEFAULT_MAX_BYTES,
+    DEFAULT_MAX_LINKS,
+    DEFAULT_MAX_LIST_ITEMS,
+)
 
 
 @dataclass
@@ -27,6 +32,8 @@ class ReadOptions:
     check_resources: bool = True
     max_bytes: int = DEFAULT_MAX_BYTES
     expansion_limit: int = DEFAULT_EXPANSION_LIMIT
+    max_list_items: int = DEFAULT_MAX_LIST_ITEMS
+    max_links: int = DEFAULT_MAX_LINKS
     xacro_args: dict[str, str] = field(default_factory=dict)
     legacy_xacro: bool | None = None
 

@@ -7,6 +7,8 @@ this one serves formats whose meshes are plain ``uri`` + ``scale``.
 
 from __future__ import annotations
 
+import errno
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,8 +18,17 @@ import numpy as np
 from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
 from modelkit.model import Mesh
 from modelkit.resources import Resolution, Resolver
+from modelkit.textio import UnreadableFile, check_regular
 
 MESH_FILE_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl"})
+
+
+def _symlink_loop(path: Path) -> bool:
+    try:
+        os.stat(path)
+    except OSError as exc:
+        return exc.errno == errno.ELOOP
+    return False
 
 
 def not_found(uri: str, path: Path | str, usage: str = "") -> str:
@@ -54,9 +65,18 @@ class MeshChecker:
             return
         self._textures.add(uri)
         resolution = self.resolution(uri, loc)
-        if resolution.path is None or not resolution.path.exists():
-            why = resolution.message or f"not found at {resolution.path}"
+        path = resolution.path
+        if path is not None and _symlink_loop(path):
+            self.sink.emit("MK001", f'texture "{uri}": cannot read file: a symlink loop', loc)
+            return
+        if path is None or not path.exists():
+            why = resolution.message or f"not found at {path}"
             self.sink.emit("MK507", f'texture "{uri}" cannot be found ({why})', loc, hint=resolution.hint)
+            return
+        try:  # modelkit does not decode images; it refuses only what no loader could read
+            check_regular(path)
+        except UnreadableFile as exc:
+            self.sink.emit(exc.code, f'texture "{uri}": {exc.message}', loc, hint=exc.hint)
 
     def mesh(
         self,

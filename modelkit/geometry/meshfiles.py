@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from modelkit.model import TriangleMeshData
+from modelkit.textio import DEFAULT_MAX_BYTES, UnreadableFile, read_regular
 
 __all__ = [
     "SUPPORTED_EXTENSIONS",
@@ -101,7 +102,12 @@ class LoadedMesh:
 # ---- entry point ----------------------------------------------------------------------------
 
 
-def load_mesh(path: Path, fragment: str | None = None, metadata: MeshMetadata | None = None) -> LoadedMesh:
+def load_mesh(
+    path: Path,
+    fragment: str | None = None,
+    metadata: MeshMetadata | None = None,
+    max_bytes: int = DEFAULT_MAX_BYTES,
+) -> LoadedMesh:
     """Load the triangles of a mesh file as Choreonoid would (§3.6).
 
     Raises :class:`MeshLoadError` (and nothing else) for any input that cannot be used: an unsupported
@@ -118,9 +124,11 @@ def load_mesh(path: Path, fragment: str | None = None, metadata: MeshMetadata | 
             + ", ".join(sorted(SUPPORTED_EXTENSIONS)),
         )
     try:
-        data = path.read_bytes()
-    except OSError as e:
-        raise MeshLoadError("MK501", f"cannot read {path.name}: {e.strerror or e}") from e
+        data = read_regular(path, max_bytes)
+    except UnreadableFile as e:  # a FIFO, a device, a directory, a loop (MK501); too large (MK002)
+        code = "MK002" if e.code == "MK002" else "MK501"
+        reason = e.message.removeprefix("cannot read file: ")
+        raise MeshLoadError(code, f"cannot read {path.name}: {reason}") from e
     if not data.strip():
         raise MeshLoadError("MK501", f"{path.name} is empty")
     try:

@@ -710,7 +710,12 @@ def _add_yaml_resource(
             ctx.yaml_cache[key] = None
         else:
             text = read_text(path, ctx.sink)
-            ctx.yaml_cache[key] = parse_yaml(text, str(path), ctx.sink) if text is not None else None
+            # Choreonoid's YAML resource reader imports the main file's anchors (local ones win).
+            ctx.yaml_cache[key] = (
+                parse_yaml(text, str(path), ctx.sink, imported_anchors=ctx.main_anchors)
+                if text is not None
+                else None
+            )
     doc = ctx.yaml_cache[key]
     if doc is None or doc.root is None:
         return

@@ -18,8 +18,10 @@ from modelkit.formats.body import values as v
 from modelkit.formats.body.elements import Collected, WalkContext, inertia_matrix, walk
 from modelkit.formats.body.materials import MaterialTable, load_materials
 from modelkit.formats.common import ReadOptions, ReadResult
+from modelkit.limits import too_many_links
 from modelkit.model import Inertial, Joint, JointLimits, JointType, Link, LoopConstraint, Robot
 from modelkit.spatial import Pose, combine_mass_properties
+from modelkit.textio import real_path
 from modelkit.yamltree import (
     YMap,
     YNode,
@@ -95,7 +97,7 @@ class _BodyReader:
         self.options = options
         self.sink = sink
         self.display = display
-        self.stack = (*stack, str(path.resolve()))
+        self.stack = (*stack, str(real_path(path)))
         self.angle_scale = math.pi / 180.0
         self.materials: MaterialTable | None = None
 
@@ -105,12 +107,23 @@ class _BodyReader:
         text = read_text(self.path, self.sink, self.options.max_bytes, self.display)
         if text is None:
             return None
-        doc = parse_yaml(text, self.display, self.sink, self.options.expansion_limit)
+        doc = parse_yaml(
+            text,
+            self.display,
+            self.sink,
+            self.options.expansion_limit,
+            self.options.max_list_items,
+            {"links": self.options.max_links},
+        )
         if doc.root is None:
             return None
         root = doc.root
         if not isinstance(root, YMap):
             self.sink.emit("MK017", "the top-level node must be a mapping", root.loc)
+            return None
+        links_list = root.get("links")
+        count = len(links_list.items) if isinstance(links_list, YSeq) else 0
+        if too_many_links(self.sink, root.loc, count, count, self.options.max_links):
             return None
         self._check_schema(root)
         if not self._header(root):
@@ -343,6 +356,7 @@ class _BodyReader:
                 limits.upper = lo_hi[1] * scale if math.isfinite(lo_hi[1]) else lo_hi[1]
         max_velocity = v.finite_or_unlimited(node.get("max_joint_velocity", "maxJointVelocity"))
         if max_velocity is not None:
+            max_velocity = abs(max_velocity)
             limits.velocity_lower, limits.velocity_upper = -max_velocity * scale, max_velocity * scale
         else:
             vr_node = node.get("joint_velocity_range", "jointVelocityRange")
@@ -458,7 +472,7 @@ class _BodyReader:
         if uri is None or uri_node is None:
             self.sink.emit("MK216", "a SubBody needs `uri`", node.loc)
             return []
-        path = (self.path.parent / uri).resolve()
+        path = real_path(self.path.parent / uri)
         if str(path) in self.stack:
             self.sink.emit(
                 "MK216",

@@ -162,9 +162,13 @@ def rotation(node: YNode | None, angle_scale: float, sink: DiagnosticSink) -> Ma
         if aa is None:
             return None
         axis = aa[:3]
-        if float(np.linalg.norm(axis)) < 1e-6:
+        if not np.all(np.isfinite(aa)):  # 1e400 reads as infinity: no rotation can be built from it
+            sink.emit("MK100", "a rotation holds a number that is not finite", part.loc)
+            return None
+        if float(np.linalg.norm(axis / 2.0)) < 0.5e-6:  # halved: |axis| of 1e308s overflows
             sink.emit("MK308", "rotation axis is the zero vector", part.loc)
             return None
+        axis = axis / float(np.max(np.abs(axis)))  # same direction, a norm that cannot overflow
         result = result @ axis_angle(axis, float(aa[3]) * angle_scale)
     return result
 
@@ -184,12 +188,14 @@ def scale3(node: YNode | None, sink: DiagnosticSink) -> Vec3 | None:
 
 
 def finite_or_unlimited(node: YNode | None) -> float | None:
-    """A number, or ±inf for ``unlimited`` (returned as +inf; callers apply the sign)."""
+    """A number, +inf for ``unlimited`` or -inf for ``-unlimited`` (as Choreonoid reads range values)."""
     text = scalar_text(node)
     if text is None:
         return None
     if text.strip() == UNLIMITED:
         return math.inf
+    if text.strip() == "-" + UNLIMITED:
+        return -math.inf
     return parse_float(text)
 
 

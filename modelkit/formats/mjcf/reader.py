@@ -29,6 +29,8 @@ from modelkit.formats.mjcf.build import Built, RobotBuilder, apply_joint_equalit
 from modelkit.formats.mjcf.compiled import CompiledModel, mesh_path
 from modelkit.formats.mjcf.devices import add_devices
 from modelkit.formats.mjcf.errors import error_location, error_text
+from modelkit.formats.mjcf.files import check_asset_files, check_sizes
+from modelkit.formats.mjcf.quiet import collected_warnings
 from modelkit.formats.mjcf.source import SourceIndex, TreeShape, locate, pair
 from modelkit.formats.mjcf.uncompiled import SpecReader
 from modelkit.model import Robot
@@ -71,13 +73,25 @@ class _MjcfReader:
             return []
         index = SourceIndex(doc, self.path.parent, self.sink, self.options.max_bytes)
         list(index.iter_all())  # reads the included files: their XML problems stop here too
-        if any(d.code in ("MK020", "MK021", "MK002", "MK003") for d in self.sink.items):
+        if any(d.code in ("MK001", "MK020", "MK021", "MK002", "MK003") for d in self.sink.items):
+            return []
+        if not check_asset_files(index, self.path.parent, self.sink, self.options.max_bytes):
+            return []
+        if not check_sizes(index, self.sink, self.options.max_links):
             return []
         try:
             mujoco = _import_mujoco()
         except ImportError as exc:  # pragma: no cover - mujoco is a dependency
             self.sink.emit("MK170", f"cannot read MJCF: mujoco is not installed ({exc})", doc.loc(doc.root))
             return []
+        with collected_warnings(mujoco) as warnings:  # never MUJOCO_LOG.TXT in the working directory
+            try:
+                return self._through_mujoco(mujoco, index, compiled)
+            finally:
+                for message in dict.fromkeys(warnings):
+                    self.sink.emit("MK177", f"MuJoCo warned: {message}", index.top().loc())
+
+    def _through_mujoco(self, mujoco: Any, index: SourceIndex, compiled: bool) -> list[Robot]:
         spec = self._spec(mujoco, index)
         if spec is None:
             return []
@@ -240,10 +254,10 @@ class _MjcfReader:
             for body_id, kind, name, pose, params in reader.cameras_and_lights():
                 robot = built.robot_of_body.get(body_id, main)
                 robot.extras[f"mjcf_{kind}s"].append(builder.attached(body_id, name, pose, **params))
+            add_devices(reader.mj, reader.m, builder, built)  # the same, as canonical devices on links
             main.extras.update(data)
 
         def attached(key: str) -> int:
-            add_devices(reader.mj, reader.m, builder, built)  # the same, as canonical devices on links
             return sum(len(r.extras.get(key, [])) for r in built.robots)
 
         counts = {

@@ -16,6 +16,7 @@ from pathlib import Path
 from lxml.etree import _Element as Element
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
+from modelkit.textio import real_path
 from modelkit.xmlsource import XmlDocument, read_xml
 
 # Containers MuJoCo flattens into their body: their children belong to the enclosing body.
@@ -77,19 +78,19 @@ class SourceIndex:
         if not name:
             return None
         if not self._owner and self.main.path is not None:
-            self._owner[self.main.path.resolve()] = None  # the main file cannot be included
+            self._owner[real_path(self.main.path)] = None  # the main file cannot be included
         candidates = [self.base_dir / name]
         if placed.doc.path is not None:
             candidates.append(placed.doc.path.parent / name)
-        path = next((p for p in candidates if p.is_file()), candidates[0])
-        key = path.resolve()
+        path = next((p for p in candidates if p.exists()), candidates[0])
+        key = real_path(path)
         owner = self._owner.setdefault(key, placed.el)
         if owner is not placed.el:
             return None
         if key not in self._included:
             display = str(Path(self.main.display).parent / name)
             self._included[key] = (
-                read_xml(path, self.sink, self.max_bytes, display) if path.is_file() else None
+                read_xml(path, self.sink, self.max_bytes, display) if path.exists() else None
             )
         return self._included[key]
 

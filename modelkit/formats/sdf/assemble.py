@@ -136,26 +136,41 @@ class Assembler:
         seeds += [n for n in order if n not in incoming]
         tops: list[str] = []
         visited: set[str] = set()
+        cycles: list[JointData] = []
+
+        def cut(link: str) -> None:  # ``link`` is on a cycle of parent joints: cut it here
+            joint = incoming.pop(link)
+            cycles.append(joint)
+            children[joint.parent_link or ""].remove(joint)
+
         while True:
             for top in seeds:
                 if top in visited or top not in self.by_name:
                     continue
+                if top in incoming:  # the top of a cycle (every link on it is some joint's child)
+                    cut(top)
                 tops.append(top)
                 stack = [top]
                 visited.add(top)
-                while stack:
+                while stack:  # each link has one tree parent, so a walk from a top never comes back
                     for j in children.get(stack.pop(), []):
-                        visited.add(j.child_link or "")
-                        stack.append(j.child_link or "")
+                        child = j.child_link or ""
+                        if child not in visited:
+                            visited.add(child)
+                            stack.append(child)
             stranded = [n for n in order if n not in visited]
             if not stranded:
                 break
-            cut = incoming.pop(stranded[0])  # on a cycle of parent joints: cut it here
-            loops.append(cut)
-            children[cut.parent_link or ""].remove(cut)
             seeds = [stranded[0]]
-        loops = [j for j in self.joints if j in loops]
-        for j in loops:
+        for j in cycles:
+            self.sink.emit(
+                "MK203",
+                f'joints form a cycle through link "{j.child_link}": every link on it is the child of '
+                f'a joint, so none can be the root; joint "{j.item.local}" is kept as a loop constraint',
+                j.joint.loc("child"),
+            )
+        loops = [j for j in self.joints if j in loops or j in cycles]
+        for j in (j for j in loops if j not in cycles):
             first = incoming.get(j.child_link or "")
             holder = f'joint "{first.item.local}"' if first is not None else "a cycle of joints"
             self.sink.emit(

@@ -16,7 +16,7 @@ import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from modelkit.diagnostics import DiagnosticSink, SourceLocation
+from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
 from modelkit.formats.common import ReadOptions
 from modelkit.formats.meshref import MeshChecker
 from modelkit.formats.sdf.document import MAX_VERSION, SdfDocument, load_document, parse_version
@@ -127,6 +127,15 @@ class Context:
     def include_file(self, uri: str, src: SdfDocument, loc: SourceLocation) -> Path | None:
         """The SDF file an ``<include><uri>`` names; faults are reported at ``loc``."""
         resolution = self.resolve(uri, src, loc)
+        if resolution.scheme in ("http", "https"):
+            self.sink.emit(
+                "MK503",
+                f'included model "{uri.strip()}" is on a web server (Gazebo Fuel): Gazebo downloads it '
+                "when it loads the world; modelkit does not fetch it, so it is not checked",
+                loc,
+                severity=Severity.INFO,
+            )
+            return None
         if resolution.code is not None or resolution.path is None:
             self.sink.emit(
                 resolution.code or "MK504",
@@ -136,8 +145,20 @@ class Context:
             )
             return None
         path = resolution.path
+        if not path.exists() and resolution.scheme in ("", "file"):
+            # libsdformat's findFile: a bare name or relative path not beside the file is looked up on
+            # the model path (SDF_PATH, GZ_SIM_RESOURCE_PATH, ...), as Gazebo does.
+            text = uri.strip()
+            relative = text[len("file://") :] if text.lower().startswith("file://") else text
+            path = self.options.resolver.find_on_model_path(relative.rstrip("/")) or path
         if not path.exists():
-            self.sink.emit("MK500", f'included model "{uri}" not found at {path}', loc)
+            self.sink.emit(
+                "MK500",
+                f'included model "{uri.strip()}" not found at {path} nor on the model path',
+                loc,
+                hint="give the folder that holds its model folder with --resource-path DIR, or add it to "
+                "SDF_PATH / GZ_SIM_RESOURCE_PATH",
+            )
             return None
         if path.is_dir():
             return self._model_folder(uri, path, loc)

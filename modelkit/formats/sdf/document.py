@@ -15,6 +15,7 @@ from pathlib import Path
 
 from modelkit.diagnostics import DiagnosticSink
 from modelkit.formats.sdf.values import Values, local_name
+from modelkit.textio import UnreadableFile, read_regular
 from modelkit.xmlsource import XmlDocument, mask_markup, parse_xml_bytes, read_xml, tag_end
 
 MIN_VERSION = (1, 4)
@@ -102,8 +103,8 @@ def _read(path: Path, display: str, sink: DiagnosticSink, max_bytes: int) -> Xml
         sink.extend(first.items)
         return None
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
+        text = read_regular(path, max_bytes).decode("utf-8")
+    except (UnreadableFile, UnicodeDecodeError):
         sink.extend(first.items)
         return None
     declared = _declare_prefixes(text)

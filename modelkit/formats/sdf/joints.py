@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from lxml.etree import _Element as Element
 
-from modelkit.diagnostics import SourceLocation, did_you_mean
+from modelkit.diagnostics import Severity, SourceLocation, did_you_mean
 from modelkit.formats.sdf.collect import Item
 from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.poses import FrameGraph
@@ -173,8 +173,10 @@ def _ends(ctx: Context, graph: FrameGraph, data: JointData, what: str) -> None:
         ctx.sink.emit(
             "MK235",
             f'the parent "{names["parent"]}" and child "{names["child"]}" of {what} are both attached to '
-            f'link "{data.child_link}"',
+            f'link "{data.child_link}": libsdformat loads it, but the joint joins that link to itself and '
+            "moves nothing",
             joint.sources.get("child"),
+            severity=Severity.WARNING,
         )
         data.child_link = None
 

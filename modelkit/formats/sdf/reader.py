@@ -29,6 +29,7 @@ from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import light_device, plugin_data
 from modelkit.formats.sdf.values import child
 from modelkit.formats.sdf.world import Placed, WorldFrames, world_frame_entries
+from modelkit.limits import too_many_links
 from modelkit.model import Device, Robot
 from modelkit.spatial import Pose
 
@@ -69,6 +70,10 @@ class _Reader:
         src, values = self.src, self.src.values
         root = src.doc.root
         robots: list[Robot] = []
+        links = sum(1 for _ in root.iter("{*}link"))
+        joints = sum(1 for _ in root.iter("{*}joint"))
+        if too_many_links(self.sink, values.loc(root), links, joints, self.ctx.options.max_links):
+            return robots
         singles = [el for el in root if isinstance(el.tag, str) and el.tag in ("model", "light", "actor")]
         for extra in singles[1:]:
             self.sink.emit(

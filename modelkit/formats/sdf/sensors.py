@@ -80,6 +80,7 @@ CONFIG_ELEMENT = {
     "boundingbox": "camera",
     "wideanglecamera": "camera",
     "wide_angle_camera": "camera",
+    "multicamera": "camera",
     "gpu_ray": "ray",
     "gpu_lidar": "lidar",
     "gps": "navsat",

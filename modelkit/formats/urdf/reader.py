@@ -24,6 +24,7 @@ from modelkit.formats.urdf.joints import read_joint
 from modelkit.formats.urdf.links import Materials, read_link
 from modelkit.formats.urdf.schema import check_structure
 from modelkit.formats.urdf.values import VERSIONS, Context
+from modelkit.limits import too_many_links
 from modelkit.model import WORLD_LINK, JointType, Robot
 from modelkit.xmlsource import XmlDocument, location_at, read_xml
 
@@ -55,6 +56,9 @@ def read_urdf_document(
             doc.loc(root),
             hint='a URDF file starts with <robot name="...">',
         )
+        return None
+    tags = [etree.QName(c).localname for c in root if isinstance(c.tag, str)]
+    if too_many_links(sink, doc.loc(root), tags.count("link"), tags.count("joint"), options.max_links):
         return None
     ctx = Context(doc=doc, sink=sink, namespace=qname.namespace)
     _external_dtd(doc, sink)

@@ -15,7 +15,9 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 from modelkit.diagnostics import Diagnostic, SourceLocation, diag
+from modelkit.formats.xacro.guard import ExpressionTooLarge, OutsideRead
 from modelkit.formats.xacro.origins import ExpansionTooLarge, Origin, OriginMap, attributes, source_elements
+from modelkit.textio import UnreadableFile
 from modelkit.xmlsource import XmlDocument
 
 
@@ -142,6 +144,14 @@ def diagnose(exc: BaseException, ctx: FailureContext) -> Diagnostic | None:
         return None
     node = ctx.failed_node
     pattern: re.Pattern[str] | None
+    bound = _first(exc, ExpressionTooLarge)
+    if bound is not None:
+        return diag(
+            "MK709",
+            f"expression refused: it would build {bound}" + _in_macro(ctx),
+            locate(ctx, None, node),
+            hint="xacro expressions are bounded in integer size, sequence length and work",
+        )
     if _first(exc, ExpansionTooLarge) is not None or _first(exc, ValueTooLarge) is not None:
         return diag(
             "MK709",
@@ -163,6 +173,18 @@ def diagnose(exc: BaseException, ctx: FailureContext) -> Diagnostic | None:
             locate(ctx, None, node),
             hint="remove the include that closes the loop",
         )
+    outside = _first(exc, OutsideRead)
+    if isinstance(outside, OutsideRead):
+        return diag(
+            "MK711",
+            f"refusing to read {outside.path}: it is outside the model's folder tree and the package "
+            "paths given",
+            locate(ctx, None, node),
+            hint="give the folder that holds it with --package-path NAME=DIR (or ROS_PACKAGE_PATH)",
+        )
+    unreadable = _first(exc, UnreadableFile)
+    if isinstance(unreadable, UnreadableFile):
+        return diag(unreadable.code, f"{unreadable.path}: {unreadable.message}", locate(ctx, None, node))
     missing = _first(exc, PackageNotFound)
     if isinstance(missing, PackageNotFound):
         name = missing.package

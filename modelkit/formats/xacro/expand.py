@@ -37,6 +37,7 @@ from modelkit.formats.xacro.errors import (
     ValueTooLarge,
     diagnose,
 )
+from modelkit.formats.xacro.guard import ExpressionGuard, Sandbox, model_root
 from modelkit.formats.xacro.legacy import (
     FileSet,
     LegacyConstruct,
@@ -47,6 +48,7 @@ from modelkit.formats.xacro.legacy import (
     scan_file_set,
 )
 from modelkit.formats.xacro.origins import OriginMap, dom_elements
+from modelkit.textio import UnreadableFile, read_regular, real_path
 from modelkit.xmlsource import XmlDocument, read_xml
 
 # Elements that macro and block expansion may create (a macro bomb stops here); a lower
@@ -90,6 +92,7 @@ class _Run:
         self.failed_text: str | None = None
         self.last_directive: minidom.Element | None = None
         self.xacro: Any = None
+        self.sandbox = _sandbox(path, options)
 
     # -- files ---------------------------------------------------------------------------------
 
@@ -104,6 +107,8 @@ class _Run:
         return key if relative.startswith("..") else relative
 
     def load(self, path: Path, sink: DiagnosticSink | None = None) -> XmlDocument | None:
+        if not self.sandbox.allows(path):  # refused (MK711) when xacro itself includes it
+            return None
         return read_xml(path, sink or DiagnosticSink(), self.options.max_bytes, self.display_for(path))
 
     def report_legacy(self, constructs: list[LegacyConstruct]) -> None:
@@ -114,11 +119,12 @@ class _Run:
         """xacro's ``parse`` of a file: our checks, origins and legacy rewriting, then a minidom tree."""
         xacro = self.xacro
         path = Path(filename)
-        if not path.is_file():
+        if not path.exists() or path.is_dir():
             xacro.filestack.pop()  # as xacro does: the missing file is not "the current file"
             code = errno.EISDIR if path.is_dir() else errno.ENOENT
             error = OSError(code, os.strerror(code), filename)
             raise xacro.XacroException(f"{error.strerror}: {filename}", exc=error)
+        self.sandbox.check(path)
         key = file_key(path)
         doc = self.files.docs.get(key)
         if doc is None:
@@ -216,6 +222,7 @@ class _Run:
             found = find_package(self.options, package, Path(current or self.path), self.path)
             if found is None:
                 raise PackageNotFound(package)
+            self.sandbox.allow(found)
             return str(found)
 
         def env(name: str) -> str:
@@ -227,6 +234,27 @@ class _Run:
             return environ.get(name, default)
 
         return {"find": find, "env": env, "optenv": optenv}
+
+    def load_yaml(self, filename: str) -> Any:
+        """xacro's ``load_yaml``, reading only inside the sandbox and only regular files."""
+        import yaml
+
+        xacro = self.xacro
+        for unit in xacro.ConstructUnits:
+            yaml.SafeLoader.add_constructor(unit.value.tag, unit.constructor)
+        filename = xacro.abs_filename_spec(filename)
+        self.sandbox.check(filename)
+        try:
+            data = read_regular(filename, self.options.max_bytes)
+        except UnreadableFile as exc:
+            exc.path = filename
+            raise
+        xacro.filestack.append(filename)
+        try:
+            return xacro.YamlListWrapper.wrap(yaml.safe_load(data))
+        finally:
+            xacro.filestack.pop()
+            xacro.all_includes.append(filename)
 
     # -- running -------------------------------------------------------------------------------
 
@@ -265,6 +293,8 @@ class _Run:
             put(xacro, "handle_macro_call", self.tracked(xacro.handle_macro_call, call=True))
             put(xacro, "eval_text", self.eval_text(xacro.eval_text))
             put(xacro, "check_attrs", self.check_attrs(xacro.check_attrs))
+            put(xacro, "safe_eval", ExpressionGuard(xacro.XacroException).safe_eval)
+            put(xacro, "load_yaml", self.load_yaml)
             for name, function in self.messages().items():
                 put(xacro, name, function)
             substitutions = self.substitutions()
@@ -329,6 +359,24 @@ class _Run:
                 origin = self.origins.get(node)
                 origins.append(origin.loc() if origin else top_loc)
             return Expanded(doc.toprettyxml(indent="  "), origins)
+
+
+def _sandbox(path: Path, options: ReadOptions) -> Sandbox:
+    """Where xacro may read: the model's folder tree and the package folders given (``$(find)``
+    adds each package it finds)."""
+    sandbox = Sandbox()
+    sandbox.allow(real_path(path).parent)
+    sandbox.allow(model_root(path))
+    resolver = options.resolver
+    for folder in resolver.package_paths.values():
+        sandbox.allow(folder)
+    for entry in resolver.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep):
+        if entry:
+            sandbox.allow(entry)
+    for entry in resolver.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
+        if entry:
+            sandbox.allow(Path(entry) / "share")
+    return sandbox
 
 
 def _with_original(hook: Callable[..., Any], original: Callable[..., Any]) -> Callable[..., Any]:

@@ -55,8 +55,8 @@ def read_xacro(path: Path, options: ReadOptions, display: str) -> ReadResult:
     if doc is not None and is_macro_library(doc):
         sink.emit(
             "MK710",
-            "this xacro file expands to no robot content (a library of macros or properties for "
-            "other xacro files): it was checked for xacro errors only",
+            "this xacro file expands to no robot content (a library of macros, properties, materials "
+            "or <gazebo> blocks for other xacro files): it was checked for xacro errors only",
             doc.loc(doc.root),
         )
     elif doc is not None:
@@ -64,10 +64,15 @@ def read_xacro(path: Path, options: ReadOptions, display: str) -> ReadResult:
     return ReadResult(robot, sorted_diagnostics(sink.items))
 
 
-def is_macro_library(doc: XmlDocument) -> bool:
-    """True when the expansion holds no robot content at all: no link, joint or other element.
+# Top-level elements a file of shared definitions may hold without being a robot itself.
+LIBRARY_ELEMENTS = frozenset({"material", "gazebo"})
 
-    Such files (``materials.xacro``, ``*_macro.xacro``) are included by others; on their own they
-    are not robots, and reporting "no links" or "no robot name" on them would be noise.
+
+def is_macro_library(doc: XmlDocument) -> bool:
+    """True when the expansion holds no robot content: nothing, or only ``<material>``/``<gazebo>`` blocks.
+
+    Such files (``materials.xacro``, ``*_macro.xacro``, a robot's ``*.gazebo.xacro``) are included by
+    others; on their own they are not robots, and reporting "no links" or "no robot name" on them would
+    be noise (check_urdf refuses them, but nobody loads them alone).
     """
-    return not any(isinstance(child.tag, str) for child in doc.root)
+    return all(child.tag in LIBRARY_ELEMENTS for child in doc.root if isinstance(child.tag, str))

@@ -1,0 +1,25 @@
+"""MuJoCo without side effects: its warnings become diagnostics instead of ``MUJOCO_LOG.TXT``.
+
+MuJoCo's default warning handler prints the message and appends it to ``MUJOCO_LOG.TXT`` in the
+working directory (``mju_writeLog``). ``validate`` and ``tree`` must never write a file, so while
+modelkit calls MuJoCo a user warning handler (``mujoco.set_mju_user_warning``) collects the
+messages; the previous handler is put back afterwards. (Errors already reach Python as exceptions.)
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterator
+from typing import Any
+
+
+@contextlib.contextmanager
+def collected_warnings(mujoco: Any) -> Iterator[list[str]]:
+    """Collect MuJoCo's warnings into the yielded list for the duration of the block."""
+    messages: list[str] = []
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: messages.append(str(message).strip()))
+    try:
+        yield messages
+    finally:
+        mujoco.set_mju_user_warning(previous)
