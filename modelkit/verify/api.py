@@ -1,0 +1,362 @@
+"""``verify(source, out_dir, ...)``: convert a model, load each conversion into each engine, run the
+layers, collect every check and skip into a :class:`~modelkit.verify.report.VerifyReport`.
+
+The engine plug-in contract (what ``engine_<name>.py`` modules provide)
+=======================================================================
+
+Engines are found by name in :data:`ENGINES` (``"name": "module:function"``) and imported lazily,
+only when ``verify`` runs; an ``ImportError`` while importing the module (the engine's Python
+package is not installed) becomes a :class:`~modelkit.verify.facts.Skip` "not installed", never a
+failure. Every module exposes::
+
+    def load(model: Path | Robot, renames: Renames, *, root: str) -> EngineModel
+
+* ``model``: the written file this engine reads (MJCF for MuJoCo, URDF for PyBullet and yourdfpy,
+  SDF or URDF for Drake: see :data:`INPUTS`), or the in-memory source :class:`Robot` for the
+  engines that read no file (``pinocchio``, ``source``).
+* ``renames``: ``{"link": {source name: written name}, "joint": {...}}`` from the conversion notes
+  (MK800), for information; an engine reports **written** names in everything it returns (the
+  layers map them back). For a ``Robot`` input both maps are empty.
+* ``root``: the written name of the root link. The engine welds it to the world at the identity
+  (delete a free joint, ``useFixedBase=True``, ``WeldFrames``); the layers compare link poses
+  relative to this root, so where the file places it does not matter.
+* gravity is always (0, 0, −9.81) m/s² in the world frame; no joint damping, armature or friction
+  is added by the adapter (only what the model itself has), and the adapter records every setting
+  that matters in ``EngineModel.settings``.
+* it raises ``modelkit.verify.api.EngineError`` (or any ``Exception``) when the file cannot be
+  loaded: that becomes a failed layer-1 ``load`` check for the engine, with the message (an engine
+  refusing our file is a conversion defect, not a skip).
+
+A module that can integrate the model (layer 3b, the replay) also exposes::
+
+    def simulator(model: Path, renames: Renames, *, root: str, dt: float) -> Simulator
+
+whose ``replay(law, seconds, dt)`` maps ``law.joints`` (source names) through its own ``renames``
+and returns q with one column per ``law.joints`` entry, in that order (MuJoCo's is in
+``engine_mujoco.py``). Layer 3b itself is ``modelkit.verify.replay``, imported lazily like the
+engines (missing → Skip)::
+
+    def default_law(source: Robot) -> TorqueLaw
+    def layer3b(source: Robot, sims: list[Simulator], law: TorqueLaw, seconds: float, dt: float
+                ) -> tuple[list[Check], list[Skip]]
+
+Fault injection (``--inject``) is ``modelkit.verify.inject:apply(spec: str, files: dict[str, Path],
+renames: dict[str, Renames]) -> str``: it perturbs the written files in place (``files`` maps "mjcf",
+"urdf", "sdf" to paths, ``renames`` maps the same keys to that file's renames) and returns a one-line
+description for the report; a bad spec raises ``ValueError`` (exit 2).
+"""
+
+from __future__ import annotations
+
+import copy
+import importlib
+import tempfile
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from modelkit.model import JointType, Robot
+from modelkit.spatial import Pose
+from modelkit.verify.facts import Check, Skip
+from modelkit.verify.report import VerifyReport
+
+Renames = dict[str, dict[str, str]]
+
+ENGINES: dict[str, str] = {
+    "source": "modelkit.verify.reference:load",
+    "pinocchio": "modelkit.verify.engine_pinocchio:load",
+    "mujoco": "modelkit.verify.engine_mujoco:load",
+    "pybullet": "modelkit.verify.engine_pybullet:load",
+    "drake": "modelkit.verify.engine_drake:load",
+    "yourdfpy": "modelkit.verify.reference:load_yourdfpy",
+}
+DEFAULT_ENGINES = ("mujoco", "pybullet", "pinocchio", "drake", "yourdfpy")
+
+# Which written file each engine reads ("robot" = the in-memory source model).
+INPUTS: dict[str, str] = {
+    "source": "robot",
+    "pinocchio": "robot",
+    "mujoco": "mjcf",
+    "pybullet": "urdf",
+    "drake": "sdf",
+    "yourdfpy": "urdf",
+}
+SUFFIX = {"mjcf": ".xml", "urdf": ".urdf", "sdf": ".sdf"}
+REPLAY = "modelkit.verify.replay:layer3b"
+INJECT = "modelkit.verify.inject:apply"
+
+CONFIGURATIONS = 50  # layer 2: q = 0 and this many random configurations
+SAMPLES = 20  # layer 3a: random (q, dq)
+REPLAY_SECONDS = 10.0
+REPLAY_DT = 1e-3
+
+
+class EngineError(RuntimeError):
+    """An engine could not load a model file."""
+
+
+class VerifyError(Exception):
+    """The run could not happen: unreadable input, no robot, a bad option (exit 2)."""
+
+
+def _resolve(target: str) -> Any:
+    module, _, name = target.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+def _read(source: Path) -> Robot:
+    from modelkit.api import validate
+    from modelkit.convert.api import CONVERTIBLE_ERRORS, UNREADABLE
+
+    if not source.exists():
+        raise VerifyError(f"{source}: no such file")
+    checked = validate(source)
+    if any(d.code in UNREADABLE for d in checked.diagnostics):
+        raise VerifyError(f"{source}: cannot be read: "
+                          + "; ".join(d.message for d in checked.diagnostics if d.code in UNREADABLE))
+    blocking = [d for d in checked.errors if d.code not in CONVERTIBLE_ERRORS]
+    robots = [r for r in checked.robots if r.root is not None]
+    if blocking or not robots:
+        why = "; ".join(f"{d.code} {d.message}" for d in blocking[:3]) or "no robot with a root link"
+        raise VerifyError(f"{source}: cannot be converted: {why}")
+    return robots[0]
+
+
+def welded_copy(robot: Robot) -> tuple[Robot, str]:
+    """The robot with its root welded to the world at the identity, and the sentence that says so."""
+    out = copy.deepcopy(robot)
+    was = robot.root_joint.value if robot.root_joint is not None else "left open by the format"
+    out.root_joint = JointType.FIXED
+    out.root_pose = Pose()
+    return out, (f"root link {robot.root!r} ({was} in the source) welded to the world at the identity "
+                 "for layers 1-3")
+
+
+def _reference(welded: Robot, report: VerifyReport) -> Robot:
+    """The model the layers compare with: the source, or its track approximation (said in a Skip)."""
+    from modelkit.convert.api import prepare
+    from modelkit.convert.notes import NoteSink
+    from modelkit.convert.options import WriteOptions
+    from modelkit.convert.registry import target_info
+
+    notes = NoteSink()
+    prepared = prepare(welded, target_info("mjcf"), WriteOptions(), notes)
+    tracks = [n for n in notes.items if n.code == "MK809"]
+    if not tracks:
+        report.reference = "the source model"
+        return welded
+    report.reference = ("the source model with its tracks approximated by rollers as every writer does "
+                        "(MK809): the written files are compared with that approximation")
+    for n in tracks:
+        report.skips.append(Skip(0, "all", "continuous track not verified, only its approximation: "
+                                 + n.message))
+    return prepared
+
+
+def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report: VerifyReport,
+             needed: set[str]) -> tuple[dict[str, Path], dict[str, Renames]]:
+    from modelkit.convert.api import output_stem, write
+    from modelkit.convert.notes import renames
+
+    files: dict[str, Path] = {}
+    maps: dict[str, Renames] = {}
+    stem = output_stem(Path(report.source)) if report.source else "robot"
+    for fmt in ("mjcf", "urdf", "sdf"):
+        user = given.get(fmt)
+        if user is not None:
+            if not user.exists():
+                raise VerifyError(f"--{fmt} {user}: no such file")
+            files[fmt], maps[fmt] = user, {"link": {}, "joint": {}}
+            report.files[fmt] = str(user)
+            continue
+        if fmt not in needed:
+            continue
+        path = out_dir / f"{stem}{SUFFIX[fmt]}"
+        notes = write(welded, path, fmt, force=True)
+        files[fmt] = path
+        maps[fmt] = {"link": renames(notes, "link"), "joint": renames(notes, "joint")}
+        report.files[fmt] = path.name
+        report.notes[fmt] = sorted({n.code for n in notes})
+    report.renames = {fmt: {k: dict(sorted(v.items())) for k, v in m.items() if v} for fmt, m in maps.items()}
+    return files, maps
+
+
+def _load_engines(names: Sequence[str], reference: Robot, files: dict[str, Path], maps: dict[str, Renames],
+                  report: VerifyReport) -> list[Any]:
+    from modelkit.verify.layers import Loaded
+
+    loaded: list[Loaded] = []
+    for name in names:
+        if name not in ENGINES:
+            raise VerifyError(f"unknown engine {name!r}; known: {', '.join(sorted(ENGINES))}")
+        kind = INPUTS[name]
+        renames: Renames = {"link": {}, "joint": {}} if kind == "robot" else maps[kind]
+        model_in: Path | Robot = reference if kind == "robot" else files[kind]
+        root = renames.get("link", {}).get(str(reference.root), str(reference.root))
+        try:
+            load = _resolve(ENGINES[name])
+        except ImportError as exc:
+            report.skips.append(Skip(0, name, f"not installed ({exc})"))
+            continue
+        try:
+            model = load(model_in, renames, root=root)
+        except Exception as exc:
+            what = "the source model" if kind == "robot" else f"the written {kind.upper()} {files[kind].name}"
+            report.checks.append(Check(1, name, "load", "", float("inf"), 0.0,
+                                       f"{name} could not load {what}: {type(exc).__name__}: {exc}"))
+            continue
+        report.engines[name] = dict(model.settings)
+        loaded.append(Loaded(name, model, renames))
+    return loaded
+
+
+def verify(
+    source: str | Path,
+    out_dir: str | Path | None = None,
+    engines: Sequence[str] = DEFAULT_ENGINES,
+    mjcf: str | Path | None = None,
+    urdf: str | Path | None = None,
+    sdf: str | Path | None = None,
+    inject: Sequence[str] = (),
+    seed: int = 0,
+    configurations: int = CONFIGURATIONS,
+    samples: int = SAMPLES,
+    replay: bool = True,
+) -> VerifyReport:
+    """Convert ``source`` (or take the given files), load every engine, run layers 1–3.
+
+    ``out_dir`` receives the written MJCF/URDF/SDF (a temporary folder, deleted afterwards, when
+    None). Never raises for a model problem: a failed check is in ``report.checks``; what stops the
+    run (unreadable input, a bad option) is in ``report.errors`` (exit 2).
+    """
+    report = VerifyReport(str(source), seed=seed)
+    report.parameters = {"configurations": configurations, "dynamics_samples": samples,
+                         "tolerance": 1e-9, "replay_seconds": REPLAY_SECONDS, "replay_dt": REPLAY_DT,
+                         "engines": list(engines)}
+    if out_dir is None:
+        with tempfile.TemporaryDirectory(prefix="modelkit-verify-") as tmp:
+            return _run(report, Path(source), Path(tmp), engines, mjcf, urdf, sdf, inject, seed,
+                        configurations, samples, replay)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    return _run(report, Path(source), out, engines, mjcf, urdf, sdf, inject, seed, configurations, samples,
+                replay)
+
+
+def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str], mjcf: str | Path | None,
+         urdf: str | Path | None, sdf: str | Path | None, inject: Sequence[str], seed: int,
+         configurations: int, samples: int, replay: bool) -> VerifyReport:
+    from modelkit.verify import layers
+    from modelkit.verify.reference import SourceModel, source_static
+
+    t0 = time.perf_counter()
+    try:
+        robot = _read(source)
+        report.robot = robot.name
+        welded, report.base = welded_copy(robot)
+        reference = _reference(welded, report)
+        given = {"mjcf": Path(mjcf) if mjcf else None, "urdf": Path(urdf) if urdf else None,
+                 "sdf": Path(sdf) if sdf else None}
+        needed = {INPUTS[e] for e in engines if e in INPUTS} - {"robot"}
+        files, maps = _convert(welded, out_dir, given, report, needed)
+        t1 = time.perf_counter()
+        for spec in inject:
+            try:
+                apply = _resolve(INJECT)
+            except ImportError as exc:
+                raise VerifyError(f"--inject {spec}: fault injection is not available ({exc})") from exc
+            try:
+                report.injected.append(str(apply(spec, files, maps)))
+            except ValueError as exc:
+                raise VerifyError(f"--inject {spec}: {exc}") from exc
+        loaded = _load_engines(engines, reference, files, maps, report)
+    except VerifyError as exc:
+        report.errors.append(str(exc))
+        return report
+    t2 = time.perf_counter()
+    report.timings["convert"] = t1 - t0
+    report.timings["load"] = t2 - t1
+
+    src = SourceModel(reference)
+    report.engines["source"] = dict(src.settings)
+    src_static = source_static(reference)
+    for eng in loaded:
+        report.checks.extend(layers.layer1(src_static, eng))
+        report.skips.extend(layers.massless_skips(src_static, eng))
+    t3 = time.perf_counter()
+    configs = layers.configurations(reference, configurations, seed)
+    for eng in loaded:
+        report.checks.extend(layers.layer2(src, eng, configs))
+    t4 = time.perf_counter()
+    pin_ref = next((e.model for e in loaded if e.label == "pinocchio"), None)
+    if layers.kinematic_only(reference):
+        report.skips.append(Skip(3, "all", "no link moved by a joint has mass in the source (a kinematic "
+                                           "model): no dynamics to verify"))
+        replay = False
+    elif pin_ref is None:
+        report.skips.append(Skip(3, "all", "layer 3a needs Pinocchio (the dynamics reference built from the "
+                                           "source model), which is not among the loaded engines"))
+    else:
+        state = layers.states(reference, pin_ref.dof_names(), samples, seed)
+        with_armature = [j.name for j in reference.joints if j.armature != 0.0]
+        for eng in loaded:
+            if eng.label == "pinocchio":
+                continue
+            dropped = bool(with_armature) and INPUTS.get(eng.label) in ("urdf", "sdf")
+            ref = _without_armature(reference) if dropped else pin_ref
+            try:
+                report.checks.extend(layers.layer3a(ref, eng, state))
+                if dropped:
+                    report.skips.append(Skip(3, eng.label, (
+                        f"joint armature (rotor inertia) of {', '.join(with_armature)} cannot be written in "
+                        "URDF/SDF (MK820): the mass matrix is compared with the Pinocchio reference "
+                        "without it")))
+            except NotImplementedError:
+                report.skips.append(layers.no_dynamics(eng))
+    t5 = time.perf_counter()
+    if replay:
+        _replay(reference, files, maps, loaded, report)
+    t6 = time.perf_counter()
+    for eng in loaded:
+        eng.model.close()
+    report.timings.update({"layer 1": t3 - t2, "layer 2": t4 - t3, "layer 3a": t5 - t4, "layer 3b": t6 - t5})
+    return report
+
+
+def _without_armature(robot: Robot) -> Any:
+    from modelkit.verify.engine_pinocchio import PinocchioModel
+
+    model = PinocchioModel(robot)
+    model.model.armature[:] = 0.0
+    model.settings["armature"] = "zeroed (the file's format cannot hold it)"
+    return model
+
+
+def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], loaded: list[Any],
+            report: VerifyReport) -> None:
+    """Layer 3b through the replay module (MuJoCo against PyBullet), when it is there."""
+    names = [e.label for e in loaded if e.label in ("mujoco", "pybullet")]
+    if len(names) < 2:
+        report.skips.append(Skip(3, "mujoco+pybullet", "layer 3b (replay) needs both MuJoCo and PyBullet "
+                                 "loaded"))
+        return
+    try:
+        layer3b = _resolve(REPLAY)
+        default_law = _resolve("modelkit.verify.replay:default_law")
+    except ImportError as exc:
+        report.skips.append(Skip(3, "mujoco+pybullet", f"layer 3b (replay) is not available: {exc}"))
+        return
+    sims = []
+    for name in names:
+        kind = INPUTS[name]
+        root = maps[kind].get("link", {}).get(str(reference.root), str(reference.root))
+        sims.append(_resolve(ENGINES[name].replace(":load", ":simulator"))(files[kind], maps[kind], root=root,
+                                                                            dt=REPLAY_DT))
+    try:
+        checks, skips = layer3b(reference, sims, default_law(reference), REPLAY_SECONDS, REPLAY_DT)
+    finally:
+        for sim in sims:
+            sim.close()
+    report.checks.extend(checks)
+    report.skips.extend(skips)

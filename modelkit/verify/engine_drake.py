@@ -1,0 +1,292 @@
+"""Drake adapter: our written SDF (engine "drake") or URDF ("drake-urdf") in a continuous
+``MultibodyPlant``, so that the SDF output is read by a real SDF consumer (Drake parses SDFormat
+with libsdformat).
+
+Loading: ``MultibodyPlant(time_step=0)`` (continuous: no discrete solver, no contact), no
+``SceneGraph`` (the shapes are parsed and checked by the parser, not registered: layers 1–3 need
+no geometry), gravity (0, 0, −9.81). The root is welded to the world at the identity: a joint the
+file itself declares between the world and the root (SDF ``<joint>`` to ``world``, URDF ``world``
+link) is removed with ``RemoveJoint`` and replaced by ``WeldFrames(world, root, identity)``, which
+is also what a free root gets; then the plant is finalized. The base weld is not reported as a
+joint (the source's root joint is not a tree joint either).
+
+Facts, in the file's names (Drake scopes names by model instance; one model is loaded, so the
+unscoped ``body.name()`` / ``joint.name()`` are the written names):
+
+* mass, COM and inertia: ``RigidBody.default_spatial_inertia()`` (about the body origin, body
+  axes), shifted to the COM (``Shift(p_BoBcm)``), rotational inertia as a full 3×3;
+* joint type (``type_name``: ``weld`` → ``fixed``, ``ball_rpy`` → ``ball``, …), axis in the child
+  link frame (``revolute_axis()`` / ``translation_axis()`` is expressed in the joint's frames F and
+  M, which coincide at q = 0; rotated by M's fixed pose in the child body), position limits.
+  SDFormat writes an unlimited joint as ±1e16 (its documented "no limit" default) and Drake keeps
+  the number: a bound of magnitude ≥ 1e16 is reported as ±inf, as URDF ``continuous`` is;
+* an SDF ``<frame attached_to>`` (how the SDF writer keeps a massless leaf link) is a frame in
+  Drake, not a body: it is reported as a massless link with its pose, and no joint;
+* poses: ``EvalBodyPoseInWorld`` (frames: ``CalcPoseInWorld``), relative to the root;
+* mass matrix: ``CalcMassMatrix`` (no reflected inertia unless the file declares one);
+* bias: ``CalcBiasTerm`` − ``CalcGravityGeneralizedForces``. Drake's equations of motion are
+  M v̇ + C(q, v) v = τ_g(q) + τ: ``CalcBiasTerm`` is C v only (no gravity) and τ_g is on the force
+  side. MuJoCo's ``qfrc_bias`` solves M q̈ + qfrc_bias = τ, so qfrc_bias = C v − τ_g (checked to
+  1e-12 against ``mj_rne`` in the tests), which is what ``bias`` returns.
+
+Drake only warns about some defects (an invalid inertia, for one: the link is then loaded with
+what Drake made of it); every warning it logs while parsing is kept in ``warnings`` and
+``settings["parser_warnings"]``, for the report.
+
+Generalised coordinates: with the base welded every remaining joint has ``num_positions`` equal to
+``num_velocities``; ``dof_names`` lists the 1-DOF joints by ``position_start()`` (equal to
+``velocity_start()`` here, checked at load).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from lxml import etree
+from pydrake.math import RigidTransform
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import (
+    Frame,
+    Joint,
+    JointIndex,
+    ModelInstanceIndex,
+    PrismaticJoint,
+    RevoluteJoint,
+    RigidBody,
+)
+
+from modelkit.model import Robot
+from modelkit.spatial import Pose
+from modelkit.verify.facts import Array, JointFacts, LinkFacts, StaticFacts
+
+Renames = dict[str, dict[str, str]]
+GRAVITY = (0.0, 0.0, -9.81)
+SDF_UNLIMITED = 1e16  # SDFormat's default joint limit, meaning "no limit"
+_TYPES = {
+    "revolute": "revolute",
+    "prismatic": "prismatic",
+    "weld": "fixed",
+    "ball_rpy": "ball",
+    "quaternion_floating": "floating",
+    "rpy_floating": "floating",
+    "planar": "planar",
+    "universal": "universal",
+    "screw": "screw",
+}
+
+
+class DrakeLoadError(RuntimeError):
+    """Drake could not load the file, or the file does not hold the expected single model/root."""
+
+
+def _version() -> str:
+    try:
+        from importlib.metadata import version
+
+        return version("drake")
+    except Exception:  # pragma: no cover - a source build has no distribution metadata
+        return "unknown"
+
+
+def _pose(transform: RigidTransform) -> Pose:
+    rotation = np.array(transform.rotation().matrix(), dtype=float)
+    return Pose(rotation, np.array(transform.translation(), dtype=float))
+
+
+def _vec(values: Any) -> Any:
+    """A float64 array typed for pydrake's stubs (which expect ``ndarray[float64, ...]``)."""
+    return np.asarray(values, dtype=np.float64)
+
+
+def _limit(value: float) -> float:
+    return math.copysign(math.inf, value) if abs(value) >= SDF_UNLIMITED else float(value)
+
+
+def _sdf_frames(path: Path) -> list[str]:
+    """Names of the model-level ``<frame>`` elements of an SDF file (massless links kept as frames)."""
+    tree = etree.parse(str(path))
+    return [str(f.get("name")) for f in tree.iterfind("./model/frame") if f.get("name")]
+
+
+class _Collect(logging.Handler):
+    """Collects what Drake logs (through Python's ``drake`` logger) while it parses a file."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(record.getMessage())
+
+
+def _parse(plant: MultibodyPlant, path: Path) -> tuple[list[ModelInstanceIndex], list[str]]:
+    logger = logging.getLogger("drake")
+    collect = _Collect()
+    logger.addHandler(collect)
+    try:
+        instances = Parser(plant).AddModels(file_name=path)
+    except Exception as exc:  # Drake raises RuntimeError with the parser's message
+        raise DrakeLoadError(f"{path.name}: Drake could not parse the file: {exc}") from exc
+    finally:
+        logger.removeHandler(collect)
+    return list(instances), collect.messages
+
+
+class DrakeModel:
+    """One written file in a continuous Drake ``MultibodyPlant``, root welded at the identity."""
+
+    def __init__(self, path: Path, root: str, engine: str) -> None:
+        self.engine = engine
+        self.path = path
+        self.root = root
+        plant = MultibodyPlant(time_step=0.0)
+        instances, self.warnings = _parse(plant, path)
+        if len(instances) != 1:
+            raise DrakeLoadError(f"{path.name}: expected one model, Drake found {len(instances)}")
+        self._instance: ModelInstanceIndex = instances[0]
+        if not plant.HasBodyNamed(root, self._instance):
+            names = sorted(plant.get_body(i).name() for i in plant.GetBodyIndices(self._instance))
+            raise DrakeLoadError(f"{path.name}: no link named {root!r} (links: {', '.join(names)})")
+        root_body = plant.GetBodyByName(root, self._instance)
+        world = plant.world_body()
+        removed: list[str] = []
+        for index in list(plant.GetJointIndices()):
+            joint = plant.get_joint(index)
+            ends = {joint.parent_body().index(), joint.child_body().index()}
+            if ends == {world.index(), root_body.index()}:
+                removed.append(f"{joint.name()} ({joint.type_name()})")
+                plant.RemoveJoint(joint)
+        plant.WeldFrames(world.body_frame(), root_body.body_frame(), RigidTransform())
+        plant.mutable_gravity_field().set_gravity_vector(_vec(GRAVITY))
+        plant.Finalize()
+        self.plant = plant
+        self.context = plant.CreateDefaultContext()
+        self._root_body: RigidBody = root_body
+        self._bodies: dict[str, RigidBody] = {
+            plant.get_body(i).name(): plant.get_body(i) for i in plant.GetBodyIndices(self._instance)
+        }
+        self._frames: dict[str, Frame] = {}
+        if path.suffix.lower() == ".sdf":
+            for name in _sdf_frames(path):
+                if name not in self._bodies and plant.HasFrameNamed(name, self._instance):
+                    self._frames[name] = plant.GetFrameByName(name, self._instance)
+        self._joints: list[Joint] = [
+            plant.get_joint(i) for i in plant.GetJointIndices(self._instance) if not self._is_base_weld(i)
+        ]
+        dofs = [j for j in self._joints if isinstance(j, RevoluteJoint | PrismaticJoint)]
+        dofs.sort(key=lambda j: j.position_start())
+        for j in dofs:
+            if j.position_start() != j.velocity_start():
+                raise DrakeLoadError(f"{path.name}: joint {j.name()!r}: position and velocity index differ")
+        self._dofs = dofs
+        self.settings: dict[str, Any] = {
+            "version": _version(),
+            "file": path.name,
+            "plant": "MultibodyPlant(time_step=0) (continuous), no SceneGraph",
+            "base": (
+                f"file's world joint removed ({', '.join(removed)}), " if removed else "free root, "
+            ) + f"WeldFrames(world, {root}, identity)",
+            "gravity": list(GRAVITY),
+            "inertia": "default_spatial_inertia shifted to the COM",
+            "limits": f"|bound| >= {SDF_UNLIMITED:g} reported as inf (SDFormat's 'no limit')",
+            "poses": "EvalBodyPoseInWorld, relative to the root",
+            "mass_matrix": "CalcMassMatrix",
+            "bias": "CalcBiasTerm - CalcGravityGeneralizedForces (MuJoCo qfrc_bias convention)",
+            "nq": int(plant.num_positions()),
+            "nv": int(plant.num_velocities()),
+            "parser_warnings": list(self.warnings),
+        }
+
+    def _is_base_weld(self, index: JointIndex) -> bool:
+        joint = self.plant.get_joint(index)
+        return (
+            joint.parent_body().index() == self.plant.world_body().index()
+            and joint.child_body().index() == self._root_body.index()
+        )
+
+    def dof_names(self) -> list[str]:
+        return [j.name() for j in self._dofs]
+
+    def static(self) -> StaticFacts:
+        facts = StaticFacts()
+        for name, body in self._bodies.items():
+            inertia = body.default_spatial_inertia()
+            com = np.array(inertia.get_com(), dtype=float)
+            about_com = inertia.Shift(_vec(com)).CalcRotationalInertia().CopyToFullMatrix3()
+            facts.links[name] = LinkFacts(float(inertia.get_mass()), com, np.array(about_com, dtype=float))
+        for name in self._frames:
+            facts.links[name] = LinkFacts(0.0, np.zeros(3), np.zeros((3, 3)))
+        for joint in self._joints:
+            facts.joints[joint.name()] = self._joint_facts(joint)
+        return facts
+
+    def _joint_facts(self, joint: Joint) -> JointFacts:
+        jtype = _TYPES.get(joint.type_name(), joint.type_name())
+        parent, child = joint.parent_body().name(), joint.child_body().name()
+        axis = np.zeros(3)
+        lower, upper = -math.inf, math.inf
+        if isinstance(joint, RevoluteJoint | PrismaticJoint):
+            local = joint.revolute_axis() if isinstance(joint, RevoluteJoint) else joint.translation_axis()
+            r_child_m = joint.frame_on_child().GetFixedPoseInBodyFrame().rotation().matrix()
+            axis = np.array(r_child_m, dtype=float) @ np.array(local, dtype=float)
+            lower = _limit(float(joint.position_lower_limits()[0]))
+            upper = _limit(float(joint.position_upper_limits()[0]))
+        return JointFacts(jtype, parent, child, axis, lower, upper)
+
+    def _set(self, q: dict[str, float], dq: dict[str, float] | None = None) -> None:
+        plant, context = self.plant, self.context
+        positions = np.array(plant.GetDefaultPositions(), dtype=float)
+        velocities = np.zeros(plant.num_velocities())
+        for joint in self._dofs:
+            positions[joint.position_start()] = q.get(joint.name(), 0.0)
+            if dq is not None:
+                velocities[joint.velocity_start()] = dq.get(joint.name(), 0.0)
+        plant.SetPositions(context, _vec(positions))
+        plant.SetVelocities(context, _vec(velocities))
+
+    def link_poses(self, q: dict[str, float]) -> dict[str, Pose]:
+        self._set(q)
+        plant, context = self.plant, self.context
+        base = _pose(plant.EvalBodyPoseInWorld(context, self._root_body)).inverse()
+        poses = {n: base @ _pose(plant.EvalBodyPoseInWorld(context, b)) for n, b in self._bodies.items()}
+        for name, frame in self._frames.items():
+            poses[name] = base @ _pose(frame.CalcPoseInWorld(context))
+        return poses
+
+    def _indices(self) -> np.ndarray:
+        return np.array([j.velocity_start() for j in self._dofs], dtype=int)
+
+    def mass_matrix(self, q: dict[str, float]) -> Array:
+        self._set(q)
+        full = np.array(self.plant.CalcMassMatrix(self.context), dtype=float)
+        idx = self._indices()
+        return full[np.ix_(idx, idx)]
+
+    def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
+        self._set(q, dq)
+        coriolis = np.array(self.plant.CalcBiasTerm(self.context), dtype=float)
+        gravity = np.array(self.plant.CalcGravityGeneralizedForces(self.context), dtype=float)
+        return (coriolis - gravity)[self._indices()]
+
+    def close(self) -> None:
+        return None
+
+
+def load(model: Path | Robot, renames: Renames, *, root: str) -> DrakeModel:
+    """The written SDF (or, by its suffix, URDF) in Drake; engine "drake" for SDF, "drake-urdf"."""
+    if isinstance(model, Robot):
+        raise TypeError("the Drake adapter reads a written SDF or URDF file")
+    path = Path(model)
+    return DrakeModel(path, root, "drake-urdf" if path.suffix.lower() == ".urdf" else "drake")
+
+
+def load_urdf(model: Path | Robot, renames: Renames, *, root: str) -> DrakeModel:
+    """The written URDF in Drake (engine "drake-urdf"): the second Drake instance."""
+    if isinstance(model, Robot):
+        raise TypeError("the Drake adapter reads a written SDF or URDF file")
+    return DrakeModel(Path(model), root, "drake-urdf")

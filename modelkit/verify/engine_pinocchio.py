@@ -1,0 +1,173 @@
+"""Pinocchio built directly from the in-memory source model: the dynamics reference no writer touched.
+
+The tree is rebuilt joint by joint: a revolute or prismatic joint becomes
+``JointModelRevoluteUnaligned``/``JointModelPrismaticUnaligned`` about its (unit) axis, placed at its
+origin composed with the fixed joints above it; a fixed joint adds no Pinocchio joint, its child
+link's inertia is appended to the supporting joint at the composed placement. Every link gets a
+body frame carrying its own inertia (read back by layer 1; ``addFrame(..., append_inertia=False)``
+so it is not counted twice). The root link is welded to the
+universe at the identity. Joint armature (rotor inertia) goes to ``model.armature``, which
+``crba`` adds to the mass matrix as MuJoCo's ``qM`` does. Dynamics: ``pin.crba`` (upper triangle,
+symmetrised) and ``pin.rnea`` with zero acceleration for the bias.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from modelkit.model import Joint, JointType, Robot
+from modelkit.spatial import Pose
+from modelkit.verify.facts import Array, JointFacts, LinkFacts, StaticFacts
+from modelkit.verify.reference import unit
+
+Renames = dict[str, dict[str, str]]
+GRAVITY = (0.0, 0.0, -9.81)
+
+
+class UnsupportedJoint(ValueError):
+    """A joint type the fixed-base Pinocchio model cannot hold (ball, planar, floating in the tree)."""
+
+
+def _se3(pose: Pose) -> pin.SE3:
+    return pin.SE3(np.array(pose.rotation, dtype=float), np.array(pose.translation, dtype=float))
+
+
+def _inertia(robot: Robot, link_name: str) -> pin.Inertia:
+    link = robot.link(link_name)
+    if link is None or link.inertial is None:
+        return pin.Inertia.Zero()
+    i = link.inertial
+    return pin.Inertia(float(i.mass), np.array(i.com, dtype=float), np.array(i.inertia, dtype=float))
+
+
+class PinocchioModel:
+    engine = "pinocchio"
+
+    def __init__(self, robot: Robot) -> None:
+        if robot.root is None:
+            raise ValueError("the model has no root link")
+        self.robot = robot
+        model = pin.Model()
+        model.name = robot.name
+        model.gravity = pin.Motion(np.array(GRAVITY), np.zeros(3))
+        children = robot.children_of()
+        armature: list[float] = []
+        # link -> (supporting joint id, link frame in that joint's frame)
+        self._support: dict[str, tuple[int, pin.SE3]] = {}
+        self._joint_types: dict[str, str] = {}
+        self._joint_child: dict[str, str] = {}
+        root_frame = model.addFrame(pin.Frame(robot.root, 0, 0, pin.SE3.Identity(), pin.FrameType.BODY,
+                                              _inertia(robot, robot.root)), False)
+        model.appendBodyToJoint(0, _inertia(robot, robot.root), pin.SE3.Identity())
+        self._support[robot.root] = (0, pin.SE3.Identity())
+        # depth-first, in document order: crba needs each joint's subtree to be contiguous in v
+        stack: list[tuple[Joint, int]] = [(j, root_frame) for j in reversed(children.get(robot.root, []))]
+        while stack:
+            joint, parent_frame = stack.pop()
+            if joint.child in self._support:
+                continue
+            pjid, pplace = self._support[joint.parent]
+            placement = pplace * _se3(joint.origin)
+            if joint.type in (JointType.REVOLUTE, JointType.PRISMATIC):
+                axis = unit(joint.axis)
+                jm = (pin.JointModelRevoluteUnaligned(axis) if joint.type is JointType.REVOLUTE
+                      else pin.JointModelPrismaticUnaligned(axis))
+                inf = np.array([math.inf])
+                jid = model.addJoint(pjid, jm, placement, joint.name, inf, inf,
+                                     np.array([joint.limits.lower]), np.array([joint.limits.upper]))
+                armature.append(float(joint.armature))
+                model.appendBodyToJoint(jid, _inertia(robot, joint.child), pin.SE3.Identity())
+                self._support[joint.child] = (jid, pin.SE3.Identity())
+                jframe = model.addFrame(pin.Frame(joint.name, jid, parent_frame, pin.SE3.Identity(),
+                                                  pin.FrameType.JOINT))
+                frame = model.addFrame(pin.Frame(joint.child, jid, jframe, pin.SE3.Identity(),
+                                                 pin.FrameType.BODY, _inertia(robot, joint.child)), False)
+            elif joint.type in (JointType.FIXED, JointType.PSEUDO_CONTINUOUS_TRACK):
+                model.appendBodyToJoint(pjid, _inertia(robot, joint.child), placement)
+                self._support[joint.child] = (pjid, placement)
+                jframe = model.addFrame(pin.Frame(joint.name, pjid, parent_frame, placement,
+                                                  pin.FrameType.FIXED_JOINT))
+                frame = model.addFrame(pin.Frame(joint.child, pjid, jframe, placement, pin.FrameType.BODY,
+                                                 _inertia(robot, joint.child)), False)
+            else:
+                raise UnsupportedJoint(f"joint {joint.name!r} is {joint.type.value}: the fixed-base "
+                                       "Pinocchio reference holds revolute, prismatic and fixed joints")
+            self._joint_child[joint.name] = joint.child
+            self._joint_types[joint.name] = ("fixed" if joint.type is JointType.PSEUDO_CONTINUOUS_TRACK
+                                             else joint.type.value)
+            stack.extend((j, frame) for j in reversed(children.get(joint.child, [])))
+        model.armature = np.array(armature, dtype=float)
+        self.model = model
+        self.data = model.createData()
+        self._dofs = [model.names[j] for j in range(1, model.njoints)]
+        self.settings: dict[str, Any] = {
+            "version": pin.__version__,
+            "built_from": "the in-memory source model (no file)",
+            "joints": "JointModelRevoluteUnaligned / JointModelPrismaticUnaligned; fixed joints merged "
+                      "into the supporting body, one BODY frame per link",
+            "base": "root link welded to the universe at the identity",
+            "gravity": list(GRAVITY),
+            "mass_matrix": "crba (upper triangle symmetrised), armature on the diagonal",
+            "bias": "rnea(q, v, 0)",
+        }
+
+    def dof_names(self) -> list[str]:
+        return list(self._dofs)
+
+    def _q(self, q: dict[str, float]) -> Array:
+        return np.array([q.get(n, 0.0) for n in self._dofs], dtype=float)
+
+    def static(self) -> StaticFacts:
+        m = self.model
+        facts = StaticFacts()
+        for frame in m.frames:
+            if frame.type == pin.FrameType.BODY:
+                inertia = frame.inertia
+                facts.links[frame.name] = LinkFacts(float(inertia.mass), np.array(inertia.lever, dtype=float),
+                                                    np.array(inertia.inertia, dtype=float))
+        parent_of = {j.child: j.parent for j in self.robot.joints}
+        for frame in m.frames:
+            if frame.type == pin.FrameType.JOINT:
+                jid = m.getJointId(frame.name)
+                jm = m.joints[jid].extract()
+                child = self._joint_child[frame.name]
+                kind = "revolute" if "Revolute" in jm.shortname() else "prismatic"
+                facts.joints[frame.name] = JointFacts(
+                    kind, parent_of[child], child, np.array(jm.axis, dtype=float),
+                    float(m.lowerPositionLimit[m.idx_qs[jid]]), float(m.upperPositionLimit[m.idx_qs[jid]]))
+            elif frame.type == pin.FrameType.FIXED_JOINT and frame.name in self._joint_child:
+                child = self._joint_child[frame.name]
+                facts.joints[frame.name] = JointFacts(self._joint_types[frame.name], parent_of[child], child,
+                                                      np.zeros(3))
+        return facts
+
+    def link_poses(self, q: dict[str, float]) -> dict[str, Pose]:
+        pin.framesForwardKinematics(self.model, self.data, self._q(q))
+        out: dict[str, Pose] = {}
+        for fid, frame in enumerate(self.model.frames):
+            if frame.type == pin.FrameType.BODY:
+                placement = self.data.oMf[fid]
+                out[frame.name] = Pose(np.array(placement.rotation), np.array(placement.translation))
+        return out
+
+    def mass_matrix(self, q: dict[str, float]) -> Array:
+        upper = np.array(pin.crba(self.model, self.data, self._q(q)))
+        return np.triu(upper) + np.triu(upper, 1).T
+
+    def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
+        v = np.array([dq.get(n, 0.0) for n in self._dofs], dtype=float)
+        return np.array(pin.rnea(self.model, self.data, self._q(q), v, np.zeros(self.model.nv)))
+
+    def close(self) -> None:
+        return None
+
+
+def load(model: Path | Robot, renames: Renames, *, root: str) -> PinocchioModel:
+    if not isinstance(model, Robot):
+        raise TypeError("the Pinocchio reference is built from the in-memory source model, not a file")
+    return PinocchioModel(model)

@@ -1,0 +1,317 @@
+"""PyBullet adapter: a written URDF loaded into PyBullet **in a child process**.
+
+PyBullet keeps global state and can crash on bad input, so it runs in
+:mod:`modelkit.verify.pybullet_worker`, started by path with this interpreter; every request has a
+timeout, and a crash, a refusal or a timeout becomes an :class:`~modelkit.verify.api.EngineError`
+carrying PyBullet's message (never a hang).
+
+Settings (verification.md §2.8, §6): ``URDF_USE_INERTIA_FROM_FILE | URDF_USE_IMPLICIT_CYLINDER``,
+``useFixedBase=True``, gravity (0, 0, −9.81), linear/angular/joint damping of every link zeroed,
+default velocity motors off (force 0), torques re-sent before every ``stepSimulation``.
+
+Frames. PyBullet keeps each link's *inertial* (COM) frame: ``getDynamicsInfo`` gives the principal
+moments and the inertial frame (position, orientation) in the URDF link frame — PyBullet
+diagonalises a URDF inertia with products of inertia into that orientation — so the tensor about
+the COM in link axes is R·diag·Rᵀ. ``getBasePositionAndOrientation`` and ``getLinkState()[0:2]``
+are COM frames (double precision); ``getLinkState()[4:6]`` is the URDF link frame but float32.
+Link poses therefore come, by default, from the COM frame with the inertial frame undone
+(``pose_path="com-frame"``, double precision), or from ``[4:6]`` (``pose_path="link-frame"``,
+float32, tolerance 1e-6). Poses are reported relative to the root link's frame, so where PyBullet
+places the welded base (it places the base's COM frame) does not matter.
+
+Joint axes: ``getJointInfo`` gives the axis in the child's inertial frame; it is rotated back into
+the child link frame with the child's inertial orientation.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import pickle
+import select
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+
+from modelkit.spatial import Pose
+from modelkit.verify.api import EngineError
+from modelkit.verify.facts import Array, JointFacts, LinkFacts, StaticFacts, TorqueLaw
+
+Renames = dict[str, dict[str, str]]
+
+WORKER = Path(__file__).with_name("pybullet_worker.py")
+GRAVITY = -9.81
+DEFAULT_TIMEOUT = 60.0  # seconds for one request (load, a batch of poses, a 10 s replay takes ~0.1 s)
+SETTINGS: dict[str, Any] = {
+    "flags": "URDF_USE_INERTIA_FROM_FILE|URDF_USE_IMPLICIT_CYLINDER",
+    "useFixedBase": True,
+    "gravity": [0.0, 0.0, GRAVITY],
+    "linearDamping": 0.0,
+    "angularDamping": 0.0,
+    "jointDamping": 0.0,
+    "default_motors": "off (VELOCITY_CONTROL force 0)",
+    "control": "TORQUE_CONTROL re-sent before every stepSimulation",
+    "integrator": "PyBullet btMultiBody semi-implicit Euler",
+    "process": "child process (modelkit/verify/pybullet_worker.py)",
+    "base_mass_properties": "getDynamicsInfo(-1) of a second, floating-base load (a fixed base reads 0)",
+}
+
+
+class PyBulletError(EngineError):
+    """PyBullet refused a file, failed a request, crashed or timed out."""
+
+
+def quat_xyzw_matrix(q: tuple[float, ...] | list[float]) -> Array:
+    """Rotation matrix of a PyBullet quaternion (x, y, z, w), normalised."""
+    x, y, z, w = (float(v) for v in q)
+    n = math.sqrt(x * x + y * y + z * z + w * w)
+    x, y, z, w = x / n, y / n, z / n, w / n
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def _pose(pos: tuple[float, ...], orn: tuple[float, ...]) -> Pose:
+    return Pose(quat_xyzw_matrix(orn), np.array(pos, dtype=float))
+
+
+class Worker:
+    """The child process and its framed pickle pipe (see ``pybullet_worker``)."""
+
+    def __init__(self) -> None:
+        self._stderr: IO[bytes] = tempfile.TemporaryFile()  # noqa: SIM115 (closed in close())
+        env = dict(os.environ, PYTHONUNBUFFERED="1")
+        self.proc = subprocess.Popen(
+            [sys.executable, str(WORKER)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+            stderr=self._stderr, env=env, close_fds=True,
+        )
+
+    def _stderr_tail(self, since: int = 0) -> str:
+        """The last lines PyBullet printed (it explains a refused file there, not in the exception)."""
+        self._stderr.seek(since)
+        text = self._stderr.read().decode(errors="replace")
+        self._stderr.seek(0, os.SEEK_END)
+        lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("pybullet build time")]
+        return "\n".join(lines[-12:])
+
+    def _died(self, what: str) -> PyBulletError:
+        code = self.proc.wait(timeout=5)
+        how = f"killed by signal {-code}" if code < 0 else f"exit status {code}"
+        tail = self._stderr_tail()
+        message = f"PyBullet child process died during {what} ({how})"
+        return PyBulletError(message + (f":\n{tail}" if tail else ""))
+
+    def _read_exactly(self, n: int, deadline: float, what: str) -> bytes:
+        assert self.proc.stdout is not None
+        fd = self.proc.stdout.fileno()
+        data = b""
+        while len(data) < n:
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                self.kill()
+                raise PyBulletError(f"PyBullet did not answer {what} within the timeout; child killed")
+            ready, _, _ = select.select([fd], [], [], remaining)
+            if not ready:
+                continue
+            chunk = os.read(fd, n - len(data))
+            if not chunk:
+                raise self._died(what)
+            data += chunk
+        return data
+
+    def request(self, command: str, timeout: float = DEFAULT_TIMEOUT, **kwargs: Any) -> Any:
+        if self.proc.poll() is not None:
+            raise self._died(command)
+        printed = self._stderr.seek(0, os.SEEK_END)
+        payload = pickle.dumps((command, kwargs), protocol=pickle.HIGHEST_PROTOCOL)
+        assert self.proc.stdin is not None
+        try:
+            self.proc.stdin.write(struct.pack(">I", len(payload)) + payload)
+            self.proc.stdin.flush()
+        except BrokenPipeError:
+            raise self._died(command) from None
+        deadline = time.monotonic() + timeout
+        size = struct.unpack(">I", self._read_exactly(4, deadline, command))[0]
+        status, result = pickle.loads(self._read_exactly(size, deadline, command))
+        if status != "ok":
+            said = self._stderr_tail(printed)
+            raise PyBulletError(f"PyBullet {command} failed: {result}".rstrip()
+                                + (f"\nPyBullet printed:\n{said}" if said else ""))
+        return result
+
+    def kill(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait(timeout=5)
+
+    def close(self) -> None:
+        if self.proc.poll() is None:
+            try:
+                self.request("quit", timeout=5.0)
+                self.proc.wait(timeout=5)
+            except (PyBulletError, subprocess.TimeoutExpired, OSError):
+                self.kill()
+        for stream in (self.proc.stdin, self.proc.stdout):
+            if stream is not None:
+                stream.close()
+        self._stderr.close()
+
+
+class PyBulletModel:
+    """A written URDF in PyBullet, base welded: the :class:`~modelkit.verify.facts.EngineModel`
+    and the :class:`~modelkit.verify.facts.Simulator` of layer 3b. Names are the URDF's."""
+
+    engine = "pybullet"
+
+    def __init__(self, urdf: Path, renames: Renames | None = None, root: str | None = None, dt: float = 1e-3,
+                 pose_path: str = "com-frame", timeout: float = DEFAULT_TIMEOUT) -> None:
+        if pose_path not in ("com-frame", "link-frame"):
+            raise ValueError(f"pose_path must be 'com-frame' or 'link-frame', not {pose_path!r}")
+        self.renames: Renames = renames or {}
+        self.pose_path = pose_path
+        self.timeout = timeout
+        self.dt = dt
+        self.last_replay_wall = math.nan
+        self._worker = Worker()
+        try:
+            info = self._worker.request("load", timeout=timeout, path=str(Path(urdf).resolve()),
+                                        gravity=GRAVITY, dt=dt)
+            dyn = self._worker.request("dynamics", timeout=timeout, path=str(Path(urdf).resolve()))
+        except BaseException:
+            self._worker.close()
+            raise
+        self._types = {v: k for k, v in info["types"].items()}
+        self._joints: list[dict[str, Any]] = info["joints"]
+        self.base: str = info["base"]
+        if root is not None and root != self.base:
+            self._worker.close()
+            raise PyBulletError(f"PyBullet's base link is {self.base!r}, not the root {root!r}")
+        self._links = [self.base] + [j["child"] for j in self._joints]  # index + 1 = PyBullet link index
+        self._dofs = [self._joints[i]["name"] for i in info["movable"]]
+        self._inertial = {self._links[d["link"] + 1]: _pose(d["inertial_pos"], d["inertial_orn"])
+                          for d in dyn}
+        self._dynamics = {self._links[d["link"] + 1]: d for d in dyn}
+        # Where the welded base's COM frame sits (undone to get the base link frame for poses).
+        self._base_inertial = _pose(dyn[0]["fixed_inertial_pos"], dyn[0]["fixed_inertial_orn"])
+        self.settings: dict[str, Any] = dict(SETTINGS, timeStep=dt, pose_path=pose_path,
+                                             pose_source=("getLinkState[0:2] with the inertial frame undone "
+                                                          "(double)" if pose_path == "com-frame" else
+                                                          "getLinkState[4:6] (float32)"))
+
+    # ---- EngineModel --------------------------------------------------------------------------
+
+    def dof_names(self) -> list[str]:
+        return list(self._dofs)
+
+    def static(self) -> StaticFacts:
+        facts = StaticFacts()
+        for name, d in self._dynamics.items():
+            rot = self._inertial[name].rotation
+            inertia = rot @ np.diag(np.asarray(d["inertia_diagonal"], dtype=float)) @ rot.T
+            facts.links[name] = LinkFacts(float(d["mass"]), np.asarray(d["inertial_pos"], dtype=float),
+                                          0.5 * (inertia + inertia.T))
+        for j in self._joints:
+            kind = self._types.get(j["type"], f"type-{j['type']}")
+            moves = kind in ("revolute", "prismatic")
+            axis = np.zeros(3)
+            if moves:
+                axis = self._inertial[j["child"]].rotation @ np.asarray(j["axis"], dtype=float)
+                axis = axis / float(np.linalg.norm(axis))
+            lower, upper = float(j["lower"]), float(j["upper"])
+            if not moves or lower > upper:  # PyBullet stores a continuous joint as lower 0 > upper -1
+                lower, upper = -math.inf, math.inf
+            facts.joints[j["name"]] = JointFacts(
+                kind, self._links[j["parent"] + 1], j["child"], axis, lower, upper)
+        return facts
+
+    def _q_vector(self, q: dict[str, float]) -> list[float]:
+        return [float(q.get(name, 0.0)) for name in self._dofs]
+
+    def link_poses(self, q: dict[str, float]) -> dict[str, Pose]:
+        raw = self._worker.request("poses", timeout=self.timeout, q=self._q_vector(q))
+        base = _pose(*raw["base"]) @ self._base_inertial.inverse()
+        world: dict[str, Pose] = {self.base: base}
+        for name, (com_pos, com_orn, link_pos, link_orn) in zip(self._links[1:], raw["links"], strict=True):
+            if self.pose_path == "com-frame":
+                world[name] = _pose(com_pos, com_orn) @ self._inertial[name].inverse()
+            else:
+                world[name] = _pose(link_pos, link_orn)
+        to_root = base.inverse()
+        return {name: to_root @ pose for name, pose in world.items()}
+
+    def mass_matrix(self, q: dict[str, float]) -> Array:
+        m = self._worker.request("mass_matrix", timeout=self.timeout, q=self._q_vector(q))
+        return np.asarray(m, dtype=float).reshape(len(self._dofs), len(self._dofs))
+
+    def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
+        """Gravity + Coriolis/centrifugal: inverse dynamics at zero acceleration."""
+        n = len(self._dofs)
+        tau = self._worker.request("inverse_dynamics", timeout=self.timeout, q=self._q_vector(q),
+                                   dq=self._q_vector(dq), ddq=[0.0] * n)
+        return np.asarray(tau, dtype=float)
+
+    # ---- Simulator ----------------------------------------------------------------------------
+
+    def law_vectors(self, law: TorqueLaw) -> dict[str, list[float]]:
+        """The law's gains in this engine's dof order (a joint the law does not name gets none)."""
+        written = self.renames.get("joint", {})
+        by_name = {written.get(j, j): i for i, j in enumerate(law.joints)}
+        missing = [j for j in law.joints if written.get(j, j) not in self._dofs]
+        if missing:
+            raise PyBulletError(f"the torque law names joints PyBullet does not move: {', '.join(missing)}")
+        out: dict[str, list[float]] = {}
+        for key in ("kp", "kd", "amplitude", "frequency", "phase"):
+            values = getattr(law, key)
+            out[key] = [float(values[by_name[d]]) if d in by_name else 0.0 for d in self._dofs]
+        return out
+
+    def replay(self, law: TorqueLaw, seconds: float, dt: float) -> Array:
+        """q after every step from q = dq = 0: (steps + 1, len(law.joints)), one column per
+        ``law.joints`` entry (source names, mapped through the renames), in that order. Joints the
+        law does not name get no torque. ``last_replay_wall`` keeps the stepping loop's wall time."""
+        steps = round(seconds / dt)
+        result = self._worker.request("replay", timeout=max(self.timeout, 20.0 * seconds),
+                                      steps=steps, dt=dt, **self.law_vectors(law))
+        self.last_replay_wall = float(result["wall"])
+        q = np.frombuffer(result["q"], dtype=np.float64).reshape(steps + 1, len(self._dofs))
+        written = self.renames.get("joint", {})
+        columns = [self._dofs.index(written.get(j, j)) for j in law.joints]
+        return q[:, columns].copy()
+
+    def bench(self, seconds: float, dt: float) -> dict[str, float]:
+        """Wall seconds of a bare ``stepSimulation`` loop and of a minimal closed loop (read states,
+        send torques, step) over ``seconds`` of simulated time, in the child."""
+        out = self._worker.request("bench", timeout=max(self.timeout, 20.0 * seconds),
+                                   steps=round(seconds / dt), dt=dt)
+        return {k: float(v) for k, v in out.items()}
+
+    def close(self) -> None:
+        self._worker.close()
+
+    def __enter__(self) -> PyBulletModel:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def load(model: Path, renames: Renames, *, root: str, pose_path: str = "com-frame",
+         timeout: float = DEFAULT_TIMEOUT) -> PyBulletModel:
+    """The engine plug-in entry point (see ``modelkit.verify.api``)."""
+    if not isinstance(model, (str, Path)):
+        raise PyBulletError("PyBullet reads a URDF file, not an in-memory model")
+    return PyBulletModel(Path(model), renames, root, pose_path=pose_path, timeout=timeout)
+
+
+def simulator(model: Path, renames: Renames, *, root: str, dt: float,
+              timeout: float = DEFAULT_TIMEOUT) -> PyBulletModel:
+    """Layer 3b's entry point: the same adapter, time step ``dt``."""
+    return PyBulletModel(Path(model), renames, root, dt=dt, timeout=timeout)

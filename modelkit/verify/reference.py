@@ -1,0 +1,171 @@
+"""The references no writer touched: the source model's own facts and forward kinematics (engine
+"source"), and yourdfpy's FK on the written URDF (engine "yourdfpy", poses only).
+
+Both compute no dynamics: their ``mass_matrix``/``bias`` raise :class:`NotImplementedError` and the
+layers say so (Pinocchio, built from the same in-memory model, is the dynamics reference).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from modelkit.model import JointType, Robot
+from modelkit.spatial import Pose
+from modelkit.verify.facts import Array, JointFacts, LinkFacts, StaticFacts
+
+Renames = dict[str, dict[str, str]]
+DOF_TYPES = (JointType.REVOLUTE, JointType.PRISMATIC)
+
+
+def unit(v: Any) -> Array:
+    a = np.asarray(v, dtype=float)
+    n = float(np.linalg.norm(a))
+    return a / n if n > 0 else np.zeros(3)
+
+
+def joint_type_name(t: JointType) -> str:
+    """The layers' joint type vocabulary; a track that is still a track moves nothing: fixed."""
+    return "fixed" if t is JointType.PSEUDO_CONTINUOUS_TRACK else t.value
+
+
+def source_static(robot: Robot) -> StaticFacts:
+    """The source model's links and joints as the layers compare them."""
+    facts = StaticFacts()
+    for link in robot.links:
+        inertial = link.inertial
+        if inertial is None:
+            facts.links[link.name] = LinkFacts(0.0, np.zeros(3), np.zeros((3, 3)))
+        else:
+            facts.links[link.name] = LinkFacts(float(inertial.mass), np.asarray(inertial.com, dtype=float),
+                                               np.asarray(inertial.inertia, dtype=float))
+    for joint in robot.joints:
+        moving = joint.type in DOF_TYPES
+        facts.joints[joint.name] = JointFacts(
+            joint_type_name(joint.type), joint.parent, joint.child,
+            unit(joint.axis) if moving else np.zeros(3),
+            joint.limits.lower if moving else -math.inf, joint.limits.upper if moving else math.inf)
+    return facts
+
+
+def dof_joints(robot: Robot) -> list[str]:
+    """The 1-DOF joints of the tree, depth-first from the root in document order (Pinocchio's order)."""
+    children = robot.children_of()
+    out: list[str] = []
+
+    def walk(link: str) -> None:
+        for joint in children.get(link, []):
+            if joint.type in DOF_TYPES:
+                out.append(joint.name)
+            walk(joint.child)
+
+    if robot.root:
+        walk(robot.root)
+    return out
+
+
+class SourceModel:
+    """The in-memory source model as an :class:`~modelkit.verify.facts.EngineModel` (no dynamics)."""
+
+    engine = "source"
+
+    def __init__(self, robot: Robot) -> None:
+        self.robot = robot
+        self.settings: dict[str, Any] = {"fk": "Robot.world_poses (modelkit), relative to the root link"}
+        self._dofs = dof_joints(robot)
+
+    def dof_names(self) -> list[str]:
+        return list(self._dofs)
+
+    def static(self) -> StaticFacts:
+        return source_static(self.robot)
+
+    def link_poses(self, q: dict[str, float]) -> dict[str, Pose]:
+        poses = self.robot.world_poses(q)
+        if self.robot.root is None or self.robot.root not in poses:
+            return poses
+        base = poses[self.robot.root].inverse()
+        return {name: base @ pose for name, pose in poses.items()}
+
+    def mass_matrix(self, q: dict[str, float]) -> Array:
+        raise NotImplementedError("the source model computes no dynamics (Pinocchio is built from it)")
+
+    def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
+        raise NotImplementedError("the source model computes no dynamics (Pinocchio is built from it)")
+
+    def close(self) -> None:
+        return None
+
+
+def load(model: Path | Robot, renames: Renames, *, root: str) -> SourceModel:
+    if not isinstance(model, Robot):
+        raise TypeError("the source reference reads the in-memory model, not a file")
+    return SourceModel(model)
+
+
+class YourdfpyModel:
+    """yourdfpy's forward kinematics on the written URDF (an independent URDF parser; poses only)."""
+
+    engine = "yourdfpy"
+
+    def __init__(self, path: Path, root: str) -> None:
+        import yourdfpy
+
+        self.urdf = yourdfpy.URDF.load(str(path), load_meshes=False, build_scene_graph=True,
+                                       load_collision_meshes=False, build_collision_scene_graph=False)
+        self.root = root
+        self.settings: dict[str, Any] = {"version": getattr(yourdfpy, "__version__", "unknown"),
+                                         "load_meshes": False, "fk": "URDF.get_transform(link, root)"}
+        self._dofs = [j.name for j in self.urdf.robot.joints
+                      if j.type in ("revolute", "continuous", "prismatic") and j.mimic is None]
+
+    def dof_names(self) -> list[str]:
+        return list(self._dofs)
+
+    def static(self) -> StaticFacts:
+        facts = StaticFacts()
+        for link in self.urdf.robot.links:
+            inertial = link.inertial
+            if inertial is None:
+                facts.links[link.name] = LinkFacts(0.0, np.zeros(3), np.zeros((3, 3)))
+                continue
+            origin = np.asarray(inertial.origin if inertial.origin is not None else np.eye(4), dtype=float)
+            rot = origin[:3, :3]
+            facts.links[link.name] = LinkFacts(float(inertial.mass or 0.0), origin[:3, 3].copy(),
+                                               rot @ np.asarray(inertial.inertia, dtype=float) @ rot.T)
+        for joint in self.urdf.robot.joints:
+            jtype = {"continuous": "revolute"}.get(joint.type, joint.type)
+            moving = jtype in ("revolute", "prismatic")
+            lower, upper = -math.inf, math.inf
+            if moving and joint.type != "continuous" and joint.limit is not None:
+                lower = float(joint.limit.lower) if joint.limit.lower is not None else 0.0
+                upper = float(joint.limit.upper) if joint.limit.upper is not None else 0.0
+            facts.joints[joint.name] = JointFacts(jtype, joint.parent, joint.child,
+                                                  unit(joint.axis) if moving else np.zeros(3), lower, upper)
+        return facts
+
+    def link_poses(self, q: dict[str, float]) -> dict[str, Pose]:
+        self.urdf.update_cfg({name: q.get(name, 0.0) for name in self._dofs})
+        out: dict[str, Pose] = {}
+        for link in self.urdf.robot.links:
+            t = np.asarray(self.urdf.get_transform(link.name, self.root), dtype=float)
+            out[link.name] = Pose(t[:3, :3].copy(), t[:3, 3].copy())
+        return out
+
+    def mass_matrix(self, q: dict[str, float]) -> Array:
+        raise NotImplementedError("yourdfpy computes kinematics only")
+
+    def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
+        raise NotImplementedError("yourdfpy computes kinematics only")
+
+    def close(self) -> None:
+        return None
+
+
+def load_yourdfpy(model: Path | Robot, renames: Renames, *, root: str) -> YourdfpyModel:
+    if isinstance(model, Robot):
+        raise TypeError("yourdfpy reads the written URDF")
+    return YourdfpyModel(Path(model), root)

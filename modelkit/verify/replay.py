@@ -1,0 +1,233 @@
+"""Layer 3b: the contact-free torque replay (verification.md §3).
+
+The same :class:`~modelkit.verify.facts.TorqueLaw` (a PD law tracking sinusoids) drives the
+fixed-base model in MuJoCo (``integrator="Euler"``) and in PyBullet at the same time step (1 ms)
+for 10 s, both from q = dq = 0. Both engines integrate semi-implicit Euler (v ← v + h·a(q, v),
+q ← q + h·v), so for a contact-free tree they compute the same ODE step up to round-off: the
+measured difference on the tutorial robot is ~1e-16 rad, and anything above 1e-8 rad means the
+two files describe different robots (inertia, COM, axis, frame, damping, armature, a motor left on).
+
+The law (:func:`default_law`) is chosen from the source model so that the replay is well
+conditioned: every moving joint is excited, the motion stays inside the joint limits and far
+from PyBullet's 100 rad/s velocity clamp, gravity cannot drag a joint far from its target, and
+the closed loop is well inside semi-implicit Euler's stability limit at 1 ms.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from modelkit.model import JointType, Robot
+from modelkit.verify.facts import Array, Check, Simulator, Skip, TorqueLaw
+
+TOLERANCE = 1e-8  # rad (m for prismatic joints) over the whole replay: verification.md §3
+GRAVITY = 9.81
+
+# The law's design constants (see default_law).
+BANDWIDTH = 2.0 * math.pi * 2.0  # rad/s: closed-loop natural frequency from the joint's own inertia
+MAX_BANDWIDTH = 100.0  # rad/s: ω·dt = 0.1 at 1 ms (semi-implicit Euler is stable below 2)
+DAMPING_RATIO = 0.7
+GRAVITY_MARGIN = 10.0  # kp ≥ 10 × the worst gravity load per unit of amplitude (sag ≤ 10 %)
+REVOLUTE_AMPLITUDE = 1.0  # rad, unlimited joints; limited: half the distance from 0 to the nearer limit
+PRISMATIC_AMPLITUDE = 0.1  # m
+MIN_INERTIA = 1e-12
+
+
+def _axis_inertia_and_gravity(robot: Robot, joint_name: str,
+                              poses: dict[str, Any], children: dict[str, list[str]]) -> tuple[float, float]:
+    """The subtree's inertia about (revolute) or mass along (prismatic) the joint axis at q = 0,
+    and an upper bound of the gravity load on the joint, root welded at the identity."""
+    joint = next(j for j in robot.joints if j.name == joint_name)
+    frame = poses[joint.child]
+    axis = frame.rotation @ np.asarray(joint.axis, dtype=float)
+    axis = axis / float(np.linalg.norm(axis))
+    origin = frame.translation
+    links = {link.name: link for link in robot.links}
+    inertia = load = 0.0
+    stack = [joint.child]
+    while stack:
+        name = stack.pop()
+        stack.extend(children.get(name, []))
+        link = links.get(name)
+        if link is None or link.inertial is None or name not in poses:
+            continue
+        mass = float(link.inertial.mass)
+        pose = poses[name]
+        com = pose.rotation @ np.asarray(link.inertial.com, dtype=float) + pose.translation
+        if joint.type is JointType.PRISMATIC:
+            inertia += mass
+            load += mass * GRAVITY
+            continue
+        r = com - origin
+        r_perp = r - float(r @ axis) * axis
+        rot_inertia = pose.rotation @ np.asarray(link.inertial.inertia, dtype=float) @ pose.rotation.T
+        inertia += float(axis @ rot_inertia @ axis) + mass * float(r_perp @ r_perp)
+        load += mass * GRAVITY * float(np.linalg.norm(r_perp))
+    return inertia, load
+
+
+def default_law(source: Robot) -> TorqueLaw:
+    """A well-conditioned PD law for the replay, from the source model (joint order = the
+    source's moving joints, mimic joints left out).
+
+    Per joint i, with I_i the subtree's inertia about the axis (revolute) or its mass (prismatic)
+    at q = 0 and G_i a bound of the gravity load on the joint:
+
+    * amplitude A_i: 1 rad (revolute) / 0.1 m (prismatic) when unlimited; otherwise half the
+      distance from q = 0 to the nearer limit (capped at those values); 0 when q = 0 is not
+      strictly inside the limits (the joint is only held);
+    * kp_i = max(I_i·ω², 10·G_i / A_ref) with ω = 2π·2 Hz and A_ref = 1 rad or 0.1 m (gravity sags
+      a joint by at most ~10 % of that), capped so that √(kp/I) ≤ 100 rad/s (ω·dt = 0.1 at 1 ms);
+    * kd_i = 2·0.7·√(kp_i·I_i) (damping ratio 0.7);
+    * frequency 0.3 + 0.17·i Hz and phase 0.9·i rad: distinct, so the joints move out of step and
+      the coupling terms of the mass matrix are excited. Peak speeds stay near A·2πf ≤ ~10 rad/s.
+
+    A joint whose subtree has no mass (I_i ≈ 0) gets no torque at all.
+    """
+    moving = [j for j in source.joints
+              if j.type in (JointType.REVOLUTE, JointType.PRISMATIC) and j.mimic is None]
+    world = source.world_poses({})
+    root = world.get(str(source.root)) if source.root is not None else None
+    poses = {k: root.inverse() @ v for k, v in world.items()} if root is not None else world
+    children: dict[str, list[str]] = {}
+    for j in source.joints:
+        children.setdefault(j.parent, []).append(j.child)
+    kp, kd, amp, freq, phase = [], [], [], [], []
+    for i, joint in enumerate(moving):
+        inertia, load = _axis_inertia_and_gravity(source, joint.name, poses, children)
+        revolute = joint.type is JointType.REVOLUTE
+        reference = REVOLUTE_AMPLITUDE if revolute else PRISMATIC_AMPLITUDE
+        lo, hi = joint.limits.lower, joint.limits.upper
+        amplitude = min(reference, 0.5 * min(-lo, hi)) if lo < 0.0 < hi else 0.0
+        if inertia <= MIN_INERTIA:
+            gains = (0.0, 0.0)
+            amplitude = 0.0
+        else:
+            stiffness = max(inertia * BANDWIDTH**2, GRAVITY_MARGIN * load / reference)
+            stiffness = min(stiffness, inertia * MAX_BANDWIDTH**2)
+            gains = (stiffness, 2.0 * DAMPING_RATIO * math.sqrt(stiffness * inertia))
+        kp.append(gains[0])
+        kd.append(gains[1])
+        amp.append(amplitude)
+        freq.append(0.3 + 0.17 * i)
+        phase.append(0.9 * i)
+    names = tuple(j.name for j in moving)
+    return TorqueLaw(names, tuple(kp), tuple(kd), tuple(amp), tuple(freq), tuple(phase))
+
+
+def _run(sim: Simulator, law: TorqueLaw, seconds: float, dt: float) -> tuple[Array | None, float, str]:
+    start = time.perf_counter()
+    try:
+        q = np.asarray(sim.replay(law, seconds, dt), dtype=float)
+    except Exception as exc:  # a crash or a refusal of the engine is reported, never hidden
+        return None, time.perf_counter() - start, f"{type(exc).__name__}: {exc}"
+    wall = time.perf_counter() - start
+    steps = round(seconds / dt)
+    if q.shape != (steps + 1, len(law.joints)):
+        return None, wall, f"replay returned shape {q.shape}, expected {(steps + 1, len(law.joints))}"
+    return q, wall, ""
+
+
+def layer3b(source: Robot, sims: list[Simulator], law: TorqueLaw, seconds: float, dt: float
+            ) -> tuple[list[Check], list[Skip]]:
+    """Replay ``law`` in every simulator; compare each one's joint trajectories with the first's
+    (MuJoCo by convention). One ``replay`` check per compared engine: the worst |Δq| over the
+    whole run and every joint, naming the joint (source name)."""
+    checks: list[Check] = []
+    skips: list[Skip] = []
+    names = "+".join(s.engine for s in sims) or "replay"
+    if len(sims) < 2:
+        skips.append(Skip(3, names, "layer 3b (replay) needs two engines that can integrate the model"))
+        return checks, skips
+    if not law.joints:
+        skips.append(Skip(3, names, "layer 3b (replay): the model has no moving joint"))
+        return checks, skips
+    runs = [(sim, *_run(sim, law, seconds, dt)) for sim in sims]
+    ref_sim, ref_q, ref_wall, ref_error = runs[0]
+    setting = f"{seconds:g} s at dt {dt:g} s, from q = dq = 0"
+    if ref_q is None or not np.all(np.isfinite(ref_q)):
+        why = ref_error or "the trajectory is not finite"
+        for sim, *_ in runs[1:]:
+            checks.append(Check(3, sim.engine, "replay", "", math.inf, TOLERANCE,
+                                f"{ref_sim.engine} replay failed ({setting}): {why}"))
+        return checks, skips
+    travel = np.ptp(ref_q, axis=0)
+    for sim, q, wall, error in runs[1:]:
+        if q is None:
+            checks.append(Check(3, sim.engine, "replay", "", math.inf, TOLERANCE,
+                                f"{sim.engine} replay failed ({setting}): {error}"))
+            continue
+        diff = np.abs(q - ref_q)
+        diff[~np.isfinite(diff)] = math.inf
+        per_joint = diff.max(axis=0)
+        worst = int(np.argmax(per_joint))
+        step = int(np.argmax(diff[:, worst]))
+        detail = (f"max |q_{sim.engine} − q_{ref_sim.engine}| over {setting}, "
+                  f"worst at t = {step * dt:.3f} s; per joint: "
+                  + ", ".join(f"{j} {e:.1e}" for j, e in zip(law.joints, per_joint, strict=True))
+                  + "; travel in " + ref_sim.engine + ": "
+                  + ", ".join(f"{j} {t:.3g}" for j, t in zip(law.joints, travel, strict=True))
+                  + f"; {seconds / wall:.0f}× real time ({sim.engine}), "
+                  f"{seconds / ref_wall:.0f}× ({ref_sim.engine})")
+        worst_error = float(per_joint[worst])
+        checks.append(Check(3, sim.engine, "replay", law.joints[worst], worst_error, TOLERANCE, detail))
+    return checks, skips
+
+
+# ---- harness overhead (bench, docs; never asserted in tests) ---------------------------------------
+
+
+def _mujoco_bare(sim: Any, seconds: float, dt: float) -> float:
+    """Wall seconds of a bare ``mj_step`` loop on the simulator's own compiled model."""
+    import mujoco
+
+    inner = getattr(sim, "inner", None)
+    model = getattr(inner, "model", None) if inner is not None else getattr(sim, "model", None)
+    if model is None:
+        raise TypeError(f"cannot reach the MjModel of {sim!r}")
+    data = mujoco.MjData(model)
+    model.opt.timestep = dt
+    step = mujoco.mj_step
+    start = time.perf_counter()
+    for _ in range(round(seconds / dt)):
+        step(model, data)
+    return time.perf_counter() - start
+
+
+def overhead(sims: list[Simulator], law: TorqueLaw, seconds: float = 10.0, dt: float = 1e-3,
+             repeats: int = 5) -> dict[str, dict[str, float]]:
+    """Simulated seconds per wall second of each engine's replay against a bare stepping loop of
+    the same engine on the same model (best of ``repeats``). PyBullet's figures are taken inside
+    its child process (``replay_loop``: the stepping loop alone, without the pipe) and for the
+    whole ``replay`` call as the layer sees it (``replay_call``)."""
+    out: dict[str, dict[str, float]] = {}
+    for sim in sims:
+        replay_call, replay_loop, bare, closed = math.inf, math.inf, math.inf, math.nan
+        for _ in range(repeats):
+            start = time.perf_counter()
+            sim.replay(law, seconds, dt)
+            replay_call = min(replay_call, time.perf_counter() - start)
+            inner_wall = float(getattr(sim, "last_replay_wall", math.nan))
+            if math.isfinite(inner_wall):
+                replay_loop = min(replay_loop, inner_wall)
+            bench = getattr(sim, "bench", None)
+            if bench is not None:
+                figures = bench(seconds, dt)
+                bare = min(bare, figures["bare"])
+                closed = figures["closed_loop"] if math.isnan(closed) else min(closed, figures["closed_loop"])
+            else:
+                bare = min(bare, _mujoco_bare(sim, seconds, dt))
+        if not math.isfinite(replay_loop):
+            replay_loop = replay_call
+        row = {"replay_call_rate": seconds / replay_call, "replay_loop_rate": seconds / replay_loop,
+               "bare_rate": seconds / bare, "ratio_call": bare / replay_call,
+               "ratio_loop": bare / replay_loop}
+        if math.isfinite(closed):
+            row["minimal_closed_loop_rate"] = seconds / closed
+            row["ratio_loop_vs_minimal_closed_loop"] = closed / replay_loop
+        out[sim.engine] = row
+    return out

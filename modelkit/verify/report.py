@@ -1,0 +1,138 @@
+"""The verdict of a ``verify`` run: the table printed on the terminal and ``report.json``
+(schema ``schemas/verify-report.schema.json``). Everything in the JSON is deterministic: the same
+input, engines and seed give the same bytes (wall times are printed, never written)."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from modelkit.verify.facts import Check, Skip
+
+SCHEMA_ID = "modelkit-verify-report/1"
+LAYER_NAMES = {0: "all", 1: "1 static", 2: "2 kinematics", 3: "3 dynamics"}
+
+
+@dataclass
+class VerifyReport:
+    source: str
+    robot: str = ""
+    seed: int = 0
+    base: str = ""  # how the base was treated for layers 1–3 (welded at the identity)
+    reference: str = ""  # what the layers compare with (the source model, or its track approximation)
+    parameters: dict[str, Any] = field(default_factory=dict)
+    files: dict[str, str] = field(default_factory=dict)  # "mjcf" → file name (as written or given)
+    renames: dict[str, dict[str, dict[str, str]]] = field(default_factory=dict)  # fmt → kind → src → written
+    notes: dict[str, list[str]] = field(default_factory=dict)  # fmt → conversion note codes (sorted, unique)
+    injected: list[str] = field(default_factory=list)
+    engines: dict[str, dict[str, Any]] = field(default_factory=dict)  # label → settings
+    checks: list[Check] = field(default_factory=list)
+    skips: list[Skip] = field(default_factory=list)
+    errors: list[str] = field(default_factory=list)  # why the run could not happen (exit 2)
+    timings: dict[str, float] = field(default_factory=dict)  # wall seconds; printed, not in report.json
+
+    @property
+    def failed(self) -> list[Check]:
+        return [c for c in self.checks if not c.passed]
+
+    @property
+    def exit_code(self) -> int:
+        if self.errors:
+            return 2
+        return 1 if self.failed else 0
+
+    @property
+    def verdict(self) -> str:
+        return {0: "pass", 1: "fail", 2: "error"}[self.exit_code]
+
+
+def _number(x: float) -> float | None:
+    """JSON has no infinity or NaN: those are written as null (the check then fails)."""
+    return float(x) if math.isfinite(x) else None
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, np.generic):
+        return _plain(value.item())
+    if isinstance(value, float):
+        return _number(value)
+    return value
+
+
+def check_json(c: Check) -> dict[str, Any]:
+    return {"layer": c.layer, "engine": c.engine, "quantity": c.quantity, "where": c.where,
+            "error": _number(c.error), "tolerance": c.tolerance, "passed": c.passed, "detail": c.detail}
+
+
+def report_json(report: VerifyReport) -> str:
+    data = {
+        "schema": SCHEMA_ID,
+        "source": report.source,
+        "robot": report.robot,
+        "verdict": report.verdict,
+        "exit_code": report.exit_code,
+        "seed": report.seed,
+        "base": report.base,
+        "reference": report.reference,
+        "parameters": _plain(report.parameters),
+        "files": dict(sorted(report.files.items())),
+        "renames": _plain(report.renames),
+        "notes": _plain(report.notes),
+        "injected": list(report.injected),
+        "engines": _plain(report.engines),
+        "checks": [check_json(c) for c in report.checks],
+        "skips": [{"layer": s.layer, "engine": s.engine, "reason": s.reason} for s in report.skips],
+        "errors": list(report.errors),
+    }
+    return json.dumps(data, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
+
+
+def _fmt(x: float) -> str:
+    if math.isinf(x):
+        return "inf"
+    if x == 0:
+        return "0"
+    if x == int(x) and abs(x) < 1e6:
+        return str(int(x))
+    return f"{x:.2e}"
+
+
+def render_table(report: VerifyReport) -> str:
+    """The verdict table: one row per layer × engine × quantity, then the skips and the verdict."""
+    lines = [f"verify {report.source} ({report.robot}): {report.base}"]
+    if report.reference:
+        lines.append(f"reference: {report.reference}")
+    if report.injected:
+        lines.append("injected: " + "; ".join(report.injected))
+    header = ("layer", "engine", "quantity", "worst error", "tolerance", "", "where")
+    rows = [(LAYER_NAMES.get(c.layer, str(c.layer)), c.engine, c.quantity, _fmt(c.error), _fmt(c.tolerance),
+             "ok" if c.passed else "FAIL", c.where) for c in report.checks]
+    widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
+    lines.append("  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)).rstrip())
+    for r in rows:
+        lines.append("  ".join(str(v).ljust(w) for v, w in zip(r, widths, strict=True)).rstrip())
+    for c in report.failed:
+        lines.append(f"FAIL layer {c.layer} {c.engine} {c.quantity} {c.where}: {c.detail} "
+                     f"(error {_fmt(c.error)} > tolerance {_fmt(c.tolerance)})")
+    for s in report.skips:
+        lines.append(f"skipped: layer {LAYER_NAMES.get(s.layer, s.layer)}, {s.engine}: {s.reason}")
+    for e in report.errors:
+        lines.append(f"error: {e}")
+    if report.timings:
+        lines.append("wall time: " + ", ".join(f"{k} {v:.2f} s" for k, v in report.timings.items()))
+    n_fail = len(report.failed)
+    verdict = {"pass": f"PASS: {len(report.checks)} checks passed",
+               "fail": f"FAIL: {n_fail} of {len(report.checks)} checks failed",
+               "error": "could not run"}[report.verdict]
+    lines.append(f"{verdict}, {len(report.skips)} skipped")
+    return "\n".join(lines) + "\n"

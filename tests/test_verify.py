@@ -1,0 +1,148 @@
+"""`modelkit verify` layers 1–3 against the real engines (MuJoCo, Pinocchio, yourdfpy; no mocks).
+
+PyBullet and Drake have their own tests (test_verify_pybullet.py, test_verify_drake.py); here the
+engines are the ones whose adapters this file's modules own, so a failure points at them.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import jsonschema
+import pytest
+
+from modelkit.verify import api
+from modelkit.verify.api import verify
+from modelkit.verify.report import report_json
+from tests.conftest import CORPUS, REPO, TUTORIAL
+
+ENGINES = ("mujoco", "pinocchio", "yourdfpy")
+PANTILT = TUTORIAL / "mobile_robot_pantilt.body"
+CHOREONOID = CORPUS / "choreonoid" / "share" / "model"
+SCHEMA = json.loads((REPO / "schemas" / "verify-report.schema.json").read_text())
+
+MODELS = [
+    TUTORIAL / "mobile_robot_primitive.body",
+    PANTILT,
+    TUTORIAL / "mobile_robot_sensors.body",
+    TUTORIAL / "mobile_robot_tracks.body",
+    CHOREONOID / "PA10" / "PA10.body",
+    CHOREONOID / "GR001" / "GR001.body",
+    CORPUS / "urdf_tutorial" / "urdf" / "07-physics.urdf",
+    CORPUS / "sdformat_urdf" / "sdformat_test_files" / "models" / "graph_tree" / "graph_tree.sdf",
+]
+
+
+def run(source: Path, out: Path, **kwargs: object) -> api.VerifyReport:
+    return verify(source, out, ENGINES, replay=False, **kwargs)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("source", MODELS, ids=lambda p: p.name)
+def test_layers_1_to_3_pass(source: Path, tmp_path: Path) -> None:
+    report = run(source, tmp_path)
+    assert report.errors == []
+    assert [f"{c.engine} {c.quantity} {c.where}: {c.detail}" for c in report.failed] == []
+    seen = {(c.layer, c.engine) for c in report.checks}
+    for engine in ("mujoco", "pinocchio", "yourdfpy"):
+        assert (1, engine) in seen and (2, engine) in seen
+    assert (3, "mujoco") in seen  # the mass matrix and bias against Pinocchio on the source
+    assert {c.quantity for c in report.checks if c.engine == "mujoco"} >= {
+        "link-set", "joint-set", "joint-type", "axis", "limits", "mass", "com", "inertia",
+        "pose-position", "pose-rotation", "mass-matrix", "bias"}
+    assert any(s.engine == "yourdfpy" and s.layer == 3 for s in report.skips)
+    assert "welded to the world at the identity" in report.base
+
+
+def test_tracks_say_what_is_skipped(tmp_path: Path) -> None:
+    report = run(TUTORIAL / "mobile_robot_tracks.body", tmp_path)
+    tracks = [s for s in report.skips if "continuous track not verified" in s.reason]
+    assert [(s.layer, s.engine) for s in tracks] == [(0, "all"), (0, "all")]
+    assert "LeftTracks" in tracks[0].reason and "RightTracks" in tracks[1].reason
+    assert "approximated by rollers" in report.reference
+
+
+def test_armature_the_urdf_cannot_hold_is_said(tmp_path: Path) -> None:
+    # PA10's rotor inertias reach MuJoCo (armature) and Pinocchio, not URDF: said, per engine
+    report = verify(CHOREONOID / "PA10" / "PA10.body", tmp_path, ("mujoco", "pinocchio"), replay=False)
+    assert report.exit_code == 0
+    assert not any("armature" in s.reason for s in report.skips)  # MuJoCo holds it: compared with it
+
+
+def test_report_json_valid_and_reproducible(tmp_path: Path) -> None:
+    a = run(PANTILT, tmp_path / "a")
+    b = run(PANTILT, tmp_path / "b")
+    ja, jb = report_json(a), report_json(b)
+    jsonschema.validate(json.loads(ja), SCHEMA)
+    assert ja == jb
+    data = json.loads(ja)
+    assert data["verdict"] == "pass" and data["exit_code"] == 0
+    assert data["engines"]["mujoco"]["version"] and data["engines"]["pinocchio"]["version"]
+    assert data["files"] == {"mjcf": "mobile_robot_pantilt.xml", "urdf": "mobile_robot_pantilt.urdf"}
+
+
+def test_missing_engine_is_skipped_not_failed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(api.ENGINES, "nosuch", "modelkit.verify.engine_nosuch:load")
+    monkeypatch.setitem(api.INPUTS, "nosuch", "mjcf")
+    report = verify(PANTILT, tmp_path, ("mujoco", "pinocchio", "nosuch"), replay=False)
+    assert report.exit_code == 0
+    assert any(s.engine == "nosuch" and "not installed" in s.reason for s in report.skips)
+
+
+def _cli(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "modelkit.cli", "verify", *args], capture_output=True,
+                          text=True, cwd=REPO, check=False)
+
+
+def _mjcf(tmp_path: Path) -> Path:
+    from modelkit.api import load
+    from modelkit.convert.api import write
+    from modelkit.verify.api import welded_copy
+
+    path = tmp_path / "given" / "pantilt.xml"
+    write(welded_copy(load(PANTILT))[0], path)
+    return path
+
+
+def test_cli_pass_writes_report(tmp_path: Path) -> None:
+    out = tmp_path / "r"
+    result = _cli(str(PANTILT), "-o", str(out), "--engines", ",".join(ENGINES), "--no-replay")
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "PASS" in result.stdout and "mass-matrix" in result.stdout
+    jsonschema.validate(json.loads((out / "report.json").read_text()), SCHEMA)
+
+
+def test_cli_given_mjcf_with_a_wrong_mass_fails(tmp_path: Path) -> None:
+    given = _mjcf(tmp_path)
+    ok = _cli(str(PANTILT), "--mjcf", str(given), "--engines", "mujoco,pinocchio", "--no-replay")
+    assert ok.returncode == 0, ok.stdout
+    text = given.read_text()
+    # PanLink's COM lies on the vertical pan axis, so with the base welded its mass changes no joint
+    # torque: layer 1 must catch it. Its Izz enters M[pan, pan]: layer 3a must catch that.
+    pattern = r'(<body name="PanLink".*?<inertial pos="0 0 0.03" mass=")1(" diaginertia="0.002 0.002 )0.003'
+    edited = re.sub(pattern, r"\g<1>1.01\g<2>0.0031", text, flags=re.S)
+    assert edited != text
+    given.write_text(edited)
+    bad = _cli(str(PANTILT), "--mjcf", str(given), "--engines", "mujoco,pinocchio", "--no-replay")
+    assert bad.returncode == 1, bad.stdout
+    assert re.search(r"FAIL layer 1 mujoco mass PanLink: mass 1 kg read back as 1.01 kg", bad.stdout)
+    assert re.search(r"FAIL layer 1 mujoco inertia PanLink", bad.stdout)
+    assert re.search(r"FAIL layer 3 mujoco mass-matrix PanJoint: sample \d+: M\[2,2\]", bad.stdout)
+
+
+def test_cli_unreadable_input_exits_2(tmp_path: Path) -> None:
+    broken = tmp_path / "broken.urdf"
+    broken.write_text("<robot name='x'><link name='a'>")
+    assert _cli(str(broken), "--engines", "mujoco").returncode == 2
+    assert _cli(str(tmp_path / "absent.body")).returncode == 2
+    assert _cli(str(PANTILT), "--engines", "nosuch").returncode == 2
+
+
+def test_validate_and_convert_do_not_import_engines() -> None:
+    code = ("import sys, modelkit.cli, modelkit.api, modelkit.convert.api; "
+            "print(sorted(m for m in ('mujoco', 'pinocchio', 'pybullet', 'pydrake') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO, check=True)
+    assert out.stdout.strip() == "[]"
