@@ -15,10 +15,10 @@ from modelkit.model import Robot
 # file's own loader accepts them: under that target they are errors, since that consumer (and
 # ``convert --to`` it) will meet them. Everywhere else they stay warnings that name the consumers.
 TARGET_REFUSALS: dict[str, frozenset[str]] = {
-    "mjcf": frozenset({"MK303"}),  # MuJoCo: inertia violating A + B >= C
+    "mjcf": frozenset({"MK303", "MK313"}),  # MuJoCo: inertia violating A + B >= C; a moving link, no mass
     "sdf": frozenset({"MK303", "MK211"}),  # libsdformat: the same, and links and joints sharing a name
     "urdf": frozenset(),
-    "pybullet": frozenset(),
+    "pybullet": frozenset({"MK122"}),  # PyBullet: a URDF visual or collision without a shape
 }
 TARGETS = tuple(TARGET_REFUSALS)
 

@@ -81,6 +81,12 @@ _TABLE: tuple[CodeInfo, ...] = (
         "The XML declares entities (`<!ENTITY>`); they are refused (entity bombs, file reads).",
     ),
     CodeInfo("MK022", "xml-root-unexpected", "error", "The top XML element is not the one the format needs."),
+    CodeInfo(
+        "MK023",
+        "xml-too-deep",
+        "error",
+        "XML elements nest deeper than 250 levels (modelkit's own limit, below lxml's 256); refused unread.",
+    ),
     # -- MK1xx: schema and header ----------------------------------------------------------
     # MK100-MK119: .body schema and header; MK120-MK129: XML elements and attributes (all XML
     # formats); MK130-MK149: URDF; MK150-MK169: SDF; MK170-MK179: MJCF.
@@ -120,9 +126,30 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A top-level key that only holds YAML anchors; the loader ignores it.",
     ),
     # -- MK12x: XML elements and attributes (URDF, SDF, MJCF) ----------------------------------
-    CodeInfo("MK120", "xml-attribute-missing", "error", "A required XML attribute is missing."),
-    CodeInfo("MK121", "xml-value-invalid", "error", "An XML attribute or text is not a valid value."),
-    CodeInfo("MK122", "xml-element-missing", "error", "A required XML element is missing."),
+    CodeInfo(
+        "MK120",
+        "xml-attribute-missing",
+        "error",
+        "A required XML attribute is missing. Reference: a URDF `<texture>` without `filename` is a warning "
+        "(urdfdom and PyBullet ignore the element and load the file).",
+    ),
+    CodeInfo(
+        "MK121",
+        "xml-value-invalid",
+        "error",
+        "An XML attribute or text is not a valid value. Reference: in SDF, every typed element is judged as "
+        "libsdformat 12 reads it (a leading number is a double, extra vector numbers are ignored; "
+        "unparsable, overflowing or out-of-bounds values such as `<mu>-1</mu>` are refused).",
+    ),
+    CodeInfo(
+        "MK122",
+        "xml-element-missing",
+        "error",
+        "A required XML element is missing. Reference: a visual or collision without a shape is a warning "
+        "(libsdformat gives it an empty geometry; urdfdom drops it with a message and loads the file; "
+        "PyBullet refuses the URDF, an error under `--target pybullet`); an SDF material `<script>` "
+        "without `<uri>` or `<name>` is refused by libsdformat.",
+    ),
     CodeInfo(
         "MK123", "xml-element-unknown", "warning", "An XML element or attribute is not part of the format."
     ),
@@ -202,10 +229,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK151",
         "sdf-version-unsupported",
         "error",
-        "The SDFormat version is not one modelkit reads (1.4 to 1.11).",
+        "The SDFormat version is not one modelkit reads (1.2 to 1.12). Reference: libsdformat converts 1.2 "
+        "and 1.3 as it loads them (an info; read as 1.4), current libsdformat reads 1.12; 1.0 is refused.",
     ),
     CodeInfo(
-        "MK152", "sdf-model-without-link", "error", "A model has no link (SDFormat requires at least one)."
+        "MK152",
+        "sdf-model-without-link",
+        "error",
+        "A model has no link. Reference: libsdformat requires one in a model that is not static; a static "
+        "model without links is accepted (an info).",
     ),
     CodeInfo(
         "MK153",
@@ -345,7 +377,21 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A link is the child of two joints (check_urdf misses it when both parents share a root).",
     ),
     CodeInfo("MK221", "child-undefined", "error", "A joint names a child link that does not exist."),
-    # (urdf tree MK222-MK229) (sdf frames and poses MK230-MK249)
+    CodeInfo(
+        "MK222",
+        "no-robot",
+        "info",
+        "The file holds no robot (an xacro macro library, a world without models): `tree` prints no tree "
+        "and exits 0, as `validate` does.",
+    ),
+    CodeInfo(
+        "MK223",
+        "tree-report-too-large",
+        "error",
+        "The tree report would pass 1,000,000 lines: check_urdf prints a link once per path from the root, "
+        "so links with several parents (MK220) multiply it (a 30-rung ladder: about 400 GB).",
+    ),
+    # (urdf tree MK224-MK229) (sdf frames and poses MK230-MK249)
     CodeInfo(
         "MK230",
         "sdf-relative-to-undefined",
@@ -391,10 +437,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "sdf-name-not-unique",
         "error",
         "Two siblings share a name: links/joints/frames/models of a model (SDF 1.7+), visuals, "
-        "collisions, sensors of a link, models of a world.",
+        "collisions, sensors of a link, models, lights, actors, frames of a world, two worlds "
+        "(libsdformat and `gz sdf -k` refuse them).",
     ),
     CodeInfo(
-        "MK238", "sdf-reserved-name", "error", "A name is reserved (`world`, `__...__`, or contains `::`)."
+        "MK238",
+        "sdf-reserved-name",
+        "error",
+        "A name is reserved (`world`, `__...__` in every SDFormat version libsdformat 12 reads, or `::` "
+        "in 1.8+).",
     ),
     CodeInfo(
         "MK239",
@@ -425,7 +476,12 @@ _TABLE: tuple[CodeInfo, ...] = (
         "Choreonoid uses the matrix as given, which no rigid body has.",
     ),
     CodeInfo(
-        "MK302", "inertia-not-positive-definite", "error", "An inertia tensor is not positive definite."
+        "MK302",
+        "inertia-not-positive-definite",
+        "error",
+        "An inertia tensor is not positive definite (a negative or a zero principal moment) on a link that "
+        "moves: it cannot be simulated meaningfully. A URDF root not welded to `world` counts as moving "
+        "(it floats in PyBullet and Gazebo). A warning on a link welded to the world.",
     ),
     CodeInfo(
         "MK303",
@@ -474,7 +530,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A `crease_angle` below 1 in degree mode is probably meant in radians.",
     ),
     CodeInfo(
-        "MK313", "moving-link-massless", "error", "A moving link has no mass (engines cannot simulate it)."
+        "MK313",
+        "moving-link-massless",
+        "error",
+        "A moving link has no mass after merging the links fixed to it. A zero mass cannot be simulated "
+        "(an error). Reference for a URDF link without `<inertial>`: check_urdf accepts kinematic-only "
+        "models, PyBullet gives 1 kg, MuJoCo refuses (a warning; an error under `--target mjcf`); MuJoCo "
+        "refuses a massless moving MJCF body.",
     ),
     CodeInfo("MK314", "inertia-count", "error", "An inertia list has neither 6 nor 9 elements."),
     CodeInfo(
@@ -618,8 +680,10 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK503",
         "uri-scheme-unsupported",
         "error",
-        "A URI scheme is not supported here. An SDF `<include>` of an `https://` (Gazebo Fuel) URI is an "
-        "info: Gazebo downloads it when it loads the world, modelkit does not fetch or check it.",
+        "A URI scheme is not supported here. An SDF `<include>` or mesh of an `https://` (Gazebo Fuel) URI "
+        "is an info: Gazebo downloads it when it loads the world, modelkit does not fetch or check it; a "
+        "URDF mesh on a web server is a warning (check_urdf never opens meshes; PyBullet and MuJoCo cannot "
+        "fetch it).",
     ),
     CodeInfo(
         "MK504", "package-not-found", "error", "A `package://` URI names a package that cannot be found."
@@ -652,7 +716,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK530",
         "sdf-include-invalid",
         "error",
-        "An `<include>` target cannot be used (no model.config or SDF file, no model in it).",
+        "An `<include>` target cannot be used (no model.config or SDF file, no model in it, or more than one "
+        "model, actor or light: libsdformat refuses that).",
     ),
     CodeInfo(
         "MK531", "sdf-include-cycle", "error", "An `<include>` includes a file that is already being read."
@@ -950,6 +1015,12 @@ _TABLE: tuple[CodeInfo, ...] = (
         "write-failed",
         "error",
         "Writing an output failed (disk full, permissions); nothing partial is left behind.",
+    ),
+    CodeInfo(
+        "MK895",
+        "nothing-to-convert",
+        "error",
+        "An input holds no robot (an xacro macro library, a world without models); nothing is written.",
     ),
 )
 

@@ -14,6 +14,7 @@ lxml parses; this module adds what the readers need on top of it:
 from __future__ import annotations
 
 import re
+from array import array
 from bisect import bisect_right
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -83,7 +84,7 @@ class XmlDocument:
     # location in the source file. Consulted before the document's own positions.
     origins: dict[Element, SourceLocation] = field(default_factory=dict)
     _starts: dict[Element, int] = field(default_factory=dict, repr=False)
-    _line_offsets: list[int] = field(default_factory=list, repr=False)
+    _line_offsets: array[int] = field(default_factory=lambda: array("q", [0]), repr=False)
 
     def _position(self, offset: int) -> tuple[int, int]:
         line = bisect_right(self._line_offsets, offset)
@@ -136,7 +137,8 @@ def tag_end(text: str, start: int) -> int:
 
 def _index_positions(doc: XmlDocument) -> None:
     text = doc.text
-    doc._line_offsets = [0] + [m.end() for m in re.finditer(r"\n", text)]
+    doc._line_offsets = array("q", [0])  # a compact array: a large file has a million lines
+    doc._line_offsets.extend(m.end() for m in re.finditer(r"\n", text))
     starts = [m.start() for m in _START_TAG.finditer(mask_markup(text))]
     elements = [e for e in doc.root.iter() if isinstance(e.tag, str)]
     if len(starts) != len(elements):  # cannot pair them safely: fall back to lxml's lines
@@ -144,10 +146,19 @@ def _index_positions(doc: XmlDocument) -> None:
     doc._starts = dict(zip(elements, starts, strict=True))
 
 
+# Our own nesting limit, below libxml2's (256 without XML_PARSE_HUGE), so that it is always ours that
+# answers (MK023), whatever the lxml build; TinyXML2 (urdfdom, libsdformat, MuJoCo) stops at 500.
+MAX_XML_DEPTH = 250
+
+
 def parse_xml_bytes(
-    data: bytes, display: str, sink: DiagnosticSink, path: Path | None = None
+    data: bytes, display: str, sink: DiagnosticSink, path: Path | None = None, keep_blank_text: bool = True
 ) -> XmlDocument | None:
-    """Parse XML held in memory; problems become diagnostics and the result is None."""
+    """Parse XML held in memory; problems become diagnostics and the result is None.
+
+    ``keep_blank_text=False`` drops whitespace-only text between elements (not the text of an element
+    without children): a third less memory for a large pretty-printed file, for readers that never
+    write the document back."""
     text = decode_text(data, display, sink)
     if text is None:
         return None
@@ -165,7 +176,12 @@ def parse_xml_bytes(
         sink.emit("MK020", "the document is empty", SourceLocation(display))
         return None
     parser = etree.XMLParser(
-        resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False, remove_comments=False
+        resolve_entities=False,
+        no_network=True,
+        load_dtd=False,
+        huge_tree=False,
+        remove_comments=False,
+        remove_blank_text=not keep_blank_text and "<!DOCTYPE" not in text,  # a DTD would decide otherwise
     )
     try:
         root = (
@@ -177,6 +193,9 @@ def parse_xml_bytes(
         line, col = exc.position if exc.position else (exc.lineno or 0, 0)
         message = str(exc.msg or exc).split(", line ")[0]
         where = SourceLocation(display, line or 0, max(col, 1))
+        if message.startswith("Excessive depth"):  # libxml2's own limit (256) behind ours
+            _too_deep(sink, where)
+            return None
         root = _lenient_comments(data, parser) if "hyphen within comment" in message else None
         if root is None:
             sink.emit("MK020", f"malformed XML: {message}", where)
@@ -192,9 +211,24 @@ def parse_xml_bytes(
     except ValueError as exc:  # e.g. an encoding declaration lxml cannot honour
         sink.emit("MK020", f"malformed XML: {exc}", SourceLocation(display))
         return None
+    deep = root.xpath("/".join(["*"] * MAX_XML_DEPTH))  # the elements one level below the limit
+    if isinstance(deep, list) and deep and isinstance(deep[0], etree._Element):
+        first = deep[0].sourceline
+        at = SourceLocation(display, first, 1) if isinstance(first, int) else SourceLocation(display)
+        _too_deep(sink, at)
+        return None
     doc = XmlDocument(root=root, display=display, text=text, path=path)
     _index_positions(doc)
     return doc
+
+
+def _too_deep(sink: DiagnosticSink, where: SourceLocation) -> None:
+    sink.emit(
+        "MK023",
+        f"XML elements nest deeper than {MAX_XML_DEPTH} levels; the document is refused unread",
+        where,
+        hint="no robot model needs this depth: an MJCF chain of bodies is the deepest real case",
+    )
 
 
 _COMMENT = re.compile(rb"<!--(.*?)-->", re.DOTALL)
@@ -219,12 +253,16 @@ def _lenient_comments(data: bytes, parser: etree.XMLParser) -> etree._Element | 
 
 
 def read_xml(
-    path: Path, sink: DiagnosticSink, max_bytes: int = DEFAULT_MAX_BYTES, display: str | None = None
+    path: Path,
+    sink: DiagnosticSink,
+    max_bytes: int = DEFAULT_MAX_BYTES,
+    display: str | None = None,
+    keep_blank_text: bool = True,
 ) -> XmlDocument | None:
     """Read and parse an XML file with the checks every input gets: exists, size, encoding, syntax."""
     name = display or str(path)
     data = read_bytes(path, sink, max_bytes, name)
-    return None if data is None else parse_xml_bytes(data, name, sink, path)
+    return None if data is None else parse_xml_bytes(data, name, sink, path, keep_blank_text)
 
 
 def sniff_root_tag(path: Path, limit: int = 65536) -> str | None:

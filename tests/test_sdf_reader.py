@@ -582,7 +582,7 @@ def write_model_folder(root: Path, name: str, versions: dict[str, str]) -> None:
 
 def test_world_with_models_and_includes(tmp_path: Path) -> None:
     write_model_folder(
-        tmp_path / "models", "wheel", {"1.6": "wheel_16.sdf", "1.9": "wheel.sdf", "1.12": "future.sdf"}
+        tmp_path / "models", "wheel", {"1.6": "wheel_16.sdf", "1.9": "wheel.sdf", "1.13": "future.sdf"}
     )
     (tmp_path / "local.sdf").write_text(
         model("1.7", LINK.format(name="body", rel="", pose="0 0 0 0 0 0"), "local")
@@ -605,7 +605,7 @@ def test_world_with_models_and_includes(tmp_path: Path) -> None:
     names = [r.name for r in result.robots]
     assert names == ["first", "front_wheel", "local"]
     wheel = result.robots[1]
-    assert [link.name for link in wheel.links] == ["link_1_9"]  # model.config: highest version <= 1.11
+    assert [link.name for link in wheel.links] == ["link_1_9"]  # model.config: highest version <= 1.12
     assert wheel.root_joint is JointType.FIXED
     assert_pose(wheel.root_pose, [5, 1, 0])
     assert_pose(result.robots[2].root_pose, [0, 0, 2])
@@ -697,7 +697,22 @@ def test_bad_values_are_reported_not_raised(tmp_path: Path) -> None:
 ORACLE_SOURCE = r"""
 #include <iostream>
 #include <sdf/sdf.hh>
-// modelkit's SDF oracle: sdf::Root::Load plus the graph checks of `gz sdf -k`.
+// modelkit's SDF oracle: sdf::Root::Load plus the checks of `gz sdf -k` (graphs, names).
+// `gz sdf -k`'s recursiveSameTypeUniqueNames, with the exception current libsdformat makes
+// (Element::NameUniquenessExceptions: <plugin> names may repeat; Gazebo loads such worlds).
+static bool sameTypeUniqueNames(sdf::ElementPtr elem) {
+  if (elem->GetName() == "plugin" || elem->GetName().find(':') != std::string::npos) return true;
+  bool ok = true;
+  for (const std::string &type : elem->GetElementTypeNames()) {
+    if (type != "plugin" && !elem->HasUniqueChildNames(type)) {
+      std::cout << "Error: Non-unique names detected in type " << type << " in <" << elem->GetName() << ">\n";
+      ok = false;
+    }
+  }
+  for (sdf::ElementPtr c = elem->GetFirstElement(); c; c = c->GetNextElement())
+    ok = sameTypeUniqueNames(c) && ok;
+  return ok;
+}
 int main(int argc, char **argv) {
   if (argc != 2) { std::cerr << "usage: sdf_check FILE\n"; return 2; }
   sdf::Root root;
@@ -708,7 +723,9 @@ int main(int argc, char **argv) {
   if (!sdf::checkCanonicalLinkNames(&root)) { std::cout << "invalid canonical link name\n"; return 1; }
   if (!sdf::checkJointParentChildLinkNames(&root)) { std::cout << "invalid parent or child\n"; return 1; }
   if (!sdf::checkFrameAttachedToGraph(&root)) { std::cout << "invalid attached_to graph\n"; return 1; }
+  if (!sdf::checkFrameAttachedToNames(&root)) { std::cout << "invalid attached_to name\n"; return 1; }
   if (!sdf::checkPoseRelativeToGraph(&root)) { std::cout << "invalid relative_to graph\n"; return 1; }
+  if (!sameTypeUniqueNames(root.Element())) { std::cout << "non-unique names\n"; return 1; }
   std::cout << "Valid.\n";
   return 0;
 }

@@ -73,7 +73,7 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
             # A link without mass information (URDF/SDF) hung on a fixed joint is part of its
             # parent's rigid body, and engines merge it; the body as a whole needs mass.
             if link.name in moving and merged.get(link.name, 0.0) <= 0.0:
-                yield diag("MK313", f'link "{link.name}" moves but has no mass', link.loc("name"))
+                yield _no_mass_information(robot, link)
             continue
         if inertial.defaulted and link.name in moving:
             what = "no mass information" if "mass" not in inertial.sources else "no inertia"
@@ -90,7 +90,34 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
                 "MK300", f'link "{link.name}" has a negative mass ({inertial.mass:g} kg)', _mass_loc(link)
             )
         elif inertial.mass == 0 and link.name in moving and merged.get(link.name, 0.0) <= 0.0:
-            yield diag("MK313", f'link "{link.name}" moves but its mass is zero', _mass_loc(link))
+            yield diag(
+                "MK313",
+                f'link "{link.name}" moves but its mass is zero: a body without mass cannot be simulated '
+                "(MuJoCo refuses it, PyBullet freezes its joint)",
+                _mass_loc(link),
+            )
+
+
+# MK313 for a moving link without <inertial> in a format whose loader accepts it (URDF: check_urdf
+# reads kinematic-only models): who fills the gap and who refuses it. An error under --target mjcf.
+NO_INERTIAL_CONSUMERS = (
+    "check_urdf accepts it (a kinematic-only model), PyBullet gives it 1 kg and a tiny inertia, "
+    "libsdformat's URDF conversion drops it, MuJoCo refuses it"
+)
+
+
+def _no_mass_information(robot: Robot, link: Link) -> Diagnostic:
+    """MK313 for a moving link without ``<inertial>``: a warning where the file's own loader accepts it."""
+    if robot.source_format == "urdf":
+        return diag(
+            "MK313",
+            f'link "{link.name}" moves but has no <inertial> (kinematics only, no dynamics); '
+            f"{NO_INERTIAL_CONSUMERS}",
+            link.loc("name"),
+            hint="give it an <inertial> with its mass and inertia to simulate the model",
+            severity=Severity.WARNING,
+        )
+    return diag("MK313", f'link "{link.name}" moves but has no mass', link.loc("name"))
 
 
 # MK301: an inertia matrix is asymmetric when an off-diagonal pair differs by more than this fraction of
@@ -117,6 +144,10 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
     largest principal moment.
     """
     moving = _moving_links(robot)
+    if robot.root is not None and robot.root_joint is None:
+        # A root the format leaves open (a URDF root other than "world") floats in PyBullet and Gazebo
+        # unless the loader is told to fix it: its inertia matters.
+        moving.add(robot.root)
     for link in robot.links:
         inertial = link.inertial
         if inertial is None or inertial.mass <= 0:
@@ -150,10 +181,11 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
                 severity=severity,
             )
             continue
-        if moments[0] < -eps:
+        if moments[0] <= eps:  # negative, or a zero moment: no finite acceleration about that axis
+            zero = " (a zero principal moment)" if moments[0] >= -eps else ""
             yield diag(
                 "MK302",
-                f'link "{link.name}": the inertia is not positive definite (principal moments '
+                f'link "{link.name}": the inertia is not positive definite{zero} (principal moments '
                 f"{', '.join(f'{m:.6g}' for m in moments)}){static}",
                 where,
                 severity=severity,

@@ -153,6 +153,10 @@ def convert(
             continue
         robots = [r for r in checked.robots if r.root is not None]
         if blocking or not robots:
+            if not checked.errors:  # a macro library, a world without models: say why nothing is written
+                result.diagnostics.append(
+                    diag("MK895", f"{source} holds no robot: nothing to convert", SourceLocation(str(source)))
+                )
             result.status = max(result.status, 1)
             continue
         plan.inputs |= {p for r in robots for p in input_files(r, source)}

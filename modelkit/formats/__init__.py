@@ -44,7 +44,7 @@ FORMATS: tuple[FormatInfo, ...] = (
     FormatInfo(
         "sdf",
         (".sdf", ".world"),
-        "SDFormat 1.4-1.11 (models and worlds)",
+        "SDFormat 1.2-1.12 (models and worlds)",
         "modelkit.formats.sdf.reader:read_sdf",
         root_tags=("sdf",),
     ),

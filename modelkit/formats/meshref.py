@@ -50,6 +50,9 @@ class MeshChecker:
     sink: DiagnosticSink
     check_resources: bool = True
     resolve: Callable[[str, SourceLocation], Resolution] | None = None
+    # The simulator that fetches http(s) meshes as it loads the file (SDF: Gazebo, from Gazebo Fuel):
+    # there such a mesh is an info (MK503); elsewhere a warning naming the consumers that cannot fetch it.
+    web_fetched_by: str | None = None
     _loaded: dict[str, str | None] = field(default_factory=dict)
     _textures: set[str] = field(default_factory=set)
 
@@ -94,7 +97,9 @@ class MeshChecker:
         severity = Severity.WARNING if visual_only else None
         usage = " (visual only)" if visual_only else ""
         path = resolution.path
-        if resolution.code is not None:
+        if resolution.scheme in ("http", "https"):
+            self._web_mesh(uri, loc)
+        elif resolution.code is not None:
             self.sink.emit(
                 resolution.code,
                 (resolution.message or uri) + usage,
@@ -126,6 +131,27 @@ class MeshChecker:
             path=str(path) if path is not None else None,
             fragment=submesh,
             scale=np.asarray(scale, dtype=float),
+        )
+
+    def _web_mesh(self, uri: str, loc: SourceLocation) -> None:
+        """MK503 for a mesh on a web server: the format's loader never opens meshes, so it accepts it."""
+        if self.web_fetched_by:
+            self.sink.emit(
+                "MK503",
+                f'mesh "{uri}" is on a web server: {self.web_fetched_by} downloads it when it loads the '
+                "model (Gazebo Fuel); modelkit does not fetch it, so it is not checked",
+                loc,
+                severity=Severity.INFO,
+            )
+            return
+        self.sink.emit(
+            "MK503",
+            f'mesh "{uri}" is on a web server: check_urdf accepts it (it never opens meshes) and Gazebo '
+            "fetches it, but PyBullet and MuJoCo read meshes only from disk; modelkit does not fetch it, so "
+            "it is not checked",
+            loc,
+            hint="for PyBullet or MuJoCo, download the mesh and refer to the local file",
+            severity=Severity.WARNING,
         )
 
     def _load(self, path: Path, fragment: str | None) -> str | None:

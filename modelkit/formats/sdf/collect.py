@@ -205,6 +205,17 @@ class Collector:
             self.ctx.sink.emit("MK530", f'included model "{uri}" cannot be read ({path})', loc)
             return None
         models = children(target.doc.root, "model")
+        placed = [
+            el for el in target.doc.root if isinstance(el.tag, str) and el.tag in ("model", "actor", "light")
+        ]
+        if len(placed) > 1:
+            self.ctx.sink.emit(
+                "MK530",
+                f"included file {path} holds {len(placed)} models, actors or lights; libsdformat refuses an "
+                '<include> that brings more than one ("Found more than one model for <include>")',
+                loc,
+            )
+            return None
         if not models:
             what = "a world" if children(target.doc.root, "world") else "no <model>"
             self.ctx.sink.emit("MK530", f"included file {path} holds {what}, not a model", loc)

@@ -16,7 +16,7 @@ import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
+from modelkit.diagnostics import Diagnostic, DiagnosticSink, Severity, SourceLocation
 from modelkit.formats.common import ReadOptions
 from modelkit.formats.meshref import MeshChecker
 from modelkit.formats.sdf.document import MAX_VERSION, SdfDocument, load_document, parse_version
@@ -32,6 +32,9 @@ class Context:
     sink: DiagnosticSink
     _meshes: dict[str, MeshChecker] = field(default_factory=dict)
     _documents: dict[str, SdfDocument | None] = field(default_factory=dict)
+    # Values libsdformat cannot parse (MK121), found by the element catalogue; the reader adds those at
+    # places it has not reported itself (see :meth:`value_faults`).
+    _value_faults: list[Diagnostic] = field(default_factory=list)
 
     # -- documents ---------------------------------------------------------------------------
 
@@ -43,9 +46,14 @@ class Context:
                 path, display or os.path.normpath(str(path)), self.sink, self.options.max_bytes
             )
             if src is not None:
-                check_elements(src.doc, self.sink, src.version)
+                check_elements(src.doc, self.sink, src.version, self._value_faults)
             self._documents[key] = src
         return self._documents[key]
+
+    def add_value_faults(self) -> None:
+        """Report the catalogue's value faults, except where the reader already reported the value."""
+        reported = {d.location for d in self.sink.items if d.code == "MK121"}
+        self.sink.extend(d for d in self._value_faults if d.location not in reported)
 
     # -- URIs ----------------------------------------------------------------------------------
 
@@ -109,6 +117,7 @@ class Context:
                 self.sink,
                 self.options.check_resources,
                 resolve=lambda uri, loc: self._file_resolution(uri, src, loc),
+                web_fetched_by="Gazebo",
             )
             self._meshes[key] = checker
         return checker

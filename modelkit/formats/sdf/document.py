@@ -13,14 +13,17 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from modelkit.diagnostics import DiagnosticSink
+from modelkit.diagnostics import DiagnosticSink, Severity
 from modelkit.formats.sdf.values import Values, local_name
 from modelkit.textio import UnreadableFile, read_regular
 from modelkit.xmlsource import XmlDocument, mask_markup, parse_xml_bytes, read_xml, tag_end
 
-MIN_VERSION = (1, 4)
-MAX_VERSION = (1, 11)
-SUPPORTED = "1.4-1.11"
+MIN_VERSION = (1, 2)
+MAX_VERSION = (1, 12)
+SUPPORTED = "1.2-1.12"
+# libsdformat converts SDFormat 1.2 and 1.3 files to its own version as it loads them; from 1.3 to 1.4
+# only world <physics> elements move, so modelkit reads them with the semantics of 1.4.
+OLDEST_SEMANTICS = (1, 4)
 _VERSION = re.compile(r"\s*(\d+)\.(\d+)\s*")
 _PREFIXED = re.compile(r"(?:<|\s)([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*")
 _DECLARED = re.compile(r"xmlns:([A-Za-z_][\w.-]*)\s*=")
@@ -90,7 +93,15 @@ def load_document(path: Path, display: str, sink: DiagnosticSink, max_bytes: int
             hint="convert older files with `gz sdf -p`" if version and version < MIN_VERSION else None,
         )
         version = MIN_VERSION if version is not None and version < MIN_VERSION else MAX_VERSION
-    return SdfDocument(doc, path, version, values)
+    elif version < OLDEST_SEMANTICS:
+        sink.emit(
+            "MK151",
+            f"SDFormat {raw}: libsdformat converts it as it loads it (only world <physics> elements "
+            "moved in 1.4); modelkit reads it as 1.4",
+            doc.loc(root, "version"),
+            severity=Severity.INFO,
+        )
+    return SdfDocument(doc, path, max(version, OLDEST_SEMANTICS), values)
 
 
 def _read(path: Path, display: str, sink: DiagnosticSink, max_bytes: int) -> XmlDocument | None:

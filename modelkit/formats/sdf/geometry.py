@@ -14,7 +14,7 @@ import numpy as np
 from lxml.etree import _Element as Element
 from numpy.typing import NDArray
 
-from modelkit.diagnostics import DiagnosticSink
+from modelkit.diagnostics import DiagnosticSink, Severity
 from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.document import SdfDocument
 from modelkit.formats.sdf.values import child, is_custom, local_name
@@ -73,7 +73,12 @@ def read_geometry(
     shapes = [c for c in geometry if isinstance(c.tag, str) and not is_custom(c)]
     known = [c for c in shapes if c.tag in (*SHAPES, *UNMODELLED, "empty")]
     if not known:
-        sink.emit("MK122", f"the <geometry> of {owner} holds no shape", values.loc(geometry))
+        sink.emit(
+            "MK122",
+            f"the <geometry> of {owner} holds no shape; libsdformat loads it as an empty geometry",
+            values.loc(geometry),
+            severity=Severity.WARNING,
+        )
         return ShapeResult()
     if len(known) > 1:
         sink.emit(
@@ -206,6 +211,16 @@ def read_material(
         uris = [values.text(u) for u in script if isinstance(u.tag, str) and u.tag == "uri"]
         result.name = name or None
         extras["script"] = {"name": name, "uri": [u for u in uris if u]}
+        for what, given in (("uri", any(uris)), ("name", bool(name))):
+            if not given:  # libsdformat's Material::Load refuses the file (errors 9 and 8)
+                ctx.sink.emit(
+                    "MK122",
+                    f"the material <script> of {owner} has no <{what}> (or it is empty); libsdformat "
+                    "refuses the file",
+                    values.loc(script),
+                    hint="give <uri> (e.g. file://media/materials/scripts/gazebo.material) and <name>, or "
+                    "replace the script by <diffuse>/<ambient> colours",
+                )
         if diffuse is None:
             ctx.sink.emit(
                 "MK533",

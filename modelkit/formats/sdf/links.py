@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 from lxml.etree import _Element as Element
 
+from modelkit.diagnostics import Severity
 from modelkit.formats.sdf.collect import Item
 from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.geometry import element_data, read_geometry, read_material
@@ -67,7 +68,13 @@ def read_link(ctx: Context, graph: FrameGraph, item: Item) -> LinkData:
                 _unique(ctx, src, names.setdefault(kind, {}), geom_el, kind, name, what)
             geometry_el = child(geom_el, "geometry")
             if geometry_el is None:
-                ctx.sink.emit("MK122", f"{label} has no <geometry>", values.loc(geom_el))
+                ctx.sink.emit(
+                    "MK122",
+                    f"{label} has no <geometry>; libsdformat gives it an empty one (nothing is "
+                    f"{'shown' if kind == 'visual' else 'collided with'})",
+                    values.loc(geom_el),
+                    severity=Severity.WARNING,
+                )
             shape = read_geometry(ctx, src, geometry_el, label, visual_only=(kind == "visual"))
             placed = place(child(geom_el, "pose"), src, item.name, label)
             if shape.unmodelled is not None:

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 from lxml.etree import _Element as Element
 
-from modelkit.diagnostics import DiagnosticSink, SourceLocation, did_you_mean
+from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation, did_you_mean
 from modelkit.formats.sdf.collect import MODEL_FRAME, Item, ModelTree, Scope
 from modelkit.formats.sdf.document import SdfDocument
 from modelkit.formats.sdf.values import child
@@ -100,7 +100,7 @@ class FrameGraph:
                 self.sink.emit("MK120", f"<{item.kind}> has no name attribute", values.loc(item.element))
                 continue
             modern = item.src.at_least(1, 7)
-            if modern and (item.local == "world" or _RESERVED.match(item.local)):
+            if item.local == "world" or _RESERVED.match(item.local):  # libsdformat 12: every version
                 self.sink.emit(
                     "MK238",
                     f'the {item.kind} name "{item.local}" is reserved in SDFormat ("world" and names '
@@ -158,11 +158,22 @@ class FrameGraph:
                 chosen = self.canonical.get(inner.frame)
                 if chosen is not None:
                     break
-        if chosen is None:
+        if chosen is None and _own_static(scope):
+            # libsdformat requires a link only of models that are not static (Model::Load)
             self.sink.emit(
                 "MK152",
-                f'model "{scope.name}" has no link; SDFormat requires at least one',
+                f'static model "{scope.name}" has no link: libsdformat loads it (a static model needs '
+                "none); there is nothing to simulate in it",
                 values.loc(element),
+                severity=Severity.INFO,
+            )
+        elif chosen is None:
+            self.sink.emit(
+                "MK152",
+                f'model "{scope.name}" has no link; SDFormat requires at least one in a model that is '
+                "not static",
+                values.loc(element),
+                hint="add a <link>, or <static>true</static> if the model is only frames",
             )
         self.canonical[scope.frame] = chosen
         return chosen
@@ -403,3 +414,10 @@ def _relative_attribute(src: SdfDocument, pose_element: Element) -> tuple[str, s
         if legacy:
             return legacy, "frame"
     return "", "relative_to"
+
+
+def _own_static(scope: Scope) -> bool:
+    """Whether the model itself says ``<static>true</static>`` (or its ``<include>`` does, at the top)."""
+    if scope.src.values.boolean(child(scope.element, "static")):
+        return True
+    return scope.parent is None and scope.static

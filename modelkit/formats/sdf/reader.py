@@ -30,10 +30,12 @@ from modelkit.formats.sdf.sensors import light_device, plugin_data
 from modelkit.formats.sdf.values import child
 from modelkit.formats.sdf.world import Placed, WorldFrames, world_frame_entries
 from modelkit.limits import too_many_links
-from modelkit.model import Device, Robot
+from modelkit.model import WORLD_LINK, Device, Robot
 from modelkit.spatial import Pose
 
 NOT_MODELLED_IN_WORLD = ("actor", "population", "joint")
+# Named elements of a world whose names libsdformat requires unique among their own kind.
+WORLD_NAMED = ("light", "actor", "frame", "joint", "road", "population")
 
 
 def read_sdf(path: Path, options: ReadOptions, display: str) -> ReadResult:
@@ -42,6 +44,7 @@ def read_sdf(path: Path, options: ReadOptions, display: str) -> ReadResult:
     ctx = Context(options, sink)
     src = ctx.document(path, display)
     robots = _Reader(ctx, src).read() if src is not None else []
+    ctx.add_value_faults()
     return ReadResult(robots[0] if robots else None, sorted_diagnostics(sink.items), robots[1:])
 
 
@@ -92,7 +95,22 @@ class _Reader:
                 robots.append(self._robot(model, frames))
             elif first.tag == "actor":
                 self._not_modelled(src, first, "an actor (animated mesh) is not a robot model")
+        seen_worlds: dict[str, int] = {}
         for world in worlds:
+            name = world.get("name")
+            if name is None:  # libsdformat: "Required attribute[name] in element[world] is not specified"
+                self.sink.emit(
+                    "MK120", "<world> has no name attribute; libsdformat refuses the file", values.loc(world)
+                )
+            elif name in seen_worlds:
+                self.sink.emit(
+                    "MK237",
+                    f'two worlds are named "{name}" (the first at line {seen_worlds[name]}); libsdformat '
+                    "refuses the file (each world must have a unique name)",
+                    values.loc(world, "name"),
+                )
+            else:
+                seen_worlds[name] = values.loc(world).line or 0
             robots.extend(self._world(world))
         if not robots:
             what = "a world without models" if worlds else "no model"
@@ -221,9 +239,37 @@ class _Reader:
                 names[name] = values.loc(el).line
                 frames.add(model.entry)
             models.append(model)
+        self._world_names(world)
+        for entry in world_frame_entries(src, world):
+            attached = entry.default
+            if attached != WORLD_LINK and not frames.exists(attached):
+                self.sink.emit(
+                    "MK232",
+                    f'frame "{entry.name}" is attached_to "{attached}", which names no model or frame of '
+                    f'world "{world_name}" (libsdformat error 22)',
+                    values.loc(entry.element, "attached_to") if entry.element is not None else None,
+                )
         if models:
             models[0].world = {"name": world_name, "lights": lights, "plugins": plugins}
         return [self._robot(model, frames) for model in models]
+
+    def _world_names(self, world: Element) -> None:
+        """Same-type siblings of a world share no name (models are checked as they are placed)."""
+        values = self.src.values
+        seen: dict[tuple[str, str], int] = {}
+        for el in world:
+            if not isinstance(el.tag, str) or el.tag not in WORLD_NAMED or el.get("name") is None:
+                continue
+            key = (str(el.tag), el.get("name") or "")
+            if key in seen:
+                self.sink.emit(
+                    "MK237",
+                    f'world "{world.get("name") or ""}" has two <{el.tag}> elements named "{key[1]}" (the '
+                    f"first at line {seen[key]}); libsdformat refuses the file",
+                    values.loc(el, "name"),
+                )
+            else:
+                seen[key] = values.loc(el).line or 0
 
 
 def _scopes(tree: ModelTree) -> list[Scope]:

@@ -14,6 +14,8 @@ An element is known by an id: the description file's stem for a file's top eleme
 from __future__ import annotations
 
 import json
+import math
+import re
 import sys
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -21,7 +23,7 @@ from pathlib import Path
 
 from lxml.etree import _Element as Element
 
-from modelkit.diagnostics import DiagnosticSink, closest, did_you_mean
+from modelkit.diagnostics import Diagnostic, DiagnosticSink, closest, diag, did_you_mean
 from modelkit.formats.sdf.values import is_custom
 from modelkit.xmlsource import XmlDocument
 
@@ -131,6 +133,9 @@ class ElementSpec:
     attributes: set[str] = field(default_factory=set)
     children: dict[str, tuple[str, bool]] = field(default_factory=dict)  # name -> (id, may repeat)
     any_content: bool = False  # copy_data: arbitrary content (plugins)
+    type: str | None = None  # the type of the element's text (libsdformat's description), if it has one
+    minimum: float | None = None  # libsdformat refuses a value below ``min`` or above ``max``
+    maximum: float | None = None
 
 
 @lru_cache(maxsize=1)
@@ -144,6 +149,9 @@ def catalogue() -> dict[str, ElementSpec]:
             attributes=set(entry.get("attributes", [])),
             children={k: (v[0], bool(v[1])) for k, v in entry.get("children", {}).items()},
             any_content=bool(entry.get("any", False)),
+            type=entry.get("type"),
+            minimum=entry.get("min"),
+            maximum=entry.get("max"),
         )
     return out
 
@@ -159,12 +167,19 @@ def _homes() -> dict[str, list[str]]:
     return {k: sorted(v) for k, v in out.items()}
 
 
-def check_elements(doc: XmlDocument, sink: DiagnosticSink, version: tuple[int, int] = (1, 11)) -> None:
+def check_elements(
+    doc: XmlDocument,
+    sink: DiagnosticSink,
+    version: tuple[int, int] = (1, 11),
+    values: list[Diagnostic] | None = None,
+) -> None:
     """Report elements and attributes that SDFormat does not define where they are written (MK123),
     and elements written twice where the specification allows one (MK124).
 
     Namespaced elements and attributes (``<gz:...>``) are legal custom content and are skipped, as
-    is everything inside ``<plugin>`` and other elements whose content is free.
+    is everything inside ``<plugin>`` and other elements whose content is free. Values that
+    libsdformat cannot parse as their element's type, or that are out of its bounds (MK121), go to
+    ``values`` when given (the reader reports the values it reads itself; these fill the rest).
     """
     table = catalogue()
     stack: list[tuple[Element, str]] = [(doc.root, "root")]
@@ -174,6 +189,14 @@ def check_elements(doc: XmlDocument, sink: DiagnosticSink, version: tuple[int, i
         if spec is None or spec.any_content:
             continue
         _check_attributes(doc, sink, element, spec)
+        if values is not None and spec.type is not None and len(element) == 0:
+            fault = value_fault(spec, element.text)
+            if fault is not None:
+                values.append(
+                    diag(
+                        "MK121", f"<{spec.name}> {fault}; libsdformat refuses the file", doc.text_loc(element)
+                    )
+                )
         if ident == "pose" and version >= (1, 7) and element.get("frame") is not None:
             sink.emit(
                 "MK123",
@@ -206,6 +229,85 @@ def check_elements(doc: XmlDocument, sink: DiagnosticSink, version: tuple[int, i
             seen.add(tag)
             pending.append((child, child_id))
         stack.extend(reversed(pending))
+
+
+_LEADING_DOUBLE = re.compile(
+    r"[+-]?(?:inf(?:inity)?|nan|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)", re.IGNORECASE
+)
+_LEADING_INT = re.compile(r"[+-]?\d+")
+# Vector types: how many numbers libsdformat reads (it ignores any that follow).
+_VECTOR_SIZES = {"vector3": 3, "vector2d": 2, "vector2i": 2, "quaternion": 4}
+
+
+def _stod(text: str) -> float | None:
+    """What ``std::stod`` makes of ``text``: its leading number (None when there is none or it overflows)."""
+    match = _LEADING_DOUBLE.match(text.lstrip())
+    if match is None:
+        return None
+    value = float(match.group(0))
+    word = match.group(0).lstrip("+-").lower()
+    if math.isinf(value) and not word.startswith("inf"):
+        return None  # 1e400: std::out_of_range
+    return value
+
+
+def value_fault(spec: ElementSpec, raw: str | None) -> str | None:
+    """Why libsdformat 12 (``sdf::Param``) refuses ``raw`` as the value of ``spec``, or None.
+
+    Modelled on what it does, not on what would be tidy: doubles and integers are read by
+    ``std::stod``/``std::stoi`` (a leading number is enough: "1x" is 1), vectors by a stream
+    (missing numbers fail, extra ones are ignored), colours need 3 or 4 numbers within 0..1, booleans
+    are true/false/1/0 in any case; an empty value keeps the default.
+    """
+    text = (raw or "").strip()
+    if not text:
+        return None
+    kind = spec.type
+    if kind in ("double", "float"):
+        value = _stod(text)
+        if value is None:
+            return f'must be a number, not "{text}"'
+        return _bounds(spec, value)
+    if kind in ("int", "unsigned int"):
+        match = _LEADING_INT.match(text)
+        if match is None:
+            return f'must be an integer, not "{text}"'
+        if kind == "unsigned int" and match.group(0).startswith("-"):
+            return f'must be an unsigned integer, not "{text}"'
+        return _bounds(spec, float(match.group(0)))
+    if kind == "bool":
+        if text.lower() not in ("true", "false", "1", "0"):
+            return f'must be true or false, not "{text}"'
+        return None
+    if kind in _VECTOR_SIZES:
+        count = _VECTOR_SIZES[kind]
+        numbers = [float(t) for t in text.split()[:count] if _is_number(t)]
+        if len(numbers) < count or len(numbers) != len(text.split()[:count]):
+            return f'must be {count} numbers, not "{text}"'
+        return None
+    if kind == "color":
+        items = text.split()
+        if len(items) not in (3, 4) or not all(_is_number(t) for t in items):
+            return f'must be 3 or 4 numbers (RGB or RGBA), not "{text}"'
+        if any(not 0.0 <= float(t) <= 1.0 for t in items):
+            return f'must have every component within 0..1, not "{text}"'
+        return None
+    return None
+
+
+def _is_number(token: str) -> bool:
+    try:
+        return math.isfinite(float(token))
+    except ValueError:
+        return False
+
+
+def _bounds(spec: ElementSpec, value: float) -> str | None:
+    if spec.minimum is not None and value < spec.minimum:
+        return f"is {value:g}, below the minimum {spec.minimum:g}"
+    if spec.maximum is not None and value > spec.maximum:
+        return f"is {value:g}, above the maximum {spec.maximum:g}"
+    return None
 
 
 def _check_attributes(doc: XmlDocument, sink: DiagnosticSink, element: Element, spec: ElementSpec) -> None:
@@ -267,12 +369,24 @@ def _generate(spec_root: Path) -> dict[str, dict[str, object]]:
                 child_id = ref if ref else f"{ident}/{name}"
                 item.children[name] = (child_id, many(child.get("required")))
                 walk(child, child_id, folder)
+                typed(child, child_id)
 
-    for folder in sorted(p for p in spec_root.iterdir() if p.is_dir() and p.name in _VERSIONS):
+    def typed(el: Element, ident: str) -> None:
+        """The element's value type and bounds; a later version's description wins."""
+        item = entry(ident, str(el.get("name")))
+        kind = el.get("type")
+        if kind and kind != "string" and len([c for c in el if c.tag == "element"]) == 0:
+            item.type = str(kind)
+            item.minimum, item.maximum = _bound(el.get("min")), _bound(el.get("max"))
+
+    for folder in sorted(
+        (p for p in spec_root.iterdir() if p.is_dir() and p.name in _VERSIONS), key=lambda p: _version(p.name)
+    ):
         for path in sorted(folder.glob("*.sdf")):
             top = _top(path)
             if top is not None:
                 walk(top, path.stem, folder)
+                typed(top, path.stem)
     for ident, (attributes, children, any_content) in LATER_ADDITIONS.items():
         item = entry(ident, ident.rsplit("/", 1)[-1].removesuffix("_shape"))
         item.attributes.update(attributes)
@@ -284,9 +398,23 @@ def _generate(spec_root: Path) -> dict[str, dict[str, object]]:
             "attributes": sorted(spec.attributes),
             "children": {k: list(v) for k, v in sorted(spec.children.items())},
             "any": spec.any_content,
+            **({"type": spec.type} if spec.type else {}),
+            **({"min": spec.minimum} if spec.minimum is not None else {}),
+            **({"max": spec.maximum} if spec.maximum is not None else {}),
         }
         for ident, spec in sorted(table.items())
     }
+
+
+def _bound(text: str | None) -> float | None:
+    try:
+        return float(text) if text else None
+    except ValueError:
+        return None  # a vector bound ("0 0"): not checked
+
+
+def _version(name: str) -> tuple[int, ...]:
+    return tuple(int(part) for part in name.split("."))
 
 
 _VERSIONS = ("1.4", "1.5", "1.6", "1.7", "1.8", "1.9")

@@ -33,6 +33,7 @@ class Placed:
     placement: str | None = None
     placement_loc: tuple[SdfDocument, Element, str | None] | None = None
     kind: str = "model"
+    element: Element | None = None  # the <frame> element of a world frame
 
 
 @dataclass
@@ -86,6 +87,10 @@ class WorldFrames:
         target = entry.graph.lookup(entry.graph.tree.scope, rest)
         inner = entry.graph.pose(target) if target is not None else Pose()
         return self.pose(model, path) @ inner
+
+    def exists(self, name: str) -> bool:
+        """Whether ``name`` is the world, a world-level model or frame, or a frame inside a model."""
+        return self._exists(name)
 
     def _exists(self, name: str) -> bool:
         if name == WORLD_LINK or name in self.entries:
@@ -146,6 +151,7 @@ def world_frame_entries(src: SdfDocument, world: Element) -> list[Placed]:
                     child(el, "pose"),
                     default=attached or WORLD_LINK,
                     kind="frame",
+                    element=el,
                 )
             )
     return out

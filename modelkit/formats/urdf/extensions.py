@@ -22,7 +22,7 @@ from lxml.etree import _Element as Element
 from modelkit.diagnostics import did_you_mean
 from modelkit.formats.devices import sdf_sensor_canonical
 from modelkit.formats.urdf.values import Context
-from modelkit.model import Device, Robot
+from modelkit.model import Device, Joint, Link, Robot
 from modelkit.spatial import Pose, matrix_from_rpy
 from modelkit.xmlsource import parse_number, parse_numbers
 
@@ -77,8 +77,15 @@ def _value(text: str | None) -> Any:
     return stripped
 
 
-def read_gazebo(ctx: Context, element: Element, robot: Robot) -> None:
-    """File one ``<gazebo>`` block under its link, joint or the robot."""
+def read_gazebo(
+    ctx: Context,
+    element: Element,
+    robot: Robot,
+    links: dict[str, Link] | None = None,
+    joints: dict[str, Joint] | None = None,
+) -> None:
+    """File one ``<gazebo>`` block under its link, joint or the robot. ``links`` and ``joints`` index
+    the robot's by name (the first of a name), so that a block per link stays linear in links."""
     reference = element.get("reference")
     entry: dict[str, Any] = {
         "reference": reference,
@@ -89,8 +96,12 @@ def read_gazebo(ctx: Context, element: Element, robot: Robot) -> None:
         tag = ctx.tag(child)
         if tag in GAZEBO_KEYS and len(child) == 0:
             entry[tag] = _value(child.text)
-    link = robot.link(reference) if reference else None
-    joint = next((j for j in robot.joints if j.name == reference), None) if reference else None
+    if links is None or joints is None:
+        link = robot.link(reference) if reference else None
+        joint = next((j for j in robot.joints if j.name == reference), None) if reference else None
+    else:
+        link = links.get(reference) if reference else None
+        joint = joints.get(reference) if reference else None
     if link is not None:
         link.extras.setdefault("gazebo", []).append(entry)
         for sensor in ctx.children(element, "sensor"):

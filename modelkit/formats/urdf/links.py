@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from lxml.etree import _Element as Element
 
-from modelkit.diagnostics import did_you_mean
+from modelkit.diagnostics import Severity, did_you_mean
 from modelkit.formats.meshref import MeshChecker
 from modelkit.formats.urdf.values import Context, number, origin, vector
 from modelkit.model import Box, Capsule, Cylinder, Geom, Geometry, Inertial, Link, Sphere, VisualMaterial
@@ -56,8 +56,14 @@ class Materials:
         texture = ctx.first(element, "texture")
         if texture is not None:
             filename = texture.get("filename")
-            if filename is None:
-                ctx.emit("MK120", "<texture> has no `filename` attribute", ctx.loc(texture))
+            if filename is None:  # urdfdom and PyBullet skip such a <texture> and load the file
+                ctx.emit(
+                    "MK120",
+                    "<texture> has no `filename` attribute; urdfdom and PyBullet ignore it",
+                    ctx.loc(texture),
+                    hint='give the image, e.g. <texture filename="package://pkg/textures/wood.png"/>',
+                    severity=Severity.WARNING,
+                )
             else:
                 found = True
                 material.texture = filename
@@ -188,6 +194,12 @@ def _inertia(ctx: Context, element: Element, link: str) -> np.ndarray | None:
     return inertia_from_moments(*(float(v or 0.0) for v in values))
 
 
+# A visual or collision without a shape (MK122): who loads the file and who refuses it.
+NO_SHAPE_CONSUMERS = (
+    "urdfdom (check_urdf, libsdformat) logs an error, drops it and loads the file; PyBullet refuses the file"
+)
+
+
 def _read_geom(
     ctx: Context, element: Element, link: str, meshes: MeshChecker, visual_only: bool
 ) -> Geom | None:
@@ -196,7 +208,12 @@ def _read_geom(
     pose = origin(ctx, ctx.first(element, "origin"), what)
     geometry_el = ctx.first(element, "geometry")
     if geometry_el is None:
-        ctx.emit("MK122", f'<{kind}> of link "{link}" has no <geometry>; it is left out', ctx.loc(element))
+        ctx.emit(
+            "MK122",
+            f'<{kind}> of link "{link}" has no <geometry>; it is left out ({NO_SHAPE_CONSUMERS})',
+            ctx.loc(element),
+            severity=Severity.WARNING,
+        )
         return None
     geometry = read_geometry(ctx, geometry_el, what, meshes, visual_only)
     if geometry is None or pose is None:
@@ -210,7 +227,12 @@ def read_geometry(
     """The first shape in ``<geometry>``: box, cylinder, sphere, capsule (URDF 1.1) or mesh."""
     shapes = ctx.children(element)
     if not shapes:
-        ctx.emit("MK122", f"<geometry> of the {what} holds no shape", ctx.loc(element))
+        ctx.emit(
+            "MK122",
+            f"<geometry> of the {what} holds no shape; it is left out ({NO_SHAPE_CONSUMERS})",
+            ctx.loc(element),
+            severity=Severity.WARNING,
+        )
         return None
     shape = shapes[0]
     tag = ctx.tag(shape)

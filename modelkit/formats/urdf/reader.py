@@ -25,14 +25,14 @@ from modelkit.formats.urdf.links import Materials, read_link
 from modelkit.formats.urdf.schema import check_structure
 from modelkit.formats.urdf.values import VERSIONS, Context
 from modelkit.limits import too_many_links
-from modelkit.model import WORLD_LINK, JointType, Robot
+from modelkit.model import WORLD_LINK, Joint, JointType, Link, Robot
 from modelkit.xmlsource import XmlDocument, location_at, read_xml
 
 
 def read_urdf(path: Path, options: ReadOptions, display: str) -> ReadResult:
     """Read a URDF file into a :class:`Robot` (None when the file is not a readable URDF)."""
     sink = DiagnosticSink()
-    doc = read_xml(path, sink, options.max_bytes, display)
+    doc = read_xml(path, sink, options.max_bytes, display, keep_blank_text=False)  # never written back
     robot = None
     if doc is not None:
         robot = read_urdf_document(doc, options, sink, path.parent, path)
@@ -165,8 +165,14 @@ def _root(robot: Robot) -> None:
 
 def _extensions(ctx: Context, root: Element, robot: Robot) -> None:
     """Gazebo blocks, transmissions, ros2_control and mujoco elements, kept as data."""
+    links: dict[str, Link] = {}
+    joints: dict[str, Joint] = {}
+    for link in robot.links:
+        links.setdefault(link.name, link)
+    for joint in robot.joints:
+        joints.setdefault(joint.name, joint)
     for element in ctx.children(root, "gazebo"):
-        read_gazebo(ctx, element, robot)
+        read_gazebo(ctx, element, robot, links, joints)
     joint_names = {joint.name for joint in robot.joints}
     transmissions = [read_transmission(ctx, t, joint_names) for t in ctx.children(root, "transmission")]
     if transmissions:

@@ -55,8 +55,11 @@ class Context:
         An element in the ``<robot>`` element's own namespace (a default ``xmlns``) counts as URDF;
         an element of any other namespace (``xmlns:drake``...) is an extension and is skipped.
         """
-        if not isinstance(element.tag, str):
+        tag = element.tag
+        if not isinstance(tag, str):
             return None
+        if not tag.startswith("{"):  # no namespace: the common case, without building a QName
+            return tag
         qname = etree.QName(element)
         if qname.namespace is None or qname.namespace == self.namespace:
             return qname.localname
@@ -119,20 +122,21 @@ def vector(ctx: Context, element: Element, attribute: str, what: str, count: int
     if text is None:
         return None
     values = parse_numbers(text)
-    loc = ctx.loc(element, attribute)
     if values is None:
         bad = next((item for item in text.split() if parse_number(item) is None), text)
-        ctx.emit("MK121", f'{what}: `{attribute}="{text}"`: "{bad}" is not a number', loc)
+        where = ctx.loc(element, attribute)
+        ctx.emit("MK121", f'{what}: `{attribute}="{text}"`: "{bad}" is not a number', where)
         return None
     if len(values) != count:
         ctx.emit(
             "MK121",
             f'{what}: `{attribute}="{text}"`: expected {count} numbers, found {len(values)}',
-            loc,
+            ctx.loc(element, attribute),  # located only when reported: a position costs a scan of the tag
         )
         return None
     if not all(math.isfinite(v) for v in values):
-        ctx.emit("MK121", f'{what}: `{attribute}="{text}"` has a value that is not finite', loc)
+        where = ctx.loc(element, attribute)
+        ctx.emit("MK121", f'{what}: `{attribute}="{text}"` has a value that is not finite', where)
         return None
     return values
 
