@@ -7,13 +7,21 @@ run (bad usage, unreadable input).
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, TypeVar
 
 import click
 
-from modelkit.diagnostics import Diagnostic, Severity, render_github, render_json, render_text
+from modelkit.diagnostics import (
+    Diagnostic,
+    Severity,
+    SourceLocation,
+    diag,
+    render_github,
+    render_json,
+    render_text,
+)
 from modelkit.format_names import FORMAT_NAMES
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -259,7 +267,7 @@ def tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: st
     Works for every format. An SDF world prints one report per model, in document order.
     """
     from modelkit.api import validate as validate_file
-    from modelkit.tree import tree_json, tree_report
+    from modelkit.tree import TreeTooLarge, json_chunks, report_chunks
 
     extra_files, xacro_args = split_xacro_args(xacro_words)
     if extra_files:
@@ -268,6 +276,12 @@ def tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: st
         )
     options = _read_options(kwargs, False, xacro_args)
     result = validate_file(file, options, kwargs["input_format"], str(file))
+    if not result.robots and not result.errors:  # no robot (a macro library): validate exits 0 too
+        for d in result.diagnostics:
+            click.echo(render_text(d), err=True)
+        click.echo(render_text(diag("MK222", "no robot in this file: there is no kinematic tree to print",
+                                    SourceLocation(str(file)))), err=True)
+        return
     blocking = [
         d
         for d in result.diagnostics
@@ -276,13 +290,30 @@ def tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: st
         and (d.code.startswith("MK2") or d.code.startswith("MK0") or result.robot is None)
     ]
     if not result.robots or any(r.root is None for r in result.robots) or blocking:
-        for d in blocking or result.errors or result.diagnostics:
+        shown = blocking or result.errors
+        for d in shown or result.diagnostics:
             click.echo(render_text(d), err=True)
+        if not shown:  # every failure carries a code, even one no reader explained
+            click.echo(render_text(diag("MK200", "no root link: the kinematic tree cannot be built",
+                                        SourceLocation(str(file)))), err=True)
         click.echo("ERROR: the kinematic tree cannot be built", err=True)
         sys.exit(2 if any(d.code in UNREADABLE_CODES for d in result.diagnostics) else 1)
-    render = tree_json if output_format == "json" else tree_report
-    for robot in result.robots:
-        click.echo(render(robot, order), nl=False)  # type: ignore[arg-type]
+    render = json_chunks if output_format == "json" else report_chunks
+    reports: list[Iterator[str]] = []
+    for robot in result.robots:  # every report is sized before the first is printed
+        try:
+            reports.append(render(robot, order))  # type: ignore[arg-type]
+        except TreeTooLarge as exc:
+            message = (f'the tree report of "{robot.name}" would pass {exc.limit:,} lines: check_urdf prints '
+                       "a link once per path from the root, and links with several parents (MK220) "
+                       f'multiply the paths (at link "{exc.link}")')
+            click.echo(render_text(diag("MK223", message, SourceLocation(str(file)),
+                                        hint="give every link one parent joint")), err=True)
+            click.echo("ERROR: the kinematic tree cannot be printed", err=True)
+            sys.exit(1)
+    for chunks in reports:  # streamed: a deep chain's report is far larger than the model
+        for text in chunks:
+            click.echo(text, nl=False)
     errors = len(result.errors)
     if errors:
         click.echo(f"note: {file} has {errors} other error(s); run `modelkit validate {file}`", err=True)
@@ -373,6 +404,42 @@ def convert(
     threshold = Severity(strict_level).rank
     if strict and any(n.severity.rank >= threshold for n in result.notes):
         sys.exit(1)
+
+
+@main.command()
+@click.argument("source", type=click.Path(path_type=Path))
+@click.option("-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="Folder for the written MJCF/URDF/SDF and report.json (default: a temporary folder, "
+              "no report).")
+@click.option("--engines", default="mujoco,pybullet,pinocchio,drake,yourdfpy", show_default=True,
+              help="Comma-separated engines to run; those not installed are skipped.")
+@click.option("--mjcf", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Verify this MJCF (a conversion already made) instead of writing one.")
+@click.option("--urdf", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Verify this URDF instead of writing one.")
+@click.option("--sdf", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Verify this SDF instead of writing one.")
+@click.option("--inject", multiple=True, metavar="FAULT",
+              help="Perturb the written files as a buggy converter would (inertia:LINK:1%, com:LINK:DX, "
+              "axis:JOINT:flip, cylinder-y:LINK, wheel-radius:LINK:5%, mass:LINK:10%); repeatable.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the random configurations.")
+@click.option("--no-replay", is_flag=True, help="Skip layer 3b (the MuJoCo/PyBullet torque replay).")
+def verify(source: Path, output: Path | None, engines: str, mjcf: Path | None, urdf: Path | None,
+           sdf: Path | None, inject: tuple[str, ...], seed: int, no_replay: bool) -> None:
+    """Prove a conversion is the same robot: static facts, kinematics and dynamics in real engines.
+
+    Exit 0 every check passed; 1 a check failed; 2 could not run (unreadable input, bad option).
+    """
+    from modelkit.verify.api import verify as run_verify
+    from modelkit.verify.report import render_table, report_json
+
+    names = tuple(e.strip() for e in engines.split(",") if e.strip())
+    report = run_verify(source, output, names, mjcf, urdf, sdf, inject, seed, replay=not no_replay)
+    click.echo(render_table(report), nl=False)
+    if output is not None and not report.errors:
+        (output / "report.json").write_text(report_json(report), encoding="utf-8")
+        click.echo(f"wrote {output / 'report.json'}")
+    sys.exit(report.exit_code)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -372,13 +372,29 @@ def test_each_fault_fails_the_right_layer(written: Written, tmp_path: Path, fmt_
         assert not [c for c in failed if c.layer == 3], failed
 
 
-@pytest.mark.parametrize(("fmt_name", "label"), [("mjcf", "mujoco"), ("sdf", "drake")])
-@pytest.mark.parametrize("spec", ["cylinder-y:LeftWheel", "wheel-radius:RightWheel:5%"])
-def test_geometry_faults_are_invisible_to_layers_1_to_3(written: Written, tmp_path: Path, fmt_name: str,
-                                                        label: str, spec: str) -> None:
-    """Collision geometry is not a fact of layers 1-3 (``StaticFacts`` has no shapes): these faults
-    change only contact, and are for the driven scenarios with contact (layer 4) to catch. This test
-    pins that gap down; it will fail, as it should, once a layer compares collision shapes."""
+GEOMETRY_FAULTS = [("cylinder-y:LeftWheel", "shape-pose", "LeftWheel"),
+                   ("wheel-radius:RightWheel:5%", "shape-size", "RightWheel")]
+
+
+@pytest.mark.parametrize(("spec", "quantity", "link"), GEOMETRY_FAULTS)
+def test_geometry_faults_fail_layer1_shapes_only(written: Written, tmp_path: Path, spec: str, quantity: str,
+                                                 link: str) -> None:
+    """Collision geometry is a layer-1 fact (``StaticFacts.shapes``, ``modelkit.verify.shapes``):
+    a turned or resized wheel fails exactly one shape check, naming the link; it changes no mass
+    property, so layers 2 and 3 stay green. (PyBullet: ``tests/test_verify_shapes.py``.)"""
     out = _copy(written, tmp_path)
-    inject(out / FORMATS[fmt_name], spec, written.renames[fmt_name])
-    assert [c for c in _layer_checks(written, out, fmt_name, label) if not c.passed] == []
+    inject(out / "x.xml", spec, written.renames["mjcf"])
+    failed = [c for c in _layer_checks(written, out, "mjcf", "mujoco") if not c.passed]
+    assert [(c.layer, c.quantity, c.where) for c in failed] == [(1, quantity, link)], failed
+    assert failed[0].error > failed[0].tolerance and failed[0].detail
+
+
+@pytest.mark.parametrize("spec", [spec for spec, _, _ in GEOMETRY_FAULTS])
+def test_geometry_faults_are_invisible_to_drake(written: Written, tmp_path: Path, spec: str) -> None:
+    """Drake's adapter registers no geometry (no SceneGraph), so it reports no shapes and the
+    verify run says so in a Skip; these faults are caught by MuJoCo and PyBullet, not by Drake.
+    This test pins that gap down; it will fail, as it should, once Drake reports shapes."""
+    out = _copy(written, tmp_path)
+    inject(out / "x.sdf", spec, written.renames["sdf"])
+    assert [c for c in _layer_checks(written, out, "sdf", "drake") if not c.passed] == []
+    assert _engine("sdf", out / "x.sdf").static().shapes == {}

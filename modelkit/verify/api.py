@@ -69,9 +69,10 @@ ENGINES: dict[str, str] = {
     "mujoco": "modelkit.verify.engine_mujoco:load",
     "pybullet": "modelkit.verify.engine_pybullet:load",
     "drake": "modelkit.verify.engine_drake:load",
+    "drake-urdf": "modelkit.verify.engine_drake:load_urdf",
     "yourdfpy": "modelkit.verify.reference:load_yourdfpy",
 }
-DEFAULT_ENGINES = ("mujoco", "pybullet", "pinocchio", "drake", "yourdfpy")
+DEFAULT_ENGINES = ("mujoco", "pybullet", "pinocchio", "drake", "drake-urdf", "yourdfpy")
 
 # Which written file each engine reads ("robot" = the in-memory source model).
 INPUTS: dict[str, str] = {
@@ -80,6 +81,7 @@ INPUTS: dict[str, str] = {
     "mujoco": "mjcf",
     "pybullet": "urdf",
     "drake": "sdf",
+    "drake-urdf": "urdf",
     "yourdfpy": "urdf",
 }
 SUFFIX = {"mjcf": ".xml", "urdf": ".urdf", "sdf": ".sdf"}
@@ -155,7 +157,9 @@ def _reference(welded: Robot, report: VerifyReport) -> Robot:
 
 
 def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report: VerifyReport,
-             needed: set[str]) -> tuple[dict[str, Path], dict[str, Renames]]:
+             needed: set[str], written: dict[str, list[Any]] | None = None
+             ) -> tuple[dict[str, Path], dict[str, Renames]]:
+    """Write the files the engines read; ``written`` receives each written file's notes."""
     from modelkit.convert.api import output_stem, write
     from modelkit.convert.notes import renames
 
@@ -174,6 +178,8 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
             continue
         path = out_dir / f"{stem}{SUFFIX[fmt]}"
         notes = write(welded, path, fmt, force=True)
+        if written is not None:
+            written[fmt] = list(notes)
         files[fmt] = path
         maps[fmt] = {"link": renames(notes, "link"), "joint": renames(notes, "joint")}
         report.files[fmt] = path.name
@@ -247,8 +253,8 @@ def verify(
 def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str], mjcf: str | Path | None,
          urdf: str | Path | None, sdf: str | Path | None, inject: Sequence[str], seed: int,
          configurations: int, samples: int, replay: bool) -> VerifyReport:
-    from modelkit.verify import layers
-    from modelkit.verify.reference import SourceModel, source_static
+    from modelkit.verify import approximations, layers, shapes
+    from modelkit.verify.reference import SourceModel, dof_joints, source_static
 
     t0 = time.perf_counter()
     try:
@@ -259,7 +265,8 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
         given = {"mjcf": Path(mjcf) if mjcf else None, "urdf": Path(urdf) if urdf else None,
                  "sdf": Path(sdf) if sdf else None}
         needed = {INPUTS[e] for e in engines if e in INPUTS} - {"robot"}
-        files, maps = _convert(welded, out_dir, given, report, needed)
+        written: dict[str, list[Any]] = {}
+        files, maps = _convert(welded, out_dir, given, report, needed, written)
         t1 = time.perf_counter()
         for spec in inject:
             try:
@@ -281,18 +288,29 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
     src = SourceModel(reference)
     report.engines["source"] = dict(src.settings)
     src_static = source_static(reference)
+    approx = _approximations(reference, loaded, files, maps, written, report)
     for eng in loaded:
-        report.checks.extend(layers.layer1(src_static, eng))
-        report.skips.extend(layers.massless_skips(src_static, eng))
+        # An engine holding a documented approximation (MK816 tiny masses, PyBullet's 1 kg) is
+        # compared with the source with that approximation applied; the report lists it.
+        eng_static = (source_static(approximations.applied(reference, approx[eng.label]))
+                      if approx[eng.label] else src_static)
+        report.checks.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: layers.layer1(st, eng)))
+        report.skips.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: layers.massless_skips(st, eng),
+                                     report.checks))
+        report.skips.extend(shapes.skips(src_static, eng))
     t3 = time.perf_counter()
     configs = layers.configurations(reference, configurations, seed)
     for eng in loaded:
-        report.checks.extend(layers.layer2(src, eng, configs))
+        report.checks.extend(_guarded(2, eng, lambda eng=eng: layers.layer2(src, eng, configs)))
     t4 = time.perf_counter()
     pin_ref = next((e.model for e in loaded if e.label == "pinocchio"), None)
     if layers.kinematic_only(reference):
         report.skips.append(Skip(3, "all", "no link moved by a joint has mass in the source (a kinematic "
                                            "model): no dynamics to verify"))
+        replay = False
+    elif not dof_joints(reference):
+        report.skips.append(Skip(3, "all", "no revolute or prismatic joint: the mass matrix and bias forces "
+                                           "are empty and nothing moves, no dynamics to verify"))
         replay = False
     elif pin_ref is None:
         report.skips.append(Skip(3, "all", "layer 3a needs Pinocchio (the dynamics reference built from the "
@@ -304,9 +322,12 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
             if eng.label == "pinocchio":
                 continue
             dropped = bool(with_armature) and INPUTS.get(eng.label) in ("urdf", "sdf")
-            ref = _without_armature(reference) if dropped else pin_ref
+            model = approximations.applied(reference, approx[eng.label])
+            ref = (_without_armature(model) if dropped
+                   else pin_ref if model is reference else _pinocchio(model))
             try:
-                report.checks.extend(layers.layer3a(ref, eng, state))
+                report.checks.extend(_guarded(3, eng,
+                                              lambda eng=eng, ref=ref: layers.layer3a(ref, eng, state)))
                 if dropped:
                     report.skips.append(Skip(3, eng.label, (
                         f"joint armature (rotor inertia) of {', '.join(with_armature)} cannot be written in "
@@ -316,12 +337,55 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
                 report.skips.append(layers.no_dynamics(eng))
     t5 = time.perf_counter()
     if replay:
-        _replay(reference, files, maps, loaded, report)
+        _replay(reference, files, maps, loaded, report, approx)
     t6 = time.perf_counter()
     for eng in loaded:
         eng.model.close()
     report.timings.update({"layer 1": t3 - t2, "layer 2": t4 - t3, "layer 3a": t5 - t4, "layer 3b": t6 - t5})
     return report
+
+
+def _guarded(layer: int, eng: Any, run: Any, checks: list[Check] | None = None) -> list[Any]:
+    """``run()``'s result, or, when the engine raises (a crash, a refusal, a None where numbers were
+    due), a failed check with the message: an engine failing on our file is a finding, never a crash
+    of the run. The check goes into the result, or into ``checks`` when the result holds skips."""
+    try:
+        return list(run())
+    except NotImplementedError:
+        raise
+    except Exception as exc:
+        failed = Check(layer, eng.label, "engine-error", "", float("inf"), 0.0,
+                       f"{eng.label} failed during layer {layer}: {type(exc).__name__}: {exc}")
+        if checks is not None:
+            checks.append(failed)
+            return []
+        return [failed]
+
+
+def _approximations(reference: Robot, loaded: list[Any], files: dict[str, Path], maps: dict[str, Renames],
+                    written: dict[str, list[Any]], report: VerifyReport) -> dict[str, Any]:
+    """Per loaded engine, the documented mass approximations it holds (see ``approximations``), each
+    listed in the report."""
+    from modelkit.verify import approximations
+
+    out: dict[str, Any] = {}
+    for eng in loaded:
+        kind = INPUTS.get(eng.label, "robot")
+        if kind == "robot":
+            out[eng.label] = {}
+            continue
+        out[eng.label] = approximations.for_engine(eng.label, kind, written.get(kind, []), files[kind],
+                                                   reference, maps[kind])
+        entry = approximations.skip(eng.label, out[eng.label])
+        if entry is not None:
+            report.skips.append(entry)
+    return out
+
+
+def _pinocchio(robot: Robot) -> Any:
+    from modelkit.verify.engine_pinocchio import PinocchioModel
+
+    return PinocchioModel(robot)
 
 
 def _without_armature(robot: Robot) -> Any:
@@ -334,7 +398,7 @@ def _without_armature(robot: Robot) -> Any:
 
 
 def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], loaded: list[Any],
-            report: VerifyReport) -> None:
+            report: VerifyReport, approx: dict[str, Any] | None = None) -> None:
     """Layer 3b through the replay module (MuJoCo against PyBullet), when it is there."""
     names = [e.label for e in loaded if e.label in ("mujoco", "pybullet")]
     if len(names) < 2:
@@ -348,11 +412,55 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
         report.skips.append(Skip(3, "mujoco+pybullet", f"layer 3b (replay) is not available: {exc}"))
         return
     sims = []
+    # Armature (rotor inertia) reaches the MJCF but not the URDF PyBullet reads (MK820): the replay
+    # runs both without it, as layer 3a compares PyBullet with a reference without it.
+    with_armature = [j.name for j in reference.joints if j.armature != 0.0]
+    # PyBullet's documented mass approximations (its 1 kg for a URDF link without <inertial>, MK816)
+    # are given to MuJoCo for the replay, so that both integrate the same robot (listed in the report).
+    pb_approx = (approx or {}).get("pybullet", {})
+    mj_approx = (approx or {}).get("mujoco", {})
+    inertials: dict[str, tuple[float, float]] = {}
+    if "mjcf" in maps:
+        for link, a in pb_approx.items():
+            mine = mj_approx.get(link)
+            if mine is None or (mine.mass, mine.inertia) != (a.mass, a.inertia):
+                inertials[maps["mjcf"].get("link", {}).get(link, link)] = (a.mass, a.inertia)
     for name in names:
         kind = INPUTS[name]
         root = maps[kind].get("link", {}).get(str(reference.root), str(reference.root))
-        sims.append(_resolve(ENGINES[name].replace(":load", ":simulator"))(files[kind], maps[kind], root=root,
-                                                                            dt=REPLAY_DT))
+        extra: dict[str, Any] = {}
+        if kind == "mjcf":
+            extra = {**({"armature": False} if with_armature else {}),
+                     **({"inertials": inertials} if inertials else {})}
+        try:
+            make = _resolve(ENGINES[name].replace(":load", ":simulator"))
+            sims.append(make(files[kind], maps[kind], root=root, dt=REPLAY_DT, **extra))
+        except Exception as exc:
+            for sim in sims:
+                sim.close()
+            report.checks.append(Check(3, name, "replay", "", float("inf"), 1e-8,
+                                       f"{name} could not load the model for the replay: "
+                                       f"{type(exc).__name__}: {exc}"))
+            return
+    equalities = sum(int(getattr(sim, "equalities", 0)) for sim in sims)
+    if equalities:
+        mimics = [j.name for j in reference.joints if j.mimic is not None]
+        report.skips.append(Skip(3, "mujoco+pybullet", (
+            f"replay of the open tree: MuJoCo's {equalities} equality constraint(s) are disabled "
+            + (f"(mimic joints {', '.join(mimics)} follow their leaders there) " if mimics else "")
+            + "because PyBullet does not read URDF <mimic> and a URDF holds no closed loop; the couplings "
+            "themselves are not verified by the replay")))
+    if inertials:
+        report.skips.append(Skip(3, "mujoco+pybullet", (
+            f"replay with PyBullet's documented approximation given to MuJoCo too: {len(inertials)} link(s) "
+            f"massless in the source ({', '.join(sorted(inertials)[:8])}) hold PyBullet's values in both "
+            "engines "
+            "(MK816, see the layer 1 approximation entry)")))
+    if with_armature:
+        report.skips.append(Skip(3, "mujoco+pybullet", (
+            f"replay without the joint armature (rotor inertia) of {', '.join(with_armature)}: the URDF "
+            "PyBullet reads cannot hold it (MK820), so MuJoCo replays with it zeroed; MuJoCo's armature "
+            "is verified by layer 3a (mass matrix against Pinocchio with armature)")))
     try:
         checks, skips = layer3b(reference, sims, default_law(reference), REPLAY_SECONDS, REPLAY_DT)
     finally:

@@ -21,7 +21,8 @@ unscoped ``body.name()`` / ``joint.name()`` are the written names):
   SDFormat writes an unlimited joint as ±1e16 (its documented "no limit" default) and Drake keeps
   the number: a bound of magnitude ≥ 1e16 is reported as ±inf, as URDF ``continuous`` is;
 * an SDF ``<frame attached_to>`` (how the SDF writer keeps a massless leaf link) is a frame in
-  Drake, not a body: it is reported as a massless link with its pose, and no joint;
+  Drake, not a body: it is reported as a massless link with its pose, and a fixed joint
+  ``fixed:NAME`` to what it is attached to (the fixed joint the link hung from);
 * poses: ``EvalBodyPoseInWorld`` (frames: ``CalcPoseInWorld``), relative to the root;
 * mass matrix: ``CalcMassMatrix`` (no reflected inertia unless the file declares one);
 * bias: ``CalcBiasTerm`` − ``CalcGravityGeneralizedForces``. Drake's equations of motion are
@@ -107,10 +108,12 @@ def _limit(value: float) -> float:
     return math.copysign(math.inf, value) if abs(value) >= SDF_UNLIMITED else float(value)
 
 
-def _sdf_frames(path: Path) -> list[str]:
-    """Names of the model-level ``<frame>`` elements of an SDF file (massless links kept as frames)."""
+def _sdf_frames(path: Path) -> dict[str, str]:
+    """The model-level ``<frame>`` elements of an SDF file (massless links kept as frames, MK816):
+    name → ``attached_to`` (the link or frame it hangs from; "" when the attribute is absent)."""
     tree = etree.parse(str(path))
-    return [str(f.get("name")) for f in tree.iterfind("./model/frame") if f.get("name")]
+    return {str(f.get("name")): str(f.get("attached_to") or "") for f in tree.iterfind("./model/frame")
+            if f.get("name")}
 
 
 class _Collect(logging.Handler):
@@ -171,10 +174,12 @@ class DrakeModel:
             plant.get_body(i).name(): plant.get_body(i) for i in plant.GetBodyIndices(self._instance)
         }
         self._frames: dict[str, Frame] = {}
+        self._frame_parent: dict[str, str] = {}
         if path.suffix.lower() == ".sdf":
-            for name in _sdf_frames(path):
+            for name, attached_to in _sdf_frames(path).items():
                 if name not in self._bodies and plant.HasFrameNamed(name, self._instance):
                     self._frames[name] = plant.GetFrameByName(name, self._instance)
+                    self._frame_parent[name] = attached_to
         self._joints: list[Joint] = [
             plant.get_joint(i) for i in plant.GetJointIndices(self._instance) if not self._is_base_weld(i)
         ]
@@ -221,6 +226,9 @@ class DrakeModel:
             facts.links[name] = LinkFacts(float(inertia.get_mass()), com, np.array(about_com, dtype=float))
         for name in self._frames:
             facts.links[name] = LinkFacts(0.0, np.zeros(3), np.zeros((3, 3)))
+            # The frame stands for a massless link on a fixed joint (MK816): reported as a link, so
+            # its joint is reported too, fixed, to what the frame is attached to.
+            facts.joints[f"fixed:{name}"] = JointFacts("fixed", self._frame_parent[name], name, np.zeros(3))
         for joint in self._joints:
             facts.joints[joint.name()] = self._joint_facts(joint)
         return facts

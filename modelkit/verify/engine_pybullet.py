@@ -41,7 +41,7 @@ import numpy as np
 
 from modelkit.spatial import Pose
 from modelkit.verify.api import EngineError
-from modelkit.verify.facts import Array, JointFacts, LinkFacts, StaticFacts, TorqueLaw
+from modelkit.verify.facts import Array, JointFacts, LinkFacts, ShapeFacts, StaticFacts, TorqueLaw
 
 Renames = dict[str, dict[str, str]]
 
@@ -57,6 +57,7 @@ SETTINGS: dict[str, Any] = {
     "jointDamping": 0.0,
     "default_motors": "off (VELOCITY_CONTROL force 0)",
     "control": "TORQUE_CONTROL re-sent before every stepSimulation",
+    "replay_joint_limits": "made inert for the replay (changeDynamics bounds ±1e30, jointLimitForce 0)",
     "integrator": "PyBullet btMultiBody semi-implicit Euler",
     "process": "child process (modelkit/verify/pybullet_worker.py)",
     "base_mass_properties": "getDynamicsInfo(-1) of a second, floating-base load (a fixed base reads 0)",
@@ -205,6 +206,22 @@ class PyBulletModel:
                                              pose_source=("getLinkState[0:2] with the inertial frame undone "
                                                           "(double)" if pose_path == "com-frame" else
                                                           "getLinkState[4:6] (float32)"))
+        # PyBullet's reduced-precision paths (verification.md §2.8, §6: 1e-6 where PyBullet is not
+        # double precision), raised for exactly the quantities that go through them:
+        # * a URDF inertia with products of inertia is diagonalised by the importer
+        #   (BulletURDFImporter: btMatrix3x3::diagonalize with threshold 1e-6, 30 iterations) and kept
+        #   as principal moments + a rotation: the tensor read back, and the mass matrix and bias
+        #   built from it, carry that approximation (GR001: 5.5e-8 inertia, 1.2e-9 mass matrix);
+        #   a link whose inertial frame stays the identity did not take that path;
+        # * getLinkState[4:6] is float32 (2.4e-8 m / 4.2e-7 rad measured), used for poses only with
+        #   pose_path="link-frame".
+        tolerances: dict[str, float] = {}
+        if any(not np.allclose(d["inertial_orn"], (0.0, 0.0, 0.0, 1.0), rtol=0.0, atol=1e-15) for d in dyn):
+            tolerances.update({"inertia": 1e-6, "mass-matrix": 1e-6, "bias": 1e-6})
+        if pose_path == "link-frame":
+            tolerances["pose"] = 1e-6
+        if tolerances:
+            self.settings["tolerances"] = tolerances
 
     # ---- EngineModel --------------------------------------------------------------------------
 
@@ -230,7 +247,23 @@ class PyBulletModel:
                 lower, upper = -math.inf, math.inf
             facts.joints[j["name"]] = JointFacts(
                 kind, self._links[j["parent"] + 1], j["child"], axis, lower, upper)
+        facts.shapes = self.shapes()
         return facts
+
+    def shapes(self) -> dict[str, list[ShapeFacts]]:
+        """Collision shapes per link from ``getCollisionShapeData``, moved from the link's inertial
+        frame (where PyBullet gives them) into the URDF link frame; sizes in the model's convention
+        (PyBullet's cylinder and capsule dimensions are (length, radius))."""
+        raw = self._worker.request("shapes", timeout=self.timeout)
+        out: dict[str, list[ShapeFacts]] = {}
+        for index, (name, shapes) in enumerate(zip(self._links, raw, strict=True)):
+            inertial = self._base_inertial if index == 0 else self._inertial[name]
+            found = out.setdefault(name, [])
+            for kind, dims, _file, pos, orn in shapes:
+                d = np.asarray(dims, dtype=float)
+                size = {"sphere": d[:1], "cylinder": d[[1, 0]], "capsule": d[[1, 0]]}.get(kind, d)
+                found.append(ShapeFacts(kind, size, inertial @ _pose(pos, orn)))
+        return out
 
     def _q_vector(self, q: dict[str, float]) -> list[float]:
         return [float(q.get(name, 0.0)) for name in self._dofs]

@@ -38,10 +38,28 @@ class JointFacts:
     upper: float = math.inf
 
 
+@dataclass(frozen=True)
+class ShapeFacts:
+    """One collision shape of a link, in the model's conventions.
+
+    ``type``: "box", "sphere", "cylinder", "capsule", "ellipsoid", "cone" (the source only: no
+    engine has one) or "mesh". ``size``: box (3,) full edge lengths; sphere (1,) radius; cylinder,
+    capsule, cone (2,) radius and length along the shape's local Z (a capsule's cylindrical part);
+    ellipsoid (3,) radii; mesh (3,) its scale (the vertices are not compared). ``pose``: the
+    shape's frame in the link frame (a mesh's frame is the one its file's vertices are given in).
+    """
+
+    type: str
+    size: Array
+    pose: Pose
+
+
 @dataclass
 class StaticFacts:
     links: dict[str, LinkFacts] = field(default_factory=dict)
     joints: dict[str, JointFacts] = field(default_factory=dict)
+    # Collision shapes per link (every link a key, [] for none); empty when the engine reports none.
+    shapes: dict[str, list[ShapeFacts]] = field(default_factory=dict)
 
 
 class EngineModel(Protocol):

@@ -21,8 +21,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from modelkit.convert.compare import random_configuration
-from modelkit.model import Robot
+from modelkit.model import WORLD_LINK, Robot
 from modelkit.spatial import Pose
+from modelkit.verify import shapes
 from modelkit.verify.facts import Array, Check, EngineModel, Skip, StaticFacts
 
 TOLERANCE = 1e-9
@@ -94,7 +95,10 @@ def layer1(source: StaticFacts, eng: Loaded) -> list[Check]:
     label = eng.label
     checks: list[Check] = []
 
-    missing = [name for name in source.links if eng.link(name) not in facts.links]
+    world = world_root(source)
+    # The source's root "world" link is the engine's world: MuJoCo's world body and PyBullet's fixed
+    # base report it (compared), Drake's world body and SDF's world frame are no link of the model.
+    missing = [name for name in source.links if eng.link(name) not in facts.links and name != world]
     written = {eng.link(name) for name in source.links}
     extra = sorted(name for name in facts.links if name not in written)
     detail = f"missing {missing}, extra {extra}" if missing or extra else f"{len(source.links)} links"
@@ -133,8 +137,8 @@ def layer1(source: StaticFacts, eng: Loaded) -> list[Check]:
     mass, com, inertia = Worst(), Worst(), Worst()
     for name, sl in source.links.items():
         el = facts.links.get(eng.link(name))
-        if el is None or sl.mass == 0.0:
-            continue  # massless links: see massless_skips
+        if el is None or sl.mass == 0.0 or name == world:
+            continue  # massless links: see massless_skips; the world welded: its mass takes part in nothing
         err = abs(sl.mass - el.mass) / abs(sl.mass)
         if mass.beats(err):
             mass.see(err, name, f"mass {sl.mass:.12g} kg read back as {el.mass:.12g} kg")
@@ -149,6 +153,7 @@ def layer1(source: StaticFacts, eng: Loaded) -> list[Check]:
     checks.append(mass.check(1, label, "mass", eng.tolerance("mass")))
     checks.append(com.check(1, label, "com", eng.tolerance("com")))
     checks.append(inertia.check(1, label, "inertia", eng.tolerance("inertia")))
+    checks.extend(shapes.compare(source, facts, eng))  # collision shapes (modelkit.verify.shapes)
     return checks
 
 
@@ -273,6 +278,13 @@ def massless_skips(source: StaticFacts, eng: Loaded) -> list[Skip]:
     shown = ", ".join(f"{n} {m:.3g} kg" for n, m in list(got.items())[:6]) + (" ..." if len(got) > 6 else "")
     return [Skip(1, eng.label, f"{len(got)} link(s) massless in the source (frames): mass, COM and inertia "
                                f"not compared; the engine has {shown} (MK816)")]
+
+
+def world_root(source: StaticFacts) -> str | None:
+    """The source's root link when it is the world itself (``world``, URDF's convention, and the MJCF
+    reader's synthesised link for top-level bodies that hang from the world by their joints)."""
+    children = {jf.child for jf in source.joints.values()}
+    return WORLD_LINK if WORLD_LINK in source.links and WORLD_LINK not in children else None
 
 
 def kinematic_only(robot: Robot) -> bool:

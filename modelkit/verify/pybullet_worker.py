@@ -89,6 +89,22 @@ class Engine:
         out[0]["fixed_inertial_pos"], out[0]["fixed_inertial_orn"] = tuple(fixed[3]), tuple(fixed[4])
         return out
 
+    def shapes(self) -> list[list[tuple[str, tuple[float, ...], str, tuple[float, ...], tuple[float, ...]]]]:
+        """``getCollisionShapeData`` of the base (-1) and every link: (type, dimensions, file name,
+        position, quaternion xyzw) per shape, raw. The frame is the link's inertial (COM) frame of
+        this (fixed-base) load; dimensions: box full extents, sphere (r, r, r), cylinder and capsule
+        (length, radius), mesh its scale. (The object and link ids PyBullet returns for the second
+        and later shapes of a compound are garbage; they are not used.)"""
+        p = self.p
+        kinds = {p.GEOM_SPHERE: "sphere", p.GEOM_BOX: "box", p.GEOM_CYLINDER: "cylinder",
+                 p.GEOM_MESH: "mesh", p.GEOM_PLANE: "plane", p.GEOM_CAPSULE: "capsule"}
+        out = []
+        for link in range(-1, self.n_joints):
+            data = p.getCollisionShapeData(self.body, link, physicsClientId=self.client)
+            out.append([(kinds.get(s[2], f"type-{s[2]}"), tuple(s[3]), s[4].decode(errors="replace"),
+                         tuple(s[5]), tuple(s[6])) for s in data])
+        return out
+
     def _set_q(self, q: list[float], dq: list[float] | None = None) -> None:
         p = self.p
         for i, j in enumerate(self.movable):
@@ -115,13 +131,27 @@ class Engine:
 
     def inverse_dynamics(self, q: list[float], dq: list[float], ddq: list[float]) -> list[float]:
         self._set_q(q, dq)
-        return list(self.p.calculateInverseDynamics(self.body, list(q), list(dq), list(ddq),
-                                                    physicsClientId=self.client))
+        tau = self.p.calculateInverseDynamics(self.body, list(q), list(dq), list(ddq),
+                                              physicsClientId=self.client)
+        if tau is None:  # PyBullet returns None, not (), for a body without degrees of freedom (measured)
+            if self.movable:
+                raise RuntimeError("calculateInverseDynamics returned None")
+            return []
+        return list(tau)
 
     def _reset(self, dt: float) -> None:
         n = len(self.movable)
         self._set_q([0.0] * n, [0.0] * n)
         self.p.setTimeStep(dt, physicsClientId=self.client)
+
+    def limits_off(self) -> None:
+        """Joint limits out of the replay (MuJoCo's side: ``mjDSBL_LIMIT``). PyBullet keeps a limit
+        constraint per limited joint whatever ``changeDynamics`` is given (lower > upper is ignored:
+        measured, the joint still stops at its URDF limit); bounds at ±1e30 and a zero limit force
+        make it inert (measured: the joint runs through its old limit)."""
+        for j in self.movable:
+            self.p.changeDynamics(self.body, j, jointLowerLimit=-1e30, jointUpperLimit=1e30,
+                                  jointLimitForce=0.0, physicsClientId=self.client)
 
     def replay(self, kp: list[float], kd: list[float], amplitude: list[float], frequency: list[float],
                phase: list[float], steps: int, dt: float) -> dict[str, Any]:
@@ -130,6 +160,7 @@ class Engine:
         Returns q after every step (row 0 = the start) as a flat float64 array."""
         p = self.p
         self._reset(dt)
+        self.limits_off()
         body, client, idx = self.body, self.client, list(self.movable)
         start = time.perf_counter()
         # The targets q*(t_k) first (the same arithmetic as TorqueLaw.torque), then the loop: read

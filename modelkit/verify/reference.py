@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from modelkit.model import JointType, Robot
+from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, JointType, Mesh, Robot, Sphere
 from modelkit.spatial import Pose
-from modelkit.verify.facts import Array, JointFacts, LinkFacts, StaticFacts
+from modelkit.verify.facts import Array, JointFacts, LinkFacts, ShapeFacts, StaticFacts
 
 Renames = dict[str, dict[str, str]]
 DOF_TYPES = (JointType.REVOLUTE, JointType.PRISMATIC)
@@ -48,7 +48,31 @@ def source_static(robot: Robot) -> StaticFacts:
             joint_type_name(joint.type), joint.parent, joint.child,
             unit(joint.axis) if moving else np.zeros(3),
             joint.limits.lower if moving else -math.inf, joint.limits.upper if moving else math.inf)
+    facts.shapes = {link.name: [s for s in map(shape_facts, link.collisions) if s is not None]
+                    for link in robot.links}
     return facts
+
+
+def shape_facts(geom: Geom) -> ShapeFacts | None:
+    """A source collision shape as the layers compare it. A mesh whose file is not there (and that
+    has no triangles) is of type "missing-mesh": the writers drop it (MK805) and the shape checks
+    leave it out, with a Skip that says so."""
+    g = geom.geometry
+    pose = Pose(np.asarray(geom.pose.rotation, dtype=float).copy(),
+                np.asarray(geom.pose.translation, dtype=float).copy())
+    if isinstance(g, Box):
+        return ShapeFacts("box", np.asarray(g.size, dtype=float), pose)
+    if isinstance(g, Sphere):
+        return ShapeFacts("sphere", np.array([g.radius], dtype=float), pose)
+    if isinstance(g, Cylinder | Capsule | Cone):
+        kind = {Cylinder: "cylinder", Capsule: "capsule", Cone: "cone"}[type(g)]
+        return ShapeFacts(kind, np.array([g.radius, g.length], dtype=float), pose)
+    if isinstance(g, Ellipsoid):
+        return ShapeFacts("ellipsoid", np.asarray(g.radii, dtype=float), pose)
+    if isinstance(g, Mesh):
+        missing = g.data is None and (g.path is None or not Path(g.path).is_file())
+        return ShapeFacts("missing-mesh" if missing else "mesh", np.asarray(g.scale, dtype=float), pose)
+    return None  # pragma: no cover - the model has no other geometry
 
 
 def dof_joints(robot: Robot) -> list[str]:

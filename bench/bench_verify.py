@@ -1,0 +1,195 @@
+"""`modelkit verify` speed: the whole command, its phases, each engine's load, the replay's overhead.
+
+    python bench/bench_verify.py [--repeat N] [--json FILE] [--source MODEL]
+
+(a) `modelkit verify MODEL` in a fresh process (N runs after a warm-up, taking turns) with every
+    engine (the default), with the default install's engines (MuJoCo, PyBullet, Pinocchio), and
+    both without the replay (`--no-replay`: layers 1-3a). Median/min/max wall time, and the
+    median of each phase as the command prints it ("wall time: convert …, load …, layer 1 …").
+    The issue's target: layers 1-3 of the tutorial pan-tilt robot under 3 s.
+(b) Each engine's share of "load": a fresh process per engine that imports the adapter and loads
+    the written file (N runs): import and load seconds, medians. "load" includes what an adapter
+    imports lazily (yourdfpy and trimesh) and PyBullet's child process (started, pybullet imported).
+(c) The replay's overhead (`modelkit.verify.replay.overhead`): simulated seconds per wall second
+    of each engine's replay against a bare stepping loop of the same engine on the same model
+    (target ≥ 0.8), and for PyBullet the minimal closed loop (read the states, send torques, step)
+    that any replay needs.
+Reports, never fails: exit 0 whatever the figures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parents[1]
+PANTILT = REPO / "samples" / "choreonoid_ros2_mobile_robot_tutorial" / "model" / "mobile_robot_pantilt.body"
+MODELKIT = Path(sys.executable).with_name("modelkit")
+DEFAULT_INSTALL = "mujoco,pybullet,pinocchio"
+FILES = {"mjcf": "x.xml", "urdf": "x.urdf", "sdf": "x.sdf"}  # the written file each input kind reads
+
+LOAD_ONE = """
+import json, sys, time
+from pathlib import Path
+engine, folder, root = sys.argv[1], Path(sys.argv[2]), sys.argv[3]
+t0 = time.perf_counter()
+import modelkit.verify.api as api
+t1 = time.perf_counter()
+load = api._resolve(api.ENGINES[engine])
+t2 = time.perf_counter()
+if api.INPUTS[engine] == "robot":
+    import modelkit
+    model_in = api.welded_copy(modelkit.load(folder / "source.body"))[0]
+else:
+    model_in = folder / {files}[api.INPUTS[engine]]
+t3 = time.perf_counter()
+model = load(model_in, {{"link": {{}}, "joint": {{}}}}, root=root)
+t4 = time.perf_counter()
+model.close()
+print(json.dumps({{"import": t2 - t1, "load": t4 - t3}}))
+"""
+
+
+def fresh(cmd: list[str]) -> tuple[float, str]:
+    start = time.perf_counter()
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    return time.perf_counter() - start, done.stdout
+
+
+def phases(stdout: str) -> dict[str, float]:
+    """The command's own split: 'wall time: convert 0.30 s, load 0.71 s, layer 1 0.01 s, ...'."""
+    line = next((ln for ln in stdout.splitlines() if ln.startswith("wall time:")), "")
+    return {name.strip(): float(value) for name, value in re.findall(r"([a-z0-9 ]+?) ([0-9.]+) s", line[10:])}
+
+
+def summary(values: list[float]) -> dict[str, float]:
+    return {"median_s": statistics.median(values), "min_s": min(values), "max_s": max(values)}
+
+
+def bench_command(source: Path, repeat: int) -> dict[str, Any]:
+    jobs = {
+        "every engine": [],
+        "every engine, --no-replay": ["--no-replay"],
+        f"{DEFAULT_INSTALL}": ["--engines", DEFAULT_INSTALL],
+        f"{DEFAULT_INSTALL}, --no-replay": ["--engines", DEFAULT_INSTALL, "--no-replay"],
+    }
+    walls: dict[str, list[float]] = {k: [] for k in jobs}
+    split: dict[str, list[dict[str, float]]] = {k: [] for k in jobs}
+    codes: dict[str, str] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        cmds = {name: [str(MODELKIT), "verify", str(source), "-o", str(Path(tmp) / f"r{i}"), *extra]
+                for i, (name, extra) in enumerate(jobs.items())}
+        for cmd in cmds.values():
+            fresh(cmd)  # warm-up
+        for _ in range(repeat):
+            for name, cmd in cmds.items():
+                wall, out = fresh(cmd)
+                walls[name].append(wall)
+                split[name].append(phases(out))
+                codes[name] = next((ln for ln in out.splitlines() if ln.startswith(("PASS", "FAIL"))), "?")
+    result: dict[str, Any] = {}
+    for name in jobs:
+        keys = sorted({k for s in split[name] for k in s}, key=lambda k: list(split[name][0]).index(k)
+                      if split[name] and k in split[name][0] else 99)
+        result[name] = {**summary(walls[name]), "verdict": codes[name],
+                        "phases_median_s": {k: statistics.median(s.get(k, 0.0) for s in split[name])
+                                            for k in keys}}
+    return result
+
+
+def bench_loads(source: Path, repeat: int) -> dict[str, Any]:
+    from modelkit import load
+    from modelkit.convert import write
+    from modelkit.verify.api import DEFAULT_ENGINES, welded_copy
+
+    robot, _ = welded_copy(load(source))
+    out: dict[str, Any] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        (folder / "source.body").write_bytes(source.read_bytes())
+        for name in ("x.xml", "x.urdf", "x.sdf"):
+            write(robot, folder / name, force=True)
+        script = LOAD_ONE.format(files=json.dumps(FILES))
+        for engine in DEFAULT_ENGINES:
+            samples: list[dict[str, float]] = []
+            for _ in range(repeat):
+                done = subprocess.run([sys.executable, "-c", script, engine, str(folder), str(robot.root)],
+                                      capture_output=True, text=True, check=False, cwd=source.parent)
+                if done.returncode != 0:
+                    out[engine] = {"error": done.stderr.strip().splitlines()[-1:]}
+                    break
+                samples.append(json.loads(done.stdout.strip().splitlines()[-1]))
+            if samples:
+                out[engine] = {k: statistics.median(s[k] for s in samples) for k in ("import", "load")}
+    return out
+
+
+def bench_replay(source: Path, repeat: int) -> dict[str, Any]:
+    from modelkit import load
+    from modelkit.convert import write
+    from modelkit.convert.notes import renames
+    from modelkit.verify.api import REPLAY_DT, REPLAY_SECONDS, welded_copy
+    from modelkit.verify.engine_mujoco import simulator as mujoco_simulator
+    from modelkit.verify.engine_pybullet import simulator as pybullet_simulator
+    from modelkit.verify.replay import default_law, overhead
+
+    robot, _ = welded_copy(load(source))
+    with tempfile.TemporaryDirectory() as tmp:
+        maps = {}
+        for name in ("x.xml", "x.urdf"):
+            notes = write(robot, Path(tmp) / name, force=True)
+            maps[name] = {"link": renames(notes, "link"), "joint": renames(notes, "joint")}
+        root = str(robot.root)
+        sims: list[Any] = [mujoco_simulator(Path(tmp) / "x.xml", maps["x.xml"], root=root, dt=REPLAY_DT),
+                pybullet_simulator(Path(tmp) / "x.urdf", maps["x.urdf"], root=root, dt=REPLAY_DT)]
+        try:
+            return overhead(sims, default_law(robot), REPLAY_SECONDS, REPLAY_DT, repeats=repeat)
+        finally:
+            for sim in sims:
+                sim.close()
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--json", type=Path, default=None)
+    parser.add_argument("--source", type=Path, default=PANTILT)
+    args = parser.parse_args()
+    source = args.source.resolve()
+    figures: dict[str, Any] = {"source": source.name, "repeat": args.repeat}
+    figures["command"] = bench_command(source, args.repeat)
+    print(f"(a) modelkit verify {source.name}, fresh process, {args.repeat} runs after a warm-up")
+    for name, row in figures["command"].items():
+        split = ", ".join(f"{k} {v:.2f}" for k, v in row["phases_median_s"].items())
+        print(f"  {name:38s} median {row['median_s']:.2f} s  (min {row['min_s']:.2f}, max {row['max_s']:.2f})"
+              f"  {row['verdict'][:40]}\n      phases (median s): {split}")
+    figures["loads"] = bench_loads(source, args.repeat)
+    print("(b) each engine in a fresh process: import and load of the written file (median s)")
+    for engine, row in figures["loads"].items():
+        print(f"  {engine:10s} " + ("error " + str(row["error"]) if "error" in row
+                                    else f"import {row['import']:.3f}  load {row['load']:.3f}"))
+    figures["replay"] = bench_replay(source, args.repeat)
+    print("(c) replay overhead: simulated s per wall s (best of runs), replay vs a bare stepping loop")
+    for engine, row in figures["replay"].items():
+        line = (f"  {engine:9s} replay {row['replay_call_rate']:.0f}x (loop {row['replay_loop_rate']:.0f}x), "
+                f"bare {row['bare_rate']:.0f}x: ratio {row['ratio_call']:.2f} (loop {row['ratio_loop']:.2f})")
+        if "minimal_closed_loop_rate" in row:
+            line += (f"; minimal closed loop {row['minimal_closed_loop_rate']:.0f}x = "
+                     f"{row['minimal_closed_loop_rate'] / row['bare_rate']:.2f} of bare "
+                     "(the best any closed-loop replay can do)")
+        print(line)
+    if args.json is not None:
+        args.json.write_text(json.dumps(figures, indent=2, sort_keys=True) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,133 @@
+"""Documented mass approximations: what a written file (or an engine reading it) gives a link that has
+no mass in the source, so that the layers compare with it instead of calling it a conversion fault,
+and the report lists it instead of passing silently.
+
+A massless link (a frame in the source) cannot always stay massless (MK816):
+
+* the SDF writer gives a massless link that carries geometry or moves an explicit tiny inertial
+  (``TINY_MASS`` kg, ``TINY_INERTIA`` kg·m² on each axis, COM at the link origin), because SDF
+  would give a link without ``<inertial>`` 1 kg; the note's target is ``link[NAME]/inertial``;
+* the MJCF writer gives a moving body whose weld group has no mass ``MIN_MASS`` kg and
+  ``MIN_INERTIA`` kg·m² on each axis (MuJoCo refuses a massless moving body); target
+  ``body[NAME]/inertial``;
+* the URDF writer writes massless links without ``<inertial>`` (URDF's own meaning: no mass), and
+  **PyBullet** reads such a link as 1 kg with a unit inertia at the link origin (its URDF parser's
+  default; the URDF note MK816 says so). Other URDF readers (yourdfpy, Drake) keep it massless.
+
+For each engine, :func:`for_engine` returns these links (source names) with the values the engine
+should hold; the caller compares the engine with the source model **with those values applied**
+(:func:`applied`): layer 1 checks the engine really holds the documented values (1e-9), layer 3a
+uses a Pinocchio reference built from the applied model, and the replay gives MuJoCo PyBullet's
+values. :func:`skip` is the report's entry naming every such link, the value and the note code.
+"""
+
+from __future__ import annotations
+
+import copy
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from lxml import etree
+
+from modelkit.convert.notes import ConversionNote
+from modelkit.model import Inertial, Robot
+from modelkit.verify.facts import Skip
+
+Renames = dict[str, dict[str, str]]
+
+# kg, kg·m² per axis: PyBullet's UrdfParser default for a link without <inertial>
+PYBULLET_NO_INERTIAL = (1.0, 1.0)
+
+
+@dataclass(frozen=True)
+class Approximated:
+    """A source-massless link given ``mass`` kg and ``inertia`` kg·m² on each axis at its origin."""
+
+    link: str  # source name
+    mass: float
+    inertia: float
+    code: str
+    by: str  # who approximates: "the SDF writer", "the MJCF writer", "PyBullet reading the URDF"
+
+
+def _source_names(renames: Renames) -> dict[str, str]:
+    return {written: source for source, written in renames.get("link", {}).items()}
+
+
+def from_notes(fmt: str, notes: Iterable[ConversionNote], renames: Renames) -> dict[str, Approximated]:
+    """The writer's own tiny-mass approximations (MK816) in the written ``fmt`` file."""
+    back = _source_names(renames)
+    out: dict[str, Approximated] = {}
+    for note in notes:
+        if note.code != "MK816" or not note.target:
+            continue
+        if fmt == "sdf":
+            from modelkit.formats.sdf.writer import TINY_INERTIA, TINY_MASS
+
+            match = re.fullmatch(r"link\[(.+)\]/inertial", note.target)
+            if match:
+                name = back.get(match[1], match[1])
+                out[name] = Approximated(name, TINY_MASS, TINY_INERTIA, note.code, "the SDF writer")
+        elif fmt == "mjcf":
+            from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, MIN_MASS
+
+            match = re.fullmatch(r"body\[(.+)\]/inertial", note.target)
+            if match and "moves but has no mass" in note.message:
+                name = back.get(match[1], match[1])
+                out[name] = Approximated(name, MIN_MASS, MIN_INERTIA, note.code, "the MJCF writer")
+    return out
+
+
+def pybullet_defaults(urdf: Path, source: Robot, renames: Renames) -> dict[str, Approximated]:
+    """Links of the written URDF without ``<inertial>`` that are massless in the source: PyBullet
+    reads each as 1 kg with a unit inertia (URDF itself says massless)."""
+    back = _source_names(renames)
+    massless = {link.name for link in source.links if link.inertial is None or link.inertial.mass == 0.0}
+    tree = etree.parse(str(urdf))
+    out: dict[str, Approximated] = {}
+    for el in tree.iterfind("./link"):
+        written = str(el.get("name"))
+        name = back.get(written, written)
+        if el.find("inertial") is None and name in massless:
+            out[name] = Approximated(name, *PYBULLET_NO_INERTIAL, "MK816", "PyBullet reading the URDF")
+    return out
+
+
+def for_engine(engine: str, fmt: str, notes: Iterable[ConversionNote], file: Path, source: Robot,
+               renames: Renames) -> dict[str, Approximated]:
+    """What ``engine`` (reading the written ``fmt`` file) holds instead of no mass, by source link."""
+    out = from_notes(fmt, notes, renames)
+    if engine == "pybullet" and fmt == "urdf":
+        out.update(pybullet_defaults(file, source, renames))
+    return out
+
+
+def applied(robot: Robot, approx: dict[str, Approximated]) -> Robot:
+    """A copy of ``robot`` whose approximated links hold the approximation's mass and inertia."""
+    if not approx:
+        return robot
+    out = copy.deepcopy(robot)
+    for link in out.links:
+        a = approx.get(link.name)
+        if a is not None:
+            link.inertial = Inertial(a.mass, np.zeros(3), a.inertia * np.eye(3))
+    return out
+
+
+def skip(engine: str, approx: dict[str, Approximated]) -> Skip | None:
+    """The report's entry for an engine's approximations (never a silent pass)."""
+    if not approx:
+        return None
+    groups: dict[tuple[str, str, float, float], list[str]] = {}
+    for a in approx.values():
+        groups.setdefault((a.by, a.code, a.mass, a.inertia), []).append(a.link)
+    parts = []
+    for (by, code, mass, inertia), links in sorted(groups.items()):
+        shown = ", ".join(links[:8]) + (f" and {len(links) - 8} more" if len(links) > 8 else "")
+        parts.append(f"{by} gives {len(links)} link(s) massless in the source {mass:g} kg and "
+                     f"{inertia:g} kg·m² per axis at the link origin ({code}): {shown}")
+    return Skip(1, engine, "approximation: " + "; ".join(parts) + ". Layers 1 and 3 compare this engine with "
+                "the source model with these values applied (layer 1 checks the engine holds them)")
