@@ -23,6 +23,7 @@ from modelkit.diagnostics import (
     render_text,
 )
 from modelkit.format_names import FORMAT_NAMES
+from modelkit.verify.api import DEFAULT_ENGINES  # light: engines are imported only when verify runs
 
 F = TypeVar("F", bound=Callable[..., Any])
 UNREADABLE_CODES = frozenset({"MK001", "MK002"})
@@ -411,7 +412,7 @@ def convert(
 @click.option("-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder for the written MJCF/URDF/SDF and report.json (default: a temporary folder, "
               "no report).")
-@click.option("--engines", default="mujoco,pybullet,pinocchio,drake,yourdfpy", show_default=True,
+@click.option("--engines", default=",".join(DEFAULT_ENGINES), show_default=True,
               help="Comma-separated engines to run; those not installed are skipped.")
 @click.option("--mjcf", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Verify this MJCF (a conversion already made) instead of writing one.")

@@ -419,3 +419,16 @@ def test_canonical_devices_and_unknown_device(tmp_path: Path) -> None:
     (lamp,) = [d for lk in back.robot.links for d in lk.devices if d.name == "lamp"]
     assert lamp.canonical_params["spot_outer_angle"] == 0.5
     assert lamp.canonical_params["spot_inner_angle"] == 0.2
+
+
+@pytest.mark.parametrize("version", ["1.6", "1.9", "1.11"])
+def test_initial_position_is_dropped_with_a_note(tmp_path: Path, version: str) -> None:
+    """SDFormat's <axis><initial_position> has no known implementation (deprecated in 1.8 and 1.9,
+    removed from 1.10; Drake's libsdformat refuses it): never written, an MK820 note says so."""
+    robot = arm()
+    robot.joints[0].initial_position = 0.25
+    notes = write(robot, tmp_path / "a.sdf", version)
+    assert etree.parse(str(tmp_path / "a.sdf")).find(".//initial_position") is None
+    (note,) = [n for n in notes if n.code == "MK820" and "initial position" in n.message]
+    assert 'joint "elbow"' in note.message and "0.25" in note.message
+    assert note.target == "joint[elbow_joint]/axis"

@@ -146,3 +146,41 @@ def test_validate_and_convert_do_not_import_engines() -> None:
             "print(sorted(m for m in ('mujoco', 'pinocchio', 'pybullet', 'pydrake') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def _emitted_quantities() -> set[str]:
+    """Every quantity a layer can emit: the third argument of each ``Check(...)`` and ``Worst.check(...)``
+    call in ``modelkit/verify`` (a literal, so that this list cannot miss one)."""
+    import ast
+
+    found: set[str] = set()
+    for path in sorted((REPO / "modelkit" / "verify").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not isinstance(node, ast.Call) or len(node.args) < 3:
+                continue
+            func = node.func
+            if (isinstance(func, ast.Name) and func.id == "Check") or (
+                    isinstance(func, ast.Attribute) and func.attr == "check"):
+                quantity = node.args[2]
+                if isinstance(quantity, ast.Name) and quantity.id == "quantity":
+                    continue  # a helper forwarding its caller's literal (layers.Worst.check)
+                assert isinstance(quantity, ast.Constant) and isinstance(quantity.value, str), (
+                    f"{path.name}:{node.lineno}: a check's quantity must be a literal")
+                found.add(quantity.value)
+    return found
+
+
+def test_every_emitted_quantity_is_in_the_schema() -> None:
+    enum = set(SCHEMA["$defs"]["check"]["properties"]["quantity"]["enum"])
+    emitted = _emitted_quantities()
+    assert {"load", "engine-error", "stability", "replay", "shape-pose", "limits"} <= emitted
+    assert emitted - enum == set()
+    assert enum - emitted == set()  # no stale entry either
+
+
+def test_cli_default_engines_are_the_api_default() -> None:
+    from modelkit.cli import verify as command
+
+    (option,) = [p for p in command.params if p.name == "engines"]
+    assert tuple(str(option.default).split(",")) == api.DEFAULT_ENGINES
+    assert "drake-urdf" in api.DEFAULT_ENGINES

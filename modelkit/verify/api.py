@@ -33,8 +33,12 @@ A module that can integrate the model (layer 3b, the replay) also exposes::
 
 whose ``replay(law, seconds, dt)`` maps ``law.joints`` (source names) through its own ``renames``
 and returns q with one column per ``law.joints`` entry, in that order (MuJoCo's is in
-``engine_mujoco.py``). Layer 3b itself is ``modelkit.verify.replay``, imported lazily like the
-engines (missing → Skip)::
+``engine_mujoco.py``). The replay tests inertial data: a simulator leaves the joints' passive terms
+out (PyBullet zeroes all damping; MuJoCo zeroes damping, friction loss and stiffness and lists them in
+``left_out``, said in a Skip). An engine that collects warnings while running (MuJoCo's
+``runtime_warnings``, never ``MUJOCO_LOG.TXT``) has them in its settings in the report; those saying
+the simulation went unstable are a failed ``stability`` check. Layer 3b itself is
+``modelkit.verify.replay``, imported lazily like the engines (missing → Skip)::
 
     def default_law(source: Robot) -> TorqueLaw
     def layer3b(source: Robot, sims: list[Simulator], law: TorqueLaw, seconds: float, dt: float
@@ -294,6 +298,12 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
         # compared with the source with that approximation applied; the report lists it.
         eng_static = (source_static(approximations.applied(reference, approx[eng.label]))
                       if approx[eng.label] else src_static)
+        # ... and so is one holding the URDF writer's ±1e16 for an infinite position bound (MK819).
+        stand_ins = approximations.limits_for_engine(INPUTS.get(eng.label, "robot"), reference)
+        eng_static = approximations.applied_limits(eng_static, stand_ins)
+        limits_entry = approximations.limits_skip(eng.label, stand_ins)
+        if limits_entry is not None:
+            report.skips.append(limits_entry)
         report.checks.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: layers.layer1(st, eng)))
         report.skips.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: layers.massless_skips(st, eng),
                                      report.checks))
@@ -340,6 +350,8 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
         _replay(reference, files, maps, loaded, report, approx)
     t6 = time.perf_counter()
     for eng in loaded:
+        messages = list(getattr(eng.model, "runtime_warnings", []))
+        report.checks.extend(engine_warnings(report, eng.label, messages, "runtime_warnings", "layers 1-3a"))
         eng.model.close()
     report.timings.update({"layer 1": t3 - t2, "layer 2": t4 - t3, "layer 3a": t5 - t4, "layer 3b": t6 - t5})
     return report
@@ -379,6 +391,23 @@ def _approximations(reference: Robot, loaded: list[Any], files: dict[str, Path],
         entry = approximations.skip(eng.label, out[eng.label])
         if entry is not None:
             report.skips.append(entry)
+    return out
+
+
+def _left_out(sims: list[Any], maps: dict[str, Renames]) -> list[str]:
+    """What the MuJoCo simulator zeroed for the replay (damping, friction loss, stiffness; armature is
+    said by its own entry), per quantity, with the joints by source name and their values."""
+    back = {w: src for src, w in maps.get("mjcf", {}).get("joint", {}).items()}
+    out = []
+    for sim in sims:
+        for quantity, joints in sorted(getattr(sim, "left_out", {}).items()):
+            if quantity == "armature":
+                continue
+            names = sorted(back.get(j, j) for j in joints)
+            values = {back.get(j, j): v for j, v in joints.items()}
+            shown = ", ".join(f"{n} {values[n]:g}" for n in names[:8]) + (
+                f" and {len(names) - 8} more" if len(names) > 8 else "")
+            out.append(f"joint {quantity} of {len(names)} joint(s) ({shown})")
     return out
 
 
@@ -456,6 +485,12 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
             f"massless in the source ({', '.join(sorted(inertials)[:8])}) hold PyBullet's values in both "
             "engines "
             "(MK816, see the layer 1 approximation entry)")))
+    left_out = _left_out(sims, maps)
+    if left_out:
+        report.skips.append(Skip(3, "mujoco+pybullet", (
+            "replay without the joints' passive terms (it tests inertial data; PyBullet's worker zeroes "
+            "all damping, its 0.04 default and the URDF's <dynamics damping>): MuJoCo's "
+            + "; ".join(left_out) + " zeroed on the compiled model")))
     if with_armature:
         report.skips.append(Skip(3, "mujoco+pybullet", (
             f"replay without the joint armature (rotor inertia) of {', '.join(with_armature)}: the URDF "
@@ -468,3 +503,26 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
             sim.close()
     report.checks.extend(checks)
     report.skips.extend(skips)
+    for sim in sims:
+        messages = list(getattr(sim, "runtime_warnings", []))
+        report.checks.extend(engine_warnings(report, sim.engine, messages, "replay_warnings",
+                                             "the replay (layer 3b)"))
+
+
+def engine_warnings(report: VerifyReport, label: str, messages: list[str], key: str, during: str
+                    ) -> list[Check]:
+    """An engine's collected warnings (MuJoCo's, never written to ``MUJOCO_LOG.TXT``) go into its
+    settings in the report under ``key``; those saying the simulation went unstable are a failed
+    ``stability`` check (the numbers of that run are not to be trusted)."""
+    if not messages:
+        return []
+    from modelkit.verify.engine_mujoco import unstable
+
+    unique = list(dict.fromkeys(messages))
+    report.engines.setdefault(label, {})[key] = unique
+    bad = unstable(unique)
+    if not bad:
+        return []
+    layer = 3 if key == "replay_warnings" else 1
+    return [Check(layer, label, "stability", "", float(len(bad)), 0.0,
+                  f"{label} warned during {during} that the simulation is unstable: " + "; ".join(bad[:3]))]

@@ -19,11 +19,22 @@ should hold; the caller compares the engine with the source model **with those v
 (:func:`applied`): layer 1 checks the engine really holds the documented values (1e-9), layer 3a
 uses a Pinocchio reference built from the applied model, and the replay gives MuJoCo PyBullet's
 values. :func:`skip` is the report's entry naming every such link, the value and the note code.
+
+Joint limits (MK819): URDF has no unlimited prismatic joint (and no revolute joint limited on one side
+only); the URDF writer writes the open bound as ±``SYNTHESISED_POSITION`` = ±1e16, the value
+libsdformat writes for an unlimited axis. Every engine reading the URDF (PyBullet, yourdfpy,
+``drake-urdf``) must then hold exactly ±1e16 where the source is infinite: :func:`urdf_limits` lists
+those joints and bounds, :func:`applied_limits` puts them into the source's static facts for layer 1
+(which checks the engine holds them at 1e-9), and :func:`limits_skip` is the report's entry. (The SDF
+writer writes ±1e16 too, SDFormat's own "no limit" default before 1.10; the Drake adapter reads a bound
+of magnitude ≥ 1e16 in an SDF file as infinite, so the SDF side needs no approximation.)
 """
 
 from __future__ import annotations
 
 import copy
+import dataclasses
+import math
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -33,8 +44,8 @@ import numpy as np
 from lxml import etree
 
 from modelkit.convert.notes import ConversionNote
-from modelkit.model import Inertial, Robot
-from modelkit.verify.facts import Skip
+from modelkit.model import Inertial, JointType, Robot
+from modelkit.verify.facts import Skip, StaticFacts
 
 Renames = dict[str, dict[str, str]]
 
@@ -131,3 +142,61 @@ def skip(engine: str, approx: dict[str, Approximated]) -> Skip | None:
                      f"{inertia:g} kg·m² per axis at the link origin ({code}): {shown}")
     return Skip(1, engine, "approximation: " + "; ".join(parts) + ". Layers 1 and 3 compare this engine with "
                 "the source model with these values applied (layer 1 checks the engine holds them)")
+
+
+@dataclass(frozen=True)
+class LimitStandIn:
+    """A source joint with an infinite position bound, written with a finite stand-in."""
+
+    joint: str  # source name
+    lower: float  # what the file (and the engine reading it) holds
+    upper: float
+    code: str
+    by: str
+
+
+def urdf_limits(source: Robot) -> dict[str, LimitStandIn]:
+    """The URDF writer's MK819 position bounds: a prismatic joint, or a revolute joint limited on one
+    side only (both sides open is ``continuous``), gets ±1e16 for each infinite bound."""
+    from modelkit.formats.urdf.write_joints import SYNTHESISED_POSITION
+
+    out: dict[str, LimitStandIn] = {}
+    for joint in source.joints:
+        lo, hi = joint.limits.lower, joint.limits.upper
+        if joint.type is JointType.PRISMATIC or (joint.type is JointType.REVOLUTE
+                                                  and (math.isfinite(lo) or math.isfinite(hi))):
+            if math.isfinite(lo) and math.isfinite(hi):
+                continue
+            out[joint.name] = LimitStandIn(joint.name, lo if math.isfinite(lo) else -SYNTHESISED_POSITION,
+                                           hi if math.isfinite(hi) else SYNTHESISED_POSITION, "MK819",
+                                           "the URDF writer")
+    return out
+
+
+def limits_for_engine(fmt: str, source: Robot) -> dict[str, LimitStandIn]:
+    """The finite stand-ins an engine reading the written ``fmt`` file holds, by source joint."""
+    return urdf_limits(source) if fmt == "urdf" else {}
+
+
+def applied_limits(facts: StaticFacts, stand_ins: dict[str, LimitStandIn]) -> StaticFacts:
+    """A copy of the source's static facts whose joints hold the stand-in bounds."""
+    if not stand_ins:
+        return facts
+    joints = dict(facts.joints)
+    for name, s in stand_ins.items():
+        if name in joints:
+            joints[name] = dataclasses.replace(joints[name], lower=s.lower, upper=s.upper)
+    return StaticFacts(facts.links, joints, facts.shapes)
+
+
+def limits_skip(engine: str, stand_ins: dict[str, LimitStandIn]) -> Skip | None:
+    """The report's entry for an engine's limit stand-ins (never a silent pass)."""
+    if not stand_ins:
+        return None
+    names = sorted(stand_ins)
+    shown = ", ".join(f"{n} [{stand_ins[n].lower:g}, {stand_ins[n].upper:g}]" for n in names[:8]) + (
+        f" and {len(names) - 8} more" if len(names) > 8 else "")
+    first = stand_ins[names[0]]
+    return Skip(1, engine, f"approximation: {first.by} writes the infinite position bounds of {len(names)} "
+                f"joint(s) as ±1e16 ({first.code}: URDF has no unlimited prismatic joint): {shown}. Layer 1 "
+                "checks this engine holds exactly these bounds")

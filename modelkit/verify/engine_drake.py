@@ -8,7 +8,10 @@ no geometry), gravity (0, 0, −9.81). The root is welded to the world at the id
 file itself declares between the world and the root (SDF ``<joint>`` to ``world``, URDF ``world``
 link) is removed with ``RemoveJoint`` and replaced by ``WeldFrames(world, root, identity)``, which
 is also what a free root gets; then the plant is finalized. The base weld is not reported as a
-joint (the source's root joint is not a tree joint either).
+joint (the source's root joint is not a tree joint either). A root named ``world`` (the MJCF
+reader's synthesised link that top-level bodies hang from by their joints, or a URDF ``world``
+link) is Drake's world body itself: nothing is welded, the file's joints to it are the model's
+joints, and it is not reported as a link (as an SDF world frame is no link of the model).
 
 Facts, in the file's names (Drake scopes names by model instance; one model is loaded, so the
 unscoped ``body.name()`` / ``joint.name()`` are the written names):
@@ -18,8 +21,10 @@ unscoped ``body.name()`` / ``joint.name()`` are the written names):
 * joint type (``type_name``: ``weld`` → ``fixed``, ``ball_rpy`` → ``ball``, …), axis in the child
   link frame (``revolute_axis()`` / ``translation_axis()`` is expressed in the joint's frames F and
   M, which coincide at q = 0; rotated by M's fixed pose in the child body), position limits.
-  SDFormat writes an unlimited joint as ±1e16 (its documented "no limit" default) and Drake keeps
-  the number: a bound of magnitude ≥ 1e16 is reported as ±inf, as URDF ``continuous`` is;
+  SDFormat writes an unlimited joint as ±1e16 (its documented "no limit" default before 1.10) and
+  Drake keeps the number: in an SDF file a bound of magnitude ≥ 1e16 is reported as ±inf, as URDF
+  ``continuous`` is. A URDF's bounds are reported as parsed: its ±1e16 is the URDF writer's stand-in
+  for an unlimited prismatic joint (MK819), which layer 1 compares as a documented approximation;
 * an SDF ``<frame attached_to>`` (how the SDF writer keeps a massless leaf link) is a frame in
   Drake, not a body: it is reported as a massless link with its pose, and a fixed joint
   ``fixed:NAME`` to what it is attached to (the fixed joint the link hung from);
@@ -68,6 +73,7 @@ from modelkit.verify.facts import Array, JointFacts, LinkFacts, StaticFacts
 Renames = dict[str, dict[str, str]]
 GRAVITY = (0.0, 0.0, -9.81)
 SDF_UNLIMITED = 1e16  # SDFormat's default joint limit, meaning "no limit"
+WORLD = "world"  # Drake's world body's name (a URDF link or SDF frame of that name is the world)
 _TYPES = {
     "revolute": "revolute",
     "prismatic": "prismatic",
@@ -146,25 +152,34 @@ class DrakeModel:
     def __init__(self, path: Path, root: str, engine: str) -> None:
         self.engine = engine
         self.path = path
+        self._sdf = path.suffix.lower() == ".sdf"
         self.root = root
         plant = MultibodyPlant(time_step=0.0)
         instances, self.warnings = _parse(plant, path)
         if len(instances) != 1:
             raise DrakeLoadError(f"{path.name}: expected one model, Drake found {len(instances)}")
         self._instance: ModelInstanceIndex = instances[0]
-        if not plant.HasBodyNamed(root, self._instance):
-            names = sorted(plant.get_body(i).name() for i in plant.GetBodyIndices(self._instance))
-            raise DrakeLoadError(f"{path.name}: no link named {root!r} (links: {', '.join(names)})")
-        root_body = plant.GetBodyByName(root, self._instance)
         world = plant.world_body()
+        # A root named "world" (URDF's convention, and the MJCF reader's synthesised link whose
+        # top-level bodies hang from it by their joints) is Drake's own world body: Drake parses a
+        # URDF link "world" and an SDF joint's parent "world" as the world, so there is no body of
+        # that name in the model instance and nothing to weld; the file's joints to it are the model's.
+        self._world_root = root == WORLD and not plant.HasBodyNamed(root, self._instance)
         removed: list[str] = []
-        for index in list(plant.GetJointIndices()):
-            joint = plant.get_joint(index)
-            ends = {joint.parent_body().index(), joint.child_body().index()}
-            if ends == {world.index(), root_body.index()}:
-                removed.append(f"{joint.name()} ({joint.type_name()})")
-                plant.RemoveJoint(joint)
-        plant.WeldFrames(world.body_frame(), root_body.body_frame(), RigidTransform())
+        if self._world_root:
+            root_body = world
+        else:
+            if not plant.HasBodyNamed(root, self._instance):
+                names = sorted(plant.get_body(i).name() for i in plant.GetBodyIndices(self._instance))
+                raise DrakeLoadError(f"{path.name}: no link named {root!r} (links: {', '.join(names)})")
+            root_body = plant.GetBodyByName(root, self._instance)
+            for index in list(plant.GetJointIndices()):
+                joint = plant.get_joint(index)
+                ends = {joint.parent_body().index(), joint.child_body().index()}
+                if ends == {world.index(), root_body.index()}:
+                    removed.append(f"{joint.name()} ({joint.type_name()})")
+                    plant.RemoveJoint(joint)
+            plant.WeldFrames(world.body_frame(), root_body.body_frame(), RigidTransform())
         plant.mutable_gravity_field().set_gravity_vector(_vec(GRAVITY))
         plant.Finalize()
         self.plant = plant
@@ -193,12 +208,14 @@ class DrakeModel:
             "version": _version(),
             "file": path.name,
             "plant": "MultibodyPlant(time_step=0) (continuous), no SceneGraph",
-            "base": (
-                f"file's world joint removed ({', '.join(removed)}), " if removed else "free root, "
-            ) + f"WeldFrames(world, {root}, identity)",
+            "base": ("the root is Drake's world body (the file's joints to 'world' are the model's)"
+                     if self._world_root else (
+                         f"file's world joint removed ({', '.join(removed)}), " if removed else "free root, "
+                     ) + f"WeldFrames(world, {root}, identity)"),
             "gravity": list(GRAVITY),
             "inertia": "default_spatial_inertia shifted to the COM",
-            "limits": f"|bound| >= {SDF_UNLIMITED:g} reported as inf (SDFormat's 'no limit')",
+            "limits": (f"|bound| >= {SDF_UNLIMITED:g} reported as inf (SDFormat's 'no limit')" if self._sdf
+                       else "as parsed (a URDF's ±1e16 is the URDF writer's stand-in for no limit, MK819)"),
             "poses": "EvalBodyPoseInWorld, relative to the root",
             "mass_matrix": "CalcMassMatrix",
             "bias": "CalcBiasTerm - CalcGravityGeneralizedForces (MuJoCo qfrc_bias convention)",
@@ -208,6 +225,8 @@ class DrakeModel:
         }
 
     def _is_base_weld(self, index: JointIndex) -> bool:
+        if self._world_root:
+            return False
         joint = self.plant.get_joint(index)
         return (
             joint.parent_body().index() == self.plant.world_body().index()
@@ -242,8 +261,10 @@ class DrakeModel:
             local = joint.revolute_axis() if isinstance(joint, RevoluteJoint) else joint.translation_axis()
             r_child_m = joint.frame_on_child().GetFixedPoseInBodyFrame().rotation().matrix()
             axis = np.array(r_child_m, dtype=float) @ np.array(local, dtype=float)
-            lower = _limit(float(joint.position_lower_limits()[0]))
-            upper = _limit(float(joint.position_upper_limits()[0]))
+            lower = float(joint.position_lower_limits()[0])
+            upper = float(joint.position_upper_limits()[0])
+            if self._sdf:  # SDFormat's "no limit" (a URDF's ±1e16 is the URDF writer's MK819 stand-in)
+                lower, upper = _limit(lower), _limit(upper)
         return JointFacts(jtype, parent, child, axis, lower, upper)
 
     def _set(self, q: dict[str, float], dq: dict[str, float] | None = None) -> None:

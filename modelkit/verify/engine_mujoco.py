@@ -3,13 +3,21 @@
 Static facts: ``body_mass``, ``body_ipos``, ``body_inertia`` rotated by ``body_iquat``, ``jnt_axis``,
 ``jnt_range``. Poses: ``mj_kinematics``. Dynamics: ``mj_fullM`` of ``qM`` and ``qfrc_bias`` after
 ``mj_forward`` (gravity + Coriolis/centrifugal). The replay (layer 3b) steps with
-``integrator="Euler"`` at the caller's dt, contacts off, torques through ``qfrc_applied``; nothing is
-added to the model (no damping, armature or friction beyond what the file has).
+``integrator="Euler"`` at the caller's dt, contacts, joint limits and equality constraints off, the
+PD law as actuators; nothing is added to the model, and the joints' passive terms (damping, friction
+loss, stiffness; armature when the other engine's URDF cannot hold it) are zeroed on the compiled
+model, as the PyBullet worker zeroes all damping (``MujocoSimulator.left_out`` says what was there).
+
+Every MuJoCo call runs inside :func:`quiet`: MuJoCo's warnings are collected in ``runtime_warnings`` (the
+caller reports them; "unstable" ones fail) instead of going to ``MUJOCO_LOG.TXT`` in the working
+directory.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -17,12 +25,31 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from modelkit.formats.mjcf.quiet import collected_warnings
 from modelkit.model import Robot
 from modelkit.spatial import Pose, axis_angle, matrix_from_quat_wxyz
 from modelkit.verify.facts import Array, JointFacts, LinkFacts, ShapeFacts, StaticFacts, TorqueLaw
 
 Renames = dict[str, dict[str, str]]
 GRAVITY = (0.0, 0.0, -9.81)
+# MuJoCo's words when mj_checkPos/Vel/Acc find the state blown up (it then resets the data).
+UNSTABLE = ("unstable", "Nan, Inf or huge value")
+
+
+def unstable(messages: list[str]) -> list[str]:
+    """The warnings among ``messages`` that say the simulation went unstable."""
+    return [m for m in messages if any(word in m for word in UNSTABLE)]
+
+
+@contextlib.contextmanager
+def quiet(into: list[str]) -> Iterator[None]:
+    """MuJoCo's warnings go into ``into`` (never MuJoCo's default handler, which writes
+    ``MUJOCO_LOG.TXT`` into the working directory): every MuJoCo call here runs inside this."""
+    with collected_warnings(mujoco) as messages:
+        try:
+            yield
+        finally:
+            into.extend(messages)
 _TYPES = {
     int(mujoco.mjtJoint.mjJNT_HINGE): "revolute",
     int(mujoco.mjtJoint.mjJNT_SLIDE): "prismatic",
@@ -42,6 +69,7 @@ _GEOMS = {
 
 
 _ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
+_DOF_WIDTH = {int(mujoco.mjtJoint.mjJNT_FREE): 6, int(mujoco.mjtJoint.mjJNT_BALL): 3}
 
 
 def _split_chains(path: Path, links: set[str]) -> str:
@@ -141,8 +169,10 @@ class MujocoModel:
     engine = "mujoco"
 
     def __init__(self, path: Path, root: str, actuated: bool = False, split: set[str] | None = None) -> None:
-        self.model, deleted = _compile(path, root, actuated, split)
-        self.data = mujoco.MjData(self.model)
+        self.runtime_warnings: list[str] = []  # MuJoCo's warnings, collected (see ``quiet``)
+        with quiet(self.runtime_warnings):
+            self.model, deleted = _compile(path, root, actuated, split)
+            self.data = mujoco.MjData(self.model)
         self.root = root
         m = self.model
         self._root_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, root)
@@ -299,7 +329,8 @@ class MujocoModel:
         ``xmat``) moved to the last joint's anchor; the chain's earlier links follow backwards:
         link_k = link_(k+1) · motion(j_(k+1))⁻¹ · translation(anchor_k − anchor_(k+1))."""
         self._set(q)
-        mujoco.mj_kinematics(self.model, self.data)
+        with quiet(self.runtime_warnings):
+            mujoco.mj_kinematics(self.model, self.data)
         m, d = self.model, self.data
         world: dict[str, Pose] = {"world": Pose()} if self._world_is_root else {}
         for body in self._bodies:
@@ -316,18 +347,20 @@ class MujocoModel:
 
     def mass_matrix(self, q: dict[str, float]) -> Array:
         self._set(q)
-        mujoco.mj_forward(self.model, self.data)
         full = np.zeros((self.model.nv, self.model.nv))
-        if hasattr(self.data, "qM"):  # MuJoCo < 4: mj_fullM(m, dst, qM)
-            mujoco.mj_fullM(self.model, full, self.data.qM)
-        else:  # MuJoCo ≥ 4: mj_fullM(m, d, dst)
-            mujoco.mj_fullM(self.model, self.data, full)
+        with quiet(self.runtime_warnings):
+            mujoco.mj_forward(self.model, self.data)
+            if hasattr(self.data, "qM"):  # MuJoCo < 4: mj_fullM(m, dst, qM)
+                mujoco.mj_fullM(self.model, full, self.data.qM)
+            else:  # MuJoCo ≥ 4: mj_fullM(m, d, dst)
+                mujoco.mj_fullM(self.model, self.data, full)
         idx = np.asarray(self._vadr, dtype=int)
         return full[np.ix_(idx, idx)]
 
     def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
         self._set(q, dq)
-        mujoco.mj_forward(self.model, self.data)
+        with quiet(self.runtime_warnings):
+            mujoco.mj_forward(self.model, self.data)
         return np.array(self.data.qfrc_bias[np.asarray(self._vadr, dtype=int)], dtype=float)
 
     def close(self) -> None:
@@ -350,15 +383,19 @@ class MujocoSimulator:
         # Another engine's documented approximation: a mass on links that are no MuJoCo body of their
         # own (the intermediates of a multi-joint body) needs the body split (same kinematics).
         self.inner = MujocoModel(path, root, actuated=True, split={n for n in inertials or {} if "__" in n})
+        self.runtime_warnings = self.inner.runtime_warnings  # compiling and stepping (see ``quiet``)
         m = self.inner.model
+        offsets = {body.index: body.offset for body in self.inner._bodies}
         for body, (mass, moment) in (inertials or {}).items():
             b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, body)
             if b == 0 or body == root:
                 continue  # the world, or the welded root: its mass takes part in no dynamics
             if b < 0:
                 raise ValueError(f"{path.name}: no body named {body!r}")
+            # At the link origin (where the other engine puts it): the body's last joint's anchor, which
+            # is not the body frame when the joint has a pos (humanoid's abdomen joints: 0 0 .065).
             m.body_mass[b], m.body_inertia[b] = mass, (moment, moment, moment)
-            m.body_ipos[b], m.body_iquat[b] = (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)
+            m.body_ipos[b], m.body_iquat[b] = offsets[b], (1.0, 0.0, 0.0, 0.0)
         m.opt.timestep = dt
         m.opt.integrator = int(mujoco.mjtIntegrator.mjINT_EULER)
         m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
@@ -369,18 +406,46 @@ class MujocoSimulator:
         # <mimic> and a URDF holds no loop, so both integrate the open tree (the caller says so).
         m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_EQUALITY)
         self.equalities = int(m.neq)
-        if not armature:  # the other engine reads a URDF, which cannot hold armature (MK820)
-            m.dof_armature[:] = 0.0
+        # The replay tests inertial data (mass matrix, bias, integrator): the joints' passive terms
+        # are left out, as the PyBullet worker zeroes all damping (its 0.04 default and the URDF's
+        # <dynamics damping>). MuJoCo's joint damping, friction loss and stiffness are zeroed on the
+        # compiled model, and armature too unless the caller keeps it; ``left_out`` says what was there.
+        self.left_out = self._zero_passive(keep_armature=armature)
         self.renames = renames
         self.settings = {**self.inner.settings, "integrator": "Euler", "timestep": dt, "contacts": "disabled",
                          "joint_limits": "disabled (mjDSBL_LIMIT)",
                          "equality_constraints": f"disabled (mjDSBL_EQUALITY), {int(m.neq)} in the model",
                          "armature": ("as in the file" if armature
                                       else "zeroed (the URDF cannot hold it, MK820)"),
+                         "passive_joint_terms": ("dof_damping, dof_frictionloss and jnt_stiffness zeroed"
+                                                 + ("" if armature else ", dof_armature zeroed")),
+                         "left_out": {k: dict(sorted(v.items())) for k, v in sorted(self.left_out.items())},
                          "inertials_replaced": {k: list(v) for k, v in sorted((inertials or {}).items())},
                          "torques": ("the PD law as affine actuators (gain kp, bias 0, -kp, -kd; the file's "
                                      "actuators removed, joint actuatorfrcrange off), targets as controls, "
                                      "stepped by mujoco.rollout")}
+
+    def _zero_passive(self, keep_armature: bool) -> dict[str, dict[str, float]]:
+        """Zero the joints' damping, friction loss, stiffness (and armature unless kept) on the compiled
+        model; returns, per quantity, the joints (written names) that had a non-zero value."""
+        m = self.inner.model
+        fields = {"damping": m.dof_damping, "frictionloss": m.dof_frictionloss}
+        if not keep_armature:
+            fields["armature"] = m.dof_armature
+        left_out: dict[str, dict[str, float]] = {}
+        for j in range(m.njnt):
+            name = self.inner._jname(j)
+            adr, width = int(m.jnt_dofadr[j]), _DOF_WIDTH.get(int(m.jnt_type[j]), 1)
+            for quantity, values in fields.items():
+                value = float(np.max(np.abs(values[adr:adr + width])))
+                if value:
+                    left_out.setdefault(quantity, {})[name] = value
+            if m.jnt_stiffness[j]:
+                left_out.setdefault("stiffness", {})[name] = float(m.jnt_stiffness[j])
+        for values in fields.values():
+            values[:] = 0.0
+        m.jnt_stiffness[:] = 0.0
+        return left_out
 
     def dof_names(self) -> list[str]:
         return self.inner.dof_names()
@@ -417,11 +482,12 @@ class MujocoSimulator:
         control = np.zeros((steps, m.nu))
         control[:, columns] = np.asarray(law.amplitude) * np.sin(
             2.0 * math.pi * np.asarray(law.frequency) * t + np.asarray(law.phase))
-        mujoco.mj_resetData(m, d)
-        full = int(mujoco.mjtState.mjSTATE_FULLPHYSICS)
-        start = np.empty(mujoco.mj_stateSize(m, full))
-        mujoco.mj_getState(m, d, start, full)
-        state, _ = rollout.rollout(m, d, start, control)
+        with quiet(self.runtime_warnings):
+            mujoco.mj_resetData(m, d)
+            full = int(mujoco.mjtState.mjSTATE_FULLPHYSICS)
+            start = np.empty(mujoco.mj_stateSize(m, full))
+            mujoco.mj_getState(m, d, start, full)
+            state, _ = rollout.rollout(m, d, start, control)
         offset = mujoco.mj_stateSize(m, int(mujoco.mjtState.mjSTATE_TIME))  # the state: time, qpos, ...
         out = np.empty((steps + 1, len(names)))
         out[0] = d.qpos[qadr] if steps == 0 else start[offset + qadr]

@@ -408,14 +408,17 @@ class _ModelWriter:
         lim = joint.limits
         limited = joint.type is JointType.PRISMATIC or lim.position_limited
         finite_rates = math.isfinite(lim.effort) or math.isfinite(lim.velocity)
-        if joint.initial_position and self.version >= (1, 9):
-            num(axis, "initial_position", joint.initial_position)
-        elif joint.initial_position:
+        if joint.initial_position:
+            # SDFormat's axis/initial_position "has no known implementation" (the spec's words): it is
+            # deprecated in 1.8 and 1.9 and removed from 1.10 on, and libsdformat 13+ (Drake's) refuses
+            # it in a 1.9 file (it converts to its newest version). No consumer reads it: dropped.
             self.ctx.note(
                 "MK820",
-                f'joint "{joint.name}": initial position {fmt(joint.initial_position)} needs SDFormat 1.9',
+                f'joint "{joint.name}": initial position {fmt(joint.initial_position)} (the joint\'s '
+                "reference position) is left out: SDFormat's <axis><initial_position> is deprecated "
+                "(1.8, 1.9), removed from 1.10 on and read by no consumer",
                 joint.source,
-                f"joint[{name}]",
+                f"joint[{name}]/axis",
             )
         if limited or finite_rates or self._continuous_as_revolute(joint):
             limit = sub(axis, "limit")
