@@ -55,6 +55,7 @@ from pathlib import Path
 
 import numpy as np
 
+from modelkit.convert.names import unique_name
 from modelkit.convert.notes import NoteSink
 from modelkit.model import (
     SYNTHESISED,
@@ -250,15 +251,6 @@ def split_mass(track: Inertial, roller_centres: list[Vec3], roller_inertia: Mat3
 # ---- the pass ----------------------------------------------------------------------------------
 
 
-def _free_name(wanted: str, taken: set[str]) -> str:
-    name, k = wanted, 1
-    while name in taken:
-        name = f"{wanted}_{k}"
-        k += 1
-    taken.add(name)
-    return name
-
-
 def roller_count(shape: TrackShape) -> int:
     """As many rollers as fit end to end without touching (at least 2); see the module docstring."""
     r = shape.radius
@@ -321,8 +313,8 @@ def _approximate(robot: Robot, joint: Joint, link: Link, notes: NoteSink) -> Non
     joint_index = robot.joints.index(joint) + 1
     geom_source = collision_sources[0] if collision_sources else link.source
     for i, centre in enumerate(centres):
-        name = _free_name(f"{link.name}_roller{i}", taken)
-        joint_name = _free_name(f"{name}_joint", taken)
+        name = unique_name(f"{link.name}_roller{i}", taken)
+        joint_name = unique_name(f"{name}_joint", taken)
         inertial = (Inertial(roller_mass, np.zeros(3), inertia_local.copy(), source=link.inertial.source)
                     if link.inertial is not None else None)
         along_axis = Pose(_rotation_z_to(shape.axis, shape.forward), np.zeros(3))

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.names import unique_name
 from modelkit.formats.body.write_devices import device_node
 from modelkit.formats.body.write_shapes import link_elements
 from modelkit.formats.body.write_yaml import Flow, Num, deg, dump, num, nums, put_pose, rotation_value
@@ -68,16 +69,6 @@ class _Names:
     joint_used: set[str] = field(default_factory=set)
 
 
-def _unique(base: str, used: set[str]) -> str:
-    n = 2
-    name = base
-    while name in used:
-        name = f"{base}_{n}"
-        n += 1
-    used.add(name)
-    return name
-
-
 def _names(robot: Robot) -> _Names:
     out = _Names()
     used = {lk.name for lk in robot.links if lk.name}
@@ -87,13 +78,13 @@ def _names(robot: Robot) -> _Names:
             name = link.name
             taken.add(name)
         else:
-            name = _unique(link.name or "link", used)
+            name = unique_name(link.name or "link", used)
         out.links[id(link)] = name
         out.by_name.setdefault(link.name, name)
     for joint in robot.joints:
         child = out.by_name.get(joint.child, joint.child)
         wanted = child if joint.extras.get("implicit_name") else (joint.name or child)
-        out.joints[id(joint)] = _unique(wanted, out.joint_used)
+        out.joints[id(joint)] = unique_name(wanted, out.joint_used)
     return out
 
 
@@ -151,7 +142,7 @@ def write_body(robot: Robot, ctx: WriteContext) -> bytes:
     for link in order:
         nodes.append(_link_node(robot, link, parent_joint.get(link.name), names, ctx, from_body))
     for link, extra in _unconnected(robot, order, ctx):
-        names.joints[id(extra)] = _unique(names.links[id(link)], names.joint_used)
+        names.joints[id(extra)] = unique_name(names.links[id(link)], names.joint_used)
         nodes.append(_link_node(robot, link, extra, names, ctx, from_body))
     doc["links"] = nodes
     loops = _extra_joints(robot, names, ctx)

@@ -14,6 +14,7 @@ from typing import Any
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.names import unique_name
 from modelkit.convert.numbers import fmt_vec
 from modelkit.formats.sdf.sensors import CONFIG_ELEMENT
 from modelkit.formats.sdf.write_xml import add_pose, data_to_element, num, parse_fragment, rgba, sub
@@ -71,7 +72,7 @@ class DeviceWriter:
         self, parent: Element, device: Device, pose: Pose, relative_to: str | None, owner: str, used: set[str]
     ) -> None:
         """Write one device under ``parent`` (a link or a joint), or note why it is left out."""
-        name = _unique(device.name or device.kind, used)
+        name = unique_name(device.name or device.kind, used)
         if is_sdf_native(device, self.source_format):
             if device.kind.startswith("light:"):
                 self._light(
@@ -288,12 +289,3 @@ def _any_finite(value: Any) -> bool:
         return False
     values = value if isinstance(value, list | tuple) else [value]
     return any(_finite(v) for v in values)
-
-
-def _unique(name: str, used: set[str]) -> str:
-    new, count = name, 2
-    while new in used:
-        new = f"{name}_{count}"
-        count += 1
-    used.add(new)
-    return new

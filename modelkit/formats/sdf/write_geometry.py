@@ -10,6 +10,7 @@ from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import PairFriction
+from modelkit.convert.names import unique_name
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.formats.sdf.write_xml import add_pose, num, rgba, sub
 from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere
@@ -37,7 +38,7 @@ class GeomWriter:
         for kind, geoms in (("visual", link.visuals), ("collision", link.collisions)):
             used: set[str] = set()
             for index, geom in enumerate(geoms):
-                name = _unique(geom.name or f"{kind}_{index}", used)
+                name = unique_name(geom.name or f"{kind}_{index}", used)
                 target = f"link[{written}]/{kind}[{name}]"
                 shape = sub(el, kind, name=name)
                 add_pose(shape, offset @ geom.pose, relative_to)
@@ -134,12 +135,3 @@ class GeomWriter:
             link.loc("material"),
             target,
         )
-
-
-def _unique(name: str, used: set[str]) -> str:
-    new, count = name, 2
-    while new in used:
-        new = f"{name}_{count}"
-        count += 1
-    used.add(new)
-    return new
