@@ -123,17 +123,11 @@ def test_the_replay_splits_a_chain_without_changing_its_kinematics(tmp_path: Pat
 
 # Engines reading the written URDF/SDF, and the replay: what still fails there, and why (measured).
 # Each is a strict xfail: the test fails if another check fails, and flags itself once the cause is fixed.
-HOPPER_LAW = ("the replay's PD law (replay.default_law) sets its gains from each joint's subtree inertia "
-              "(the mass matrix's diagonal); with the armature zeroed (the URDF cannot hold it) hopper's "
-              "effective inertias 1/(M^-1)_ii are ~100x smaller (the planar root lets the torso counter-"
-              "rotate) and kd*dt/I_eff reaches 1.85 at the waist: semi-implicit Euler at 1 ms is unstable "
-              "(spectral radius 1.9-2.2 measured) in both engines, MuJoCo warns 'Nan, Inf or huge value in "
-              "QACC'")
 URDF_SDF_ENGINES = ("pybullet", "drake", "drake-urdf", "yourdfpy")
 KNOWN: dict[str, dict[tuple[str, str], str]] = {}  # model stem -> (engine, quantity) -> why, layers 1-3a
-REPLAY_KNOWN: dict[str, dict[tuple[str, str], str]] = {
-    "hopper": {("pybullet", "replay"): HOPPER_LAW, ("mujoco", "stability"): HOPPER_LAW},
-}
+# hopper's replay was unstable here until replay.default_law took its gains from the effective
+# inertia 1/(M^-1)_ii and checked the linearised step's growth factor (docs/verify.md).
+REPLAY_KNOWN: dict[str, dict[tuple[str, str], str]] = {}
 
 
 class KnownFailure(Exception):

@@ -10,7 +10,9 @@ two files describe different robots (inertia, COM, axis, frame, damping, armatur
 The law (:func:`default_law`) is chosen from the source model so that the replay is well
 conditioned: every moving joint is excited, the motion stays inside the joint limits and far
 from PyBullet's 100 rad/s velocity clamp, gravity cannot drag a joint far from its target, and
-the closed loop is well inside semi-implicit Euler's stability limit at 1 ms.
+the closed loop is inside semi-implicit Euler's stability limit at 1 ms: the gains come from each
+joint's effective inertia 1/(M⁻¹)ᵢᵢ (Pinocchio on the source), and the growth factor of the
+linearised step (:func:`step_growth`) is checked below 1, the bandwidth halved until it is.
 """
 
 from __future__ import annotations
@@ -28,13 +30,15 @@ TOLERANCE = 1e-8  # rad (m for prismatic joints) over the whole replay: verifica
 GRAVITY = 9.81
 
 # The law's design constants (see default_law).
-BANDWIDTH = 2.0 * math.pi * 2.0  # rad/s: closed-loop natural frequency from the joint's own inertia
+BANDWIDTH = 2.0 * math.pi * 2.0  # rad/s: closed-loop natural frequency from the joint's effective inertia
 MAX_BANDWIDTH = 100.0  # rad/s: ω·dt = 0.1 at 1 ms (semi-implicit Euler is stable below 2)
 DAMPING_RATIO = 0.7
 GRAVITY_MARGIN = 10.0  # kp ≥ 10 × the worst gravity load per unit of amplitude (sag ≤ 10 %)
 REVOLUTE_AMPLITUDE = 1.0  # rad, unlimited joints; limited: half the distance from 0 to the nearer limit
 PRISMATIC_AMPLITUDE = 0.1  # m
 MIN_INERTIA = 1e-12
+MAX_GROWTH = 1.0 - 1e-6  # the linearised step must contract (step_growth); else the bandwidth is halved
+MAX_HALVINGS = 60
 
 
 def _axis_inertia_and_gravity(robot: Robot, joint_name: str,
@@ -70,12 +74,76 @@ def _axis_inertia_and_gravity(robot: Robot, joint_name: str,
     return inertia, load
 
 
-def default_law(source: Robot) -> TorqueLaw:
-    """A well-conditioned PD law for the replay, from the source model (joint order = the
-    source's moving joints, mimic joints left out).
+def step_growth(mass_matrix: Array, kp: Array, kd: Array, dt: float) -> float:
+    """The per-step growth factor of semi-implicit Euler (v ← v + dt·a, q ← q + dt·v) on the PD loop
+    u = kp·(q* − q) − kd·dq linearised with the mass matrix ``mass_matrix`` (joints in the order of
+    ``kp``/``kd``; gravity and velocity products left out): the spectral radius of the step matrix
 
-    Per joint i, with I_i the subtree's inertia about the axis (revolute) or its mass (prismatic)
-    at q = 0 and G_i a bound of the gravity load on the joint:
+        [[I − dt²·A·K, dt·(I − dt·A·D)], [−dt·A·K, I − dt·A·D]],  A = M⁻¹, K = diag(kp), D = diag(kd).
+
+    Below 1 the linearised closed loop contracts at every step; at or above 1 it grows."""
+    inverse = np.linalg.inv(np.asarray(mass_matrix, dtype=float))
+    return _growth(inverse, np.asarray(kp, dtype=float), np.asarray(kd, dtype=float), dt)
+
+
+def _growth(inverse: Array, kp: Array, kd: Array, dt: float) -> float:
+    n = len(kp)
+    eye = np.eye(n)
+    ak = inverse @ np.diag(kp)
+    ad = eye - dt * (inverse @ np.diag(kd))
+    step = np.block([[eye - dt * dt * ak, dt * ad], [-dt * ak, ad]])
+    return float(np.max(np.abs(np.linalg.eigvals(step)))) if n else 0.0
+
+
+def stable_scale(inverse: Array, kp: Array, kd: Array, dt: float) -> float:
+    """The bandwidth scale s (1, 1/2, 1/4, ...) that makes the gains (s²·kp, s·kd) stable at ``dt``
+    (:func:`step_growth` below ``MAX_GROWTH``) for the inverse mass matrix ``inverse``; halving the
+    bandwidth keeps the damping ratio."""
+    scale = 1.0
+    for _ in range(MAX_HALVINGS):
+        if _growth(inverse, kp * scale**2, kd * scale, dt) < MAX_GROWTH:
+            return scale
+        scale *= 0.5
+    raise ValueError(f"no stable PD gains for the replay at dt {dt:g} s")
+
+
+def _effective_inverse(source: Robot, names: list[str]) -> Array | None:
+    """(M⁻¹) restricted to ``names`` at q = 0, root welded, armature zeroed (the replay zeroes it),
+    the other joints free; None when Pinocchio is not installed or cannot hold the model."""
+    try:
+        from modelkit.verify.engine_pinocchio import PinocchioModel
+    except ImportError:
+        return None
+    try:
+        model = PinocchioModel(source)
+    except (ValueError, RuntimeError):
+        return None
+    model.model.armature = np.zeros(model.model.nv)
+    dofs = model.dof_names()
+    full = model.mass_matrix({})
+    massive = [i for i in range(len(dofs)) if full[i, i] > MIN_INERTIA]
+    sub = full[np.ix_(massive, massive)]
+    if not massive or np.linalg.cond(sub) > 1e12:
+        return None
+    inverse = np.linalg.inv(sub)
+    where = {dofs[i]: k for k, i in enumerate(massive)}
+    index = [where.get(n, -1) for n in names]
+    out = np.zeros((len(names), len(names)))
+    for a, ia in enumerate(index):
+        for b, ib in enumerate(index):
+            if ia >= 0 and ib >= 0:
+                out[a, b] = inverse[ia, ib]
+    return out
+
+
+def default_law(source: Robot, dt: float = 1e-3) -> TorqueLaw:
+    """A well-conditioned PD law for the replay at time step ``dt``, from the source model (joint
+    order = the source's moving joints, mimic joints left out).
+
+    Per joint i, with I_i the **effective inertia** 1/(M⁻¹)_ii (M the joint-space mass matrix of
+    the source at q = 0, root welded, armature zeroed as in the replay, computed with Pinocchio
+    built from the source; the joints left out of the law are free) and G_i a bound of the gravity
+    load on the joint (the subtree's weight times its COM's distance from the axis):
 
     * amplitude A_i: 1 rad (revolute) / 0.1 m (prismatic) when unlimited; otherwise half the
       distance from q = 0 to the nearer limit (capped at those values); 0 when q = 0 is not
@@ -83,8 +151,18 @@ def default_law(source: Robot) -> TorqueLaw:
     * kp_i = max(I_i·ω², 10·G_i / A_ref) with ω = 2π·2 Hz and A_ref = 1 rad or 0.1 m (gravity sags
       a joint by at most ~10 % of that), capped so that √(kp/I) ≤ 100 rad/s (ω·dt = 0.1 at 1 ms);
     * kd_i = 2·0.7·√(kp_i·I_i) (damping ratio 0.7);
+    * stability, checked: the per-step growth factor of semi-implicit Euler on the loop linearised
+      with M at q = 0 (:func:`step_growth`: the spectral radius of the step matrix built from
+      M⁻¹·K, M⁻¹·D and dt, the joints' couplings included) must be below 1 − 1e-6; while it is not,
+      every joint's bandwidth is halved (kp/4, kd/2: the damping ratio is kept);
     * frequency 0.3 + 0.17·i Hz and phase 0.9·i rad: distinct, so the joints move out of step and
       the coupling terms of the mass matrix are excited. Peak speeds stay near A·2πf ≤ ~10 rad/s.
+
+    The subtree's inertia about the axis (its mass for a prismatic joint) was the old rule: it is
+    the mass matrix's diagonal M_ii ≥ 1/(M⁻¹)_ii, which overstates what a joint drives when the
+    joints above it can move (hopper's planar root: ~100×, and the loop was unstable at 1 ms). It
+    stays the fallback when Pinocchio is not installed or cannot hold the model, with the same
+    stability check on the diagonal M.
 
     A joint whose subtree has no mass (I_i ≈ 0) gets no torque at all.
     """
@@ -96,9 +174,13 @@ def default_law(source: Robot) -> TorqueLaw:
     children: dict[str, list[str]] = {}
     for j in source.joints:
         children.setdefault(j.parent, []).append(j.child)
-    kp, kd, amp, freq, phase = [], [], [], [], []
+    names = [j.name for j in moving]
+    inverse = _effective_inverse(source, names) if moving else None
+    kp, kd, amp, freq, phase, inertias = [], [], [], [], [], []
     for i, joint in enumerate(moving):
         inertia, load = _axis_inertia_and_gravity(source, joint.name, poses, children)
+        if inverse is not None:
+            inertia = 1.0 / inverse[i, i] if inverse[i, i] > 0.0 and inertia > MIN_INERTIA else 0.0
         revolute = joint.type is JointType.REVOLUTE
         reference = REVOLUTE_AMPLITUDE if revolute else PRISMATIC_AMPLITUDE
         lo, hi = joint.limits.lower, joint.limits.upper
@@ -115,8 +197,17 @@ def default_law(source: Robot) -> TorqueLaw:
         amp.append(amplitude)
         freq.append(0.3 + 0.17 * i)
         phase.append(0.9 * i)
-    names = tuple(j.name for j in moving)
-    return TorqueLaw(names, tuple(kp), tuple(kd), tuple(amp), tuple(freq), tuple(phase))
+        inertias.append(inertia)
+    driven = [i for i, k in enumerate(kp) if k > 0.0]
+    if driven:
+        if inverse is None:  # fallback: the joints taken as decoupled, M = diag(I)
+            inverse = np.diag([1.0 / inertias[i] if i in driven else 0.0 for i in range(len(kp))])
+        scale = stable_scale(inverse[np.ix_(driven, driven)], np.array([kp[i] for i in driven]),
+                             np.array([kd[i] for i in driven]), dt)
+        for i in driven:
+            kp[i] *= scale**2
+            kd[i] *= scale
+    return TorqueLaw(tuple(names), tuple(kp), tuple(kd), tuple(amp), tuple(freq), tuple(phase))
 
 
 def _run(sim: Simulator, law: TorqueLaw, seconds: float, dt: float) -> tuple[Array | None, float, str]:
