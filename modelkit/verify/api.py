@@ -53,12 +53,15 @@ description for the report; a bad spec raises ``ValueError`` (exit 2).
 from __future__ import annotations
 
 import copy
+import dataclasses
 import importlib
 import tempfile
 import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from modelkit.model import JointType, Robot
 from modelkit.spatial import Pose
@@ -212,6 +215,10 @@ def _load_engines(names: Sequence[str], reference: Robot, files: dict[str, Path]
         try:
             model = load(model_in, renames, root=root)
         except Exception as exc:
+            loop_skip = _loop_refusal(name, reference, kind, files, exc)
+            if loop_skip is not None:
+                report.skips.append(loop_skip)
+                continue
             what = "the source model" if kind == "robot" else f"the written {kind.upper()} {files[kind].name}"
             report.checks.append(Check(1, name, "load", "", float("inf"), 0.0,
                                        f"{name} could not load {what}: {type(exc).__name__}: {exc}"))
@@ -219,6 +226,23 @@ def _load_engines(names: Sequence[str], reference: Robot, files: dict[str, Path]
         report.engines[name] = dict(model.settings)
         loaded.append(Loaded(name, model, renames))
     return loaded
+
+
+def _loop_refusal(name: str, reference: Robot, kind: str, files: dict[str, Path], exc: Exception
+                  ) -> Skip | None:
+    """A Skip (all layers, this engine) when an engine that models a tree of joints only refused the
+    written file because the source's closed loops (``robot.loops``, written as extra joints, MK811)
+    make its joints form a loop; None for any other failure (that stays a failed ``load`` check).
+    Only Drake raises this (``engine_drake.DrakeLoopError``); it is recognised by its ``loop_refusal`` flag
+    so that this module imports no engine."""
+    if not reference.loops or not getattr(type(exc), "loop_refusal", False):
+        return None
+    joints = ", ".join(f"{loop.name} ({loop.type}, {loop.link1}–{loop.link2})" for loop in reference.loops)
+    limitation = str(getattr(type(exc), "limitation", ""))
+    return Skip(0, name, (
+        f"not verified (layers 1, 2 and 3): the source has {len(reference.loops)} closed-loop joint(s), "
+        f"{joints}, which the written {kind.upper()} {files[kind].name} keeps as extra joint(s) (MK811); "
+        f"{limitation}. Drake said: {exc}"))
 
 
 def verify(
@@ -308,6 +332,7 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
         report.skips.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: layers.massless_skips(st, eng),
                                      report.checks))
         report.skips.extend(shapes.skips(src_static, eng))
+    report.checks[:] = _explain_invalid_inertia(reference, loaded, report.checks)
     t3 = time.perf_counter()
     configs = layers.configurations(reference, configurations, seed)
     for eng in loaded:
@@ -355,6 +380,33 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
         eng.model.close()
     report.timings.update({"layer 1": t3 - t2, "layer 2": t4 - t3, "layer 3a": t5 - t4, "layer 3b": t6 - t5})
     return report
+
+
+def _explain_invalid_inertia(reference: Robot, loaded: list[Any], checks: list[Check]) -> list[Check]:
+    """A failed layer-1 ``inertia`` check of PyBullet or drake-urdf at a link whose source inertia
+    violates the triangle inequality (MK303) stays failed (the consumer refuses the source's data;
+    the URDF keeps that data as it is), but its message says what the engine made of it and why."""
+    from modelkit.verify.approximations import triangle_moments
+
+    labels = {e.label for e in loaded}
+    links = {link.name: link for link in reference.links}
+    out = []
+    for check in checks:
+        link = links.get(check.where)
+        if (check.layer == 1 and check.quantity == "inertia" and not check.passed and link is not None
+                and link.inertial is not None and check.engine in labels
+                and check.engine in ("pybullet", "drake-urdf")):
+            moments = triangle_moments(np.asarray(link.inertial.inertia, dtype=float))
+            if moments is not None:
+                if check.engine == "pybullet":
+                    note = _resolve("modelkit.verify.engine_pybullet:invalid_inertia_note")
+                    why = str(note(link.name, moments))
+                else:
+                    why = str(_resolve("modelkit.verify.engine_drake:invalid_inertia_note")(
+                        link.name, moments, link.inertial.mass))
+                check = dataclasses.replace(check, detail=f"{check.detail}: {why}")
+        out.append(check)
+    return out
 
 
 def _guarded(layer: int, eng: Any, run: Any, checks: list[Check] | None = None) -> list[Any]:

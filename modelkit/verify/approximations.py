@@ -62,6 +62,7 @@ class Approximated:
     inertia: float
     code: str
     by: str  # who approximates: "the SDF writer", "the MJCF writer", "PyBullet reading the URDF"
+    tensor: tuple[float, ...] | None = None  # a lifted inertia (row-major 3×3): mass and COM kept
 
 
 def _source_names(renames: Renames) -> dict[str, str]:
@@ -92,6 +93,58 @@ def from_notes(fmt: str, notes: Iterable[ConversionNote], renames: Renames) -> d
     return out
 
 
+def triangle_moments(tensor: np.ndarray) -> tuple[float, float, float] | None:
+    """The principal moments (ascending) of ``tensor`` when they violate a + b ≥ c (MK303), else None."""
+    a, b, c = (float(v) for v in np.linalg.eigvalsh(0.5 * (tensor + tensor.T)))
+    return (a, b, c) if a + b < c else None
+
+
+class _Collect:
+    """Stands in for a writer's ``ctx`` so that its own repair function runs without notes."""
+
+    def note(self, *args: object, **kwargs: object) -> None:
+        return None
+
+
+def lifted_inertias(fmt: str, notes: Iterable[ConversionNote], renames: Renames, source: Robot
+                    ) -> dict[str, Approximated]:
+    """Links whose inertia the writer lifted to satisfy the triangle inequality (SDF MK860, MJCF MK870
+    "violate a + b"): the engine must hold exactly the writer's tensor, recomputed here from the source
+    tensor by the writer's own repair function (mass and COM unchanged)."""
+    back = _source_names(renames)
+    out: dict[str, Approximated] = {}
+    links = {link.name: link for link in source.links}
+    for note in notes:
+        if not note.target:
+            continue
+        match = re.fullmatch(r"(?:link|body)\[(.+)\]/inertial", note.target)
+        if match is None:
+            continue
+        written = match[1]
+        name = back.get(written, written)
+        link = links.get(name)
+        if link is None or link.inertial is None:
+            continue
+        tensor = np.asarray(link.inertial.inertia, dtype=float)
+        if fmt == "sdf" and note.code == "MK860":
+            from modelkit.formats.sdf.writer import _ModelWriter
+
+            stub = type("Stub", (), {"ctx": _Collect()})()
+            fixed = _ModelWriter._valid_inertia(stub, link, written, tensor)
+            by = "the SDF writer"
+        elif fmt == "mjcf" and note.code == "MK870" and "violate a + b" in note.message:
+            from modelkit.formats.mjcf.write_bodies import BodyTree
+
+            stub = type("Stub", (), {"ctx": _Collect()})()
+            fixed = BodyTree._triangle(stub, tensor, link, note.target)
+            by = "the MJCF writer"
+        else:
+            continue
+        out[name] = Approximated(name, float(link.inertial.mass), 0.0, note.code, by,
+                                 tuple(float(v) for v in np.asarray(fixed, dtype=float).ravel()))
+    return out
+
+
 def pybullet_defaults(urdf: Path, source: Robot, renames: Renames) -> dict[str, Approximated]:
     """Links of the written URDF without ``<inertial>`` that are massless in the source: PyBullet
     reads each as 1 kg with a unit inertia (URDF itself says massless)."""
@@ -110,7 +163,9 @@ def pybullet_defaults(urdf: Path, source: Robot, renames: Renames) -> dict[str, 
 def for_engine(engine: str, fmt: str, notes: Iterable[ConversionNote], file: Path, source: Robot,
                renames: Renames) -> dict[str, Approximated]:
     """What ``engine`` (reading the written ``fmt`` file) holds instead of no mass, by source link."""
+    notes = list(notes)
     out = from_notes(fmt, notes, renames)
+    out.update(lifted_inertias(fmt, notes, renames, source))
     if engine == "pybullet" and fmt == "urdf":
         out.update(pybullet_defaults(file, source, renames))
     return out
@@ -123,7 +178,10 @@ def applied(robot: Robot, approx: dict[str, Approximated]) -> Robot:
     out = copy.deepcopy(robot)
     for link in out.links:
         a = approx.get(link.name)
-        if a is not None:
+        if a is not None and a.tensor is not None and link.inertial is not None:
+            link.inertial = Inertial(link.inertial.mass, np.asarray(link.inertial.com, dtype=float),
+                                     np.asarray(a.tensor, dtype=float).reshape(3, 3))
+        elif a is not None:
             link.inertial = Inertial(a.mass, np.zeros(3), a.inertia * np.eye(3))
     return out
 
@@ -133,13 +191,21 @@ def skip(engine: str, approx: dict[str, Approximated]) -> Skip | None:
     if not approx:
         return None
     groups: dict[tuple[str, str, float, float], list[str]] = {}
-    for a in approx.values():
-        groups.setdefault((a.by, a.code, a.mass, a.inertia), []).append(a.link)
+    lifts = []
+    for a in sorted(approx.values(), key=lambda a: a.link):
+        if a.tensor is None:
+            groups.setdefault((a.by, a.code, a.mass, a.inertia), []).append(a.link)
+            continue
+        lifted = np.linalg.eigvalsh(np.asarray(a.tensor).reshape(3, 3))
+        lifts.append(f"{a.by} lifts the inertia of {a.link}, whose principal moments violate the triangle "
+                     f"inequality in the source (MK303), to moments {', '.join(f'{v:.9g}' for v in lifted)} "
+                     f"kg·m² about the same axes ({a.code})")
     parts = []
     for (by, code, mass, inertia), links in sorted(groups.items()):
         shown = ", ".join(links[:8]) + (f" and {len(links) - 8} more" if len(links) > 8 else "")
         parts.append(f"{by} gives {len(links)} link(s) massless in the source {mass:g} kg and "
                      f"{inertia:g} kg·m² per axis at the link origin ({code}): {shown}")
+    parts += lifts
     return Skip(1, engine, "approximation: " + "; ".join(parts) + ". Layers 1 and 3 compare this engine with "
                 "the source model with these values applied (layer 1 checks the engine holds them)")
 

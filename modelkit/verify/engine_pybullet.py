@@ -64,6 +64,16 @@ SETTINGS: dict[str, Any] = {
 }
 
 
+
+def invalid_inertia_note(link: str, moments: tuple[float, float, float]) -> str:
+    """Why PyBullet holds a zero tensor for a link whose source inertia violates the triangle
+    inequality: its URDF importer prints "Bad inertia tensor properties" and replaces the tensor by
+    zero. A real consumer refusing the source's data (MK303), so the check stays failed."""
+    a, b, c = moments
+    return (f"PyBullet replaced the invalid tensor by zero (\"Bad inertia tensor properties\"): the source "
+            f"inertia of {link} violates the triangle inequality (principal moments {a:g} + {b:g} < {c:g}, "
+            "MK303), so this is PyBullet refusing the source's data, not a conversion fault")
+
 class PyBulletError(EngineError):
     """PyBullet refused a file, failed a request, crashed or timed out."""
 
