@@ -161,6 +161,35 @@ def main() -> None:
     """Validate, convert and verify robot model files (Choreonoid .body, URDF/xacro, SDF, MJCF)."""
 
 
+def _validate_one(path: Path, options: Any, input_format: str | None, target: str | None) -> list[Diagnostic]:
+    """The findings of one file (a top-level function, so that worker processes can run it)."""
+    from modelkit.api import validate as validate_file
+
+    return list(validate_file(path, options, input_format, str(path), target).diagnostics)
+
+
+def _validate_all(
+    files: tuple[Path, ...], options: Any, input_format: str | None, target: str | None, jobs: int
+) -> Iterator[list[Diagnostic]]:
+    """The findings of every file, in input order; with ``jobs`` > 1 the files are checked in
+    that many processes (each file whole in one process, so its findings are those of -j 1)."""
+    if jobs <= 1 or len(files) <= 1:
+        for path in files:
+            yield _validate_one(path, options, input_format, target)
+        return
+    from concurrent.futures import ProcessPoolExecutor
+
+    import modelkit.api  # noqa: F401  (imported once here, inherited by forked workers)
+
+    n = len(files)
+    workers = min(jobs, n)
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        chunk = max(1, n // (workers * 4))
+        yield from pool.map(
+            _validate_one, files, [options] * n, [input_format] * n, [target] * n, chunksize=chunk
+        )
+
+
 @main.command()
 @click.argument("words", nargs=-1, required=True, metavar="FILES... [KEY:=VALUE]...")
 @click.option(
@@ -188,6 +217,14 @@ def main() -> None:
     metavar="CODE",
     help="Silence a code (MK103) or name (unknown-key); repeatable.",
 )
+@click.option(
+    "-j",
+    "--jobs",
+    type=click.IntRange(min=1),
+    default=1,
+    show_default=True,
+    help="Check the files in this many processes; findings are printed in input order, as with -j 1.",
+)
 @reading_options
 def validate(
     words: tuple[str, ...],
@@ -197,6 +234,7 @@ def validate(
     no_resources: bool,
     target: str | None,
     ignored: tuple[str, ...],
+    jobs: int,
     **kwargs: Any,
 ) -> None:
     """Check model files and print file:line:col findings with stable codes.
@@ -204,7 +242,6 @@ def validate(
     FILES may be .body, .urdf, .xacro, .sdf/.world or MJCF (.xml/.mjcf); KEY:=VALUE words are
     passed to xacro as arguments.
     """
-    from modelkit.api import validate as validate_file
     from modelkit.codes import resolve
 
     silenced: set[str] = set()
@@ -219,9 +256,8 @@ def validate(
     options = _read_options(kwargs, not no_resources, xacro_args)
     findings: list[Diagnostic] = []
     unreadable = False
-    for path in files:
-        result = validate_file(path, options, kwargs["input_format"], str(path), target)
-        for d in result.diagnostics:
+    for diagnostics in _validate_all(files, options, kwargs["input_format"], target, jobs):
+        for d in diagnostics:
             if d.code in silenced:
                 continue
             if d.code in UNREADABLE_CODES:

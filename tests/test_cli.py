@@ -137,3 +137,20 @@ def test_package_path_option(tmp_path: Path) -> None:
 def test_bad_option_value_is_usage_error() -> None:
     code, _, err = run("validate", "--package-path", "novalue", "x.body")
     assert code == 2 and "expected NAME=DIR" in err
+
+
+def test_jobs_2_prints_the_same_bytes_as_jobs_1(corpus: Path) -> None:
+    """`validate -j 2` checks files in two processes and prints exactly what `-j 1` prints, in
+    input order (corpus files with and without findings, plus broken ones)."""
+    here = Path(__file__).parent
+    files = sorted(corpus.glob("choreonoid/share/model/*/*.body"))[:6]
+    files += sorted(corpus.rglob("*.urdf"))[:3]
+    files += sorted((here / "broken_urdf").glob("*.urdf"))[:2]
+    files += sorted((here / "broken_body").glob("*.body"))[:2]
+    assert len(files) >= 6
+    words = [str(f) for f in files]
+    for fmt in ("text", "json"):
+        one = run("validate", "--show-info", "--format", fmt, "-j", "1", *words)
+        two = run("validate", "--show-info", "--format", fmt, "-j", "2", *words)
+        assert one == two
+        assert one[1]  # there are findings to compare

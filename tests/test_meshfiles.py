@@ -676,3 +676,20 @@ def test_directory_is_wrapped(tmp_path: Path) -> None:
     with pytest.raises(MeshLoadError) as e:
         load_mesh(d)
     assert e.value.code == "MK501"
+
+
+def test_mesh_outcome_is_kept_per_file_version(tmp_path: Path) -> None:
+    """`mesh_problem` loads a file once per (path, mtime, size, fragment) and again once it changes."""
+    from modelkit.geometry.meshfiles import clear_mesh_cache, mesh_problem
+
+    clear_mesh_cache()
+    mesh = tmp_path / "m.stl"
+    header = b"x".ljust(80, b" ") + struct.pack("<I", 1)
+    mesh.write_bytes(header + struct.pack("<12fH", 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0))
+    assert mesh_problem(mesh) is None
+    assert mesh_problem(tmp_path / "." / "m.stl") is None  # same resolved path: the kept outcome
+    mesh.write_text("solid broken\nfacet normal 0 0 1\n")  # another size: loaded again
+    problem = mesh_problem(mesh)
+    assert problem is not None and problem.startswith("MK501\t")
+    assert mesh_problem(tmp_path / "missing.stl", None) is not None  # not a regular file: not kept
+    clear_mesh_cache()

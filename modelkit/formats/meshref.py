@@ -159,9 +159,5 @@ class MeshChecker:
         if key not in self._loaded:
             from modelkit.geometry import meshfiles
 
-            try:
-                meshfiles.load_mesh(path, fragment)
-                self._loaded[key] = None
-            except meshfiles.MeshLoadError as exc:
-                self._loaded[key] = f"{exc.code}\t{exc}"
+            self._loaded[key] = meshfiles.mesh_problem(path, fragment)
         return self._loaded[key]

@@ -151,6 +151,50 @@ def load_mesh(
         raise MeshLoadError("MK501", f"cannot load {path.name}: {type(e).__name__}: {e}") from e
 
 
+# ---- per-run outcome cache --------------------------------------------------------------------
+
+# (resolved path, mtime_ns, size, fragment, metadata, max_bytes) -> None (loads) or "CODE\tmessage".
+# Validating many files that share meshes loads each once per process (one CLI run).
+_OUTCOMES: dict[tuple[str, int, int, str | None, MeshMetadata | None, int], str | None] = {}
+
+
+def mesh_problem(
+    path: Path,
+    fragment: str | None = None,
+    metadata: MeshMetadata | None = None,
+    max_bytes: int = DEFAULT_MAX_BYTES,
+) -> str | None:
+    """None when :func:`load_mesh` loads ``path`` (``fragment``), else ``"CODE\tmessage"`` of its
+    :class:`MeshLoadError`. Outcomes for regular files are kept for the process, keyed by the resolved
+    path, modification time, size, fragment and metadata, so a changed file is loaded again."""
+    import os
+    import stat
+
+    key = None
+    try:
+        info = os.stat(path)
+        if stat.S_ISREG(info.st_mode):
+            resolved = str(Path(path).resolve())
+            key = (resolved, info.st_mtime_ns, info.st_size, fragment, metadata, max_bytes)
+    except (OSError, RuntimeError, ValueError):  # missing, a loop: load_mesh reports it
+        key = None
+    if key is not None and key in _OUTCOMES:
+        return _OUTCOMES[key]
+    try:
+        load_mesh(path, fragment, metadata, max_bytes)
+        outcome = None
+    except MeshLoadError as exc:
+        outcome = f"{exc.code}\t{exc}"
+    if key is not None:
+        _OUTCOMES[key] = outcome
+    return outcome
+
+
+def clear_mesh_cache() -> None:
+    """Forget every outcome kept by :func:`mesh_problem` (benchmarks, long-running processes)."""
+    _OUTCOMES.clear()
+
+
 # ---- shared scene graph ---------------------------------------------------------------------
 
 

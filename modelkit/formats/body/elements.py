@@ -667,15 +667,9 @@ def _check_mesh_loads(
         from modelkit.geometry import meshfiles
 
         metadata = _mesh_metadata(node)
-        try:
-            meshfiles.load_mesh(
-                path,
-                fragment,
-                meshfiles.MeshMetadata(metadata.get("length_unit"), metadata.get("upper_axis")),
-            )
-            ctx.mesh_cache[key] = None
-        except meshfiles.MeshLoadError as exc:
-            ctx.mesh_cache[key] = f"{exc.code}\t{exc}"
+        ctx.mesh_cache[key] = meshfiles.mesh_problem(
+            path, fragment, meshfiles.MeshMetadata(metadata.get("length_unit"), metadata.get("upper_axis"))
+        )
     problem = ctx.mesh_cache[key]
     if problem:
         code, message = problem.split("\t", 1)
