@@ -412,18 +412,26 @@ def _axis_urdf(root: Element, joint: str, _: float | None, changes: list[str]) -
     _set_attr(axis, "xyz", fmt_vec([-x for x in xyz]), f"joint[{joint}]/axis", changes)
 
 
-def _urdf_shapes(root: Element, link: str, tags: tuple[str, ...]) -> list[tuple[str, Element, Element]]:
-    el = _named(root, "link", link)
+def _shapes(
+    root: Element, link_path: str, link: str, tags: tuple[str, ...]
+) -> list[tuple[str, Element, Element]]:
+    """(where, visual/collision element, shape element) for every ``tags`` shape of a link; shared by
+    URDF (``link_path="link"``) and SDF (``"model/link"``, whose items are named)."""
+    el = _named(root, link_path, link)
     out: list[tuple[str, Element, Element]] = []
     for role in ("collision", "visual"):
         for i, item in enumerate(el.findall(role)):
             for tag in tags:
                 shape = item.find(f"geometry/{tag}")
                 if shape is not None:
-                    out.append((f"link[{link}]/{role}[{i}]", item, shape))
+                    out.append((f"link[{link}]/{role}[{item.get('name') or i}]", item, shape))
     if not out:
         raise _NotApplicable(f"link {link!r} has no {' or '.join(tags)}")
     return out
+
+
+def _urdf_shapes(root: Element, link: str, tags: tuple[str, ...]) -> list[tuple[str, Element, Element]]:
+    return _shapes(root, "link", link, tags)
 
 
 def _cylinder_y_urdf(root: Element, link: str, _: float | None, changes: list[str]) -> None:
@@ -527,17 +535,7 @@ def _axis_sdf(root: Element, joint: str, _: float | None, changes: list[str]) ->
 
 
 def _sdf_shapes(root: Element, link: str, tags: tuple[str, ...]) -> list[tuple[str, Element, Element]]:
-    el = _named(root, "model/link", link)
-    out: list[tuple[str, Element, Element]] = []
-    for role in ("collision", "visual"):
-        for i, item in enumerate(el.findall(role)):
-            for tag in tags:
-                shape = item.find(f"geometry/{tag}")
-                if shape is not None:
-                    out.append((f"link[{link}]/{role}[{item.get('name') or i}]", item, shape))
-    if not out:
-        raise _NotApplicable(f"link {link!r} has no {' or '.join(tags)}")
-    return out
+    return _shapes(root, "model/link", link, tags)
 
 
 def _cylinder_y_sdf(root: Element, link: str, _: float | None, changes: list[str]) -> None:
