@@ -23,7 +23,7 @@ from modelkit.diagnostics import (
     render_text,
 )
 from modelkit.format_names import FORMAT_NAMES
-from modelkit.verify.api import DEFAULT_ENGINES  # light: engines are imported only when verify runs
+from modelkit.verify.engines import DEFAULT_ENGINES  # data only: no numpy, no engine
 
 F = TypeVar("F", bound=Callable[..., Any])
 UNREADABLE_CODES = frozenset({"MK001", "MK002"})

@@ -161,3 +161,14 @@ def test_convert_imports_no_simulator_but_mujoco_for_mjcf(suffix: str, tmp_path:
     loaded = {m.partition(".")[0] for m in report["modules"]} & set(watched)
     attempted = {m.partition(".")[0] for m in report["attempted"]}
     assert loaded <= allowed and attempted <= allowed, (loaded, attempted)
+
+
+def test_cli_import_and_help_load_no_numpy_and_no_reader() -> None:
+    """`import modelkit.cli` (and `modelkit --help`) loads click and the code catalogue only: numpy,
+    the readers, yaml, lxml and jsonschema are imported when a file needs them."""
+    heavy = ("numpy", "yaml", "lxml", "jsonschema", "trimesh", "mujoco", "pybullet", "pinocchio")
+    report = _run(["--help"], heavy)
+    assert report["exit_code"] == 0, report["output"]
+    loaded = sorted({m.partition(".")[0] for m in report["modules"]} & set(heavy))
+    assert loaded == [], f"`modelkit --help` imported {loaded}"
+    assert not any(m.startswith("modelkit.formats") or m == "modelkit.api" for m in report["modules"])

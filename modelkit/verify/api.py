@@ -65,32 +65,12 @@ import numpy as np
 
 from modelkit.model import JointType, Robot
 from modelkit.spatial import Pose
+from modelkit.verify.engines import DEFAULT_ENGINES, ENGINES, INPUTS
 from modelkit.verify.facts import Check, Skip
 from modelkit.verify.report import VerifyReport
 
 Renames = dict[str, dict[str, str]]
 
-ENGINES: dict[str, str] = {
-    "source": "modelkit.verify.reference:load",
-    "pinocchio": "modelkit.verify.engine_pinocchio:load",
-    "mujoco": "modelkit.verify.engine_mujoco:load",
-    "pybullet": "modelkit.verify.engine_pybullet:load",
-    "drake": "modelkit.verify.engine_drake:load",
-    "drake-urdf": "modelkit.verify.engine_drake:load_urdf",
-    "yourdfpy": "modelkit.verify.reference:load_yourdfpy",
-}
-DEFAULT_ENGINES = ("mujoco", "pybullet", "pinocchio", "drake", "drake-urdf", "yourdfpy")
-
-# Which written file each engine reads ("robot" = the in-memory source model).
-INPUTS: dict[str, str] = {
-    "source": "robot",
-    "pinocchio": "robot",
-    "mujoco": "mjcf",
-    "pybullet": "urdf",
-    "drake": "sdf",
-    "drake-urdf": "urdf",
-    "yourdfpy": "urdf",
-}
 SUFFIX = {"mjcf": ".xml", "urdf": ".urdf", "sdf": ".sdf"}
 REPLAY = "modelkit.verify.replay:layer3b"
 INJECT = "modelkit.verify.inject:apply"
