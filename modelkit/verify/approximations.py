@@ -99,18 +99,11 @@ def triangle_moments(tensor: np.ndarray) -> tuple[float, float, float] | None:
     return (a, b, c) if a + b < c else None
 
 
-class _Collect:
-    """Stands in for a writer's ``ctx`` so that its own repair function runs without notes."""
-
-    def note(self, *args: object, **kwargs: object) -> None:
-        return None
-
-
 def lifted_inertias(fmt: str, notes: Iterable[ConversionNote], renames: Renames, source: Robot
                     ) -> dict[str, Approximated]:
     """Links whose inertia the writer lifted to satisfy the triangle inequality (SDF MK860, MJCF MK870
     "violate a + b"): the engine must hold exactly the writer's tensor, recomputed here from the source
-    tensor by the writer's own repair function (mass and COM unchanged)."""
+    tensor by the writer's own rule (mass and COM unchanged)."""
     back = _source_names(renames)
     out: dict[str, Approximated] = {}
     links = {link.name: link for link in source.links}
@@ -127,16 +120,14 @@ def lifted_inertias(fmt: str, notes: Iterable[ConversionNote], renames: Renames,
             continue
         tensor = np.asarray(link.inertial.inertia, dtype=float)
         if fmt == "sdf" and note.code == "MK860":
-            from modelkit.formats.sdf.writer import _ModelWriter
+            from modelkit.formats.sdf.writer import sdformat_valid_inertia
 
-            stub = type("Stub", (), {"ctx": _Collect()})()
-            fixed = _ModelWriter._valid_inertia(stub, link, written, tensor)
+            fixed = sdformat_valid_inertia(tensor)[0]
             by = "the SDF writer"
         elif fmt == "mjcf" and note.code == "MK870" and "violate a + b" in note.message:
-            from modelkit.formats.mjcf.write_bodies import BodyTree
+            from modelkit.formats.mjcf.write_bodies import mujoco_valid_inertia
 
-            stub = type("Stub", (), {"ctx": _Collect()})()
-            fixed = BodyTree._triangle(stub, tensor, link, note.target)
+            fixed = mujoco_valid_inertia(tensor)[0]
             by = "the MJCF writer"
         else:
             continue

@@ -42,9 +42,29 @@ from modelkit.spatial import Pose, combine_mass_properties, principal_moments, r
 
 MIN_MASS = 1e-6  # kg, given to a moving body whose weld group has no mass
 MIN_INERTIA = 1e-9  # kg·m², added on each axis when the weld group's inertia is singular
-PLATE_MARGIN = 1e-10  # relative: how far above a + b = c a full tensor is raised (see _triangle)
+PLATE_MARGIN = 1e-10  # relative: how far above a + b = c a full tensor is raised (mujoco_valid_inertia)
 SINGULAR = 1e-12  # below this a mass or principal moment counts as zero (MuJoCo's mjMINVAL is 1e-15)
 MOVING = (JointType.REVOLUTE, JointType.PRISMATIC, JointType.BALL, JointType.PLANAR, JointType.FLOATING)
+
+
+def mujoco_valid_inertia(tensor: np.ndarray) -> tuple[np.ndarray, tuple[float, float, float], float]:
+    """The tensor, or the nearest one with principal moments a + b ≥ c that MuJoCo accepts: the two
+    smaller moments are raised equally, the axes and the largest moment kept. Returns the tensor,
+    the original moments (ascending) and the raise (0 when nothing changed).
+
+    MuJoCo checks a full tensor after its own eigen-decomposition, without tolerance: a flat plate
+    (a + b = c exactly) fails on rounding, so a full tensor needs a small margin (PLATE_MARGIN).
+    """
+    sym = 0.5 * (tensor + tensor.T)
+    values, vectors = np.linalg.eigh(sym)
+    a, b, c = (float(v) for v in values)
+    diagonal = not np.any(sym - np.diag(np.diag(sym)))
+    need = c if diagonal else c * (1.0 + PLATE_MARGIN)
+    if a + b >= need:
+        return tensor, (a, b, c), 0.0
+    delta = (need - a - b) / 2.0
+    fixed: np.ndarray = vectors @ np.diag([a + delta, b + delta, c]) @ vectors.T
+    return fixed, (a, b, c), delta
 
 
 @dataclass
@@ -421,19 +441,10 @@ class BodyTree:
             el.set("diaginertia", fmt_vec([tensor[0, 0], tensor[1, 1], tensor[2, 2]]))
 
     def _triangle(self, tensor: np.ndarray, link: Link, target: str) -> np.ndarray:
-        """The tensor, or the nearest one with principal moments a + b ≥ c (MuJoCo refuses others):
-        the two smaller moments are raised equally, the axes and the largest moment kept."""
-        sym = 0.5 * (tensor + tensor.T)
-        values, vectors = np.linalg.eigh(sym)
-        a, b, c = (float(v) for v in values)
-        diagonal = not np.any(sym - np.diag(np.diag(sym)))
-        # MuJoCo checks a full tensor after its own eigen-decomposition, without tolerance: a flat
-        # plate (a + b = c exactly) fails on rounding, so a full tensor needs a small margin.
-        need = c if diagonal else c * (1.0 + PLATE_MARGIN)
-        if a + b >= need:
+        """The tensor, or MuJoCo's nearest acceptable one (:func:`mujoco_valid_inertia`), noted."""
+        fixed, (a, b, c), delta = mujoco_valid_inertia(tensor)
+        if delta == 0.0:
             return tensor
-        delta = (need - a - b) / 2.0
-        fixed: np.ndarray = vectors @ np.diag([a + delta, b + delta, c]) @ vectors.T
         why = (
             "no rigid body has them; MuJoCo refuses them"
             if a + b < c * (1.0 - PLATE_MARGIN)

@@ -43,7 +43,7 @@ from modelkit.formats.sdf.write_geometry import GeomWriter
 from modelkit.formats.sdf.write_names import Names
 from modelkit.formats.sdf.write_xml import add_pose, num, sub
 from modelkit.model import SYNTHESISED, WORLD_LINK, DeviceKind, Joint, JointType, Link, LoopConstraint, Robot
-from modelkit.spatial import Mat3, Pose
+from modelkit.spatial import Mat3, Pose, Vec3
 
 TINY_MASS = 1e-6
 TINY_INERTIA = 1e-12
@@ -68,6 +68,31 @@ def write_sdf(robot: Robot, ctx: WriteContext) -> bytes:
 def massless(link: Link) -> bool:
     return link.inertial is None or link.inertial.mass <= 0.0
 
+
+
+def sdformat_valid_inertia(m: Mat3) -> tuple[Mat3, Vec3, Vec3]:
+    """``m`` (symmetrised), or the nearest tensor libsdformat accepts (gz-math
+    ``MassMatrix3::IsValid``: principal moments ≥ 0 and A + B ≥ C within 10 machine epsilons).
+    Returns the tensor, the original principal moments and the written ones (equal: unchanged)."""
+    m = 0.5 * (m + m.T)
+    diagonal = not np.any(m - np.diag(np.diag(m)))
+    moments, axes = np.linalg.eigh(m)
+    if diagonal:  # exact moments: libsdformat's own test, A + B + 10ε·C ≥ C
+        order = np.argsort(np.diag(m), kind="stable")
+        moments, axes = np.diag(m)[order], np.eye(3)[:, order]
+    top = max(0.0, float(moments[-1]))
+    # off the diagonal, gz-math's eigen-solver rounds: keep a relative margin of INERTIA_MARGIN
+    low = -10.0 * np.finfo(float).eps * top if diagonal else top * INERTIA_MARGIN
+    fixed = np.maximum(moments, 0.0)
+    short = float(fixed[2] - fixed[0] - fixed[1])
+    if short > -low and short + low > 0.0:  # A + B ≥ C fails (or within the margin): lift A and B
+        lift = 0.5 * short + max(low, 0.0)
+        fixed[0] += lift
+        fixed[1] += lift
+    if np.array_equal(fixed, moments):
+        return m, moments, fixed
+    adjusted: Mat3 = axes @ np.diag(fixed) @ axes.T
+    return adjusted, moments, fixed
 
 class _ModelWriter:
     def __init__(self, robot: Robot, ctx: WriteContext) -> None:
@@ -294,26 +319,10 @@ class _ModelWriter:
             num(tensor, key, 0.5 * (m[i, j] + m[j, i]) if i != j else m[i, j])
 
     def _valid_inertia(self, link: Link, name: str, m: Mat3) -> Mat3:
-        """``m``, or the nearest tensor libsdformat accepts (gz-math ``MassMatrix3::IsValid``: principal
-        moments ≥ 0 and A + B ≥ C within 10 machine epsilons); a change is an MK860 note."""
-        m = 0.5 * (m + m.T)
-        diagonal = not np.any(m - np.diag(np.diag(m)))
-        moments, axes = np.linalg.eigh(m)
-        if diagonal:  # exact moments: libsdformat's own test, A + B + 10ε·C ≥ C
-            order = np.argsort(np.diag(m), kind="stable")
-            moments, axes = np.diag(m)[order], np.eye(3)[:, order]
-        top = max(0.0, float(moments[-1]))
-        # off the diagonal, gz-math's eigen-solver rounds: keep a relative margin of INERTIA_MARGIN
-        low = -10.0 * np.finfo(float).eps * top if diagonal else top * INERTIA_MARGIN
-        fixed = np.maximum(moments, 0.0)
-        short = float(fixed[2] - fixed[0] - fixed[1])
-        if short > -low and short + low > 0.0:  # A + B ≥ C fails (or within the margin): lift A and B
-            lift = 0.5 * short + max(low, 0.0)
-            fixed[0] += lift
-            fixed[1] += lift
+        """``m``, or libsdformat's nearest acceptable tensor (:func:`sdformat_valid_inertia`), noted."""
+        adjusted, moments, fixed = sdformat_valid_inertia(m)
         if np.array_equal(fixed, moments):
-            return m
-        adjusted: Mat3 = axes @ np.diag(fixed) @ axes.T
+            return adjusted
         self.ctx.note(
             "MK860",
             f'link "{link.name}": principal moments {fmt_vec(moments)} violate A + B ≥ C or meet it '
