@@ -522,3 +522,23 @@ def test_texture_copied_or_noted(tmp_path: Path) -> None:
     assert (tmp_path / "out" / "textures" / "wood.png").read_bytes() == (tmp_path / "wood.png").read_bytes()
     assert [n.code for n in notes if n.code == "MK818"] == ["MK818"]
     run_check_urdf(tmp_path / "out" / "robot.urdf")
+
+
+def test_mjcf_cameras_on_links_are_written_not_reported_as_dropped(tmp_path: Path) -> None:
+    """An MJCF camera on a body is a device (a Gazebo camera sensor in URDF); only what hangs on the
+    world body is left out, and the note counts only that."""
+    path = tmp_path / "cam.xml"
+    path.write_text(
+        '<mujoco model="m"><worldbody><light name="sun" pos="0 0 3"/><body name="b">'
+        '<inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>'
+        '<camera name="eye" pos="0 0 0.3"/><light name="lamp" pos="0 0 0.2"/></body></worldbody></mujoco>'
+    )
+    robot = validate(path).robots[0]
+    out = tmp_path / "out" / "m.urdf"
+    from modelkit.convert import write
+
+    notes = write(robot, out)
+    assert '<sensor name="eye" type="camera">' in out.read_text()
+    dropped = [n.message for n in notes if "MJCF cameras" in n.message or "MJCF lights" in n.message]
+    assert dropped == ["1 MJCF lights: URDF has no equivalent; left out"]  # the world's sun only
+    assert any(n.code == "MK806" and '"lamp"' in n.message for n in notes)  # the link's lamp, once

@@ -263,7 +263,11 @@ def _notes(robot: Robot, ctx: WriteContext) -> None:
             loop.source,
             "robot",
         )
+    on_links = {(link.name, device.name) for link in robot.links for device in link.devices}
     for key, value in sorted(robot.extras.items()):
+        if key in ("mjcf_cameras", "mjcf_lights") and isinstance(value, list):
+            # those on a link are its devices too, written or noted with them: only the others count
+            value = [v for v in value if (v.get("link"), v.get("name")) not in on_links]
         if key in SILENT_EXTRAS or not value:
             continue
         code, what = DROPPED_EXTRAS.get(key, ("MK808", f"extension data {key}"))
