@@ -13,6 +13,8 @@ from typing import Any, TypeVar
 
 import click
 
+from modelkit.convert.options import MESH_FORMATS, SDF_VERSIONS
+from modelkit.convert.registry import TARGET_NAMES
 from modelkit.diagnostics import (
     Diagnostic,
     Severity,
@@ -360,7 +362,7 @@ def tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: st
 @click.argument("words", nargs=-1, required=True, metavar="INPUTS... [KEY:=VALUE]...")
 @click.option("-o", "--output", type=click.Path(path_type=Path), required=True,
               help="Output file (its suffix picks the target: .urdf .sdf .xml .body) or folder (with --to).")
-@click.option("--to", "target", type=click.Choice(["urdf", "sdf", "mjcf", "body"]), default=None,
+@click.option("--to", "target", type=click.Choice(TARGET_NAMES), default=None,
               help="Target format (default: from the output file's suffix).")
 @click.option("--report", "report_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Write every conversion note and reading finding to this JSON file.")
@@ -369,10 +371,10 @@ def tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: st
               help="The note severity --strict fails on.")
 @click.option("--force", is_flag=True, help="Replace output files that exist.")
 @click.option("--quiet", "-q", is_flag=True, help="Print only warnings and errors, no info notes.")
-@click.option("--sdf-version", type=click.Choice(["1.6", "1.7", "1.8", "1.9", "1.10", "1.11"]),
+@click.option("--sdf-version", type=click.Choice(SDF_VERSIONS),
               default="1.9", show_default=True,
               help="SDFormat version to write (1.6 for Gazebo 9 / libsdformat 6 users).")
-@click.option("--mesh-format", type=click.Choice(["stl", "obj"]), default="stl", show_default=True,
+@click.option("--mesh-format", type=click.Choice(MESH_FORMATS), default="stl", show_default=True,
               help="File format of meshes modelkit writes (generated geometry, converted COLLADA/VRML).")
 @click.option("--keep-collada", is_flag=True,
               help="URDF/SDF/.body: copy COLLADA meshes as they are (MJCF always converts).")

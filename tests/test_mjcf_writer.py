@@ -20,12 +20,11 @@ from modelkit.convert.api import CONVERTIBLE_ERRORS, prepare
 from modelkit.convert.compare import Difference, compare_robots
 from modelkit.convert.context import WriteContext
 from modelkit.convert.meshes import MeshExporter
-from modelkit.convert.notes import ConversionNote, NoteSink
+from modelkit.convert.notes import ConversionNote, NoteSink, renames
 from modelkit.convert.options import WriteOptions
 from modelkit.convert.output import OutputPlan
 from modelkit.convert.registry import target_info
 from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, MIN_MASS
-from modelkit.formats.mjcf.write_names import renames_from_notes
 from modelkit.formats.mjcf.writer import write_mjcf
 from modelkit.model import (
     Box,
@@ -265,14 +264,14 @@ def corpus_results(tmp: str) -> dict[str, object]:
             else:
                 stats["clean"] = int(stats["clean"]) + 1  # type: ignore[call-overload]
             back = validate(written.path).robots
-            renames = renames_from_notes([x.message for x in written.notes if x.code == "MK800"])
-            diffs = compare_robots(written.source, back[0], renames)
+            link_renames = renames(written.notes, "link")
+            diffs = compare_robots(written.source, back[0], link_renames)
             if not diffs:
                 stats["exact"] = int(stats["exact"]) + 1  # type: ignore[call-overload]
                 continue
             key = corpus_key(path, k)
             differences[key] = frozenset(f"{d.quantity} {d.where}" for d in diffs)
-            unannounced.extend(f"{key}: {d}" for d in diffs if not explained(d, written, renames))
+            unannounced.extend(f"{key}: {d}" for d in diffs if not explained(d, written, link_renames))
     return stats
 
 
@@ -733,13 +732,12 @@ def test_names_are_unique_and_renames_noted(tmp_path: Path) -> None:
     assert len({a for a, _ in assets}) == len(assets) == 2
     assert [b.get("name") for b in tree.iter("body")] == ["base", "world_2"]
     assert [g.get("name") for g in tree.iter("geom") if g.get("name")] == ["g", "g_2"]
-    renames = renames_from_notes([n.message for n in written.notes if n.code == "MK800"])
-    assert renames == {"world": "world_2"}
-    assert renames_from_notes([n.message for n in written.notes if n.code == "MK800"], "geom") == {"g": "g_2"}
+    assert renames(written.notes, "link") == {"world": "world_2"}
+    assert renames(written.notes, "geom") == {"g": "g_2"}
     model = mujoco.MjModel.from_xml_path(str(written.path))
     assert model.nmesh == 2 and step_warnings(model) == {}
     back = validate(written.path).robots[0]
-    assert compare_robots(written.source, back, renames) == []
+    assert compare_robots(written.source, back, renames(written.notes, "link")) == []
 
 
 def test_root_conventions(tmp_path: Path) -> None:

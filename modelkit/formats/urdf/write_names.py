@@ -2,8 +2,8 @@
 
 URDF itself allows a joint named like a link (``check_urdf`` accepts it), but libsdformat's
 URDF → SDF conversion fails on it (peers.md §2.1), so the joint is renamed ``<name>_joint``.
-Empty and duplicate names are renamed too. Each rename is an MK800 note whose message
-:func:`renames_from_notes` reads back (for round-trip comparisons).
+Empty and duplicate names are renamed too. Each rename is an MK800 note that records it as data
+(:func:`modelkit.convert.notes.renames` reads it back for round-trip comparisons).
 """
 
 from __future__ import annotations
