@@ -143,3 +143,17 @@ class Skip:
     layer: int
     engine: str
     reason: str
+
+
+@dataclass(frozen=True)
+class Observation:
+    """A number the report shows but does not grade (layer 4: slip against the engine's own wheel
+    odometry, distance from the ideal unicycle, a report-only profile or the native-wheel run)."""
+
+    layer: int
+    engine: str  # "mujoco", "pybullet", "mujoco~pybullet" for a comparison between two runs
+    quantity: str  # "slip", "unicycle-position", "unicycle-yaw", "native-position", ...
+    where: str  # the profile (and variant) it was measured on
+    value: float
+    unit: str  # "m", "rad"
+    detail: str = ""

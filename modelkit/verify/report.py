@@ -11,10 +11,10 @@ from typing import Any
 
 import numpy as np
 
-from modelkit.verify.facts import Check, Skip
+from modelkit.verify.facts import Check, Observation, Skip
 
 SCHEMA_ID = "modelkit-verify-report/1"
-LAYER_NAMES = {0: "all", 1: "1 static", 2: "2 kinematics", 3: "3 dynamics"}
+LAYER_NAMES = {0: "all", 1: "1 static", 2: "2 kinematics", 3: "3 dynamics", 4: "4 driven"}
 
 
 @dataclass
@@ -32,6 +32,11 @@ class VerifyReport:
     engines: dict[str, dict[str, Any]] = field(default_factory=dict)  # label → settings
     checks: list[Check] = field(default_factory=list)
     skips: list[Skip] = field(default_factory=list)
+    observations: list[Observation] = field(default_factory=list)  # layer 4: reported, not graded
+    scenario: dict[str, Any] = field(default_factory=dict)  # layer 4: the scenario as run (plain data)
+    drive: dict[str, Any] = field(default_factory=dict)  # layer 4: Drive.as_dict() of the model
+    trajectories: list[Any] = field(default_factory=list)  # layer 4: drive.Trajectory, for the plots
+    artefacts: dict[str, str] = field(default_factory=dict)  # "html" → report.html, "plot:xy" → png...
     errors: list[str] = field(default_factory=list)  # why the run could not happen (exit 2)
     timings: dict[str, float] = field(default_factory=dict)  # wall seconds; printed, not in report.json
 
