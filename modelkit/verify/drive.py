@@ -151,8 +151,8 @@ class Drive:
     def from_dict(data: dict[str, Any]) -> Drive:
         return Drive(
             kind=data["kind"], left=data["left"], right=data["right"], radius=float(data["radius"]),
-            half_axle=float(data["half_axle"]), wheel_links=tuple(data["wheel_links"]),  # type: ignore[arg-type]
-            signs=tuple(data["signs"]),  # type: ignore[arg-type]
+            half_axle=float(data["half_axle"]), wheel_links=tuple(data["wheel_links"]),
+            signs=tuple(data["signs"]),
             pan=data.get("pan"), tilt=data.get("tilt"),
             rollers={k: tuple(v) for k, v in data.get("rollers", {}).items()},
             roller_radius=float(data.get("roller_radius", 0.0)),
