@@ -139,7 +139,10 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "An XML attribute or text is not a valid value. Reference: in SDF, every typed element is judged as "
         "libsdformat 12 reads it (a leading number is a double, extra vector numbers are ignored; "
-        "unparsable, overflowing or out-of-bounds values such as `<mu>-1</mu>` are refused).",
+        "unparsable, overflowing or out-of-bounds values such as `<mu>-1</mu>` are refused; an empty value "
+        "is refused where libsdformat's description marks the element or attribute required, e.g. "
+        "`<uri></uri>`, `<size/>`, `name=\"\"`, and otherwise keeps the default, e.g. `<pose></pose>`, "
+        "`<mass></mass>`, `<static/>`).",
     ),
     CodeInfo(
         "MK122",
@@ -423,8 +426,10 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK235",
         "sdf-joint-parent-is-child",
         "error",
-        "A joint's parent and child are the same link or frame: libsdformat refuses it (error 21). Two "
-        "different frames attached to one link: libsdformat loads it (a warning: the joint moves nothing).",
+        "A joint's parent and child are the same link or frame, or frames that resolve to the same link "
+        "(a frame or joint attached to the child). Reference: libsdformat refuses both (error 21); "
+        "libsdformat 12 checks resolved links only for the top model's joints, so in a nested model the "
+        "second case is a warning.",
     ),
     CodeInfo(
         "MK236",
@@ -445,7 +450,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "sdf-reserved-name",
         "error",
         "A name is reserved (`world`, `__...__` in every SDFormat version libsdformat 12 reads, or `::` "
-        "in 1.8+).",
+        "in 1.8+). Reference: libsdformat refuses it (error 3); a link named `world` is left out of the "
+        "model so that it causes no follow-on errors.",
     ),
     CodeInfo(
         "MK239",
@@ -463,7 +469,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK241",
         "sdf-closed-loop",
         "warning",
-        "A link is the child of several joints; the extra joints are kept as loop constraints.",
+        "A link is the child of several joints, or the joints form a closed chain in which every link is a "
+        "child; the extra joints are kept as loop constraints. Reference: libsdformat loads closed chains "
+        "(its own `four_bar.sdf`).",
     ),
     # -- MK3xx: mass properties, joints, transforms ---------------------------------------------
     CodeInfo("MK300", "mass-not-positive", "error", "A link's mass is zero or negative."),
@@ -1022,6 +1030,17 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "An input holds no robot (an xacro macro library, a world without models); nothing is written.",
     ),
+    # -- MK9xx: verify scenario files (layer 4 command profiles, `verify --scenario`) ------------------
+    CodeInfo("MK900", "scenario-wrong-type", "error", "A value in a scenario file has the wrong type."),
+    CodeInfo("MK901", "scenario-unknown-key", "error", "A scenario file has a key the schema lacks."),
+    CodeInfo(
+        "MK902",
+        "scenario-bad-value",
+        "error",
+        "A scenario value is out of its range (a duration not above 0, command times not increasing...).",
+    ),
+    CodeInfo("MK903", "scenario-missing-key", "error", "A scenario entry lacks a key it needs."),
+    CodeInfo("MK904", "scenario-unknown-profile", "error", "A scenario names an unknown built-in profile."),
 )
 
 CODES: dict[str, CodeInfo] = {c.code: c for c in _TABLE}

@@ -16,13 +16,18 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from enum import StrEnum
-from typing import Any
-
-import numpy as np
-from numpy.typing import NDArray
+from typing import TYPE_CHECKING, Any
 
 from modelkit.diagnostics import SourceLocation
+from modelkit.rot3 import ArrayField
 from modelkit.spatial import Mat3, Pose, Vec3
+
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
+
+# Array fields (ArrayField) read as numpy arrays but may hold plain tuples, which the numpy-free readers
+# store: read them with modelkit.rot3.peek (or Pose.rotation_tuple ...) where numpy must not be imported.
 
 WORLD_LINK = "world"
 """The name of the link that stands for the world itself (every format's convention)."""
@@ -51,7 +56,7 @@ class JointType(StrEnum):
 
 @dataclass(eq=False)
 class Box:
-    size: Vec3  # full edge lengths
+    size: ArrayField[Vec3] = ArrayField()  # noqa: RUF009 full edge lengths
 
 
 @dataclass(eq=False)
@@ -79,7 +84,7 @@ class Cone:
 
 @dataclass(eq=False)
 class Ellipsoid:
-    radii: Vec3
+    radii: ArrayField[Vec3] = ArrayField()  # noqa: RUF009
 
 
 @dataclass(eq=False)
@@ -103,7 +108,7 @@ class Mesh:
     uri: str | None = None
     path: str | None = None
     fragment: str | None = None
-    scale: Vec3 = field(default_factory=lambda: np.ones(3))
+    scale: ArrayField[Vec3] = ArrayField((1.0, 1.0, 1.0))  # noqa: RUF009
     data: TriangleMeshData | None = None
     generator: str | None = None
     source_params: dict[str, Any] = field(default_factory=dict)
@@ -115,11 +120,11 @@ Geometry = Box | Sphere | Cylinder | Capsule | Cone | Ellipsoid | Mesh
 @dataclass(eq=False)
 class VisualMaterial:
     name: str | None = None
-    diffuse: Vec3 | None = None  # RGB 0..1
+    diffuse: ArrayField[Vec3 | None] = ArrayField(None)  # noqa: RUF009 RGB 0..1
     transparency: float = 0.0
     ambient: float | None = None
-    specular: Vec3 | None = None
-    emissive: Vec3 | None = None
+    specular: ArrayField[Vec3 | None] = ArrayField(None)  # noqa: RUF009
+    emissive: ArrayField[Vec3 | None] = ArrayField(None)  # noqa: RUF009
     specular_exponent: float | None = None
     texture: str | None = None
 
@@ -127,7 +132,7 @@ class VisualMaterial:
     def rgba(self) -> tuple[float, float, float, float] | None:
         if self.diffuse is None:
             return None
-        r, g, b = (float(v) for v in self.diffuse)
+        r, g, b = (float(v) for v in self.__dict__["_diffuse"])
         return (r, g, b, 1.0 - self.transparency)
 
 
@@ -145,8 +150,8 @@ class Geom:
 @dataclass(eq=False)
 class Inertial:
     mass: float
-    com: Vec3 = field(default_factory=lambda: np.zeros(3))
-    inertia: Mat3 = field(default_factory=lambda: np.zeros((3, 3)))  # about the COM, link axes
+    com: ArrayField[Vec3] = ArrayField((0.0, 0.0, 0.0))  # noqa: RUF009
+    inertia: ArrayField[Mat3] = ArrayField(((0.0, 0.0, 0.0),) * 3)  # noqa: RUF009 about the COM, link axes
     defaulted: bool = False  # True when the source gave no mass information (Choreonoid defaults)
     source: SourceLocation | None = None
     sources: dict[str, SourceLocation] = field(default_factory=dict)
@@ -266,7 +271,7 @@ class Joint:
     parent: str
     child: str
     origin: Pose = field(default_factory=Pose)  # child frame in parent frame at q = 0
-    axis: Vec3 = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))  # in the child frame
+    axis: ArrayField[Vec3] = ArrayField((0.0, 0.0, 1.0))  # noqa: RUF009 in the child frame
     limits: JointLimits = field(default_factory=JointLimits)
     armature: float = 0.0
     damping: float = 0.0  # viscous, N·m·s/rad or N·s/m
@@ -293,7 +298,7 @@ class LoopConstraint:
     link2: str
     pose_in_link1: Pose = field(default_factory=Pose)
     pose_in_link2: Pose = field(default_factory=Pose)
-    axis: Vec3 = field(default_factory=lambda: np.array([1.0, 0.0, 0.0]))  # in the joint frame
+    axis: ArrayField[Vec3] = ArrayField((1.0, 0.0, 0.0))  # noqa: RUF009 in the joint frame
     source: SourceLocation | None = None
 
 
@@ -339,6 +344,8 @@ class Robot:
 
         ``positions`` maps joint names to q (default 0). Links unreachable from the root are absent.
         """
+        import numpy as np
+
         from modelkit.spatial import axis_angle
 
         positions = positions or {}

@@ -1,56 +1,85 @@
-"""Rigid transforms, rotations and inertia arithmetic (SI units, radians, right-handed frames)."""
+"""Rigid transforms, rotations and inertia arithmetic (SI units, radians, right-handed frames).
+
+numpy is imported by the functions that use it, not by this module: :class:`Pose` keeps plain tuples when
+a numpy-free reader builds it (see :mod:`modelkit.rot3`) and hands numpy arrays to whoever reads
+``.rotation`` / ``.translation``.
+"""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
-from numpy.typing import NDArray
+from modelkit import rot3
+from modelkit.rot3 import ArrayField, peek
 
-Vec3 = NDArray[np.float64]
-Mat3 = NDArray[np.float64]
-Mat4 = NDArray[np.float64]
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
 
-
-def _identity3() -> Mat3:
-    return np.eye(3)
-
-
-def _zero3() -> Vec3:
-    return np.zeros(3)
+    Vec3 = NDArray[np.float64]
+    Mat3 = NDArray[np.float64]
+    Mat4 = NDArray[np.float64]
+else:  # annotations only: the names exist so that modules can import them without numpy
+    Vec3 = Mat3 = Mat4 = Any
 
 
 @dataclass(eq=False)
 class Pose:
-    """A rigid transform: ``p_parent = rotation @ p_child + translation``."""
+    """A rigid transform: ``p_parent = rotation @ p_child + translation``.
 
-    rotation: Mat3 = field(default_factory=_identity3)
-    translation: Vec3 = field(default_factory=_zero3)
+    ``rotation`` and ``translation`` read as numpy arrays; ``rotation_tuple`` / ``translation_tuple`` read
+    the same values as tuples without importing numpy (the readers and the rules use those).
+    """
+
+    rotation: ArrayField[Mat3] = ArrayField(rot3.IDENTITY)  # noqa: RUF009
+    translation: ArrayField[Vec3] = ArrayField(rot3.ZERO3)  # noqa: RUF009
+
+    @property
+    def rotation_tuple(self) -> rot3.M3:
+        value = peek(self, "rotation")
+        return value if type(value) is tuple else rot3.mat3(value)
+
+    @property
+    def translation_tuple(self) -> rot3.V3:
+        value = peek(self, "translation")
+        return value if type(value) is tuple else rot3.vec3(value)
+
+    def _plain(self) -> bool:
+        return rot3.is_plain(peek(self, "rotation")) and rot3.is_plain(peek(self, "translation"))
 
     def __matmul__(self, other: Pose) -> Pose:
+        if self._plain() and other._plain():
+            r = self.rotation_tuple
+            return Pose(rot3.matmul(r, other.rotation_tuple),
+                        rot3.add(rot3.matvec(r, other.translation_tuple), self.translation_tuple))
         return Pose(self.rotation @ other.rotation, self.rotation @ other.translation + self.translation)
 
     def inverse(self) -> Pose:
         """The inverse transform: ``p_child = rotationᵀ @ (p_parent - translation)``."""
-        rt = self.rotation.T
-        return Pose(rt, -(rt @ self.translation))
+        if self._plain():
+            rt = rot3.transpose(self.rotation_tuple)
+            return Pose(rt, rot3.scale(-1.0, rot3.matvec(rt, self.translation_tuple)))
+        rt_array = self.rotation.T
+        return Pose(rt_array, -(rt_array @ self.translation))
 
     def is_identity(self, tol: float = 1e-12) -> bool:
         """Every entry within ``tol`` (absolute; no relative tolerance) of the identity transform's."""
-        return bool(
-            np.allclose(self.rotation, np.eye(3), atol=tol, rtol=0.0)
-            and np.allclose(self.translation, 0.0, atol=tol, rtol=0.0)
-        )
+        r, t = self.rotation_tuple, self.translation_tuple
+        rotation_ok = all(abs(r[i][j] - (1.0 if i == j else 0.0)) <= tol for i in range(3) for j in range(3))
+        return rotation_ok and all(abs(x) <= tol for x in t)
 
     def __repr__(self) -> str:
-        return f"Pose(xyz={self.translation.tolist()}, rpy={rpy_from_matrix(self.rotation).tolist()})"
+        return f"Pose(xyz={list(self.translation_tuple)}, rpy={list(rot3.rpy_from(self.rotation_tuple))})"
 
 
 def axis_angle(axis: Vec3 | list[float], angle: float, normalise: bool = True) -> Mat3:
     """Rodrigues' rotation matrix. With ``normalise=False`` the axis is used as given, as Eigen's
     ``AngleAxis::toRotationMatrix`` does (which Choreonoid's Extrusion relies on)."""
+    import numpy as np
+
     a = np.asarray(axis, dtype=float)
     if normalise:
         n = float(np.linalg.norm(a))
@@ -68,6 +97,8 @@ def rot_x(angle: float) -> Mat3:
 
 def matrix_from_rpy(roll: float, pitch: float, yaw: float) -> Mat3:
     """URDF/SDF fixed-axis roll-pitch-yaw: R = Rz(yaw)·Ry(pitch)·Rx(roll)."""
+    import numpy as np
+
     cr, sr = math.cos(roll), math.sin(roll)
     cp, sp = math.cos(pitch), math.sin(pitch)
     cy, sy = math.cos(yaw), math.sin(yaw)
@@ -86,6 +117,8 @@ def matrix_from_quat_wxyz(quat: Sequence[float] | NDArray[np.float64]) -> Mat3:
     A zero or non-finite quaternion gives the identity, as MuJoCo does; readers of formats where
     that is an error report it before calling. URDF/SDF write x, y, z, w: pass ``(w, x, y, z)``.
     """
+    import numpy as np
+
     q = np.asarray(quat, dtype=float)
     n = float(np.linalg.norm(q))
     if n == 0.0 or not math.isfinite(n):
@@ -102,6 +135,8 @@ def matrix_from_quat_wxyz(quat: Sequence[float] | NDArray[np.float64]) -> Mat3:
 
 def rpy_from_matrix(r: Mat3) -> Vec3:
     """URDF/SDF fixed-axis roll-pitch-yaw of R = Rz(yaw)·Ry(pitch)·Rx(roll), pitch in [-π/2, π/2]."""
+    import numpy as np
+
     sy = -float(r[2, 0])
     sy = max(-1.0, min(1.0, sy))
     pitch = math.asin(sy)
@@ -116,17 +151,23 @@ def rpy_from_matrix(r: Mat3) -> Vec3:
 
 def inertia_from_moments(ixx: float, ixy: float, ixz: float, iyy: float, iyz: float, izz: float) -> Mat3:
     """The symmetric inertia tensor of its six moments (URDF/SDF order: ixx ixy ixz iyy iyz izz)."""
+    import numpy as np
+
     return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], dtype=float)
 
 
 def rotate_inertia(inertia: Mat3, rotation: Mat3) -> Mat3:
     """R·I·Rᵀ: an inertia tensor given in rotated axes, re-expressed in the outer axes."""
+    import numpy as np
+
     r = np.asarray(rotation, dtype=float)
     return r @ np.asarray(inertia, dtype=float) @ r.T
 
 
 def parallel_axis(mass: float, offset: Vec3) -> Mat3:
     """The term m(|d|²E − d dᵀ) that moves an inertia about the COM to a point offset by d."""
+    import numpy as np
+
     d = np.asarray(offset, dtype=float)
     return mass * (float(d @ d) * np.eye(3) - np.outer(d, d))
 
@@ -136,6 +177,8 @@ def combine_mass_properties(parts: list[tuple[float, Vec3, Mat3]]) -> tuple[floa
 
     Zero total mass gives (0, 0, 0), as Choreonoid does.
     """
+    import numpy as np
+
     total = sum(m for m, _, _ in parts)
     if total <= 0.0:
         return 0.0, np.zeros(3), np.zeros((3, 3))
@@ -149,9 +192,13 @@ def combine_mass_properties(parts: list[tuple[float, Vec3, Mat3]]) -> tuple[floa
 # Tolerance of libsdformat / gz-math MassMatrix3::IsValid: eigenvalues and the triangle inequality
 # are checked with ε = 10 · machine-epsilon · (largest principal moment).
 def inertia_tolerance(principal: NDArray[np.float64]) -> float:
+    import numpy as np
+
     return 10.0 * float(np.finfo(float).eps) * float(np.max(np.abs(principal)) if principal.size else 0.0)
 
 
 def principal_moments(inertia: Mat3) -> NDArray[np.float64]:
+    import numpy as np
+
     sym = 0.5 * (np.asarray(inertia, dtype=float) + np.asarray(inertia, dtype=float).T)
     return np.sort(np.linalg.eigvalsh(sym))

@@ -31,6 +31,7 @@ from collections.abc import Iterable, Iterator
 from typing import Literal
 
 from modelkit.model import Joint, Robot
+from modelkit.rot3 import peek
 
 Order = Literal["joint-name", "document"]
 
@@ -145,10 +146,10 @@ def json_chunks(
             "joint": joint.name,
             "type": joint.type.value,
             "origin": {
-                "xyz": [round(float(x), 12) for x in joint.origin.translation],
-                "rotation": [[round(float(x), 12) for x in row] for row in joint.origin.rotation],
+                "xyz": [round(float(x), 12) for x in joint.origin.translation_tuple],
+                "rotation": [[round(float(x), 12) for x in row] for row in joint.origin.rotation_tuple],
             },
-            "axis": [round(float(x), 12) for x in joint.axis],
+            "axis": [round(float(x), 12) for x in peek(joint, "axis")],
             "link": joint.child,
         }
         path[-1].append(entry)

@@ -480,3 +480,56 @@ def test_deep_nesting_is_reported_not_raised() -> None:
 
 
 # ---- speed -----------------------------------------------------------------------------------------------
+
+
+# ---- the compiled validity check agrees with jsonschema ----------------------------------------------------
+# check_schema decides validity with the compiled check (modelkit.formats.body.schema_check) and runs
+# jsonschema only for invalid documents: a document the compiled check passes wrongly would lose its
+# diagnostics, so the two must agree on every document.
+
+
+def _agree(instance: Any) -> tuple[bool, bool]:
+    from modelkit.formats.body.schema_check import compile_schema
+
+    compiled = compile_schema(schema())(instance)
+    reference = jsonschema.Draft202012Validator(schema()).is_valid(instance)
+    return compiled, reference
+
+
+def _plain_of(text: str) -> Any:
+    doc = parse_yaml(text, "t.body", DiagnosticSink())
+    return None if doc.root is None else to_plain(doc.root)
+
+
+def test_the_compiled_check_covers_the_whole_schema() -> None:
+    assert body_schema._compiled() is not None  # an unsupported keyword would make every file use jsonschema
+
+
+def test_compiled_check_agrees_with_jsonschema_on_files() -> None:
+    files = [*sorted((REPO / "tests").rglob("*.body")), *sorted(REPO.glob("samples/**/*.body")),
+             *corpus_bodies()]
+    verdicts = {True: 0, False: 0}
+    for path in files:
+        instance = _plain_of(path.read_text(encoding="utf-8", errors="replace"))
+        if instance is None:
+            continue
+        compiled, reference = _agree(instance)
+        assert compiled == reference, path
+        verdicts[reference] += 1
+    assert verdicts[True] >= 10 and verdicts[False] >= 5, verdicts  # both verdicts exercised
+
+
+@pytest.mark.parametrize("text", [f[1] for f in FAULTS], ids=[f[0] for f in FAULTS])
+def test_compiled_check_agrees_with_jsonschema_on_crafted_faults(text: str) -> None:
+    instance = _plain_of(text)
+    compiled, reference = _agree(instance)
+    assert compiled == reference
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(tree=_trees, links=_trees)
+def test_compiled_check_agrees_with_jsonschema_on_random_documents(tree: Any, links: Any) -> None:
+    for document in (tree, {"format": "ChoreonoidBody", "links": links, "extra": tree},
+                     {"format": "ChoreonoidBody", "links": [{"name": "a", "elements": tree}, links]}):
+        compiled, reference = _agree(document)
+        assert compiled == reference, document

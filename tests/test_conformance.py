@@ -638,6 +638,53 @@ _REFUSED_SDF: dict[str, tuple[str, str]] = {
         f'<model name="m"><link name="a"><collision name="c"><geometry>{_BOX}</geometry><surface><friction>'
         "<ode><mu>-1</mu></ode></friction></surface></collision></link></model>",
     ),
+    # an empty value where libsdformat's description requires one ("Empty string used when setting a
+    # required parameter")
+    "an empty mesh uri": (
+        "1.7",
+        '<model name="m"><link name="a"><visual name="v"><geometry><mesh><uri></uri></mesh></geometry>'
+        "</visual></link></model>",
+    ),
+    "an empty box size": (
+        "1.7",
+        '<model name="m"><link name="a"><collision name="c"><geometry><box><size/></box></geometry>'
+        "</collision></link></model>",
+    ),
+    "an empty gravity": ("1.7", f'<world name="w"><gravity></gravity><model name="m">{_LINK.format("a")}'
+                         "</model></world>"),
+    "an empty include uri": ("1.8", "<world name=\"w\"><include><uri></uri></include></world>"),
+    "an empty model name": ("1.7", f'<model name="">{_LINK.format("a")}</model>'),
+    "an empty joint axis": (
+        "1.7",
+        f'<model name="m">{_LINK.format("a")}{_LINK.format("b")}<joint name="j" type="revolute"><parent>a'
+        "</parent><child>b</child><axis><xyz></xyz></axis></joint></model>",
+    ),
+    # a joint's parent frame that resolves to its child link (libsdformat error 21; its own
+    # joint_invalid_resolved_parent_same_as_child.sdf)
+    "a parent frame attached to the child": (
+        "1.7",
+        f'<model name="m">{_LINK.format("a")}{_LINK.format("c")}<frame name="f" attached_to="c"/>'
+        '<joint name="j" type="revolute"><parent>f</parent><child>c</child><axis><xyz>0 0 1</xyz></axis>'
+        '</joint><joint name="k" type="fixed"><parent>a</parent><child>c</child></joint></model>',
+    ),
+    "a parent joint resolving to the child": (
+        "1.8",
+        f'<model name="m">{_LINK.format("a")}{_LINK.format("b")}<joint name="j1" type="prismatic"><parent>a'
+        "</parent><child>j2</child><axis><xyz>1 0 0</xyz></axis></joint>"
+        '<joint name="j2" type="prismatic"><parent>j1</parent><child>b</child><axis><xyz>0 1 0</xyz>'
+        "</axis></joint></model>",
+    ),
+    # libsdformat's Material::Load (its material_normal_map_missing.sdf), also on a visual without geometry
+    "a normal-map shader without a normal map": (
+        "1.6",
+        '<model name="m"><link name="a"><visual name="v"><material><shader type="normal_map_tangent_space">'
+        "</shader></material></visual></link></model>",
+    ),
+    "an unknown shader type": (
+        "1.6",
+        f'<model name="m"><link name="a"><visual name="v"><geometry>{_BOX}</geometry><material>'
+        '<shader type="Pixel"/></material></visual></link></model>',
+    ),
 }
 # Values libsdformat 12 reads although they look wrong (std::stod takes a leading number, a vector
 # ignores extra numbers, booleans are case-insensitive): no error.
@@ -653,6 +700,36 @@ _ACCEPTED_SDF: dict[str, tuple[str, str]] = {
         "1.9",
         '<model name="m"><link name="a"><sensor name="s" type="imu"><visualize>True</visualize></sensor>'
         "</link></model>",
+    ),
+    # an empty value of an element the description does not require keeps the default
+    "empty optional values": (
+        "1.7",
+        '<model name="m"><static></static><pose></pose><link name="a"><pose/><inertial><mass></mass>'
+        "</inertial></link></model>",
+    ),
+    "both spellings of the normal-map shaders": (
+        "1.6",
+        f'<model name="m"><link name="a"><visual name="v"><geometry>{_BOX}</geometry><material><shader '
+        'type="normal_map_objectspace"><normal_map>n.png</normal_map></shader></material></visual>'
+        f'<visual name="w"><geometry>{_BOX}</geometry><material><shader type="normal_map_tangent_space">'
+        "<normal_map>n.png</normal_map></shader></material></visual></link></model>",
+    ),
+    # libsdformat 12 checks resolved parent and child links only for the top model's joints
+    "a nested model's joint between two frames of one link": (
+        "1.8",
+        f'<model name="top">{_LINK.format("a")}<model name="n">{_LINK.format("l")}{_LINK.format("b")}'
+        '<frame name="f" attached_to="l"/><joint name="j" type="revolute"><parent>f</parent><child>l</child>'
+        '<axis><xyz>0 0 1</xyz></axis></joint><joint name="k" type="fixed"><parent>b</parent><child>l</child>'
+        '</joint></model><joint name="m" type="fixed"><parent>a</parent><child>n</child></joint></model>',
+    ),
+    # a closed chain in which every link is a joint's child (libsdformat's four_bar.sdf): a warning
+    "a closed chain of four links": (
+        "1.6",
+        '<model name="m">' + "".join(_LINK.format(n) for n in ("l1", "l2", "l3", "l4")) + "".join(
+            f'<joint name="j{i}" type="revolute"><parent>l{i}</parent><child>l{i % 4 + 1}</child>'
+            "<axis><xyz>0 0 1</xyz></axis></joint>"
+            for i in range(1, 5)
+        ) + "</model>",
     ),
 }
 
@@ -747,3 +824,36 @@ def test_kinematic_only_urdf_is_a_warning_and_an_error_for_mujoco(tmp_path: Path
     with pytest.raises(ValueError, match="mass and inertia of moving bodies"):
         mujoco.MjModel.from_xml_path(str(mjcf))
     assert validate(mjcf).errors
+
+
+def test_a_link_named_world_is_one_error(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+    """One root cause, one error: no follow-on duplicate-link (MK204) or second-root (MK201) findings."""
+    path = tmp_path / "m.sdf"
+    for version in ("1.6", "1.9"):
+        path.write_text(
+            _sdf(
+                version,
+                f'<model name="m"><link name="world"/>{_LINK.format("base")}{_LINK.format("arm")}'
+                '<joint name="fix" type="revolute"><parent>world</parent><child>base</child><axis><xyz>0 0 1'
+                '</xyz></axis></joint><joint name="j" type="revolute"><parent>base</parent><child>arm</child>'
+                "<axis><xyz>0 0 1</xyz></axis></joint></model>",
+            )
+        )
+        assert not _libsdformat_accepts(sdf_oracle, path)  # "The supplied link name [world] is reserved."
+        v = validate(path)
+        assert [d.code for d in v.errors] == ["MK238"] and _codes(v, "warning") == [], v.diagnostics
+
+
+def test_model_frame_as_joint_end_is_an_exception_for_libsdformat_12(
+    tmp_path: Path, sdf_oracle: Path  # noqa: F811
+) -> None:
+    """libsdformat 12 refuses ``__model__`` as a joint's parent or child; current libsdformat loads it (its
+    own joint_parent_model_frame.sdf and joint_child_model_frame.sdf are valid test files), as modelkit."""
+    path = tmp_path / "m.sdf"
+    for ends in ("<parent>__model__</parent><child>b</child>", "<parent>b</parent><child>__model__</child>"):
+        path.write_text(
+            _sdf("1.8", f'<model name="m">{_LINK.format("a")}{_LINK.format("b")}<joint name="j" type="fixed">'
+                 f"{ends}</joint></model>")
+        )
+        assert not _libsdformat_accepts(sdf_oracle, path)
+        assert validate(path).errors == []

@@ -269,7 +269,10 @@ def test_sdf_joint_cycle_is_reported_not_looped(tmp_path: Path) -> None:
         for p, c in ("ab", "bc", "ca")
     )
     model.write_text(f'<sdf version="1.9"><model name="m">{links}{joints}</model></sdf>')
-    assert_refused(model, {"MK203"}, seconds=10)
+    # a closed chain, which libsdformat loads (its own four_bar.sdf is one): a located warning, at once
+    status, found = validate_json(model, seconds=10)
+    assert status == 0 and [d["code"] for d in found if d["severity"] != "info"].count("MK241") == 1, found
+    assert run("tree", str(model), seconds=10).exit_code == 0
 
 
 def test_urdf_joint_cycle_is_reported(tmp_path: Path) -> None:
@@ -557,8 +560,18 @@ def test_xml_number_parser_never_raises(text: str) -> None:
     assert value is None or isinstance(value, float)
     if value is not None:
         assert value == float(text.strip()) or (value != value)
+    # A list is read item by item: doubling the text doubles the list (``text`` may itself hold several
+    # numbers, e.g. "0 0"), and one item that is not a number refuses the whole list.
+    items = text.split()
+    single = parse_numbers(text)
     listed = parse_numbers(f"{text} {text}")
-    assert listed is None or len(listed) == 2 or not text.strip()
+    if single is None:
+        assert listed is None and any(parse_number(item) is None for item in items)
+    else:
+        assert listed is not None and len(single) == len(items) and len(listed) == 2 * len(items)
+        assert [repr(v) for v in listed] == [repr(v) for v in single + single]
+    if value is not None:
+        assert listed is not None and [repr(v) for v in listed] == [repr(value)] * 2
 
 
 @given(st.lists(st.floats(allow_nan=True, allow_infinity=True, width=64), min_size=0, max_size=6))

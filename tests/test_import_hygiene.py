@@ -172,3 +172,89 @@ def test_cli_import_and_help_load_no_numpy_and_no_reader() -> None:
     loaded = sorted({m.partition(".")[0] for m in report["modules"]} & set(heavy))
     assert loaded == [], f"`modelkit --help` imported {loaded}"
     assert not any(m.startswith("modelkit.formats") or m == "modelkit.api" for m in report["modules"])
+
+
+SMALL_URDF = """\
+<robot name="r">
+  <material name="blue"><color rgba="0 0 1 1"/></material>
+  <link name="base">
+    <inertial><origin xyz="0 0 0.1" rpy="0 0.1 0"/><mass value="1"/>
+      <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>
+    <visual><origin xyz="0 0 0.1" rpy="0.1 0.2 0.3"/><geometry><box size="0.1 0.2 0.3"/></geometry>
+      <material name="blue"/></visual>
+    <collision><geometry><cylinder radius="0.1" length="0.2"/></geometry></collision>
+  </link>
+  <link name="arm">
+    <inertial><mass value="0.5"/>
+      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+    <visual><geometry><sphere radius="0.05"/></geometry></visual>
+  </link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/>
+    <origin xyz="0 0 0.3" rpy="0 0 1.57"/><axis xyz="0 1 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+</robot>
+"""
+SMALL_XACRO = """\
+<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:property name="m" value="0.5"/>
+  <xacro:macro name="limb" params="name">
+    <link name="${name}">
+      <inertial><mass value="${m}"/>
+        <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+      <visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual>
+    </link>
+  </xacro:macro>
+  <xacro:limb name="base"/>
+  <xacro:limb name="arm"/>
+  <joint name="j" type="continuous"><parent link="base"/><child link="arm"/>
+    <origin xyz="0 0 ${m}" rpy="0 0 0.5"/><axis xyz="1 0 0"/></joint>
+</robot>
+"""
+SMALL_SDF = """\
+<sdf version="1.9">
+  <model name="r">
+    <link name="base">
+      <pose>0 0 0.1 0 0 0.3</pose>
+      <inertial><pose>0 0 0.05 0.1 0 0</pose><mass>1</mass>
+        <inertia><ixx>0.1</ixx><iyy>0.1</iyy><izz>0.1</izz></inertia></inertial>
+      <visual name="v"><geometry><box><size>0.1 0.2 0.3</size></box></geometry>
+        <material><diffuse>0 0 1 1</diffuse><ambient>0 0 0.5 1</ambient></material></visual>
+      <collision name="c"><pose>0 0 0.1 0 0 0</pose><geometry><sphere><radius>0.1</radius></sphere></geometry>
+      </collision>
+    </link>
+    <link name="arm">
+      <pose relative_to="j">0 0 0 0 0 0</pose>
+      <inertial><mass>0.5</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial>
+    </link>
+    <joint name="j" type="revolute"><pose relative_to="base">0 0 0.3 0 0 1.57</pose>
+      <parent>base</parent><child>arm</child>
+      <axis><xyz expressed_in="base">0 1 0</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis>
+    </joint>
+  </model>
+</sdf>
+"""
+
+
+@pytest.mark.parametrize(("name", "text"), [("r.urdf", SMALL_URDF), ("r.urdf.xacro", SMALL_XACRO),
+                                            ("r.sdf", SMALL_SDF)], ids=["urdf", "xacro", "sdf"])
+@pytest.mark.parametrize("command", [["validate"], ["tree"]], ids=["validate", "tree"])
+def test_small_urdf_xacro_sdf_without_numpy(name: str, text: str, command: list[str], tmp_path: Path) -> None:
+    """Start-up (issue 9 §3): the readers and the rules build and judge the model with plain tuples
+    (modelkit.rot3); numpy (3× the interpreter's start-up by itself) is for meshes, writers and verify."""
+    path = tmp_path / name
+    path.write_text(text)
+    report = _run([*command, str(path)], ("numpy",))
+    assert report["exit_code"] == 0, report["output"]
+    assert "modelkit.checks.physics" in report["modules"] or command == ["tree"]
+    assert any(m.startswith("modelkit.formats.") and m.endswith(".reader") for m in report["modules"])
+    loaded = [m for m in report["modules"] if m.partition(".")[0] == "numpy"]
+    assert loaded == [], f"`modelkit {command[0]} {name}` imported numpy"
+
+
+def test_valid_body_file_does_not_import_jsonschema(small_model: Path) -> None:
+    """A valid .body document is decided by the compiled schema check; jsonschema only explains errors."""
+    report = _run(["validate", str(small_model)], ("jsonschema",))
+    assert report["exit_code"] == 0, report["output"]
+    assert "modelkit.formats.body.schema" in report["modules"]
+    assert [m for m in report["modules"] if m.partition(".")[0] == "jsonschema"] == []

@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 
-import numpy as np
-
+from modelkit import rot3
 from modelkit.checks.masses import lumped_masses
 from modelkit.checks.registry import rule
 from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
 from modelkit.model import SYNTHESISED, JointType, Link, Robot
-from modelkit.spatial import inertia_tolerance, principal_moments
 
 # Who fills in missing mass properties, per source format (the wording of MK304).
 DEFAULTS_APPLIED_BY = {"body": "Choreonoid uses", "sdf": "SDFormat's defaults apply"}
@@ -157,12 +156,12 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
         severity = None if link.name in moving else Severity.WARNING
         static = "" if link.name in moving else " (the link does not move, so simulators ignore it)"
         where = inertial.sources.get("inertia", _mass_loc(link))
-        tensor = np.asarray(inertial.inertia, dtype=float)
-        if not (np.all(np.isfinite(tensor)) and np.isfinite(inertial.mass)):  # e.g. 1e400 in the file
+        tensor = rot3.mat3(rot3.peek(inertial, "inertia"))  # plain floats: no numpy on the validate path
+        if not (rot3.all_finite(tensor) and math.isfinite(inertial.mass)):  # e.g. 1e400 in the file
             yield diag("MK302", f'link "{link.name}": the mass or inertia is not a finite number', where)
             continue
-        skew = float(np.max(np.abs(tensor - tensor.T)))
-        if skew > ASYMMETRY_TOLERANCE * float(np.max(np.abs(np.diag(tensor)))):
+        skew = max(abs(tensor[i][j] - tensor[j][i]) for i in range(3) for j in range(3))
+        if skew > ASYMMETRY_TOLERANCE * max(abs(tensor[i][i]) for i in range(3)):
             yield diag(
                 "MK301",
                 f'link "{link.name}": the inertia matrix is not symmetric (off-diagonal pairs differ by up '
@@ -171,9 +170,9 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
                 severity=severity,
             )
             continue
-        moments = principal_moments((tensor + tensor.T) / 2)  # a rounding-level asymmetry is ignored
-        eps = inertia_tolerance(moments)
-        if np.all(np.abs(moments) <= eps):
+        moments = rot3.symmetric_eigenvalues(tensor)  # of the symmetric part: rounding asymmetry ignored
+        eps = rot3.inertia_tolerance(moments)
+        if all(abs(m) <= eps for m in moments):
             yield diag(
                 "MK302",
                 f'link "{link.name}" has mass {inertial.mass:g} kg but a zero inertia{static}',

@@ -17,26 +17,25 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
 from lxml import etree
 from lxml.etree import _Element as Element
 
+from modelkit import rot3
 from modelkit.model import DeviceKind
-from modelkit.spatial import Mat3
 from modelkit.xmlsource import parse_number, parse_numbers
 
 # The canonical (robotics) sensor frame's axes seen from a GL camera frame: columns are the GL
 # camera's X (right), Y (up), Z (backwards) written in the robotics frame. Choreonoid calls this
 # R_opt of ``optical_frame: robotics`` (body-format.md §3.7).
-GL_IN_ROBOTICS: Mat3 = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+GL_IN_ROBOTICS: rot3.M3 = ((0.0, 0.0, -1.0), (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
 
 
-def canonical_from_gl(gl_rotation: Mat3) -> Mat3:
+def canonical_from_gl(gl_rotation: Any) -> rot3.M3:
     """The canonical sensor frame's rotation, given the rotation of a GL-style camera frame.
 
     ``T_gl = T_canonical · GL_IN_ROBOTICS``, so ``T_canonical = T_gl · GL_IN_ROBOTICSᵀ``.
     """
-    return np.asarray(gl_rotation, dtype=float) @ GL_IN_ROBOTICS.T
+    return rot3.matmul(rot3.mat3(gl_rotation), rot3.transpose(GL_IN_ROBOTICS))
 
 
 def horizontal_fov(vertical_fov: float, width: float, height: float) -> float:

@@ -13,8 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
+from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
 from modelkit.model import Mesh
 from modelkit.resources import Resolution, Resolver
@@ -130,7 +129,7 @@ class MeshChecker:
             uri=uri,
             path=str(path) if path is not None else None,
             fragment=submesh,
-            scale=np.asarray(scale, dtype=float),
+            scale=rot3.vec3(scale),
         )
 
     def _web_mesh(self, uri: str, loc: SourceLocation) -> None:

@@ -215,7 +215,7 @@ def _range_sensor(node: YMap, angle_scale: float, params: dict[str, Any]) -> set
 OPTICAL_FRAMES: dict[str, Mat3] = {
     "gl": np.eye(3),
     "cv": np.diag([1.0, -1.0, -1.0]),
-    "robotics": GL_IN_ROBOTICS,
+    "robotics": np.array(GL_IN_ROBOTICS),
 }
 OPTICAL_DEVICES = frozenset({"Camera", "CameraDevice", "RangeSensor"})
 CANONICAL_CAMERAS = {
@@ -249,7 +249,7 @@ def canonical_rotation(kind: str, params: dict[str, Any], rotation: Mat3) -> Mat
     extra = params.get("optical_frame_rotation")
     if extra is not None:
         r_opt = r_opt @ np.asarray(extra, dtype=float)
-    return canonical_from_gl(rotation @ r_opt)
+    return np.array(canonical_from_gl(rotation @ r_opt))
 
 
 def node_rotation(kind: str, params: dict[str, Any], canonical: Mat3) -> Mat3:

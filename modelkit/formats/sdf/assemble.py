@@ -19,15 +19,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
+from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, Severity
 from modelkit.formats.sdf.collect import ModelTree
 from modelkit.formats.sdf.joints import AxisSpec, JointData
 from modelkit.formats.sdf.links import LinkData
 from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.model import SYNTHESISED, WORLD_LINK, Inertial, Joint, JointType, Link, LoopConstraint, Robot
-from modelkit.spatial import Pose, Vec3, rotate_inertia
+from modelkit.rot3 import peek
+from modelkit.spatial import Pose
 
 LOOP_TYPES = {
     JointType.FIXED: "fixed",
@@ -162,11 +162,12 @@ class Assembler:
             if not stranded:
                 break
             seeds = [stranded[0]]
-        for j in cycles:
+        for j in cycles:  # a closed chain (libsdformat loads it, e.g. its four_bar.sdf): not an error
             self.sink.emit(
-                "MK203",
-                f'joints form a cycle through link "{j.child_link}": every link on it is the child of '
-                f'a joint, so none can be the root; joint "{j.item.local}" is kept as a loop constraint',
+                "MK241",
+                f'joints form a closed chain through link "{j.child_link}": every link on it is the child '
+                f'of a joint; joint "{j.item.local}" is kept as a loop constraint and "{j.child_link}" '
+                "is taken as the top of the chain",
                 j.joint.loc("child"),
             )
         loops = [j for j in self.joints if j in loops or j in cycles]
@@ -214,25 +215,26 @@ class Assembler:
             entry["pose"] = offset @ entry["pose"]
         inertial = link.inertial
         if inertial is not None:
-            r = offset.rotation
+            r = offset.rotation_tuple
             link.inertial = Inertial(
                 inertial.mass,
-                r @ inertial.com + offset.translation,
-                rotate_inertia(inertial.inertia, r),
+                rot3.add(rot3.matvec(r, rot3.vec3(peek(inertial, "com"))), offset.translation_tuple),
+                rot3.rotate_inertia(rot3.mat3(peek(inertial, "inertia")), r),
                 inertial.defaulted,
                 inertial.source,
                 inertial.sources,
             )
 
-    def _axis_in_joint(self, joint_pose: Pose, spec: AxisSpec | None) -> Vec3:
+    def _axis_in_joint(self, joint_pose: Pose, spec: AxisSpec | None) -> rot3.V3:
         if spec is None:
-            return np.array([0.0, 0.0, 1.0])
-        xyz = np.asarray(spec.xyz, dtype=float)
+            return (0.0, 0.0, 1.0)
+        xyz = rot3.vec3(spec.xyz)
         if spec.frame:
             frame = self.graph.pose(spec.frame)
-            xyz = joint_pose.rotation.T @ frame.rotation @ xyz
-        norm = float(np.linalg.norm(xyz))
-        return xyz / norm if norm > 0.0 else xyz
+            to_joint = rot3.matmul(rot3.transpose(joint_pose.rotation_tuple), frame.rotation_tuple)
+            xyz = rot3.matvec(to_joint, xyz)
+        norm = rot3.norm(xyz)
+        return (xyz[0] / norm, xyz[1] / norm, xyz[2] / norm) if norm > 0.0 else xyz
 
     def _joint(self, data: JointData) -> Joint:
         joint = data.joint

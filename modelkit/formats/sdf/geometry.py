@@ -10,9 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
 from lxml.etree import _Element as Element
-from numpy.typing import NDArray
 
 from modelkit.diagnostics import DiagnosticSink, Severity
 from modelkit.formats.sdf.context import Context
@@ -117,13 +115,13 @@ def _shape(ctx: Context, src: SdfDocument, shape: Element, owner: str, visual_on
         value = default if value is None else value
         return _positive(sink, src, el, value, f"<{kind}> {name} of {owner}")
 
-    def positive_vector(name: str) -> NDArray[np.float64]:
+    def positive_vector(name: str) -> tuple[float, ...]:
         """A three-number child (ones when absent or unreadable); non-positive entries reported."""
         el = child(shape, name)
         vector = values.vector(el, 3) if el is not None else None
-        vector = np.ones(3) if vector is None else vector
-        if el is not None and np.any(vector <= 0.0):
-            message = f"<{kind}> {name} of {owner} must be positive: {vector.tolist()}"
+        vector = (1.0, 1.0, 1.0) if vector is None else vector
+        if el is not None and any(v <= 0.0 for v in vector):
+            message = f"<{kind}> {name} of {owner} must be positive: {list(vector)}"
             sink.emit("MK400", message, values.text_loc(el))
         return vector
 
@@ -152,7 +150,7 @@ def _mesh(ctx: Context, src: SdfDocument, shape: Element, owner: str, visual_onl
     scale_el = child(shape, "scale")
     scale = values.vector(scale_el, 3) if scale_el is not None else None
     if scale is None:
-        scale = np.ones(3)
+        scale = (1.0, 1.0, 1.0)
     submesh_el = child(shape, "submesh")
     submesh = values.text(child(submesh_el, "name")) if submesh_el is not None else None
     mesh = ctx.mesh(
@@ -194,14 +192,14 @@ def read_material(
     specular = values.color(child(material, "specular"))
     emissive = values.color(child(material, "emissive"))
     if diffuse is not None:
-        result.diffuse = np.array(diffuse[:3])
+        result.diffuse = tuple(diffuse[:3])
         result.transparency = 1.0 - diffuse[3]
     if visual_transparency is not None:
         result.transparency = visual_transparency
     if specular is not None:
-        result.specular = np.array(specular[:3])
+        result.specular = tuple(specular[:3])
     if emissive is not None:
-        result.emissive = np.array(emissive[:3])
+        result.emissive = tuple(emissive[:3])
     if ambient is not None:
         extras["ambient"] = list(ambient)
         result.ambient = _ambient_intensity(ambient, diffuse)
@@ -228,6 +226,7 @@ def read_material(
                 values.loc(script),
                 hint="add a <diffuse> colour for tools that do not read Gazebo material scripts",
             )
+    _check_shader(ctx, src, child(material, "shader"), owner)
     for key in ("pbr", "shader", "lighting", "double_sided", "render_order"):
         el = child(material, key)
         if el is not None:
@@ -244,17 +243,51 @@ def read_material(
     return MaterialResult(result, extras)
 
 
+_SHADERS = (  # libsdformat 12 takes both spellings of the normal-map types
+    "pixel",
+    "vertex",
+    "normal_map_object_space",
+    "normal_map_tangent_space",
+    "normal_map_objectspace",
+    "normal_map_tangentspace",
+)
+
+
+def _check_shader(ctx: Context, src: SdfDocument, shader: Element | None, owner: str) -> None:
+    """libsdformat's Material::Load refuses an unknown shader type and a normal-map shader without a
+    ``<normal_map>`` (error 8)."""
+    if shader is None:
+        return
+    kind = (shader.get("type") or "pixel").strip()
+    if kind not in _SHADERS:
+        ctx.sink.emit(
+            "MK121",
+            f'the material shader type "{kind}" of {owner} is not one of {", ".join(_SHADERS[:4])}; '
+            "libsdformat refuses the file",
+            src.values.loc(shader, "type"),
+        )
+    elif kind.startswith("normal_map") and child(shader, "normal_map") is None:
+        ctx.sink.emit(
+            "MK122",
+            f'the material shader of {owner} is "{kind}" but has no <normal_map>; libsdformat refuses '
+            "the file",
+            src.values.loc(shader),
+            hint="give <normal_map> the texture file, or use the shader type pixel",
+        )
+
+
 def _ambient_intensity(
     ambient: tuple[float, float, float, float], diffuse: tuple[float, float, float, float] | None
 ) -> float | None:
     """VRML's ambientIntensity when the ambient colour is a multiple of the diffuse colour."""
     if diffuse is None:
         return None
-    a = np.array(ambient[:3])
-    d = np.array(diffuse[:3])
-    if float(np.max(d)) <= 0.0:
+    a = ambient[:3]
+    d = diffuse[:3]
+    if max(d) <= 0.0:
         return None
-    k = float(a @ d) / float(d @ d)
-    if np.allclose(a, k * d, atol=1e-6) and 0.0 <= k <= 1.0:
+    k = sum(x * y for x, y in zip(a, d, strict=True)) / sum(y * y for y in d)
+    # numpy.allclose(a, k·d, atol=1e-6): |a − k·d| ≤ atol + rtol·|k·d|, rtol = 1e-5
+    if all(abs(x - k * y) <= 1e-6 + 1e-5 * abs(k * y) for x, y in zip(a, d, strict=True)) and 0.0 <= k <= 1.0:
         return k
     return None

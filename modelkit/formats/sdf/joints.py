@@ -16,9 +16,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import numpy as np
 from lxml.etree import _Element as Element
 
+from modelkit import rot3
 from modelkit.diagnostics import Severity, SourceLocation, did_you_mean
 from modelkit.formats.sdf.collect import Item
 from modelkit.formats.sdf.context import Context
@@ -26,7 +26,7 @@ from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import sensor_device
 from modelkit.formats.sdf.values import child, children
 from modelkit.model import WORLD_LINK, Device, Joint, JointLimits, JointType, Mimic
-from modelkit.spatial import Pose, Vec3
+from modelkit.spatial import Pose
 
 TYPES = {
     "revolute": JointType.REVOLUTE,
@@ -43,7 +43,7 @@ UNLIMITED = 1e16
 class AxisSpec:
     """An axis as written: the vector and the frame it is expressed in (a vertex name; "" = joint)."""
 
-    xyz: Vec3
+    xyz: tuple[float, ...]
     frame: str
     loc: SourceLocation | None
 
@@ -170,14 +170,19 @@ def _ends(ctx: Context, graph: FrameGraph, data: JointData, what: str) -> None:
         )
         data.child_link = None
     elif data.child_link is not None and data.child_link == data.parent_link:
+        # libsdformat 12 checks the resolved links of the top model's joints only (error 21); a nested
+        # model's joint is loaded as it is (gz-sim's nested_models/model.sdf)
+        top = item.scope.parent is None
         ctx.sink.emit(
             "MK235",
             f'the parent "{names["parent"]}" and child "{names["child"]}" of {what} are both attached to '
-            f'link "{data.child_link}": libsdformat loads it, but the joint joins that link to itself and '
-            "moves nothing",
+            f'link "{data.child_link}": the joint would join that link to itself and move nothing; '
+            + ("libsdformat refuses it" if top else "libsdformat checks this only in the top model"),
             joint.sources.get("child"),
-            severity=Severity.WARNING,
+            severity=None if top else Severity.WARNING,
         )
+        if top:
+            data.child_link = None
         data.child_link = None
 
 
@@ -189,7 +194,7 @@ def _axis(ctx: Context, graph: FrameGraph, data: JointData, axis_el: Element) ->
     xyz = values.vector(xyz_el, 3) if xyz_el is not None else None
     loc = values.text_loc(xyz_el) if xyz_el is not None else values.loc(axis_el)
     if xyz is None:
-        xyz = np.array([0.0, 0.0, 1.0])
+        xyz = (0.0, 0.0, 1.0)
     frame = ""
     if src.at_least(1, 7):
         written = (xyz_el.get("expressed_in") or "").strip() if xyz_el is not None else ""
@@ -209,7 +214,7 @@ def _axis(ctx: Context, graph: FrameGraph, data: JointData, axis_el: Element) ->
         frame = item.scope.frame  # SDF 1.4: axes are expressed in the model frame
     elif values.boolean(child(axis_el, "use_parent_model_frame")):
         frame = item.scope.frame
-    if float(np.linalg.norm(xyz)) == 0.0 and data.joint.type.moves:
+    if rot3.norm(xyz) == 0.0 and data.joint.type.moves:
         ctx.sink.emit("MK305", f'joint "{item.local}": the axis is the zero vector', loc)
     return AxisSpec(xyz, frame, loc)
 
@@ -280,7 +285,7 @@ def _keep_unsupported(data: JointData) -> None:
     joint = data.joint
     for key, spec in (("sdf_axis", data.axis), ("sdf_axis2", data.axis2)):
         if spec is not None:
-            joint.extras[key] = {"xyz": spec.xyz.tolist(), "expressed_in": spec.frame}
+            joint.extras[key] = {"xyz": list(spec.xyz), "expressed_in": spec.frame}
     values = data.item.src.values
     for key in ("gearbox_ratio", "gearbox_reference_body", "thread_pitch", "screw_thread_pitch"):
         el = child(data.item.element, key)

@@ -17,9 +17,9 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
 from lxml.etree import _Element as Element
 
+from modelkit import rot3
 from modelkit.diagnostics import Severity
 from modelkit.formats.sdf.collect import Item
 from modelkit.formats.sdf.context import Context
@@ -28,7 +28,7 @@ from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import light_device, plugin_data, sensor_device
 from modelkit.formats.sdf.values import child, children
 from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Inertial, Link, Sphere
-from modelkit.spatial import Mat3, Pose, Vec3, combine_mass_properties, inertia_from_moments, rotate_inertia
+from modelkit.spatial import Mat3, Pose, Vec3
 
 DEFAULT_DENSITY = 1000.0
 LINK_FLAGS = ("gravity", "kinematic", "self_collide", "enable_wind", "must_be_base_link")
@@ -81,6 +81,8 @@ def read_link(ctx: Context, graph: FrameGraph, item: Item) -> LinkData:
                 entry = {"element": kind, "name": name, "pose": placed, **shape.unmodelled}
                 link.extras.setdefault("sdf_geometry", []).append(entry)
             if shape.geometry is None:
+                if kind == "visual":  # libsdformat still loads (and judges) its material
+                    read_material(ctx, src, child(geom_el, "material"), child(geom_el, "transparency"), label)
                 continue
             geom = Geom(shape.geometry, placed, name, source=values.loc(geom_el))
             if kind == "visual":
@@ -146,7 +148,7 @@ def _inertial(ctx: Context, graph: FrameGraph, item: Item, to_link: Pose, data: 
     values = src.values
     el = child(item.element, "inertial")
     if el is None:
-        return Inertial(1.0, np.zeros(3), np.eye(3), defaulted=True, source=values.loc(item.element))
+        return Inertial(1.0, rot3.ZERO3, rot3.IDENTITY, defaulted=True, source=values.loc(item.element))
     inertial = Inertial(1.0, source=values.loc(el))
     mass_el = child(el, "mass")
     mass = values.number(mass_el, 1.0)
@@ -160,14 +162,14 @@ def _inertial(ctx: Context, graph: FrameGraph, item: Item, to_link: Pose, data: 
     if pose_el is not None:
         inertial.sources["com"] = values.loc(pose_el)
     inertia_el = child(el, "inertia")
-    tensor = np.eye(3)
+    tensor = rot3.IDENTITY
     if inertia_el is not None:
         inertial.sources["inertia"] = values.loc(inertia_el)
         get = {k: values.child_number(inertia_el, k, d) for k, d in _INERTIA_DEFAULTS.items()}
         v = {k: (d if get[k] is None else float(get[k] or 0.0)) for k, d in _INERTIA_DEFAULTS.items()}
-        tensor = inertia_from_moments(**v)
-    inertial.com = frame.translation.copy()
-    inertial.inertia = rotate_inertia(tensor, frame.rotation)
+        tensor = rot3.inertia_from_moments(**v)
+    inertial.com = frame.translation_tuple
+    inertial.inertia = rot3.rotate_inertia(tensor, frame.rotation_tuple)
     if values.attribute_bool(el, "auto"):
         _auto(ctx, item, el, inertial, data)
     return inertial
@@ -177,6 +179,10 @@ _INERTIA_DEFAULTS = {"ixx": 1.0, "ixy": 0.0, "ixz": 0.0, "iyy": 1.0, "iyz": 0.0,
 
 
 def _auto(ctx: Context, item: Item, el: Element, inertial: Inertial, data: LinkData) -> None:
+    import numpy as np  # automatic inertia is rare: numpy only for the files that ask for it
+
+    from modelkit.spatial import combine_mass_properties, rotate_inertia
+
     values = item.src.values
     link = data.link
     density = values.child_number(el, "density", DEFAULT_DENSITY) or DEFAULT_DENSITY
@@ -217,6 +223,8 @@ def _auto(ctx: Context, item: Item, el: Element, inertial: Inertial, data: LinkD
 
 def _solid(geometry: object, density: float) -> tuple[float, Vec3, Mat3] | None:
     """Mass, centre of mass and inertia about it (own axes) of a uniform primitive."""
+    import numpy as np
+
     zero = np.zeros(3)
     if isinstance(geometry, Box):
         a, b, c = (float(x) for x in geometry.size)

@@ -31,6 +31,11 @@ from modelkit.spatial import Pose
 _RESERVED = re.compile(r"^__.*__$")
 
 
+def reserved_name(local: str) -> bool:
+    """A name libsdformat 12 refuses for a link, joint, frame or model in every version (MK238)."""
+    return local == "world" or _RESERVED.match(local) is not None
+
+
 @dataclass(eq=False)
 class Vertex:
     name: str  # flattened
@@ -100,7 +105,7 @@ class FrameGraph:
                 self.sink.emit("MK120", f"<{item.kind}> has no name attribute", values.loc(item.element))
                 continue
             modern = item.src.at_least(1, 7)
-            if item.local == "world" or _RESERVED.match(item.local):  # libsdformat 12: every version
+            if reserved_name(item.local):  # libsdformat 12: every version
                 self.sink.emit(
                     "MK238",
                     f'the {item.kind} name "{item.local}" is reserved in SDFormat ("world" and names '

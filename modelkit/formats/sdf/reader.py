@@ -166,7 +166,9 @@ class _Reader:
 
     def _robot(self, model: _Model, frames: WorldFrames) -> Robot:
         ctx, tree, graph = self.ctx, model.tree, model.graph
-        links = [read_link(ctx, graph, item) for item in tree.of_kind("link")]
+        # a link named "world" is refused (MK238) and left out, so that it causes no follow-on errors
+        # (a duplicate of the world a joint's parent "world" names, a second root)
+        links = [read_link(ctx, graph, item) for item in tree.of_kind("link") if item.local != "world"]
         joints = [read_joint(ctx, graph, item) for item in tree.of_kind("joint")]
         placement = Placement(frames.pose(model.entry.name) if model.entry.name else Pose(), model.static)
         robot = Assembler(tree, graph, links, joints, placement, self.sink).robot()

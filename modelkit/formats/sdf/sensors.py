@@ -243,7 +243,7 @@ def light_device(ctx: Context, src: SdfDocument, el: Element, owner: str) -> Dev
                 params[f"attenuation_{key}" if key != "range" else "range"] = value
     direction = values.vector(child(el, "direction"), 3)
     if direction is not None:
-        params["direction"] = direction.tolist()
+        params["direction"] = list(direction)
     spot = child(el, "spot")
     if spot is not None:
         for key in ("inner_angle", "outer_angle", "falloff"):

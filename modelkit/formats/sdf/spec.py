@@ -136,6 +136,10 @@ class ElementSpec:
     type: str | None = None  # the type of the element's text (libsdformat's description), if it has one
     minimum: float | None = None  # libsdformat refuses a value below ``min`` or above ``max``
     maximum: float | None = None
+    # required="1" in the description: libsdformat refuses an empty value ("Empty string used when
+    # setting a required parameter"); an empty optional value keeps the default
+    required: bool = False
+    required_attributes: set[str] = field(default_factory=set)  # likewise for attributes
 
 
 @lru_cache(maxsize=1)
@@ -152,6 +156,8 @@ def catalogue() -> dict[str, ElementSpec]:
             type=entry.get("type"),
             minimum=entry.get("min"),
             maximum=entry.get("max"),
+            required=bool(entry.get("required", False)),
+            required_attributes=set(entry.get("required_attributes", [])),
         )
     return out
 
@@ -189,6 +195,8 @@ def check_elements(
         if spec is None or spec.any_content:
             continue
         _check_attributes(doc, sink, element, spec)
+        if values is not None:
+            values.extend(_empty_required(doc, element, spec))
         if values is not None and spec.type is not None and len(element) == 0:
             fault = value_fault(spec, element.text)
             if fault is not None:
@@ -310,6 +318,31 @@ def _bounds(spec: ElementSpec, value: float) -> str | None:
     return None
 
 
+def _empty_required(doc: XmlDocument, element: Element, spec: ElementSpec) -> list[Diagnostic]:
+    """Empty values libsdformat refuses: those of elements and attributes its description requires."""
+    out = []
+    if spec.required and len(element) == 0 and not (element.text or "").strip():
+        out.append(
+            diag(
+                "MK121",
+                f"<{spec.name}> is empty; libsdformat refuses an empty value for a required element",
+                doc.text_loc(element),
+            )
+        )
+    for name in sorted(spec.required_attributes):
+        raw = element.get(name)
+        if raw is not None and not raw.strip():
+            out.append(
+                diag(
+                    "MK121",
+                    f"attribute {name} of <{spec.name}> is empty; libsdformat refuses an empty required "
+                    "attribute",
+                    doc.loc(element, name),
+                )
+            )
+    return out
+
+
 def _check_attributes(doc: XmlDocument, sink: DiagnosticSink, element: Element, spec: ElementSpec) -> None:
     for name in element.attrib:
         key = str(name)
@@ -341,6 +374,7 @@ def _hint(tag: str, spec: ElementSpec) -> str | None:
 
 def _generate(spec_root: Path) -> dict[str, dict[str, object]]:
     table: dict[str, ElementSpec] = {}
+    attribute_required: dict[tuple[str, str], bool] = {}  # a later version's description wins
 
     def entry(ident: str, name: str) -> ElementSpec:
         return table.setdefault(ident, ElementSpec(name))
@@ -355,6 +389,7 @@ def _generate(spec_root: Path) -> dict[str, dict[str, object]]:
                 continue
             if child.tag == "attribute":
                 item.attributes.add(str(child.get("name")))
+                attribute_required[(ident, str(child.get("name")))] = child.get("required") == "1"
             elif child.tag == "include":
                 stem = Path(str(child.get("filename"))).stem
                 top = _top(folder / f"{stem}.sdf")
@@ -378,6 +413,7 @@ def _generate(spec_root: Path) -> dict[str, dict[str, object]]:
         if kind and kind != "string" and len([c for c in el if c.tag == "element"]) == 0:
             item.type = str(kind)
             item.minimum, item.maximum = _bound(el.get("min")), _bound(el.get("max"))
+        item.required = bool(kind) and el.get("required") == "1" and not any(c.tag == "element" for c in el)
 
     for folder in sorted(
         (p for p in spec_root.iterdir() if p.is_dir() and p.name in _VERSIONS), key=lambda p: _version(p.name)
@@ -392,6 +428,9 @@ def _generate(spec_root: Path) -> dict[str, dict[str, object]]:
         item.attributes.update(attributes)
         item.children.update(children)
         item.any_content = item.any_content or any_content
+    for (ident, name), required in attribute_required.items():
+        if required:
+            table[ident].required_attributes.add(name)
     return {
         ident: {
             "name": spec.name,
@@ -401,6 +440,8 @@ def _generate(spec_root: Path) -> dict[str, dict[str, object]]:
             **({"type": spec.type} if spec.type else {}),
             **({"min": spec.minimum} if spec.minimum is not None else {}),
             **({"max": spec.maximum} if spec.maximum is not None else {}),
+            **({"required": True} if spec.required else {}),
+            **({"required_attributes": sorted(spec.required_attributes)} if spec.required_attributes else {}),
         }
         for ident, spec in sorted(table.items())
     }

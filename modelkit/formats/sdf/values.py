@@ -11,11 +11,11 @@ import math
 import re
 from dataclasses import dataclass
 
-import numpy as np
 from lxml.etree import _Element as Element
 
+from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
-from modelkit.spatial import Pose, Vec3, matrix_from_quat_wxyz, matrix_from_rpy
+from modelkit.spatial import Pose
 from modelkit.xmlsource import XmlDocument, parse_number
 
 _INF = re.compile(r"[+-]?inf(inity)?", re.IGNORECASE)
@@ -78,10 +78,16 @@ class Values:
     def number(
         self, element: Element | None, default: float | None = None, allow_inf: bool = False
     ) -> float | None:
-        """The number written in ``element`` (``default`` when absent; reported when invalid)."""
+        """The number written in ``element`` (``default`` when absent or empty; reported when invalid).
+
+        An empty value is libsdformat's default; where its description requires a value, the element
+        check (:func:`modelkit.formats.sdf.spec.check_elements`) reports it, for every value kind.
+        """
         if element is None:
             return default
         text = (element.text or "").strip()
+        if not text:
+            return default
         value = parse_number(text)
         if value is None and allow_inf and _INF.fullmatch(text):
             value = -math.inf if text.startswith("-") else math.inf
@@ -97,23 +103,29 @@ class Values:
     ) -> float | None:
         return self.number(None if parent is None else child(parent, name), default, allow_inf)
 
-    def vector(self, element: Element | None, count: int, what: str | None = None) -> Vec3 | None:
+    def vector(
+        self, element: Element | None, count: int, what: str | None = None
+    ) -> tuple[float, ...] | None:
         """``count`` blank-separated numbers, or None (reported) when the text is not that."""
         if element is None:
             return None
         text = (element.text or "").strip()
+        if not text:
+            return None  # libsdformat's default; the element check reports it where a value is required
         items = text.split()
         values = [_finite(parse_number(t)) for t in items]
         if len(items) != count or any(v is None for v in values):
             shown = what or f"<{element.tag}>"
             self.invalid(element, f'{shown} must be {count} numbers, not "{text}"')
             return None
-        return np.array([float(v) for v in values if v is not None])
+        return tuple(float(v) for v in values if v is not None)
 
     def boolean(self, element: Element | None, default: bool = False) -> bool:
         if element is None:
             return default
         text = (element.text or "").strip().lower()
+        if not text:
+            return default  # libsdformat's default; the element check reports it where a value is required
         if text in TRUE_WORDS:
             return True
         if text in FALSE_WORDS:
@@ -140,6 +152,8 @@ class Values:
         if element is None:
             return None
         text = (element.text or "").strip()
+        if not text:
+            return None
         values = [_finite(parse_number(t)) for t in text.split()]
         if len(values) not in (3, 4) or any(v is None for v in values):
             self.invalid(element, f'<{element.tag}> must be a colour of 3 or 4 numbers, not "{text}"')
@@ -180,7 +194,7 @@ class Values:
             self.invalid(element, f'<pose> must be {count} numbers ({layout}); {why}: "{text}"')
             return None
         nums = [float(v) for v in values if v is not None]
-        translation = np.array(nums[:3])
+        translation = rot3.vec3(nums[:3])
         if fmt == "quat_xyzw":
             if degrees:
                 self.sink.emit(
@@ -190,6 +204,6 @@ class Values:
                 self.invalid(element, "<pose> quaternion is zero")
                 return None
             x, y, z, w = nums[3:]
-            return Pose(matrix_from_quat_wxyz((w, x, y, z)), translation)
+            return Pose(rot3.from_quat_wxyz((w, x, y, z)), translation)
         angles = [math.radians(a) for a in nums[3:]] if degrees else nums[3:]
-        return Pose(matrix_from_rpy(*angles), translation)
+        return Pose(rot3.from_rpy(*angles), translation)

@@ -15,15 +15,15 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
 from lxml import etree
 from lxml.etree import _Element as Element
 
+from modelkit import rot3
 from modelkit.diagnostics import did_you_mean
 from modelkit.formats.devices import sdf_sensor_canonical
 from modelkit.formats.urdf.values import Context
 from modelkit.model import Device, Joint, Link, Robot
-from modelkit.spatial import Pose, matrix_from_rpy
+from modelkit.spatial import Pose
 from modelkit.xmlsource import parse_number, parse_numbers
 
 # Simple values of a <gazebo> block that libsdformat maps onto the model (peers.md §2.1).
@@ -155,7 +155,7 @@ def _sensor(ctx: Context, element: Element) -> Device | None:
                 ctx.text_loc(pose_el),
             )
         else:
-            device.pose = Pose(matrix_from_rpy(*values[3:]), np.array(values[:3]))
+            device.pose = Pose(rot3.from_rpy(*values[3:]), rot3.vec3(values[:3]))
     return device
 
 

@@ -8,9 +8,9 @@ and upper are ignored on it, as urdfdom, libsdformat and MuJoCo ignore them.
 
 from __future__ import annotations
 
-import numpy as np
 from lxml.etree import _Element as Element
 
+from modelkit import rot3
 from modelkit.diagnostics import did_you_mean
 from modelkit.formats.urdf.values import Context, number, origin, vector
 from modelkit.model import Joint, JointLimits, JointType, Mimic
@@ -34,7 +34,7 @@ def read_joint(ctx: Context, element: Element) -> Joint:
         ctx.emit("MK120", "<joint> has no `name` attribute", ctx.loc(element))
     word = element.get("type")
     joint = Joint(name=name or "", type=JointType.FIXED, parent="", child="", source=ctx.loc(element))
-    joint.axis = np.array([1.0, 0.0, 0.0])
+    joint.axis = (1.0, 0.0, 0.0)
     joint.sources["name"] = ctx.loc(element, "name")
     joint.sources["type"] = ctx.loc(element, "type")
     label = f'joint "{joint.name}"'
@@ -96,8 +96,7 @@ def _axis(ctx: Context, element: Element, joint: Joint, label: str) -> None:
     values = vector(ctx, axis_el, "xyz", f"axis of {label}")
     if values is None:
         return
-    axis = np.array(values)
-    norm = float(np.linalg.norm(axis))
+    norm = rot3.norm(values)
     if norm == 0.0:
         ctx.emit(
             "MK305",
@@ -105,7 +104,7 @@ def _axis(ctx: Context, element: Element, joint: Joint, label: str) -> None:
             ctx.loc(axis_el, "xyz"),
         )
         return
-    joint.axis = axis / norm
+    joint.axis = tuple(v / norm for v in values)
 
 
 def _limit(ctx: Context, element: Element, joint: Joint, word: str | None, label: str) -> None:

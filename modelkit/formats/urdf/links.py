@@ -9,14 +9,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import numpy as np
 from lxml.etree import _Element as Element
 
+from modelkit import rot3
 from modelkit.diagnostics import Severity, did_you_mean
 from modelkit.formats.meshref import MeshChecker
 from modelkit.formats.urdf.values import Context, number, origin, vector
 from modelkit.model import Box, Capsule, Cylinder, Geom, Geometry, Inertial, Link, Sphere, VisualMaterial
-from modelkit.spatial import inertia_from_moments, rotate_inertia
 
 INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
@@ -51,7 +50,7 @@ class Materials:
                         ctx.loc(color, "rgba"),
                         hint="colours are fractions: 255 is written 1",
                     )
-                material.diffuse = np.array([min(max(v, 0.0), 1.0) for v in rgba[:3]])
+                material.diffuse = tuple(min(max(v, 0.0), 1.0) for v in rgba[:3])
                 material.transparency = 1.0 - min(max(rgba[3], 0.0), 1.0)
         texture = ctx.first(element, "texture")
         if texture is not None:
@@ -167,8 +166,8 @@ def read_inertial(ctx: Context, element: Element, link: str) -> Inertial | None:
         return None
     inertial = Inertial(
         mass=mass,
-        com=pose.translation.copy(),
-        inertia=rotate_inertia(tensor, pose.rotation),
+        com=pose.translation_tuple,
+        inertia=rot3.rotate_inertia(tensor, pose.rotation_tuple),
         source=ctx.loc(element),
     )
     inertial.sources["mass"] = ctx.loc(mass_el, "value")
@@ -178,7 +177,7 @@ def read_inertial(ctx: Context, element: Element, link: str) -> Inertial | None:
     return inertial
 
 
-def _inertia(ctx: Context, element: Element, link: str) -> np.ndarray | None:
+def _inertia(ctx: Context, element: Element, link: str) -> rot3.M3 | None:
     missing = [k for k in INERTIA_KEYS if element.get(k) is None]
     if missing:
         ctx.emit(
@@ -191,7 +190,7 @@ def _inertia(ctx: Context, element: Element, link: str) -> np.ndarray | None:
     values = [number(ctx, element, k, f'inertia of link "{link}"') for k in INERTIA_KEYS]
     if any(v is None for v in values):
         return None
-    return inertia_from_moments(*(float(v or 0.0) for v in values))
+    return rot3.inertia_from_moments(*(float(v or 0.0) for v in values))
 
 
 # A visual or collision without a shape (MK122): who loads the file and who refuses it.
@@ -246,7 +245,7 @@ def read_geometry(
             return None
         if any(s <= 0.0 for s in size):
             _not_positive(ctx, shape, "size", f"box of the {what}")
-        return Box(size=np.array(size))
+        return Box(size=tuple(size))
     if tag in ("cylinder", "capsule"):
         if tag == "capsule":
             ctx.uses_feature("<capsule>", "1.1", loc)

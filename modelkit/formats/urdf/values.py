@@ -9,12 +9,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import numpy as np
 from lxml import etree
 from lxml.etree import _Element as Element
 
+from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
-from modelkit.spatial import Pose, matrix_from_quat_wxyz, matrix_from_rpy
+from modelkit.spatial import Pose
 from modelkit.xmlsource import XmlDocument, parse_number, parse_numbers
 
 # URDF versions modelkit reads, and the version that introduced each later feature.
@@ -69,7 +69,9 @@ class Context:
         """URDF child elements of ``element`` (all, or those called ``name``), in document order."""
         out = []
         for child in element:
-            tag = self.tag(child)
+            raw = child.tag
+            # no namespace, the common case, at once; comments and namespaced elements by the full rule
+            tag = raw if type(raw) is str and not raw.startswith("{") else self.tag(child)
             if tag is not None and (name is None or tag == name):
                 out.append(child)
         return out
@@ -152,7 +154,7 @@ def origin(ctx: Context, element: Element | None, what: str) -> Pose | None:
     pose = Pose()
     xyz = vector(ctx, element, "xyz", f"{what} origin")
     if xyz is not None:
-        pose.translation = np.array(xyz)
+        pose.translation = rot3.vec3(xyz)
     elif element.get("xyz") is not None:
         ok = False
     has_rpy = element.get("rpy") is not None
@@ -170,7 +172,7 @@ def origin(ctx: Context, element: Element | None, what: str) -> Pose | None:
         if rpy is None:
             ok = False
         else:
-            pose.rotation = matrix_from_rpy(*rpy)
+            pose.rotation = rot3.from_rpy(*rpy)
     elif has_quat:
         ctx.uses_feature("`quat_xyzw`", "1.1", ctx.loc(element, "quat_xyzw"))
         quat = vector(ctx, element, "quat_xyzw", f"{what} origin", count=4)
@@ -187,5 +189,5 @@ def origin(ctx: Context, element: Element | None, what: str) -> Pose | None:
                 ok = False
             else:
                 x, y, z, w = quat
-                pose.rotation = matrix_from_quat_wxyz((w, x, y, z))
+                pose.rotation = rot3.from_quat_wxyz((w, x, y, z))
     return pose if ok else None
