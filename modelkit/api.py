@@ -15,10 +15,14 @@ from modelkit.model import Robot
 # file's own loader accepts them: under that target they are errors, since that consumer (and
 # ``convert --to`` it) will meet them. Everywhere else they stay warnings that name the consumers.
 TARGET_REFUSALS: dict[str, frozenset[str]] = {
-    "mjcf": frozenset({"MK303", "MK313"}),  # MuJoCo: inertia violating A + B >= C; a moving link, no mass
+    # MuJoCo: inertia violating A + B >= C; a moving link, no mass; URDF parts its URDF import refuses (a
+    # shape without its size or file, an incomplete inertia or inertial, a short rgba or mesh scale)
+    "mjcf": frozenset({"MK303", "MK313", "MK143", "MK144", "MK145", "MK146", "MK420"}),
     "sdf": frozenset({"MK303", "MK211"}),  # libsdformat: the same, and links and joints sharing a name
     "urdf": frozenset(),
-    "pybullet": frozenset({"MK122"}),  # PyBullet: a URDF visual or collision without a shape
+    # PyBullet: a URDF visual or collision without a shape, a shape without its size or file, an
+    # inertial without mass value, inertia or a diagonal moment
+    "pybullet": frozenset({"MK122", "MK143", "MK145"}),
 }
 TARGETS = tuple(TARGET_REFUSALS)
 

@@ -225,6 +225,43 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A URDF 1.1/1.2 feature (`quat_xyzw`, `<capsule>`, `<limit acceleration>`...) in a document that "
         "declares an older version; older parsers silently misread it.",
     ),
+    CodeInfo(
+        "MK143",
+        "urdf-shape-unreadable",
+        "warning",
+        "A URDF `<mesh>` without `filename`, `<box>` without `size`, `<sphere>` without `radius` or "
+        "`<cylinder>`/`<capsule>` without `radius` or `length`; modelkit leaves that visual or collision "
+        "out. Reference: urdfdom (check_urdf, libsdformat's URDF conversion) logs an error, drops it and "
+        "every later visual and collision of the link, and loads the robot; PyBullet and MuJoCo refuse the "
+        "file (an error under `--target pybullet|mjcf`).",
+    ),
+    CodeInfo(
+        "MK144",
+        "urdf-inertia-incomplete",
+        "warning",
+        "A URDF `<inertia>` lacks some of `ixy`, `ixz`, `iyz`; modelkit reads them as 0, as PyBullet does. "
+        "Reference: urdfdom logs an error, keeps the mass with an all-zero inertia, drops every visual and "
+        "collision of the link, and loads the robot (so does libsdformat's URDF conversion); MuJoCo refuses "
+        "the file (an error under `--target mjcf`).",
+    ),
+    CodeInfo(
+        "MK145",
+        "urdf-inertial-unreadable",
+        "warning",
+        "A URDF `<inertial>` without `<mass value>` or without `<inertia>`, or an `<inertia>` lacking a "
+        "diagonal moment; modelkit leaves the inertial out. Reference: urdfdom logs an error, keeps what it "
+        "read before (mass 0 when unread, an all-zero inertia), drops every visual and collision of the "
+        "link, and loads the robot; PyBullet and MuJoCo refuse the file (an error under "
+        "`--target pybullet|mjcf`).",
+    ),
+    CodeInfo(
+        "MK146",
+        "urdf-color-unreadable",
+        "warning",
+        "A URDF `<color rgba>` does not hold four numbers; modelkit leaves the colour unset. Reference: "
+        "urdfdom silently makes the colour black (0 0 0 1) and loads the robot, PyBullet uses its default "
+        "colour; MuJoCo refuses the file (an error under `--target mjcf`).",
+    ),
     # -- MK15x/MK16x: SDF -------------------------------------------------------------------
     # (sdf section)
     CodeInfo("MK150", "sdf-version-missing", "error", "`<sdf>` has no `version` attribute."),
@@ -505,7 +542,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "A link has no mass information; Choreonoid uses 1 kg and an identity inertia.",
     ),
-    CodeInfo("MK305", "joint-axis-zero", "error", "A joint axis is the zero vector."),
+    CodeInfo(
+        "MK305",
+        "joint-axis-zero",
+        "error",
+        "A joint axis is the zero vector: the joint has no direction of motion and cannot be simulated "
+        "meaningfully. Reference: check_urdf and PyBullet load such a URDF; libsdformat and MuJoCo refuse "
+        "it.",
+    ),
     CodeInfo(
         "MK306",
         "joint-axis-not-unit",
@@ -513,7 +557,11 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A joint axis is not a unit vector (Choreonoid uses it as given).",
     ),
     CodeInfo(
-        "MK307", "joint-range-reversed", "error", "A joint range has its lower bound above its upper bound."
+        "MK307",
+        "joint-range-reversed",
+        "error",
+        "A joint range has its lower bound above its upper bound. Reference: in URDF a warning (urdfdom, "
+        "libsdformat's URDF conversion, PyBullet and MuJoCo load it).",
     ),
     CodeInfo("MK308", "rotation-axis-zero", "error", "A rotation axis is the zero vector."),
     CodeInfo(
@@ -554,7 +602,12 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A velocity range has its lower bound above its upper.",
     ),
     CodeInfo(
-        "MK320", "mimic-target-undefined", "error", "A mimic joint follows a joint that does not exist."
+        "MK320",
+        "mimic-target-undefined",
+        "error",
+        "A mimic joint follows a joint that does not exist. Reference: in URDF a warning (urdfdom, "
+        "libsdformat's URDF conversion, PyBullet and MuJoCo load the robot and the joint moves freely; "
+        "modelkit drops the mimic).",
     ),
     CodeInfo(
         "MK321",
@@ -660,7 +713,10 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK420",
         "mesh-scale-single-number",
         "warning",
-        "A URDF mesh `scale` has one number; URDF needs three (urdfdom drops the shape).",
+        "A URDF mesh `scale` has one or two numbers; URDF needs three. modelkit reads the first as a uniform "
+        "scale, as PyBullet does. Reference: urdfdom logs an error, drops the shape and every later visual "
+        "and collision of the link, and loads the robot; MuJoCo refuses the file (an error under "
+        "`--target mjcf`).",
     ),
     # (urdf geometry MK421-MK429)
     # (sdf geometry MK430-MK439)

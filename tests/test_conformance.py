@@ -28,6 +28,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import mujoco
@@ -857,3 +858,169 @@ def test_model_frame_as_joint_end_is_an_exception_for_libsdformat_12(
         )
         assert not _libsdformat_accepts(sdf_oracle, path)
         assert validate(path).errors == []
+
+
+# ---- URDF parts urdfdom logs an error for, drops, and loads the robot anyway --------------------------
+# Each case: the robot's extra text, the code and severity modelkit gives, and which consumers refuse
+# the file (checked live below: check_urdf always accepts; PyBullet in a child process, MuJoCo's URDF
+# import and libsdformat's URDF conversion, which runs the same urdfdom). ``--target`` makes the finding
+# an error exactly for the consumers that refuse it.
+
+_ARM = (
+    '<link name="arm"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/>'
+    "</inertial></link>"
+)
+_HINGE = (
+    '<joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="{axis}"/>'
+    '<limit lower="{lower}" upper="{upper}" effort="1" velocity="1"/>{mimic}</joint>'
+)
+
+
+def _hinge(axis: str = "0 0 1", lower: str = "-1", upper: str = "1", mimic: str = "") -> str:
+    return _ARM + _HINGE.format(axis=axis, lower=lower, upper=upper, mimic=mimic)
+
+
+def _part(part: str) -> str:
+    return _URDF_BASE.replace("</link>", part + "</link>") + _hinge()
+
+
+def _inertial(inertial: str) -> str:
+    """The base and a moving arm whose inertial is ``inertial`` (and a collision box)."""
+    arm = f'<link name="arm">{inertial}<collision><geometry><box size="1 1 1"/></geometry></collision></link>'
+    return _URDF_BASE + _hinge().replace(_ARM, arm)
+
+
+_MESH = "m.stl"
+_TRIANGLE_STL = (
+    "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+    "endsolid t\n"
+)
+_URDFDOM_TOLERATED: dict[str, tuple[str, str, str, frozenset[str]]] = {
+    # case: (robot text, code, severity, consumers that refuse the file)
+    "a mesh without filename": (
+        _part("<collision><geometry><mesh/></geometry></collision>"), "MK143", "warning",
+        frozenset({"pybullet", "mjcf"}),
+    ),
+    "a box without size": (
+        _part("<collision><geometry><box/></geometry></collision>"), "MK143", "warning",
+        frozenset({"pybullet", "mjcf"}),
+    ),
+    "a cylinder without radius": (
+        _part('<collision><geometry><cylinder length="1"/></geometry></collision>'), "MK143", "warning",
+        frozenset({"pybullet", "mjcf"}),
+    ),
+    "a mesh scale of two numbers": (
+        _part(f'<collision><geometry><mesh filename="{_MESH}" scale="0.5 0.5"/></geometry></collision>'),
+        "MK420", "warning", frozenset({"mjcf"}),
+    ),
+    "an inertia without its off-diagonal terms": (
+        _inertial('<inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1"/></inertial>'), "MK144",
+        "warning", frozenset({"mjcf"}),
+    ),
+    "an inertia without ixx": (
+        _inertial('<inertial><mass value="1"/><inertia iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>'),
+        "MK145", "warning", frozenset({"pybullet", "mjcf"}),
+    ),
+    "a mass without value": (
+        _inertial('<inertial><mass/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>'),
+        "MK145", "warning", frozenset({"pybullet", "mjcf"}),
+    ),
+    "an inertial without inertia": (
+        _inertial('<inertial><mass value="1"/></inertial>'), "MK145", "warning",
+        frozenset({"pybullet", "mjcf"}),
+    ),
+    "a colour of three numbers": (
+        _part('<visual><geometry><box size="1 1 1"/></geometry><material name="red"><color rgba="1 0 0"/>'
+              "</material></visual>"),
+        "MK146", "warning", frozenset({"mjcf"}),
+    ),
+    "a mimic of a joint that does not exist": (
+        _URDF_BASE + _hinge(mimic='<mimic joint="nothere"/>'), "MK320", "warning", frozenset(),
+    ),
+    "a lower limit above the upper": (
+        _URDF_BASE + _hinge(lower="1", upper="-1"), "MK307", "warning", frozenset(),
+    ),
+    # not simulable: the joint has no direction of motion (an error by the policy; PyBullet loads it)
+    "a zero axis on a revolute joint": (
+        _URDF_BASE + _hinge(axis="0 0 0"), "MK305", "error", frozenset({"sdf", "mjcf"}),
+    ),
+}
+
+_PYBULLET_LOADS = """
+import sys
+import pybullet
+pybullet.connect(pybullet.DIRECT)
+try:
+    pybullet.loadURDF(sys.argv[1])
+except pybullet.error:
+    sys.exit(3)
+"""
+
+
+def _consumers_refusing(path: Path, oracle: Path) -> set[str]:
+    """Which of PyBullet, MuJoCo's URDF import and libsdformat's URDF conversion refuse the file, live."""
+    refused = set()
+    run = subprocess.run(
+        [sys.executable, "-c", _PYBULLET_LOADS, str(path)], capture_output=True, timeout=60
+    )
+    assert run.returncode in (0, 3), run.stderr[-400:]
+    if run.returncode == 3:
+        refused.add("pybullet")
+    try:
+        mujoco.MjModel.from_xml_path(str(path))
+    except ValueError:
+        refused.add("mjcf")
+    # urdfdom's console lines ("Error: ... at line N in urdf_parser/src/link.cpp") are logs, not
+    # refusals: libsdformat's verdict is its exit status
+    if subprocess.run([str(oracle), path.name], cwd=path.parent, capture_output=True, timeout=60).returncode:
+        refused.add("sdf")
+    return refused
+
+
+@pytest.mark.parametrize("case", sorted(_URDFDOM_TOLERATED))
+def test_urdf_parts_urdfdom_tolerates(
+    case: str, tmp_path: Path, sdf_oracle: Path, monkeypatch: pytest.MonkeyPatch  # noqa: F811
+) -> None:
+    body, code, severity, refusing = _URDFDOM_TOLERATED[case]
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes MUJOCO_LOG.TXT where it runs when it refuses a file
+    (tmp_path / _MESH).write_text(_TRIANGLE_STL)
+    path = tmp_path / "r.urdf"
+    path.write_text(_urdf(body))
+    assert check_urdf_accepts(path)[0], case  # urdfdom logs an error at most, and loads the robot
+    assert _consumers_refusing(path, sdf_oracle) == refusing, case
+    v = validate(path)
+    found = [(d.code, d.severity.value) for d in v.diagnostics if d.code == code]
+    assert found == [(code, severity)], (case, v.diagnostics)
+    assert [d.code for d in v.errors] == ([code] if severity == "error" else []), (case, v.errors)
+    for target in ("pybullet", "mjcf", "sdf", "urdf"):
+        judged = validate(path, target=target)
+        expected = severity == "error" or (target in refusing and target != "sdf")
+        assert bool(judged.errors) == expected, (case, target, judged.errors)
+
+
+def test_unreadable_urdf_parts_keep_the_rest_of_the_link(tmp_path: Path) -> None:
+    """urdfdom stops reading a link at its first unreadable part: the visuals after a bad visual and every
+    collision are gone, an unreadable inertia zeroes the inertia and drops the link's geometry (seen in
+    libsdformat's URDF conversion, which runs the same urdfdom). modelkit keeps the readable parts and says
+    what urdfdom drops."""
+    path = tmp_path / "r.urdf"
+    path.write_text(
+        _urdf(
+            '<link name="base"><inertial><mass value="2"/><inertia ixx="1" iyy="1" izz="1"/></inertial>'
+            '<collision name="kept_not"><geometry><sphere radius="1"/></geometry></collision></link>'
+            '<link name="b2"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" '
+            'iyz="0"/></inertial><visual name="first"><geometry><box size="1 1 1"/></geometry></visual>'
+            '<visual><geometry><mesh/></geometry></visual><visual name="after"><geometry>'
+            '<box size="2 2 2"/></geometry></visual><collision name="c"><geometry><sphere radius="1"/>'
+            '</geometry></collision></link><joint name="j" type="continuous"><parent link="base"/>'
+            '<child link="b2"/><axis xyz="0 0 1"/></joint>'
+        )
+    )
+    v = validate(path)
+    assert v.errors == [] and sorted(_codes(v, "warning")) == ["MK143", "MK144"]
+    for d in v.warnings:
+        assert "every" in d.message and "urdfdom" in d.message, d.message
+    robot = v.robot
+    assert robot is not None
+    b2 = next(link for link in robot.links if link.name == "b2")
+    assert len(b2.visuals) == 2 and len(b2.collisions) == 1  # modelkit keeps the readable parts

@@ -208,11 +208,15 @@ def joint_ranges(robot: Robot) -> Iterator[Diagnostic]:
     for joint in robot.joints:
         limits = joint.limits
         if limits.lower > limits.upper:
+            urdf = robot.source_format == "urdf"  # urdfdom, libsdformat, PyBullet and MuJoCo load it
             yield diag(
                 "MK307",
                 f'joint "{joint.name}": lower limit {limits.lower:.6g} is above upper limit '
-                f"{limits.upper:.6g}",
+                f"{limits.upper:.6g}"
+                + ("; no position is within the limits (urdfdom, libsdformat's URDF conversion, PyBullet "
+                   "and MuJoCo load it)" if urdf else ""),
                 joint.loc("range"),
+                severity=Severity.WARNING if urdf else None,
             )
         if limits.velocity_lower > limits.velocity_upper:
             yield diag(

@@ -100,7 +100,9 @@ def _axis(ctx: Context, element: Element, joint: Joint, label: str) -> None:
     if norm == 0.0:
         ctx.emit(
             "MK305",
-            f'{label}: the axis "{axis_el.get("xyz")}" is the zero vector; the joint cannot move',
+            f'{label}: the axis "{axis_el.get("xyz")}" is the zero vector; the joint has no direction of '
+            "motion and cannot be simulated (check_urdf and PyBullet load it; libsdformat and MuJoCo "
+            "refuse it)",
             ctx.loc(axis_el, "xyz"),
         )
         return

@@ -7,6 +7,7 @@ stops reading the link at the first bad part (and check_urdf still exits 0).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from lxml.etree import _Element as Element
@@ -16,6 +17,7 @@ from modelkit.diagnostics import Severity, did_you_mean
 from modelkit.formats.meshref import MeshChecker
 from modelkit.formats.urdf.values import Context, number, origin, vector
 from modelkit.model import Box, Capsule, Cylinder, Geom, Geometry, Inertial, Link, Sphere, VisualMaterial
+from modelkit.xmlsource import parse_numbers
 
 INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
@@ -37,8 +39,10 @@ class Materials:
         found = False
         color = ctx.first(element, "color")
         if color is not None:
-            rgba = vector(ctx, color, "rgba", f'material "{name}" color', count=4)
-            if color.get("rgba") is None:
+            rgba = _rgba(ctx, color, name)
+            if rgba is _SHORT_RGBA:
+                found = True  # urdfdom keeps the material (black); modelkit keeps it without a colour
+            elif color.get("rgba") is None:
                 ctx.emit("MK120", "<color> has no `rgba` attribute", ctx.loc(color))
             elif rgba is not None:
                 found = True
@@ -122,6 +126,25 @@ class Materials:
         return VisualMaterial(name=name)
 
 
+_SHORT_RGBA: list[float] = []  # the colour of an rgba that does not hold four numbers (MK146)
+
+
+def _rgba(ctx: Context, color: Element, name: str | None) -> list[float] | None:
+    """The four numbers of ``rgba``; :data:`_SHORT_RGBA` (reported, MK146) when it holds another count."""
+    text = color.get("rgba")
+    numbers = parse_numbers(text)
+    if numbers is None or len(numbers) == 4:
+        return vector(ctx, color, "rgba", f'material "{name}" color', count=4)
+    ctx.emit(
+        "MK146",
+        f'material "{name}": `rgba="{text}"` holds {len(numbers)} numbers, not 4; urdfdom silently makes the '
+        "colour black (0 0 0 1) and PyBullet uses its default colour; MuJoCo refuses the file",
+        ctx.loc(color, "rgba"),
+        hint='give red, green, blue and alpha, e.g. rgba="1 0 0 1"',
+    )
+    return _SHORT_RGBA
+
+
 def read_link(ctx: Context, element: Element, meshes: MeshChecker, materials: Materials) -> Link:
     """A :class:`Link` with its inertial, visuals and collisions; faults are reported, never raised."""
     name = element.get("name")
@@ -159,8 +182,12 @@ def read_inertial(ctx: Context, element: Element, link: str) -> Inertial | None:
     inertia_el = ctx.first(element, "inertia")
     for name, child in (("mass", mass_el), ("inertia", inertia_el)):
         if child is None:
-            ctx.emit("MK122", f'<inertial> of link "{link}" has no <{name}>', ctx.loc(element))
-    mass = None if mass_el is None else number(ctx, mass_el, "value", f'mass of link "{link}"', required=True)
+            _unreadable_inertial(ctx, element, link, f"has no <{name}>")
+    if mass_el is not None and mass_el.get("value") is None:
+        _unreadable_inertial(ctx, mass_el, link, "has a <mass> without `value`")
+        mass = None
+    else:
+        mass = None if mass_el is None else number(ctx, mass_el, "value", f'mass of link "{link}"')
     tensor = None if inertia_el is None else _inertia(ctx, inertia_el, link)
     if pose is None or mass is None or tensor is None or mass_el is None or inertia_el is None:
         return None
@@ -177,20 +204,56 @@ def read_inertial(ctx: Context, element: Element, link: str) -> Inertial | None:
     return inertial
 
 
+# What urdfdom does with a link whose <inertial> it cannot read (MK144, MK145).
+URDFDOM_INERTIAL = (
+    "urdfdom (check_urdf, libsdformat's URDF conversion) logs an error, keeps the mass it read with an "
+    "all-zero inertia, drops every visual and collision of the link, and loads the robot"
+)
+
+
+def _unreadable_inertial(ctx: Context, element: Element, link: str, what: str) -> None:
+    ctx.emit(
+        "MK145",
+        f'<inertial> of link "{link}" {what}; modelkit leaves the inertial out; {URDFDOM_INERTIAL}; PyBullet '
+        "and MuJoCo refuse the file",
+        ctx.loc(element),
+        hint='give <mass value="..."/> and <inertia ixx=".." ixy=".." ixz=".." iyy=".." iyz=".." izz=".."/>',
+    )
+
+
 def _inertia(ctx: Context, element: Element, link: str) -> rot3.M3 | None:
     missing = [k for k in INERTIA_KEYS if element.get(k) is None]
+    if any(k in missing for k in ("ixx", "iyy", "izz")):
+        _unreadable_inertial(ctx, element, link, f"has an <inertia> without {', '.join(missing)}")
+        return None
     if missing:
         ctx.emit(
-            "MK120",
-            f'<inertia> of link "{link}" lacks {", ".join(missing)} (all six of ixx, ixy, ixz, iyy, iyz, '
-            "izz are required)",
+            "MK144",
+            f'<inertia> of link "{link}" lacks {", ".join(missing)}; modelkit reads them as 0, as PyBullet '
+            f"does; {URDFDOM_INERTIAL}; MuJoCo refuses the file",
             ctx.loc(element),
+            hint=" ".join(f'{k}="0"' for k in missing) + " (all six of ixx, ixy, ixz, iyy, iyz, izz)",
         )
-        return None
-    values = [number(ctx, element, k, f'inertia of link "{link}"') for k in INERTIA_KEYS]
+    values = [number(ctx, element, k, f'inertia of link "{link}"', default=0.0) for k in INERTIA_KEYS]
     if any(v is None for v in values):
         return None
     return rot3.inertia_from_moments(*(float(v or 0.0) for v in values))
+
+
+# A shape without its size or file (MK143): who loads the file and who refuses it.
+UNREADABLE_SHAPE_CONSUMERS = (
+    "urdfdom (check_urdf, libsdformat) logs an error, drops it and every later visual and collision of the "
+    "link, and loads the file; PyBullet and MuJoCo refuse the file"
+)
+
+
+def _unreadable_shape(ctx: Context, shape: Element, what: str, lacks: str) -> None:
+    ctx.emit(
+        "MK143",
+        f"<{ctx.tag(shape)}> of the {what} has no {lacks}; modelkit leaves the {what} out "
+        f"({UNREADABLE_SHAPE_CONSUMERS})",
+        ctx.loc(shape),
+    )
 
 
 # A visual or collision without a shape (MK122): who loads the file and who refuses it.
@@ -238,7 +301,7 @@ def read_geometry(
     loc = ctx.loc(shape)
     if tag == "box":
         if shape.get("size") is None:
-            ctx.emit("MK120", f"<box> of the {what} has no `size` attribute", loc)
+            _unreadable_shape(ctx, shape, what, "`size`")
             return None
         size = vector(ctx, shape, "size", f"box of the {what}")
         if size is None:
@@ -251,7 +314,7 @@ def read_geometry(
             ctx.uses_feature("<capsule>", "1.1", loc)
         missing = [k for k in ("radius", "length") if shape.get(k) is None]
         if missing:
-            ctx.emit("MK120", f"<{tag}> of the {what} needs both `radius` and `length`", loc)
+            _unreadable_shape(ctx, shape, what, " and ".join(f"`{k}`" for k in missing))
             return None
         radius = number(ctx, shape, "radius", f"{tag} of the {what}")
         length = number(ctx, shape, "length", f"{tag} of the {what}")
@@ -263,7 +326,10 @@ def read_geometry(
             _not_positive(ctx, shape, "length", f"{tag} of the {what}")
         return Cylinder(radius, length) if tag == "cylinder" else Capsule(radius, length)
     if tag == "sphere":
-        radius = number(ctx, shape, "radius", f"sphere of the {what}", required=True)
+        if shape.get("radius") is None:
+            _unreadable_shape(ctx, shape, what, "`radius`")
+            return None
+        radius = number(ctx, shape, "radius", f"sphere of the {what}")
         if radius is None:
             return None
         if radius <= 0.0:
@@ -292,29 +358,29 @@ def _not_positive(
 def _mesh(ctx: Context, shape: Element, what: str, meshes: MeshChecker, visual_only: bool) -> Geometry | None:
     filename = shape.get("filename")
     if filename is None:
-        ctx.emit("MK120", f"<mesh> of the {what} has no `filename` attribute", ctx.loc(shape))
+        _unreadable_shape(ctx, shape, what, "`filename`")
         return None
     scale = (1.0, 1.0, 1.0)
     text = shape.get("scale")
     if text is not None:
-        items = text.split()
-        if len(items) == 1 and number(ctx, shape, "scale", f"mesh of the {what}") is not None:
-            value = float(items[0])
+        numbers = parse_numbers(text)
+        if numbers is not None and len(numbers) in (1, 2) and all(math.isfinite(v) for v in numbers):
+            value = numbers[0]
             ctx.emit(
                 "MK420",
-                f'mesh of the {what}: `scale="{text}"` has one number; URDF needs three (urdfdom drops '
-                "the shape); modelkit reads it as a uniform scale",
+                f'mesh of the {what}: `scale="{text}"` has {("one number", "two numbers")[len(numbers) - 1]}'
+                "; URDF needs three. modelkit reads the first as a uniform scale, as PyBullet does; urdfdom "
+                "logs an error, drops the shape and every later visual and collision of the link, and loads "
+                "the robot; MuJoCo refuses the file",
                 ctx.loc(shape, "scale"),
                 hint=f'write scale="{value:g} {value:g} {value:g}"',
             )
             scale = (value, value, value)
-        elif len(items) != 1:
+        else:
             values = vector(ctx, shape, "scale", f"mesh of the {what}")
             if values is None:
                 return None
             scale = (values[0], values[1], values[2])
-        else:
-            return None
         if any(s == 0.0 for s in scale):
             _not_positive(ctx, shape, "scale", f"mesh of the {what}", "not be zero")
     return meshes.mesh(filename, ctx.loc(shape, "filename"), scale=scale, visual_only=visual_only)

@@ -77,6 +77,7 @@ def read_urdf_document(
         robot.joints.append(read_joint(ctx, element))
     robot.extras["materials"] = dict(materials.table)
     _check_children(ctx, robot)
+    _unknown_mimic_leaders(ctx, robot)
     _root(robot)
     _extensions(ctx, root, robot)
     _newer_features(ctx)
@@ -146,6 +147,26 @@ def _check_children(ctx: Context, robot: Robot) -> None:
                 where,
                 hint=did_you_mean(joint.child, names),
             )
+
+
+def _unknown_mimic_leaders(ctx: Context, robot: Robot) -> None:
+    """A ``<mimic joint>`` naming no joint: urdfdom, libsdformat's URDF conversion, PyBullet and MuJoCo
+    load the robot and the joint moves on its own, so it is a warning here and the mimic is dropped."""
+    names = {joint.name for joint in robot.joints}
+    for joint in robot.joints:
+        mimic = joint.mimic
+        if mimic is None or mimic.joint in names:
+            continue
+        ctx.emit(
+            "MK320",
+            f'joint "{joint.name}" mimics "{mimic.joint}", which is not a joint; urdfdom, libsdformat\'s '
+            "URDF conversion, PyBullet and MuJoCo load the robot and the joint moves on its own (modelkit "
+            "drops the mimic)",
+            mimic.source or joint.loc("mimic"),
+            hint=did_you_mean(mimic.joint, names),
+            severity=Severity.WARNING,
+        )
+        joint.mimic = None
 
 
 def _root(robot: Robot) -> None:

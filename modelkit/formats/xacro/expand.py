@@ -30,6 +30,7 @@ from typing import Any
 
 from modelkit.diagnostics import Diagnostic, DiagnosticSink, Severity, SourceLocation, diag
 from modelkit.formats.common import ReadOptions
+from modelkit.formats.xacro import splice
 from modelkit.formats.xacro.errors import (
     FailureContext,
     PackageNotFound,
@@ -177,12 +178,15 @@ class _Run:
         limit = self.options.max_bytes
 
         def wrapper(text: Any, symbols: Any) -> Any:
-            try:
-                result = function(text, symbols)
-            except BaseException:
-                if self.failed_text is None and isinstance(text, str):
-                    self.failed_text = text
-                raise
+            if type(text) is str and "$" not in text:
+                result: Any = text  # what xacro's lexer gives back for plain text, without lexing it
+            else:
+                try:
+                    result = function(text, symbols)
+                except BaseException:
+                    if self.failed_text is None and isinstance(text, str):
+                        self.failed_text = text
+                    raise
             if isinstance(result, str) and len(result) > limit:
                 self.failed_text = text if isinstance(text, str) else None
                 raise ValueTooLarge()
@@ -295,6 +299,7 @@ class _Run:
             put(xacro, "check_attrs", self.check_attrs(xacro.check_attrs))
             put(xacro, "safe_eval", ExpressionGuard(xacro.XacroException).safe_eval)
             put(xacro, "load_yaml", self.load_yaml)
+            put(xacro, "replace_node", splice.replace_node)  # xacro's own is quadratic in siblings
             for name, function in self.messages().items():
                 put(xacro, name, function)
             substitutions = self.substitutions()

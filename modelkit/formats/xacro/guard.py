@@ -16,12 +16,14 @@ else, ``/etc/passwd`` for one, is refused (MK711) before a byte of it is read.
 from __future__ import annotations
 
 import ast
+import functools
 import math
 import os
 import re
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import CodeType
 from typing import Any
 
 # An integer may have at most this many bits (real xacro files stay within 64).
@@ -107,18 +109,9 @@ class ExpressionGuard:
         }
 
     def safe_eval(self, expr: str, globals: dict[str, Any], locals: Any = None) -> Any:
-        tree = ast.parse(expr.strip(), "<expression>", "eval")
-        invalid = sorted(
-            {
-                name
-                for node in ast.walk(tree)
-                for name in (_name_of(node),)
-                if name is not None and name.startswith("__")
-            }
-        )
-        if invalid:
-            raise self.exception("Use of invalid name(s): " + ", ".join(invalid))
-        code = compile(ast.fix_missing_locations(_Rewriter().visit(tree)), "<expression>", "eval")
+        code = _checked_code(expr.strip())
+        if isinstance(code, tuple):
+            raise self.exception("Use of invalid name(s): " + ", ".join(code))
         globals.update(__builtins__=self.builtins())
         return eval(code, globals, locals)
 
@@ -191,6 +184,26 @@ class ExpressionGuard:
         for item in iterable:
             self._spend(1)
             yield item
+
+
+@functools.lru_cache(maxsize=4096)
+def _checked_code(expr: str) -> CodeType | tuple[str, ...]:
+    """The guarded code of one expression, or the invalid (dunder) names it uses.
+
+    A pure function of the text, so cached: a macro called a thousand times evaluates the same
+    expressions a thousand times. A syntax error is raised (and not cached)."""
+    tree = ast.parse(expr, "<expression>", "eval")
+    invalid = sorted(
+        {
+            name
+            for node in ast.walk(tree)
+            for name in (_name_of(node),)
+            if name is not None and name.startswith("__")
+        }
+    )
+    if invalid:
+        return tuple(invalid)
+    return compile(ast.fix_missing_locations(_Rewriter().visit(tree)), "<expression>", "eval")
 
 
 def _name_of(node: ast.AST) -> str | None:
