@@ -1,0 +1,659 @@
+"""Layer 4: the mobile robot driven through command profiles on a floor, in MuJoCo and PyBullet, with
+the seed's controllers; the trajectories compared with each other and with engine-independent
+references (verification.md §1, §2, §6).
+
+What is graded (a :class:`~modelkit.verify.facts.Check`, layer 4), per graded profile:
+
+* ``mujoco~pybullet``: ``path-position`` (the largest planar distance between the two root-frame
+  paths over the run), ``path-yaw`` (the largest wrapped heading difference), ``wheel-angle`` (the
+  largest wheel joint angle difference), ``pan-tilt-angle`` (the largest pan/tilt joint angle
+  difference, at the wheel-angle tolerance); tolerances 1 cm, 10 mrad, 0.02 rad.
+* each engine against the rigid **no-slip** reference built from the source model's own mass
+  properties and driven by the same controllers (:mod:`modelkit.verify.reference_drive`):
+  ``noslip-position``, ``noslip-yaw``; tolerances 1.5 cm, 15 mrad.
+
+What is reported only (an :class:`~modelkit.verify.facts.Observation`): each engine's ``slip``
+(distance between its path and its own wheel odometry) and ``effective-radius`` (the rolling radius
+its own path implies for each wheel), the distance from the ideal ``unicycle`` (it differs from any
+physical robot under this controller by v·τ plus the COM-offset yaw bias, §2.1), every comparison on
+a report-only profile (``steps``: slip-dominated reversals), and the **native** wheel geometry run
+(§2.2: MuJoCo and PyBullet model a cylinder on a plane differently, so that run has no meaningful
+tolerance).
+
+Tracked robots are driven through the rollers ``convert`` writes (sphere proxies at the roller
+centres in the verification variant). Their no-slip reference is the ideal velocity servo: only
+straight profiles (w = 0 throughout) are compared with it; a turning tracked robot skids sideways
+(skid steering), which no rigid no-slip model describes, so turning profiles compare the engines
+with each other only, report-only (each engine's friction cone decides the skid).
+"""
+
+from __future__ import annotations
+
+import copy
+import importlib
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from modelkit.model import JointType, Robot
+from modelkit.verify.drive import Array, Drive, Profile, Scenario, Trajectory, WheelProxy
+from modelkit.verify.facts import Check, Observation, Skip
+from modelkit.verify.reference_drive import PlanarModel, noslip, odometry, planar_model, unicycle
+
+LAYER = 4
+DRIVERS = {
+    "mujoco": "modelkit.verify.engine_mujoco:driver",
+    "pybullet": "modelkit.verify.engine_pybullet:driver",
+}
+PAIR = "mujoco~pybullet"
+NATIVE_WARNING = (
+    "native wheel geometry, report-only: MuJoCo and PyBullet model a cylinder wheel on a plane differently "
+    "(MuJoCo: two contacts, one on each rim edge, so a yawing wheel scrubs; PyBullet's implicit cylinder: "
+    "one contact at whichever rim edge its support mapping picks, so the first acceleration yaws the robot); "
+    "verification.md §2.2 measured up to 2.6 m and π rad between them on the arc. Choreonoid's own contact "
+    "model (not run here) is a third meaning. The graded runs use sphere proxies of the wheel radius."
+)
+TRACK_SKIP = (
+    "tracks: the no-slip reference is compared only on straight profiles (w = 0): a turning tracked robot "
+    "must skid sideways (skid steering), which no rigid no-slip model describes; turning profiles compare "
+    "MuJoCo with PyBullet report-only (each engine's friction cone decides the skid). Continuous tracks "
+    "themselves are not simulated by either engine: both drive the rollers convert writes (MK809), as "
+    "spheres of the roller radius at the roller centres, each track's rollers coupled like its belt (MuJoCo: "
+    "the file's mimic equality; PyBullet: a gear constraint). The rollers are velocity-servoed with a torque "
+    "bound of half what friction can pass (variant.SERVO_FRICTION_SHARE), so a start is torque-limited and "
+    "slip-free, and the no-slip reference models that servo and its start-up ramp. The same bound limits "
+    "turning: the belts' yaw moment (n·τ_max/r·b, half of μ·m·g·b) can be smaller than the scrub moment of "
+    "the rollers' point contacts at the track ends (up to μ·m·g times their fore-aft arm), and then the "
+    "robot does not turn on the spot in either engine (the tutorial robot: 13 N·m against 19 N·m), where "
+    "Choreonoid's track, which imposes its surface speed with no torque bound and spreads its contact over "
+    "the track's length, turns; the turning profiles show the two engines' agreement on that, report-only"
+)
+
+
+@dataclass
+class Layer4Result:
+    checks: list[Check] = field(default_factory=list)
+    observations: list[Observation] = field(default_factory=list)
+    skips: list[Skip] = field(default_factory=list)
+    trajectories: list[Trajectory] = field(default_factory=list)
+    settings: dict[str, Any] = field(default_factory=dict)
+    injected: list[str] = field(default_factory=list)
+    timings: dict[str, float] = field(default_factory=dict)  # wall seconds (not for report.json)
+
+
+def _resolve(target: str) -> Any:
+    module, _, name = target.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+def floating(source: Robot) -> Robot:
+    """The source with a floating root (a URDF leaves it open); raises ValueError for a fixed root."""
+    if source.root_joint is JointType.FLOATING:
+        return source
+    if source.root_joint is JointType.FIXED:
+        raise ValueError(
+            f"the root link {source.root!r} is fixed to the world: a driven robot needs a floating base"
+        )
+    out = copy.deepcopy(source)
+    out.root_joint = JointType.FLOATING
+    return out
+
+
+def run(
+    source: Robot,
+    drive: Drive,
+    scenario: Scenario,
+    out_dir: Path,
+    engines: Sequence[str] = ("mujoco", "pybullet"),
+    inject: Sequence[str] = (),
+    prepared: Robot | None = None,
+) -> Layer4Result:
+    """Run every profile of ``scenario`` in every engine, compute the references, compare.
+
+    ``source``: the model as read (its root free, not welded); ``prepared``: the model with its track
+    approximation (``convert``'s prepare), needed for tracked robots (computed when None).
+    ``inject``: fault specs (:mod:`modelkit.verify.inject`) applied to the verification variant's
+    files, as ``verify --inject`` applies them to the converted files. Never raises for a model
+    problem: an engine failing is a failed check."""
+    result = Layer4Result()
+    t0 = time.perf_counter()
+    try:
+        robot = floating(source)
+    except ValueError as exc:
+        result.skips.append(Skip(LAYER, "all", f"layer 4 not run: {exc}"))
+        return result
+    if drive.kind == "tracks" and prepared is None:
+        from modelkit.verify.vehicle import prepare_tracks
+
+        prepared = prepare_tracks(robot)
+    model = planar_model(
+        prepared if drive.kind == "tracks" and prepared is not None else robot, drive, scenario.friction
+    )
+    result.settings["reference"] = {"noslip": model.as_dict(), "unicycle": "exact, from the commanded (v, w)"}
+    wanted = [e for e in engines if e in DRIVERS]
+    for e in engines:
+        if e not in DRIVERS:
+            result.skips.append(Skip(LAYER, e, "layer 4 runs MuJoCo and PyBullet only"))
+    proxies: list[WheelProxy] = [scenario.wheel_proxy]
+    if scenario.native_report and scenario.wheel_proxy == "sphere" and wanted:
+        proxies.append("native")
+    out_dir = Path(out_dir)
+    jobs = []
+    try:
+        for proxy in proxies:
+            profiles = list(scenario.profiles) if proxy == scenario.wheel_proxy else native_profiles(scenario)
+            jobs.append(_Job(proxy, profiles))
+            _setup(jobs[-1], robot, drive, scenario, out_dir, wanted, inject, result)
+        t1 = time.perf_counter()
+        for job in jobs:  # MuJoCo here while PyBullet's children step their batches
+            job.run_here(scenario, drive, result)
+        references = {p.name: _references(model, p, scenario, drive) for p in scenario.profiles}
+        t2 = time.perf_counter()
+        for job in jobs:
+            job.collect(result)
+    finally:
+        for job in jobs:
+            job.close(result)
+    t3 = time.perf_counter()
+    if drive.kind == "tracks":
+        result.skips.append(Skip(LAYER, "all", TRACK_SKIP))
+    for profile in scenario.profiles:
+        ref = references[profile.name]
+        result.trajectories.extend(ref.values())
+        for job in jobs:
+            runs = {e: got[profile.name] for e, got in sorted(job.runs.items()) if profile.name in got}
+            if not runs:
+                continue
+            result.trajectories.extend(runs.values())
+            graded = profile.graded and job.proxy == scenario.wheel_proxy
+            _compare(profile, job.proxy, graded, runs, ref, model, drive, scenario, result)
+    t4 = time.perf_counter()
+    result.timings.update(
+        {
+            "layer 4 setup": t1 - t0,
+            "layer 4 mujoco and references": t2 - t1,
+            "layer 4 pybullet wait": t3 - t2,
+            "layer 4 compare": t4 - t3,
+            "layer 4": t4 - t0,
+        }
+    )
+    return result
+
+
+NATIVE_PROFILES = ("arc",)
+"""The profiles the report-only native-wheel run drives (the arc shows the cylinder-contact disagreement
+most, verification.md §2.2); the first graded profile when the scenario has none of them."""
+
+
+def native_profiles(scenario: Scenario) -> list[Profile]:
+    chosen = [p for p in scenario.profiles if p.name in NATIVE_PROFILES]
+    if not chosen:
+        chosen = [p for p in scenario.profiles if p.graded][:1] or list(scenario.profiles[:1])
+    return chosen
+
+
+# ----------------------------------------------------------------------------------------------------
+# running the engines
+
+
+@dataclass
+class _Job:
+    """One verification variant (sphere or native) in every engine."""
+
+    proxy: WheelProxy
+    profiles: list[Profile]
+    drivers: dict[str, Any] = field(default_factory=dict)
+    pending: list[str] = field(default_factory=list)
+    runs: dict[str, dict[str, Trajectory]] = field(default_factory=dict)  # engine → profile → trajectory
+
+    def run_here(self, scenario: Scenario, drive: Drive, result: Layer4Result) -> None:
+        for e, d in self.drivers.items():
+            if e in self.pending:
+                continue
+            got = _guard(
+                lambda d=d: [d.run(p, scenario, drive) for p in self.profiles], e, self.proxy, result
+            )
+            self._keep(e, got)
+
+    def collect(self, result: Layer4Result) -> None:
+        for e in self.pending:
+            self._keep(e, _guard(lambda e=e: self.drivers[e].result(), e, self.proxy, result))
+        self.pending = []
+
+    def _keep(self, engine: str, got: list[Trajectory] | None) -> None:
+        if got is None:
+            return
+        for trajectory in got:
+            trajectory.variant = self.proxy
+        self.runs[engine] = {p.name: t for p, t in zip(self.profiles, got, strict=True)}
+
+    def close(self, result: Layer4Result) -> None:
+        for e, d in self.drivers.items():
+            result.settings.setdefault("engines", {}).setdefault(e, {})[self.proxy] = dict(d.settings)
+            warnings = list(getattr(d, "warnings", []))
+            if warnings:
+                _warnings(e, self.proxy, warnings, result)
+            d.close()
+        self.drivers = {}
+
+
+def _setup(
+    job: _Job,
+    robot: Robot,
+    drive: Drive,
+    scenario: Scenario,
+    out_dir: Path,
+    engines: list[str],
+    inject: Sequence[str],
+    result: Layer4Result,
+) -> None:
+    """Write the variant, apply the injected faults, load every engine and start the engines that run
+    in a child process (PyBullet) on the job's profiles."""
+    from modelkit.verify.variant import write_variant
+
+    proxy = job.proxy
+    try:
+        files, maps = write_variant(robot, drive, scenario, out_dir, proxy)
+    except Exception as exc:  # a conversion defect: every engine's layer 4 fails
+        for e in engines:
+            result.checks.append(
+                Check(
+                    LAYER,
+                    e,
+                    "variant",
+                    proxy,
+                    math.inf,
+                    0.0,
+                    f"the {proxy} verification variant could not be written: {type(exc).__name__}: {exc}",
+                )
+            )
+        return
+    result.settings.setdefault("variant", {})[proxy] = {k: p.name for k, p in sorted(files.items())}
+    for spec in inject:
+        apply = _resolve("modelkit.verify.inject:apply")
+        result.injected.append(f"layer 4 {proxy} variant: {apply(spec, files, maps)}")
+    kinds = {"mujoco": "mjcf", "pybullet": "urdf"}
+    for e in engines:
+        try:
+            make = _resolve(DRIVERS[e])
+        except ImportError as exc:
+            result.skips.append(Skip(LAYER, e, f"not installed ({exc})"))
+            continue
+        try:
+            job.drivers[e] = make(files[kinds[e]], maps[kinds[e]], drive=drive, scenario=scenario)
+        except Exception as exc:
+            result.checks.append(
+                Check(
+                    LAYER,
+                    e,
+                    "load",
+                    proxy,
+                    math.inf,
+                    0.0,
+                    f"{e} could not load the {proxy} verification variant "
+                    f"{files[kinds[e]].name}: {type(exc).__name__}: {exc}",
+                )
+            )
+    for e, d in job.drivers.items():
+        if hasattr(d, "start") and _guard(
+            lambda d=d: d.start(job.profiles, scenario, drive) or True, e, proxy, result
+        ):
+            job.pending.append(e)
+
+
+def _guard(call: Any, engine: str, proxy: str, result: Layer4Result) -> Any:
+    try:
+        return call()
+    except Exception as exc:
+        result.checks.append(
+            Check(
+                LAYER,
+                engine,
+                "engine-error",
+                proxy,
+                math.inf,
+                0.0,
+                f"{engine} failed while driving the {proxy} variant: {type(exc).__name__}: {exc}",
+            )
+        )
+        return None
+
+
+def _warnings(engine: str, proxy: str, messages: list[str], result: Layer4Result) -> None:
+    unique = list(dict.fromkeys(messages))
+    result.settings.setdefault("engines", {}).setdefault(engine, {})[f"{proxy}_warnings"] = unique
+    if engine != "mujoco":
+        return
+    from modelkit.verify.engine_mujoco import unstable
+
+    bad = unstable(unique)
+    if bad:
+        result.checks.append(
+            Check(
+                LAYER,
+                engine,
+                "stability",
+                proxy,
+                float(len(bad)),
+                0.0,
+                f"{engine} warned while driving the {proxy} variant that the simulation is "
+                "unstable: " + "; ".join(bad[:3]),
+            )
+        )
+
+
+# ----------------------------------------------------------------------------------------------------
+# references and comparisons
+
+
+def _references(
+    model: PlanarModel, profile: Profile, scenario: Scenario, drive: Drive
+) -> dict[str, Trajectory]:
+    return {
+        "noslip": noslip(model, profile, scenario, drive),
+        "unicycle": unicycle(model, profile, scenario, drive),
+    }
+
+
+def wrap(angle: Array) -> Array:
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def _on(t: Array, other: Trajectory, values: Array) -> Array:
+    """``values`` (sampled at ``other.t``) at the times ``t`` (identical grids: no interpolation)."""
+    if len(other.t) == len(t) and np.array_equal(other.t, t):
+        return values
+    return np.interp(t, other.t, values)
+
+
+@dataclass(frozen=True)
+class Difference:
+    position: float
+    position_t: float
+    yaw: float
+    yaw_t: float
+    final: float
+
+
+def difference(a: Trajectory, b: Trajectory) -> Difference:
+    """The largest planar position and wrapped yaw differences between two trajectories (and when)."""
+    bx, by, byaw = _on(a.t, b, b.x), _on(a.t, b, b.y), _on(a.t, b, b.yaw)
+    distance = np.hypot(a.x - bx, a.y - by)
+    yaw = np.abs(wrap(a.yaw - byaw))
+    i, k = int(np.argmax(distance)), int(np.argmax(yaw))
+    return Difference(float(distance[i]), float(a.t[i]), float(yaw[k]), float(a.t[k]), float(distance[-1]))
+
+
+def wheel_difference(a: Trajectory, b: Trajectory) -> tuple[float, float, int]:
+    """(largest |Δ wheel angle|, when, which wheel: 0 left, 1 right)."""
+    diff = np.abs(a.wheels - np.column_stack([_on(a.t, b, b.wheels[:, 0]), _on(a.t, b, b.wheels[:, 1])]))
+    i, side = np.unravel_index(int(np.argmax(diff)), diff.shape)
+    return float(diff[i, side]), float(a.t[i]), int(side)
+
+
+def effective_radius(trajectory: Trajectory, model: PlanarModel, drive: Drive) -> tuple[float, float]:
+    """The rolling radius each wheel's own motion implies: the forward ground distance its centre
+    travelled divided by its (sign-corrected) rotation, over the run. Negative: the joint's positive
+    rotation moved that side backwards (a flipped axis, or left and right swapped)."""
+    th = trajectory.yaw
+    c, s = np.cos(th), np.sin(th)
+    ox, oy = model.root_offset
+    px = trajectory.x - (c * ox - s * oy) + ox  # the axle midpoint P, start frame
+    py = trajectory.y - (s * ox + c * oy) + oy
+    out = []
+    for side, (sign, lateral) in enumerate(
+        ((drive.signs[0], model.half_axle), (drive.signs[1], -model.half_axle))
+    ):
+        wx, wy = px - s * lateral, py + c * lateral
+        mid = th[:-1] + 0.5 * np.diff(th)
+        forward = np.diff(wx) * np.cos(mid) + np.diff(wy) * np.sin(mid)
+        turn = sign * np.diff(trajectory.wheels[:, side])
+        rotation = float(np.sum(np.abs(turn)))
+        out.append(float(np.sum(forward * np.sign(turn))) / rotation if rotation > 1e-9 else math.nan)
+    return out[0], out[1]
+
+
+def _turns(profile: Profile) -> bool:
+    return any(c.w != 0.0 for c in profile.commands)
+
+
+def _compare(
+    profile: Profile,
+    proxy: str,
+    graded: bool,
+    runs: dict[str, Trajectory],
+    ref: dict[str, Trajectory],
+    model: PlanarModel,
+    drive: Drive,
+    scenario: Scenario,
+    result: Layer4Result,
+) -> None:
+    tol = scenario.tolerances
+    where = profile.name if proxy == "sphere" else f"{profile.name} ({proxy} wheels)"
+    native = proxy == "native"
+    prefix = "native-" if native and not graded else ""
+    note = (
+        (NATIVE_WARNING + " ")
+        if native
+        else ("report-only profile: " + profile.description + ". " if not profile.graded else "")
+    )
+    tracks_turning = drive.kind == "tracks" and _turns(profile)
+    pair_graded = graded and not tracks_turning
+
+    def record(
+        engine: str,
+        quantity: str,
+        value: float,
+        tolerance: float,
+        detail: str,
+        unit: str = "m",
+        grade: bool = True,
+    ) -> None:
+        if grade:
+            result.checks.append(Check(LAYER, engine, quantity, where, value, tolerance, detail))
+        else:
+            result.observations.append(
+                Observation(LAYER, engine, prefix + quantity, where, value, unit, note + detail)
+            )
+
+    mj, pb = runs.get("mujoco"), runs.get("pybullet")
+    if mj is not None and pb is not None:
+        d = difference(mj, pb)
+        record(
+            PAIR,
+            "path-position",
+            d.position,
+            tol.engines_position,
+            f"MuJoCo's and PyBullet's root paths differ by up to {_cm(d.position)} "
+            f"(t = {d.position_t:.2f} s; "
+            f"{_cm(d.final)} at the end; tolerance {_cm(tol.engines_position)})",
+            grade=pair_graded,
+        )
+        record(
+            PAIR,
+            "path-yaw",
+            d.yaw,
+            tol.engines_yaw,
+            f"MuJoCo's and PyBullet's headings differ by up to {_mrad(d.yaw)} (t = {d.yaw_t:.2f} s; "
+            f"tolerance {_mrad(tol.engines_yaw)})",
+            "rad",
+            grade=pair_graded,
+        )
+        w, wt, side = wheel_difference(mj, pb)
+        joint = (
+            (drive.left, drive.right)[side]
+            if drive.kind == "wheels"
+            else f"{(drive.left, drive.right)[side]} roller 0"
+        )
+        record(
+            PAIR,
+            "wheel-angle",
+            w,
+            tol.engines_wheel,
+            f"wheel joint angles differ by up to {w:.4f} rad ({joint}, t = {wt:.2f} s; tolerance "
+            f"{tol.engines_wheel:g} rad)",
+            "rad",
+            grade=pair_graded,
+        )
+        shared = [j for j in (drive.pan, drive.tilt) if j and j in mj.joints and j in pb.joints]
+        if shared:
+            worst = max(
+                shared, key=lambda j: float(np.max(np.abs(mj.joints[j] - _on(mj.t, pb, pb.joints[j]))))
+            )
+            value = float(np.max(np.abs(mj.joints[worst] - _on(mj.t, pb, pb.joints[worst]))))
+            record(
+                PAIR,
+                "pan-tilt-angle",
+                value,
+                tol.engines_wheel,
+                f"pan/tilt joint angles differ by up to {value:.2e} rad ({worst}; tolerance "
+                f"{tol.engines_wheel:g} rad, the wheel-angle tolerance)",
+                "rad",
+                grade=pair_graded,
+            )
+    reference = ref["noslip"]
+    for engine, trajectory in sorted(runs.items()):
+        name = {"mujoco": "MuJoCo", "pybullet": "PyBullet"}.get(engine, engine)
+        radii = effective_radius(trajectory, model, drive)
+        radius_text = (
+            f"effective rolling radius from its own path: left {_mm(radii[0])}, right {_mm(radii[1])} "
+            f"(model {_mm(model.radius)})" + _radius_hint(radii, model.radius, drive)
+        )
+        if drive.kind == "tracks" and _turns(profile):
+            pass  # not meaningful (TRACK_SKIP)
+        else:
+            d = difference(trajectory, reference)
+            record(
+                engine,
+                "noslip-position",
+                d.position,
+                tol.noslip_position,
+                f"{name}'s path is up to {_cm(d.position)} from the rigid no-slip reference built from the "
+                f"source's mass properties (t = {d.position_t:.2f} s; tolerance {_cm(tol.noslip_position)}); "
+                + radius_text,
+                grade=graded,
+            )
+            record(
+                engine,
+                "noslip-yaw",
+                d.yaw,
+                tol.noslip_yaw,
+                f"{name}'s heading is up to {_mrad(d.yaw)} from the rigid no-slip reference (t = "
+                f"{d.yaw_t:.2f} s; tolerance {_mrad(tol.noslip_yaw)}); " + radius_text,
+                "rad",
+                grade=graded,
+            )
+        if native:
+            continue
+        odo = odometry(trajectory, model, drive)
+        result.trajectories.append(odo)
+        slip = difference(trajectory, odo)
+        result.observations.append(
+            Observation(
+                LAYER,
+                engine,
+                "slip",
+                where,
+                slip.position,
+                "m",
+                note + f"largest distance between {name}'s path and its own wheel odometry "
+                f"(r {_mm(model.radius)}, "
+                f"b {_mm(model.half_axle)}): slip and effective-radius effects; heading {_mrad(slip.yaw)}",
+            )
+        )
+        for label, value in zip(("left", "right"), radii, strict=True):
+            result.observations.append(
+                Observation(
+                    LAYER,
+                    engine,
+                    f"effective-radius-{label}",
+                    where,
+                    value,
+                    "m",
+                    note + f"the rolling radius {name}'s own path implies for the {label} "
+                    f"{'wheel' if drive.kind == 'wheels' else 'track roller 0'} (model {_mm(model.radius)}); "
+                    "negative: a positive joint rotation moved that side backwards",
+                )
+            )
+        u = difference(trajectory, ref["unicycle"])
+        result.observations.append(
+            Observation(
+                LAYER,
+                engine,
+                "unicycle-position",
+                where,
+                u.position,
+                "m",
+                note + f"{name} vs the ideal unicycle of the commanded (v, w) "
+                "(advisory, verification.md §2.1: the "
+                f"controller's lag v·τ and the COM-offset yaw bias; heading {_mrad(u.yaw)})",
+            )
+        )
+        result.observations.append(
+            Observation(
+                LAYER,
+                engine,
+                "unicycle-yaw",
+                where,
+                u.yaw,
+                "rad",
+                note + f"{name}'s heading vs the ideal unicycle (advisory)",
+            )
+        )
+
+
+RADIUS_HINT = 0.02  # an effective radius this far (relative) from the model's is pointed out
+
+
+def _radius_hint(radii: tuple[float, float], radius: float, drive: Drive) -> str:
+    """What an effective rolling radius far from the model's suggests (a wheel-radius, axis or
+    left/right fault), for a failing check's detail."""
+    what = "wheel" if drive.kind == "wheels" else "track roller"
+    hints = []
+    for side, value in zip(("left", "right"), radii, strict=True):
+        if not math.isfinite(value):
+            continue
+        if value < 0:
+            hints.append(
+                f"the {side} {what} moves its side backwards for a positive rotation (a flipped joint "
+                "axis, or left and right swapped?)"
+            )
+        elif abs(value - radius) > RADIUS_HINT * radius:
+            hints.append(
+                f"the {side} {what}'s effective radius is {100 * (value / radius - 1):+.1f} % off the "
+                "model's (a wrong wheel radius, or left and right swapped?)"
+            )
+    return ": " + "; ".join(hints) if hints else ""
+
+
+def _cm(x: float) -> str:
+    return f"{x * 100:.3g} cm" if math.isfinite(x) else str(x)
+
+
+def _mm(x: float) -> str:
+    return f"{x * 1000:.4g} mm" if math.isfinite(x) else "n/a"
+
+
+def _mrad(x: float) -> str:
+    return f"{x * 1000:.3g} mrad" if math.isfinite(x) else str(x)
+
+
+def profile_summary(result: Layer4Result) -> list[str]:
+    """One line per check and observation (for logs and the benchmark)."""
+    lines = []
+    for c in result.checks:
+        lines.append(
+            f"{'PASS' if c.passed else 'FAIL'} {c.engine:16s} {c.quantity:16s} {c.where:20s} "
+            f"{c.error:.3e} / {c.tolerance:.3e}"
+        )
+    for o in result.observations:
+        lines.append(f"obs  {o.engine:16s} {o.quantity:26s} {o.where:28s} {o.value:.3e} {o.unit}")
+    return lines
+
+
+__all__ = ["Layer4Result", "difference", "effective_radius", "floating", "run"]

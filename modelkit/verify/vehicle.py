@@ -1,0 +1,308 @@
+"""What the controllers and references need to know about a mobile robot, found in its model.
+
+:func:`find_drive` returns a :class:`~modelkit.verify.drive.Drive` or raises ``ValueError`` with one
+sentence saying why the model is not a two-sided wheeled or tracked robot (layer 4 then becomes a
+Skip). Everything is measured in the root link's frame at q = 0:
+
+* **wheels**: the two unlimited revolute joints whose child link has a round collision (a cylinder
+  whose axis lies along the joint axis, a sphere, or a mesh whose extent around the axis is round),
+  axes parallel to the root's Y, one on each side (mirrored in Y). Left is the one at +Y. The radius
+  comes from the collision (cylinder or sphere radius, half the mesh's extent across the axis); the
+  half axle width b is half the distance between the two collision centres along Y. ``signs``: +1
+  when the joint axis points along +Y (a positive rotation then rolls the wheel forward, towards +X),
+  −1 when it points along −Y. The scenario may name the joints and give the radius and b instead.
+* **tracks** (Choreonoid's ``PSEUDO_CONTINUOUS_TRACK`` joints): the two track joints, one on each
+  side; ``rollers`` and ``roller_radius`` come from the track approximation every writer makes
+  (``prepared.extras["tracks"]``, see :mod:`modelkit.convert.tracks`); ``track_offset_y`` is the
+  left track joint's origin y in the root frame (the seed's ``trackUnits[0]->offsetTranslation().y()``).
+* **pan / tilt**: named in the scenario, else found by name (a revolute joint whose name contains
+  "pan" or "tilt"), else by axis (pan: a vertical revolute joint hanging from the root; tilt: a
+  horizontal revolute joint hanging from the pan's child link).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from modelkit.model import Cylinder, Geom, Joint, JointType, Link, Mesh, Robot, Sphere
+from modelkit.spatial import Pose
+from modelkit.verify.drive import Drive, Scenario
+
+PARALLEL = 1e-6  # |1 − |cos|| below this: two directions are parallel
+MIRROR = 1e-3  # m: the two sides must agree this well in x and z (and in |y|)
+
+
+def find_drive(robot: Robot, scenario: Scenario, prepared: Robot | None = None) -> Drive:
+    """The drive of ``robot`` (source names); ``prepared``: the robot after ``convert``'s prepare (its
+    track approximation), computed here when a tracked robot comes without it."""
+    if robot.root is None:
+        raise ValueError("the model has no root link")
+    poses = robot.world_poses()
+    root_inv = poses[robot.root].inverse()
+    frames = {name: root_inv @ pose for name, pose in poses.items()}
+    tracks = [j for j in robot.joints if j.type is JointType.PSEUDO_CONTINUOUS_TRACK]
+    named = {scenario.left, scenario.right} - {None}
+    if tracks and (not named or named <= {j.name for j in tracks}):
+        drive = _tracks(robot, scenario, tracks, frames, prepared)
+    else:
+        drive = _wheels(robot, scenario, frames)
+    pan, tilt = _pan_tilt(robot, scenario, frames, {drive.left, drive.right})
+    return Drive(
+        kind=drive.kind,
+        left=drive.left,
+        right=drive.right,
+        radius=drive.radius,
+        half_axle=drive.half_axle,
+        wheel_links=drive.wheel_links,
+        signs=drive.signs,
+        pan=pan,
+        tilt=tilt,
+        rollers=drive.rollers,
+        roller_radius=drive.roller_radius,
+        track_offset_y=drive.track_offset_y,
+    )
+
+
+# ----------------------------------------------------------------------------------------------------
+# wheels
+
+
+def _axis_in_root(joint: Joint, frames: dict[str, Pose]) -> np.ndarray:
+    axis = np.asarray(joint.axis, dtype=float)
+    norm = float(np.linalg.norm(axis))
+    if norm == 0.0:
+        return axis
+    return np.asarray(frames[joint.child].rotation @ (axis / norm))
+
+
+def _parallel(a: np.ndarray, b: np.ndarray | Sequence[float]) -> bool:
+    return bool(abs(1.0 - abs(float(np.dot(a, b)))) < PARALLEL)
+
+
+def wheel_shape(link: Link, axis_local: np.ndarray) -> tuple[float, np.ndarray] | None:
+    """(radius, centre in the link frame) of the link's round collision about ``axis_local`` (unit,
+    link frame), or None when it has none: the largest cylinder along the axis, or sphere; a mesh
+    whose vertices are round about the axis (extent across it equal in both directions to 2 %)."""
+    best: tuple[float, np.ndarray] | None = None
+    for geom in link.collisions:
+        found = _round(geom, axis_local)
+        if found is not None and (best is None or found[0] > best[0]):
+            best = found
+    return best
+
+
+def _round(geom: Geom, axis: np.ndarray) -> tuple[float, np.ndarray] | None:
+    g = geom.geometry
+    centre = np.asarray(geom.pose.translation, dtype=float)
+    if isinstance(g, Sphere):
+        return float(g.radius), centre
+    if isinstance(g, Cylinder):
+        along = geom.pose.rotation @ np.array([0.0, 0.0, 1.0])
+        return (float(g.radius), centre) if _parallel(along, axis) else None
+    if isinstance(g, Mesh) and g.data is not None and len(g.data.vertices):
+        points = (geom.pose.rotation @ (np.asarray(g.data.vertices) * np.asarray(g.scale)).T).T + centre
+        # two directions across the axis
+        helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
+        u = np.cross(axis, helper)
+        u /= np.linalg.norm(u)
+        w = np.cross(axis, u)
+        span_u = float(np.ptp(points @ u))
+        span_w = float(np.ptp(points @ w))
+        if span_u <= 0.0 or abs(span_u - span_w) > 0.02 * max(span_u, span_w):
+            return None
+        mid = 0.5 * (points.max(axis=0) + points.min(axis=0))
+        return 0.25 * (span_u + span_w), mid
+    return None
+
+
+def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
+    links = {link.name: link for link in robot.links}
+    joints = {j.name: j for j in robot.joints}
+    named = [scenario.left, scenario.right]
+    if any(n is not None for n in named):
+        if None in named:
+            raise ValueError("the scenario names only one wheel joint: give both robot.left and robot.right")
+        for n in named:
+            if n not in joints:
+                raise ValueError(f"the scenario's wheel joint {n!r} is not a joint of the model")
+        candidates = [joints[str(n)] for n in named]
+    else:
+        candidates = [
+            j
+            for j in robot.joints
+            if j.type is JointType.REVOLUTE
+            and not j.limits.position_limited
+            and _parallel(_axis_in_root(j, frames), (0.0, 1.0, 0.0))
+            and j.child in links
+            and j.mimic is None
+        ]
+    found: list[tuple[Joint, float, np.ndarray]] = []  # joint, radius, centre in the root frame
+    for j in candidates:
+        axis_root = _axis_in_root(j, frames)
+        frame = frames[j.child]
+        local = np.asarray(frame.rotation.T @ axis_root)
+        shape = wheel_shape(links[j.child], local) if j.child in links else None
+        if shape is None:
+            if scenario.wheel_radius is None or named[0] is None:
+                continue
+            shape = (scenario.wheel_radius, np.zeros(3))
+        centre = frame.rotation @ shape[1] + frame.translation
+        found.append((j, shape[0], centre))
+    if named[0] is None and len(found) != 2:
+        what = ", ".join(j.name for j, _, _ in found) or "none"
+        raise ValueError(
+            "not a two-wheeled differential-drive robot: layer 4 needs exactly two unlimited revolute joints "
+            f"about the root's Y axis whose links have a round collision (found: {what}); name them in the "
+            "scenario (robot.left, robot.right) if the model has them"
+        )
+    if len(found) != 2:
+        raise ValueError("the scenario's wheel joints have no round collision shape: give robot.wheel_radius")
+    if named[0] is None:
+        found.sort(key=lambda f: -float(f[2][1]))  # left (+Y) first
+    (left, r_left, c_left), (right, r_right, c_right) = found
+    if c_left[1] <= 0.0 or c_right[1] >= 0.0:
+        raise ValueError(
+            f"the wheels {left.name} and {right.name} are not on opposite sides of the root's "
+            "X-Z plane (left at +Y, right at −Y)"
+        )
+    if named[0] is None and (abs(c_left[0] - c_right[0]) > MIRROR or abs(c_left[2] - c_right[2]) > MIRROR):
+        raise ValueError(
+            f"the wheels {left.name} and {right.name} are not mirrored in Y (centres "
+            f"{np.round(c_left, 4).tolist()} and {np.round(c_right, 4).tolist()})"
+        )
+    radius = scenario.wheel_radius
+    if radius is None:
+        if abs(r_left - r_right) > 1e-9 * max(r_left, r_right):
+            raise ValueError(
+                f"the wheels have different radii ({r_left:g} and {r_right:g} m): give "
+                "robot.wheel_radius in the scenario"
+            )
+        radius = r_left
+    half_axle = scenario.half_axle if scenario.half_axle is not None else 0.5 * float(c_left[1] - c_right[1])
+    signs = tuple(1.0 if float(_axis_in_root(j, frames)[1]) > 0.0 else -1.0 for j in (left, right))
+    return Drive(
+        kind="wheels",
+        left=left.name,
+        right=right.name,
+        radius=float(radius),
+        half_axle=float(half_axle),
+        wheel_links=(left.child, right.child),
+        signs=(signs[0], signs[1]),
+    )
+
+
+# ----------------------------------------------------------------------------------------------------
+# tracks
+
+
+def _tracks(
+    robot: Robot, scenario: Scenario, tracks: list[Joint], frames: dict[str, Pose], prepared: Robot | None
+) -> Drive:
+    joints = {j.name: j for j in robot.joints}
+    if scenario.left is not None and scenario.right is not None:
+        pair = [joints[n] for n in (scenario.left, scenario.right) if n in joints]
+        if len(pair) != 2:
+            raise ValueError("the scenario's track joints are not joints of the model")
+    else:
+        if len(tracks) != 2:
+            raise ValueError(
+                f"layer 4 drives a robot with two tracks; this one has {len(tracks)} "
+                f"({', '.join(j.name for j in tracks)})"
+            )
+        pair = sorted(tracks, key=lambda j: -float(frames[j.child].translation[1]))
+    left, right = pair
+    y_left, y_right = (float(frames[j.child].translation[1]) for j in pair)
+    if y_left <= 0.0 or y_right >= 0.0:
+        raise ValueError(
+            f"the tracks {left.name} and {right.name} are not on opposite sides of the root's X-Z plane"
+        )
+    if prepared is None:
+        prepared = prepare_tracks(robot)
+    info = prepared.extras.get("tracks", {})
+    if left.name not in info or right.name not in info:
+        raise ValueError(
+            f"the track approximation (convert's rollers) is missing for {left.name}/{right.name}"
+        )
+    radii = {float(info[n]["radius"]) for n in (left.name, right.name)}
+    if len(radii) != 1:
+        raise ValueError(f"the two tracks' rollers differ in radius ({sorted(radii)})")
+    roller_radius = radii.pop()
+    p_frames = _root_frames(prepared)
+    signs = []
+    for name in (left.name, right.name):
+        roller0 = next(j for j in prepared.joints if j.name == info[name]["rollers"][0])
+        signs.append(1.0 if float(_axis_in_root(roller0, p_frames)[1]) > 0.0 else -1.0)
+    half_axle = scenario.half_axle if scenario.half_axle is not None else 0.5 * (y_left - y_right)
+    return Drive(
+        kind="tracks",
+        left=left.name,
+        right=right.name,
+        radius=float(scenario.wheel_radius or roller_radius),
+        half_axle=float(half_axle),
+        wheel_links=(left.child, right.child),
+        signs=(signs[0], signs[1]),
+        rollers={n: tuple(info[n]["rollers"]) for n in (left.name, right.name)},
+        roller_radius=roller_radius,
+        track_offset_y=float(frames[left.child].translation[1]),
+    )
+
+
+def _root_frames(robot: Robot) -> dict[str, Pose]:
+    poses = robot.world_poses()
+    inv = poses[str(robot.root)].inverse()
+    return {name: inv @ pose for name, pose in poses.items()}
+
+
+def prepare_tracks(robot: Robot) -> Robot:
+    """The robot with its tracks approximated by rollers, as every writer writes it."""
+    from modelkit.convert.api import prepare
+    from modelkit.convert.notes import NoteSink
+    from modelkit.convert.options import WriteOptions
+    from modelkit.convert.registry import target_info
+
+    return prepare(robot, target_info("mjcf"), WriteOptions(), NoteSink())
+
+
+# ----------------------------------------------------------------------------------------------------
+# pan / tilt
+
+
+def _pan_tilt(
+    robot: Robot, scenario: Scenario, frames: dict[str, Pose], drive_joints: set[str]
+) -> tuple[str | None, str | None]:
+    joints = {j.name: j for j in robot.joints}
+    for n in (scenario.pan, scenario.tilt):
+        if n is not None and n not in joints:
+            raise ValueError(f"the scenario's pan/tilt joint {n!r} is not a joint of the model")
+    revolute = [
+        j
+        for j in robot.joints
+        if j.type is JointType.REVOLUTE and j.name not in drive_joints and j.mimic is None
+    ]
+    pan = scenario.pan or _one([j for j in revolute if "pan" in j.name.lower()])
+    tilt = scenario.tilt or _one([j for j in revolute if "tilt" in j.name.lower()])
+    if pan is None:
+        pan = _one(
+            [
+                j
+                for j in revolute
+                if j.parent == robot.root and _parallel(_axis_in_root(j, frames), (0.0, 0.0, 1.0))
+            ]
+        )
+    if tilt is None and pan is not None:
+        child = joints[pan].child
+        tilt = _one(
+            [
+                j
+                for j in revolute
+                if j.parent == child and abs(float(_axis_in_root(j, frames)[2])) < math.sqrt(PARALLEL)
+            ]
+        )
+    return pan, tilt
+
+
+def _one(joints: list[Joint]) -> str | None:
+    return joints[0].name if len(joints) == 1 else None
