@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -501,3 +502,452 @@ class MujocoSimulator:
 def simulator(model: Path, renames: Renames, *, root: str, dt: float, armature: bool = True,
               inertials: dict[str, tuple[float, float]] | None = None) -> MujocoSimulator:
     return MujocoSimulator(Path(model), renames, root, dt, armature, inertials)
+
+
+# ---- layer 4: the floating-base robot driven on a floor ----------------------------------------
+
+CONTACT_SOLREF = (0.004, 1.0)
+CONTACT_SOLIMP = (0.99, 0.999, 0.001, 0.5, 2.0)
+VELOCITY_KV = 100.0
+"""Gain (N·m·s/rad) of the velocity servo of a velocity-mode joint (the track rollers): MuJoCo's
+``velocity`` actuator, force ``kv·(target − q̇)`` bounded by ``variant.servo_torque_limit`` (the
+same bound as PyBullet's VELOCITY_CONTROL maximum force), its damping integrated implicitly by
+``implicitfast``. Choreonoid's velocity mode and PyBullet's motor are velocity constraints; at this
+gain the speed error under a load of 1 N·m is 0.01 rad/s (0.1 % at 0.5 m/s)."""
+
+LAW_PLUGIN = "mujoco.pid"
+"""MuJoCo's bundled PID actuator plugin (``plugin/libactuator.so``, loaded by ``import mujoco``): with
+only ``kd`` set its force is ``kd·(0 − q̇)``, computed in C inside every ``mj_step``. It is the one
+velocity feedback MuJoCo integrates **explicitly** under ``implicitfast``: plugins add no
+``∂force/∂q̇`` to the implicit step (MuJoCo's own TODO in ``pid.cc``), whereas a ``general``/
+``velocity`` actuator's ``kv`` term is integrated implicitly (measured: 6e-8 rad/s off the explicit
+``qfrc_applied`` law after 20 steps on a 1 kg test wheel), which would change the physics."""
+
+
+def affine_laws(controllers: list[Any], command: Any) -> list[tuple[np.ndarray, np.ndarray]] | None:
+    """Each controller's law for ``command`` as ``(offset, gain)``, ``output = offset − gain·q̇``
+    (the controllers' optional ``affine_law``), or None when one of them has no such method (its
+    law is not affine in q̇ with command-only coefficients: the driver calls it every step)."""
+    out = []
+    for c in controllers:
+        law = getattr(c, "affine_law", None)
+        if law is None:
+            return None
+        offset, gain = law(command)
+        out.append((np.array(offset, dtype=float), np.array(gain, dtype=float)))
+    return out
+
+
+def floor_clearance(model: mujoco.MjModel, data: mujoco.MjData, floor: int) -> float:
+    """The smallest distance between the floor geom and any robot geom that collides with it, at
+    the data's current pose (``mj_geomDistance``: MuJoCo's own collision geometry)."""
+    best = math.inf
+    fromto = np.zeros(6)
+    for g in range(model.ngeom):
+        if g == floor or int(model.geom_bodyid[g]) == 0:
+            continue
+        if not (int(model.geom_contype[g]) & int(model.geom_conaffinity[floor])
+                or int(model.geom_conaffinity[g]) & int(model.geom_contype[floor])):
+            continue
+        best = min(best, float(mujoco.mj_geomDistance(model, data, floor, g, 10.0, fromto)))
+    return best
+
+
+class MujocoDriver:
+    """The written floating-base MJCF on a floor plane, verification.md §6's settings, the seed's
+    controllers (``make_controllers``) applied every physics step: :class:`modelkit.verify.drive.Driver`.
+
+    Two ways of applying them, the same physics (``tests/test_verify_drivers_fast.py``: ≤ 1e-9 m/rad
+    apart over 10 s; they differ in the rounding of ``kd·q* − kd·q̇`` against ``kd·(q* − q̇)``):
+
+    * **laws as actuators** (``fast``, the default, when every controller has ``affine_law``): the
+      seed's laws are ``u = offset − gain·q̇`` with offset and gain fixed between command changes.
+      MuJoCo computes ``−gain·q̇`` itself, in every step, through a :data:`LAW_PLUGIN` actuator per
+      torque joint (``kd`` = the gain; gear 1 while a profile runs, 0 otherwise, which makes it
+      inert), ``offset`` goes into ``qfrc_applied`` and a velocity target into the servo's ``ctrl``,
+      set at each command change; Python steps ``mj_step(m, d, nstep)`` from one sample or command
+      change to the next, so no Python runs per physics step. A joint's ``actuatorfrcrange`` (the
+      file's effort limit) is switched off on those joints (``jnt_actfrclimited`` 0) and the law
+      actuators have no force range: the Python law is not clamped either;
+    * **per step** (the fallback: a controller without ``affine_law``, a gain that changes with the
+      command, ``fast=False``): ``output`` called before every ``mj_step``, torques through
+      ``qfrc_applied``, velocity targets through the servo's ``ctrl``.
+
+    Edits (MjSpec, then the compiled model; the file is not changed): the options; a floor plane
+    (``modelkit_floor``, z = 0); the file's actuators deleted (torques go through ``qfrc_applied``
+    on the controlled dofs, not clamped; a velocity-mode joint gets a ``velocity`` actuator of gain
+    :data:`VELOCITY_KV`); on every robot geom that collides with the floor and on the floor itself
+    solref/solimp (MuJoCo averages a pair's values: set on both, the pair gets exactly these);
+    friction: the floor's is 0 so MuJoCo's max rule leaves each geom's own (the contact material's,
+    as the writer put it; ``Scenario.friction`` replaces the wheel geoms'); torsional and rolling
+    coefficients 0; condim 3 where a geom has friction, 1 where it has none (the slider, the chassis)
+    and on the floor (MuJoCo takes the pair's max)."""
+
+    engine = "mujoco"
+
+    def __init__(self, model: Path, renames: Renames, drive: Any, scenario: Any,
+                 factory: str | None = None, fast: bool = True) -> None:
+        from modelkit.verify import variant as v
+
+        self.path = Path(model)
+        self.renames = renames
+        self.drive = drive
+        self.factory = factory or v.CONTROLLERS
+        self.warnings: list[str] = []
+        self.controllers = v.load_factory(self.factory)(drive.as_dict(), v.scenario_data(scenario))
+        joints = renames.get("joint", {})
+        links = renames.get("link", {})
+        controlled = v.controlled_joints(self.controllers)
+        velocity = [j for j, mode in controlled if mode == "velocity"]
+        servoed = [g for j in velocity for g in v.driven_groups(drive, j)]
+        # The laws' gains at the zero command: one explicit damping actuator per torque joint of
+        # non-zero gain. A velocity-mode law with a q̇ term is not the servo's: per step, then.
+        probe = affine_laws(self.controllers, v.Command(0.0)) if fast else None
+        if probe is not None and any(c.mode == "velocity" and np.any(gain != 0.0)
+                                     for c, (_, gain) in zip(self.controllers, probe, strict=True)):
+            probe = None
+        law_gain: dict[str, float] = {}
+        for c, law in zip(self.controllers, probe, strict=True) if probe is not None else ():
+            if c.mode == "torque":
+                law_gain.update((j, float(g)) for j, g in zip(c.joints, law[1], strict=True) if g != 0.0)
+        def build(with_laws: bool) -> mujoco.MjModel:
+            """The world's spec compiled: options, floor, servos; ``with_laws``: the law actuators."""
+            spec = mujoco.MjSpec.from_file(str(self.path))
+            o = spec.option
+            o.timestep = scenario.dt
+            o.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+            o.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+            o.impratio = 10.0
+            o.solver = mujoco.mjtSolver.mjSOL_NEWTON
+            o.iterations = 100
+            o.tolerance = 1e-8
+            o.gravity = list(GRAVITY)
+            for actuator in list(spec.actuators):
+                spec.delete(actuator)
+            floor = spec.worldbody.add_geom()
+            floor.name, floor.type = "modelkit_floor", mujoco.mjtGeom.mjGEOM_PLANE
+            floor.size = [0.0, 0.0, 1.0]
+            for name in servoed:
+                act = spec.add_actuator()
+                act.name, act.target, act.trntype = f"modelkit_servo_{name}", joints.get(name, name), \
+                    mujoco.mjtTrn.mjTRN_JOINT
+                act.set_to_velocity(kv=VELOCITY_KV)
+            if with_laws:
+                spec.activate_plugin(LAW_PLUGIN)
+            for name, gain in (law_gain if with_laws else {}).items():
+                # repr(gain) is the shortest string strtod reads back as the same double
+                spec.add_plugin(name=f"modelkit_law_{name}", plugin_name=LAW_PLUGIN, active=False
+                                ).config = {"kd": repr(gain)}
+                act = spec.add_actuator()
+                act.name, act.target, act.trntype = f"modelkit_law_{name}", joints.get(name, name), \
+                    mujoco.mjtTrn.mjTRN_JOINT
+                act.plugin.name, act.plugin.active = f"modelkit_law_{name}", True
+            return spec.compile()
+
+        with quiet(self.warnings):
+            try:
+                self.model = build(bool(law_gain))
+            except (AttributeError, ValueError) as exc:  # no mujoco.pid plugin here: per step
+                if not law_gain:
+                    raise
+                self.warnings.append(f"the laws as actuators: {exc}; the controllers run per step")
+                probe, law_gain = None, {}
+                self.model = build(False)
+            self.data = mujoco.MjData(self.model)
+        m = self.model
+        self.floor = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "modelkit_floor")
+        free = [j for j in range(m.njnt) if int(m.jnt_type[j]) == int(mujoco.mjtJoint.mjJNT_FREE)]
+        if not free:
+            raise ValueError(f"{self.path.name}: no free joint; layer 4 needs the floating-base model")
+        self.root_body = int(m.jnt_bodyid[free[0]])
+        self.root_qadr = int(m.jnt_qposadr[free[0]])
+        # Contact links (wheels, rollers): their geoms get the scenario's friction when it is set.
+        prepared_links = set(drive.wheel_links) if drive.kind == "wheels" else set()
+        for rollers in drive.rollers.values():
+            for j in rollers:
+                jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, joints.get(j, j))
+                if jid >= 0:
+                    prepared_links.add(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.jnt_bodyid[jid])))
+        wheel_bodies = {mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, links.get(n, n))
+                        for n in prepared_links}
+        self.friction: dict[str, float] = {}
+        contact_mu = 0.0
+        for g in range(m.ngeom):
+            if g != self.floor and not (int(m.geom_contype[g]) | int(m.geom_conaffinity[g])):
+                continue
+            m.geom_solref[g] = CONTACT_SOLREF
+            m.geom_solimp[g] = CONTACT_SOLIMP
+            # Robot geoms collide with the floor only, never with each other: PyBullet leaves a
+            # body's self-collision off (no URDF_USE_SELF_COLLISION), while MuJoCo filters only
+            # parent/child pairs, so a roller's sphere proxy (wider than the roller) would hit the
+            # chassis two bodies up. (a & b) || (b & a): robot 2/1 with floor 1/2 → yes; robot-robot → no.
+            m.geom_contype[g], m.geom_conaffinity[g] = (1, 2) if g == self.floor else (2, 1)
+            m.geom_friction[g, 1:] = 0.0
+            if g == self.floor:
+                m.geom_friction[g, 0] = 0.0
+            elif int(m.geom_bodyid[g]) in wheel_bodies and scenario.friction is not None:
+                m.geom_friction[g, 0] = scenario.friction
+            mu = float(m.geom_friction[g, 0])
+            if int(m.geom_bodyid[g]) in wheel_bodies:
+                contact_mu = max(contact_mu, mu)
+            m.geom_condim[g] = 3 if mu > 0 else 1
+            if g != self.floor:
+                body = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g])) or ""
+                self.friction[body] = max(self.friction.get(body, 0.0), mu)
+        self.servo_limit = v.servo_torque_limit(float(m.body_subtreemass[self.root_body]), contact_mu,
+                                                drive.roller_radius or drive.radius, len(servoed))
+        servos = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, f"modelkit_servo_{n}") for n in servoed]
+        m.actuator_forcelimited[servos] = 1
+        m.actuator_forcerange[servos] = (-self.servo_limit, self.servo_limit)
+        # kv = J/dt (variant.servo_gain): stiffer chatters between the bounds once clamped (explicit).
+        self.servo_kv = v.servo_gain(float(m.body_subtreemass[self.root_body]),
+                                     drive.roller_radius or drive.radius, len(servoed),
+                                     float(m.opt.timestep)) if servoed else 0.0
+        m.actuator_gainprm[servos, 0] = self.servo_kv
+        m.actuator_biasprm[servos, 2] = -self.servo_kv
+        # The law actuators, gear 0 (inert) until a profile runs them (``_run_laws``).
+        self._law_gain = law_gain if probe is not None else None
+        actuator = mujoco.mjtObj.mjOBJ_ACTUATOR
+        self._law_actuators = np.array([mujoco.mj_name2id(m, actuator, f"modelkit_law_{n}")
+                                        for n in law_gain], dtype=int)
+        for name in law_gain:
+            jid = self._joint(joints.get(name, name))
+            m.jnt_actfrclimited[jid] = 0
+        m.actuator_forcelimited[self._law_actuators] = 0
+        m.actuator_gear[self._law_actuators, 0] = 0.0
+        # The controlled joints: qpos/qvel addresses, torque (qfrc_applied) or servo (ctrl) columns.
+        self._plan: list[tuple[Any, np.ndarray, np.ndarray, np.ndarray | None, list[list[int]]]] = []
+        servo_of = {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a): a for a in range(m.nu)}
+        for c in self.controllers:
+            ids = [self._joint(joints.get(j, j)) for j in c.joints]
+            qadr = np.array([int(m.jnt_qposadr[i]) for i in ids])
+            vadr = np.array([int(m.jnt_dofadr[i]) for i in ids])
+            if c.mode == "velocity":
+                groups = [[servo_of[f"modelkit_servo_{g}"] for g in v.driven_groups(drive, j)]
+                          for j in c.joints]
+                self._plan.append((c, qadr, vadr, None, groups))
+            else:
+                self._plan.append((c, qadr, vadr, vadr.copy(), []))
+        self.recorded = sorted({j for j, _ in controlled} | set(v.wheel_joints(drive)))
+        self._rec_qadr = np.array([int(m.jnt_qposadr[self._joint(joints.get(j, j))]) for j in self.recorded])
+        with quiet(self.warnings):
+            self._start = self._initial_state()
+        self.settings: dict[str, Any] = {
+            "version": mujoco.__version__, "file": self.path.name, "base": "free joint (floating)",
+            "timestep": scenario.dt, "integrator": "implicitfast", "cone": "elliptic", "impratio": 10.0,
+            "solver": "Newton", "iterations": 100, "tolerance": 1e-8, "gravity": list(GRAVITY),
+            "floor": "plane z = 0, friction 0 (MuJoCo's max rule keeps each geom's own), condim 1",
+            "contact_solref": list(CONTACT_SOLREF), "contact_solimp": list(CONTACT_SOLIMP),
+            "contact_params_on": "every robot geom that collides and the floor (a pair averages them)",
+            "self_collision": ("off, as in PyBullet: robot geoms contype 2 / conaffinity 1, the floor 1 / 2, "
+                               "so robot geoms touch the floor only"),
+            "friction": dict(sorted(self.friction.items())),
+            "friction_source": ("Scenario.friction on the wheel geoms" if scenario.friction is not None
+                                else "the file's geom friction (the contact materials against the floor)"),
+            "torsional_rolling": 0.0, "condim": "3 on geoms with friction, 1 without (slider, chassis)",
+            "torque": "qfrc_applied on the controlled dofs (see control), not clamped",
+            "control": (("the laws u = offset - gain·dq as MuJoCo computes them: offset in qfrc_applied "
+                         "and velocity targets in the servos' ctrl, set at each command change; -gain·dq "
+                         f"by a {LAW_PLUGIN} actuator per torque joint (kd = gain; explicit, as the Python "
+                         "law; gear 1 while a profile runs, 0 otherwise); actuatorfrcrange off on those "
+                         "joints, no forcerange (the Python law is not clamped); mj_step(nstep) between "
+                         "samples and command changes (no Python per step)")
+                        if self._law_gain is not None else
+                        "the controllers' output() called before every mj_step (per step, in Python)"),
+            "law_actuators": dict(sorted(law_gain.items())),
+            "velocity_servo": (f"MuJoCo velocity actuator kv {self.servo_kv:.4g} N·m·s/rad (m·r²/(n·dt)), "
+                               "force within "
+                               f"±{self.servo_limit:.4g} N·m (½·m·g·μ·r / rollers), on every roller of a "
+                               "track, all with roller 0's target (roller i > 0 also keeps the file's "
+                               "mimic equality)") if servoed else "none",
+            "file_actuators": "deleted", "start_height": self._start_height,
+            "settle": "zero torque; velocity servos held at 0",
+            "controllers": [f"{c.name} ({c.mode}: {', '.join(c.joints)})" for c in self.controllers],
+        }
+
+    def _joint(self, name: str) -> int:
+        jid = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, name)
+        if jid < 0:
+            raise ValueError(f"{self.path.name}: no joint named {name!r}")
+        return int(jid)
+
+    def _initial_state(self) -> np.ndarray:
+        """The root at the origin, lowered (or raised) so that the robot's lowest collision point
+        touches the floor; q = 0."""
+        m, d = self.model, self.data
+        mujoco.mj_resetData(m, d)
+        d.qpos[self.root_qadr:self.root_qadr + 7] = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
+        mujoco.mj_forward(m, d)
+        gap = floor_clearance(m, d, self.floor)
+        self._start_height = 0.0 if not math.isfinite(gap) else -gap
+        d.qpos[self.root_qadr + 2] = self._start_height
+        return np.array(d.qpos)
+
+    def run(self, profile: Any, scenario: Any, drive: Any) -> Any:
+        from modelkit.verify import variant as v
+
+        m, d = self.model, self.data
+        wall = time.perf_counter()
+        warned = len(self.warnings)
+        dt = float(m.opt.timestep)
+        every = max(1, round(1.0 / (scenario.sample_rate * dt)))
+        steps = round(profile.duration / dt)
+        settle = round(profile.settle / dt)
+        changes = v.command_steps(profile, dt, steps)
+        laws = self._laws(changes)
+        n = steps // every + 1
+        base = np.empty((n, 7))
+        qrec = np.empty((n, len(self.recorded)))
+        with quiet(self.warnings):
+            mujoco.mj_resetData(m, d)
+            d.qpos[:] = self._start
+            mujoco.mj_forward(m, d)
+            step = mujoco.mj_step
+            if settle:  # zero torque, servos at 0, law actuators inert (gear 0)
+                step(m, d, nstep=settle)
+            if laws is not None:
+                self._run_laws(laws, changes, steps, every, base, qrec)
+            else:
+                self._run_per_step(changes, steps, every, base, qrec)
+        self.last_wall = time.perf_counter() - wall
+        out = v.planar("mujoco", profile, "", np.arange(n) * every * dt, base[:, :3],
+                       v.rotations_wxyz(base[:, 3:]),
+                       {name: qrec[:, i] for i, name in enumerate(self.recorded)}, v.wheel_joints(drive))
+        out.settings = dict(self.settings)
+        if laws is None and self._law_gain is not None:
+            out.settings["control"] = ("the controllers' output() called before every mj_step: a law's "
+                                       "gain changed with the command")
+        out.warnings = self.warnings[warned:]  # "unstable" ones: MuJoCo reset the state mid-run
+        return out
+
+    def _laws(self, changes: dict[int, Any]) -> dict[int, list[tuple[np.ndarray, np.ndarray]]] | None:
+        """Step → the controllers' affine laws from that step (step 0: the zero command until the
+        profile's first), or None (per step) when the driver has no law actuators or a law's gain is
+        not the one compiled into them."""
+        from modelkit.verify.drive import Command
+
+        if self._law_gain is None:
+            return None
+        out: dict[int, list[tuple[np.ndarray, np.ndarray]]] = {}
+        for k, command in [(0, Command(0.0)), *sorted(changes.items(), key=lambda kc: kc[0])]:
+            laws = affine_laws(self.controllers, command)
+            if laws is None:
+                return None
+            for c, (_, gain) in zip(self.controllers, laws, strict=True):
+                expected = [0.0 if c.mode == "velocity" else self._law_gain.get(j, 0.0) for j in c.joints]
+                if gain.shape != (len(c.joints),) or not np.array_equal(gain, expected):
+                    return None
+            out[k] = laws
+        return out
+
+    def _run_laws(self, laws: dict[int, list[tuple[np.ndarray, np.ndarray]]], changes: dict[int, Any],
+                  steps: int, every: int, base: np.ndarray, qrec: np.ndarray) -> None:
+        """The profile with the laws as actuators (see the class): Python only at samples and command
+        changes, ``mj_step(nstep)`` in between."""
+        m, d = self.model, self.data
+        qpos, applied, ctrl = d.qpos, d.qfrc_applied, d.ctrl
+        ra, rec = self.root_qadr, self._rec_qadr
+        stops = sorted({*range(0, steps + 1, every), *laws, steps})
+        m.actuator_gear[self._law_actuators, 0] = 1.0
+        try:
+            s = 0
+            for i, k in enumerate(stops):
+                if k % every == 0:  # the state after k steps (the free joint's qpos is the root's pose)
+                    base[s] = qpos[ra:ra + 7]
+                    qrec[s] = qpos[rec]
+                    s += 1
+                if k == steps:
+                    break
+                if k in laws:
+                    for (_, _, _, torque_dofs, groups), (offset, _) in zip(self._plan, laws[k], strict=True):
+                        if torque_dofs is not None:
+                            applied[torque_dofs] = offset
+                        else:
+                            for group, target in zip(groups, offset, strict=True):
+                                ctrl[group] = target
+                mujoco.mj_step(m, d, nstep=stops[i + 1] - k)
+        finally:
+            m.actuator_gear[self._law_actuators, 0] = 0.0
+
+    def _run_per_step(self, changes: dict[int, Any], steps: int, every: int, base: np.ndarray,
+                      qrec: np.ndarray) -> None:
+        """The profile with every controller's ``output`` called before every ``mj_step``."""
+        from modelkit.verify import variant as v
+
+        m, d = self.model, self.data
+        dt = float(m.opt.timestep)
+        step = mujoco.mj_step
+        plan, qpos, qvel, applied, ctrl = self._plan, d.qpos, d.qvel, d.qfrc_applied, d.ctrl
+        ra, rec = self.root_qadr, self._rec_qadr
+        command = v.Command(0.0)
+        s = 0
+        for k in range(steps + 1):
+            if k % every == 0:  # the state after k steps (the free joint's qpos is the root's pose)
+                base[s] = qpos[ra:ra + 7]
+                qrec[s] = qpos[rec]
+                s += 1
+            if k == steps:
+                break
+            if k in changes:
+                command = changes[k]
+            t = k * dt
+            for c, qa, va, torque_dofs, groups in plan:
+                u = c.output(t, command, qpos[qa], qvel[va])
+                if torque_dofs is not None:
+                    applied[torque_dofs] = u
+                else:
+                    for group, target in zip(groups, u, strict=True):
+                        ctrl[group] = target
+            step(m, d)
+
+    def bench(self, seconds: float, command: Any = None) -> dict[str, float]:
+        """Wall seconds over ``seconds`` of simulated time on this model, from the start pose, of a
+        bare Python ``mj_step`` loop (``bare``: no control, no read-back, actuation off by
+        ``mjDSBL_ACTUATION``: not even the inert law actuators or idle servos) and of a minimal closed
+        loop (``closed_loop``: the same controllers called with one fixed ``command``, torques set, step;
+        no sampling, no command schedule): what the harness adds is the rest."""
+        from modelkit.verify.drive import Command
+
+        m, d = self.model, self.data
+        steps = round(seconds / float(m.opt.timestep))
+        command = command or Command(0.0, 0.3, 0.5)
+        with quiet(self.warnings):
+            mujoco.mj_resetData(m, d)
+            d.qpos[:] = self._start
+            step = mujoco.mj_step
+            actuation = int(mujoco.mjtDisableBit.mjDSBL_ACTUATION)
+            m.opt.disableflags |= actuation
+            try:
+                start = time.perf_counter()
+                for _ in range(steps):
+                    step(m, d)
+                bare = time.perf_counter() - start
+            finally:
+                m.opt.disableflags &= ~actuation
+            mujoco.mj_resetData(m, d)
+            d.qpos[:] = self._start
+            plan, qpos, qvel, applied, ctrl = self._plan, d.qpos, d.qvel, d.qfrc_applied, d.ctrl
+            dt = float(m.opt.timestep)
+            start = time.perf_counter()
+            for k in range(steps):
+                for c, qa, va, torque_dofs, groups in plan:
+                    u = c.output(k * dt, command, qpos[qa], qvel[va])
+                    if torque_dofs is not None:
+                        applied[torque_dofs] = u
+                    else:
+                        for group, target in zip(groups, u, strict=True):
+                            ctrl[group] = target
+                step(m, d)
+            closed = time.perf_counter() - start
+        return {"bare": bare, "closed_loop": closed}
+
+    def close(self) -> None:
+        return None
+
+
+def driver(model: Path, renames: Renames, *, drive: Any, scenario: Any, factory: str | None = None,
+           fast: bool = True) -> MujocoDriver:
+    """Layer 4's entry point (:class:`modelkit.verify.drive.Driver`). ``fast`` False: the controllers'
+    ``output`` every step even when they have affine laws (the reference the fast path is tested
+    against)."""
+    return MujocoDriver(Path(model), renames, drive, scenario, factory, fast)

@@ -354,7 +354,219 @@ def load(model: Path, renames: Renames, *, root: str, pose_path: str = "com-fram
     return PyBulletModel(Path(model), renames, root, pose_path=pose_path, timeout=timeout)
 
 
+def render(urdfs: dict[str, Path], configurations: list[dict[str, float]], camera: dict[str, Any],
+           timeout: float = DEFAULT_TIMEOUT) -> dict[tuple[str, int], tuple[Any, Any]]:
+    """TinyRenderer pictures for the report (``modelkit.verify.pictures``), in a child worker of its
+    own: (view, configuration index) → (RGB (H, W, 3) uint8, robot mask (H, W) bool). Joint names
+    are the URDF's."""
+    worker = Worker()
+    try:
+        paths = {k: str(Path(v).resolve()) for k, v in urdfs.items()}
+        raw = worker.request("render", timeout=timeout, paths=paths, configurations=configurations,
+                             camera=camera)
+    finally:
+        worker.close()
+    h, w = int(camera["height"]), int(camera["width"])
+    out: dict[tuple[str, int], tuple[Any, Any]] = {}
+    for item in raw:
+        rgba = np.frombuffer(item["rgba"], dtype=np.uint8).reshape(h, w, 4)
+        seg = np.frombuffer(item["seg"], dtype=np.int32).reshape(h, w)
+        out[(item["view"], int(item["config"]))] = (rgba[:, :, :3].copy(), seg >= 0)
+    return out
+
+
 def simulator(model: Path, renames: Renames, *, root: str, dt: float,
               timeout: float = DEFAULT_TIMEOUT) -> PyBulletModel:
     """Layer 3b's entry point: the same adapter, time step ``dt``."""
     return PyBulletModel(Path(model), renames, root, dt=dt, timeout=timeout)
+
+
+# ---- layer 4: the floating-base robot driven on a floor ----------------------------------------
+
+SOLVER_ITERATIONS = 50
+FLOOR_FRICTION = 1.0
+DEFAULT_LINK_FRICTION = 1.0  # a link the URDF gives no friction: MuJoCo's default geom friction
+
+
+def urdf_friction(path: Path) -> dict[str, float]:
+    """Link → friction as the URDF writer wrote it (``<gazebo reference="link"><mu1>``: the link's
+    contact material against the floor material); PyBullet itself ignores those elements."""
+    from lxml import etree
+
+    out: dict[str, float] = {}
+    for gazebo in etree.parse(str(path)).getroot().iter("gazebo"):
+        reference, mu = gazebo.get("reference"), gazebo.find("mu1")
+        if reference and mu is not None and mu.text:
+            out[reference] = float(mu.text)
+    return out
+
+
+class _PendingWorker(Worker):
+    """A :class:`Worker` whose request can be sent now and its answer collected later, so the
+    PyBullet child steps while the parent runs MuJoCo."""
+
+    def send(self, command: str, **kwargs: Any) -> int:
+        if self.proc.poll() is not None:
+            raise self._died(command)
+        printed = self._stderr.seek(0, os.SEEK_END)
+        payload = pickle.dumps((command, kwargs), protocol=pickle.HIGHEST_PROTOCOL)
+        assert self.proc.stdin is not None
+        try:
+            self.proc.stdin.write(struct.pack(">I", len(payload)) + payload)
+            self.proc.stdin.flush()
+        except BrokenPipeError:
+            raise self._died(command) from None
+        return int(printed)
+
+    def receive(self, command: str, printed: int, timeout: float) -> Any:
+        deadline = time.monotonic() + timeout
+        size = struct.unpack(">I", self._read_exactly(4, deadline, command))[0]
+        status, result = pickle.loads(self._read_exactly(size, deadline, command))
+        if status != "ok":
+            said = self._stderr_tail(printed)
+            raise PyBulletError(f"PyBullet {command} failed: {result}".rstrip()
+                                + (f"\nPyBullet printed:\n{said}" if said else ""))
+        return result
+
+
+class PyBulletDriver:
+    """The written floating-base URDF on a floor in the PyBullet child, verification.md §6's
+    settings and every §2.8 pitfall handled, the seed's controllers built **in the child** from plain
+    data (``make_controllers(drive.as_dict(), scenario_dict)``) and run every step there:
+    :class:`modelkit.verify.drive.Driver`, plus :meth:`start`/:meth:`result` to run profiles while
+    the parent does something else (MuJoCo)."""
+
+    engine = "pybullet"
+
+    def __init__(self, model: Path, renames: Renames, drive: Any, scenario: Any, factory: str | None = None,
+                 sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT) -> None:
+        from modelkit.verify import variant as v
+
+        self.path = Path(model)
+        self.renames = renames
+        self.drive = drive
+        self.timeout = timeout
+        self.dt = float(scenario.dt)
+        self.factory = factory or v.CONTROLLERS
+        self.friction = urdf_friction(self.path)
+        joint_names = dict(renames.get("joint", {}))
+        for rollers in drive.rollers.values():
+            for j in rollers:
+                joint_names.setdefault(j, j)
+        self._worker = _PendingWorker()
+        self._pending: tuple[int, list[Any], Any, Any] | None = None
+        try:
+            info = self._worker.request(
+                "drive_setup", timeout=timeout, path=str(self.path.resolve()), gravity=GRAVITY, dt=self.dt,
+                solver_iterations=SOLVER_ITERATIONS, friction=self.friction,
+                default_friction=DEFAULT_LINK_FRICTION, floor_friction=FLOOR_FRICTION,
+                contact_joints=[joint_names.get(j, j) for j in self._contact_joints(drive)],
+                contact_friction=scenario.friction,
+                drive=drive.as_dict(), scenario=v.scenario_data(scenario), factory=self.factory,
+                joint_names=joint_names, roller_radius=drive.roller_radius or drive.radius, sys_path=sys_path)
+        except BaseException:
+            self._worker.close()
+            raise
+        self.controllers = info["controllers"]
+        controlled = [j for _, _, joints in self.controllers for j in joints]
+        self.recorded = sorted(set(controlled) | set(v.wheel_joints(drive)))
+        velocity = any(mode == "velocity" for _, mode, _ in self.controllers)
+        self.settings: dict[str, Any] = {
+            "version": "pybullet (child process)", "file": self.path.name, "useFixedBase": False,
+            "flags": "URDF_USE_INERTIA_FROM_FILE|URDF_USE_IMPLICIT_CYLINDER", "gravity": [0.0, 0.0, GRAVITY],
+            "timestep": self.dt, "numSolverIterations": SOLVER_ITERATIONS,
+            "enableConeFriction": "default (1)",
+            "damping": "linearDamping, angularDamping, jointDamping 0 on every link",
+            "default_motors": "off (VELOCITY_CONTROL force 0)",
+            "torque": "TORQUE_CONTROL re-sent before every stepSimulation",
+            "velocity_servo": ("VELOCITY_CONTROL (a velocity constraint), max force "
+                               f"{info['servo_limit']:.4g} "
+                               "N·m (½·m·g·μ·r / rollers, as MuJoCo's bound), on every roller of a track "
+                               "with "
+                               "roller 0's target; the rollers of a track coupled by a JOINT_GEAR constraint "
+                               "(ratio −1: equal speeds), the URDF's <mimic> that PyBullet ignores")
+            if velocity else "none",
+            "floor": f"plane z = 0 (createCollisionShape GEOM_PLANE), lateralFriction {FLOOR_FRICTION:g}",
+            "friction": dict(sorted(info["friction"].items())),
+            "friction_rule": "Bullet multiplies the two bodies' values: floor 1 × the link's",
+            "friction_source": ("Scenario.friction on the wheel links" if scenario.friction is not None
+                                else "the URDF's <gazebo><mu1> (the contact materials against the floor); "
+                                     f"{DEFAULT_LINK_FRICTION:g} for a link without"),
+            "rolling_spinning": 0.0,
+            "base_pose": "getBasePositionAndOrientation (COM frame) moved to the root link frame with "
+                         "getDynamicsInfo(-1)[3:5] (the local inertial frame)",
+            "start_height": info["start_height"],
+            "settle": "zero torque; velocity servos held at 0",
+            "per_run": "resetSimulation and a fresh load (every run starts from the same state)",
+            "controllers": [f"{name} ({mode}: {', '.join(joints)})"
+                            for name, mode, joints in self.controllers],
+            "process": "child process (modelkit/verify/pybullet_worker.py); controllers built in the child",
+        }
+        self.last_wall: list[float] = []
+
+    @staticmethod
+    def _contact_joints(drive: Any) -> list[str]:
+        """The joints whose child links roll on the floor: the wheels, or every track roller."""
+        if drive.kind == "wheels":
+            return [drive.left, drive.right]
+        return [j for rollers in drive.rollers.values() for j in rollers]
+
+    def start(self, profiles: list[Any], scenario: Any, drive: Any) -> None:
+        """Send the profiles to the child and return at once; :meth:`result` collects them."""
+        from modelkit.verify import variant as v
+
+        if self._pending is not None:
+            raise RuntimeError("a batch is still running; collect it with result() first")
+        every = max(1, round(1.0 / (scenario.sample_rate * self.dt)))
+        budget = self.timeout + sum(20.0 * (p.duration + p.settle) for p in profiles)
+        printed = self._worker.send("drive_batch", runs=[
+            {"profile": v.profile_data(p), "sample_every": every, "recorded": self.recorded}
+            for p in profiles])
+        self._pending = (printed, list(profiles), every, budget)
+
+    def result(self) -> list[Any]:
+        """The trajectories of the batch :meth:`start` sent, in its order."""
+        if self._pending is None:
+            raise RuntimeError("nothing started")
+        printed, profiles, every, budget = self._pending
+        self._pending = None
+        raw = self._worker.receive("drive_batch", printed, budget)
+        self.last_wall = [float(r["wall"]) for r in raw]
+        return [self._trajectory(p, r, every) for p, r in zip(profiles, raw, strict=True)]
+
+    def run(self, profile: Any, scenario: Any, drive: Any) -> Any:
+        self.start([profile], scenario, drive)
+        return self.result()[0]
+
+    def _trajectory(self, profile: Any, raw: dict[str, Any], every: int) -> Any:
+        from modelkit.verify import variant as v
+
+        base = np.frombuffer(raw["base"], dtype=np.float64).reshape(-1, 7)
+        q = np.frombuffer(raw["q"], dtype=np.float64).reshape(len(base), len(self.recorded))
+        inertial = _pose(*raw["base_inertial"]).inverse()
+        rotations: Array = np.empty((len(base), 3, 3))
+        positions: Array = np.empty((len(base), 3))
+        for i, row in enumerate(base):
+            link = _pose(tuple(row[:3]), tuple(row[3:])) @ inertial  # COM frame → the URDF link frame
+            rotations[i], positions[i] = link.rotation, link.translation
+        times: Array = np.arange(len(base), dtype=np.float64) * (every * self.dt)
+        out = v.planar("pybullet", profile, "", times, positions, rotations,
+                       {name: q[:, i].copy() for i, name in enumerate(self.recorded)},
+                       v.wheel_joints(self.drive))
+        out.settings = dict(self.settings)
+        return out
+
+    def bench(self, seconds: float) -> dict[str, float]:
+        """Wall seconds of a bare ``stepSimulation`` loop on this world (floating robot on the floor)."""
+        out = self._worker.request("drive_bench", timeout=self.timeout + 20.0 * seconds,
+                                   steps=round(seconds / self.dt))
+        return {k: float(x) for k, x in out.items()}
+
+    def close(self) -> None:
+        self._worker.close()
+
+
+def driver(model: Path, renames: Renames, *, drive: Any, scenario: Any, factory: str | None = None,
+           sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT) -> PyBulletDriver:
+    """Layer 4's entry point (:class:`modelkit.verify.drive.Driver`, plus ``start``/``result``)."""
+    return PyBulletDriver(Path(model), renames, drive, scenario, factory, sys_path, timeout)

@@ -9,6 +9,11 @@ duplicate of the original stdout and fd 1 is pointed at stderr before PyBullet i
 
 The worker returns raw PyBullet numbers (link COM frames, inertial frames, joint infos); the frame
 algebra lives in the parent, where it can be tested and typed.
+
+Layer 4's requests (``drive_setup``, ``drive_run``, ``drive_batch``, ``drive_bench``) are the
+exception to "standard library only": they import numpy, :mod:`modelkit.verify.drive` and the
+controller factory (``modelkit.verify.controllers:make_controllers``) on first use, so that the seed's
+controllers run here, every physics step, without crossing the pipe.
 """
 
 from __future__ import annotations
@@ -205,6 +210,304 @@ class Engine:
             step(physicsClientId=client)
         closed = time.perf_counter() - start
         return {"bare": bare, "closed_loop": closed}
+
+    def render(self, paths: dict[str, str], configurations: list[dict[str, float]], camera: dict[str, Any]
+               ) -> list[dict[str, Any]]:
+        """Pictures for the report (``modelkit.verify.pictures``): each URDF in ``paths`` (view name →
+        file) loaded fixed-base at the identity in a client of its own, at every configuration (joint
+        name → q), through ``camera`` (eye, target, up, fovy, width, height, near, far) with
+        TinyRenderer (software: no GPU, no display). Raw RGBA bytes and the segmentation buffer
+        (int32, −1 = background) per (view, configuration)."""
+        p = self.p
+        width, height = int(camera["width"]), int(camera["height"])
+        out = []
+        for view, path in sorted(paths.items()):
+            client = p.connect(p.DIRECT)
+            try:
+                flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER
+                body = p.loadURDF(path, useFixedBase=True, flags=flags, physicsClientId=client)
+                index = {p.getJointInfo(body, j, physicsClientId=client)[1].decode(): j
+                         for j in range(p.getNumJoints(body, physicsClientId=client))}
+                view_matrix = p.computeViewMatrix(camera["eye"], camera["target"], camera["up"],
+                                                  physicsClientId=client)
+                projection = p.computeProjectionMatrixFOV(camera["fovy"], width / height, camera["near"],
+                                                          camera["far"], physicsClientId=client)
+                for number, q in enumerate(configurations):
+                    for name, value in q.items():
+                        if name in index:
+                            p.resetJointState(body, index[name], value, 0.0, physicsClientId=client)
+                    _, _, rgba, _, seg = p.getCameraImage(
+                        width, height, view_matrix, projection, renderer=p.ER_TINY_RENDERER, shadow=0,
+                        lightDirection=[float(c) for c in camera["eye"]], physicsClientId=client)
+                    rgba_bytes = rgba.tobytes() if hasattr(rgba, "tobytes") else array("B", rgba).tobytes()
+                    seg_bytes = (seg.astype("int32").tobytes() if hasattr(seg, "astype")
+                                 else array("i", seg).tobytes())
+                    out.append({"view": view, "config": number, "rgba": rgba_bytes, "seg": seg_bytes})
+            finally:
+                p.disconnect(physicsClientId=client)
+        return out
+
+
+    # ---- layer 4: the floating-base robot driven on a floor (engine_pybullet.driver) -------------
+
+    def drive_setup(self, path: str, gravity: float, dt: float, solver_iterations: int,
+                    friction: dict[str, float], default_friction: float, floor_friction: float,
+                    contact_joints: list[str], contact_friction: float | None,
+                    drive: dict[str, Any], scenario: dict[str, Any], factory: str,
+                    joint_names: dict[str, str], roller_radius: float,
+                    sys_path: list[str] | None = None) -> dict[str, Any]:
+        """Keep the layer-4 set-up and build the controllers here, from plain data, with the same
+        factory the parent uses (``module:function``), so the stepping loop never crosses the pipe.
+        ``joint_names``: source joint name → the URDF's. ``friction``: link → its friction against
+        the floor (``default_friction`` for the others); ``contact_friction`` (when set) replaces it
+        on the child links of ``contact_joints`` (the wheels, the rollers). Loads the world once to
+        report it."""
+        import importlib
+
+        for entry in sys_path or []:
+            if entry not in sys.path:
+                sys.path.insert(0, entry)
+        module, _, function = factory.partition(":")
+        make = getattr(importlib.import_module(module), function)
+        self.drive_cfg: dict[str, Any] = {
+                          "path": path, "gravity": gravity, "dt": dt, "iterations": solver_iterations,
+                          "friction": dict(friction), "default_friction": default_friction,
+                          "floor_friction": floor_friction, "roller_radius": roller_radius,
+                          "contact_joints": list(contact_joints), "contact_friction": contact_friction}
+        self.drive_rollers = {k: list(v) for k, v in drive.get("rollers", {}).items()}
+        self.drive_names = dict(joint_names)
+        self.controllers = make(drive, scenario)
+        info = self._drive_world()
+        info["controllers"] = [(c.name, str(c.mode), list(c.joints)) for c in self.controllers]
+        return info
+
+    def _drive_world(self) -> dict[str, Any]:
+        """A fresh world (``resetSimulation``: no contact cache or warm start survives a run, so every
+        run starts from the same state): gravity, dt, solver iterations, a floor plane built in code,
+        the URDF floating, damping zeroed, default motors off, friction per link, the root link frame
+        at the origin lowered until the closest point touches the floor."""
+        p, cfg = self.p, self.drive_cfg
+        if getattr(self, "drive_client", -1) < 0:
+            self.drive_client = p.connect(p.DIRECT)
+        c = self.drive_client
+        p.resetSimulation(physicsClientId=c)
+        p.setGravity(0.0, 0.0, cfg["gravity"], physicsClientId=c)
+        p.setTimeStep(cfg["dt"], physicsClientId=c)
+        p.setPhysicsEngineParameter(numSolverIterations=cfg["iterations"], physicsClientId=c)
+        plane = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c)
+        self.floor = p.createMultiBody(0.0, plane, physicsClientId=c)
+        p.changeDynamics(self.floor, -1, lateralFriction=cfg["floor_friction"], rollingFriction=0.0,
+                         spinningFriction=0.0, physicsClientId=c)
+        flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER
+        body = p.loadURDF(cfg["path"], useFixedBase=False, flags=flags, physicsClientId=c)
+        self.drive_body = body
+        n = p.getNumJoints(body, physicsClientId=c)
+        joints = [p.getJointInfo(body, j, physicsClientId=c) for j in range(n)]
+        link_index = {p.getBodyInfo(body, physicsClientId=c)[0].decode(): -1}
+        link_index.update({j[12].decode(): j[0] for j in joints})
+        joint_index = {j[1].decode(): j[0] for j in joints}
+        friction = {}
+        contact = {j[12].decode() for j in joints if j[1].decode() in cfg["contact_joints"]}
+        for name, link in link_index.items():
+            p.changeDynamics(body, link, linearDamping=0.0, angularDamping=0.0, jointDamping=0.0,
+                             physicsClientId=c)
+            mu = cfg["friction"].get(name, cfg["default_friction"])
+            if name in contact and cfg["contact_friction"] is not None:
+                mu = cfg["contact_friction"]
+            p.changeDynamics(body, link, lateralFriction=mu, rollingFriction=0.0, spinningFriction=0.0,
+                             physicsClientId=c)
+            friction[name] = mu
+        for j in range(n):
+            p.setJointMotorControl2(body, j, p.VELOCITY_CONTROL, targetVelocity=0.0, force=0.0,
+                                    physicsClientId=c)
+        self.drive_gears = self._belts(body, joint_index)
+        inertial = p.getDynamicsInfo(body, -1, physicsClientId=c)
+        self.base_inertial = (tuple(inertial[3]), tuple(inertial[4]))
+        p.resetBasePositionAndOrientation(body, inertial[3], inertial[4], physicsClientId=c)
+        points = p.getClosestPoints(body, self.floor, 10.0, physicsClientId=c)
+        gap = min((pt[8] for pt in points), default=0.0)
+        com = list(inertial[3])
+        com[2] -= gap
+        p.resetBasePositionAndOrientation(body, com, inertial[4], physicsClientId=c)
+        self.drive_start_height = -gap
+        self.drive_joint_index = joint_index
+        # The velocity servos' bound, ½·m·g·μ·r / rollers (``variant.servo_torque_limit``; MuJoCo's too).
+        mass = sum(p.getDynamicsInfo(body, link, physicsClientId=c)[0] for link in range(-1, n))
+        mu = max((friction[name] for name in contact), default=0.0)
+        count = sum(len(g) for g in self.drive_rollers.values())
+        from modelkit.verify.variant import servo_torque_limit
+
+        self.servo_limit = servo_torque_limit(mass, mu, cfg["roller_radius"], count, abs(cfg["gravity"]))
+        return {"links": sorted(link_index), "friction": friction, "start_height": -gap,
+                "servo_limit": self.servo_limit, "belts": [list(pair) for pair in self.drive_gears],
+                "base_inertial": self.base_inertial, "joints": sorted(joint_index)}
+
+    BELT_MAX_TORQUE = 1.0e4
+    """N·m: the gear constraints' bound (far above any servo's; the belt never gives way)."""
+
+    def _belts(self, body: int, joint_index: dict[str, int]) -> list[tuple[str, str]]:
+        """Each track's rollers coupled like the belt the URDF's ``<mimic>`` describes (roller i > 0
+        turns with roller 0, multiplier 1): PyBullet ignores ``<mimic>``, so a gear constraint
+        (``JOINT_GEAR``, gear ratio −1: equal speeds) per roller i > 0. Without it each roller is
+        driven alone, and a roller the rigid solver leaves lightly loaded (four coplanar supports: the
+        split of the weight among them is not determined; measured 11 N of an average 43 N) slips
+        while the others don't, so the robot accelerates slower than its servos' torque allows."""
+        p, c = self.p, self.drive_client
+        coupled = []
+        for group in self.drive_rollers.values():
+            ids = [joint_index.get(self.drive_names.get(name, name)) for name in group]
+            if len(ids) < 2 or any(i is None for i in ids):
+                continue
+            for name, other in zip(group[1:], ids[1:], strict=True):
+                gear = p.createConstraint(body, ids[0], body, other, jointType=p.JOINT_GEAR,
+                                          jointAxis=[0.0, 1.0, 0.0], parentFramePosition=[0.0, 0.0, 0.0],
+                                          childFramePosition=[0.0, 0.0, 0.0], physicsClientId=c)
+                p.changeConstraint(gear, gearRatio=-1.0, maxForce=self.BELT_MAX_TORQUE, physicsClientId=c)
+                coupled.append((group[0], name))
+        return coupled
+
+    def drive_run(self, profile: dict[str, Any], sample_every: int, recorded: list[str]) -> dict[str, Any]:
+        """One profile: settle at zero torque (velocity joints held at 0), then the controllers every
+        step, torques re-sent before every ``stepSimulation`` (TORQUE_CONTROL lasts one step), velocity
+        targets through VELOCITY_CONTROL at the set maximum force on every roller of a track.
+        Returns the base COM frame poses and the ``recorded`` joints' positions after every
+        ``sample_every`` steps (raw float64 bytes; the frame algebra is the parent's)."""
+        import numpy as np
+
+        from modelkit.verify.drive import Command
+
+        p, cfg = self.p, self.drive_cfg
+        self._drive_world()
+        c, body, dt = self.drive_client, self.drive_body, cfg["dt"]
+        index = self.drive_joint_index
+
+        def jid(name: str) -> int:
+            return index[self.drive_names.get(name, name)]
+
+        plan = []  # (controller, columns in the state read, torque?, joint ids that take its outputs)
+        read: list[int] = []
+        torque_ids: list[int] = []
+        velocity_ids: list[int] = []
+        velocity_fan: list[int] = []  # per velocity joint id: which velocity output drives it
+        v_count = 0
+        for ctl in self.controllers:
+            cols = []
+            for name in ctl.joints:
+                if jid(name) not in read:
+                    read.append(jid(name))
+                cols.append(read.index(jid(name)))
+            torque = str(ctl.mode) != "velocity"
+            if torque:
+                torque_ids.extend(jid(name) for name in ctl.joints)
+            else:
+                for i, name in enumerate(ctl.joints):
+                    group = next((g for g in self.drive_rollers.values() if g and g[0] == name), [name])
+                    for member in group:
+                        velocity_ids.append(jid(member))
+                        velocity_fan.append(v_count + i)
+                v_count += len(ctl.joints)
+            plan.append((ctl, cols, torque))
+        rec_cols = []
+        for name in recorded:
+            if jid(name) not in read:
+                read.append(jid(name))
+            rec_cols.append(read.index(jid(name)))
+        steps = round(profile["duration"] / dt)
+        settle = round(profile["settle"] / dt)
+        commands = [Command(**cmd) for cmd in profile["commands"]]
+        changes = {}
+        for cmd in commands:
+            k = max(0, math.ceil(cmd.t / dt - 1e-9))
+            if k <= steps:
+                changes[k] = cmd
+        torque_mode, velocity_mode = p.TORQUE_CONTROL, p.VELOCITY_CONTROL
+        set_array, step, get_states = p.setJointMotorControlArray, p.stepSimulation, p.getJointStates
+        base_pose = p.getBasePositionAndOrientation
+        zeros_t = [0.0] * len(torque_ids)
+        zeros_v = [0.0] * len(velocity_ids)
+        max_force = [self.servo_limit] * len(velocity_ids)
+        start = time.perf_counter()
+        for _ in range(settle):
+            if torque_ids:
+                set_array(body, torque_ids, torque_mode, forces=zeros_t, physicsClientId=c)
+            if velocity_ids:
+                set_array(body, velocity_ids, velocity_mode, targetVelocities=zeros_v, forces=max_force,
+                          physicsClientId=c)
+            step(physicsClientId=c)
+        settled = time.perf_counter() - start
+        command = Command(0.0)
+        base_log = array("d")
+        q_log = array("d")
+        asarray = np.array
+        for k in range(steps + 1):
+            states = get_states(body, read, physicsClientId=c)
+            if k % sample_every == 0:
+                pos, orn = base_pose(body, physicsClientId=c)
+                base_log.extend(pos)
+                base_log.extend(orn)
+                q_log.extend(states[i][0] for i in rec_cols)
+            if k == steps:
+                break
+            if k in changes:
+                command = changes[k]
+            t = k * dt
+            torques: list[float] = []
+            targets: list[float] = []
+            for ctl, cols, torque in plan:
+                u = ctl.output(t, command, asarray([states[i][0] for i in cols]),
+                               asarray([states[i][1] for i in cols]))
+                (torques if torque else targets).extend(u)
+            if torque_ids:
+                set_array(body, torque_ids, torque_mode, forces=torques, physicsClientId=c)
+            if velocity_ids:
+                set_array(body, velocity_ids, velocity_mode,
+                          targetVelocities=[targets[i] for i in velocity_fan], forces=max_force,
+                          physicsClientId=c)
+            step(physicsClientId=c)
+        wall = time.perf_counter() - start
+        return {"base": base_log.tobytes(), "q": q_log.tobytes(), "wall": wall, "settle_wall": settled,
+                "base_inertial": self.base_inertial, "start_height": self.drive_start_height}
+
+    def drive_batch(self, runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
+        """Several ``drive_run`` requests in one (one pipe round trip for all the profiles)."""
+        return [self.drive_run(**run) for run in runs]
+
+    def drive_bench(self, steps: int) -> dict[str, float]:
+        """Wall times over ``steps`` steps on the layer-4 world (floating robot on the floor): a bare
+        ``stepSimulation`` loop (``bare``) and a minimal closed loop (``closed_loop``: read the
+        controlled joints' states, call the torque controllers with one fixed command, send the
+        torques, step; no sampling, no command schedule)."""
+        import numpy as np
+
+        from modelkit.verify.drive import Command
+
+        p = self.p
+        self._drive_world()
+        c, body, step = self.drive_client, self.drive_body, p.stepSimulation
+        start = time.perf_counter()
+        for _ in range(steps):
+            step(physicsClientId=c)
+        bare = time.perf_counter() - start
+        self._drive_world()
+        index = self.drive_joint_index
+        plan = [(ctl, [index[self.drive_names.get(j, j)] for j in ctl.joints]) for ctl in self.controllers
+                if str(ctl.mode) != "velocity"]
+        ids = [i for _, joints in plan for i in joints]
+        command = Command(0.0, 0.3, 0.5)
+        dt = self.drive_cfg["dt"]
+        start = time.perf_counter()
+        for k in range(steps):
+            states = p.getJointStates(body, ids, physicsClientId=c)
+            forces: list[float] = []
+            offset = 0
+            for ctl, joints in plan:
+                part = states[offset:offset + len(joints)]
+                offset += len(joints)
+                forces.extend(ctl.output(k * dt, command, np.array([s[0] for s in part]),
+                                         np.array([s[1] for s in part])))
+            p.setJointMotorControlArray(body, ids, p.TORQUE_CONTROL, forces=forces, physicsClientId=c)
+            step(physicsClientId=c)
+        return {"bare": bare, "closed_loop": time.perf_counter() - start}
 
 
 def _read(stream: BinaryIO, n: int) -> bytes | None:

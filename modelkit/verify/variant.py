@@ -1,0 +1,329 @@
+"""The verification variant of a converted mobile robot (layer 4): the floating-base model written as
+MJCF and URDF, its wheels' collision shapes replaced by spheres.
+
+Why spheres (verification.md §2.2): MuJoCo and PyBullet give a cylinder lying on a plane different
+meanings. MuJoCo's cylinder–plane collision makes two contacts, one on each rim edge, so a yawing
+wheel scrubs (about μN·w/2 of resisting moment per wheel); PyBullet's implicit cylinder makes one
+contact at whichever rim edge its support mapping picks (the outer one on the left wheel, the inner
+one on the right), so the first acceleration yaws the robot. A sphere of the wheel radius at the
+wheel centre touches a flat floor at exactly one point under the hub in both engines: the only wheel
+shape whose contact means the same thing in the two. It differs from the cylinder only when a wheel
+meets an obstacle sideways, which never happens on a flat floor; the oversized sphere cannot touch
+the chassis (MuJoCo filters parent/child contacts, PyBullet leaves self-collision off).
+
+Tracks: ``convert`` writes each pseudo continuous track as a row of driven rollers (cylinders of the
+track's half height, ``convert/tracks.py``), and those rollers are the contact geometry. A cylinder
+roller on the floor is the same line contact as a cylinder wheel, with the same two meanings, so
+each roller becomes a sphere of the roller radius at its centre too: every roller then touches the
+floor at one point under its hub, in both engines. The track's footprint is thereby reduced to the
+rollers' contact points (two per track for the tutorial robot, 0.22 m apart): the fore–aft spread
+that resists skid-steer turning is kept, the lateral spread across the 6 cm width is not. Neither
+the cylinder rollers nor the spheres are Choreonoid's track (a surface velocity over the whole
+track shape); the spheres are the approximation both engines agree on.
+
+``proxy="native"``: the converted geometry as is (the report-only run that shows the disagreement).
+
+Friction stays the contact materials' (the writers put each link's friction against the floor
+material into the files: MuJoCo geom ``friction``, URDF ``<gazebo><mu1>``); the drivers read it
+from the files, override the wheels' with ``Scenario.friction`` when set, and make the floor's
+combination rule leave each value as it is (``engine_mujoco.driver``, ``engine_pybullet.driver``).
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import importlib
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from modelkit.model import Capsule, Cylinder, Ellipsoid, Geom, Link, Robot, Sphere
+from modelkit.spatial import Pose
+from modelkit.verify.drive import Array, Command, Drive, Profile, Scenario, Trajectory, WheelProxy
+
+Renames = dict[str, dict[str, str]]
+SUFFIX = {"mjcf": ".xml", "urdf": ".urdf"}
+
+
+def _centre(link: Link) -> Pose:
+    """The wheel (or roller) centre in its link frame: the centre of its largest round collision
+    shape (a cylinder, sphere, capsule or ellipsoid), else the link origin (the joint axis passes
+    through it)."""
+    best: tuple[float, Geom] | None = None
+    for geom in link.collisions:
+        g = geom.geometry
+        size = (g.radius if isinstance(g, (Cylinder, Sphere, Capsule))
+                else max(g.radii) if isinstance(g, Ellipsoid) else -1.0)
+        if size > 0 and (best is None or size > best[0]):
+            best = (size, geom)
+    return Pose(translation=best[1].pose.translation.copy()) if best is not None else Pose()
+
+
+def contact_links(prepared: Robot, drive: Drive) -> list[str]:
+    """The links whose collision shapes roll on the floor, source names of the prepared model: the
+    wheel links, or for tracks every roller link ``convert`` wrote (roller 0 first)."""
+    if drive.kind == "wheels":
+        return list(drive.wheel_links)
+    tracks = prepared.extras.get("tracks", {})
+    out: list[str] = []
+    for track in (drive.left, drive.right):
+        record = tracks.get(track)
+        if record is not None:
+            out.extend(record.get("roller_links", []))
+        else:  # the rollers named in the drive: their child links
+            children = {j.name: j.child for j in prepared.joints}
+            out.extend(children[j] for j in drive.rollers.get(track, ()) if j in children)
+    return out
+
+
+def sphere_proxies(prepared: Robot, drive: Drive) -> dict[str, float]:
+    """Replace, in place, the collision shapes of every contact link by one sphere at the wheel
+    centre: radius ``drive.radius`` for wheels, the roller's own radius for track rollers. Returns
+    link → sphere radius."""
+    by_name = {link.name: link for link in prepared.links}
+    out: dict[str, float] = {}
+    for name in contact_links(prepared, drive):
+        link = by_name.get(name)
+        if link is None:
+            raise ValueError(f"the drive names the wheel link {name!r}, which the model does not have")
+        if drive.kind == "wheels":
+            radius = drive.radius
+        else:
+            round_shapes = [g.geometry.radius for g in link.collisions if isinstance(g.geometry, Cylinder)]
+            radius = max(round_shapes) if round_shapes else drive.roller_radius
+        if radius <= 0:
+            raise ValueError(f"no radius for the sphere proxy of {name!r}")
+        centre = _centre(link)
+        source = link.collisions[0].source if link.collisions else link.source
+        link.collisions = [Geom(Sphere(radius), centre, name=f"{name}_proxy", source=source)]
+        out[name] = radius
+    return out
+
+
+def prepare_variant(robot: Robot, drive: Drive, proxy: WheelProxy) -> tuple[Robot, dict[str, float]]:
+    """A deep copy of the floating-base ``robot`` with its tracks approximated as ``convert`` does and,
+    for ``proxy="sphere"``, the sphere proxies in place (link → radius)."""
+    from modelkit.convert.notes import NoteSink
+    from modelkit.convert.tracks import approximate_tracks
+
+    if proxy not in ("sphere", "native"):
+        raise ValueError(f"wheel proxy must be 'sphere' or 'native', not {proxy!r}")
+    prepared = copy.deepcopy(robot)
+    approximate_tracks(prepared, NoteSink())  # what the writers' prepare() would do; a no-op after it
+    spheres = sphere_proxies(prepared, drive) if proxy == "sphere" else {}
+    return prepared, spheres
+
+
+def write_variant(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path, proxy: WheelProxy
+                  ) -> tuple[dict[str, Path], dict[str, Renames]]:
+    """Write the floating-base verification variant of ``robot`` (the source model, root not welded)
+    as MJCF and URDF into ``out_dir`` (``<name>_<proxy>.xml`` / ``.urdf``, meshes in ``meshes/``).
+
+    Returns the files (``"mjcf"``, ``"urdf"``) and each file's renames (``{"link": {source:
+    written}, "joint": {...}}``, from the writers' MK800 notes), as ``verify``'s conversion does.
+    ``scenario`` is not needed to write the files (friction is applied by the drivers); it is taken
+    so that a later variant option (another proxy shape) has its place."""
+    from modelkit.convert.api import write
+    from modelkit.convert.notes import renames
+
+    del scenario
+    prepared, _ = prepare_variant(robot, drive, proxy)
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    stem = f"{_safe(robot.name or 'robot')}_{proxy}"
+    files: dict[str, Path] = {}
+    maps: dict[str, Renames] = {}
+    for fmt in ("mjcf", "urdf"):
+        path = out_dir / f"{stem}{SUFFIX[fmt]}"
+        notes = write(prepared, path, fmt, force=True)
+        files[fmt] = path
+        maps[fmt] = {"link": renames(notes, "link"), "joint": renames(notes, "joint")}
+    return files, maps
+
+
+def _safe(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in name) or "robot"
+
+
+
+# ---- shared by the two drivers (engine_mujoco.driver, engine_pybullet.driver) --------------------
+
+CONTROLLERS = "modelkit.verify.controllers:make_controllers"
+"""The controller factory (``make_controllers(drive: dict, scenario: dict) -> list[Controller]``),
+as ``module:function`` so that PyBullet's child process imports the very same one."""
+
+
+def scenario_data(scenario: Scenario) -> dict[str, Any]:
+    """The scenario as plain data for ``make_controllers`` (``scenario.scenario_dict`` when the
+    scenario module has it, else the dataclass fields)."""
+    try:
+        from modelkit.verify.scenario import scenario_dict
+    except ImportError:
+        return dataclasses.asdict(scenario)
+    return dict(scenario_dict(scenario))
+
+
+def profile_data(profile: Profile) -> dict[str, Any]:
+    return dataclasses.asdict(profile)
+
+
+def profile_from_data(data: dict[str, Any]) -> Profile:
+    commands = tuple(Command(**c) for c in data["commands"])
+    return Profile(**{**data, "commands": commands})
+
+
+def load_factory(spec: str) -> Callable[[dict[str, Any], dict[str, Any]], list[Any]]:
+    module, _, function = spec.partition(":")
+    factory: Callable[[dict[str, Any], dict[str, Any]], list[Any]] = getattr(importlib.import_module(module),
+                                                                             function)
+    return factory
+
+
+def controlled_joints(controllers: list[Any]) -> list[tuple[str, str]]:
+    """(joint, mode) of every joint some controller drives, in controller order (source names)."""
+    out: list[tuple[str, str]] = []
+    for c in controllers:
+        out.extend((j, str(c.mode)) for j in c.joints)
+    return out
+
+
+def driven_groups(drive: Drive, joint: str) -> tuple[str, ...]:
+    """The joints a velocity target for ``joint`` drives: for a track's roller 0, every roller of
+    that track (roller i > 0 mimics roller 0 with multiplier 1; the servo of each gets the target);
+    otherwise the joint itself."""
+    for rollers in drive.rollers.values():
+        if rollers and rollers[0] == joint:
+            return tuple(rollers)
+    return (joint,)
+
+
+def wheel_joints(drive: Drive) -> tuple[str, str]:
+    """The joints whose angles a trajectory's ``wheels`` holds: the wheels, or each track's roller 0."""
+    if drive.kind == "tracks":
+        left, right = drive.rollers.get(drive.left, ()), drive.rollers.get(drive.right, ())
+        if left and right:
+            return left[0], right[0]
+    return drive.left, drive.right
+
+
+def yaw_of(rotations: Array) -> Array:
+    """Heading of each rotation matrix (n, 3, 3): the angle of its x axis in the world XY plane."""
+    return np.arctan2(rotations[:, 1, 0], rotations[:, 0, 0])
+
+
+def planar(source: str, profile: Profile, variant: str, t: Array, positions: Array, rotations: Array,
+           joints: dict[str, Array], wheels: tuple[str, str]) -> Trajectory:
+    """A trajectory from raw samples of the root link frame (world positions (n, 3), rotations
+    (n, 3, 3)) and joint positions: x, y in the start pose's frame, yaw unwrapped relative to the
+    start, joint angles relative to the start."""
+    yaw = np.unwrap(yaw_of(rotations))
+    c, s = math.cos(yaw[0]), math.sin(yaw[0])
+    dx, dy = positions[:, 0] - positions[0, 0], positions[:, 1] - positions[0, 1]
+    rel = {name: q - q[0] for name, q in joints.items()}
+    return Trajectory(source=source, profile=profile.name, variant=variant, t=t,
+                      x=c * dx + s * dy, y=-s * dx + c * dy, yaw=yaw - yaw[0],
+                      wheels=np.column_stack([rel[wheels[0]], rel[wheels[1]]]), joints=rel)
+
+
+def command_steps(profile: Profile, dt: float, steps: int) -> dict[int, Command]:
+    """Step index → the command that takes over at that step (zero-order hold at the physics rate:
+    a command at time t acts from the first step k with k·dt ≥ t). Both drivers use this, so they
+    switch at the same step."""
+    out: dict[int, Command] = {}
+    for command in profile.commands:
+        k = max(0, math.ceil(command.t / dt - 1e-9))
+        if k <= steps:
+            out[k] = command
+    return out
+
+
+def rotations_wxyz(q: Array) -> Array:
+    """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) in MuJoCo's (w, x, y, z) order."""
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=1),
+    ], axis=1)
+
+
+def bench(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path, profile: Profile | None = None,
+          factory: str | None = None) -> dict[str, float]:
+    """Layer 4's harness overhead on one model: wall seconds of one profile (settle + duration) run by
+    each driver (controllers every step, samples) and of a bare stepping loop of the same engine on the
+    same world over the same simulated time; ``*_ratio`` = bare / harness (1 = no overhead),
+    ``*_realtime`` = simulated seconds per wall second inside the harness; ``*_closed_ratio`` =
+    a minimal hand-written closed loop with the same controllers (read, control, step: verification.md
+    §4's "closed loop") / harness, i.e. the harness's own overhead. PyBullet's figures are the
+    child's own loop times (no pipe)."""
+    from modelkit.verify import engine_mujoco, engine_pybullet
+
+    profile = profile or scenario.profiles[0]
+    files, maps = write_variant(robot, drive, scenario, out_dir, "sphere")
+    simulated = profile.settle + profile.duration
+    out: dict[str, float] = {"simulated_s": simulated}
+    mj = engine_mujoco.driver(files["mjcf"], maps["mjcf"], drive=drive, scenario=scenario, factory=factory)
+    mj.run(profile, scenario, drive)  # warm-up
+    mj.run(profile, scenario, drive)
+    harness, loops = mj.last_wall, mj.bench(simulated)
+    bare, closed = loops["bare"], loops["closed_loop"]
+    out.update(mujoco_harness_s=harness, mujoco_bare_s=bare, mujoco_ratio=bare / harness,
+               mujoco_closed_loop_s=closed, mujoco_closed_ratio=closed / harness,
+               mujoco_realtime=simulated / harness, mujoco_bare_realtime=simulated / bare)
+    pb = engine_pybullet.driver(files["urdf"], maps["urdf"], drive=drive, scenario=scenario, factory=factory)
+    try:
+        pb.start([profile, profile], scenario, drive)
+        pb.result()
+        harness, loops = pb.last_wall[-1], pb.bench(simulated)
+        bare, closed = loops["bare"], loops["closed_loop"]
+    finally:
+        pb.close()
+    out.update(pybullet_harness_s=harness, pybullet_bare_s=bare, pybullet_ratio=bare / harness,
+               pybullet_closed_loop_s=closed, pybullet_closed_ratio=closed / harness,
+               pybullet_realtime=simulated / harness, pybullet_bare_realtime=simulated / bare)
+    return out
+
+
+SERVO_FRICTION_SHARE = 0.5
+"""The share of the friction limit a roller servo may use. At 1 (the whole ``m·g·μ·r / n``) a start
+is a friction-limit manoeuvre: any roller carrying less than the average load slips, and the split
+of the weight among four coplanar supports is not determined for a rigid solver (PyBullet split the
+tutorial robot's 172 N as 16/70/65/21 N), nor is the load transfer while accelerating — so the two
+engines slipped differently (MuJoCo 0.7 cm, PyBullet none but a lighter roller saturated) and no
+no-slip reference describes either (verification.md §2.1: slip-dominated manoeuvres make poor
+verification cases). At 0.5 a side's belt passes at most half what its weight can carry, so a
+start is torque-limited (acceleration ``n·τ_max / (r·M_eff)``, about μg/2), slip-free, and the
+no-slip reference models it exactly (``reference_drive``). Steady driving needs no torque at all."""
+
+
+def servo_torque_limit(mass: float, mu: float, radius: float, count: int, gravity: float = 9.81,
+                       share: float | None = None) -> float:
+    """The torque bound of each roller's velocity servo (both engines): the most that friction can
+    pass to the floor through one of ``count`` rollers sharing the robot's weight, ``m·g·μ·r / count``.
+    A servo never needs more in steady driving; at a command step it saturates where friction would
+    anyway. The bound is needed in MuJoCo: its constraint solver computes the contact forces from
+    the actuator's explicit force ``kv·(target − q̇)`` before the implicit integration damps it, so
+    an unbounded stiff servo's reaction at a speed step throws the robot off the floor (measured:
+    kv 1000 launched the tracked robot 24 m; kv 10 still hopped 1.3 cm)."""
+    share = SERVO_FRICTION_SHARE if share is None else share
+    return share * mass * gravity * mu * radius / max(1, count)
+
+
+def servo_gain(mass: float, radius: float, count: int, dt: float) -> float:
+    """The gain kv (N·m·s/rad) of MuJoCo's roller velocity servos: ``J / dt`` with ``J = m·r² / n`` the
+    robot's mass reflected onto one of the ``n`` rollers, i.e. a servo time constant of one step.
+
+    Why not stiffer: a MuJoCo actuator at its force bound is integrated explicitly (``implicitfast``
+    takes no ``∂force/∂q̇`` from a clamped actuator), and an explicit velocity loop on the inertia J
+    is stable only for ``kv·dt / J < 2``. Above that the servo chatters between its two bounds at the
+    step rate once the speed error enters its linear band ``τ_max / kv``: measured on the tracked
+    tutorial robot (J = 0.0158 kg m², dt 1 ms, so the limit is 32): kv 30 settles exactly, kv 100
+    chatters ±0.04 rad/s with the mean 0.24 % fast (1.2 cm over the 5 m straight, growing). At ``J / dt``
+    (half the limit) the servo reaches its target within about a step after a saturated start, as
+    PyBullet's velocity constraint does."""
+    return mass * radius * radius / max(1, count) / dt
