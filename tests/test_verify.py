@@ -38,6 +38,8 @@ MODELS = [
 
 
 def run(source: Path, out: Path, **kwargs: object) -> api.VerifyReport:
+    """Layers 1-3 (layer 4, the driven scenarios, has its own tests: test_verify_layer4.py)."""
+    kwargs.setdefault("driven", False)
     return verify(source, out, ENGINES, replay=False, **kwargs)  # type: ignore[arg-type]
 
 
@@ -150,15 +152,24 @@ def test_validate_and_convert_do_not_import_engines() -> None:
 
 def _emitted_quantities() -> set[str]:
     """Every quantity a layer can emit: the third argument of each ``Check(...)`` and ``Worst.check(...)``
-    call in ``modelkit/verify`` (a literal, so that this list cannot miss one)."""
+    call in ``modelkit/verify``, and the second of layer 4's ``record(...)`` (a literal, so that this
+    list cannot miss one)."""
     import ast
 
     found: set[str] = set()
     for path in sorted((REPO / "modelkit" / "verify").glob("*.py")):
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if not isinstance(node, ast.Call) or len(node.args) < 3:
+            if not isinstance(node, ast.Call) or len(node.args) < 2:
                 continue
             func = node.func
+            if isinstance(func, ast.Name) and func.id == "record" and path.name == "layer4.py":
+                quantity = node.args[1]
+                assert isinstance(quantity, ast.Constant) and isinstance(quantity.value, str), (
+                    f"{path.name}:{node.lineno}: a check's quantity must be a literal")
+                found.add(quantity.value)
+                continue
+            if len(node.args) < 3:
+                continue
             if (isinstance(func, ast.Name) and func.id == "Check") or (
                     isinstance(func, ast.Attribute) and func.attr == "check"):
                 quantity = node.args[2]

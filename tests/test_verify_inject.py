@@ -398,3 +398,43 @@ def test_geometry_faults_are_invisible_to_drake(written: Written, tmp_path: Path
     inject(out / "x.sdf", spec, written.renames["sdf"])
     assert [c for c in _layer_checks(written, out, "sdf", "drake") if not c.passed] == []
     assert _engine("sdf", out / "x.sdf").static().shapes == {}
+
+
+@pytest.mark.parametrize("fmt_name", list(FORMATS))
+def test_swap_fault_exchanges_two_joints_and_moves_the_wheels(written: Written, fmt_name: str,
+                                                               tmp_path: Path) -> None:
+    out = _copy(written, tmp_path)
+    path = out / FORMATS[fmt_name]
+    done = inject(path, "swap:LeftWheel:RightWheel", written.renames[fmt_name])
+    assert done.changes and all("→" in c for c in done.changes)
+    if fmt_name == "sdf":
+        return  # no engine of this test reads SDF without Drake; the edit itself is checked above
+    original = _engine(fmt_name, written.folder / FORMATS[fmt_name])
+    perturbed = _engine(fmt_name, path)
+    a, b = original.static(), perturbed.static()
+    # same joint names, but the joint called LeftWheel now moves the right wheel's link
+    assert set(a.joints) == set(b.joints)
+    left = written.renames[fmt_name]["joint"].get("LeftWheel", "LeftWheel")
+    right = written.renames[fmt_name]["joint"].get("RightWheel", "RightWheel")
+    assert b.joints[left].child == a.joints[right].child
+    assert b.joints[right].child == a.joints[left].child
+
+
+def test_swap_fault_grammar() -> None:
+    fault = parse("swap:LeftWheel:RightWheel")
+    assert (fault.kind, fault.target, fault.other) == ("swap", "LeftWheel", "RightWheel")
+    with pytest.raises(InjectError, match="second, different joint"):
+        parse("swap:LeftWheel:LeftWheel")
+
+
+def test_swapped_wheels_fail_layer_4_naming_the_quantity(tmp_path: Path) -> None:
+    """A converter that mixes up the left and right wheel: layer 2 sees the wheels' poses swap, and the
+    driven robot turns the wrong way (layer 4: the heading against the no-slip reference)."""
+    from modelkit.verify.api import verify
+
+    report = verify(PANTILT, tmp_path, ("mujoco", "pybullet"), inject=["swap:LeftWheel:RightWheel"],
+                    configurations=5, replay=False)
+    failed = {(c.layer, c.engine, c.quantity, c.where) for c in report.failed}
+    assert (2, "mujoco", "pose-rotation", "LeftWheel") in failed
+    assert {(4, e, "noslip-yaw", "spin") for e in ("mujoco", "pybullet")} <= failed
+    assert any("swap:LeftWheel:RightWheel" in line and "layer 4" in line for line in report.injected)

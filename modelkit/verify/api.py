@@ -237,8 +237,12 @@ def verify(
     configurations: int = CONFIGURATIONS,
     samples: int = SAMPLES,
     replay: bool = True,
+    scenario: str | Path | None = None,
+    driven: bool = True,
 ) -> VerifyReport:
-    """Convert ``source`` (or take the given files), load every engine, run layers 1–3.
+    """Convert ``source`` (or take the given files), load every engine, run layers 1–3, then layer 4
+    (the driven scenarios with contact: ``scenario`` is a scenario file, None for the defaults;
+    ``driven`` False skips the layer).
 
     ``out_dir`` receives the written MJCF/URDF/SDF (a temporary folder, deleted afterwards, when
     None). Never raises for a model problem: a failed check is in ``report.checks``; what stops the
@@ -250,17 +254,74 @@ def verify(
                          "engines": list(engines)}
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="modelkit-verify-") as tmp:
-            return _run(report, Path(source), Path(tmp), engines, mjcf, urdf, sdf, inject, seed,
-                        configurations, samples, replay)
+            _run(report, Path(source), Path(tmp), engines, mjcf, urdf, sdf, inject, seed,
+                 configurations, samples, replay, scenario, driven)
+            return report
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    return _run(report, Path(source), out, engines, mjcf, urdf, sdf, inject, seed, configurations, samples,
-                replay)
+    _run(report, Path(source), out, engines, mjcf, urdf, sdf, inject, seed, configurations, samples,
+         replay, scenario, driven)
+    return report
 
 
 def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str], mjcf: str | Path | None,
          urdf: str | Path | None, sdf: str | Path | None, inject: Sequence[str], seed: int,
-         configurations: int, samples: int, replay: bool) -> VerifyReport:
+         configurations: int, samples: int, replay: bool, scenario_path: str | Path | None,
+         driven: bool) -> None:
+    try:
+        robot = _layers_1_to_3(report, source, out_dir, engines, mjcf, urdf, sdf, inject, seed,
+                               configurations, samples, replay)
+    except VerifyError as exc:
+        report.errors.append(str(exc))
+        return
+    if robot is None:
+        return
+    if not driven:
+        report.skips.append(Skip(4, "all", "layer 4 (driven scenarios) not run: switched off (--no-driven)"))
+        return
+    try:
+        _layer4(report, robot, out_dir, engines, inject, scenario_path)
+    except VerifyError as exc:
+        report.errors.append(str(exc))
+
+
+def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence[str], inject: Sequence[str],
+            scenario_path: str | Path | None) -> None:
+    """Layer 4: the source driven by the seed's controllers in MuJoCo and PyBullet, on a floor."""
+    from modelkit.diagnostics import render_text
+    from modelkit.verify import layer4, vehicle
+    from modelkit.verify import scenario as scenarios
+
+    chosen = None
+    if scenario_path is not None:
+        chosen, diagnostics = scenarios.load(scenario_path)
+        if chosen is None:
+            raise VerifyError("--scenario: " + "; ".join(render_text(d) for d in diagnostics))
+    try:
+        drive = vehicle.find_drive(robot, chosen or scenarios.default_scenario())
+    except ValueError as exc:
+        report.skips.append(Skip(4, "all", f"layer 4 (driven scenarios) not run: {exc}"))
+        return
+    chosen = chosen or scenarios.default_scenario(drive.kind, bool(drive.pan or drive.tilt))
+    t0 = time.perf_counter()
+    result = layer4.run(robot, drive, chosen, out_dir / "layer4", list(engines), inject=inject)
+    report.checks.extend(result.checks)
+    report.observations.extend(result.observations)
+    report.skips.extend(result.skips)
+    report.injected.extend(result.injected)
+    report.trajectories = list(result.trajectories)
+    report.scenario = scenarios.scenario_dict(chosen)
+    report.drive = drive.as_dict()
+    report.engines["layer4"] = dict(result.settings)
+    report.timings.update(result.timings)
+    report.timings["layer 4"] = time.perf_counter() - t0
+
+
+def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str],
+                   mjcf: str | Path | None, urdf: str | Path | None, sdf: str | Path | None,
+                   inject: Sequence[str], seed: int, configurations: int, samples: int, replay: bool
+                   ) -> Robot | None:
+    """Layers 1–3 on the welded model; returns the source model as read (None when nothing ran)."""
     from modelkit.verify import approximations, layers, shapes
     from modelkit.verify.reference import SourceModel, dof_joints, source_static
 
@@ -288,7 +349,7 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
         loaded = _load_engines(engines, reference, files, maps, report)
     except VerifyError as exc:
         report.errors.append(str(exc))
-        return report
+        return None
     t2 = time.perf_counter()
     report.timings["convert"] = t1 - t0
     report.timings["load"] = t2 - t1
@@ -359,7 +420,7 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
         report.checks.extend(engine_warnings(report, eng.label, messages, "runtime_warnings", "layers 1-3a"))
         eng.model.close()
     report.timings.update({"layer 1": t3 - t2, "layer 2": t4 - t3, "layer 3a": t5 - t4, "layer 3b": t6 - t5})
-    return report
+    return robot
 
 
 def _explain_invalid_inertia(reference: Robot, loaded: list[Any], checks: list[Check]) -> list[Check]:

@@ -13,6 +13,9 @@ written in the file; it may itself contain ``:``)::
                            a converter writes when it leaves Choreonoid's Y-axis cylinders unconverted
     wheel-radius:LINK:P%   scale the radius of every cylinder and sphere of the link (collision and
                            visual) by 1 + P/100
+    swap:JOINT:OTHER       exchange the names of two joints everywhere the file names them (a
+                           converter that mixed up the left and right wheel: the joint named
+                           ``LeftWheel`` is the right one)
 
 P is a signed decimal (``1%``, ``-5%``, ``2.5%``), non-zero, with 1 + P/100 > 0; DX a signed
 non-zero decimal, optionally followed by ``m``. A bad spec raises :class:`InjectError` (a
@@ -53,13 +56,15 @@ KINDS: dict[str, str] = {  # kind -> what it names
     "axis": "joint",
     "cylinder-y": "link",
     "wheel-radius": "link",
+    "swap": "joint",
 }
 _VALUE_KINDS = {
     "inertia": "percent", "mass": "percent", "wheel-radius": "percent", "com": "metres", "axis": "flip",
 }
 _NUMBER = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?")
 GRAMMAR = (
-    "inertia:LINK:P% | mass:LINK:P% | com:LINK:DX | axis:JOINT:flip | cylinder-y:LINK | wheel-radius:LINK:P%"
+    "inertia:LINK:P% | mass:LINK:P% | com:LINK:DX | axis:JOINT:flip | cylinder-y:LINK | wheel-radius:LINK:P% "
+    "| swap:JOINT:OTHER"
 )
 
 
@@ -82,6 +87,8 @@ class Fault:
     amount: float | None
     spec: str
     name_column: int = 0
+    other: str = ""  # swap: the second joint
+    other_column: int = 0
 
 
 @dataclass
@@ -123,6 +130,10 @@ def parse(spec: str) -> Fault:
     if not sep or not name:
         raise InjectError(spec, len(spec), f"missing the value: {_usage(kind)}")
     column = start + len(name) + 1
+    if kind == "swap":
+        if not value or value == name:
+            raise InjectError(spec, column, f"expected a second, different joint: {_usage(kind)}")
+        return Fault(kind, name, None, spec, start, value, column)
     what = _VALUE_KINDS[kind]
     amount: float | None
     if what == "flip":
@@ -182,6 +193,16 @@ def inject(path: Path, fault: Fault | str, renames: Renames | None = None) -> In
             f"{path.name} has no {kind} {fault.target!r}; its {kind}s: {', '.join(valid) or '(none)'}",
         )
     result = Injection(fault.spec, path.name, fmt_name, fault.kind, fault.target, written)
+    if fault.kind == "swap":
+        other = mapping.get(fault.other, fault.other)
+        if other not in names:
+            back = {w: s for s, w in mapping.items()}
+            valid = sorted(back.get(n, n) for n in names)
+            raise InjectError(fault.spec, fault.other_column, f"{path.name} has no joint {fault.other!r}; "
+                              f"its joints: {', '.join(valid) or '(none)'}")
+        _swap_names(root, fmt_name, written, other, result.changes)
+        _save(path, tree)
+        return result
     edit = _EDITS[(fault.kind, fmt_name)]
     try:
         edit(root, written, fault.amount, result.changes)
@@ -552,6 +573,32 @@ def _wheel_radius_sdf(root: Element, link: str, factor: float | None, changes: l
     for where, _item, shape in _sdf_shapes(root, link, ("cylinder", "sphere")):
         radius = _sdf_child(shape, "radius", where)
         _set_text(radius, fmt(factor * float(radius.text or 0)), f"{where}/{shape.tag}/radius", changes)
+
+
+# Where each format names a joint: the joint's own name, and the attributes that refer to one.
+_JOINT_REFERENCES: dict[str, tuple[tuple[str, str], ...]] = {
+    "mjcf": ((".//joint", "name"), (".//*[@joint]", "joint"), (".//*[@joint1]", "joint1"),
+             (".//*[@joint2]", "joint2"), (".//*[@jointinparent]", "jointinparent")),
+    "urdf": (("joint", "name"), (".//mimic", "joint"), (".//transmission/joint", "name")),
+    "sdf": (("model/joint", "name"),),
+}
+
+
+def _swap_names(root: Element, fmt_name: str, a: str, b: str, changes: list[str]) -> None:
+    """Exchange joint names ``a`` and ``b`` in every place the format names a joint."""
+    swap = {a: b, b: a}
+    for xpath, attr in _JOINT_REFERENCES[fmt_name]:
+        for el in root.iterfind(xpath):
+            old = el.get(attr)
+            if old in swap:
+                el.set(attr, swap[old])
+                changes.append(f"{el.tag}[{old}] {attr}: {old} → {swap[old]}")
+    if fmt_name == "sdf":  # <mimic joint="..."> and <joint_name> texts in SDF
+        for el in root.iter("joint_name"):
+            if (el.text or "").strip() in swap:
+                old = (el.text or "").strip()
+                el.text = swap[old]
+                changes.append(f"joint_name: {old} → {swap[old]}")
 
 
 _Edit = Callable[[Element, str, "float | None", list[str]], None]

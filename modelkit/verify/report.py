@@ -97,6 +97,11 @@ def report_json(report: VerifyReport) -> str:
         "engines": _plain(report.engines),
         "checks": [check_json(c) for c in report.checks],
         "skips": [{"layer": s.layer, "engine": s.engine, "reason": s.reason} for s in report.skips],
+        "observations": [{"layer": o.layer, "engine": o.engine, "quantity": o.quantity, "where": o.where,
+                          "value": _number(o.value), "unit": o.unit, "detail": o.detail}
+                         for o in report.observations],
+        "scenario": _plain(report.scenario),
+        "drive": _plain(report.drive),
         "errors": list(report.errors),
     }
     return json.dumps(data, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
@@ -129,6 +134,9 @@ def render_table(report: VerifyReport) -> str:
     for c in report.failed:
         lines.append(f"FAIL layer {c.layer} {c.engine} {c.quantity} {c.where}: {c.detail} "
                      f"(error {_fmt(c.error)} > tolerance {_fmt(c.tolerance)})")
+    for o in report.observations:
+        value = "inf" if not math.isfinite(o.value) else f"{o.value:.3g} {o.unit}"
+        lines.append(f"reported (not graded): layer 4 {o.engine} {o.quantity} {o.where}: {value}")
     for s in report.skips:
         lines.append(f"skipped: layer {LAYER_NAMES.get(s.layer, s.layer)}, {s.engine}: {s.reason}")
     for e in report.errors:
