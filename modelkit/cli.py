@@ -446,39 +446,97 @@ def convert(
 
 
 @main.command()
-@click.argument("source", type=click.Path(path_type=Path))
+@click.argument("sources", nargs=-1, required=True, type=click.Path(path_type=Path), metavar="MODELS...")
 @click.option("-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder for the written MJCF/URDF/SDF and report.json (default: a temporary folder, "
-              "no report).")
+              "no report); with many models, one folder per model in it plus summary.json and summary.html.")
 @click.option("--engines", default=",".join(DEFAULT_ENGINES), show_default=True,
               help="Comma-separated engines to run; those not installed are skipped.")
 @click.option("--mjcf", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Verify this MJCF (a conversion already made) instead of writing one.")
+              help="Verify this MJCF (a conversion already made) instead of writing one (one model only).")
 @click.option("--urdf", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Verify this URDF instead of writing one.")
+              help="Verify this URDF instead of writing one (one model only).")
 @click.option("--sdf", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Verify this SDF instead of writing one.")
+              help="Verify this SDF instead of writing one (one model only).")
 @click.option("--inject", multiple=True, metavar="FAULT",
               help="Perturb the written files as a buggy converter would (inertia:LINK:1%, com:LINK:DX, "
               "axis:JOINT:flip, cylinder-y:LINK, wheel-radius:LINK:5%, mass:LINK:10%); repeatable.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the random configurations.")
 @click.option("--no-replay", is_flag=True, help="Skip layer 3b (the MuJoCo/PyBullet torque replay).")
-def verify(source: Path, output: Path | None, engines: str, mjcf: Path | None, urdf: Path | None,
-           sdf: Path | None, inject: tuple[str, ...], seed: int, no_replay: bool) -> None:
+@click.option("--scenario", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Layer 4's scenario file (command profiles, controller gains, contact, tolerances: "
+              "docs/scenarios.md); default: the built-in profiles.")
+@click.option("--no-driven", is_flag=True, help="Skip layer 4 (the driven scenarios with contact).")
+@click.option("-j", "--jobs", type=click.IntRange(min=1), default=None,
+              help="Many models: verify this many at a time, each in its own process (default: the number "
+              "of cores; 1 runs them one after the other in this process).")
+@click.option("--cluster", metavar="ADDRESS", default=None,
+              help="Many models: run each model as a Ray task on this cluster (ray://HOST:PORT, or local "
+              "for a private Ray on this machine); needs modelkit[cluster].")
+def verify(sources: tuple[Path, ...], output: Path | None, engines: str, mjcf: Path | None, urdf: Path | None,
+           sdf: Path | None, inject: tuple[str, ...], seed: int, no_replay: bool, scenario: Path | None,
+           no_driven: bool, jobs: int | None, cluster: str | None) -> None:
     """Prove a conversion is the same robot: static facts, kinematics and dynamics in real engines.
 
-    Exit 0 every check passed; 1 a check failed; 2 could not run (unreadable input, bad option).
-    """
-    from modelkit.verify.api import verify as run_verify
-    from modelkit.verify.report import render_table, report_json
+    MODELS: one model file, or many (files, or folders: the model files directly inside), verified
+    in parallel with one report folder each and a summary.
 
+    Exit 0 every check passed; 1 a check failed; 2 could not run (unreadable input, bad option; with
+    many models: any model that could not be verified, which takes precedence over a failed check).
+    """
     names = tuple(e.strip() for e in engines.split(",") if e.strip())
-    report = run_verify(source, output, names, mjcf, urdf, sdf, inject, seed, replay=not no_replay)
-    click.echo(render_table(report), nl=False)
-    if output is not None and not report.errors:
-        (output / "report.json").write_text(report_json(report), encoding="utf-8")
-        click.echo(f"wrote {output / 'report.json'}")
-    sys.exit(report.exit_code)
+    if len(sources) == 1 and not sources[0].is_dir() and cluster is None:
+        from modelkit.verify.api import verify as run_verify
+        from modelkit.verify.report import render_table
+
+        report = run_verify(sources[0], output, names, mjcf, urdf, sdf, inject, seed, replay=not no_replay,
+                            scenario=scenario, driven=not no_driven)
+        click.echo(render_table(report), nl=False)
+        if output is not None and not report.errors:
+            from modelkit.verify.many import save
+
+            save(report, output)
+            click.echo(f"wrote {output / 'report.json'}")
+            if "html" in report.artefacts:
+                click.echo(f"report: {output / report.artefacts['html']}")
+        sys.exit(report.exit_code)
+    if mjcf or urdf or sdf:
+        raise click.UsageError("--mjcf/--urdf/--sdf name the conversion of one model: give one model")
+    _verify_many(sources, output, {"engines": list(names), "inject": list(inject), "seed": seed,
+                                   "replay": not no_replay, "driven": not no_driven,
+                                   "scenario": str(scenario.resolve()) if scenario else None}, jobs, cluster)
+
+
+def _verify_many(sources: tuple[Path, ...], output: Path | None, options: dict[str, Any], jobs: int | None,
+                 cluster: str | None) -> None:
+    from modelkit.verify import many
+
+    try:
+        many.check_options(options)
+    except ValueError as exc:
+        raise click.UsageError(str(exc)) from exc
+    paths = many.expand_inputs(sources)
+    if not paths:
+        raise click.UsageError("no model file found in " + ", ".join(str(s) for s in sources))
+    progress = many.progress_printer(sys.stderr) if many.progress_wanted(sys.stderr) else None
+    if cluster is not None:
+        from modelkit.verify.cluster import ClusterError, run_ray
+
+        try:
+            results = run_ray(many.make_jobs(paths, options, absolute=True), output, cluster, progress)
+        except ClusterError as exc:
+            click.echo(f"error: {exc}", err=True)
+            sys.exit(2)
+    else:
+        workers = min(jobs or many.default_workers(), len(paths))
+        if progress is not None:
+            click.echo(f"verifying {len(paths)} models, {workers} at a time", err=True)
+        results = many.run_local(many.make_jobs(paths, options), output, workers, progress)
+    click.echo(many.render_summary(results), nl=False)
+    if output is not None:
+        for path in many.write_summary(results, options, output):
+            click.echo(f"wrote {path}")
+    sys.exit(many.exit_code(results))
 
 
 if __name__ == "__main__":  # pragma: no cover

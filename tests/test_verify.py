@@ -195,3 +195,18 @@ def test_cli_default_engines_are_the_api_default() -> None:
     (option,) = [p for p in command.params if p.name == "engines"]
     assert tuple(str(option.default).split(",")) == api.DEFAULT_ENGINES
     assert "drake-urdf" in api.DEFAULT_ENGINES
+
+
+def test_two_full_runs_write_the_same_report(tmp_path: Path) -> None:
+    """Every layer (the replay and the driven scenarios included): report.json is the same bytes from
+    run to run (wall times and engine speeds are printed, never written)."""
+    from modelkit.verify.many import save
+
+    texts = []
+    for name in ("a", "b"):
+        report = verify(PANTILT, tmp_path / name, ("mujoco", "pybullet", "pinocchio"))
+        assert report.verdict == "pass", [c.detail for c in report.failed]
+        assert any(c.layer == 4 for c in report.checks) and any(c.layer == 3 for c in report.checks)
+        save(report, tmp_path / name)
+        texts.append((tmp_path / name / "report.json").read_bytes())
+    assert texts[0] == texts[1]

@@ -69,7 +69,7 @@ def _chromium() -> str:
     pytest.skip("no Chromium installed (apt-get install chromium-headless-shell)")
 
 
-def _screenshot(chromium: str, page: Path, out: Path, size: tuple[int, int] = (1280, 8000)) -> np.ndarray:
+def _screenshot(chromium: str, page: Path, out: Path, size: tuple[int, int] = (1280, 16000)) -> np.ndarray:
     """The whole page (a tall window: headless Chromium's --screenshot ignores a URL fragment's scroll)."""
     subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
                     f"--window-size={size[0]},{size[1]}", f"--screenshot={out}", page.resolve().as_uri()],
@@ -274,10 +274,13 @@ def test_report_renders_in_headless_chromium(verified: tuple[VerifyReport, Path]
     assert np.all(np.abs(region - (0xFF, 0x7F, 0x0E)) < 40, axis=2).sum() > 150  # PyBullet's lines
     # Below the last plot, the first rows with the collision colour are configuration 0's collision
     # pictures (the visual ones come first, grey).
-    below = shot[y + drawn.shape[0]:]
+    last_key = [k for k in r.artefacts if k.startswith("plot:")][-1]
+    last = _pixels((page.parent / r.artefacts[last_key]).read_bytes())
+    end = _find_rows(shot, last) + last.shape[0]
+    below = shot[end:]
     orange_rows = np.nonzero(_orange(below).sum(axis=1) > 60)[0]
     assert len(orange_rows) > 0, "no collision picture on the page"
-    top = y + drawn.shape[0] + int(orange_rows[0])
+    top = end + int(orange_rows[0])
     band = shot[top:top + 300]
     orange = _orange(band)
     columns = np.nonzero(orange.any(axis=0))[0]

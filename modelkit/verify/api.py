@@ -268,6 +268,15 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
          urdf: str | Path | None, sdf: str | Path | None, inject: Sequence[str], seed: int,
          configurations: int, samples: int, replay: bool, scenario_path: str | Path | None,
          driven: bool) -> None:
+    chosen = None
+    if scenario_path is not None and driven:  # a bad scenario file stops the run before any layer
+        from modelkit.diagnostics import render_text
+        from modelkit.verify import scenario as scenarios
+
+        chosen, diagnostics = scenarios.load(scenario_path)
+        if chosen is None:
+            report.errors.extend(f"--scenario: {render_text(d)}" for d in diagnostics)
+            return
     try:
         robot = _layers_1_to_3(report, source, out_dir, engines, mjcf, urdf, sdf, inject, seed,
                                configurations, samples, replay)
@@ -279,24 +288,16 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
     if not driven:
         report.skips.append(Skip(4, "all", "layer 4 (driven scenarios) not run: switched off (--no-driven)"))
         return
-    try:
-        _layer4(report, robot, out_dir, engines, inject, scenario_path)
-    except VerifyError as exc:
-        report.errors.append(str(exc))
+    _layer4(report, robot, out_dir, engines, inject, chosen)
 
 
 def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence[str], inject: Sequence[str],
-            scenario_path: str | Path | None) -> None:
-    """Layer 4: the source driven by the seed's controllers in MuJoCo and PyBullet, on a floor."""
-    from modelkit.diagnostics import render_text
+            chosen: Any) -> None:
+    """Layer 4: the source driven by the seed's controllers in MuJoCo and PyBullet, on a floor;
+    ``chosen``: the scenario read from the user's file (None: the built-in one)."""
     from modelkit.verify import layer4, vehicle
     from modelkit.verify import scenario as scenarios
 
-    chosen = None
-    if scenario_path is not None:
-        chosen, diagnostics = scenarios.load(scenario_path)
-        if chosen is None:
-            raise VerifyError("--scenario: " + "; ".join(render_text(d) for d in diagnostics))
     try:
         drive = vehicle.find_drive(robot, chosen or scenarios.default_scenario())
     except ValueError as exc:

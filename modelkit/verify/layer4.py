@@ -276,7 +276,11 @@ def _setup(
     result.settings.setdefault("variant", {})[proxy] = {k: p.name for k, p in sorted(files.items())}
     for spec in inject:
         apply = _resolve("modelkit.verify.inject:apply")
-        result.injected.append(f"layer 4 {proxy} variant: {apply(spec, files, maps)}")
+        try:
+            result.injected.append(f"layer 4 {proxy} variant: {apply(spec, files, maps)}")
+        except ValueError as exc:  # e.g. cylinder-y on a variant whose wheels are sphere proxies
+            reason = str(exc).splitlines()[0]
+            result.injected.append(f"layer 4 {proxy} variant: {spec}: not applicable ({reason})")
     kinds = {"mujoco": "mjcf", "pybullet": "urdf"}
     for e in engines:
         try:
