@@ -439,9 +439,11 @@ class PyBulletDriver:
     engine = "pybullet"
 
     def __init__(self, model: Path, renames: Renames, drive: Any, scenario: Any, factory: str | None = None,
-                 sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT) -> None:
+                 sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT,
+                 fast: bool = True) -> None:
         from modelkit.verify import variant as v
 
+        self.fast = fast
         self.path = Path(model)
         self.renames = renames
         self.drive = drive
@@ -476,9 +478,13 @@ class PyBulletDriver:
             "flags": "URDF_USE_INERTIA_FROM_FILE|URDF_USE_IMPLICIT_CYLINDER", "gravity": [0.0, 0.0, GRAVITY],
             "timestep": self.dt, "numSolverIterations": SOLVER_ITERATIONS,
             "enableConeFriction": "default (1)",
-            "damping": "linearDamping, angularDamping, jointDamping 0 on every link",
+            "damping": ("linearDamping, angularDamping, jointDamping 0 on every link"
+                        + ("; while a profile's commands run, the torque-law joints' jointDamping is the "
+                           "controller's gain (the law's −gain·q̇, see control), nothing else"
+                           if fast else "")),
             "default_motors": "off (VELOCITY_CONTROL force 0)",
             "torque": "TORQUE_CONTROL re-sent before every stepSimulation",
+            "control": self._control_setting(fast),
             "velocity_servo": ("VELOCITY_CONTROL (a velocity constraint), max force "
                                f"{info['servo_limit']:.4g} "
                                "N·m (½·m·g·μ·r / rollers, as MuJoCo's bound), on every roller of a track "
@@ -520,8 +526,8 @@ class PyBulletDriver:
         every = max(1, round(1.0 / (scenario.sample_rate * self.dt)))
         budget = self.timeout + sum(20.0 * (p.duration + p.settle) for p in profiles)
         printed = self._worker.send("drive_batch", runs=[
-            {"profile": v.profile_data(p), "sample_every": every, "recorded": self.recorded}
-            for p in profiles])
+            {"profile": v.profile_data(p), "sample_every": every, "recorded": self.recorded,
+             "fast": self.fast} for p in profiles])
         self._pending = (printed, list(profiles), every, budget)
 
     def result(self) -> list[Any]:
@@ -532,6 +538,7 @@ class PyBulletDriver:
         self._pending = None
         raw = self._worker.receive("drive_batch", printed, budget)
         self.last_wall = [float(r["wall"]) for r in raw]
+        self.last_law = [str(r.get("law", "per-step")) for r in raw]
         return [self._trajectory(p, r, every) for p, r in zip(profiles, raw, strict=True)]
 
     def run(self, profile: Any, scenario: Any, drive: Any) -> Any:
@@ -554,12 +561,33 @@ class PyBulletDriver:
                        {name: q[:, i].copy() for i, name in enumerate(self.recorded)},
                        v.wheel_joints(self.drive))
         out.settings = dict(self.settings)
+        if raw.get("law") == "per-step" and self.fast:
+            out.settings["control"] = self._control_setting(False)  # a controller without an affine law
         return out
 
-    def bench(self, seconds: float) -> dict[str, float]:
-        """Wall seconds of a bare ``stepSimulation`` loop on this world (floating robot on the floor)."""
+    @staticmethod
+    def _control_setting(fast: bool) -> str:
+        if not fast:
+            return ("per step: the controllers' output every step from getJointStates, torques through "
+                    "TORQUE_CONTROL, velocity targets through VELOCITY_CONTROL, both re-sent before every "
+                    "stepSimulation")
+        return ("affine laws u = offset − gain·q̇ applied by Bullet (when every controller has affine_law): "
+                "−gain·q̇ as the law joints' jointDamping (changeDynamics; PyBullet applies −d·q̇ explicitly "
+                "before every step from the step's starting velocity), set to the gain while a profile's "
+                "commands run, 0 while settling and on every other joint; offset through TORQUE_CONTROL "
+                "re-sent before every stepSimulation (none sent while it is 0); velocity targets through "
+                "VELOCITY_CONTROL at command changes (the motor persists); states read at samples only. "
+                "The same physics as calling the controllers every step to round-off")
+
+    def bench(self, seconds: float, command: Any = None) -> dict[str, float]:
+        """Wall seconds of a bare ``stepSimulation`` loop on this world (floating robot on the floor)
+        and of a minimal closed loop, at ``command`` (a :class:`~modelkit.verify.drive.Command`; None:
+        v 0.3, w 0.5): the worker's ``drive_bench``."""
+        import dataclasses
+
+        data = dataclasses.asdict(command) if command is not None else None
         out = self._worker.request("drive_bench", timeout=self.timeout + 20.0 * seconds,
-                                   steps=round(seconds / self.dt))
+                                   steps=round(seconds / self.dt), at=data)
         return {k: float(x) for k, x in out.items()}
 
     def close(self) -> None:
@@ -567,6 +595,9 @@ class PyBulletDriver:
 
 
 def driver(model: Path, renames: Renames, *, drive: Any, scenario: Any, factory: str | None = None,
-           sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT) -> PyBulletDriver:
-    """Layer 4's entry point (:class:`modelkit.verify.drive.Driver`, plus ``start``/``result``)."""
-    return PyBulletDriver(Path(model), renames, drive, scenario, factory, sys_path, timeout)
+           sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT, fast: bool = True
+           ) -> PyBulletDriver:
+    """Layer 4's entry point (:class:`modelkit.verify.drive.Driver`, plus ``start``/``result``).
+    ``fast`` False: the controllers' ``output`` every step even when they have affine laws (the
+    reference the fast path is tested against, ``tests/test_verify_drivers_pybullet_fast.py``)."""
+    return PyBulletDriver(Path(model), renames, drive, scenario, factory, sys_path, timeout, fast)

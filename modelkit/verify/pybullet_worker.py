@@ -366,12 +366,17 @@ class Engine:
                 coupled.append((group[0], name))
         return coupled
 
-    def drive_run(self, profile: dict[str, Any], sample_every: int, recorded: list[str]) -> dict[str, Any]:
+    def drive_run(self, profile: dict[str, Any], sample_every: int, recorded: list[str],
+                  fast: bool = False) -> dict[str, Any]:
         """One profile: settle at zero torque (velocity joints held at 0), then the controllers every
         step, torques re-sent before every ``stepSimulation`` (TORQUE_CONTROL lasts one step), velocity
         targets through VELOCITY_CONTROL at the set maximum force on every roller of a track.
         Returns the base COM frame poses and the ``recorded`` joints' positions after every
-        ``sample_every`` steps (raw float64 bytes; the frame algebra is the parent's)."""
+        ``sample_every`` steps (raw float64 bytes; the frame algebra is the parent's).
+
+        ``fast``: the affine laws applied by Bullet itself when every controller allows it
+        (:meth:`_drive_laws`; ``"law"`` in the result says which path ran: ``"bullet"`` or
+        ``"per-step"``)."""
         import numpy as np
 
         from modelkit.verify.drive import Command
@@ -420,6 +425,10 @@ class Engine:
             k = max(0, math.ceil(cmd.t / dt - 1e-9))
             if k <= steps:
                 changes[k] = cmd
+        laws = self._drive_laws(plan, commands, torque_ids) if fast else None
+        if laws is not None:
+            return self._drive_run_fast(laws, torque_ids, velocity_ids, velocity_fan, read, rec_cols, steps,
+                                        settle, changes, sample_every)
         torque_mode, velocity_mode = p.TORQUE_CONTROL, p.VELOCITY_CONTROL
         set_array, step, get_states = p.setJointMotorControlArray, p.stepSimulation, p.getJointStates
         base_pose = p.getBasePositionAndOrientation
@@ -466,34 +475,161 @@ class Engine:
             step(physicsClientId=c)
         wall = time.perf_counter() - start
         return {"base": base_log.tobytes(), "q": q_log.tobytes(), "wall": wall, "settle_wall": settled,
-                "base_inertial": self.base_inertial, "start_height": self.drive_start_height}
+                "base_inertial": self.base_inertial, "start_height": self.drive_start_height,
+                "law": "per-step"}
+
+    @staticmethod
+    def _drive_laws(plan: list[Any], commands: list[Any], torque_ids: list[int]
+                    ) -> dict[Any, tuple[list[float], list[float], list[float]]] | None:
+        """Per command (and the zero command before the first): ``(torque offsets, torque gains,
+        velocity targets)`` in the order of ``torque_ids`` / the velocity outputs, from the
+        controllers' ``affine_law`` (``output = offset − gain·q̇`` while the command holds). None
+        (the per-step path runs) when a controller has no ``affine_law``, a gain is negative or not
+        finite, a velocity-mode law has a q̇ term (that is not a velocity target), or a joint takes
+        torques from two controllers (Bullet's damping is per joint)."""
+        if len(set(torque_ids)) != len(torque_ids):
+            return None
+        out: dict[Any, tuple[list[float], list[float], list[float]]] = {}
+        from modelkit.verify.drive import Command
+
+        for command in [Command(0.0), *commands]:
+            offsets: list[float] = []
+            gains: list[float] = []
+            targets: list[float] = []
+            for ctl, _, torque in plan:
+                law = getattr(ctl, "affine_law", None)
+                if law is None:
+                    return None
+                offset, gain = law(command)
+                offset = [float(x) for x in offset]
+                gain = [float(x) for x in gain]
+                if len(offset) != len(ctl.joints) or len(gain) != len(ctl.joints):
+                    return None
+                if not all(math.isfinite(x) for x in offset + gain) or any(g < 0.0 for g in gain):
+                    return None
+                if torque:
+                    offsets.extend(offset)
+                    gains.extend(gain)
+                elif any(g != 0.0 for g in gain):
+                    return None
+                else:
+                    targets.extend(offset)
+            out[command] = (offsets, gains, targets)
+        return out
+
+    def _drive_run_fast(self, laws: dict[Any, tuple[list[float], list[float], list[float]]],
+                        torque_ids: list[int], velocity_ids: list[int], velocity_fan: list[int],
+                        read: list[int], rec_cols: list[int], steps: int, settle: int,
+                        changes: dict[int, Any], sample_every: int) -> dict[str, Any]:
+        """``drive_run`` with the seed's affine laws ``u = offset − gain·q̇`` applied by Bullet:
+
+        * ``−gain·q̇``: the law joints' ``jointDamping`` (``changeDynamics``), which PyBullet's server
+          applies before every ``stepSimulation`` as the explicit joint torque ``−d·q̇`` from the
+          velocity at the start of the step (``PhysicsServerCommandProcessor::applyJointDamping``,
+          ``addJointTorqueMultiDof``) — the per-step path's ``kd·(q* − q̇)`` from the state it reads
+          just before the step, to round-off (``tests/test_verify_drivers_pybullet_fast.py``). 0 on
+          every joint while settling (the per-step path sends zero torque) and on every other joint;
+        * ``offset``: TORQUE_CONTROL re-sent before every step (it lasts one step), nothing sent
+          while it is zero on every joint (a zero torque and no call are the same step: the
+          applied torques are cleared after each step);
+        * velocity targets: VELOCITY_CONTROL at command changes only (the motor persists; the
+          per-step path re-sends the same target and force every step);
+        * states and the base pose read at samples only."""
+        p = self.p
+        c, body = self.drive_client, self.drive_body
+        torque_mode, velocity_mode = p.TORQUE_CONTROL, p.VELOCITY_CONTROL
+        set_array, step, get_states = p.setJointMotorControlArray, p.stepSimulation, p.getJointStates
+        base_pose, change_dynamics = p.getBasePositionAndOrientation, p.changeDynamics
+        max_force = [self.servo_limit] * len(velocity_ids)
+        start = time.perf_counter()
+        if velocity_ids:
+            set_array(body, velocity_ids, velocity_mode, targetVelocities=[0.0] * len(velocity_ids),
+                      forces=max_force, physicsClientId=c)
+        for _ in range(settle):
+            step(physicsClientId=c)
+        settled = time.perf_counter() - start
+        damping = [0.0] * len(torque_ids)
+        targets: list[float] | None = None
+        forces: list[float] = []
+        base_log = array("d")
+        q_log = array("d")
+        events = sorted(set(range(0, steps + 1, sample_every)) | {k for k in changes if k < steps} | {steps})
+        law = laws[next(iter(laws))]  # the zero command's, until the first change
+        for at, until in zip(events, [*events[1:], steps], strict=True):
+            if at % sample_every == 0:
+                states = get_states(body, read, physicsClientId=c)
+                pos, orn = base_pose(body, physicsClientId=c)
+                base_log.extend(pos)
+                base_log.extend(orn)
+                q_log.extend(states[i][0] for i in rec_cols)
+            if at == steps:
+                break
+            if at in changes:
+                law = laws[changes[at]]
+            offsets, gains, velocity = law
+            for joint, gain, old in zip(torque_ids, gains, damping, strict=True):
+                if gain != old:
+                    change_dynamics(body, joint, jointDamping=gain, physicsClientId=c)
+            damping = gains
+            if velocity_ids and velocity != targets:
+                set_array(body, velocity_ids, velocity_mode,
+                          targetVelocities=[velocity[i] for i in velocity_fan], forces=max_force,
+                          physicsClientId=c)
+                targets = velocity
+            forces = offsets
+            if torque_ids and any(f != 0.0 for f in forces):
+                for _ in range(until - at):
+                    set_array(body, torque_ids, torque_mode, forces=forces, physicsClientId=c)
+                    step(physicsClientId=c)
+            else:
+                for _ in range(until - at):
+                    step(physicsClientId=c)
+        for joint, gain in zip(torque_ids, damping, strict=True):
+            if gain != 0.0:  # the world is rebuilt for every run; leave nothing acting anyway
+                change_dynamics(body, joint, jointDamping=0.0, physicsClientId=c)
+        wall = time.perf_counter() - start
+        return {"base": base_log.tobytes(), "q": q_log.tobytes(), "wall": wall, "settle_wall": settled,
+                "base_inertial": self.base_inertial, "start_height": self.drive_start_height,
+                "law": "bullet"}
 
     def drive_batch(self, runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
         """Several ``drive_run`` requests in one (one pipe round trip for all the profiles)."""
         return [self.drive_run(**run) for run in runs]
 
-    def drive_bench(self, steps: int) -> dict[str, float]:
+    def drive_bench(self, steps: int, at: dict[str, float] | None = None) -> dict[str, float]:
         """Wall times over ``steps`` steps on the layer-4 world (floating robot on the floor): a bare
         ``stepSimulation`` loop (``bare``) and a minimal closed loop (``closed_loop``: read the
         controlled joints' states, call the torque controllers with one fixed command, send the
-        torques, step; no sampling, no command schedule)."""
+        torques, step; no sampling, no command schedule). ``at``: that command (plain data;
+        default v 0.3, w 0.5). In both loops a velocity-mode controller's servos (the track rollers) are
+        engaged once at that command's targets before the loop: velocity constraints the solver
+        carries in every step of a driven run, part of the model's physics like MuJoCo's velocity
+        actuators, not harness work (``bare_unservoed``: the bare loop without them, robot at rest)."""
         import numpy as np
 
         from modelkit.verify.drive import Command
 
         p = self.p
+        command = Command(**at) if at is not None else Command(0.0, 0.3, 0.5)
+        c, step = self.drive_client, p.stepSimulation
         self._drive_world()
-        c, body, step = self.drive_client, self.drive_body, p.stepSimulation
+        start = time.perf_counter()
+        for _ in range(steps):
+            step(physicsClientId=c)
+        unservoed = time.perf_counter() - start
+        self._drive_world()
+        self._engage_servos(command)
         start = time.perf_counter()
         for _ in range(steps):
             step(physicsClientId=c)
         bare = time.perf_counter() - start
         self._drive_world()
+        self._engage_servos(command)
+        body = self.drive_body
         index = self.drive_joint_index
         plan = [(ctl, [index[self.drive_names.get(j, j)] for j in ctl.joints]) for ctl in self.controllers
                 if str(ctl.mode) != "velocity"]
         ids = [i for _, joints in plan for i in joints]
-        command = Command(0.0, 0.3, 0.5)
         dt = self.drive_cfg["dt"]
         start = time.perf_counter()
         for k in range(steps):
@@ -507,7 +643,29 @@ class Engine:
                                          np.array([s[1] for s in part])))
             p.setJointMotorControlArray(body, ids, p.TORQUE_CONTROL, forces=forces, physicsClientId=c)
             step(physicsClientId=c)
-        return {"bare": bare, "closed_loop": time.perf_counter() - start}
+        return {"bare": bare, "closed_loop": time.perf_counter() - start, "bare_unservoed": unservoed}
+
+    def _engage_servos(self, command: Any) -> None:
+        """The velocity-mode controllers' targets for ``command`` into their joints' VELOCITY_CONTROL
+        servos (every roller of a track gets roller 0's), at the servo force bound."""
+        import numpy as np
+
+        p, index = self.p, self.drive_joint_index
+        ids: list[int] = []
+        targets: list[float] = []
+        for ctl in self.controllers:
+            if str(ctl.mode) != "velocity":
+                continue
+            out = ctl.output(0.0, command, np.zeros(len(ctl.joints)), np.zeros(len(ctl.joints)))
+            for name, target in zip(ctl.joints, out, strict=True):
+                group = next((g for g in self.drive_rollers.values() if g and g[0] == name), [name])
+                for member in group:
+                    ids.append(index[self.drive_names.get(member, member)])
+                    targets.append(float(target))
+        if ids:
+            p.setJointMotorControlArray(self.drive_body, ids, p.VELOCITY_CONTROL, targetVelocities=targets,
+                                        forces=[self.servo_limit] * len(ids),
+                                        physicsClientId=self.drive_client)
 
 
 def _read(stream: BinaryIO, n: int) -> bytes | None:

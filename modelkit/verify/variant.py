@@ -279,7 +279,7 @@ def bench(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path, profile
     try:
         pb.start([profile, profile], scenario, drive)
         pb.result()
-        harness, loops = pb.last_wall[-1], pb.bench(simulated)
+        harness, loops = pb.last_wall[-1], pb.bench(simulated, (profile.commands or (None,))[0])
         bare, closed = loops["bare"], loops["closed_loop"]
     finally:
         pb.close()
