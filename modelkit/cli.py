@@ -487,14 +487,20 @@ def verify(sources: tuple[Path, ...], output: Path | None, engines: str, mjcf: P
     names = tuple(e.strip() for e in engines.split(",") if e.strip())
     if len(sources) == 1 and not sources[0].is_dir() and cluster is None:
         from modelkit.verify.api import verify as run_verify
+        from modelkit.verify.many import progress_wanted, save
         from modelkit.verify.report import render_table
 
+        shown = progress_wanted(sys.stderr)
+
+        def progress(line: str) -> None:
+            if shown:
+                click.echo(f"verify: {line} ...", err=True)
+
         report = run_verify(sources[0], output, names, mjcf, urdf, sdf, inject, seed, replay=not no_replay,
-                            scenario=scenario, driven=not no_driven)
+                            scenario=scenario, driven=not no_driven, progress=progress)
         click.echo(render_table(report), nl=False)
         if output is not None and not report.errors:
-            from modelkit.verify.many import save
-
+            progress("writing the report (plots, pictures, report.html)")
             save(report, output)
             click.echo(f"wrote {output / 'report.json'}")
             if "html" in report.artefacts:

@@ -210,3 +210,39 @@ def test_two_full_runs_write_the_same_report(tmp_path: Path) -> None:
         save(report, tmp_path / name)
         texts.append((tmp_path / name / "report.json").read_bytes())
     assert texts[0] == texts[1]
+
+
+def _cli_on_a_terminal(*args: str, env: dict[str, str]) -> str:
+    """The CLI's whole output when stdout and stderr are a terminal (a pseudo-terminal)."""
+    import os
+    import pty
+
+    pid, fd = pty.fork()
+    if pid == 0:  # pragma: no cover (the child)
+        os.chdir(REPO)
+        os.execve(sys.executable, [sys.executable, "-m", "modelkit.cli", "verify", *args], env)
+    chunks = []
+    while True:
+        try:
+            data = os.read(fd, 65536)
+        except OSError:
+            break
+        if not data:
+            break
+        chunks.append(data)
+    os.waitpid(pid, 0)
+    return b"".join(chunks).decode()
+
+
+def test_one_model_shows_progress_on_a_terminal_only(tmp_path: Path) -> None:
+    import os
+
+    args = (str(PANTILT), "--engines", "mujoco,pybullet", "--no-replay", "-o", str(tmp_path / "a"))
+    env = {k: v for k, v in os.environ.items() if k != "CI"}
+    shown = _cli_on_a_terminal(*args, env=env)
+    assert "verify: layer 4: driving the robot in MuJoCo and PyBullet ..." in shown
+    assert "verify: writing the report" in shown and "report: " in shown
+    quiet = _cli_on_a_terminal(*args, env={**env, "CI": "true"})
+    assert "verify: " not in quiet and "PASS" in quiet
+    piped = _cli(*args)  # not a terminal
+    assert "verify: " not in piped.stdout + piped.stderr and piped.returncode == 0

@@ -57,7 +57,7 @@ import dataclasses
 import importlib
 import tempfile
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -239,10 +239,12 @@ def verify(
     replay: bool = True,
     scenario: str | Path | None = None,
     driven: bool = True,
+    progress: Callable[[str], None] | None = None,
 ) -> VerifyReport:
     """Convert ``source`` (or take the given files), load every engine, run layers 1–3, then layer 4
     (the driven scenarios with contact: ``scenario`` is a scenario file, None for the defaults;
-    ``driven`` False skips the layer).
+    ``driven`` False skips the layer). ``progress`` receives a short line as each phase starts (the
+    CLI shows them on a terminal).
 
     ``out_dir`` receives the written MJCF/URDF/SDF (a temporary folder, deleted afterwards, when
     None). Never raises for a model problem: a failed check is in ``report.checks``; what stops the
@@ -255,19 +257,23 @@ def verify(
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="modelkit-verify-") as tmp:
             _run(report, Path(source), Path(tmp), engines, mjcf, urdf, sdf, inject, seed,
-                 configurations, samples, replay, scenario, driven)
+                 configurations, samples, replay, scenario, driven, progress or _silent)
             return report
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     _run(report, Path(source), out, engines, mjcf, urdf, sdf, inject, seed, configurations, samples,
-         replay, scenario, driven)
+         replay, scenario, driven, progress or _silent)
     return report
+
+
+def _silent(_: str) -> None:
+    return None
 
 
 def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str], mjcf: str | Path | None,
          urdf: str | Path | None, sdf: str | Path | None, inject: Sequence[str], seed: int,
          configurations: int, samples: int, replay: bool, scenario_path: str | Path | None,
-         driven: bool) -> None:
+         driven: bool, progress: Callable[[str], None]) -> None:
     chosen = None
     if scenario_path is not None and driven:  # a bad scenario file stops the run before any layer
         from modelkit.diagnostics import render_text
@@ -277,6 +283,7 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
         if chosen is None:
             report.errors.extend(f"--scenario: {render_text(d)}" for d in diagnostics)
             return
+    progress(f"reading and converting {source.name}; layers 1-3 (static, kinematics, dynamics)")
     try:
         robot = _layers_1_to_3(report, source, out_dir, engines, mjcf, urdf, sdf, inject, seed,
                                configurations, samples, replay)
@@ -288,6 +295,7 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
     if not driven:
         report.skips.append(Skip(4, "all", "layer 4 (driven scenarios) not run: switched off (--no-driven)"))
         return
+    progress("layer 4: driving the robot in MuJoCo and PyBullet")
     _layer4(report, robot, out_dir, engines, inject, chosen)
 
 
