@@ -69,6 +69,52 @@ def chain_body(links: int) -> str:
     return "\n".join(out) + "\n"
 
 
+def big_body(target_bytes: int = 50_000_000, grid: int = 140) -> str:
+    """A real-looking large `.body`: a chain of links, each drawn by an inline `TriangleMesh` (a torus of
+    ``grid``² vertices, as Choreonoid's scene writer exports converted meshes: flow lists over many lines),
+    with a primitive collision, an inertial and a joint; links are added until ``target_bytes`` is reached.
+    Every list stays under the default `--max-list-items` (250,000)."""
+    head = ["format: ChoreonoidBody", "format_version: 2.0", "angle_unit: degree", "name: big",
+            "root_link: link0", "links:"]
+    vertices: list[str] = []
+    for i in range(grid):
+        u = 2 * math.pi * i / grid
+        for j in range(grid):
+            w = 2 * math.pi * j / grid
+            r = 0.1 + 0.03 * math.cos(w)
+            vertices.append(f"{r * math.cos(u):.6f}, {r * math.sin(u):.6f}, {0.03 * math.sin(w):.6f}")
+    triangles: list[str] = []
+    for i in range(grid):
+        for j in range(grid):
+            a, b = i * grid + j, ((i + 1) % grid) * grid + j
+            c, d = ((i + 1) % grid) * grid + (j + 1) % grid, i * grid + (j + 1) % grid
+            triangles.append(f"{a}, {b}, {c}, {a}, {c}, {d}")
+    pad = "                  "
+    vertex_text = ",\n".join(pad + ", ".join(vertices[k:k + 4]) for k in range(0, len(vertices), 4))
+    triangle_text = ",\n".join(pad + ", ".join(triangles[k:k + 3]) for k in range(0, len(triangles), 3))
+    out = "\n".join(head) + "\n"
+    i = 0
+    while len(out) < target_bytes:
+        link = [f"  - name: link{i}"]
+        if i:
+            link += [f"    parent: link{i - 1}", "    joint_type: revolute", f"    joint_id: {i - 1}",
+                     "    joint_axis: [0, 0, 1]", "    translation: [0, 0, 0.1]",
+                     "    joint_range: [-170, 170]"]
+        else:
+            link.append("    joint_type: free")
+        link += ["    center_of_mass: [0, 0, 0]", "    mass: 0.5",
+                 "    inertia: [0.0025, 0, 0, 0, 0.0025, 0, 0, 0, 0.005]", "    elements:",
+                 "      - type: Visual", "        elements:", "          - type: Shape",
+                 "            appearance: { material: { diffuse: [0.6, 0.6, 0.7] } }",
+                 "            geometry:", "              type: TriangleMesh", "              vertices: [",
+                 vertex_text + " ]", "              faces: [", triangle_text + " ]",
+                 "      - type: Collision", "        elements:", "          - type: Shape",
+                 "            geometry: { type: Cylinder, radius: 0.13, height: 0.06 }"]
+        out += "\n".join(link) + "\n"
+        i += 1
+    return out
+
+
 def chain_sdf(links: int) -> str:
     """The same chain as `chain_urdf`, as SDF 1.9 (poses relative to the parent link)."""
     out = ['<?xml version="1.0"?>', '<sdf version="1.9">', '<model name="chain">']
@@ -149,6 +195,16 @@ def fresh(command: list[str], env: dict[str, str]) -> float:
     return time.perf_counter() - start
 
 
+def fresh_with_rss(command: list[str], env: dict[str, str]) -> tuple[float, float]:
+    """Wall time (s) and peak resident memory (MiB) of one fresh process."""
+    probe = ("import resource, subprocess, sys; subprocess.run(sys.argv[1:], capture_output=True); "
+             "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)")
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, "-c", probe, *command], capture_output=True, text=True, env=env,
+                          check=False)
+    return time.perf_counter() - start, int(done.stdout.strip() or 0) / 1024
+
+
 def repeat_for(size: int, repeat: int, big: int) -> int:
     return repeat if size < big else max(1, repeat // 3)
 
@@ -187,6 +243,17 @@ def run(repeat: int, corpus: Path, max_links: int, work: Path, env: dict[str, st
                   f"({row['in_process_per_link_us']:7.1f} µs/link)  fresh {row['fresh_s'] * 1e3:8.1f} ms  "
                   f"{','.join(row['in_process']['codes']) or 'clean'}", flush=True)
         results["chains"][fmt] = rows
+    # issue 9 §2: a 10,000-link .body and a 50 MB real-looking .body, < 20 s and < 1 GiB each
+    big = work / "big50.body"
+    big.write_text(big_body())
+    results["large_body"] = []
+    for path in (work / "chain10000.body", big):
+        if path.exists():
+            wall, rss = fresh_with_rss([*mk, "validate", str(path)], env)
+            results["large_body"].append({"file": path.name, "bytes": path.stat().st_size, "fresh_s": wall,
+                                          "peak_rss_mib": rss})
+            print(f"  {path.name}: {path.stat().st_size / 1e6:.1f} MB, fresh validate {wall:.2f} s, "
+                  f"peak RSS {rss:.0f} MiB", flush=True)
     rows = []
     for tris in TRIANGLES:
         mesh = work / f"mesh{tris}.stl"

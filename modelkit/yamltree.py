@@ -7,11 +7,16 @@
   explode, and refuses recursive aliases.
 * ``<<`` merge keys follow Choreonoid: explicit keys win, and in a merge list the earlier mapping wins.
 * Duplicate keys, which PyYAML and Choreonoid silently collapse, are reported.
+* Long flow lists of plain decimal numbers (inline meshes: a 50 MB file holds millions of them) are
+  not composed a node per number: :func:`parse_yaml` finds them in the text, blanks their contents
+  (same length, line breaks kept, so every other mark stays put), and keeps each as a
+  :class:`YNumbers`: the floats in an ``array('d')``, the item nodes made only when asked for.
 """
 
 from __future__ import annotations
 
 import re
+from array import array
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -83,6 +88,105 @@ class YMap(YNode):
             yield key, value
 
 
+class YNumbers(YSeq):
+    """A flow list of plain decimal numbers, kept compactly (see :func:`parse_yaml`).
+
+    ``values`` holds the floats (what ``float`` and C's ``strtod`` read from each item); ``items`` makes
+    the item nodes, with their locations, on first use, exactly as a composed list would have them.
+    """
+
+    def __init__(
+        self, loc: SourceLocation, text: str, start: int, end: int, values: array, anchor: str | None = None
+    ) -> None:
+        self.loc = loc
+        self.anchor = anchor
+        self.text = text  # the document text; start/end: the '[' and just after the ']'
+        self.start = start
+        self.end = end
+        self.values = values
+        self._items: list[YNode] | None = None
+
+    @property
+    def items(self) -> list[YNode]:
+        if self._items is None:
+            self._items = self._make_items()
+        return self._items
+
+    @items.setter
+    def items(self, value: list[YNode]) -> None:
+        self._items = value
+
+    def texts(self) -> list[str]:
+        """The items' texts."""
+        return _NUMBER_RE.findall(self.text, self.start + 1, self.end - 1)
+
+    def _make_items(self) -> list[YNode]:
+        line = self.loc.line  # 1-based
+        line_start = self.start - (self.loc.col - 1)  # text index where the current line begins
+        out: list[YNode] = []
+        for match in _TOKEN_OR_BREAK_RE.finditer(self.text, self.start + 1, self.end - 1):
+            token = match.group(1)
+            if token is None:  # a line break (libyaml's: CRLF, CR or LF)
+                line += 1
+                line_start = match.end()
+            else:
+                where = SourceLocation(self.loc.file, line, match.start() - line_start + 1)
+                out.append(YScalar(where, token))
+        return out
+
+
+_NUMBER = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+_NUMBER_RE = re.compile(_NUMBER)
+_TOKEN_OR_BREAK_RE = re.compile(r"\r\n|\r|\n|(" + _NUMBER + ")")
+# A flow list of at least two plain decimal numbers, separated by commas, blanks and line breaks (no tab,
+# no comment, no trailing comma): what Choreonoid's scene writer emits for meshes.
+_NUMBER_LIST_RE = re.compile(r"\[[ \r\n]*" + _NUMBER + r"(?:[ \r\n]*,[ \r\n]*" + _NUMBER + r")+[ \r\n]*\]")
+_BLANK = str.maketrans("0123456789.eE+-,", " " * 16)
+FAST_LIST_MIN_ITEMS = 64
+"""Shorter number lists are composed as usual (a node per number): the fast path pays off on long ones."""
+
+
+def _blank_number_lists(text: str, min_items: int) -> tuple[str, dict[int, tuple[int, array]]]:
+    """``text`` with the contents of every long number list blanked, and the lists found: the index of
+    each '[' -> (the index after its ']', the numbers). A list may sit where no list is (in a quoted
+    string, a comment, a block scalar): the caller checks that each one became a composed flow list."""
+    regions: dict[int, tuple[int, array]] = {}
+    if "[" not in text:
+        return text, regions
+    pieces: list[str] = []
+    done = 0
+    for match in _NUMBER_LIST_RE.finditer(text):
+        start, end = match.span()
+        if text.count(",", start, end) + 1 < min_items:
+            continue
+        values = array("d", map(float, _NUMBER_RE.findall(text, start + 1, end - 1)))
+        regions[start] = (end, values)
+        pieces.append(text[done:start + 1])
+        pieces.append(text[start + 1:end - 1].translate(_BLANK))
+        done = end - 1
+    if not regions:
+        return text, regions
+    pieces.append(text[done:])
+    return "".join(pieces), regions
+
+
+class _FastPathMissed(Exception):
+    """A blanked number list did not compose as a flow list: parse the text as it is."""
+
+
+@dataclass
+class _FastCheck:
+    """What the event scan saw of the blanked lists: the '[' indices that opened a flow sequence, and how
+    far the parser read. Blanking keeps every position, so the parser behaves the same up to the first
+    blanked place that was not a flow list; a verdict reached before any such place stands."""
+
+    confirmed: set[int] = field(default_factory=set)
+    stop: int = 0
+
+    def trusted(self, blanked: dict[int, tuple[int, array]]) -> bool:
+        return all(start in self.confirmed for start in blanked if start <= self.stop)
+
+
 @dataclass
 class YamlDocument:
     root: YNode | None
@@ -105,11 +209,15 @@ class _Converter:
         sink: DiagnosticSink,
         anchor_names: dict[int, str],
         imported: dict[tuple[int, int], YNode] | None = None,
+        numbers: tuple[str, dict[int, tuple[int, array]]] | None = None,
     ) -> None:
         self.path = path
         self.sink = sink
         self.memo: dict[int, YNode] = {}
         self.anchor_names = anchor_names
+        # The original text and its blanked number lists (by the index of the '['), when there are some.
+        self.text, self.numbers = numbers or ("", {})
+        self.numbers_found = 0
         # Aliases of another file's anchors, by the 0-based (line, column) of their stand-in scalar.
         self.imported = imported or {}
 
@@ -126,6 +234,13 @@ class _Converter:
         result: YNode
         if isinstance(node, yaml.ScalarNode):
             result = YScalar(loc, node.value, plain=node.style in (None, ""), anchor=anchor)
+            self.memo[id(node)] = result
+        elif self.numbers and isinstance(node, yaml.SequenceNode) and node.start_mark.index in self.numbers:
+            end, values = self.numbers[node.start_mark.index]
+            if node.value or node.end_mark.index != end or node.flow_style is not True:
+                raise _FastPathMissed
+            result = YNumbers(loc, self.text, node.start_mark.index, end, values, anchor=anchor)
+            self.numbers_found += 1
             self.memo[id(node)] = result
         elif isinstance(node, yaml.SequenceNode):
             seq = YSeq(loc, anchor=anchor)
@@ -209,7 +324,11 @@ _ITEM_EVENTS = (yaml.ScalarEvent, yaml.AliasEvent, yaml.SequenceStartEvent, yaml
 
 
 def _scan_events(
-    text: str, max_list_items: int = DEFAULT_MAX_LIST_ITEMS, top_limits: dict[str, int] | None = None
+    text: str,
+    max_list_items: int = DEFAULT_MAX_LIST_ITEMS,
+    top_limits: dict[str, int] | None = None,
+    blanked: dict[int, tuple[int, array]] | None = None,
+    check: _FastCheck | None = None,
 ) -> tuple[dict[tuple[int, int], str], Any, list[tuple[str, int, int]]]:
     """One pass over the event stream (libyaml's parser is iterative, so this is safe on any input).
 
@@ -222,9 +341,13 @@ def _scan_events(
     must not depend on a library's internal limit, so such a refusal is re-scanned with PyYAML's
     pure-Python parser (iterative too, and without a nesting limit) to find our own mark.
     """
-    names, too_deep, aliases, error = _scan_events_with(text, yaml.CSafeLoader, max_list_items, top_limits)
+    names, too_deep, aliases, error = _scan_events_with(
+        text, yaml.CSafeLoader, max_list_items, top_limits, blanked, check
+    )
     if too_deep is None and error is not None and _is_nesting_refusal(error):
-        names, too_deep, aliases, _ = _scan_events_with(text, yaml.SafeLoader, max_list_items, top_limits)
+        names, too_deep, aliases, _ = _scan_events_with(
+            text, yaml.SafeLoader, max_list_items, top_limits, blanked, check
+        )
     return names, too_deep, aliases
 
 
@@ -238,6 +361,8 @@ def _scan_events_with(
     loader: Any,
     max_list_items: int = DEFAULT_MAX_LIST_ITEMS,
     top_limits: dict[str, int] | None = None,
+    blanked: dict[int, tuple[int, array]] | None = None,
+    check: _FastCheck | None = None,
 ) -> tuple[dict[tuple[int, int], str], Any, list[tuple[str, int, int]], yaml.YAMLError | None]:
     names: dict[tuple[int, int], str] = {}
     aliases: list[tuple[str, int, int]] = []  # (anchor, line, column) of every alias, 0-based
@@ -248,6 +373,8 @@ def _scan_events_with(
     counts: list[list[Any]] = []
     try:
         for event in yaml.parse(text, Loader=loader):
+            if check is not None and event.start_mark is not None:
+                check.stop = max(check.stop, event.start_mark.index)
             if isinstance(event, yaml.DocumentStartEvent):
                 documents += 1
                 if documents > 1:
@@ -263,6 +390,14 @@ def _scan_events_with(
                 key = counts[0][3] if len(counts) == 1 and counts[0][3] is not None else ""
                 limit = (top_limits or {}).get(key, max_list_items)
                 counts.append([0, event.start_mark, limit, None, key])
+                at = event.start_mark.index if event.start_mark is not None else -1
+                numbers = blanked.get(at) if blanked else None
+                if numbers is not None:  # a blanked number list: its items are counted at once
+                    if check is not None and event.flow_style:
+                        check.confirmed.add(at)
+                    counts[-1][0] = len(numbers[1])
+                    if counts[-1][0] > limit:
+                        raise ListTooLong(event.start_mark, limit, key)
             elif isinstance(event, yaml.MappingStartEvent):
                 counts.append([0, event.start_mark, 0, "", ""])
             elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)) and counts:
@@ -279,6 +414,9 @@ def _scan_events_with(
             elif anchor and event.start_mark is not None:
                 names[(event.start_mark.line, event.start_mark.column)] = anchor
     except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        if check is not None and mark is not None:
+            check.stop = max(check.stop, mark.index)
         return names, None, aliases, exc
     return names, None, aliases, None
 
@@ -299,7 +437,7 @@ def measure_expansion(root: YNode, limit: int) -> tuple[str, YNode] | None:
         key = id(node)
         if children_done:
             on_stack.discard(key)
-            total = 1
+            total = 1 + (len(node.values) if isinstance(node, YNumbers) else 0)
             for child in _children(node):
                 total += sizes[id(child)]
                 if total > limit:
@@ -321,6 +459,8 @@ def measure_expansion(root: YNode, limit: int) -> tuple[str, YNode] | None:
 
 
 def _children(node: YNode) -> list[YNode]:
+    if isinstance(node, YNumbers):
+        return []  # numbers only
     if isinstance(node, YSeq):
         return node.items
     if isinstance(node, YMap):
@@ -345,15 +485,54 @@ def parse_yaml(
     max_list_items: int = DEFAULT_MAX_LIST_ITEMS,
     top_limits: dict[str, int] | None = None,
     imported_anchors: dict[str, YNode] | None = None,
+    fast_lists: int | None = FAST_LIST_MIN_ITEMS,
 ) -> YamlDocument:
     """Compose the first YAML document of ``text`` into Y-nodes, reporting problems into ``sink``.
 
     ``top_limits`` bounds the list under a top-level key more tightly (the ``links`` of a body:
     MK005) than any other list (``max_list_items``: MK006); both are checked before composing.
     ``imported_anchors`` are another document's anchors that aliases here may use when no anchor of
-    that name precedes them in this text (Choreonoid's YAML resources see the main .body's anchors)."""
+    that name precedes them in this text (Choreonoid's YAML resources see the main .body's anchors).
+
+    Long number lists are kept compactly (:class:`YNumbers`; ``fast_lists`` items or more, None: never).
+    The result, diagnostics included, is the same as without; where a blanked list turns out not to be
+    a flow list (it sat in a string or a comment), the text is parsed again as it is."""
+    if fast_lists:
+        blanked, regions = _blank_number_lists(text, fast_lists)
+        if regions:
+            trial = DiagnosticSink()
+            try:
+                doc = _parse_yaml(blanked, path, trial, expansion_limit, max_list_items, top_limits,
+                                  imported_anchors, (text, regions))
+            except _FastPathMissed:
+                pass
+            else:
+                sink.extend(trial.items)
+                return doc
+    return _parse_yaml(text, path, sink, expansion_limit, max_list_items, top_limits, imported_anchors, None)
+
+
+def _parse_yaml(
+    text: str,
+    path: str,
+    sink: DiagnosticSink,
+    expansion_limit: int,
+    max_list_items: int,
+    top_limits: dict[str, int] | None,
+    imported_anchors: dict[str, YNode] | None,
+    numbers: tuple[str, dict[int, tuple[int, array]]] | None,
+) -> YamlDocument:
+    check = _FastCheck() if numbers else None
+    blanked = numbers[1] if numbers else None
+    original = numbers[0] if numbers else text
     try:
-        anchors_by_pos, too_deep, alias_marks = _scan_events(text, max_list_items, top_limits)
+        try:
+            anchors_by_pos, too_deep, alias_marks = _scan_events(
+                text, max_list_items, top_limits, blanked, check
+            )
+        finally:
+            if check is not None and blanked and not check.trusted(blanked):
+                raise _FastPathMissed
     except ListTooLong as exc:
         if exc.key:
             sink.emit(
@@ -387,7 +566,7 @@ def parse_yaml(
         finally:
             loader.dispose()
     except yaml.MarkedYAMLError as exc:
-        _report_yaml_error(exc, path, sink, text)
+        _report_yaml_error(exc, path, sink, original)
         return YamlDocument(None, path, {})
     except yaml.YAMLError as exc:  # pragma: no cover - libyaml errors are marked
         sink.emit("MK010", f"YAML error: {exc}", SourceLocation(path))
@@ -396,7 +575,7 @@ def parse_yaml(
         sink.emit("MK004", "the file contains no YAML document", SourceLocation(path, 1, 1))
         return YamlDocument(None, path, {})
     anchor_names = _anchor_ids(node, anchors_by_pos)
-    converter = _Converter(path, sink, anchor_names, stand_ins)
+    converter = _Converter(path, sink, anchor_names, stand_ins, numbers)
     root = converter.convert(node)
     anchors = {name: converter.memo[nid] for nid, name in anchor_names.items() if nid in converter.memo}
     # Without an alias nothing expands: the node count is bounded by the file size, and a large genuine
@@ -547,6 +726,10 @@ def to_plain(node: YNode) -> object:
             return done
         if isinstance(n, YScalar):
             return n.value
+        if isinstance(n, YNumbers):
+            texts: list[object] = list(n.texts())
+            memo[id(n)] = texts
+            return texts
         if isinstance(n, YSeq):
             out_list: list[object] = []
             memo[id(n)] = out_list

@@ -588,7 +588,8 @@ def test_body_rotation_parser_never_raises(numbers: list[float]) -> None:
     words = (repr(n).replace("inf", "1e400") for n in numbers)
     doc = parse_yaml("r: [" + ", ".join(words) + "]\n", "t.body", sink)
     assert doc.root is not None
-    matrix = rotation(doc.root.get("r"), 1.0, sink)  # type: ignore[union-attr]
+    rows = rotation(doc.root.get("r"), 1.0, sink)  # type: ignore[union-attr]
+    matrix = None if rows is None else np.array(rows)  # the reader's rotations are tuples (rot3)
     if matrix is not None:
         assert np.all(np.isfinite(matrix))
         np.testing.assert_allclose(matrix @ matrix.T, np.eye(3), atol=1e-9)

@@ -258,3 +258,22 @@ def test_valid_body_file_does_not_import_jsonschema(small_model: Path) -> None:
     assert report["exit_code"] == 0, report["output"]
     assert "modelkit.formats.body.schema" in report["modules"]
     assert [m for m in report["modules"] if m.partition(".")[0] == "jsonschema"] == []
+
+
+PRIMITIVE_BODY = PROJECT_ROOT / "samples" / "choreonoid_ros2_mobile_robot_tutorial" / "model" / \
+    "mobile_robot_primitive.body"
+
+
+@pytest.mark.parametrize("which", ["pendulum", "primitive"])
+@pytest.mark.parametrize("command", [["validate"], ["tree"]], ids=["validate", "tree"])
+def test_small_body_without_numpy(which: str, command: list[str], small_model: Path) -> None:
+    """Start-up (issue 9 §3): the `.body` reader composes its transforms with plain tuples
+    (modelkit.rot3); a file of primitives (boxes, cylinders, a material colour) imports neither numpy
+    nor lxml. Meshes and generated geometry (Extrusion ...) import numpy when a file has them."""
+    path = small_model if which == "pendulum" else PRIMITIVE_BODY
+    report = _run([*command, str(path)], ("numpy", "lxml"))
+    assert report["exit_code"] == 0, report["output"]
+    assert "modelkit.formats.body.reader" in report["modules"]
+    assert "modelkit.checks.physics" in report["modules"] or command == ["tree"]
+    loaded = sorted({m.partition(".")[0] for m in report["modules"]} & {"numpy", "lxml"})
+    assert loaded == [], f"`modelkit {command[0]} {path.name}` imported {loaded}"

@@ -10,14 +10,15 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
-
+from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink
 from modelkit.formats.body import values as v
-from modelkit.formats.devices import GL_IN_ROBOTICS, canonical_from_gl, horizontal_fov
 from modelkit.model import DeviceKind
 from modelkit.spatial import Mat3
 from modelkit.yamltree import YMap, to_plain
+
+# modelkit.formats.devices (the frame facts shared with the XML readers) imports lxml: it is imported
+# where a camera or a range sensor needs it, so that reading a `.body` file without one stays light.
 
 INF3 = (math.inf, math.inf, math.inf)
 _CLIP = (
@@ -148,8 +149,7 @@ def _read(
     elif kind == "text":
         value = v.scalar_text(raw)
     elif kind == "vec3":
-        vec = v.vector(raw, 3)
-        value = None if vec is None else tuple(float(x) for x in vec)
+        value = v.vector3(raw)
     else:  # angle_rotation
         rot = v.rotation(raw, angle_scale, sink)
         value = None if rot is None else rot
@@ -212,10 +212,10 @@ def _range_sensor(node: YMap, angle_scale: float, params: dict[str, Any]) -> set
 
 # R_opt of each `optical_frame` (body-format.md §3.7): columns are the GL camera frame's axes in
 # the device frame, T_glcam = T_device · R_opt · Rot(optical_frame_rotation).
-OPTICAL_FRAMES: dict[str, Mat3] = {
-    "gl": np.eye(3),
-    "cv": np.diag([1.0, -1.0, -1.0]),
-    "robotics": np.array(GL_IN_ROBOTICS),
+OPTICAL_FRAMES: dict[str, rot3.M3] = {
+    "gl": rot3.IDENTITY,
+    "cv": ((1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, -1.0)),
+    "robotics": ((0.0, 0.0, -1.0), (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),  # devices.GL_IN_ROBOTICS
 }
 OPTICAL_DEVICES = frozenset({"Camera", "CameraDevice", "RangeSensor"})
 CANONICAL_CAMERAS = {
@@ -236,27 +236,32 @@ CANONICAL_KINDS = {
 }
 
 
-def canonical_rotation(kind: str, params: dict[str, Any], rotation: Mat3) -> Mat3:
+def canonical_rotation(kind: str, params: dict[str, Any], rotation: Any) -> Any:
     """The canonical (robotics) sensor frame of a device whose node frame has ``rotation``.
 
     Cameras and range sensors look through their optical frame: the GL camera frame is
     R·R_opt·R_ofr, and the canonical frame is that times GL_IN_ROBOTICSᵀ (§8.7). Other devices'
-    frames are their node frames.
+    frames are their node frames (``rotation`` itself is returned). Otherwise a tuple rotation
+    (:mod:`modelkit.rot3`), whatever ``rotation`` was (a tuple or a numpy array).
     """
     if kind not in OPTICAL_DEVICES:
         return rotation
-    r_opt = OPTICAL_FRAMES.get(str(params.get("optical_frame", "gl")), np.eye(3))
+    from modelkit.formats.devices import canonical_from_gl
+
+    r_opt = OPTICAL_FRAMES.get(str(params.get("optical_frame", "gl")), rot3.IDENTITY)
     extra = params.get("optical_frame_rotation")
     if extra is not None:
-        r_opt = r_opt @ np.asarray(extra, dtype=float)
-    return np.array(canonical_from_gl(rotation @ r_opt))
+        r_opt = rot3.matmul(r_opt, rot3.mat3(extra))
+    return canonical_from_gl(rot3.matmul(rot3.mat3(rotation), r_opt))
 
 
 def node_rotation(kind: str, params: dict[str, Any], canonical: Mat3) -> Mat3:
     """The inverse of :func:`canonical_rotation`: the node rotation a `.body` writer writes back,
     given the device's ``optical_frame`` / ``optical_frame_rotation`` words in ``params``."""
+    import numpy as np
+
     identity = np.eye(3)
-    return np.asarray(canonical, dtype=float) @ canonical_rotation(kind, params, identity).T
+    return np.asarray(canonical, dtype=float) @ np.asarray(canonical_rotation(kind, params, identity)).T
 
 
 def canonical_device(kind: str, params: dict[str, Any]) -> tuple[DeviceKind, dict[str, Any]]:
@@ -309,6 +314,8 @@ def canonical_device(kind: str, params: dict[str, Any]) -> tuple[DeviceKind, dic
 
 
 def _camera(params: dict[str, Any], canonical: DeviceKind) -> dict[str, Any]:
+    from modelkit.formats.devices import horizontal_fov
+
     width, height, fov = params["width"], params["height"], params["field_of_view"]
     # field_of_view is the shorter side's (§3.7): the vertical one unless the image is taller than wide.
     hfov = fov if width < height else horizontal_fov(fov, width, height)

@@ -1,7 +1,8 @@
 """Walking a link's `elements` tree: shapes, rigid bodies, devices, resources.
 
-A 4×4 affine transform stack (Trans·Rot·Scale per node, §3.3 of body-format.md) and a
-visual/collision mode are carried down the tree. Choreonoid's Y-axis primitives are turned into
+An affine transform stack (Trans·Rot·Scale per node, §3.3 of body-format.md; plain tuples, see
+:mod:`modelkit.rot3`: reading imports no numpy) and a visual/collision mode are carried down the
+tree. Choreonoid's Y-axis primitives are turned into
 the model's Z-axis primitives here (the only place where that rotation is applied).
 """
 
@@ -12,11 +13,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
+from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
 from modelkit.formats.body import devices as dev
 from modelkit.formats.body import values as v
+from modelkit.formats.body.values import IDENTITY_AFFINE, Affine
 from modelkit.model import (
     Box,
     Capsule,
@@ -32,11 +33,22 @@ from modelkit.model import (
     VisualMaterial,
 )
 from modelkit.resources import Resolver
-from modelkit.spatial import Mat3, Pose, Vec3, inertia_from_moments, rot_x
+from modelkit.rot3 import peek
+from modelkit.spatial import Pose
 from modelkit.yamltree import YamlDocument, YMap, YNode, YScalar, YSeq, parse_yaml, read_text
 
 # Choreonoid's cylinders, capsules and cones lie along local Y; the model's along Z.
-Y_TO_Z = rot_x(-math.pi / 2.0)
+Y_TO_Z_TUPLE: rot3.M3 = rot3.axis_angle((1.0, 0.0, 0.0), -math.pi / 2.0)
+
+
+def __getattr__(name: str) -> Any:
+    """``Y_TO_Z`` as a numpy array, for the writers (imported on first use, not by the reader)."""
+    if name == "Y_TO_Z":
+        import numpy as np
+
+        return np.array(Y_TO_Z_TUPLE)
+    raise AttributeError(name)
+
 
 SCENE_ONLY_NODES = frozenset(
     {"Node", "LineSet", "DirectionalLight", "PerspectiveCamera", "OrthographicCamera", "Fog", "Text"}
@@ -72,7 +84,7 @@ class Collected:
 
     visuals: list[Geom] = field(default_factory=list)
     collisions: list[Geom] = field(default_factory=list)
-    rigid_bodies: list[tuple[float, Vec3, Mat3, SourceLocation]] = field(default_factory=list)
+    rigid_bodies: list[tuple[float, rot3.V3, rot3.M3, SourceLocation]] = field(default_factory=list)
     devices: list[Device] = field(default_factory=list)
 
 
@@ -107,7 +119,7 @@ def iter_elements(node: YNode | None) -> list[tuple[str, YMap]]:
 
 
 def walk(
-    elements: YNode | None, transform: np.ndarray, mode: str, out: Collected, ctx: WalkContext, depth: int = 0
+    elements: YNode | None, transform: Affine, mode: str, out: Collected, ctx: WalkContext, depth: int = 0
 ) -> None:
     if depth > MAX_ELEMENT_DEPTH:
         if elements is not None:
@@ -122,7 +134,7 @@ def walk(
 
 
 def _walk_node(
-    node_type: str, node: YMap, transform: np.ndarray, mode: str, out: Collected, ctx: WalkContext, depth: int
+    node_type: str, node: YMap, transform: Affine, mode: str, out: Collected, ctx: WalkContext, depth: int
 ) -> None:
     sink = ctx.sink
     if node_type == "Skip" or node_type in SCENE_ONLY_NODES:
@@ -132,7 +144,7 @@ def _walk_node(
     elif node_type == "Transform":
         walk(
             node.get("elements"),
-            transform @ v.node_transform(node, ctx.angle_scale, sink),
+            v.compose(transform, v.node_transform(node, ctx.angle_scale, sink)),
             mode,
             out,
             ctx,
@@ -144,7 +156,7 @@ def _walk_node(
             other = "Collision" if new_mode == "visual" else "Visual"
             sink.emit("MK604", f"a {node_type} node inside a {other} node: Choreonoid refuses this", node.loc)
             return
-        inner = transform @ v.node_transform(node, ctx.angle_scale, sink)
+        inner = v.compose(transform, v.node_transform(node, ctx.angle_scale, sink))
         shape = node.get("shape")
         if isinstance(shape, YMap):
             add_shape(shape, inner, new_mode, out, ctx)
@@ -153,7 +165,7 @@ def _walk_node(
             add_resource(resource, inner, new_mode, out, ctx, depth)
         walk(node.get("elements"), inner, new_mode, out, ctx, depth + 1)
     elif node_type == "RigidBody":
-        inner = transform @ v.node_transform(node, ctx.angle_scale, sink)
+        inner = v.compose(transform, v.node_transform(node, ctx.angle_scale, sink))
         _add_rigid_body(node, inner, out)
         walk(node.get("elements"), inner, mode, out, ctx, depth + 1)
     elif node_type == "Resource":
@@ -161,38 +173,38 @@ def _walk_node(
     elif node_type == "Shape":
         add_shape(node, transform, mode, out, ctx)
     elif node_type in dev.CORE_DEVICES or node_type in dev.PLUGIN_DEVICES:
-        inner = transform @ v.node_transform(node, ctx.angle_scale, sink)
+        inner = v.compose(transform, v.node_transform(node, ctx.angle_scale, sink))
         _add_device(node_type, node, inner, out, ctx)
         walk(node.get("elements"), inner, mode, out, ctx, depth + 1)
     # Unknown node types are reported by the schema check (MK602/MK603) and skipped here.
 
 
-def _add_rigid_body(node: YMap, affine: np.ndarray, out: Collected) -> None:
+def _add_rigid_body(node: YMap, affine: Affine, out: Collected) -> None:
     mass = v.get_number(node, "mass", default=0.0) or 0.0
-    com = v.vector(node.get("center_of_mass", "centerOfMass"), 3)
+    com = v.vector3(node.get("center_of_mass", "centerOfMass"))
     local_inertia = inertia_matrix(node.get("inertia"))
-    linear = affine[:3, :3]
-    c = affine[:3, :3] @ (np.zeros(3) if com is None else com) + affine[:3, 3]
-    inertia = linear @ (np.zeros((3, 3)) if local_inertia is None else local_inertia) @ linear.T
+    linear, offset = affine
+    c = rot3.add(rot3.matvec(linear, rot3.ZERO3 if com is None else com), offset)
+    inertia = rot3.rotate_inertia(rot3.ZERO33 if local_inertia is None else local_inertia, linear)
     out.rigid_bodies.append((mass, c, inertia, node.loc))
 
 
-def inertia_matrix(node: YNode | None) -> Mat3 | None:
+def inertia_matrix(node: YNode | None) -> rot3.M3 | None:
     """9 numbers row-major, or 6 numbers xx, xy, xz, yy, yz, zz."""
     values = v.numbers(node)
     if values is None:
         return None
     if len(values) == 9:
-        return np.array(values, dtype=float).reshape(3, 3)
+        return rot3.mat3((values[0:3], values[3:6], values[6:9]))
     if len(values) == 6:
-        return inertia_from_moments(*values)
+        return rot3.inertia_from_moments(*values)
     return None
 
 
 # ---- devices ---------------------------------------------------------------------------------
 
 
-def _add_device(kind: str, node: YMap, affine: np.ndarray, out: Collected, ctx: WalkContext) -> None:
+def _add_device(kind: str, node: YMap, affine: Affine, out: Collected, ctx: WalkContext) -> None:
     name = v.get_text(node, "name") or ""
     if "scale" in node:
         ctx.sink.emit(
@@ -231,10 +243,10 @@ def _add_device(kind: str, node: YMap, affine: np.ndarray, out: Collected, ctx: 
         params["id"] = device_id
     pose, _ = split_affine(affine)
     if pose is None:
-        pose = Pose(np.eye(3), affine[:3, 3].copy())
+        pose = Pose(rot3.IDENTITY, affine[1])
     # The canonical device model: the pose becomes the robotics sensor frame (§8.7); the source's
     # optical_frame words stay in params for the .body writer.
-    pose = Pose(dev.canonical_rotation(kind, params, pose.rotation), pose.translation)
+    pose = Pose(dev.canonical_rotation(kind, params, pose.rotation_tuple), pose.translation_tuple)
     canonical, canonical_params = dev.canonical_device(kind, params)
     out.devices.append(Device(kind, name, pose, params, node.loc, canonical, canonical_params))
 
@@ -242,22 +254,30 @@ def _add_device(kind: str, node: YMap, affine: np.ndarray, out: Collected, ctx: 
 # ---- shapes ----------------------------------------------------------------------------------
 
 
-def split_affine(affine: np.ndarray) -> tuple[Pose | None, Vec3]:
+def _close(a: float, b: float, rtol: float = 1e-5, atol: float = 1e-8) -> bool:
+    """numpy's ``isclose``: |a − b| ≤ atol + rtol·|b|."""
+    return abs(a - b) <= atol + rtol * abs(b)
+
+
+def split_affine(affine: Affine) -> tuple[Pose | None, rot3.V3]:
     """Split an affine map into a rigid pose and a per-axis scale applied first.
 
     Returns (None, scale) when the linear part is not a rotation times a diagonal scale (shear).
     """
-    linear = affine[:3, :3]
-    scale = np.linalg.norm(linear, axis=0)
-    if np.any(scale <= 1e-12):
+    linear, offset = affine
+    columns = rot3.transpose(linear)
+    scale = (rot3.norm(columns[0]), rot3.norm(columns[1]), rot3.norm(columns[2]))
+    if any(s <= 1e-12 for s in scale):
         return None, scale
-    rotation = linear / scale
-    if not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-9):
+    c0, c1, c2 = ((c[0] / s, c[1] / s, c[2] / s) for c, s in zip(columns, scale, strict=True))
+    gram = rot3.matmul((c0, c1, c2), rot3.transpose((c0, c1, c2)))  # RᵀR (its rows are R's columns)
+    if not all(_close(gram[i][j], 1.0 if i == j else 0.0, atol=1e-9) for i in range(3) for j in range(3)):
         return None, scale
-    if np.linalg.det(rotation) < 0:  # a mirror: keep a proper rotation and a negative x scale
-        rotation[:, 0] = -rotation[:, 0]
-        scale = scale * np.array([-1.0, 1.0, 1.0])
-    return Pose(rotation, affine[:3, 3].copy()), scale
+    if rot3.dot(c0, (c1[1] * c2[2] - c1[2] * c2[1], c1[2] * c2[0] - c1[0] * c2[2],
+                     c1[0] * c2[1] - c1[1] * c2[0])) < 0:  # a mirror: a proper rotation, a negative x scale
+        c0 = (-c0[0], -c0[1], -c0[2])
+        scale = (-scale[0], scale[1], scale[2])
+    return Pose(rot3.transpose((c0, c1, c2)), offset), scale
 
 
 def _material(shape: YMap, ctx: WalkContext) -> VisualMaterial | None:
@@ -267,10 +287,10 @@ def _material(shape: YMap, ctx: WalkContext) -> VisualMaterial | None:
     m = appearance.get("material")
     result = VisualMaterial()
     if isinstance(m, YMap):
-        result.diffuse = v.vector(m.get("diffuse", "diffuseColor"), 3)
+        result.diffuse = v.vector3(m.get("diffuse", "diffuseColor"))
         result.ambient = v.number(m.get("ambient", "ambientIntensity"))
-        result.specular = v.vector(m.get("specular", "specularColor"), 3)
-        result.emissive = v.vector(m.get("emissive", "emissiveColor"), 3)
+        result.specular = v.vector3(m.get("specular", "specularColor"))
+        result.emissive = v.vector3(m.get("emissive", "emissiveColor"))
         result.transparency = v.get_number(m, "transparency", default=0.0) or 0.0
         exponent = v.number(m.get("specular_exponent"))
         shininess = v.number(m.get("shininess"))
@@ -291,13 +311,13 @@ def _material(shape: YMap, ctx: WalkContext) -> VisualMaterial | None:
                     uri_node.loc,
                 )
             result.texture = str(res.path) if res.path is not None else uri
-    if result.diffuse is None and result.texture is None and not isinstance(m, YMap):
+    if peek(result, "diffuse") is None and result.texture is None and not isinstance(m, YMap):
         return None
     return result
 
 
-def add_shape(shape: YMap, transform: np.ndarray, mode: str, out: Collected, ctx: WalkContext) -> None:
-    affine = transform @ v.node_transform(shape, ctx.angle_scale, ctx.sink)
+def add_shape(shape: YMap, transform: Affine, mode: str, out: Collected, ctx: WalkContext) -> None:
+    affine = v.compose(transform, v.node_transform(shape, ctx.angle_scale, ctx.sink))
     geometry_node = shape.get("geometry")
     if not isinstance(geometry_node, YMap):
         return  # an empty shape
@@ -313,7 +333,7 @@ def add_shape(shape: YMap, transform: np.ndarray, mode: str, out: Collected, ctx
     if built is None:
         return
     geometry, local = built
-    placed = _place(geometry, affine @ local, kind, geometry_node.loc, ctx)
+    placed = _place(geometry, v.compose(affine, local), kind, geometry_node.loc, ctx)
     if placed is None:
         return
     geom = Geom(placed[0], placed[1], name=name, material=material, source=shape.loc)
@@ -332,21 +352,21 @@ def _positive(geometry: YMap, key: str, default: float) -> float:
     return default if value is None else value
 
 
-def _build_geometry(kind: str, g: YMap, ctx: WalkContext) -> tuple[Geometry, np.ndarray] | None:
-    """The geometry in Choreonoid's shape frame (cylinders along Y) and a local 4×4 (identity)."""
+def _build_geometry(kind: str, g: YMap, ctx: WalkContext) -> tuple[Geometry, Affine] | None:
+    """The geometry in Choreonoid's shape frame (cylinders along Y) and a local affine (identity)."""
     sink = ctx.sink
-    local = np.eye(4)
+    local = IDENTITY_AFFINE
     if kind == "Box":
-        size = v.vector(g.get("size"), 3)
-        size = np.ones(3) if size is None else size
-        if np.any(size < 0):
+        read = v.vector3(g.get("size"))
+        size = (1.0, 1.0, 1.0) if read is None else read
+        if any(x < 0 for x in size):
             size_node = g.get("size")
             where = (
-                size_node.items[int(np.flatnonzero(size < 0)[0])].loc
+                size_node.items[next(i for i, x in enumerate(size) if x < 0)].loc
                 if isinstance(size_node, YSeq)
                 else g.loc
             )
-            sink.emit("MK400", f"a box cannot be generated with size {size.tolist()} (negative edge)", where)
+            sink.emit("MK400", f"a box cannot be generated with size {list(size)} (negative edge)", where)
             return None
         return Box(size), local
     if kind == "Sphere":
@@ -504,33 +524,37 @@ def _extrusion_findings(report: Any, g: YMap, ctx: WalkContext) -> None:
 
 
 def _place(
-    geometry: Geometry, affine: np.ndarray, kind: str, loc: SourceLocation, ctx: WalkContext
+    geometry: Geometry, affine: Affine, kind: str, loc: SourceLocation, ctx: WalkContext
 ) -> tuple[Geometry, Pose] | None:
     """Apply the accumulated transform: scale goes into the geometry, the rest into a pose."""
     pose, scale = split_affine(affine)
-    uniform = bool(np.allclose(scale, scale[0], rtol=1e-12))
+    uniform = all(_close(x, scale[0], rtol=1e-12) for x in scale)
+    magnitude = (abs(scale[0]), abs(scale[1]), abs(scale[2]))
     if pose is None:
         # Shear: only triangles can carry it. Bake the linear map into the vertices.
         mesh = _as_triangles(geometry)
         if mesh is None:
             ctx.sink.emit("MK414", f"a sheared {kind} cannot be represented; it is left out", loc)
             return None
-        baked = TriangleMeshData(mesh.vertices @ affine[:3, :3].T, mesh.faces.copy())
+        import numpy as np  # the triangles are numpy arrays already
+
+        baked = TriangleMeshData(mesh.vertices @ np.array(affine[0]).T, mesh.faces.copy())
         ctx.sink.emit(
             "MK414", f"the transforms above this {kind} shear it; its triangles carry the shear", loc
         )
-        return Mesh(data=baked, generator=kind), Pose(np.eye(3), affine[:3, 3].copy())
+        return Mesh(data=baked, generator=kind), Pose(rot3.IDENTITY, affine[1])
     if isinstance(geometry, Box):
-        return Box(geometry.size * np.abs(scale)), pose
+        size = peek(geometry, "size")
+        return Box((size[0] * magnitude[0], size[1] * magnitude[1], size[2] * magnitude[2])), pose
     if isinstance(geometry, Sphere):
         if uniform:
             return Sphere(geometry.radius * abs(scale[0])), pose
         ctx.sink.emit("MK414", "a sphere scaled non-uniformly becomes an ellipsoid", loc)
-        return Ellipsoid(geometry.radius * np.abs(scale)), pose
+        return Ellipsoid(rot3.scale(geometry.radius, magnitude)), pose
     if isinstance(geometry, (Cylinder, Capsule, Cone)):
         radial_ok = math.isclose(abs(scale[0]), abs(scale[2]), rel_tol=1e-12)
         if radial_ok and (uniform or not isinstance(geometry, Capsule)):
-            rz = Pose(pose.rotation @ Y_TO_Z, pose.translation)
+            rz = Pose(rot3.matmul(pose.rotation_tuple, Y_TO_Z_TUPLE), pose.translation_tuple)
             cls = type(geometry)
             return cls(geometry.radius * abs(scale[0]), geometry.length * abs(scale[1])), rz
         ctx.sink.emit(
@@ -540,7 +564,7 @@ def _place(
             generator=kind, scale=scale, source_params={"radius": geometry.radius, "height": geometry.length}
         ), pose
     if isinstance(geometry, Mesh):
-        geometry.scale = scale if not np.allclose(scale, 1.0) else np.ones(3)
+        geometry.scale = scale if not all(_close(x, 1.0) for x in scale) else (1.0, 1.0, 1.0)
         return geometry, pose
     return geometry, pose  # pragma: no cover - all geometry kinds handled above
 
@@ -555,14 +579,14 @@ def _as_triangles(geometry: Geometry) -> TriangleMeshData | None:
 
 
 def add_resource(
-    node: YMap, transform: np.ndarray, mode: str, out: Collected, ctx: WalkContext, depth: int
+    node: YMap, transform: Affine, mode: str, out: Collected, ctx: WalkContext, depth: int
 ) -> None:
     uri_node = node.get("uri")
     uri = v.scalar_text(uri_node)
     if uri is None or uri_node is None:
         return  # missing uri: reported by the schema check (MK101)
     suffix = Path(uri).suffix.lower()
-    affine = transform @ v.node_transform(node, ctx.angle_scale, ctx.sink)
+    affine = v.compose(transform, v.node_transform(node, ctx.angle_scale, ctx.sink))
     if suffix in YAML_EXTENSIONS:
         _add_yaml_resource(node, uri, uri_node, affine, mode, out, ctx, depth)
         return
@@ -573,7 +597,7 @@ def add_resource(
 
 def _add_mesh_file(
     node: YMap,
-    affine: np.ndarray,
+    affine: Affine,
     mode: str,
     out: Collected,
     ctx: WalkContext,
@@ -681,7 +705,7 @@ def _add_yaml_resource(
     node: YMap,
     uri: str,
     uri_node: YNode,
-    affine: np.ndarray,
+    affine: Affine,
     mode: str,
     out: Collected,
     ctx: WalkContext,

@@ -11,16 +11,16 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
+from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, SourceLocation, sorted_diagnostics
 from modelkit.formats.body import values as v
 from modelkit.formats.body.elements import Collected, WalkContext, inertia_matrix, walk
 from modelkit.formats.body.materials import MaterialTable, load_materials
+from modelkit.formats.body.values import IDENTITY_AFFINE
 from modelkit.formats.common import ReadOptions, ReadResult
 from modelkit.limits import too_many_links
 from modelkit.model import Inertial, Joint, JointLimits, JointType, Link, LoopConstraint, Robot
-from modelkit.spatial import Pose, combine_mass_properties
+from modelkit.spatial import Pose
 from modelkit.textio import real_path
 from modelkit.yamltree import (
     YMap,
@@ -301,7 +301,7 @@ class _BodyReader:
             link.sources["material"] = material_node.loc
             self._check_material(link.contact_material, material_node.loc)
         collected = Collected()
-        walk(node.get("elements"), np.eye(4), "both", collected, ctx)
+        walk(node.get("elements"), IDENTITY_AFFINE, "both", collected, ctx)
         link.visuals, link.collisions, link.devices = (
             collected.visuals,
             collected.collisions,
@@ -334,18 +334,18 @@ class _BodyReader:
             joint.sources["axis"] = axis_node.loc
             axis = self._axis(axis_node)
             if axis is not None:
-                norm = float(np.linalg.norm(axis))
+                norm = rot3.norm(axis)
                 if norm == 0.0:
                     sink.emit("MK305", f'joint "{joint.name}": the axis is the zero vector', axis_node.loc)
                 else:
                     if abs(norm - 1.0) > 1e-6:
                         sink.emit(
                             "MK306",
-                            f'joint "{joint.name}": the axis {axis.tolist()} has length {norm:.6g}; '
+                            f'joint "{joint.name}": the axis {list(axis)} has length {norm:.6g}; '
                             "Choreonoid uses it unnormalised (modelkit normalises it)",
                             axis_node.loc,
                         )
-                    joint.axis = axis / norm
+                    joint.axis = (axis[0] / norm, axis[1] / norm, axis[2] / norm)
         limits = JointLimits()
         range_node = node.get("joint_range", "jointRange")
         if range_node is not None:
@@ -405,13 +405,13 @@ class _BodyReader:
                     node.key_loc(present[0]),
                 )
 
-    def _axis(self, node: YNode) -> np.ndarray | None:
+    def _axis(self, node: YNode) -> rot3.V3 | None:
         if isinstance(node, YScalar):
             word = node.value.strip().lower()
             sign = -1.0 if word.startswith("-") else 1.0
             base = AXIS_SYMBOLS.get(word.lstrip("+-"))
-            return None if base is None else sign * np.array(base)
-        return v.vector(node, 3)
+            return None if base is None else rot3.scale(sign, base)
+        return v.vector3(node)
 
     def _range(self, node: YNode) -> tuple[float, float] | None:
         if isinstance(node, YScalar):
@@ -429,16 +429,16 @@ class _BodyReader:
         present = [k for k in MASS_KEYS if k in node]
         has_rigid = bool(collected.rigid_bodies)
         if not present and not has_rigid:
-            return Inertial(1.0, np.zeros(3), np.eye(3), defaulted=True, source=node.loc)
+            return Inertial(1.0, rot3.ZERO3, rot3.IDENTITY, defaulted=True, source=node.loc)
         parts = [(m, c, i) for m, c, i, _ in collected.rigid_bodies]
         inertial = Inertial(1.0, source=node.loc)
         if present:
             mass_node = node.get("mass")
             com_node = node.get("center_of_mass", "centerOfMass")
             inertia_node = node.get("inertia")
-            default_mass, default_inertia = (0.0, np.zeros((3, 3))) if has_rigid else (1.0, np.eye(3))
+            default_mass, default_inertia = (0.0, rot3.ZERO33) if has_rigid else (1.0, rot3.IDENTITY)
             mass = v.number_prefix(mass_node)
-            com = v.vector(com_node, 3)
+            com = v.vector3(com_node)
             inertia = inertia_matrix(inertia_node)
             if isinstance(inertia_node, YSeq) and v.numbers(inertia_node) is not None and inertia is None:
                 self.sink.emit(
@@ -451,7 +451,7 @@ class _BodyReader:
             parts.append(
                 (
                     default_mass if mass is None else mass,
-                    np.zeros(3) if com is None else com,
+                    rot3.ZERO3 if com is None else com,
                     default_inertia if inertia is None else inertia,
                 )
             )
@@ -459,9 +459,9 @@ class _BodyReader:
                 if n is not None:
                     inertial.sources[key] = n.loc
         if len(parts) == 1:
-            inertial.mass, inertial.com, inertial.inertia = parts[0][0], np.asarray(parts[0][1]), parts[0][2]
+            inertial.mass, inertial.com, inertial.inertia = parts[0][0], parts[0][1], parts[0][2]
         else:
-            inertial.mass, inertial.com, inertial.inertia = combine_mass_properties(parts)
+            inertial.mass, inertial.com, inertial.inertia = rot3.combine_mass_properties(parts)
         return inertial
 
     # -- SubBody and ContinuousTrack -------------------------------------------------------------
@@ -563,7 +563,7 @@ class _BodyReader:
                 (node.get("numJoints") or node).loc,
             )
             return []
-        joint_offset = v.vector(node.get("joint_offset", "jointOffset"), 3)
+        joint_offset = v.vector3(node.get("joint_offset", "jointOffset"))
         angles = v.numbers(node.get("initialJointAngles")) or []
         records: list[_LinkRecord] = []
         first = self._link(node, ctx, name_override=f"{name}0")
@@ -576,7 +576,7 @@ class _BodyReader:
             rec.joint.name = f"{name}{i}"
             rec.parent = f"{name}{i - 1}"
             rec.joint.origin = Pose(
-                rec.joint.origin.rotation.copy(), np.zeros(3) if joint_offset is None else joint_offset.copy()
+                rec.joint.origin.rotation_tuple, rot3.ZERO3 if joint_offset is None else joint_offset
             )
             if i - 1 < len(angles):
                 rec.joint.initial_position = angles[i - 1] * self.angle_scale
@@ -650,7 +650,7 @@ class _BodyReader:
                 self.sink.emit("MK215", f"extra joint {i}: {problem}", item.loc)
                 continue
             assert link1 is not None and link2 is not None and kind is not None
-            axis = v.vector(item.get("axis", "jointAxis"), 3)
+            axis = v.vector3(item.get("axis", "jointAxis"))
             loop = LoopConstraint(
                 name=v.get_text(item, "name") or f"extra_joint_{i}",
                 type=kind,
@@ -658,15 +658,16 @@ class _BodyReader:
                 link2=link2,
                 source=item.loc,
             )
-            if axis is not None and float(np.linalg.norm(axis)) > 0:
-                loop.axis = axis / np.linalg.norm(axis)
+            if axis is not None and rot3.norm(axis) > 0:
+                length = rot3.norm(axis)
+                loop.axis = (axis[0] / length, axis[1] / length, axis[2] / length)
             for which, t_keys, r_key in (
                 (1, ("translation_in_link1", "link1LocalPos"), "rotation_in_link1"),
                 (2, ("translation_in_link2", "link2LocalPos"), "rotation_in_link2"),
             ):
-                t = v.vector(item.get(*t_keys), 3)
+                t = v.vector3(item.get(*t_keys))
                 r = v.rotation(item.get(r_key), self.angle_scale, self.sink)
-                pose = Pose(np.eye(3) if r is None else r, np.zeros(3) if t is None else t)
+                pose = Pose(rot3.IDENTITY if r is None else r, rot3.ZERO3 if t is None else t)
                 if which == 1:
                     loop.pose_in_link1 = pose
                 else:

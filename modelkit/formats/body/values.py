@@ -4,6 +4,9 @@ Every YAML scalar is a string; these helpers turn Y-nodes into floats, ints, boo
 rotations and translations. Type and shape mistakes are the schema's to report
 (:mod:`modelkit.formats.body.schema`); the helpers here return ``None`` for them and report only the
 semantic faults the schema cannot see (a zero rotation axis, an empty vector).
+
+Vectors are tuples and rotations tuples of three rows (:mod:`modelkit.rot3`): reading a `.body` file
+imports no numpy. A node's transform is an :data:`Affine` ``(linear 3×3, translation)``.
 """
 
 from __future__ import annotations
@@ -11,11 +14,13 @@ from __future__ import annotations
 import math
 import re
 
-import numpy as np
-
+from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink
-from modelkit.spatial import Mat3, Vec3, axis_angle
-from modelkit.yamltree import YMap, YNode, YScalar, YSeq
+from modelkit.yamltree import YMap, YNode, YNumbers, YScalar, YSeq
+
+Affine = tuple[rot3.M3, rot3.V3]
+"""A 3-D affine map ``p ↦ linear·p + translation`` (Choreonoid's Trans·Rot·Scale of a node)."""
+IDENTITY_AFFINE: Affine = (rot3.IDENTITY, rot3.ZERO3)
 
 # C strtod's syntax: decimal with optional exponent, hex floats, inf/infinity, nan.
 _FLOAT_RE = re.compile(
@@ -112,6 +117,8 @@ def get_text(m: YMap, *keys: str) -> str | None:
 
 def numbers(node: YNode | None) -> list[float] | None:
     """A flat list of numbers, or None when it is not one."""
+    if isinstance(node, YNumbers):  # a long list of plain decimals, read once by the YAML reader
+        return node.values.tolist()
     if not isinstance(node, YSeq):
         return None
     out: list[float] = []
@@ -123,14 +130,28 @@ def numbers(node: YNode | None) -> list[float] | None:
     return out
 
 
-def vector(node: YNode | None, size: int) -> Vec3 | None:
+def vector(node: YNode | None, size: int) -> tuple[float, ...] | None:
+    """``size`` numbers as a tuple of floats, or None."""
     values = numbers(node)
     if values is None or len(values) != size:
         return None
-    return np.array(values, dtype=float)
+    return tuple(float(x) for x in values)
 
 
-def translation(node: YNode | None, sink: DiagnosticSink) -> Vec3 | None:
+def vector3(node: YNode | None) -> rot3.V3 | None:
+    """Three numbers as a 3-vector, or None."""
+    values = numbers(node)
+    if values is None or len(values) != 3:
+        return None
+    return rot3.vec3(values)
+
+
+def compose(a: Affine, b: Affine) -> Affine:
+    """The affine map ``a ∘ b`` (b applied first)."""
+    return rot3.matmul(a[0], b[0]), rot3.add(rot3.matvec(a[0], b[1]), a[1])
+
+
+def translation(node: YNode | None, sink: DiagnosticSink) -> rot3.V3 | None:
     """``[x, y, z]`` or a list of such vectors (summed), as links and Transforms accept it."""
     if node is None:
         return None
@@ -138,17 +159,17 @@ def translation(node: YNode | None, sink: DiagnosticSink) -> Vec3 | None:
         sink.emit("MK309", "`translation: []` is empty (undefined behaviour in Choreonoid)", node.loc)
         return None
     if isinstance(node, YSeq) and node.items and all(isinstance(i, YSeq) for i in node.items):
-        total = np.zeros(3)
+        total = rot3.ZERO3
         for item in node.items:
-            v = vector(item, 3)
+            v = vector3(item)
             if v is None:
                 return None
-            total += v
+            total = rot3.add(total, v)
         return total
-    return vector(node, 3)
+    return vector3(node)
 
 
-def rotation(node: YNode | None, angle_scale: float, sink: DiagnosticSink) -> Mat3 | None:
+def rotation(node: YNode | None, angle_scale: float, sink: DiagnosticSink) -> rot3.M3 | None:
     """``[ax, ay, az, angle]`` or a list of them composed left to right (R1·R2·…)."""
     if node is None:
         return None
@@ -156,24 +177,25 @@ def rotation(node: YNode | None, angle_scale: float, sink: DiagnosticSink) -> Ma
         sink.emit("MK309", "`rotation: []` is empty (undefined behaviour in Choreonoid)", node.loc)
         return None
     parts = node.items if isinstance(node, YSeq) and all(isinstance(i, YSeq) for i in node.items) else [node]
-    result = np.eye(3)
+    result = rot3.IDENTITY
     for part in parts:
         aa = vector(part, 4)
         if aa is None:
             return None
-        axis = aa[:3]
-        if not np.all(np.isfinite(aa)):  # 1e400 reads as infinity: no rotation can be built from it
+        if not all(math.isfinite(x) for x in aa):  # 1e400 reads as infinity: no rotation from it
             sink.emit("MK100", "a rotation holds a number that is not finite", part.loc)
             return None
-        if float(np.linalg.norm(axis / 2.0)) < 0.5e-6:  # halved: |axis| of 1e308s overflows
+        axis = (aa[0], aa[1], aa[2])
+        if rot3.norm(rot3.scale(0.5, axis)) < 0.5e-6:  # halved: |axis| of 1e308s overflows
             sink.emit("MK308", "rotation axis is the zero vector", part.loc)
             return None
-        axis = axis / float(np.max(np.abs(axis)))  # same direction, a norm that cannot overflow
-        result = result @ axis_angle(axis, float(aa[3]) * angle_scale)
+        biggest = max(abs(x) for x in axis)
+        axis = (axis[0] / biggest, axis[1] / biggest, axis[2] / biggest)  # a norm that cannot overflow
+        result = rot3.matmul(result, rot3.axis_angle(axis, aa[3] * angle_scale))
     return result
 
 
-def scale3(node: YNode | None, sink: DiagnosticSink) -> Vec3 | None:
+def scale3(node: YNode | None, sink: DiagnosticSink) -> rot3.V3 | None:
     if node is None:
         return None
     if isinstance(node, YScalar):
@@ -184,7 +206,7 @@ def scale3(node: YNode | None, sink: DiagnosticSink) -> Vec3 | None:
             hint=f"write scale: [{node.value}, {node.value}, {node.value}]",
         )
         return None
-    return vector(node, 3)
+    return vector3(node)
 
 
 def finite_or_unlimited(node: YNode | None) -> float | None:
@@ -199,16 +221,12 @@ def finite_or_unlimited(node: YNode | None) -> float | None:
     return parse_float(text)
 
 
-def node_transform(m: YMap, angle_scale: float, sink: DiagnosticSink) -> np.ndarray:
-    """The 4×4 affine Trans(p)·Rot(R)·Scale(s) of a node with translation/rotation/scale keys."""
+def node_transform(m: YMap, angle_scale: float, sink: DiagnosticSink) -> Affine:
+    """The affine Trans(p)·Rot(R)·Scale(s) of a node with translation/rotation/scale keys."""
     t = translation(m.get("translation"), sink)
     r = rotation(m.get("rotation"), angle_scale, sink)
     s = scale3(m.get("scale"), sink)
-    out = np.eye(4)
-    linear = np.eye(3) if r is None else r
-    if s is not None:
-        linear = linear @ np.diag(s)
-    out[:3, :3] = linear
-    if t is not None:
-        out[:3, 3] = t
-    return out
+    linear = rot3.IDENTITY if r is None else r
+    if s is not None:  # R·diag(s): column j scaled by s[j]
+        linear = tuple((row[0] * s[0], row[1] * s[1], row[2] * s[2]) for row in linear)  # type: ignore[assignment]
+    return linear, rot3.ZERO3 if t is None else t
