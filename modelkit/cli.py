@@ -6,6 +6,7 @@ run (bad usage, unreadable input).
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -157,6 +158,13 @@ def _read_options(kwargs: dict[str, Any], check_resources: bool, xacro_args: dic
     )
 
 
+def _no_mujoco_rendering() -> None:
+    """``validate`` and ``tree`` only compile MJCF: MuJoCo's import then skips its OpenGL back end
+    (glfw, ~50 ms), unless the user chose one. Only in these commands' own process: a library user's
+    MuJoCo keeps rendering."""
+    os.environ.setdefault("MUJOCO_GL", "disable")
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="modelkit")
 def main() -> None:
@@ -246,6 +254,8 @@ def validate(
     """
     from modelkit.codes import resolve
 
+    _no_mujoco_rendering()
+
     silenced: set[str] = set()
     for item in ignored:
         info = resolve(item)
@@ -305,6 +315,7 @@ def tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: st
 
     Works for every format. An SDF world prints one report per model, in document order.
     """
+    _no_mujoco_rendering()
     from modelkit.api import validate as validate_file
     from modelkit.tree import TreeTooLarge, json_chunks, report_chunks
 
