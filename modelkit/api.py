@@ -16,8 +16,9 @@ from modelkit.model import Robot
 # ``convert --to`` it) will meet them. Everywhere else they stay warnings that name the consumers.
 TARGET_REFUSALS: dict[str, frozenset[str]] = {
     # MuJoCo: inertia violating A + B >= C; a moving link, no mass; URDF parts its URDF import refuses (a
-    # shape without its size or file, an incomplete inertia or inertial, a short rgba or mesh scale)
-    "mjcf": frozenset({"MK303", "MK313", "MK143", "MK144", "MK145", "MK146", "MK420"}),
+    # shape without its size or file, an incomplete inertia or inertial, a short rgba or mesh scale); a
+    # collision shape of size zero
+    "mjcf": frozenset({"MK303", "MK313", "MK143", "MK144", "MK145", "MK146", "MK420", "MK416"}),
     "sdf": frozenset({"MK303", "MK211"}),  # libsdformat: the same, and links and joints sharing a name
     "urdf": frozenset(),
     # PyBullet: a URDF visual or collision without a shape, a shape without its size or file, an

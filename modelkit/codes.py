@@ -708,6 +708,26 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "An Extrusion orientation axis is not unit length (Choreonoid uses it unnormalised).",
     ),
+    # (URDF and SDF primitives: a size that is not positive, judged by the consumers that load it)
+    CodeInfo(
+        "MK416",
+        "collision-size-not-positive",
+        "warning",
+        "A URDF or SDF collision box, sphere, cylinder, capsule or ellipsoid with a zero size (a zero box is "
+        "a common way to say \"no collision\"). Reference: check_urdf, libsdformat and PyBullet load it "
+        "(PyBullet collides with a point); MuJoCo refuses it (\"size 0 must be positive in geom\"; an "
+        "error under `--target mjcf`), and `convert` to MJCF leaves the shape out (MK871). A negative size "
+        "is an error: the loaders accept it, but the shape cannot be simulated meaningfully (PyBullet "
+        "inverts a negative box's or sphere's bounds and the body falls through the floor).",
+    ),
+    CodeInfo(
+        "MK417",
+        "visual-size-not-positive",
+        "warning",
+        "A URDF or SDF visual box, sphere, cylinder, capsule or ellipsoid with a zero or negative size: it "
+        "draws nothing. Reference: check_urdf, libsdformat, PyBullet and MuJoCo's URDF import (which drops "
+        "visuals) load it; `convert` to MJCF leaves the shape out (MK871).",
+    ),
     # (urdf/sdf/mjcf geometry MK420-MK439: urdf MK420-MK429)
     CodeInfo(
         "MK420",
@@ -1049,6 +1069,22 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "An inertia MuJoCo refuses (principal moments violating A + B ≥ C, or singular on a moving body) "
         "is written as the nearest one it accepts; the note gives the change.",
+    ),
+    CodeInfo(
+        "MK871",
+        "mjcf-shape-size-not-positive",
+        "warning",
+        "A shape with a zero or negative size, which MuJoCo refuses (\"size must be positive in geom\"), "
+        "is left out; the note says whether it was a collision shape (a consumer that loads it, such as "
+        "PyBullet, collides with a point there).",
+    ),
+    CodeInfo(
+        "MK880",
+        "body-shape-size-not-positive",
+        "warning",
+        "A shape Choreonoid cannot generate (a negative box edge; a zero or negative sphere radius; a "
+        "cylinder, cone or capsule with a radius not positive, or a height not positive (negative for a "
+        "capsule)) is left out of the written `.body`: Choreonoid refuses the whole file otherwise.",
     ),
     CodeInfo(
         "MK890",

@@ -398,3 +398,22 @@ def test_mimic_and_ball_joints_are_noted(tmp_path: Path) -> None:
     assert {"MK812", "MK813"} <= {n.code for n in notes}
     back = validate(tmp_path / "m.body").robot
     assert back is not None and back.joints[1].type is JointType.FIXED
+
+
+def test_shapes_choreonoid_cannot_generate_are_left_out(tmp_path: Path) -> None:
+    """A URDF zero-radius sphere (check_urdf and PyBullet load it) would make the whole .body refused
+    by Choreonoid (MK400): the writer leaves that shape out with an MK880 note and keeps the rest."""
+    source = tmp_path / "s.urdf"
+    source.write_text(
+        '<robot name="r"><link name="a"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" '
+        'ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry><sphere radius="0"/></geometry></collision>'
+        '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link></robot>'
+    )
+    robot = validate(source).robot
+    assert robot is not None
+    notes = write(robot, tmp_path / "s.body", "body")
+    assert [n.code for n in notes if n.code == "MK880"] == ["MK880"]
+    back = validate(tmp_path / "s.body")
+    assert back.errors == [] and back.robot is not None
+    (link,) = back.robot.links
+    assert [type(g.geometry).__name__ for g in link.collisions] == ["Box"]

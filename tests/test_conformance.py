@@ -131,10 +131,6 @@ EXCEPTIONS: dict[str, str] = {
         "its only collision mesh is in package pr2_simulator_benchmarks, which is not present (MK504); "
         "check_urdf never resolves package:// URIs"
     ),
-    "corpus/gazebo_ros_pkgs/gazebo_plugins/test/multi_robot_scenario/xacro/p3dx/pioneer3dx.xacro": (
-        'collision boxes of size="0 0 0" (MK400: sizes must be positive, issue 9 §1); check_urdf does '
-        "not look at geometry sizes"
-    ),
     "corpus/gazebo_ros_pkgs/gazebo_plugins/test/test_worlds/gazebo_ros_block_laser.world": (
         "the PR2 gripper and chair collision meshes it names are not in the snapshot (MK500); libsdformat "
         "never opens meshes"
@@ -690,6 +686,23 @@ _REFUSED_SDF: dict[str, tuple[str, str]] = {
 # Values libsdformat 12 reads although they look wrong (std::stod takes a leading number, a vector
 # ignores extra numbers, booleans are case-insensitive): no error.
 _ACCEPTED_SDF: dict[str, tuple[str, str]] = {
+    # a zero size: libsdformat loads it (a warning, MK416/MK417; MuJoCo would refuse it)
+    "a collision box of size zero": (
+        "1.7",
+        '<model name="m"><link name="a"><collision name="c"><geometry><box><size>0 0 0</size></box>'
+        "</geometry></collision></link></model>",
+    ),
+    "a collision sphere and cylinder of radius zero": (
+        "1.7",
+        '<model name="m"><link name="a"><collision name="s"><geometry><sphere><radius>0</radius></sphere>'
+        '</geometry></collision><collision name="c"><geometry><cylinder><radius>0</radius><length>1</length>'
+        "</cylinder></geometry></collision></link></model>",
+    ),
+    "a visual box of negative size": (
+        "1.7",
+        '<model name="m"><link name="a"><visual name="v"><geometry><box><size>-1 1 1</size></box></geometry>'
+        "</visual></link></model>",
+    ),
     "a double with trailing text": (
         "1.9",
         f'<world name="w"><physics type="ode"><max_step_size>0.001s</max_step_size></physics>'
@@ -940,6 +953,29 @@ _URDFDOM_TOLERATED: dict[str, tuple[str, str, str, frozenset[str]]] = {
     "a lower limit above the upper": (
         _URDF_BASE + _hinge(lower="1", upper="-1"), "MK307", "warning", frozenset(),
     ),
+    # a zero size (Gazebo models' way to say "no collision"): MuJoCo's URDF import refuses it ("size 0
+    # must be positive in geom"); on a visual it is dropped with all visuals, so MuJoCo loads the file
+    "a collision box of size zero": (
+        _part('<collision><geometry><box size="0 0 0"/></geometry></collision>'), "MK416", "warning",
+        frozenset({"mjcf"}),
+    ),
+    "a collision sphere of radius zero": (
+        _part('<collision><geometry><sphere radius="0"/></geometry></collision>'), "MK416", "warning",
+        frozenset({"mjcf"}),
+    ),
+    "a collision cylinder of radius zero": (
+        _part('<collision><geometry><cylinder radius="0" length="1"/></geometry></collision>'), "MK416",
+        "warning", frozenset({"mjcf"}),
+    ),
+    "a visual box of size zero": (
+        _part('<visual><geometry><box size="0 0 0"/></geometry></visual>'), "MK417", "warning", frozenset(),
+    ),
+    # not simulable: every loader but MuJoCo takes a negative size; PyBullet inverts the shape's bounds and
+    # the body falls through the floor (test_negative_sizes_cannot_be_simulated)
+    "a collision box of negative size": (
+        _part('<collision><geometry><box size="-1 1 1"/></geometry></collision>'), "MK416", "error",
+        frozenset({"mjcf"}),
+    ),
     # not simulable: the joint has no direction of motion (an error by the policy; PyBullet loads it)
     "a zero axis on a revolute joint": (
         _URDF_BASE + _hinge(axis="0 0 0"), "MK305", "error", frozenset({"sdf", "mjcf"}),
@@ -996,6 +1032,89 @@ def test_urdf_parts_urdfdom_tolerates(
         judged = validate(path, target=target)
         expected = severity == "error" or (target in refusing and target != "sdf")
         assert bool(judged.errors) == expected, (case, target, judged.errors)
+
+
+_PYBULLET_DROP = """
+import sys
+import pybullet
+pybullet.connect(pybullet.DIRECT)
+pybullet.setGravity(0, 0, -10)
+pybullet.createMultiBody(0, pybullet.createCollisionShape(pybullet.GEOM_PLANE))
+body = pybullet.loadURDF(sys.argv[1], [0, 0, 2])
+low, high = pybullet.getAABB(body)
+for _ in range(480):
+    pybullet.stepSimulation()
+print(low[0] <= high[0], pybullet.getBasePositionAndOrientation(body)[0][2])
+"""
+
+
+@pytest.mark.parametrize(
+    ("shape", "z"),
+    [('<box size="1 1 1"/>', 0.5), ('<box size="-1 1 1"/>', -0.5), ('<sphere radius="-0.5"/>', -0.5)],
+)
+def test_negative_sizes_cannot_be_simulated(
+    shape: str, z: float, tmp_path: Path, sdf_oracle: Path  # noqa: F811
+) -> None:
+    """Every loader but MuJoCo takes a negative size, but PyBullet inverts the shape's bounds and the body
+    sinks through the floor (a 1 m box dropped from 2 m rests at z = 0.5 with a positive size): an error by
+    the policy (the model cannot be simulated meaningfully)."""
+    path = tmp_path / "r.urdf"
+    collision = f"<collision><geometry>{shape}</geometry></collision></link>"
+    path.write_text(_urdf(_URDF_BASE.replace("</link>", collision)))
+    assert check_urdf_accepts(path)[0]
+    run = subprocess.run([sys.executable, "-c", _PYBULLET_DROP, str(path)], capture_output=True, text=True,
+                         timeout=60)
+    bounds_ordered, rest = run.stdout.split()[-2:]
+    assert (bounds_ordered == "True") == (z > 0) and abs(float(rest) - z) < 0.01, run.stdout
+    errors = [d.code for d in validate(path).errors]
+    assert errors == ([] if z > 0 else ["MK416"]), errors
+    sdf = tmp_path / "m.sdf"
+    sdf.write_text(_sdf("1.7", '<model name="m"><link name="a"><collision name="c"><geometry>'
+                        "<sphere><radius>-0.5</radius></sphere></geometry></collision></link></model>"))
+    assert _libsdformat_accepts(sdf_oracle, sdf)
+    assert [d.code for d in validate(sdf).errors] == ["MK416"]
+
+
+def test_a_zero_collision_box_is_a_warning_naming_mujoco(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from modelkit.cli import main
+
+    path = tmp_path / "r.urdf"
+    path.write_text(_urdf(_part('<collision><geometry><box size="0 0 0"/></geometry></collision>')))
+    (d,) = validate(path).warnings
+    assert d.code == "MK416" and "MuJoCo refuses it" in d.message and "PyBullet" in d.message
+    assert d.location is not None and d.location.col > 0
+    runner = CliRunner()
+    cases: list[tuple[list[str], int]] = [
+        ([], 0), (["--strict"], 1), (["--target", "mjcf"], 1), (["--target", "pybullet"], 0)
+    ]
+    for options, code in cases:
+        result = runner.invoke(main, ["validate", *options, str(path)])
+        assert result.exit_code == code, (options, result.output)
+
+
+_PIONEER = CORPUS / "gazebo_ros_pkgs/gazebo_plugins/test/multi_robot_scenario/xacro/p3dx/pioneer3dx.xacro"
+
+
+def test_zero_boxes_are_kept_for_consumers_that_accept_them(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+    """URDF and SDF keep a zero collision box as written (check_urdf and libsdformat load it); only the MJCF
+    writer leaves it out (tests/test_mjcf_writer.py)."""
+    from click.testing import CliRunner
+
+    from modelkit.cli import main
+
+    if not _PIONEER.is_file():
+        pytest.skip("shared corpus not available")
+    for suffix, zero in ((".urdf", 'size="0 0 0"'), (".sdf", "<size>0 0 0</size>")):
+        out = tmp_path / suffix[1:] / f"p3dx{suffix}"
+        result = CliRunner().invoke(main, ["convert", str(_PIONEER), "-o", str(out)])
+        assert result.exit_code == 0 and "MK871" not in result.output, result.output
+        assert out.read_text().count(zero) == 5
+        accepted = check_urdf_accepts(out)[0] if suffix == ".urdf" else _libsdformat_accepts(sdf_oracle, out)
+        assert accepted, suffix
+        v = validate(out)
+        assert v.errors == [] and _codes(v, "warning").count("MK416") == 5, v.diagnostics
 
 
 def test_unreadable_urdf_parts_keep_the_rest_of_the_link(tmp_path: Path) -> None:

@@ -28,6 +28,7 @@ from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, MIN_MASS
 from modelkit.formats.mjcf.writer import write_mjcf
 from modelkit.model import (
     Box,
+    Capsule,
     Cylinder,
     Geom,
     Inertial,
@@ -39,6 +40,7 @@ from modelkit.model import (
     Mesh,
     Mimic,
     Robot,
+    Sphere,
     TriangleMeshData,
 )
 from modelkit.spatial import Pose
@@ -762,3 +764,55 @@ def test_triangle_inequality_is_repaired_with_a_note(tmp_path: Path) -> None:
     arm = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "arm")
     assert np.allclose(np.sort(model.body_inertia[arm]), [50.0, 50.0, 100.0])
     assert any(n.code == "MK870" and "a + b ≥ c" in n.message for n in written.notes)
+
+
+def test_shapes_of_size_zero_are_left_out_with_a_note(tmp_path: Path) -> None:
+    """MuJoCo refuses a geom whose size is not positive ("size 0 must be positive in geom"): such a shape is
+    left out with an MK871 note; a capsule of length 0 is the sphere it is."""
+    robot = _chain(_hinge("j", "base", "arm"))
+    base, arm = robot.links
+    base.collisions = [Geom(Box((0.0, 0.0, 0.0))), Geom(Box((0.1, 0.2, 0.3)))]
+    base.visuals = [Geom(Sphere(0.0)), Geom(Cylinder(0.0, 1.0))]
+    arm.collisions = [Geom(Capsule(0.05, 0.0))]
+    written = render(robot, tmp_path)
+    model = mujoco.MjModel.from_xml_path(str(written.path))
+    geoms = sorted(
+        (int(model.geom_type[i]), tuple(np.round(model.geom_size[i], 9)))
+        for i in range(model.ngeom)
+    )
+    assert geoms == [
+        (int(mujoco.mjtGeom.mjGEOM_SPHERE), (0.05, 0.0, 0.0)),
+        (int(mujoco.mjtGeom.mjGEOM_BOX), (0.05, 0.1, 0.15)),
+    ]
+    notes = sorted((n.target, n.message) for n in written.notes if n.code == "MK871")
+    assert [target for target, _ in notes] == [
+        "body[base]/collision[0]", "body[base]/visual[0]", "body[base]/visual[1]"
+    ]
+    assert "box 0 0 0" in notes[0][1] and "collides with a point" in notes[0][1]
+    assert "draws nothing" in notes[1][1]
+    assert step_warnings(model) == {}
+
+
+PIONEER = CORPUS / "gazebo_ros_pkgs/gazebo_plugins/test/multi_robot_scenario/xacro/p3dx/pioneer3dx.xacro"
+
+
+def test_pioneer3dx_zero_collision_boxes_convert_to_a_model_mujoco_loads(tmp_path: Path) -> None:
+    """The Pioneer 3-DX xacro says "no collision" with <box size="0 0 0"/> (MK416, a warning): convert
+    proceeds, leaves those boxes out (MK871) and MuJoCo loads the result."""
+    from click.testing import CliRunner
+
+    from modelkit.cli import main
+
+    if not PIONEER.is_file():
+        pytest.skip("shared corpus not available")
+    out = tmp_path / "out" / "p3dx.xml"
+    result = CliRunner().invoke(main, ["convert", str(PIONEER), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert result.output.count("MK871") == 5 and result.output.count("MK416") == 5, result.output
+    model = mujoco.MjModel.from_xml_path(str(out))
+    for body in ("sonar", "swivel", "center_hubcap", "left_hub", "right_hub"):
+        b = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body)
+        collisions = [g for g in range(model.ngeom) if model.geom_bodyid[g] == b and model.geom_group[g] == 3]
+        assert b > 0 and collisions == [], body
+    assert step_warnings(model) == {}
+

@@ -689,7 +689,9 @@ def test_bad_values_are_reported_not_raised(tmp_path: Path) -> None:
       <limit><lower>low</lower></limit></axis></joint>"""
     result = read_text(tmp_path, model("1.7", body))
     found = codes(result)
-    assert found.count("MK121") >= 6 and "MK400" in found and "MK235" in found
+    assert found.count("MK121") >= 6 and "MK416" in found and "MK235" in found
+    (negative,) = [d for d in result.diagnostics if d.code == "MK416"]
+    assert negative.severity.value == "error" and "negative" in negative.message  # radius -1
 
 
 # ---- libsdformat as an oracle ----------------------------------------------------------------------

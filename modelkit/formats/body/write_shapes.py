@@ -78,10 +78,29 @@ def link_elements(link: Link, ctx: WriteContext, from_body: bool = False) -> lis
     return out
 
 
+def not_generated(g: object) -> bool:
+    """The primitives Choreonoid's reader refuses (the reader's MK400 rules, body-format.md §3)."""
+    if isinstance(g, Box):
+        return any(float(x) < 0.0 for x in g.size)
+    if isinstance(g, Sphere):
+        return float(g.radius) <= 0.0
+    if isinstance(g, Ellipsoid):
+        return any(float(x) <= 0.0 for x in g.radii)
+    if isinstance(g, (Cylinder, Cone)):
+        return float(g.radius) <= 0.0 or float(g.length) <= 0.0
+    if isinstance(g, Capsule):
+        return float(g.radius) <= 0.0 or float(g.length) < 0.0
+    return False
+
+
 def shape_node(geom: Geom, ctx: WriteContext, target: str, mesh_name: str,
                from_body: bool = False) -> dict[str, Any] | None:
     """One Shape (or Resource) element; None when the shape cannot be written (note made)."""
     g = geom.geometry
+    if not_generated(g):
+        ctx.note("MK880", f"{type(g).__name__.lower()} of {target} has a size Choreonoid cannot generate "
+                 "(it refuses the whole file); this shape is left out", geom.source, target)
+        return None
     rotation, translation = geom.pose.rotation, geom.pose.translation
     scale: np.ndarray | None = None
     geometry: dict[str, Any]

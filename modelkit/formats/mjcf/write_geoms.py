@@ -9,6 +9,9 @@
 * Box ``size`` = half extents; sphere ``r``; cylinder and capsule ``r h/2`` (the model's capsule
   length is the cylindrical part, as MuJoCo's); ellipsoid ``rx ry rz``; cones and generated
   geometry become mesh files (MK802/MK803); COLLADA/VRML meshes are converted to STL/OBJ (MK804).
+* A primitive with a zero or negative size is left out (MK871): MuJoCo refuses any such geom ("size 0
+  must be positive in geom"). A tiny stand-in would invent a contact the source does not mean (a zero
+  box is how Gazebo models say "no collision"), and geoms add no mass here, so nothing else changes.
 * A mesh asset is named after its file (``wheel``), made unique with ``_2``... (MK800); one asset
   per (file, scale). Each ``file`` is a path relative to the model file (no ``meshdir``), so the
   output folder can be moved as a whole.
@@ -58,6 +61,21 @@ class GeomWriter:
             self.geom(body, geom, f"body[{body_name}]/visual[{i}]", link, collision=False)
 
     def geom(self, body: Element, geom: Geom, target: str, link: Link, collision: bool) -> None:
+        if refused_by_mujoco(geom.geometry):
+            role = (
+                "collision shape (a consumer that loads it, such as PyBullet, collides with a point there)"
+                if collision
+                else "visual shape (it draws nothing)"
+            )
+            what = f"{type(geom.geometry).__name__.lower()} {fmt_vec(primitive_sizes(geom.geometry))}"
+            self.ctx.note(
+                "MK871",
+                f"{what} of link {link.name} has a size that is not positive, which MuJoCo refuses; this "
+                f"{role} is left out",
+                geom.source,
+                target,
+            )
+            return
         shape = self.shape(
             geom, target, f"{link.name}_{target.rsplit('/', 1)[1].replace('[', '').rstrip(']')}"
         )
@@ -88,6 +106,8 @@ class GeomWriter:
         if isinstance(g, Cylinder):
             return {"type": "cylinder", "size": f"{fmt(g.radius)} {fmt(g.length / 2.0)}"}
         if isinstance(g, Capsule):
+            if g.length == 0.0:  # MuJoCo refuses a capsule of half-length 0: it is a sphere
+                return {"type": "sphere", "size": fmt(g.radius)}
             return {"type": "capsule", "size": f"{fmt(g.radius)} {fmt(g.length / 2.0)}"}
         if isinstance(g, Ellipsoid):
             return {"type": "ellipsoid", "size": fmt_vec(g.radii)}
@@ -159,3 +179,24 @@ class GeomWriter:
             link.loc("material"),
             f"body[{target.split('[', 1)[1].split(']', 1)[0]}]",
         )
+
+
+def primitive_sizes(g: object) -> tuple[float, ...]:
+    """A primitive's sizes (box edges, radius, length, radii); () for a mesh or cone (written as a mesh)."""
+    if isinstance(g, Box):
+        return tuple(float(x) for x in g.size)
+    if isinstance(g, Sphere):
+        return (float(g.radius),)
+    if isinstance(g, (Cylinder, Capsule)):
+        return (float(g.radius), float(g.length))
+    if isinstance(g, Ellipsoid):
+        return tuple(float(x) for x in g.radii)
+    return ()
+
+
+def refused_by_mujoco(g: object) -> bool:
+    """MuJoCo refuses a geom whose size is not positive; a capsule of length 0 is written as a sphere."""
+    sizes = primitive_sizes(g)
+    if isinstance(g, Capsule):
+        return sizes[0] <= 0.0 or sizes[1] < 0.0
+    return bool(sizes) and min(sizes) <= 0.0

@@ -98,9 +98,46 @@ def read_geometry(
     return ShapeResult(geometry=_shape(ctx, src, shape, owner, visual_only))
 
 
-def _positive(sink: DiagnosticSink, src: SdfDocument, el: Element | None, value: float, what: str) -> float:
+def _not_positive(
+    sink: DiagnosticSink,
+    src: SdfDocument,
+    el: Element,
+    what: str,
+    values: tuple[float, ...],
+    visual_only: bool,
+) -> None:
+    """MK417 for a visual; MK416 for a collision: a warning when zero, an error when negative (see codes)."""
+    shown = f"{values[0]:g}" if len(values) == 1 else str([float(v) for v in values])
+    where = src.values.text_loc(el)
+    if visual_only:
+        sink.emit(
+            "MK417",
+            f"{what} is {shown}, not positive, so it draws nothing (libsdformat loads it)",
+            where,
+        )
+    elif min(values) < 0.0:
+        sink.emit(
+            "MK416",
+            f"{what} is negative ({shown}); libsdformat loads it, but it cannot be simulated "
+            "meaningfully (PyBullet inverts the shape's bounds and the body falls through the floor); "
+            "MuJoCo refuses it",
+            where,
+            severity=Severity.ERROR,
+        )
+    else:
+        sink.emit(
+            "MK416",
+            f"{what} is {shown}; libsdformat loads it, MuJoCo refuses it",
+            where,
+            hint="to mean no collision, leave the <collision> out",
+        )
+
+
+def _positive(
+    sink: DiagnosticSink, src: SdfDocument, el: Element | None, value: float, what: str, visual_only: bool
+) -> float:
     if value <= 0.0 and el is not None:
-        sink.emit("MK400", f"{what} must be positive, not {value:g}", src.values.text_loc(el))
+        _not_positive(sink, src, el, what, (value,), visual_only)
     return value
 
 
@@ -113,7 +150,7 @@ def _shape(ctx: Context, src: SdfDocument, shape: Element, owner: str, visual_on
         el = child(shape, name)
         value = values.number(el, default)
         value = default if value is None else value
-        return _positive(sink, src, el, value, f"<{kind}> {name} of {owner}")
+        return _positive(sink, src, el, value, f"<{kind}> {name} of {owner}", visual_only)
 
     def positive_vector(name: str) -> tuple[float, ...]:
         """A three-number child (ones when absent or unreadable); non-positive entries reported."""
@@ -121,8 +158,7 @@ def _shape(ctx: Context, src: SdfDocument, shape: Element, owner: str, visual_on
         vector = values.vector(el, 3) if el is not None else None
         vector = (1.0, 1.0, 1.0) if vector is None else vector
         if el is not None and any(v <= 0.0 for v in vector):
-            message = f"<{kind}> {name} of {owner} must be positive: {list(vector)}"
-            sink.emit("MK400", message, values.text_loc(el))
+            _not_positive(sink, src, el, f"<{kind}> {name} of {owner}", tuple(vector), visual_only)
         return vector
 
     if kind == "box":

@@ -307,7 +307,7 @@ def read_geometry(
         if size is None:
             return None
         if any(s <= 0.0 for s in size):
-            _not_positive(ctx, shape, "size", f"box of the {what}")
+            _size_not_positive(ctx, shape, "size", f"box of the {what}", min(size), visual_only)
         return Box(size=tuple(size))
     if tag in ("cylinder", "capsule"):
         if tag == "capsule":
@@ -321,9 +321,9 @@ def read_geometry(
         if radius is None or length is None:
             return None
         if radius <= 0.0:
-            _not_positive(ctx, shape, "radius", f"{tag} of the {what}")
+            _size_not_positive(ctx, shape, "radius", f"{tag} of the {what}", radius, visual_only)
         if length < 0.0 or (length == 0.0 and tag == "cylinder"):
-            _not_positive(ctx, shape, "length", f"{tag} of the {what}")
+            _size_not_positive(ctx, shape, "length", f"{tag} of the {what}", length, visual_only)
         return Cylinder(radius, length) if tag == "cylinder" else Capsule(radius, length)
     if tag == "sphere":
         if shape.get("radius") is None:
@@ -333,7 +333,7 @@ def read_geometry(
         if radius is None:
             return None
         if radius <= 0.0:
-            _not_positive(ctx, shape, "radius", f"sphere of the {what}")
+            _size_not_positive(ctx, shape, "radius", f"sphere of the {what}", radius, visual_only)
         return Sphere(radius)
     if tag == "mesh":
         return _mesh(ctx, shape, what, meshes, visual_only)
@@ -352,6 +352,37 @@ def _not_positive(
         "MK400",
         f'{what}: `{attribute}="{element.get(attribute)}"` must {rule}',
         ctx.loc(element, attribute),
+    )
+
+
+def _size_not_positive(
+    ctx: Context, element: Element, attribute: str, what: str, value: float, visual_only: bool
+) -> None:
+    """MK417 for a visual; MK416 for a collision: a warning when zero, an error when negative (see codes)."""
+    if visual_only:
+        ctx.emit(
+            "MK417",
+            f'{what}: `{attribute}="{element.get(attribute)}"` is not positive, so it draws nothing '
+            "(check_urdf, PyBullet and MuJoCo's URDF import, which drops visuals, load it)",
+            ctx.loc(element, attribute),
+        )
+        return
+    if value < 0.0:
+        ctx.emit(
+            "MK416",
+            f'{what}: `{attribute}="{element.get(attribute)}"` is negative; check_urdf and PyBullet load it, '
+            "but it cannot be simulated meaningfully (PyBullet inverts the shape's bounds and the body falls "
+            "through the floor) and MuJoCo refuses it",
+            ctx.loc(element, attribute),
+            severity=Severity.ERROR,
+        )
+        return
+    ctx.emit(
+        "MK416",
+        f'{what}: `{attribute}="{element.get(attribute)}"` is zero; check_urdf and PyBullet load it '
+        "(PyBullet collides with a point), MuJoCo refuses it",
+        ctx.loc(element, attribute),
+        hint="to mean no collision, leave the <collision> out",
     )
 
 
