@@ -34,6 +34,8 @@ _START_TAG = re.compile(r"<([^\s/>!?][^\s/>]*)")
 _ATTRIBUTE = re.compile(r"""([^\s=/>"']+)\s*=\s*(?:"[^"]*"|'[^']*')""")
 _ENTITY_DECL = re.compile(r"<!ENTITY", re.IGNORECASE)
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+# Blank-separated numbers, whole: ``\s`` is exactly the whitespace ``str.split()`` splits on.
+_NUMBERS = re.compile(rf"\s*(?:{_NUMBER.pattern}(?:\s+{_NUMBER.pattern})*)?\s*")
 
 
 def mask_markup(text: str) -> str:
@@ -61,15 +63,9 @@ def parse_number(text: str | None) -> float | None:
 
 def parse_numbers(text: str | None) -> list[float] | None:
     """Blank-separated numbers; None when any item is not a number."""
-    if text is None:
+    if text is None or _NUMBERS.fullmatch(text) is None:  # one match for the whole list
         return None
-    out: list[float] = []
-    for item in text.split():
-        value = parse_number(item)
-        if value is None:
-            return None
-        out.append(value)
-    return out
+    return [float(item) for item in text.split()]
 
 
 @dataclass
@@ -93,7 +89,17 @@ class XmlDocument:
     def loc(self, element: Element, attribute: str | None = None) -> SourceLocation:
         """Where ``element`` starts, or where its ``attribute`` is written (1-based line and col).
 
-        An attribute the element does not have is placed at the element."""
+        An attribute the element does not have is placed at the element. The line and column are found
+        when first read (:class:`LazyLocation`): a reader records a location for every element and
+        attribute it reads, and only the few a diagnostic shows are ever looked at."""
+        if self.origins:
+            origin = self.origins.get(element)
+            if origin is not None:
+                return origin
+        return LazyLocation.at(self, element, attribute)
+
+    def find_loc(self, element: Element, attribute: str | None = None) -> SourceLocation:
+        """:meth:`loc`, found now (what a :class:`LazyLocation` computes when first read)."""
         origin = self.origins.get(element)
         if origin is not None:
             return origin
@@ -110,18 +116,106 @@ class XmlDocument:
         return SourceLocation(self.display, *self._position(start))
 
     def text_loc(self, element: Element) -> SourceLocation:
-        """Where the text content of ``element`` starts (just after its start tag)."""
+        """Where the text content of ``element`` starts (just after its start tag), found when first read."""
+        origin = self.origins.get(element)
+        if origin is not None:
+            return origin
+        return LazyLocation.at(self, element, None, text=True)
+
+    def find_text_loc(self, element: Element) -> SourceLocation:
+        """:meth:`text_loc`, found now."""
         origin = self.origins.get(element)
         if origin is not None:
             return origin
         start = self._starts.get(element)
         if start is None:
-            return self.loc(element)
+            return self.find_loc(element)
         end = tag_end(self.text, start)
         offset = min(end + 1, len(self.text))
         while offset < len(self.text) and self.text[offset] in " \t\r\n":
             offset += 1
         return SourceLocation(self.display, *self._position(offset))
+
+
+class LazyLocation(SourceLocation):
+    """A :class:`SourceLocation` in an :class:`XmlDocument` whose line and column are computed when first
+    read. It equals, hashes, orders, prints and pickles as the plain location it stands for (a pickle or a
+    copy is that plain location), so no consumer can tell the two apart.
+
+    The document stays alive as long as the location does; it must not change after the location is
+    taken (readers only read)."""
+
+    # ``file`` is the document's display name (set at once); the pending look-up and, once made, the
+    # found place live in the instance dict; ``line`` and ``col`` are properties over them.
+
+    def __init__(self, file: str, line: int = 0, col: int = 0) -> None:  # as SourceLocation (replace())
+        self.__dict__.update(file=file, _found=SourceLocation(file, line, col))
+
+    @classmethod
+    def at(
+        cls, doc: XmlDocument, element: Element, attribute: str | None, text: bool = False
+    ) -> LazyLocation:
+        """Where ``element`` (its ``attribute``, or with ``text`` its text content) is in ``doc``."""
+        self = cls.__new__(cls)
+        self.__dict__.update(file=doc.display, _found=None, _pending=(doc, element, attribute, text))
+        return self
+
+    def _resolve(self) -> SourceLocation:
+        found: SourceLocation | None = self.__dict__["_found"]
+        if found is None:
+            doc, element, attribute, text = self.__dict__.pop("_pending")
+            found = doc.find_text_loc(element) if text else doc.find_loc(element, attribute)
+            self.__dict__["_found"] = found
+        return found
+
+    @property
+    def line(self) -> int:
+        return self._resolve().line
+
+    @property
+    def col(self) -> int:
+        return self._resolve().col
+
+    def _key(self) -> tuple[str, int, int]:
+        found = self._resolve()
+        return (found.file, found.line, found.col)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, SourceLocation):
+            return self._key() == (other.file, other.line, other.col)
+        return NotImplemented
+
+    def __hash__(self) -> int:
+        return hash(self._key())  # what the dataclass hashes for a plain location
+
+    def __lt__(self, other: object) -> bool:
+        if isinstance(other, SourceLocation):
+            return self._key() < (other.file, other.line, other.col)
+        return NotImplemented
+
+    def __le__(self, other: object) -> bool:
+        if isinstance(other, SourceLocation):
+            return self._key() <= (other.file, other.line, other.col)
+        return NotImplemented
+
+    def __gt__(self, other: object) -> bool:
+        if isinstance(other, SourceLocation):
+            return self._key() > (other.file, other.line, other.col)
+        return NotImplemented
+
+    def __ge__(self, other: object) -> bool:
+        if isinstance(other, SourceLocation):
+            return self._key() >= (other.file, other.line, other.col)
+        return NotImplemented
+
+    def __repr__(self) -> str:
+        return repr(self._resolve())
+
+    def __str__(self) -> str:
+        return str(self._resolve())
+
+    def __reduce__(self) -> tuple[type[SourceLocation], tuple[str, int, int]]:
+        return (SourceLocation, self._key())
 
 
 _TAG_TOKEN = re.compile(r"\"[^\"]*\"|'[^']*'|>")

@@ -93,15 +93,19 @@ def check_structure(ctx: Context, root: Element) -> None:
     """Report unknown, misplaced and repeated elements and unknown attributes below ``<robot>``."""
     _check_attributes(ctx, root, "robot")
     stack: list[tuple[Element, str]] = [(root, "robot")]
+    no_once: frozenset[str] = frozenset()
     while stack:
         element, tag = stack.pop()
         allowed = CHILDREN.get(tag)
         if allowed is None:  # a leaf element: nothing below it is read
             _check_leaf(ctx, element, tag)
             continue
+        once = ONCE.get(tag, no_once)
         seen: set[str] = set()
         for child in element:
-            child_tag = ctx.tag(child)
+            raw = child.tag
+            # a tag without a namespace is URDF's at once (every element is visited: keep this cheap)
+            child_tag = raw if type(raw) is str and raw[:1] != "{" else ctx.tag(child)
             if child_tag is None:
                 _foreign(ctx, child)
                 continue
@@ -110,7 +114,7 @@ def check_structure(ctx: Context, root: Element) -> None:
                 continue
             if tag == "robot" and child_tag in EXTENSIONS:
                 continue
-            if child_tag in ONCE.get(tag, frozenset()) and child_tag in seen:
+            if child_tag in once and child_tag in seen:
                 ctx.emit(
                     "MK124",
                     f"<{child_tag}> appears more than once in <{tag}>; only the first is read",
@@ -162,7 +166,7 @@ def _unknown(ctx: Context, child: Element, child_tag: str, parent: str, allowed:
 
 def _check_attributes(ctx: Context, element: Element, tag: str) -> None:
     known = ATTRIBUTES.get(tag, ())
-    for key in element.attrib:
+    for key in element.keys():  # noqa: SIM118  (an lxml element: keys() is its cheapest attribute walk)
         name = key.decode() if isinstance(key, bytes) else key
         if name in known or name.startswith("{"):  # "{ns}name": an attribute of another namespace
             continue

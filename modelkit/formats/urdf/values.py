@@ -67,6 +67,10 @@ class Context:
 
     def children(self, element: Element, name: str | None = None) -> list[Element]:
         """URDF child elements of ``element`` (all, or those called ``name``), in document order."""
+        if name is not None and self.namespace is None:
+            # a document without a default namespace: exactly the children whose tag is ``name``
+            # (comments, processing instructions and namespaced elements never match), found by lxml
+            return list(element.iterchildren(name))
         out = []
         for child in element:
             raw = child.tag
@@ -78,6 +82,8 @@ class Context:
 
     def first(self, element: Element, name: str) -> Element | None:
         """The first child called ``name`` (urdfdom reads only the first; repeats are reported apart)."""
+        if self.namespace is None:
+            return next(element.iterchildren(name), None)  # the first child `children` would give
         found = self.children(element, name)
         return found[0] if found else None
 

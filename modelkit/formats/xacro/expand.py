@@ -18,14 +18,17 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import importlib
 import io
 import os
+import sys
 import threading
 import xml.dom.minidom as minidom
 import xml.parsers.expat
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 from modelkit.diagnostics import Diagnostic, DiagnosticSink, Severity, SourceLocation, diag
@@ -58,6 +61,36 @@ from modelkit.xmlsource import XmlDocument, read_xml
 CLONE_BUDGET = 100_000
 
 _LOCK = threading.Lock()
+
+
+class _Deferred(ModuleType):
+    """A stand-in for a module in another module's namespace: the real module is imported (an ordinary
+    import, the one module object every importer shares) when an attribute is first used."""
+
+    def __getattr__(self, attribute: str) -> Any:
+        if sys.modules.get(self.__name__) is self:  # still registered (another thread, mid-import)
+            del sys.modules[self.__name__]
+        return getattr(importlib.import_module(self.__name__), attribute)
+
+
+def substitution_args() -> Any:
+    """``xacro.substitution_args`` (``$(find)``, ``$(arg)`` ...), imported without importing PyYAML.
+
+    The module imports ``yaml`` at its top for one rare case (an argument converted as yaml); PyYAML is a
+    tenth of a small xacro file's start-up. When nothing has imported PyYAML yet, the module is imported
+    with a :class:`_Deferred` ``yaml``, which imports PyYAML if that case ever comes; ``sys.modules`` is
+    left as it was, so any other ``import yaml`` is the ordinary one."""
+    if "xacro.substitution_args" not in sys.modules and "yaml" not in sys.modules:
+        stand_in = _Deferred("yaml")
+        sys.modules["yaml"] = stand_in
+        try:
+            import xacro.substitution_args  # noqa: F401  (imported with the stand-in)
+        finally:
+            if sys.modules.get("yaml") is stand_in:
+                del sys.modules["yaml"]
+    import xacro.substitution_args as sa
+
+    return sa
 
 
 @dataclass
@@ -217,7 +250,7 @@ class _Run:
         self.sink.emit(code, f"xacro: {' '.join(text.split())}", self.here(), severity=severity)
 
     def substitutions(self) -> dict[str, Callable[..., str]]:
-        import xacro.substitution_args as sa
+        sa = substitution_args()
 
         environ = self.options.resolver.environ
 
@@ -281,8 +314,8 @@ class _Run:
     def patched(self) -> Iterator[None]:
         """xacro with our hooks and fresh state; everything restored afterwards."""
         import xacro
-        import xacro.substitution_args as sa
 
+        sa = substitution_args()
         self.xacro = xacro
         saved: list[tuple[Any, str, Any]] = []
 
