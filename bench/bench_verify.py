@@ -1,16 +1,25 @@
-"""`modelkit verify` speed: the whole command, its phases, each engine's load, the replay's overhead.
+"""`modelkit verify` speed: the whole command with its report, layer 4's harness overhead, many models
+at once, each engine's load, the replay's overhead.
 
-    python bench/bench_verify.py [--repeat N] [--json FILE] [--source MODEL]
+    python bench/bench_verify.py [--repeat N] [--many-repeat M] [--no-many] [--json FILE] [--source MODEL]
 
-(a) `modelkit verify MODEL` in a fresh process (N runs after a warm-up, taking turns) with every
-    engine (the default), with the default install's engines (MuJoCo, PyBullet, Pinocchio), and
-    both without the replay (`--no-replay`: layers 1-3a). Median/min/max wall time, and the
-    median of each phase as the command prints it ("wall time: convert …, load …, layer 1 …").
-    The issue's target: layers 1-3 of the tutorial pan-tilt robot under 3 s.
-(b) Each engine's share of "load": a fresh process per engine that imports the adapter and loads
+(a) `modelkit verify MODEL -o DIR` in a fresh process (N runs after a warm-up, taking turns): all four
+    layers and the report (report.json, report.html with its plots and pictures), with every engine
+    (the default) and with the default install's engines (MuJoCo, PyBullet, Pinocchio), and both
+    without the replay (`--no-replay`: layers 1-3a + 4). Median/min/max wall time, and the median of
+    each phase as the command prints it ("wall time: convert …, load …, layer 1 …, layer 4 …").
+    The issue's target: the full verify of the tutorial pan-tilt robot under 5 s on a 2-core machine
+    (part 1's: layers 1-3 under 3 s). The machine's load average is printed with the figures.
+(b) Layer 4's harness overhead (`modelkit.verify.variant.bench`) per profile of the default scenario:
+    simulated seconds per wall second of each engine's driver inside verify (controllers, samples)
+    against a bare stepping loop of the same engine on the same floating-base variant (target ≥ 0.8),
+    and a minimal hand-written closed loop (read, control, step) with the same controllers.
+(c) The speed-up of `-j 2` over `-j 1` on the four tutorial robots (`bench_verify_many.py`, M runs
+    each after a warm-up, the same summary.json required).
+(d) Each engine's share of "load": a fresh process per engine that imports the adapter and loads
     the written file (N runs): import and load seconds, medians. "load" includes what an adapter
     imports lazily (yourdfpy and trimesh) and PyBullet's child process (started, pybullet imported).
-(c) The replay's overhead (`modelkit.verify.replay.overhead`): simulated seconds per wall second
+(e) The replay's overhead (`modelkit.verify.replay.overhead`): simulated seconds per wall second
     of each engine's replay against a bare stepping loop of the same engine on the same model
     (target ≥ 0.8), and for PyBullet the minimal closed loop (read the states, send torques, step)
     that any replay needs.
@@ -21,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import statistics
 import subprocess
@@ -67,7 +77,8 @@ def fresh(cmd: list[str]) -> tuple[float, str]:
 def phases(stdout: str) -> dict[str, float]:
     """The command's own split: 'wall time: convert 0.30 s, load 0.71 s, layer 1 0.01 s, ...'."""
     line = next((ln for ln in stdout.splitlines() if ln.startswith("wall time:")), "")
-    return {name.strip(): float(value) for name, value in re.findall(r"([a-z0-9 ]+?) ([0-9.]+) s", line[10:])}
+    return {name.strip(): float(value) for name, value in re.findall(r"([a-z][a-z0-9 ]*?) ([0-9.]+) s(?:,|$)",
+                                                                      line[10:].strip())}
 
 
 def summary(values: list[float]) -> dict[str, float]:
@@ -157,27 +168,90 @@ def bench_replay(source: Path, repeat: int) -> dict[str, Any]:
                 sim.close()
 
 
+def bench_layer4(source: Path, repeat: int) -> dict[str, Any]:
+    """(b): ``variant.bench`` on every profile of the default scenario, ``repeat`` times; medians."""
+    from modelkit import load
+    from modelkit.verify import scenario as scenarios
+    from modelkit.verify import vehicle
+    from modelkit.verify.layer4 import floating
+    from modelkit.verify.variant import bench
+
+    robot = floating(load(source))
+    drive = vehicle.find_drive(robot, scenarios.default_scenario())
+    scenario = scenarios.default_scenario(drive.kind, bool(drive.pan or drive.tilt))
+    out: dict[str, Any] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for profile in scenario.profiles:
+            runs = [bench(robot, drive, scenario, Path(tmp), profile=profile) for _ in range(repeat)]
+            out[profile.name] = {k: statistics.median(r[k] for r in runs) for k in runs[0]}
+    return out
+
+
+def bench_many(repeat: int) -> dict[str, Any]:
+    """(c): ``bench_verify_many.py`` in a child process (its own JSON)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        target = Path(tmp) / "many.json"
+        done = subprocess.run([sys.executable, str(Path(__file__).with_name("bench_verify_many.py")),
+                               "--repeat", str(repeat), "--json", str(target)],
+                              capture_output=True, text=True, check=False)
+        if not target.exists():
+            return {"error": (done.stderr or done.stdout).strip().splitlines()[-1:]}
+        result: dict[str, Any] = json.loads(target.read_text())
+        return result
+
+
+def load_average() -> str:
+    try:
+        return " ".join(Path("/proc/loadavg").read_text().split()[:3])
+    except OSError:
+        return "?"
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--json", type=Path, default=None)
     parser.add_argument("--source", type=Path, default=PANTILT)
+    parser.add_argument("--many-repeat", type=int, default=3, help="runs of each -j for (c)")
+    parser.add_argument("--no-many", action="store_true", help="leave (c) out")
     args = parser.parse_args()
     source = args.source.resolve()
-    figures: dict[str, Any] = {"source": source.name, "repeat": args.repeat}
+    figures: dict[str, Any] = {"source": source.name, "repeat": args.repeat,
+                               "cores": len(os.sched_getaffinity(0)), "load_average_before": load_average()}
     figures["command"] = bench_command(source, args.repeat)
-    print(f"(a) modelkit verify {source.name}, fresh process, {args.repeat} runs after a warm-up")
+    print(f"(a) modelkit verify {source.name} -o DIR (all four layers and the report), fresh process, "
+          f"{args.repeat} runs after a warm-up; {figures['cores']} cores, load average "
+          f"{figures['load_average_before']} before; target: under 5 s")
     for name, row in figures["command"].items():
         split = ", ".join(f"{k} {v:.2f}" for k, v in row["phases_median_s"].items())
         print(f"  {name:38s} median {row['median_s']:.2f} s  (min {row['min_s']:.2f}, max {row['max_s']:.2f})"
               f"  {row['verdict'][:40]}\n      phases (median s): {split}")
+    figures["layer4"] = bench_layer4(source, args.repeat)
+    print("(b) layer 4 harness overhead: simulated s per wall s inside verify's drivers vs a bare stepping "
+          "loop of the same engine on the same model (target ratio >= 0.8; medians)")
+    for profile, row in figures["layer4"].items():
+        print(f"  {profile:9s} " + "   ".join(
+            f"{e} {row[f'{e}_realtime']:.0f}x vs bare {row[f'{e}_bare_realtime']:.0f}x: "
+            f"ratio {row[f'{e}_ratio']:.2f} (minimal closed loop {row[f'{e}_closed_ratio']:.2f}x slower "
+            "than the harness)" for e in ("mujoco", "pybullet")))
+    if not args.no_many:
+        figures["many"] = bench_many(args.many_repeat)
+        many = figures["many"]
+        print(f"(c) modelkit verify on the four tutorial robots, -j 1 vs -j 2 ({args.many_repeat} runs each)")
+        if "error" in many:
+            print(f"  error {many['error']}")
+        else:
+            s1, s2 = many["seconds"]["-j 1"], many["seconds"]["-j 2"]
+            print(f"  -j 1 median {s1['median']:.2f} s, -j 2 median {s2['median']:.2f} s: speed-up "
+                  f"{many['speedup_j2_over_j1']:.2f}x on {many['cores']} cores; same summary.json: "
+                  f"{many['same_summary']}")
     figures["loads"] = bench_loads(source, args.repeat)
-    print("(b) each engine in a fresh process: import and load of the written file (median s)")
+    print("(d) each engine in a fresh process: import and load of the written file (median s)")
     for engine, row in figures["loads"].items():
         print(f"  {engine:10s} " + ("error " + str(row["error"]) if "error" in row
                                     else f"import {row['import']:.3f}  load {row['load']:.3f}"))
     figures["replay"] = bench_replay(source, args.repeat)
-    print("(c) replay overhead: simulated s per wall s (best of runs), replay vs a bare stepping loop")
+    print("(e) replay overhead: simulated s per wall s (best of runs), replay vs a bare stepping loop")
     for engine, row in figures["replay"].items():
         line = (f"  {engine:9s} replay {row['replay_call_rate']:.0f}x (loop {row['replay_loop_rate']:.0f}x), "
                 f"bare {row['bare_rate']:.0f}x: ratio {row['ratio_call']:.2f} (loop {row['ratio_loop']:.2f})")
@@ -186,6 +260,7 @@ def main() -> int:
                      f"{row['minimal_closed_loop_rate'] / row['bare_rate']:.2f} of bare "
                      "(the best any closed-loop replay can do)")
         print(line)
+    figures["load_average_after"] = load_average()
     if args.json is not None:
         args.json.write_text(json.dumps(figures, indent=2, sort_keys=True) + "\n")
     return 0

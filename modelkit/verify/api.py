@@ -240,6 +240,7 @@ def verify(
     scenario: str | Path | None = None,
     driven: bool = True,
     progress: Callable[[str], None] | None = None,
+    artefacts: bool = False,
 ) -> VerifyReport:
     """Convert ``source`` (or take the given files), load every engine, run layers 1–3, then layer 4
     (the driven scenarios with contact: ``scenario`` is a scenario file, None for the defaults;
@@ -249,6 +250,9 @@ def verify(
     ``out_dir`` receives the written MJCF/URDF/SDF (a temporary folder, deleted afterwards, when
     None). Never raises for a model problem: a failed check is in ``report.checks``; what stops the
     run (unreadable input, a bad option) is in ``report.errors`` (exit 2).
+
+    ``artefacts`` True (the caller will write the report with ``many.save``, which needs ``out_dir``):
+    the report's plotting processes and pictures start while the layers run (``report.prepared``).
     """
     report = VerifyReport(str(source), seed=seed)
     report.parameters = {"configurations": configurations, "dynamics_samples": samples,
@@ -261,8 +265,17 @@ def verify(
             return report
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    _run(report, Path(source), out, engines, mjcf, urdf, sdf, inject, seed, configurations, samples,
-         replay, scenario, driven, progress or _silent)
+    if artefacts:
+        from modelkit.verify.html import Prepared
+
+        report.prepared = Prepared()
+    try:
+        _run(report, Path(source), out, engines, mjcf, urdf, sdf, inject, seed, configurations, samples,
+             replay, scenario, driven, progress or _silent)
+    finally:
+        if report.prepared is not None and report.errors:  # no report to write (many.save)
+            report.prepared.close()
+            report.prepared = None
     return report
 
 
@@ -296,6 +309,8 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
         report.skips.append(Skip(4, "all", "layer 4 (driven scenarios) not run: switched off (--no-driven)"))
         return
     progress("layer 4: driving the robot in MuJoCo and PyBullet")
+    if report.prepared is not None:  # the plotting processes import matplotlib while layer 4 runs
+        report.prepared.start_plotters()
     _layer4(report, robot, out_dir, engines, inject, chosen)
 
 
@@ -355,6 +370,8 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                 report.injected.append(str(apply(spec, files, maps)))
             except ValueError as exc:
                 raise VerifyError(f"--inject {spec}: {exc}") from exc
+        if report.prepared is not None:  # the pictures of the files as verified, on another core
+            report.prepared.start_pictures(report, out_dir, welded, files)
         loaded = _load_engines(engines, reference, files, maps, report)
     except VerifyError as exc:
         report.errors.append(str(exc))

@@ -10,7 +10,8 @@ deterministic too: :mod:`modelkit.verify.plots` and :func:`png`).
 
 :func:`write_artefacts` is the entry point ``verify`` calls: plots (layer 4 trajectories),
 pictures (every engine's view of the robot, :mod:`modelkit.verify.pictures`) and the HTML. The
-plots are drawn while the pictures' child processes render.
+plots are drawn (in child processes, :class:`~modelkit.verify.plots.Plotters`) while the pictures' child
+process renders; ``verify(..., artefacts=True)`` starts both early (:class:`Prepared`).
 """
 
 from __future__ import annotations
@@ -20,7 +21,6 @@ import html
 import json
 import math
 import struct
-import threading
 import time
 import zlib
 from dataclasses import dataclass, field
@@ -76,18 +76,43 @@ def _robot_and_files(report: VerifyReport, out_dir: Path, robot: Any, files: dic
     return robot, files
 
 
-def _render_pictures(report: VerifyReport, out_dir: Path, robot: Any, files: dict[str, Path] | None,
-                     art: Artefacts) -> None:
+def _picture_job(report: VerifyReport, out_dir: Path, robot: Any, files: dict[str, Path] | None) -> Any:
+    """The pictures' child process (:class:`~modelkit.verify.pictures.PictureJob`), started."""
     from modelkit.verify.layers import configurations
-    from modelkit.verify.pictures import render_pictures
+    from modelkit.verify.pictures import PictureJob
 
-    try:
-        model, paths = _robot_and_files(report, out_dir, robot, files)
-        engines = tuple(e for e in PICTURE_ENGINES if e in report.parameters.get("engines", PICTURE_ENGINES))
-        art.pictures = render_pictures(model, paths, report.renames, configurations(model, 1, report.seed),
-                                       engines)
-    except Exception as exc:  # pictures are an aid: never the reason a verify run fails
-        art.notes.append(f"pictures could not be made: {type(exc).__name__}: {exc}")
+    model, paths = _robot_and_files(report, out_dir, robot, files)
+    engines = tuple(e for e in PICTURE_ENGINES if e in report.parameters.get("engines", PICTURE_ENGINES))
+    return PictureJob(model, paths, report.renames, configurations(model, 1, report.seed), engines)
+
+
+@dataclass
+class Prepared:
+    """The report's slow parts started early (``verify(..., artefacts=True)``): the plotting children
+    import matplotlib and the pictures are made on another core while the layers run;
+    :func:`write_artefacts` takes them from ``report.prepared``. Not part of report.json."""
+
+    plotters: Any = None  # plots.Plotters | None
+    pictures: Any = None  # pictures.PictureJob | None
+
+    def start_plotters(self) -> None:
+        from modelkit.verify.plots import PLOTTERS, Plotters, _cores
+
+        if _cores() > 1:
+            self.plotters = Plotters(PLOTTERS)
+
+    def start_pictures(self, report: VerifyReport, out_dir: Path, robot: Any, files: dict[str, Path]) -> None:
+        """``robot``: the model verified, root welded; ``files``: the written (and injected) files."""
+        try:
+            self.pictures = _picture_job(report, out_dir, robot, files)
+        except Exception:  # made again (or the failure noted) by write_artefacts
+            self.pictures = None
+
+    def close(self) -> None:
+        for job in (self.plotters, self.pictures):
+            if job is not None:
+                job.close()
+        self.plotters = self.pictures = None
 
 
 def write_artefacts(report: VerifyReport, out_dir: Path, robot: Any = None,
@@ -102,31 +127,43 @@ def write_artefacts(report: VerifyReport, out_dir: Path, robot: Any = None,
     out_dir.mkdir(parents=True, exist_ok=True)
     art = Artefacts()
     t0 = time.perf_counter()
-    worker = None
-    if pictures:
-        worker = threading.Thread(target=_render_pictures, args=(report, out_dir, robot, files, art),
-                                  daemon=True)
-        worker.start()
-    if report.trajectories:
-        from modelkit.verify.plots import write_plots
+    prepared = report.prepared if isinstance(report.prepared, Prepared) else Prepared()
+    report.prepared = None
+    job = prepared.pictures
+    try:
+        if pictures and job is None:
+            try:
+                job = _picture_job(report, out_dir, robot, files)
+            except Exception as exc:  # pictures are an aid: never the reason a verify run fails
+                art.notes.append(f"pictures could not be made: {type(exc).__name__}: {exc}")
+        if report.trajectories:
+            from modelkit.verify.plots import write_plots
 
-        tolerances = report.scenario.get("tolerances") if isinstance(report.scenario, dict) else None
-        try:
-            drive = report.drive if isinstance(report.drive, dict) else {}
-            wheels = [drive.get("left"), drive.get("right"),
-                      *[j for rollers in drive.get("rollers", {}).values() for j in rollers]]
-            for profile, path, data in write_plots(report.trajectories, out_dir / "plots", tolerances,
-                                                   wheels=[w for w in wheels if w]):
-                rel = path.relative_to(out_dir).as_posix()
-                art.plots.append((profile, rel, data))
-                report.artefacts[f"plot:{profile}"] = rel
-        except Exception as exc:
-            art.notes.append(f"plots could not be drawn: {type(exc).__name__}: {exc}")
-    t1 = time.perf_counter()
-    report.timings["plots"] = t1 - t0
-    if worker is not None:
-        worker.join()
-        report.timings["pictures (after plots)"] = time.perf_counter() - t1
+            tolerances = report.scenario.get("tolerances") if isinstance(report.scenario, dict) else None
+            try:
+                drive = report.drive if isinstance(report.drive, dict) else {}
+                wheels = [drive.get("left"), drive.get("right"),
+                          *[j for rollers in drive.get("rollers", {}).values() for j in rollers]]
+                for profile, path, data in write_plots(report.trajectories, out_dir / "plots", tolerances,
+                                                       wheels=[w for w in wheels if w],
+                                                       plotters=prepared.plotters):
+                    rel = path.relative_to(out_dir).as_posix()
+                    art.plots.append((profile, rel, data))
+                    report.artefacts[f"plot:{profile}"] = rel
+            except Exception as exc:
+                art.notes.append(f"plots could not be drawn: {type(exc).__name__}: {exc}")
+        t1 = time.perf_counter()
+        report.timings["plots"] = t1 - t0
+        if pictures and job is not None:
+            try:
+                art.pictures = job.result()
+            except Exception as exc:  # pictures are an aid: never the reason a verify run fails
+                art.notes.append(f"pictures could not be made: {type(exc).__name__}: {exc}")
+            report.timings["pictures (after plots)"] = time.perf_counter() - t1
+    finally:
+        prepared.close()
+        if job is not None:
+            job.close()
     ps = art.pictures
     if ps is not None:
         folder = out_dir / "pictures"

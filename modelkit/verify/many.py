@@ -212,10 +212,15 @@ def run_one(job: Job, out_root: Path | None) -> ModelResult:
     return result
 
 
+_EARLY_ARTEFACTS = True
+
+
 def _verify_into(job: Job, out_dir: Path) -> ModelResult:
     from modelkit.verify.api import verify
 
-    report = verify(job.read_path, out_dir, **dict(job.options))
+    # Early report work (plotting and picture processes alongside the layers) helps one model at a
+    # time; with several models in parallel the cores are already busy, and it would oversubscribe them.
+    report = verify(job.read_path, out_dir, artefacts=_EARLY_ARTEFACTS, **dict(job.options))
     report.source = job.source  # the path as the user gave it, wherever the job ran
     files = save(report, out_dir, job.read_path)
     return _result_of(job, report, files)
@@ -312,10 +317,12 @@ def run_local(jobs: Sequence[Job], out_root: Path | None, workers: int,
         if progress is not None:
             progress(result, len(results), total)
 
+    global _EARLY_ARTEFACTS
     if workers <= 1 or total <= 1:
         for job in jobs:
             done(run_one(job, out_root))
         return results
+    _EARLY_ARTEFACTS = False  # read by the forked children (see _verify_into)
     methods = multiprocessing.get_all_start_methods()
     ctx: Any = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
     if "fork" in methods:
@@ -345,6 +352,7 @@ def run_local(jobs: Sequence[Job], out_root: Path | None, workers: int,
         for process, _ in running.values():
             process.kill()
             process.join()
+        _EARLY_ARTEFACTS = True
     return results
 
 

@@ -26,6 +26,7 @@ it: root welded at the identity.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import pickle
@@ -641,3 +642,74 @@ def render_pictures(robot: Robot, files: dict[str, Path], renames: dict[str, Ren
     pictures.pictures.sort(key=lambda p: (p.config, KINDS.index(p.kind), order.get(p.engine, 9)))
     pictures.timings["total"] = time.perf_counter() - t0
     return pictures
+
+
+# ---- the whole set in a child process -------------------------------------------------------------
+# ``verify`` starts this as soon as the files are written, so that the pictures (the source's
+# rasterising in numpy and both engines' children) are made on another core while the layers run,
+# and the report only collects them. Any failure of the child falls back to rendering here.
+
+PICTURES_TIMEOUT = 180.0
+_PICTURES_CHILD = ("import sys; from modelkit.verify.pictures import pictures_child; "
+                   "sys.exit(pictures_child())")
+
+
+def pictures_child() -> int:
+    """The child's entry point: pickled :func:`render_pictures` arguments on stdin, the pickled
+    ("ok", PictureSet) or ("error", message) on stdout."""
+    raw = sys.stdin.buffer.read()
+    if not raw:  # the parent went away without asking
+        return 0
+    try:
+        args = pickle.loads(raw)
+        reply: tuple[str, Any] = ("ok", render_pictures(*args))
+    except Exception as exc:
+        reply = ("error", f"{type(exc).__name__}: {exc}")
+    sys.stdout.buffer.write(pickle.dumps(reply, protocol=pickle.HIGHEST_PROTOCOL))
+    sys.stdout.buffer.flush()
+    return 0
+
+
+class PictureJob:
+    """:func:`render_pictures` in a child process, started at once; :meth:`result` waits for it (and
+    renders here when the child failed), :meth:`close` ends it unasked."""
+
+    def __init__(self, robot: Robot, files: dict[str, Path], renames: dict[str, Renames],
+                 configurations: list[dict[str, float]], engines: tuple[str, ...] = ("mujoco", "pybullet")
+                 ) -> None:
+        self.args = (robot, {k: Path(v).resolve() for k, v in files.items()}, renames,
+                     [dict(q) for q in configurations], tuple(engines))
+        self.proc: subprocess.Popen[bytes] | None = None
+        try:
+            self.proc = subprocess.Popen([sys.executable, "-c", _PICTURES_CHILD], stdin=subprocess.PIPE,
+                                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+            assert self.proc.stdin is not None
+            self.proc.stdin.write(pickle.dumps(self.args, protocol=pickle.HIGHEST_PROTOCOL))
+            self.proc.stdin.close()
+            self.proc.stdin = None  # communicate() must not flush it again
+        except (OSError, pickle.PicklingError):
+            self.close()
+
+    def result(self) -> PictureSet:
+        proc, self.proc = self.proc, None
+        if proc is not None:
+            try:
+                out, _ = proc.communicate(timeout=PICTURES_TIMEOUT)
+                status, value = pickle.loads(out) if out else ("error", "no reply")
+                if status == "ok" and isinstance(value, PictureSet):
+                    return value
+            except Exception:
+                _end(proc)
+        return render_pictures(*self.args)
+
+    def close(self) -> None:
+        proc, self.proc = self.proc, None
+        if proc is not None:
+            _end(proc)
+
+
+def _end(proc: subprocess.Popen[bytes]) -> None:
+    if proc.poll() is None:
+        proc.kill()
+    with contextlib.suppress(Exception):
+        proc.communicate(timeout=10.0)

@@ -21,8 +21,13 @@ user ``matplotlibrc`` applies), and no ``Software`` metadata.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import math
+import os
+import pickle
+import subprocess
+import sys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
@@ -145,14 +150,29 @@ def _pair_style(label: str, a: Any, b: Any, kind: str) -> dict[str, Any]:
 
 
 def _log_panel(ax: Any, title: str, unit: str) -> None:
-    from matplotlib.ticker import LogLocator, NullLocator
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
 
     ax.set_yscale("log", nonpositive="mask")
     ax.yaxis.set_major_locator(LogLocator(base=10.0, numticks=6))
     ax.yaxis.set_minor_locator(NullLocator())  # log minor ticks cost more than the rest of the panel
+    ax.yaxis.set_major_formatter(FuncFormatter(_decade))  # plain text: no mathtext to parse and lay out
     ax.set_title(title)
     ax.set_xlabel("time (s)")
     ax.set_ylabel(unit)
+
+
+SUPERSCRIPT = str.maketrans("-0123456789",
+                            "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079")
+
+
+def _decade(value: float, _: Any = None) -> str:
+    """A log axis' tick label as plain text: 10⁻³ (superscript digits, in DejaVu Sans)."""
+    if value <= 0.0 or not math.isfinite(value):
+        return ""
+    exponent = math.log10(value)
+    if abs(exponent - round(exponent)) > 1e-9:
+        return f"{value:g}"
+    return "10" + str(round(exponent)).translate(SUPERSCRIPT)
 
 
 def profile_figure(profile: str, trajectories: Sequence[Any], tolerances: dict[str, float] | None = None,
@@ -286,18 +306,136 @@ def profiles(trajectories: Sequence[Any]) -> list[str]:
 
 
 def write_plots(trajectories: Sequence[Any], out_dir: Path, tolerances: dict[str, float] | None = None,
-                wheels: Iterable[str] = ()) -> list[tuple[str, Path, bytes]]:
+                wheels: Iterable[str] = (), plotters: Plotters | None = None
+                ) -> list[tuple[str, Path, bytes]]:
     """One PNG per profile in ``out_dir`` (``<profile>.png``, a file-safe name): (profile, path,
-    bytes)."""
+    bytes). The figures are drawn by ``plotters`` (child processes, see :class:`Plotters`; started
+    here when None and there are several profiles and cores), the same bytes as drawn here."""
     out_dir.mkdir(parents=True, exist_ok=True)
+    names = profiles(trajectories)
+    jobs = [(p, [t for t in trajectories if t.profile == p], tolerances, tuple(wheels)) for p in names]
+    own = plotters is None and len(jobs) > 1 and _cores() > 1
+    if own:
+        plotters = Plotters()
+    try:
+        figures = plotters.draw(jobs) if plotters is not None else [_draw(job) for job in jobs]
+    finally:
+        if own and plotters is not None:
+            plotters.close()
     written = []
-    for profile in profiles(trajectories):
-        runs = [t for t in trajectories if t.profile == profile]
-        data = profile_figure(profile, runs, tolerances, wheels=tuple(wheels))
+    for profile, data in zip(names, figures, strict=True):
         path = out_dir / f"{safe_name(profile)}.png"
         path.write_bytes(data)
         written.append((profile, path, data))
     return written
+
+
+# ---- drawing in child processes -------------------------------------------------------------------
+# Each figure costs ~0.3 s of pure-Python matplotlib work (text layout, ticks) and matplotlib's import
+# another ~0.3 s: drawn serially, the plots were a third of a verify run. Plotters are plain child
+# processes (``sys.executable -c``, no fork: safe in any parent, threads or not) that import matplotlib
+# as soon as they start (``verify`` starts them while the layers run) and draw their share of the
+# profiles when asked; the parent never imports matplotlib. Any failure of a child falls back to
+# drawing here, so the result never depends on the children: the same function draws the same bytes.
+
+PLOTTERS = 2
+PLOTTER_TIMEOUT = 120.0
+_CHILD = "import sys; from modelkit.verify.plots import serve; sys.exit(serve())"
+
+
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
+
+
+def _draw(job: tuple[str, list[Any], dict[str, float] | None, tuple[str, ...]]) -> bytes:
+    profile, runs, tolerances, wheels = job
+    return profile_figure(profile, runs, tolerances, wheels=wheels)
+
+
+def serve() -> int:
+    """A plotter's entry point: import matplotlib, then read one pickled list of jobs (profile, runs,
+    tolerances, wheels) on stdin and write the pickled ("ok", [PNG bytes]) or ("error", message)."""
+    # The imports are the point: done before the jobs come.
+    import matplotlib.backends.backend_agg
+    import matplotlib.figure  # noqa: F401
+
+    raw = sys.stdin.buffer.read()
+    if not raw:  # the parent went away without asking
+        return 0
+    try:
+        reply: tuple[str, Any] = ("ok", [_draw(job) for job in pickle.loads(raw)])
+    except Exception as exc:
+        reply = ("error", f"{type(exc).__name__}: {exc}")
+    sys.stdout.buffer.write(pickle.dumps(reply, protocol=pickle.HIGHEST_PROTOCOL))
+    sys.stdout.buffer.flush()
+    return 0
+
+
+class Plotters:
+    """``count`` plotting child processes, started at once (they import matplotlib while the caller
+    works); :meth:`draw` shares the figures out among them (one request each) and returns the PNG
+    bytes in order. Use each once; :meth:`close` ends what is left."""
+
+    def __init__(self, count: int = PLOTTERS) -> None:
+        self.procs: list[subprocess.Popen[bytes]] = []
+        for _ in range(max(1, count)):
+            try:
+                self.procs.append(subprocess.Popen([sys.executable, "-c", _CHILD], stdin=subprocess.PIPE,
+                                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE))
+            except OSError:
+                break
+
+    def draw(self, jobs: Sequence[tuple[str, list[Any], dict[str, float] | None, tuple[str, ...]]]
+             ) -> list[bytes]:
+        procs, self.procs = self.procs, []
+        n = max(1, min(len(procs), len(jobs)))
+        # Largest first, each to the least loaded child (the cost grows with the number of lines).
+        order = sorted(range(len(jobs)), key=lambda i: (-len(jobs[i][1]), i))
+        shares: list[list[int]] = [[] for _ in range(n)]
+        load = [0] * n
+        for i in order:
+            k = load.index(min(load))
+            shares[k].append(i)
+            load[k] += len(jobs[i][1]) + 4
+        out: list[bytes | None] = [None] * len(jobs)
+        sent = []
+        for proc, share in zip(procs, shares, strict=False):
+            try:
+                assert proc.stdin is not None
+                proc.stdin.write(pickle.dumps([jobs[i] for i in share], protocol=pickle.HIGHEST_PROTOCOL))
+                proc.stdin.close()
+                proc.stdin = None  # communicate() must not flush it again
+                sent.append((proc, share))
+            except (OSError, ValueError):
+                _end(proc)
+        for proc in procs[len(shares):]:
+            _end(proc)
+        for proc, share in sent:
+            try:
+                reply, _ = proc.communicate(timeout=PLOTTER_TIMEOUT)
+                status, value = pickle.loads(reply) if reply else ("error", "no reply")
+            except Exception as exc:
+                _end(proc)
+                status, value = "error", str(exc)
+            if status == "ok" and len(value) == len(share):
+                for i, data in zip(share, value, strict=True):
+                    out[i] = data
+        return [data if data is not None else _draw(jobs[i]) for i, data in enumerate(out)]
+
+    def close(self) -> None:
+        for proc in self.procs:
+            _end(proc)
+        self.procs = []
+
+
+def _end(proc: subprocess.Popen[bytes]) -> None:
+    if proc.poll() is None:
+        proc.kill()
+    with contextlib.suppress(Exception):
+        proc.communicate(timeout=10.0)
 
 
 def safe_name(name: str) -> str:

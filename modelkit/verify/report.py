@@ -39,6 +39,7 @@ class VerifyReport:
     artefacts: dict[str, str] = field(default_factory=dict)  # "html" → report.html, "plot:xy" → png...
     errors: list[str] = field(default_factory=list)  # why the run could not happen (exit 2)
     timings: dict[str, float] = field(default_factory=dict)  # wall seconds; printed, not in report.json
+    prepared: Any = field(default=None, repr=False, compare=False)  # html.Prepared: artefacts started early
 
     @property
     def failed(self) -> list[Check]:
