@@ -162,9 +162,14 @@ def _read_options(kwargs: dict[str, Any], check_resources: bool, xacro_args: dic
 
 def _no_mujoco_rendering() -> None:
     """``validate`` and ``tree`` only compile MJCF: MuJoCo's import then skips its OpenGL back end
-    (glfw, ~50 ms), unless the user chose one. Only in these commands' own process: a library user's
-    MuJoCo keeps rendering."""
-    os.environ.setdefault("MUJOCO_GL", "disable")
+    (glfw, ~50 ms), unless the user chose one or MuJoCo is already imported. The variable is removed
+    again when the command ends, so a program that runs the command in its own process (click's
+    test runner, a script calling ``main``) keeps its environment (child processes of verify's
+    pictures read it)."""
+    if "MUJOCO_GL" in os.environ or "mujoco" in sys.modules:
+        return
+    os.environ["MUJOCO_GL"] = "disable"
+    click.get_current_context().call_on_close(lambda: os.environ.pop("MUJOCO_GL", None))
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})

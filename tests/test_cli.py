@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
 from click.testing import CliRunner
 
 from modelkit.cli import main
@@ -154,3 +155,15 @@ def test_jobs_2_prints_the_same_bytes_as_jobs_1(corpus: Path) -> None:
         two = run("validate", "--show-info", "--format", fmt, "-j", "2", *words)
         assert one == two
         assert one[1]  # there are findings to compare
+
+
+def test_validate_leaves_the_callers_environment_as_it_was(monkeypatch: pytest.MonkeyPatch) -> None:
+    """validate lets MuJoCo skip its OpenGL back end only for the command's own run: a program that
+    runs the command in its process keeps MUJOCO_GL unset (verify's picture processes read it)."""
+    import os
+
+    monkeypatch.delenv("MUJOCO_GL", raising=False)
+    pendulum = Path(__file__).parent / "mjcf" / "pendulum.xml"
+    result = CliRunner().invoke(main, ["validate", str(pendulum)])
+    assert result.exit_code == 0, result.output
+    assert "MUJOCO_GL" not in os.environ
