@@ -246,13 +246,20 @@ MAX_XML_DEPTH = 250
 
 
 def parse_xml_bytes(
-    data: bytes, display: str, sink: DiagnosticSink, path: Path | None = None, keep_blank_text: bool = True
+    data: bytes,
+    display: str,
+    sink: DiagnosticSink,
+    path: Path | None = None,
+    keep_blank_text: bool = True,
+    positions: bool = True,
 ) -> XmlDocument | None:
     """Parse XML held in memory; problems become diagnostics and the result is None.
 
     ``keep_blank_text=False`` drops whitespace-only text between elements (not the text of an element
     without children): a third less memory for a large pretty-printed file, for readers that never
-    write the document back."""
+    write the document back. ``positions=False`` leaves out the index of start-tag positions, for a
+    document whose every element is given an entry in ``origins`` (an xacro expansion): its locations
+    are those, and a location not found there is the element's line as lxml has it."""
     text = decode_text(data, display, sink)
     if text is None:
         return None
@@ -312,7 +319,8 @@ def parse_xml_bytes(
         _too_deep(sink, at)
         return None
     doc = XmlDocument(root=root, display=display, text=text, path=path)
-    _index_positions(doc)
+    if positions:
+        _index_positions(doc)
     return doc
 
 

@@ -5,13 +5,19 @@
 * the xacro deep clone (:class:`modelkit.formats.xacro.origins._Cloner`) makes the same tree as
   minidom's ``cloneNode(deep=True)``;
 * ``xacro.substitution_args`` is imported without PyYAML, and PyYAML still works for it when needed;
-* ``parse_numbers`` (one regular expression for the whole list) agrees with the item-by-item parse.
+* ``parse_numbers`` (one regular expression for the whole list) agrees with the item-by-item parse;
+* an xacro expansion is printed (:func:`modelkit.formats.xacro.pretty.pretty_xml`) exactly as xacro prints
+  it, and leaves no cyclic garbage (:meth:`OriginMap.release`);
+* kept ``<gazebo>``/``<transmission>`` blocks (:class:`modelkit.formats.urdf.extensions.KeptBlock`) read as
+  the plain dicts with their canonical XML made at once.
 """
 
 from __future__ import annotations
 
 import copy
 import dataclasses
+import gc
+import json
 import pickle
 import random
 import subprocess
@@ -20,9 +26,17 @@ import xml.dom.minidom as minidom
 from pathlib import Path
 from typing import Any
 
+import pytest
+
+from modelkit.api import validate
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
+from modelkit.formats.urdf.extensions import KeptBlock, canonical_xml
+from modelkit.formats.xacro import expand as xacro_expand
 from modelkit.formats.xacro.origins import OriginMap, dom_elements
+from modelkit.formats.xacro.pretty import pretty_xml
+from modelkit.formats.xacro.reader import expand_xacro
 from modelkit.xmlsource import LazyLocation, parse_number, parse_numbers, parse_xml_bytes
+from tests.conftest import CORPUS, REPO
 
 TEXT = b"""<?xml version="1.0"?>
 <robot name="r">
@@ -146,3 +160,105 @@ def test_parse_numbers_agrees_with_items() -> None:
     cases += ["".join(rng.choice(alphabet) for _ in range(rng.randint(0, 14))) for _ in range(20000)]
     for text in cases:
         assert parse_numbers(text) == by_items(text), repr(text)
+
+
+def _xacro_files() -> list[Path]:
+    roots = (REPO / "samples", REPO / "tests", CORPUS)
+    return sorted(p for root in roots if root.is_dir() for p in root.rglob("*.xacro"))
+
+
+def test_xacro_text_as_xacro_prints_it(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every xacro file of the samples, tests and corpus expands to the same text and findings whether the
+    expansion is printed by :func:`pretty_xml` or by minidom's ``toprettyxml`` with xacro's writer."""
+    files = _xacro_files()
+    assert len(files) >= 30
+    ours = [expand_xacro(path) for path in files]
+    monkeypatch.setattr(xacro_expand, "pretty_xml", lambda doc: doc.toprettyxml(indent="  "))
+    theirs = [expand_xacro(path) for path in files]
+    assert sum(text is not None for text, _ in ours) >= 30
+    for path, (text, found), (text_x, found_x) in zip(files, ours, theirs, strict=True):
+        assert text == text_x, path
+        assert [repr(d) for d in found] == [repr(d) for d in found_x], path
+    tricky = minidom.parseString(
+        b'<?xml version="1.0"?><!--top--><r a="1&amp;&lt;&quot;" b="x\ty"><!--c--><?pi d?>t&amp;'
+        b'<![CDATA[z]]><v/>\n  <w>only &gt;</w><x>  </x><y><!--k--></y><z><![CDATA[q]]></z>tail</r><!--end-->'
+    )
+    import xacro  # noqa: F401  (its element writer is what pretty_xml follows)
+
+    assert pretty_xml(tricky) == tricky.toprettyxml(indent="  ")
+
+
+def test_xacro_expansion_leaves_no_cyclic_garbage(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    calls = "".join(f'<xacro:part n="l{i}"><origin xyz="{i} 0 0"/></xacro:part>' for i in range(60))
+    model = tmp_path / "m.urdf.xacro"
+    model.write_text(
+        '<robot name="r" xmlns:xacro="http://ros.org/wiki/xacro"><xacro:macro name="part" params="n *o">'
+        '<link name="${n}"><visual><xacro:insert_block name="o"/><geometry><box size="1 1 1"/></geometry>'
+        '</visual></link><gazebo reference="${n}"><mu1>1</mu1></gazebo></xacro:macro>'
+        f"{calls}</robot>"
+    )
+
+    def garbage() -> int:
+        collecting = gc.isenabled()
+        gc.disable()
+        try:
+            gc.collect()
+            text, _ = expand_xacro(model)
+            assert text is not None and text.count("<link ") == 60
+            return gc.collect()
+        finally:
+            if collecting:
+                gc.enable()
+
+    assert garbage() < 100  # the tracking class and xacro's own few cycles
+    monkeypatch.setattr(OriginMap, "release", lambda self, others: None)
+    assert garbage() > 2000  # the DOMs, left to the collector
+
+
+def test_kept_blocks_read_as_plain_dicts(tmp_path: Path) -> None:
+    model = tmp_path / "r.urdf"
+    model.write_text(
+        '<robot name="r" xmlns:g="urn:g"><link name="a"/><link name="b"/>'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="b"/><limit effort="1" velocity="1"/>'
+        '</joint><gazebo reference="a"><mu1>0.5</mu1><g:x y="1">t</g:x></gazebo><gazebo><static>true</static>'
+        '</gazebo><transmission name="t"><type>T</type><joint name="j"/><actuator name="m"/></transmission>'
+        "</robot>"
+    )
+    from lxml import etree
+
+    root = etree.parse(str(model)).getroot()
+    blocks: dict[str | None, Any] = {
+        "a": root.find("gazebo"), None: root.findall("gazebo")[1], "t": root.find("transmission")
+    }
+
+    def fresh() -> list[tuple[KeptBlock, dict[str, Any]]]:
+        robot = validate(model).robot
+        link = robot.link("a") if robot is not None else None
+        assert robot is not None and link is not None
+        kept = [(link.extras["gazebo"][0], "a"), (robot.extras["gazebo"][0], None),
+                (robot.extras["transmissions"][0], "t")]
+        out = []
+        for entry, key in kept:
+            assert type(entry) is KeptBlock
+            plain = dict(dict.items(entry))
+            plain["xml"] = canonical_xml(blocks[key])
+            out.append((entry, plain))
+        return out
+
+    assert next(e for e, _ in fresh())["mu1"] == 0.5
+    readers: list[Any] = [
+        dict, lambda b: {**b}, copy.copy, copy.deepcopy, lambda b: pickle.loads(pickle.dumps(b)),
+        lambda b: json.loads(json.dumps(b, default=str)), lambda b: dict(b.items()), lambda b: b.copy(),
+        lambda b: dict(zip(b.keys(), b.values(), strict=True)), lambda b: {k: b[k] for k in b},
+        lambda b: {k: b.get(k) for k in b}, lambda b: b | {}, lambda b: {} | b,
+    ]
+    for index, read in enumerate(readers):
+        for entry, plain in fresh():
+            got = read(entry)
+            assert type(got) is dict
+            assert got == (json.loads(json.dumps(plain, default=str)) if index == 5 else plain)
+    for entry, plain in fresh():
+        assert entry == plain and plain == entry and (entry != plain) is False and list(entry) == list(plain)
+        assert repr(entry) == repr(plain) and "xml" in entry and len(entry) == len(plain)
+    for (entry, _plain), (other, _) in zip(fresh(), fresh(), strict=True):
+        assert entry == other

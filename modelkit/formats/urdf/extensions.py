@@ -61,6 +61,97 @@ def canonical_xml(element: Element) -> str:
     return etree.tostring(copy, method="c14n").decode("utf-8")
 
 
+class _Pending:
+    """The value of a :class:`KeptBlock`'s ``"xml"`` item before anyone asked for it."""
+
+    __slots__ = ()
+
+
+_PENDING = _Pending()
+
+
+class KeptBlock(dict[str, Any]):
+    """A kept extension block (``<gazebo>``, ``<transmission>`` ...) as a dict whose ``"xml"`` item, the
+    block's canonical XML, is made the first time it is read.
+
+    Only writers read it, and making it is most of the cost of reading a block (a large xacro expansion has
+    thousands). The key is present from the start, in its place; every way of reading values (``[]``,
+    ``get``, ``items``, ``values``, iteration as a mapping, ``==``, ``repr``, copies and pickles, which are
+    plain dicts) sees the canonical XML, the same string the eager reader stored.
+    """
+
+    __slots__ = ("_element",)
+
+    def __init__(self, element: Element, items: dict[str, Any]) -> None:
+        super().__init__(items)
+        self._element: Element | None = element
+
+    def _fill(self) -> None:
+        element = self._element
+        if element is not None:
+            self._element = None
+            if dict.get(self, "xml") is _PENDING:
+                dict.__setitem__(self, "xml", canonical_xml(element))
+
+    def __getitem__(self, key: str) -> Any:
+        self._fill()
+        return dict.__getitem__(self, key)
+
+    def get(self, key: str, default: Any = None) -> Any:
+        self._fill()
+        return dict.get(self, key, default)
+
+    def __iter__(self) -> Any:  # overridden so that dict(block) and {**block} read values through []
+        self._fill()
+        return dict.__iter__(self)
+
+    def items(self) -> Any:
+        self._fill()
+        return dict.items(self)
+
+    def values(self) -> Any:
+        self._fill()
+        return dict.values(self)
+
+    def pop(self, key: str, *default: Any) -> Any:
+        self._fill()
+        return dict.pop(self, key, *default)
+
+    def popitem(self) -> tuple[str, Any]:
+        self._fill()
+        return dict.popitem(self)
+
+    def setdefault(self, key: str, default: Any = None) -> Any:
+        self._fill()
+        return dict.setdefault(self, key, default)
+
+    def copy(self) -> dict[str, Any]:
+        self._fill()
+        return dict(dict.items(self))
+
+    def __eq__(self, other: object) -> bool:
+        self._fill()
+        if isinstance(other, KeptBlock):
+            other._fill()
+        return dict.__eq__(self, other)
+
+    def __ne__(self, other: object) -> bool:
+        return not self == other
+
+    def __or__(self, other: Any) -> Any:
+        self._fill()
+        return dict.__or__(self, other)
+
+    def __repr__(self) -> str:
+        self._fill()
+        return dict.__repr__(self)
+
+    def __reduce_ex__(self, protocol: Any) -> Any:  # copies and pickles are plain dicts
+        self._fill()
+        return (dict, (dict(dict.items(self)),))
+
+
+
 def _value(text: str | None) -> Any:
     """A simple value: a number when it is one, true/false words as bools, else the stripped text."""
     if text is None:
@@ -87,11 +178,7 @@ def read_gazebo(
     """File one ``<gazebo>`` block under its link, joint or the robot. ``links`` and ``joints`` index
     the robot's by name (the first of a name), so that a block per link stays linear in links."""
     reference = element.get("reference")
-    entry: dict[str, Any] = {
-        "reference": reference,
-        "xml": canonical_xml(element),
-        "source": ctx.loc(element),
-    }
+    entry = KeptBlock(element, {"reference": reference, "xml": _PENDING, "source": ctx.loc(element)})
     for child in element:
         tag = ctx.tag(child)
         if tag in GAZEBO_KEYS and len(child) == 0:
@@ -162,27 +249,31 @@ def _sensor(ctx: Context, element: Element) -> Device | None:
 def read_transmission(ctx: Context, element: Element, joint_names: set[str]) -> dict[str, Any]:
     """A ROS transmission: both the current form (``<type>`` element) and the old PR2 attribute."""
     type_el = ctx.first(element, "type")
-    entry: dict[str, Any] = {
-        "name": element.get("name"),
+    name = element.get("name")
+    joints: list[str] = []
+    actuators: list[str] = []
+    entry = KeptBlock(element, {
+        "name": name,
         "type": (type_el.text or "").strip() if type_el is not None else element.get("type"),
-        "joints": [],
-        "actuators": [],
+        "joints": joints,
+        "actuators": actuators,
         "source": ctx.loc(element),
-        "xml": canonical_xml(element),
-    }
+        "xml": _PENDING,
+    })
     for joint_el in ctx.children(element, "joint"):
-        name = joint_el.get("name")
-        if name is None:
+        joint = joint_el.get("name")
+        if joint is None:
             continue
-        entry["joints"].append(name)
-        if name not in joint_names:
+        joints.append(joint)
+        if joint not in joint_names:
             ctx.emit(
                 "MK139",
-                f'transmission "{entry["name"]}" drives joint "{name}", which is not a joint of this robot',
+                f'transmission "{name}" drives joint "{joint}", which is not a joint of this robot',
                 ctx.loc(joint_el, "name"),
-                hint=did_you_mean(name, joint_names),
+                hint=did_you_mean(joint, joint_names),
             )
     for actuator in ctx.children(element, "actuator"):
-        if actuator.get("name") is not None:
-            entry["actuators"].append(actuator.get("name"))
+        actuator_name = actuator.get("name")
+        if actuator_name is not None:
+            actuators.append(actuator_name)
     return entry

@@ -52,6 +52,7 @@ from modelkit.formats.xacro.legacy import (
     scan_file_set,
 )
 from modelkit.formats.xacro.origins import OriginMap, dom_elements
+from modelkit.formats.xacro.pretty import pretty_xml
 from modelkit.textio import UnreadableFile, read_regular, real_path
 from modelkit.xmlsource import XmlDocument, read_xml
 
@@ -377,26 +378,39 @@ class _Run:
         self.files = scan_file_set(top, self.path, self.options, self.load)
         self.report_legacy(self.files.constructs)
         stray = io.StringIO()
-        with _LOCK, self.patched(), contextlib.redirect_stdout(stray), contextlib.redirect_stderr(stray):
-            try:
-                doc = self.xacro.process_file(
-                    str(self.path), mappings=dict(self.options.xacro_args), verbosity=1
-                )
-            except Exception as exc:
-                found = diagnose(exc, self.context())
-                if found is not None:
-                    self.sink.add(found)
-                return None
-            finally:
-                for line in stray.getvalue().splitlines():
-                    self.say(Severity.WARNING, (line,))
-            fallback = self.origins.get(doc.documentElement)
-            top_loc = fallback.loc() if fallback else SourceLocation(self.display)
-            origins = []
-            for node in dom_elements(doc.documentElement):
-                origin = self.origins.get(node)
-                origins.append(origin.loc() if origin else top_loc)
-            return Expanded(doc.toprettyxml(indent="  "), origins)
+        elements: list[minidom.Element] = []
+        try:
+            with _LOCK, self.patched(), contextlib.redirect_stdout(stray), contextlib.redirect_stderr(stray):
+                try:
+                    doc = self.xacro.process_file(
+                        str(self.path), mappings=dict(self.options.xacro_args), verbosity=1
+                    )
+                except Exception as exc:
+                    found = diagnose(exc, self.context())
+                    if found is not None:
+                        self.sink.add(found)
+                    return None
+                finally:
+                    for line in stray.getvalue().splitlines():
+                        self.say(Severity.WARNING, (line,))
+                fallback = self.origins.get(doc.documentElement)
+                top_loc = fallback.loc() if fallback else SourceLocation(self.display)
+                origins = []
+                elements = list(dom_elements(doc.documentElement))
+                # The clones of one macro body element share its Origin: one location each.
+                located: dict[int, SourceLocation] = {}
+                for node in elements:
+                    origin = self.origins.get(node)
+                    if origin is None:
+                        origins.append(top_loc)
+                        continue
+                    loc = located.get(id(origin))
+                    if loc is None:
+                        loc = located[id(origin)] = origin.loc()
+                    origins.append(loc)
+                return Expanded(pretty_xml(doc), origins)
+        finally:
+            self.origins.release(elements)  # the DOMs go now, by reference counting, not in a collection
 
 
 def _sandbox(path: Path, options: ReadOptions) -> Sandbox:

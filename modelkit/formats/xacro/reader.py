@@ -23,7 +23,8 @@ def expand_document(
     if expanded is None:
         return None
     scratch = DiagnosticSink()
-    doc = parse_xml_bytes(expanded.text.encode("utf-8"), display, scratch, path)
+    # Every element gets its place in the xacro sources below: no positions in the generated text needed.
+    doc = parse_xml_bytes(expanded.text.encode("utf-8"), display, scratch, path, positions=False)
     if doc is None:  # e.g. <xacro:element xacro:name="..."> gave a name XML does not allow
         first = scratch.items[0].message if scratch.items else "it cannot be parsed"
         where = expanded.origins[0] if expanded.origins else SourceLocation(display)
