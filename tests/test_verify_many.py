@@ -139,8 +139,9 @@ def test_cli_exit_codes_and_no_progress_when_not_a_terminal(tmp_path: Path) -> N
     assert mixed.returncode == 2, mixed.stdout + mixed.stderr
     assert (out / "mobile_robot_primitive" / "report.json").is_file()
     summary = json.loads((out / "summary.json").read_text())
-    assert [(m["folder"], m["verdict"]) for m in summary["models"]] == [  # sorted by source: /tmp < /work
-        ("broken", "error"), ("mobile_robot_primitive", "pass")]
+    expected = sorted([(str(_broken(tmp_path)), "broken", "error"), (str(PRIMITIVE), "mobile_robot_primitive",
+                                                                      "pass")])  # sorted by source path
+    assert [(m["folder"], m["verdict"]) for m in summary["models"]] == [(f, v) for _, f, v in expected]
     assert "[1/2]" not in mixed.stderr + mixed.stdout and "at a time" not in mixed.stderr  # stderr is a pipe
     assert "PASS" in mixed.stdout and "broken: error:" in mixed.stdout
 

@@ -350,7 +350,13 @@ def render_html(report: VerifyReport, art: Artefacts | None = None) -> str:
     static = [c for c in report.checks if c.layer != 4]
     driven = [c for c in report.checks if c.layer == 4]
     out.append("<h2>Layers 1–3: static, kinematics, dynamics</h2>")
-    out.append(_checks_table(static) if static else "<p>No checks.</p>")
+    if static:  # a long table: folded when every check passed, open when one failed
+        failed = sum(1 for c in static if not c.passed)
+        state = f"{failed} of {len(static)} checks failed" if failed else f"all {len(static)} checks passed"
+        out.append(f"<details{' open' if failed else ''}><summary>{state} (the table)</summary>"
+                   + _checks_table(static) + "</details>")
+    else:
+        out.append("<p>No checks.</p>")
     out.append("<h2>Layer 4: driven on a floor</h2>")
     if driven:
         out.append(_checks_table(driven))
