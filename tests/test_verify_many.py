@@ -110,6 +110,11 @@ def test_many_models_in_parallel_one_crashing_one_raising_one_broken(
     many.write_summary(results, {"engines": QUICK["engines"]}, out)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["schema"] == many.SUMMARY_SCHEMA_ID and summary["exit_code"] == 2
+    import jsonschema
+
+    schema = json.loads((REPO / "schemas" / "verify-summary.schema.json").read_text())
+    jsonschema.validate(summary, schema)
+    assert schema["properties"]["schema"]["const"] == many.SUMMARY_SCHEMA_ID
     assert summary["counts"] == {"pass": 1, "fail": 1, "error": 4}
     assert [m["source"] for m in summary["models"]] == sorted(m["source"] for m in summary["models"])
     row = {m["folder"]: m for m in summary["models"]}
