@@ -139,6 +139,11 @@ class Worker:
         return data
 
     def request(self, command: str, timeout: float = DEFAULT_TIMEOUT, **kwargs: Any) -> Any:
+        return self.receive(command, self.send(command, **kwargs), timeout)
+
+    def send(self, command: str, **kwargs: Any) -> int:
+        """Send a request without waiting for its answer (the child works while the parent does
+        something else); returns where the child's stderr stood, for :meth:`receive`."""
         if self.proc.poll() is not None:
             raise self._died(command)
         printed = self._stderr.seek(0, os.SEEK_END)
@@ -149,6 +154,10 @@ class Worker:
             self.proc.stdin.flush()
         except BrokenPipeError:
             raise self._died(command) from None
+        return int(printed)
+
+    def receive(self, command: str, printed: int, timeout: float = DEFAULT_TIMEOUT) -> Any:
+        """The answer to the request :meth:`send` sent (``printed``: what it returned)."""
         deadline = time.monotonic() + timeout
         size = struct.unpack(">I", self._read_exactly(4, deadline, command))[0]
         status, result = pickle.loads(self._read_exactly(size, deadline, command))
@@ -401,34 +410,6 @@ def urdf_friction(path: Path) -> dict[str, float]:
     return out
 
 
-class _PendingWorker(Worker):
-    """A :class:`Worker` whose request can be sent now and its answer collected later, so the
-    PyBullet child steps while the parent runs MuJoCo."""
-
-    def send(self, command: str, **kwargs: Any) -> int:
-        if self.proc.poll() is not None:
-            raise self._died(command)
-        printed = self._stderr.seek(0, os.SEEK_END)
-        payload = pickle.dumps((command, kwargs), protocol=pickle.HIGHEST_PROTOCOL)
-        assert self.proc.stdin is not None
-        try:
-            self.proc.stdin.write(struct.pack(">I", len(payload)) + payload)
-            self.proc.stdin.flush()
-        except BrokenPipeError:
-            raise self._died(command) from None
-        return int(printed)
-
-    def receive(self, command: str, printed: int, timeout: float) -> Any:
-        deadline = time.monotonic() + timeout
-        size = struct.unpack(">I", self._read_exactly(4, deadline, command))[0]
-        status, result = pickle.loads(self._read_exactly(size, deadline, command))
-        if status != "ok":
-            said = self._stderr_tail(printed)
-            raise PyBulletError(f"PyBullet {command} failed: {result}".rstrip()
-                                + (f"\nPyBullet printed:\n{said}" if said else ""))
-        return result
-
-
 class PyBulletDriver:
     """The written floating-base URDF on a floor in the PyBullet child, verification.md §6's
     settings and every §2.8 pitfall handled, the seed's controllers built **in the child** from plain
@@ -455,7 +436,7 @@ class PyBulletDriver:
         for rollers in drive.rollers.values():
             for j in rollers:
                 joint_names.setdefault(j, j)
-        self._worker = _PendingWorker()
+        self._worker = Worker()
         self._pending: tuple[int, list[Any], Any, Any] | None = None
         try:
             info = self._worker.request(
