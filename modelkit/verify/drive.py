@@ -29,6 +29,7 @@ starts at (0, 0, 0).
 from __future__ import annotations
 
 import bisect
+import math
 from dataclasses import dataclass, field
 from typing import Any, Literal, Protocol
 
@@ -74,6 +75,18 @@ class Profile:
         times = [c.t for c in self.commands]
         i = bisect.bisect_right(times, t) - 1
         return self.commands[i] if i >= 0 else Command(0.0)
+
+
+def command_steps(profile: Profile, dt: float, steps: int) -> dict[int, Command]:
+    """Step index → the command that takes over at that step (zero-order hold at the physics rate:
+    a command at time t acts from the first step k with k·dt ≥ t). The drivers and the references
+    all use this, so they switch at the same step."""
+    out: dict[int, Command] = {}
+    for command in profile.commands:
+        k = max(0, math.ceil(command.t / dt - 1e-9))
+        if k <= steps:
+            out[k] = command
+    return out
 
 
 @dataclass(frozen=True)

@@ -588,6 +588,7 @@ class MujocoDriver:
     def __init__(self, model: Path, renames: Renames, drive: Any, scenario: Any,
                  factory: str | None = None, fast: bool = True) -> None:
         from modelkit.verify import variant as v
+        from modelkit.verify.drive import Command
 
         self.path = Path(model)
         self.renames = renames
@@ -602,7 +603,7 @@ class MujocoDriver:
         servoed = [g for j in velocity for g in v.driven_groups(drive, j)]
         # The laws' gains at the zero command: one explicit damping actuator per torque joint of
         # non-zero gain. A velocity-mode law with a q̇ term is not the servo's: per step, then.
-        probe = affine_laws(self.controllers, v.Command(0.0)) if fast else None
+        probe = affine_laws(self.controllers, Command(0.0)) if fast else None
         if probe is not None and any(c.mode == "velocity" and np.any(gain != 0.0)
                                      for c, (_, gain) in zip(self.controllers, probe, strict=True)):
             probe = None
@@ -785,6 +786,7 @@ class MujocoDriver:
 
     def run(self, profile: Any, scenario: Any, drive: Any) -> Any:
         from modelkit.verify import variant as v
+        from modelkit.verify.drive import command_steps
 
         m, d = self.model, self.data
         wall = time.perf_counter()
@@ -793,7 +795,7 @@ class MujocoDriver:
         every = max(1, round(1.0 / (scenario.sample_rate * dt)))
         steps = round(profile.duration / dt)
         settle = round(profile.settle / dt)
-        changes = v.command_steps(profile, dt, steps)
+        changes = command_steps(profile, dt, steps)
         laws = self._laws(changes)
         n = steps // every + 1
         base = np.empty((n, 7))
@@ -872,14 +874,14 @@ class MujocoDriver:
     def _run_per_step(self, changes: dict[int, Any], steps: int, every: int, base: np.ndarray,
                       qrec: np.ndarray) -> None:
         """The profile with every controller's ``output`` called before every ``mj_step``."""
-        from modelkit.verify import variant as v
+        from modelkit.verify.drive import Command
 
         m, d = self.model, self.data
         dt = float(m.opt.timestep)
         step = mujoco.mj_step
         plan, qpos, qvel, applied, ctrl = self._plan, d.qpos, d.qvel, d.qfrc_applied, d.ctrl
         ra, rec = self.root_qadr, self._rec_qadr
-        command = v.Command(0.0)
+        command = Command(0.0)
         s = 0
         for k in range(steps + 1):
             if k % every == 0:  # the state after k steps (the free joint's qpos is the root's pose)

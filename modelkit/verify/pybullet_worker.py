@@ -379,7 +379,7 @@ class Engine:
         ``"per-step"``)."""
         import numpy as np
 
-        from modelkit.verify.drive import Command
+        from modelkit.verify.drive import Command, Profile, command_steps
 
         p, cfg = self.p, self.drive_cfg
         self._drive_world()
@@ -420,11 +420,7 @@ class Engine:
         steps = round(profile["duration"] / dt)
         settle = round(profile["settle"] / dt)
         commands = [Command(**cmd) for cmd in profile["commands"]]
-        changes = {}
-        for cmd in commands:
-            k = max(0, math.ceil(cmd.t / dt - 1e-9))
-            if k <= steps:
-                changes[k] = cmd
+        changes = command_steps(Profile(**{**profile, "commands": tuple(commands)}), dt, steps)
         laws = self._drive_laws(plan, commands, torque_ids) if fast else None
         if laws is not None:
             return self._drive_run_fast(laws, torque_ids, velocity_ids, velocity_fan, read, rec_cols, steps,

@@ -55,8 +55,9 @@ from typing import Any
 import numpy as np
 
 from modelkit.model import Robot
+from modelkit.spatial import combine_mass_properties, rotate_inertia
 from modelkit.verify.controllers import make_controllers
-from modelkit.verify.drive import Array, Command, Drive, Profile, Scenario, Trajectory
+from modelkit.verify.drive import Array, Command, Drive, Profile, Scenario, Trajectory, command_steps
 from modelkit.verify.scenario import scenario_dict
 
 RK4_SUBSTEPS = 1  # RK4 steps per control period (1 ms); 10 (0.1 ms, as §1) agrees to 1e-11 m, 5x slower
@@ -151,22 +152,17 @@ def planar_model(robot: Robot, drive: Drive, friction: float | None = None) -> P
         shape = wheel_shape(links[link_name], frame.rotation.T @ axis) if drive.kind == "wheels" else None
         centres.append(frame.rotation @ shape[1] + frame.translation if shape else frame.translation)
     p = 0.5 * (centres[0] + centres[1])
-    mass = 0.0
-    first = np.zeros(3)
-    inertia = 0.0
     masses: list[tuple[str, float, np.ndarray, np.ndarray]] = []  # link, m, COM in root, inertia in root
     for link in robot.links:
         if link.inertial is None or link.name not in frames or link.inertial.mass <= 0.0:
             continue
         frame = frames[link.name]
-        m = float(link.inertial.mass)
         c = frame.rotation @ np.asarray(link.inertial.com, dtype=float) + frame.translation
-        i_root = frame.rotation @ np.asarray(link.inertial.inertia, dtype=float) @ frame.rotation.T
-        masses.append((link.name, m, c, i_root))
-        mass += m
-        first += m * (c - p)
-        inertia += float(i_root[2, 2]) + m * float((c[0] - p[0]) ** 2 + (c[1] - p[1]) ** 2)
-    com = first / mass
+        masses.append((link.name, float(link.inertial.mass), c,
+                       rotate_inertia(link.inertial.inertia, frame.rotation)))
+    mass, centre, about_com = combine_mass_properties([(m, c, i) for _, m, c, i in masses])
+    com = np.asarray(centre) - p  # relative to the axle midpoint
+    inertia = float(about_com[2, 2]) + mass * float(com[0] ** 2 + com[1] ** 2)  # yaw, about P
     spin = []
     spinning = (
         ([drive.wheel_links[0]], [drive.wheel_links[1]])
@@ -310,6 +306,13 @@ def noslip(
     command = Command(0.0)
     half, sixth = 0.5 * h, h / 6.0
     cos, sin = math.cos, math.sin
+
+    def accelerations(v: float, w: float, fv: float, fw: float, u_p: float) -> tuple[float, float, float]:
+        """(v̇, ẇ, pan q̈) at forward speed v and yaw rate w under the held generalised forces."""
+        rv, rw = fv + mcx * w * w, fw - mcx * v * w
+        return (a00 * rv + a01 * rw + a02 * u_p, a10 * rv + a11 * rw + a12 * u_p,
+                a20 * rv + a21 * rw + a22 * u_p)
+
     for step in range(steps + 1):
         t = step * dt
         if step in sampled:
@@ -338,33 +341,13 @@ def noslip(
         u_p, u_t = torques[2], torques[3]
         for _ in range(substeps):
             # RK4 with the torques held (zero-order hold). Positions follow the velocities.
-            rv, rw = fv + mcx * w * w, fw - mcx * v * w
-            gv1, gw1, gp1 = (
-                a00 * rv + a01 * rw + a02 * u_p,
-                a10 * rv + a11 * rw + a12 * u_p,
-                a20 * rv + a21 * rw + a22 * u_p,
-            )
+            gv1, gw1, gp1 = accelerations(v, w, fv, fw, u_p)
             v2, w2, p2 = v + half * gv1, w + half * gw1, dqp + half * gp1
-            rv, rw = fv + mcx * w2 * w2, fw - mcx * v2 * w2
-            gv2, gw2, gp2 = (
-                a00 * rv + a01 * rw + a02 * u_p,
-                a10 * rv + a11 * rw + a12 * u_p,
-                a20 * rv + a21 * rw + a22 * u_p,
-            )
+            gv2, gw2, gp2 = accelerations(v2, w2, fv, fw, u_p)
             v3, w3, p3 = v + half * gv2, w + half * gw2, dqp + half * gp2
-            rv, rw = fv + mcx * w3 * w3, fw - mcx * v3 * w3
-            gv3, gw3, gp3 = (
-                a00 * rv + a01 * rw + a02 * u_p,
-                a10 * rv + a11 * rw + a12 * u_p,
-                a20 * rv + a21 * rw + a22 * u_p,
-            )
+            gv3, gw3, gp3 = accelerations(v3, w3, fv, fw, u_p)
             v4, w4, p4 = v + h * gv3, w + h * gw3, dqp + h * gp3
-            rv, rw = fv + mcx * w4 * w4, fw - mcx * v4 * w4
-            gv4, gw4, gp4 = (
-                a00 * rv + a01 * rw + a02 * u_p,
-                a10 * rv + a11 * rw + a12 * u_p,
-                a20 * rv + a21 * rw + a22 * u_p,
-            )
+            gv4, gw4, gp4 = accelerations(v4, w4, fv, fw, u_p)
             th2, th3 = th + half * w, th + half * w2
             th4 = th + h * w3
             x += sixth * (v * cos(th) + 2.0 * v2 * cos(th2) + 2.0 * v3 * cos(th3) + v4 * cos(th4))
@@ -432,17 +415,6 @@ class _Servo:
                 free = (need[i] - g[i, j] * tau[j]) / g[i, i]
                 tau[i] = min(self.caps[i], max(-self.caps[i], free))
         return tau[0], tau[1]
-
-
-def command_steps(profile: Profile, dt: float, steps: int) -> dict[int, Command]:
-    """Step index → the command taking over there: a command at time t acts from the first step k
-    with k·dt ≥ t (the drivers' rule, ``variant.command_steps``)."""
-    out: dict[int, Command] = {}
-    for command in profile.commands:
-        k = max(0, math.ceil(command.t / dt - 1e-9))
-        if k <= steps:
-            out[k] = command
-    return out
 
 
 def _wiring(controllers: list[Any], drive: Drive) -> list[list[str]]:

@@ -43,7 +43,7 @@ import numpy as np
 
 from modelkit.model import Capsule, Cylinder, Ellipsoid, Geom, Link, Robot, Sphere
 from modelkit.spatial import Pose
-from modelkit.verify.drive import Array, Command, Drive, Profile, Scenario, Trajectory, WheelProxy
+from modelkit.verify.drive import Array, Drive, Profile, Scenario, Trajectory, WheelProxy
 
 Renames = dict[str, dict[str, str]]
 SUFFIX = {"mjcf": ".xml", "urdf": ".urdf"}
@@ -168,12 +168,8 @@ def scenario_data(scenario: Scenario) -> dict[str, Any]:
 
 
 def profile_data(profile: Profile) -> dict[str, Any]:
+    """Plain data for PyBullet's child, which builds the Profile again (``Command(**c)`` each)."""
     return dataclasses.asdict(profile)
-
-
-def profile_from_data(data: dict[str, Any]) -> Profile:
-    commands = tuple(Command(**c) for c in data["commands"])
-    return Profile(**{**data, "commands": commands})
 
 
 def load_factory(spec: str) -> Callable[[dict[str, Any], dict[str, Any]], list[Any]]:
@@ -227,18 +223,6 @@ def planar(source: str, profile: Profile, variant: str, t: Array, positions: Arr
     return Trajectory(source=source, profile=profile.name, variant=variant, t=t,
                       x=c * dx + s * dy, y=-s * dx + c * dy, yaw=yaw - yaw[0],
                       wheels=np.column_stack([rel[wheels[0]], rel[wheels[1]]]), joints=rel)
-
-
-def command_steps(profile: Profile, dt: float, steps: int) -> dict[int, Command]:
-    """Step index → the command that takes over at that step (zero-order hold at the physics rate:
-    a command at time t acts from the first step k with k·dt ≥ t). Both drivers use this, so they
-    switch at the same step."""
-    out: dict[int, Command] = {}
-    for command in profile.commands:
-        k = max(0, math.ceil(command.t / dt - 1e-9))
-        if k <= steps:
-            out[k] = command
-    return out
 
 
 def rotations_wxyz(q: Array) -> Array:
