@@ -26,12 +26,9 @@ it: root welded at the identity.
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
 import pickle
-import subprocess
-import sys
 import tempfile
 import time
 from dataclasses import dataclass, field
@@ -42,6 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Mesh, Robot, Sphere
+from modelkit.verify.oneshot import Child, serve
 
 Array = NDArray[np.float64]
 Image = NDArray[np.uint8]
@@ -456,16 +454,9 @@ def _mujoco_render(request: dict[str, Any]) -> dict[str, Any]:
 
 
 def mujoco_child() -> int:
-    """The child's entry point: a pickled request on stdin, a pickled ("ok", result) or ("error",
-    message) on stdout."""
-    request = pickle.loads(sys.stdin.buffer.read())
-    try:
-        reply: tuple[str, Any] = ("ok", _mujoco_render(request))
-    except Exception as exc:
-        reply = ("error", f"{type(exc).__name__}: {exc}")
-    sys.stdout.buffer.write(pickle.dumps(reply, protocol=pickle.HIGHEST_PROTOCOL))
-    sys.stdout.buffer.flush()
-    return 0
+    """The child's entry point (:func:`modelkit.verify.oneshot.serve`): a render request in, the
+    images out."""
+    return serve(_mujoco_render)
 
 
 def _gl_backends() -> list[str]:
@@ -477,51 +468,28 @@ class _MujocoJob:
     """The MuJoCo child, started at once so that it renders while the parent draws the source."""
 
     def __init__(self, mjcf: Path, joints: list[dict[str, float]], camera: Camera) -> None:
-        self.payload = pickle.dumps(_mujoco_request(mjcf, joints, camera), protocol=pickle.HIGHEST_PROTOCOL)
+        self.request = _mujoco_request(mjcf, joints, camera)
         self.backends = _gl_backends()
         self.tried: list[str] = []
-        self.proc: subprocess.Popen[bytes] | None = None
         self._tmp = tempfile.TemporaryDirectory(prefix="modelkit-mjrender-")
         self._start()
 
     def _start(self) -> None:
         gl = self.backends.pop(0)
-        env = dict(os.environ, MUJOCO_GL=gl, PYOPENGL_PLATFORM=gl)
         code = "import sys; from modelkit.verify.pictures import mujoco_child; sys.exit(mujoco_child())"
         self.gl = gl
         # cwd: a temporary folder, so that nothing MuJoCo might write lands in the user's folder.
-        self.proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env,
-                                     cwd=self._tmp.name)
-        assert self.proc.stdin is not None
-        self.proc.stdin.write(self.payload)
-        self.proc.stdin.close()
-        self.proc.stdin = None  # communicate() must not flush it again
+        self.child = Child(code, env=dict(os.environ, MUJOCO_GL=gl, PYOPENGL_PLATFORM=gl), cwd=self._tmp.name)
+        self.child.send(self.request)
 
     def result(self) -> tuple[dict[str, Any] | None, str]:
         """(result, "") or (None, why MuJoCo could not render)."""
         try:
             while True:
-                assert self.proc is not None and self.proc.stdout is not None and self.proc.stderr is not None
-                try:
-                    out, err = self.proc.communicate(timeout=CHILD_TIMEOUT)
-                except subprocess.TimeoutExpired:
-                    self.proc.kill()
-                    self.proc.communicate()
-                    out, err = b"", b"timed out"
-                why = ""
-                if out:
-                    try:
-                        status, value = pickle.loads(out)
-                    except Exception as exc:
-                        status, value = "error", f"unreadable reply ({exc})"
-                    if status == "ok":
-                        return value, ""
-                    why = str(value)
-                else:
-                    tail = err.decode(errors="replace").strip().splitlines()
-                    why = (tail[-1] if tail else f"exit status {self.proc.returncode}")
-                self.tried.append(f"MUJOCO_GL={self.gl}: {why}")
+                status, value = self.child.reply(CHILD_TIMEOUT)
+                if status == "ok":
+                    return value, ""
+                self.tried.append(f"MUJOCO_GL={self.gl}: {value}")
                 if not self.backends:
                     return None, "; ".join(self.tried)
                 self._start()
@@ -655,19 +623,9 @@ _PICTURES_CHILD = ("import sys; from modelkit.verify.pictures import pictures_ch
 
 
 def pictures_child() -> int:
-    """The child's entry point: pickled :func:`render_pictures` arguments on stdin, the pickled
-    ("ok", PictureSet) or ("error", message) on stdout."""
-    raw = sys.stdin.buffer.read()
-    if not raw:  # the parent went away without asking
-        return 0
-    try:
-        args = pickle.loads(raw)
-        reply: tuple[str, Any] = ("ok", render_pictures(*args))
-    except Exception as exc:
-        reply = ("error", f"{type(exc).__name__}: {exc}")
-    sys.stdout.buffer.write(pickle.dumps(reply, protocol=pickle.HIGHEST_PROTOCOL))
-    sys.stdout.buffer.flush()
-    return 0
+    """The child's entry point (:func:`modelkit.verify.oneshot.serve`): :func:`render_pictures`'s
+    arguments in, the PictureSet out."""
+    return serve(lambda args: render_pictures(*args))
 
 
 class PictureJob:
@@ -679,37 +637,22 @@ class PictureJob:
                  ) -> None:
         self.args = (robot, {k: Path(v).resolve() for k, v in files.items()}, renames,
                      [dict(q) for q in configurations], tuple(engines))
-        self.proc: subprocess.Popen[bytes] | None = None
+        self.child: Child | None = None
         try:
-            self.proc = subprocess.Popen([sys.executable, "-c", _PICTURES_CHILD], stdin=subprocess.PIPE,
-                                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-            assert self.proc.stdin is not None
-            self.proc.stdin.write(pickle.dumps(self.args, protocol=pickle.HIGHEST_PROTOCOL))
-            self.proc.stdin.close()
-            self.proc.stdin = None  # communicate() must not flush it again
-        except (OSError, pickle.PicklingError):
+            self.child = Child(_PICTURES_CHILD)
+            self.child.send(self.args)
+        except (OSError, ValueError, pickle.PicklingError):
             self.close()
 
     def result(self) -> PictureSet:
-        proc, self.proc = self.proc, None
-        if proc is not None:
-            try:
-                out, _ = proc.communicate(timeout=PICTURES_TIMEOUT)
-                status, value = pickle.loads(out) if out else ("error", "no reply")
-                if status == "ok" and isinstance(value, PictureSet):
-                    return value
-            except Exception:
-                _end(proc)
+        child, self.child = self.child, None
+        if child is not None:
+            status, value = child.reply(PICTURES_TIMEOUT)
+            if status == "ok" and isinstance(value, PictureSet):
+                return value
         return render_pictures(*self.args)
 
     def close(self) -> None:
-        proc, self.proc = self.proc, None
-        if proc is not None:
-            _end(proc)
-
-
-def _end(proc: subprocess.Popen[bytes]) -> None:
-    if proc.poll() is None:
-        proc.kill()
-    with contextlib.suppress(Exception):
-        proc.communicate(timeout=10.0)
+        child, self.child = self.child, None
+        if child is not None:
+            child.end()

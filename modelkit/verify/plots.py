@@ -21,19 +21,17 @@ user ``matplotlibrc`` applies), and no ``Software`` metadata.
 
 from __future__ import annotations
 
-import contextlib
 import io
 import math
 import os
-import pickle
-import subprocess
-import sys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from modelkit.verify import oneshot
 
 Array = NDArray[np.float64]
 
@@ -362,16 +360,7 @@ def serve() -> int:
     import matplotlib.backends.backend_agg
     import matplotlib.figure  # noqa: F401
 
-    raw = sys.stdin.buffer.read()
-    if not raw:  # the parent went away without asking
-        return 0
-    try:
-        reply: tuple[str, Any] = ("ok", [_draw(job) for job in pickle.loads(raw)])
-    except Exception as exc:
-        reply = ("error", f"{type(exc).__name__}: {exc}")
-    sys.stdout.buffer.write(pickle.dumps(reply, protocol=pickle.HIGHEST_PROTOCOL))
-    sys.stdout.buffer.flush()
-    return 0
+    return oneshot.serve(lambda jobs: [_draw(job) for job in jobs])
 
 
 class Plotters:
@@ -380,18 +369,17 @@ class Plotters:
     bytes in order. Use each once; :meth:`close` ends what is left."""
 
     def __init__(self, count: int = PLOTTERS) -> None:
-        self.procs: list[subprocess.Popen[bytes]] = []
+        self.children: list[oneshot.Child] = []
         for _ in range(max(1, count)):
             try:
-                self.procs.append(subprocess.Popen([sys.executable, "-c", _CHILD], stdin=subprocess.PIPE,
-                                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE))
+                self.children.append(oneshot.Child(_CHILD))
             except OSError:
                 break
 
     def draw(self, jobs: Sequence[tuple[str, list[Any], dict[str, float] | None, tuple[str, ...]]]
              ) -> list[bytes]:
-        procs, self.procs = self.procs, []
-        n = max(1, min(len(procs), len(jobs)))
+        children, self.children = self.children, []
+        n = max(1, min(len(children), len(jobs)))
         # Largest first, each to the least loaded child (the cost grows with the number of lines).
         order = sorted(range(len(jobs)), key=lambda i: (-len(jobs[i][1]), i))
         shares: list[list[int]] = [[] for _ in range(n)]
@@ -402,40 +390,25 @@ class Plotters:
             load[k] += len(jobs[i][1]) + 4
         out: list[bytes | None] = [None] * len(jobs)
         sent = []
-        for proc, share in zip(procs, shares, strict=False):
+        for child, share in zip(children, shares, strict=False):
             try:
-                assert proc.stdin is not None
-                proc.stdin.write(pickle.dumps([jobs[i] for i in share], protocol=pickle.HIGHEST_PROTOCOL))
-                proc.stdin.close()
-                proc.stdin = None  # communicate() must not flush it again
-                sent.append((proc, share))
+                child.send([jobs[i] for i in share])
+                sent.append((child, share))
             except (OSError, ValueError):
-                _end(proc)
-        for proc in procs[len(shares):]:
-            _end(proc)
-        for proc, share in sent:
-            try:
-                reply, _ = proc.communicate(timeout=PLOTTER_TIMEOUT)
-                status, value = pickle.loads(reply) if reply else ("error", "no reply")
-            except Exception as exc:
-                _end(proc)
-                status, value = "error", str(exc)
+                child.end()
+        for child in children[len(shares):]:
+            child.end()
+        for child, share in sent:
+            status, value = child.reply(PLOTTER_TIMEOUT)
             if status == "ok" and len(value) == len(share):
                 for i, data in zip(share, value, strict=True):
                     out[i] = data
         return [data if data is not None else _draw(jobs[i]) for i, data in enumerate(out)]
 
     def close(self) -> None:
-        for proc in self.procs:
-            _end(proc)
-        self.procs = []
-
-
-def _end(proc: subprocess.Popen[bytes]) -> None:
-    if proc.poll() is None:
-        proc.kill()
-    with contextlib.suppress(Exception):
-        proc.communicate(timeout=10.0)
+        for child in self.children:
+            child.end()
+        self.children = []
 
 
 def safe_name(name: str) -> str:
