@@ -15,25 +15,11 @@ import pytest
 import modelkit
 from modelkit.verify import engine_mujoco, engine_pybullet, variant
 from modelkit.verify.drive import Command, Drive, Profile, Scenario, Trajectory
+from tests.drivers_support import DRIVE, PANTILT, TRACKS, profile
 
-MODELS = Path(__file__).resolve().parent.parent / "samples/choreonoid_ros2_mobile_robot_tutorial/model"
-PANTILT = MODELS / "mobile_robot_pantilt.body"
-TRACKS = MODELS / "mobile_robot_tracks.body"
-
-# The seed's drive: LeftWheel/RightWheel, r 0.076, b 0.145 (built by hand: these tests do not depend
-# on vehicle.find_drive).
-DRIVE = Drive("wheels", "LeftWheel", "RightWheel", 0.076, 0.145, ("LeftWheel", "RightWheel"),
-              pan="PanJoint", tilt="TiltJoint")
-# verification.md §1's graded profiles, with the pan and tilt joints moving (the pan-tilt controller).
-PAN_TILT = (Command(1.0, pan=0.5, tilt=0.3), Command(3.0, pan=-0.5, tilt=-0.3), Command(5.0))
-
-
-def _profile(name: str, v: float, w: float) -> Profile:
-    commands = (Command(0.0, v, w), *(dataclasses.replace(c, v=v, w=w) for c in PAN_TILT))
-    return Profile(name, 10.0, commands)
-
-
-PROFILES = (_profile("straight", 0.5, 0.0), _profile("spin", 0.0, 1.0), _profile("arc", 0.3, 0.5))
+# The seed's drive built by hand (LeftWheel/RightWheel, r 0.076, b 0.145: these tests do not depend on
+# vehicle.find_drive); verification.md §1's graded profiles with the pan and tilt joints moving.
+PROFILES = (profile("straight", 0.5, 0.0), profile("spin", 0.0, 1.0), profile("arc", 0.3, 0.5))
 SCENARIO = Scenario(profiles=PROFILES, controller="drive")
 
 

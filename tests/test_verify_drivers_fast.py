@@ -15,37 +15,16 @@ import pytest
 
 import modelkit
 from modelkit.verify import controllers, engine_mujoco, layer4, variant
-from modelkit.verify.drive import Command, Drive, Profile, Scenario, Trajectory
-
-MODELS = Path(__file__).resolve().parent.parent / "samples/choreonoid_ros2_mobile_robot_tutorial/model"
-PANTILT = MODELS / "mobile_robot_pantilt.body"
-TRACKS = MODELS / "mobile_robot_tracks.body"
-DRIVE = Drive("wheels", "LeftWheel", "RightWheel", 0.076, 0.145, ("LeftWheel", "RightWheel"),
-              pan="PanJoint", tilt="TiltJoint")
-PAN_TILT = (Command(1.0, pan=0.5, tilt=0.3), Command(3.0, pan=-0.5, tilt=-0.3), Command(5.0))
-ROUND_OFF = 1e-9  # m / rad over 10 s
-
-
-def _profile(name: str, v: float, w: float) -> Profile:
-    commands = (Command(0.0, v, w), *(dataclasses.replace(c, v=v, w=w) for c in PAN_TILT))
-    return Profile(name, 10.0, commands)
-
-
-# straight and arc with pan and tilt moving; a command change between two samples (t = 6.0005 s)
-PROFILES = (
-    _profile("straight", 0.5, 0.0),
-    _profile("arc", 0.3, 0.5),
-    Profile("steps", 10.0, (Command(0.0, 0.3), Command(2.0, 0.3, 0.6, pan=0.4),
-                            Command(4.0, 0.0, -1.0, tilt=0.2), Command(6.0005, -0.2, 0.0),
-                            Command(8.0, 0.4, -0.4)), graded=False),
+from modelkit.verify.drive import Command, Drive, Scenario
+from tests.drivers_support import (
+    DRIVE,
+    PANTILT,
+    PROFILES,
+    ROUND_OFF,
+    TRACKS,
+    assert_same_layer4,
+    run_difference,
 )
-
-
-def _largest(a: Trajectory, b: Trajectory) -> float:
-    assert np.array_equal(a.t, b.t) and set(a.joints) == set(b.joints)
-    return max(float(np.hypot(a.x - b.x, a.y - b.y).max()), float(np.abs(a.yaw - b.yaw).max()),
-               float(np.abs(a.wheels - b.wheels).max()),
-               *(float(np.abs(a.joints[j] - b.joints[j]).max()) for j in a.joints))
 
 
 def _pair(files: dict[str, Path], maps: dict[str, Any], drive: Drive, scenario: Scenario,
@@ -84,7 +63,7 @@ def test_laws_as_actuators_equal_the_python_law_every_step(pantilt_files: Any, c
     for profile in PROFILES if controller == "drive" else PROFILES[:2]:
         a, b = fast.run(profile, scenario, DRIVE), slow.run(profile, scenario, DRIVE)
         assert not a.warnings and not b.warnings
-        largest = _largest(a, b)
+        largest = run_difference(a, b)
         print(controller, profile.name, f"{largest:.3g}", f"fast {fast.last_wall:.3f} s, per step "
               f"{slow.last_wall:.3f} s")
         assert largest <= ROUND_OFF, (profile.name, largest)
@@ -110,7 +89,7 @@ def test_an_implicit_damping_term_would_not_be_round_off(pantilt_files: Any) -> 
     for name, gain in implicit.settings["law_actuators"].items():
         m.dof_damping[m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)]] = gain
     implicit._law_actuators = np.zeros(0, dtype=int)  # plugins left at gear 0: damping carries -kd·q̇
-    largest = _largest(implicit.run(PROFILES[0], scenario, DRIVE), reference)
+    largest = run_difference(implicit.run(PROFILES[0], scenario, DRIVE), reference)
     print("implicit damping vs the explicit law", largest)
     assert largest > 1e3 * ROUND_OFF
 
@@ -136,8 +115,8 @@ def test_a_controller_without_an_affine_law_runs_per_step(pantilt_files: Any) ->
                                    factory=f"{__name__}:_no_affine_law")
     assert "per step" in wrapped.settings["control"] and wrapped.model.nu == 0
     a = wrapped.run(PROFILES[1], scenario, DRIVE)
-    assert _largest(a, slow.run(PROFILES[1], scenario, DRIVE)) == 0.0  # the very same computation
-    assert _largest(a, fast.run(PROFILES[1], scenario, DRIVE)) <= ROUND_OFF
+    assert run_difference(a, slow.run(PROFILES[1], scenario, DRIVE)) == 0.0  # the very same computation
+    assert run_difference(a, fast.run(PROFILES[1], scenario, DRIVE)) <= ROUND_OFF
 
 
 def test_track_controller_servo_targets_set_at_command_changes(tmp_path: Path) -> None:
@@ -164,9 +143,9 @@ def test_track_controller_servo_targets_set_at_command_changes(tmp_path: Path) -
     for profile in scenario.profiles:
         still = dataclasses.replace(profile, commands=tuple(dataclasses.replace(c, pan=0.0, tilt=0.0)
                                                             for c in profile.commands))
-        exact = _largest(fast.run(still, scenario, drive), slow.run(still, scenario, drive))
+        exact = run_difference(fast.run(still, scenario, drive), slow.run(still, scenario, drive))
         assert exact == 0.0, (profile.name, exact)
-        largest = _largest(fast.run(profile, scenario, drive), slow.run(profile, scenario, drive))
+        largest = run_difference(fast.run(profile, scenario, drive), slow.run(profile, scenario, drive))
         print("tracks", profile.name, largest)
         if profile.name == "straight":
             assert largest <= ROUND_OFF, (profile.name, largest)
@@ -189,14 +168,5 @@ def test_layer4_results_unchanged(pantilt: Any, tmp_path: Path, monkeypatch: pyt
     fast = layer4.run(pantilt, drive, scenario, tmp_path / "fast", engines=("mujoco",))
     monkeypatch.setitem(layer4.DRIVERS, "mujoco", f"{__name__}:per_step_driver")
     slow = layer4.run(pantilt, drive, scenario, tmp_path / "slow", engines=("mujoco",))
-    assert [(c.engine, c.quantity, c.where, c.passed) for c in fast.checks] == \
-        [(c.engine, c.quantity, c.where, c.passed) for c in slow.checks]
-    assert fast.checks and all(abs(a.error - b.error) <= ROUND_OFF for a, b in zip(fast.checks, slow.checks,
-                                                                                     strict=True))
-    assert [(o.engine, o.quantity, o.where) for o in fast.observations] == \
-        [(o.engine, o.quantity, o.where) for o in slow.observations]
-    assert all(abs(a.value - b.value) <= ROUND_OFF for a, b in zip(fast.observations, slow.observations,
-                                                                    strict=True))
-    runs = [(a, b) for a, b in zip(fast.trajectories, slow.trajectories, strict=True) if a.source == "mujoco"]
-    assert runs and all(_largest(a, b) <= ROUND_OFF for a, b in runs)
+    assert_same_layer4(fast, slow, "mujoco")
     print("layer 4 wall s: fast", fast.timings, "per step", slow.timings)

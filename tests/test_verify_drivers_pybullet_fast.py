@@ -16,41 +16,19 @@ import pytest
 
 import modelkit
 from modelkit.verify import controllers, engine_pybullet, layer4, variant
-from modelkit.verify.drive import Command, Drive, Profile, Scenario, Trajectory
-
-MODELS = Path(__file__).resolve().parent.parent / "samples/choreonoid_ros2_mobile_robot_tutorial/model"
-PANTILT = MODELS / "mobile_robot_pantilt.body"
-TRACKS = MODELS / "mobile_robot_tracks.body"
-DRIVE = Drive("wheels", "LeftWheel", "RightWheel", 0.076, 0.145, ("LeftWheel", "RightWheel"),
-              pan="PanJoint", tilt="TiltJoint")
-PAN_TILT = (Command(1.0, pan=0.5, tilt=0.3), Command(3.0, pan=-0.5, tilt=-0.3), Command(5.0))
-ROUND_OFF = 1e-9  # m / rad over 10 s
-# where the child process finds this module (for the factories below): "tests.x" or "x"
-HERE = [str(Path(__file__).resolve().parents[__name__.count(".")])]
-
-
-def _profile(name: str, v: float, w: float) -> Profile:
-    commands = (Command(0.0, v, w), *(dataclasses.replace(c, v=v, w=w) for c in PAN_TILT))
-    return Profile(name, 10.0, commands)
-
-
-# straight and arc with pan and tilt moving; a command change between two samples (t = 6.0005 s)
-PROFILES = (
-    _profile("straight", 0.5, 0.0),
-    _profile("arc", 0.3, 0.5),
-    Profile("steps", 10.0, (Command(0.0, 0.3), Command(2.0, 0.3, 0.6, pan=0.4),
-                            Command(4.0, 0.0, -1.0, tilt=0.2), Command(6.0005, -0.2, 0.0),
-                            Command(8.0, 0.4, -0.4)), graded=False),
+from modelkit.verify.drive import Command, Drive, Scenario
+from tests.drivers_support import (
+    DRIVE,
+    PANTILT,
+    PROFILES,
+    ROUND_OFF,
+    TRACKS,
+    assert_same_layer4,
+    run_difference,
 )
 
-
-def _largest(a: Trajectory, b: Trajectory, until: int | None = None) -> float:
-    assert np.array_equal(a.t, b.t) and set(a.joints) == set(b.joints)
-    s = slice(0, until)
-    return max(float(np.hypot(a.x[s] - b.x[s], a.y[s] - b.y[s]).max()),
-               float(np.abs(a.yaw[s] - b.yaw[s]).max()),
-               float(np.abs(a.wheels[s] - b.wheels[s]).max()),
-               *(float(np.abs(a.joints[j][s] - b.joints[j][s]).max()) for j in a.joints))
+# where the child process finds this module (for the factories below): "tests.x" or "x"
+HERE = [str(Path(__file__).resolve().parents[__name__.count(".")])]
 
 
 def _pair(files: dict[str, Path], maps: dict[str, Any], drive: Drive, scenario: Scenario, **kw: Any
@@ -89,7 +67,7 @@ def test_drive_law_as_joint_damping_equals_the_python_law_every_step(pantilt_fil
         for profile in PROFILES:
             a, b = fast.run(profile, scenario, DRIVE), slow.run(profile, scenario, DRIVE)
             assert fast.last_law == ["bullet"] and slow.last_law == ["per-step"]
-            largest = _largest(a, b)
+            largest = run_difference(a, b)
             print(profile.name, f"{largest:.3g}",
                   f"fast {fast.last_wall[0]:.3f} s, per step {slow.last_wall[0]:.3f} s")
             assert largest <= ROUND_OFF, (profile.name, largest)
@@ -125,10 +103,10 @@ def test_drive_tester_equal_until_its_wheels_spin_out(pantilt_files: Any) -> Non
         profile = PROFILES[0]
         a, b, c = (d.run(profile, scenario, DRIVE) for d in (fast, slow, nudged))
         assert fast.last_law == ["bullet"]
-        early = _largest(a, b, until=201)  # samples up to 2.0 s
-        print("tester to 2 s", early, "10 s: fast", _largest(a, b), "one ulp", _largest(c, b))
+        early = run_difference(a, b, until=201)  # samples up to 2.0 s
+        print("tester to 2 s", early, "10 s: fast", run_difference(a, b), "one ulp", run_difference(c, b))
         assert early <= ROUND_OFF
-        assert 0.0 < _largest(a, b) <= 2.0 * _largest(c, b)
+        assert 0.0 < run_difference(a, b) <= 2.0 * run_difference(c, b)
     finally:
         for d in (fast, slow, nudged):
             d.close()
@@ -151,12 +129,13 @@ def test_tracks_velocity_targets_at_command_changes(tmp_path: Path) -> None:
         for profile in scenario.profiles:
             still = dataclasses.replace(profile, commands=tuple(dataclasses.replace(c, pan=0.0, tilt=0.0)
                                                                 for c in profile.commands))
-            exact = _largest(fast.run(still, scenario, drive), slow.run(still, scenario, drive))
+            exact = run_difference(fast.run(still, scenario, drive), slow.run(still, scenario, drive))
             assert fast.last_law == ["bullet"]
             print("tracks still", profile.name, exact, fast.last_wall, slow.last_wall)
             assert exact == 0.0, (profile.name, exact)
             if profile.name == "straight":
-                largest = _largest(fast.run(profile, scenario, drive), slow.run(profile, scenario, drive))
+                largest = run_difference(fast.run(profile, scenario, drive),
+                                         slow.run(profile, scenario, drive))
                 print("tracks", profile.name, largest)
                 assert largest <= ROUND_OFF, (profile.name, largest)
     finally:
@@ -187,7 +166,7 @@ def test_a_controller_without_an_affine_law_runs_per_step(pantilt_files: Any) ->
     try:
         a = wrapped.run(PROFILES[1], scenario, DRIVE)
         assert wrapped.last_law == ["per-step"] and "per step" in a.settings["control"]
-        assert _largest(a, slow.run(PROFILES[1], scenario, DRIVE)) == 0.0  # the very same computation
+        assert run_difference(a, slow.run(PROFILES[1], scenario, DRIVE)) == 0.0  # the very same computation
     finally:
         wrapped.close()
         slow.close()
@@ -223,8 +202,8 @@ def test_the_damping_half_of_the_law_matters(pantilt_files: Any) -> None:
     try:
         a, b = offsets.run(PROFILES[0], scenario, DRIVE), slow.run(PROFILES[0], scenario, DRIVE)
         assert offsets.last_law == ["bullet"]
-        print("offsets only vs the law", _largest(a, b))
-        assert _largest(a, b) > 0.1
+        print("offsets only vs the law", run_difference(a, b))
+        assert run_difference(a, b) > 0.1
     finally:
         offsets.close()
         slow.close()
@@ -247,16 +226,6 @@ def test_layer4_results_unchanged(pantilt: Any, tmp_path: Path, monkeypatch: pyt
     fast = layer4.run(pantilt, drive, scenario, tmp_path / "fast", engines=("pybullet",))
     monkeypatch.setitem(layer4.DRIVERS, "pybullet", f"{__name__}:per_step_driver")
     slow = layer4.run(pantilt, drive, scenario, tmp_path / "slow", engines=("pybullet",))
-    assert [(c.engine, c.quantity, c.where, c.passed) for c in fast.checks] == \
-        [(c.engine, c.quantity, c.where, c.passed) for c in slow.checks]
-    assert fast.checks and all(abs(a.error - b.error) <= ROUND_OFF for a, b in zip(fast.checks, slow.checks,
-                                                                                     strict=True))
-    assert [(o.engine, o.quantity, o.where) for o in fast.observations] == \
-        [(o.engine, o.quantity, o.where) for o in slow.observations]
-    assert all(abs(a.value - b.value) <= ROUND_OFF for a, b in zip(fast.observations, slow.observations,
-                                                                    strict=True))
-    runs = [(a, b) for a, b in zip(fast.trajectories, slow.trajectories, strict=True)
-            if a.source == "pybullet"]
-    assert runs and all(_largest(a, b) <= ROUND_OFF for a, b in runs)
+    runs = assert_same_layer4(fast, slow, "pybullet")
     assert all("jointDamping" in a.settings["control"] for a, _ in runs)
     print("layer 4 wall s: fast", fast.timings, "per step", slow.timings)
