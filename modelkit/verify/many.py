@@ -31,6 +31,7 @@ verdict is unknown: it may hide a failure.
 
 from __future__ import annotations
 
+import dataclasses
 import html
 import json
 import multiprocessing
@@ -60,6 +61,9 @@ class Job:
     folder: str
     options: Mapping[str, Any] = field(default_factory=dict)
     path: str = ""
+    # Start the report's plotting and picture processes while the layers run: helps one model at a
+    # time; with several models in parallel the cores are already busy and it would oversubscribe them.
+    early_report: bool = True
 
     @property
     def read_path(self) -> str:
@@ -212,15 +216,10 @@ def run_one(job: Job, out_root: Path | None) -> ModelResult:
     return result
 
 
-_EARLY_ARTEFACTS = True
-
-
 def _verify_into(job: Job, out_dir: Path) -> ModelResult:
     from modelkit.verify.api import verify
 
-    # Early report work (plotting and picture processes alongside the layers) helps one model at a
-    # time; with several models in parallel the cores are already busy, and it would oversubscribe them.
-    report = verify(job.read_path, out_dir, artefacts=_EARLY_ARTEFACTS, **dict(job.options))
+    report = verify(job.read_path, out_dir, artefacts=job.early_report, **dict(job.options))
     report.source = job.source  # the path as the user gave it, wherever the job ran
     files = save(report, out_dir, job.read_path)
     return _result_of(job, report, files)
@@ -317,12 +316,11 @@ def run_local(jobs: Sequence[Job], out_root: Path | None, workers: int,
         if progress is not None:
             progress(result, len(results), total)
 
-    global _EARLY_ARTEFACTS
     if workers <= 1 or total <= 1:
         for job in jobs:
             done(run_one(job, out_root))
         return results
-    _EARLY_ARTEFACTS = False  # read by the forked children (see _verify_into)
+    jobs = [dataclasses.replace(job, early_report=False) for job in jobs]
     methods = multiprocessing.get_all_start_methods()
     ctx: Any = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
     if "fork" in methods:
@@ -352,7 +350,6 @@ def run_local(jobs: Sequence[Job], out_root: Path | None, workers: int,
         for process, _ in running.values():
             process.kill()
             process.join()
-        _EARLY_ARTEFACTS = True
     return results
 
 
