@@ -47,9 +47,20 @@ def run_difference(a: Trajectory, b: Trajectory, until: int | None = None) -> fl
                *(float(np.abs(a.joints[j][s] - b.joints[j][s]).max()) for j in a.joints))
 
 
-def assert_same_layer4(fast: Any, slow: Any, engine: str) -> list[tuple[Trajectory, Trajectory]]:
-    """Two layer-4 results (fast and per-step driver) with every check and observation the same to
+def assert_same_layer4(robot: Any, engine: str, per_step: str, tmp_path: Path, monkeypatch: Any
+                       ) -> list[tuple[Trajectory, Trajectory]]:
+    """Layer 4 on ``robot`` (its default scenario) with ``engine``'s fast driver, then with the per-step
+    one (``per_step``: "module:function" building it), every check and observation the same to
     round-off and the same pass/fail; returns the engine's pairs of runs (each equal to round-off)."""
+    from modelkit.verify import layer4, vehicle
+    from modelkit.verify.scenario import default_scenario
+
+    scenario = default_scenario("wheels", True)
+    drive = vehicle.find_drive(robot, scenario)
+    fast = layer4.run(robot, drive, scenario, tmp_path / "fast", engines=(engine,))
+    monkeypatch.setitem(layer4.DRIVERS, engine, per_step)
+    slow = layer4.run(robot, drive, scenario, tmp_path / "slow", engines=(engine,))
+    print("layer 4 wall s: fast", fast.timings, "per step", slow.timings)
     assert [(c.engine, c.quantity, c.where, c.passed) for c in fast.checks] == \
         [(c.engine, c.quantity, c.where, c.passed) for c in slow.checks]
     assert fast.checks and all(abs(a.error - b.error) <= ROUND_OFF for a, b in zip(fast.checks, slow.checks,

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import modelkit
-from modelkit.verify import controllers, engine_mujoco, layer4, variant
+from modelkit.verify import controllers, engine_mujoco, variant
 from modelkit.verify.drive import Command, Drive, Scenario
 from tests.drivers_support import (
     DRIVE,
@@ -160,13 +160,5 @@ def test_layer4_results_unchanged(pantilt: Any, tmp_path: Path, monkeypatch: pyt
     """Layer 4 (MuJoCo, default scenario of the pan-tilt robot, sphere and native variants): every
     check and observation the same to round-off, the same pass/fail, with the fast driver as with the
     per-step one."""
-    from modelkit.verify import vehicle
-    from modelkit.verify.scenario import default_scenario
-
-    scenario = default_scenario("wheels", True)
-    drive = vehicle.find_drive(pantilt, scenario)
-    fast = layer4.run(pantilt, drive, scenario, tmp_path / "fast", engines=("mujoco",))
-    monkeypatch.setitem(layer4.DRIVERS, "mujoco", f"{__name__}:per_step_driver")
-    slow = layer4.run(pantilt, drive, scenario, tmp_path / "slow", engines=("mujoco",))
-    assert_same_layer4(fast, slow, "mujoco")
-    print("layer 4 wall s: fast", fast.timings, "per step", slow.timings)
+    runs = assert_same_layer4(pantilt, "mujoco", f"{__name__}:per_step_driver", tmp_path, monkeypatch)
+    assert runs
