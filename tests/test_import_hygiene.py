@@ -1,9 +1,10 @@
 """`modelkit validate` and `modelkit tree` must not import the simulators (mujoco, pybullet), nor
 the mesh stack (trimesh) for a model that has no mesh files.
 
-MJCF input is the only exception: an MJCF file is read through MuJoCo, so reading one imports
-mujoco (inside ``modelkit.formats.mjcf``, when the file is read). pybullet is never imported, and
-other XML files (a URDF named ``.xml``, told apart by its top element) do not import mujoco.
+An MJCF file is compiled by MuJoCo, through its C library called directly (``modelkit.formats.mjcf.native``):
+a file that compiles imports neither the mujoco bindings nor numpy; one that does not falls back to the
+bindings (they report the error and read the uncompiled spec). pybullet is never imported, and other XML
+files (a URDF named ``.xml``, told apart by its top element) do not touch MuJoCo.
 
 Each command runs in a fresh interpreter (the test process has imported who knows what). The
 child puts a recording finder first on ``sys.meta_path`` before importing modelkit, so an import
@@ -127,12 +128,13 @@ URDF_AS_XML = """\
 
 
 @pytest.mark.parametrize("command", [["validate"], ["tree"]], ids=["validate", "tree"])
-def test_mjcf_input_is_the_only_exception(command: list[str]) -> None:
-    """An MJCF file is read through MuJoCo: mujoco is imported for it; pybullet still never."""
-    report = _run([*command, str(MJCF_MODEL)], SIMULATORS)
+def test_mjcf_input_is_read_through_mujocos_library_not_its_bindings(command: list[str]) -> None:
+    """An MJCF file is compiled by MuJoCo's C library, called directly (``formats.mjcf.native``): neither
+    the mujoco bindings nor numpy are imported for a file that compiles; pybullet never."""
+    report = _run([*command, str(MJCF_MODEL)], (*SIMULATORS, "numpy"))
     assert report["exit_code"] == 0, report["output"]
-    assert "mujoco" in report["modules"]
-    assert "modelkit.formats.mjcf.reader" in report["modules"]
+    assert "modelkit.formats.mjcf.native" in report["modules"]
+    assert [m for m in report["modules"] if m.partition(".")[0] in ("mujoco", "numpy")] == []
     assert [m for m in report["modules"] if m.partition(".")[0] == "pybullet"] == []
     assert [m for m in report["attempted"] if m.partition(".")[0] == "pybullet"] == []
 

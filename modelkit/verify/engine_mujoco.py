@@ -46,11 +46,12 @@ def unstable(messages: list[str]) -> list[str]:
 def quiet(into: list[str]) -> Iterator[None]:
     """MuJoCo's warnings go into ``into`` (never MuJoCo's default handler, which writes
     ``MUJOCO_LOG.TXT`` into the working directory): every MuJoCo call here runs inside this."""
-    with collected_warnings(mujoco) as messages:
-        try:
+    messages: list[str] = []
+    try:
+        with collected_warnings(mujoco) as messages:
             yield
-        finally:
-            into.extend(messages)
+    finally:
+        into.extend(messages)  # complete only once the block has ended
 _TYPES = {
     int(mujoco.mjtJoint.mjJNT_HINGE): "revolute",
     int(mujoco.mjtJoint.mjJNT_SLIDE): "prismatic",

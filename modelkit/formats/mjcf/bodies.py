@@ -4,6 +4,10 @@ The compiled reader (:mod:`.compiled`) and the fallback (:mod:`.uncompiled`) bot
 records; :mod:`.build` turns them into robots. Values are MuJoCo's: poses relative to the parent
 body, joint anchors and axes in the body frame, sizes as MuJoCo stores them (half-lengths), angles
 in radians.
+
+The records hold plain tuples (vectors ``(x, y, z)``, matrices tuples of rows, :mod:`modelkit.rot3`)
+whatever the arrays they were read from (numpy rows from the ``mujoco`` bindings or plain tuples), so
+turning them into robots imports no numpy.
 """
 
 from __future__ import annotations
@@ -11,18 +15,18 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
-from modelkit.spatial import Mat3, Pose, Vec3, matrix_from_quat_wxyz
+from modelkit import rot3
+from modelkit.rot3 import M3, V3
+from modelkit.spatial import Pose
 
 
 def pose_of(pos: Any, quat: Any) -> Pose:
     """A MuJoCo position and quaternion (w, x, y, z; a zero one is no rotation, as in MuJoCo)."""
-    return Pose(matrix_from_quat_wxyz(quat), np.asarray(pos, dtype=float).copy())
+    return Pose(rot3.from_quat_wxyz(quat), rot3.vec3(pos))
 
 
 def translation(vector: Any) -> Pose:
-    return Pose(np.eye(3), np.asarray(vector, dtype=float).copy())
+    return Pose(rot3.IDENTITY, rot3.vec3(vector))
 
 
 @dataclass
@@ -32,8 +36,8 @@ class MjJoint:
     index: int
     name: str | None
     kind: str
-    pos: Vec3
-    axis: Vec3  # unit once compiled; as written from a bare spec (the builder normalises)
+    pos: V3
+    axis: V3  # unit once compiled; as written from a bare spec (the builder normalises)
     limited: bool = False
     range: tuple[float, float] = (0.0, 0.0)
     ref: float = 0.0
@@ -53,7 +57,7 @@ class MjGeom:
     index: int
     name: str | None
     kind: str  # "box", "sphere", "capsule", "cylinder", "ellipsoid", "mesh", "plane", "hfield", "sdf"
-    size: Vec3
+    size: V3
     pose: Pose
     contype: int = 1
     conaffinity: int = 1
@@ -63,7 +67,7 @@ class MjGeom:
     mesh_name: str | None = None
     mesh_file: str | None = None
     mesh_path: str | None = None
-    mesh_scale: Vec3 = field(default_factory=lambda: np.ones(3))
+    mesh_scale: V3 = (1.0, 1.0, 1.0)
 
     @property
     def visual_only(self) -> bool:
@@ -76,8 +80,8 @@ class MjInertial:
     """Mass, centre of mass and the full inertia tensor about it, in body axes."""
 
     mass: float
-    ipos: Vec3
-    inertia: Mat3
+    ipos: V3
+    inertia: M3
 
 
 @dataclass
@@ -86,7 +90,7 @@ class MjSite:
     name: str | None
     kind: str
     pose: Pose
-    size: Vec3
+    size: V3
 
 
 @dataclass

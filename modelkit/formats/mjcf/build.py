@@ -12,6 +12,9 @@ The mapping (``docs/mjcf.md`` says it for users):
 * a joint's q is MuJoCo's qpos: a joint ``ref`` is folded into the joint origin;
 * each top-level body starts a robot: free joint → floating root, no joint → fixed root at its
   pose, other joints → a synthesised fixed ``world`` link they hang from.
+
+The build imports no numpy: vectors and poses stay plain tuples (:mod:`modelkit.rot3`, and
+``Pose.rotation_tuple`` / ``translation_tuple`` rather than the numpy-reading attributes).
 """
 
 from __future__ import annotations
@@ -20,8 +23,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
+from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
 from modelkit.formats.mjcf.bodies import MjBody, MjGeom, MjJoint, MjSite, translation
 from modelkit.formats.mjcf.source import Locator
@@ -45,7 +47,7 @@ from modelkit.model import (
     Sphere,
     VisualMaterial,
 )
-from modelkit.spatial import Pose, axis_angle
+from modelkit.spatial import Pose
 
 JOINT_TYPES = {
     "hinge": JointType.REVOLUTE,
@@ -224,12 +226,12 @@ class RobotBuilder:
             joint.sources["name"] = joint.sources["parent"] = self.loc.body(body.index)
             robot.joints.append(joint)
             return
-        parent, previous = start, np.zeros(3)
+        parent, previous = start, rot3.ZERO3
         links: list[str] = []
         for k, mj in enumerate(joints):
             last = k == len(joints) - 1
-            anchor = np.zeros(3) if mj.kind == "free" else mj.pos
-            step = pose @ translation(anchor) if k == 0 else translation(anchor - previous)
+            anchor = rot3.ZERO3 if mj.kind == "free" else rot3.vec3(mj.pos)
+            step = pose @ translation(anchor) if k == 0 else translation(rot3.sub(anchor, previous))
             origin = step @ self._ref(mj)
             if last:
                 child = link.name
@@ -258,12 +260,14 @@ class RobotBuilder:
     def _ref(mj: MjJoint) -> Pose:
         """The motion of the joint to q = 0 from its reference position (MuJoCo's body pose is
         the pose at qpos = ref)."""
-        if mj.ref == 0.0 or float(np.linalg.norm(mj.axis)) == 0.0:
+        norm = rot3.norm(mj.axis)
+        if mj.ref == 0.0 or norm == 0.0:
             return Pose()
         if mj.kind == "hinge":
-            return Pose(axis_angle(mj.axis, -mj.ref), np.zeros(3))
+            return Pose(rot3.axis_angle(mj.axis, -mj.ref), rot3.ZERO3)
         if mj.kind == "slide":
-            return translation(-mj.ref * np.asarray(mj.axis) / float(np.linalg.norm(mj.axis)))
+            x, y, z = rot3.scale(-mj.ref, rot3.vec3(mj.axis))
+            return translation((x / norm, y / norm, z / norm))
         return Pose()
 
     def _intermediate(self, name: str, body: MjBody, mj: MjJoint) -> Link:
@@ -276,14 +280,15 @@ class RobotBuilder:
 
     def _joint(self, mj: MjJoint, parent: str, child: str, origin: Pose) -> Joint:
         loc = self.loc
-        norm = float(np.linalg.norm(mj.axis))
+        norm = rot3.norm(mj.axis)
+        x, y, z = rot3.vec3(mj.axis)
         joint = Joint(
             self.joint_name[mj.index],
             JOINT_TYPES[mj.kind],
             parent,
             child,
             origin=origin,
-            axis=np.asarray(mj.axis, dtype=float) / norm if norm > 0 else np.asarray(mj.axis, dtype=float),
+            axis=(x / norm, y / norm, z / norm) if norm > 0 else (x, y, z),
             armature=mj.armature,
             damping=mj.damping,
             friction=mj.frictionloss,
@@ -326,8 +331,9 @@ class RobotBuilder:
         link = Link(self.link_name[b], source=self.loc.body(b))
         link.sources["name"] = self.loc.body(b, "name")
         link.extras["mjcf_body_id"] = b
-        if np.any(offset.translation != 0.0):
-            link.extras["mjcf_body_offset"] = [float(x) for x in offset.translation]
+        shift = offset.translation_tuple
+        if any(x != 0.0 for x in shift):
+            link.extras["mjcf_body_offset"] = [float(x) for x in shift]
         if body.mocap:
             link.extras["mjcf_mocap"] = True
         back = offset.inverse()
@@ -335,8 +341,9 @@ class RobotBuilder:
         if inertial is not None:
             link.inertial = Inertial(
                 inertial.mass,
-                com=back.translation + np.asarray(inertial.ipos, dtype=float),
-                inertia=inertial.inertia,  # written, or computed by MuJoCo from the geoms: never a default
+                com=rot3.add(back.translation_tuple, rot3.vec3(inertial.ipos)),
+                # written, or computed by MuJoCo from the geoms: never a default
+                inertia=rot3.mat3(inertial.inertia),
                 source=self.loc.inertial(b),
             )
             link.inertial.sources["mass"] = self.loc.inertial(b, "mass")
@@ -378,7 +385,8 @@ class RobotBuilder:
         material = None
         if mg.rgba is not None:
             r, g, b, a = mg.rgba
-            material = VisualMaterial(name=mg.material, diffuse=np.array([r, g, b]), transparency=1.0 - a)
+            diffuse = (float(r), float(g), float(b))
+            material = VisualMaterial(name=mg.material, diffuse=diffuse, transparency=1.0 - a)
         return Geom(geometry, back @ mg.pose, mg.name, material, where)
 
     @staticmethod
@@ -386,7 +394,7 @@ class RobotBuilder:
         s = mg.size
         kind = mg.kind
         if kind == "box":
-            return Box(2.0 * np.asarray(s[:3], dtype=float))
+            return Box(rot3.scale(2.0, rot3.vec3(s[:3])))
         if kind == "sphere":
             return Sphere(float(s[0]))
         if kind == "capsule":
@@ -394,9 +402,9 @@ class RobotBuilder:
         if kind == "cylinder":
             return Cylinder(float(s[0]), 2.0 * float(s[1]))
         if kind == "ellipsoid":
-            return Ellipsoid(np.asarray(s[:3], dtype=float).copy())
+            return Ellipsoid(rot3.vec3(s[:3]))
         if kind == "mesh" and (mg.mesh_file or mg.mesh_name):
-            return Mesh(uri=mg.mesh_file, path=mg.mesh_path, scale=np.asarray(mg.mesh_scale, dtype=float))
+            return Mesh(uri=mg.mesh_file, path=mg.mesh_path, scale=rot3.vec3(mg.mesh_scale))
         return None
 
     # -- data kept on the robots ---------------------------------------------------------------
@@ -407,8 +415,8 @@ class RobotBuilder:
         return {
             "name": name,
             "link": self.link_name.get(body),
-            "xyz": [float(x) for x in placed.translation],
-            "rotation": [[float(x) for x in row] for row in placed.rotation],
+            "xyz": [float(x) for x in placed.translation_tuple],
+            "rotation": [[float(x) for x in row] for row in placed.rotation_tuple],
             **params,
         }
 

@@ -3,6 +3,9 @@
 Compilation resolves everything MJCF leaves implicit: defaults and classes, ``childclass``,
 ``<include>``, ``<frame>``, angle units and Euler sequences, ``fromto``, inertia from geoms. Reading
 the compiled arrays therefore gives exactly what MuJoCo simulates.
+
+No numpy here: the arrays are read row by row into plain floats (:mod:`modelkit.rot3`), so the same
+code reads the ``mujoco`` bindings' numpy arrays and a model whose arrays are plain tuples.
 """
 
 from __future__ import annotations
@@ -10,8 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
+from modelkit import rot3
 from modelkit.formats.mjcf.bodies import (
     MjBody,
     MjGeom,
@@ -21,10 +23,21 @@ from modelkit.formats.mjcf.bodies import (
     pose_of,
     translation,
 )
-from modelkit.spatial import Pose, matrix_from_quat_wxyz, rotate_inertia
+from modelkit.spatial import Pose
 
 JOINT_KINDS = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
 DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)
+
+
+def all_close(a: tuple[float, ...], b: tuple[float, ...], rtol: float = 1e-5, atol: float = 1e-8) -> bool:
+    """``numpy.allclose`` for two equally long rows of floats: ``|a − b| ≤ atol + rtol·|b|`` each."""
+    return len(a) == len(b) and all(abs(x - y) <= atol + rtol * abs(y) for x, y in zip(a, b, strict=True))
+
+
+def diagonal(moments: Any) -> rot3.M3:
+    """The diagonal matrix of three principal moments."""
+    x, y, z = rot3.vec3(moments)
+    return rot3.inertia_from_moments(x, 0.0, 0.0, y, 0.0, z)
 
 
 def enum_word(enum_value: Any, prefix: str) -> str:
@@ -59,8 +72,8 @@ class CompiledModel:
                 pose=pose_of(m.body_pos[b], m.body_quat[b]),
                 inertial=MjInertial(
                     float(m.body_mass[b]),
-                    np.array(m.body_ipos[b], dtype=float),
-                    rotate_inertia(np.diag(m.body_inertia[b]), matrix_from_quat_wxyz(m.body_iquat[b])),
+                    rot3.vec3(m.body_ipos[b]),
+                    rot3.rotate_inertia(diagonal(m.body_inertia[b]), rot3.from_quat_wxyz(m.body_iquat[b])),
                 ),
                 mocap=int(m.body_mocapid[b]) >= 0,
             )
@@ -93,8 +106,8 @@ class CompiledModel:
             index=j,
             name=self.name("joint", j),
             kind=kind,
-            pos=np.array(m.jnt_pos[j], dtype=float),
-            axis=np.array(m.jnt_axis[j], dtype=float),
+            pos=rot3.vec3(m.jnt_pos[j]),
+            axis=rot3.vec3(m.jnt_axis[j]),
             limited=bool(m.jnt_limited[j]),
             range=(float(m.jnt_range[j][0]), float(m.jnt_range[j][1])),
             ref=float(m.qpos0[qadr]) if scalar else 0.0,
@@ -117,13 +130,13 @@ class CompiledModel:
         matid = int(m.geom_matid[g])
         if matid >= 0:
             material = self.name("material", matid)
-            if np.allclose(rgba, DEFAULT_RGBA):
+            if all_close(rgba, DEFAULT_RGBA):
                 rgba = tuple(float(x) for x in m.mat_rgba[matid])
         geom = MjGeom(
             index=g,
             name=self.name("geom", g),
             kind=kind,
-            size=np.array(m.geom_size[g], dtype=float),
+            size=rot3.vec3(m.geom_size[g]),
             pose=pose,
             contype=int(m.geom_contype[g]),
             conaffinity=int(m.geom_conaffinity[g]),
@@ -143,7 +156,7 @@ class CompiledModel:
         m = self.m
         geom.mesh_name = self.name("mesh", mesh)
         geom.pose = geom.pose @ pose_of(m.mesh_pos[mesh], m.mesh_quat[mesh]).inverse()
-        geom.mesh_scale = np.array(m.mesh_scale[mesh], dtype=float)
+        geom.mesh_scale = rot3.vec3(m.mesh_scale[mesh])
         meshes = list(self.spec.meshes)
         if mesh < len(meshes):
             written = str(meshes[mesh].file or "")
@@ -158,7 +171,7 @@ class CompiledModel:
             name=self.name("site", s),
             kind=enum_word(self.mj.mjtGeom(int(m.site_type[s])), "mjGEOM_"),
             pose=pose_of(m.site_pos[s], m.site_quat[s]),
-            size=np.array(m.site_size[s], dtype=float),
+            size=rot3.vec3(m.site_size[s]),
         )
 
     # -- what the model keeps as data ---------------------------------------------------------

@@ -23,8 +23,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
-
+from modelkit import rot3
 from modelkit.formats.devices import canonical_from_gl, horizontal_fov
 from modelkit.formats.mjcf.bodies import pose_of, translation
 from modelkit.formats.mjcf.build import Built, RobotBuilder
@@ -34,7 +33,7 @@ from modelkit.spatial import Pose
 
 # The device frame's axes seen from a rangefinder site (columns: site x, y, z in the device frame):
 # the site's +Z (the ray) is the device's +X.
-RAY_SITE_IN_DEVICE = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+RAY_SITE_IN_DEVICE: rot3.M3 = ((0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
 LIGHT_KINDS = {
     "spot": DeviceKind.SPOT_LIGHT,
     "directional": DeviceKind.DIRECTIONAL_LIGHT,
@@ -95,7 +94,7 @@ class _Placer:
             canonical=DeviceKind.CAMERA,
             canonical_params=canonical,
         )
-        self.attach(body, device, Pose(canonical_from_gl(pose.rotation), pose.translation))
+        self.attach(body, device, Pose(canonical_from_gl(pose.rotation_tuple), pose.translation_tuple))
 
     def light(self, lt: int) -> None:
         m = self.m
@@ -169,7 +168,10 @@ class _Placer:
                 }
                 if float(m.sensor_cutoff[s]) > 0.0:
                     canonical["range_max"] = float(m.sensor_cutoff[s])
-                pose = Pose(site_pose.rotation @ RAY_SITE_IN_DEVICE.T, site_pose.translation)
+                pose = Pose(
+                    rot3.matmul(site_pose.rotation_tuple, rot3.transpose(RAY_SITE_IN_DEVICE)),
+                    site_pose.translation_tuple,
+                )
             elif kind in ("accelerometer", "gyro"):
                 canonical_kind = DeviceKind.ACCELEROMETER if kind == "accelerometer" else DeviceKind.GYRO
                 pose = site_pose

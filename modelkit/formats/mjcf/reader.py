@@ -5,7 +5,8 @@ Steps:
 1. modelkit parses the file itself (:mod:`modelkit.xmlsource`): malformed XML (MK020) and entity
    declarations (MK021) are refused before MuJoCo sees the file, and every element gets a line
    and column;
-2. ``mujoco.MjSpec.from_file`` parses it (schema errors → MK170 at MuJoCo's line);
+2. MuJoCo parses it: through its C library directly (:mod:`.native`, no numpy, no bindings) when
+   that can be used, else ``mujoco.MjSpec.from_file`` (schema errors → MK170 at MuJoCo's line);
 3. the spec is compiled with static-body fusion and visual discarding switched off, so every body
    and geom survives; the compiled ``MjModel`` is read (:mod:`.compiled`);
 4. if compilation fails (a missing mesh, a bad inertia...), the error is reported (MK170) and the
@@ -13,7 +14,8 @@ Steps:
 5. the bodies become robots (:mod:`.build`), paired with their XML elements for source
    locations (:mod:`.source`).
 
-``mujoco`` is imported here only, when an MJCF file is read.
+``mujoco`` is imported here only, when an MJCF file is read and the C library cannot be used directly
+or the file does not compile.
 """
 
 from __future__ import annotations
@@ -79,16 +81,34 @@ class _MjcfReader:
             return []
         if not check_sizes(index, self.sink, self.options.max_links):
             return []
+        if compiled and not _uses_plugins(index):
+            robots = self._through_native(index)
+            if robots is not None:
+                return robots
         try:
             mujoco = _import_mujoco()
         except ImportError as exc:  # pragma: no cover - mujoco is a dependency
             self.sink.emit("MK170", f"cannot read MJCF: mujoco is not installed ({exc})", doc.loc(doc.root))
             return []
         with collected_warnings(mujoco) as warnings:  # never MUJOCO_LOG.TXT in the working directory
+            robots = self._through_mujoco(mujoco, index, compiled)
+        for message in dict.fromkeys(warnings):
+            self.sink.emit("MK177", f"MuJoCo warned: {message}", index.top().loc())
+        return robots
+
+    def _through_native(self, index: SourceIndex) -> list[Robot] | None:
+        """The compiled model through MuJoCo's C library (:mod:`.native`); ``None`` when the bindings
+        must read it (they then report any parse or compile error themselves)."""
+        from modelkit.formats.mjcf import native
+
+        with native.compiled(self.path) as result:
+            if result is None:
+                return None
             try:
-                return self._through_mujoco(mujoco, index, compiled)
+                name = self._model_name(index)
+                return self._from_compiled(result.mj, result.model, result.spec, index, name)
             finally:
-                for message in dict.fromkeys(warnings):
+                for message in dict.fromkeys(result.warnings):
                     self.sink.emit("MK177", f"MuJoCo warned: {message}", index.top().loc())
 
     def _through_mujoco(self, mujoco: Any, index: SourceIndex, compiled: bool) -> list[Robot]:
@@ -223,8 +243,8 @@ class _MjcfReader:
             "name": geom.name,
             "type": geom.kind,
             "size": [float(x) for x in geom.size],
-            "xyz": [float(x) for x in geom.pose.translation],
-            "rotation": [[float(x) for x in row] for row in geom.pose.rotation],
+            "xyz": [float(x) for x in geom.pose.translation_tuple],
+            "rotation": [[float(x) for x in row] for row in geom.pose.rotation_tuple],
             "source": str(builder.loc.geom(geom.index)),
         }
 
@@ -314,6 +334,11 @@ class _MjcfReader:
                 placed = by_file.get(written)
                 loc = placed.loc("file") if placed is not None else index.top().loc()
                 self.sink.emit("MK500", not_found(written, path), loc)
+
+
+def _uses_plugins(index: SourceIndex) -> bool:
+    """Whether the model names an engine plugin, which only the bindings load (see :mod:`.native`)."""
+    return any(placed.tag in ("extension", "plugin") for placed in index.iter_all())
 
 
 def _shapes(bodies: list[MjBody]) -> list[TreeShape]:

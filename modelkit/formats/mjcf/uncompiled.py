@@ -12,10 +12,9 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
-
+from modelkit import rot3
 from modelkit.formats.mjcf.bodies import MjBody, MjInertial, MjJoint, pose_of
-from modelkit.spatial import Pose, inertia_from_moments, matrix_from_quat_wxyz, rotate_inertia
+from modelkit.spatial import Pose
 
 JOINT_KINDS = {"mjJNT_FREE": "free", "mjJNT_BALL": "ball", "mjJNT_SLIDE": "slide", "mjJNT_HINGE": "hinge"}
 
@@ -79,24 +78,34 @@ class SpecReader:
             index=index,
             name=str(joint.name) or None,
             kind=kind,
-            pos=np.array(joint.pos, dtype=float),
-            axis=np.array(joint.axis, dtype=float),  # as written; the builder normalises it
+            pos=rot3.vec3(joint.pos),
+            axis=rot3.vec3(joint.axis),  # as written; the builder normalises it
             limited=limited and kind != "free",
             range=(low * scale, high * scale),
             ref=float(joint.ref) * (scale if kind == "hinge" else 1.0),
-            damping=float(np.asarray(joint.damping).ravel()[0]),
+            damping=first(joint.damping),
             frictionloss=float(joint.frictionloss),
             armature=float(joint.armature),
-            stiffness=float(np.asarray(joint.stiffness).ravel()[0]),
+            stiffness=first(joint.stiffness),
             springref=float(joint.springref),
         )
 
     def _inertial(self, body: Any) -> MjInertial:
-        full = np.array(body.fullinertia, dtype=float)
+        full = [float(x) for x in body.fullinertia]
         if math.isfinite(full[0]):
             xx, yy, zz, xy, xz, yz = full  # MuJoCo's order
-            tensor = inertia_from_moments(xx, xy, xz, yy, yz, zz)
+            tensor = rot3.inertia_from_moments(xx, xy, xz, yy, yz, zz)
         else:
-            rotation = matrix_from_quat_wxyz(self._quat(body.iquat, body.ialt))
-            tensor = rotate_inertia(np.diag(np.array(body.inertia, dtype=float)), rotation)
-        return MjInertial(float(body.mass), np.array(body.ipos, dtype=float), tensor)
+            rotation = rot3.from_quat_wxyz(self._quat(body.iquat, body.ialt))
+            x, y, z = rot3.vec3(body.inertia)
+            tensor = rot3.rotate_inertia(rot3.inertia_from_moments(x, 0.0, 0.0, y, 0.0, z), rotation)
+        return MjInertial(float(body.mass), rot3.vec3(body.ipos), tensor)
+
+
+def first(value: Any) -> float:
+    """The first number of a scalar or a (nested) sequence: the spec keeps some scalars as arrays."""
+    try:
+        items = list(value)
+    except TypeError:  # a number (or a 0-d array)
+        return float(value)
+    return first(items[0])
