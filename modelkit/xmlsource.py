@@ -297,18 +297,9 @@ def parse_xml_bytes(
         if message.startswith("Excessive depth"):  # libxml2's own limit (256) behind ours
             _too_deep(sink, where)
             return None
-        root = _lenient_comments(data, parser) if "hyphen within comment" in message else None
+        root = _as_tinyxml2_reads(data, parser, message, where, text, display, sink)
         if root is None:
-            sink.emit("MK020", f"malformed XML: {message}", where)
             return None
-        sink.emit(
-            "MK020",
-            'a comment contains "--", which XML forbids: libsdformat, urdfdom and MuJoCo (TinyXML2) '
-            "accept it, strict XML tools (xacro, lxml, ROS launch) refuse it",
-            where,
-            hint='write "- -" or "-" inside comments',
-            severity=Severity.WARNING,
-        )
     except ValueError as exc:  # e.g. an encoding declaration lxml cannot honour
         sink.emit("MK020", f"malformed XML: {exc}", SourceLocation(display))
         return None
@@ -334,13 +325,12 @@ def _too_deep(sink: DiagnosticSink, where: SourceLocation) -> None:
 
 
 _COMMENT = re.compile(rb"<!--(.*?)-->", re.DOTALL)
+_DECLARATION = re.compile(rb"\A(\xef\xbb\xbf)?(\s*)(<\?xml\b.*?\?>)", re.DOTALL)
+_DECLARED_ENCODING = re.compile(rb"""encoding\s*=\s*["']([^"']*)["']""")
 
 
-def _lenient_comments(data: bytes, parser: etree.XMLParser) -> etree._Element | None:
-    """Parse ``data`` as TinyXML2 does, which takes ``--`` inside comments: each such pair (and a ``-``
-    before ``-->``) becomes a space, so every offset stays where it was. None if it still fails."""
-    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        return None
+def _blank_comment_hyphens(data: bytes) -> bytes | None:
+    """TinyXML2 takes ``--`` inside comments: each such pair (and a ``-`` before ``-->``) becomes a space."""
 
     def blank(match: re.Match[bytes]) -> bytes:
         inner = match.group(1).replace(b"--", b"- ")
@@ -348,10 +338,84 @@ def _lenient_comments(data: bytes, parser: etree.XMLParser) -> etree._Element | 
             inner = inner[:-1] + b" "
         return b"<!--" + inner + b"-->"
 
-    try:
-        return etree.fromstring(_COMMENT.sub(blank, data), parser)
-    except (etree.XMLSyntaxError, ValueError):
+    return _COMMENT.sub(blank, data)
+
+
+def _blank_declaration(data: bytes) -> bytes | None:
+    """TinyXML2 does not judge the XML declaration (any ``version``, whitespace before it): it becomes
+    spaces. Not when it names an encoding other than UTF-8, which the blanked document would lose."""
+    found = _DECLARATION.match(data)
+    if found is None:
         return None
+    encoding = _DECLARED_ENCODING.search(found.group(3))
+    if encoding and encoding.group(1).lower().replace(b"-", b"") not in (b"utf8", b"usascii", b"ascii"):
+        return None
+    start, end = found.span(3)
+    return data[:start] + bytes(b if b in b"\r\n" else 32 for b in data[start:end]) + data[end:]
+
+
+_COMMENT_HYPHENS = (
+    'a comment contains "--", which XML forbids: libsdformat, urdfdom and MuJoCo (TinyXML2) accept it, '
+    "strict XML tools (xacro, lxml, ROS launch) refuse it",
+    'write "- -" or "-" inside comments',
+)
+_DECLARATION_PROBLEM = (
+    "the XML declaration {problem}; libsdformat, urdfdom, MuJoCo and PyBullet (TinyXML2) ignore it, strict "
+    "XML tools (lxml, so urdf_parser_py and yourdfpy{expat}) refuse it",
+    'start the file with <?xml version="1.0"?> or leave the declaration out',
+)
+#: libxml2's complaint → (how TinyXML2 reads past it, what to say, the hint).
+_TINYXML2_LENIENCY = {
+    "hyphen within comment": (_blank_comment_hyphens, *_COMMENT_HYPHENS),
+    "Unsupported version": (_blank_declaration, *_DECLARATION_PROBLEM),
+    "XML declaration allowed only at the start": (_blank_declaration, *_DECLARATION_PROBLEM),
+}
+
+
+def _as_tinyxml2_reads(
+    data: bytes,
+    parser: etree.XMLParser,
+    message: str,
+    where: SourceLocation,
+    text: str,
+    display: str,
+    sink: DiagnosticSink,
+) -> etree._Element | None:
+    """Parse ``data`` again past what libxml2 refuses and TinyXML2 (the reference loaders' parser)
+    accepts, each with a warning; every offset stays where it was. The error (MK020) when that fails."""
+    applied: set[str] = set()
+    while not data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        problem = next((p for p in _TINYXML2_LENIENCY if p in message and p not in applied), None)
+        if problem is None:
+            break
+        applied.add(problem)
+        repair, said, hint = _TINYXML2_LENIENCY[problem]
+        repaired = repair(data)
+        if repaired is None:
+            break
+        if repair is _blank_declaration:
+            declaration = _DECLARATION.match(data)
+            at = declaration.start(3) if declaration else 0
+            where = location_at(text, display, len(data[:at].decode("utf-8", "replace")))
+            version = re.search(r"version\s*=\s*[\"']([^\"']*)", text)
+            said = said.format(
+                problem=(f'names version "{version.group(1)}", not 1.0' if "version" in problem and version
+                         else "is not at the start of the file"),
+                expat="" if "version" in problem else ", and xacro",
+            )
+        sink.emit("MK020", said, where, hint=hint, severity=Severity.WARNING)
+        data = repaired
+        try:
+            return etree.fromstring(data, parser)
+        except etree.XMLSyntaxError as exc:
+            line, col = exc.position if exc.position else (exc.lineno or 0, 0)
+            message = str(exc.msg or exc).split(", line ")[0]
+            where = SourceLocation(display, line or 0, max(col, 1))
+        except ValueError as exc:
+            message = str(exc)
+            break
+    sink.emit("MK020", f"malformed XML: {message}", where)
+    return None
 
 
 def read_xml(
