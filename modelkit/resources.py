@@ -6,7 +6,9 @@ Search order for ``package://NAME/REL`` (see docs/resources.md):
 2. each entry E of ``ROS_PACKAGE_PATH``: ``E/NAME/REL`` (and ``E/REL`` when E is the package itself);
 3. each entry E of ``AMENT_PREFIX_PATH``: ``E/share/NAME/REL``;
 4. walking up from the model file: the first folder whose ``package.xml`` names NAME, or which holds
-   ``NAME/package.xml``.
+   ``NAME/package.xml``;
+5. as PyBullet does when none of those finds the package: ``NAME/REL`` beside the model file. That is
+   reported (a warning, MK504): ROS tools and Gazebo will not find the file.
 
 ``model://NAME/REL`` looks in the ``--resource-path`` folders, then ``GZ_SIM_RESOURCE_PATH``,
 ``IGN_GAZEBO_RESOURCE_PATH``, ``SDF_PATH`` and ``GAZEBO_MODEL_PATH`` (:data:`MODEL_PATH_VARIABLES`); an SDF
@@ -35,7 +37,9 @@ MODEL_PATH_VARIABLES = ("GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH", "SDF
 @dataclass(frozen=True)
 class Resolution:
     """Where a URI points. ``path`` is None when it cannot be resolved; then ``code`` and
-    ``message`` say why (``path`` may also be set for a file that does not exist: check it)."""
+    ``message`` say why (``path`` may also be set for a file that does not exist: check it). A
+    ``package://`` URI found only by PyBullet's rule has a ``path``, no ``code`` and a ``message``
+    (see :func:`package_report`)."""
 
     uri: str
     path: Path | None
@@ -90,6 +94,18 @@ class Resolver:
     def _resolve_package(self, uri: str, rest: str, model_file: Path) -> Resolution:
         package, _, relative = rest.partition("/")
         root = self.find_package(package, model_file.parent)
+        beside = _normal(model_file.parent / rest)
+        if root is None and relative and beside.is_file():
+            return Resolution(
+                uri,
+                beside,
+                "package",
+                message=f'package "{package}" of "{uri}" cannot be found on the package paths; the file is '
+                f"read beside the model ({beside}), as PyBullet reads it, but ROS tools (RViz, "
+                "robot_state_publisher) and Gazebo will not find it",
+                hint=f"give the package's folder with --package-path {package}=DIR, or add a package.xml "
+                f'naming "{package}"',
+            )
         if root is None:
             return Resolution(
                 uri,
@@ -159,6 +175,14 @@ class Resolver:
             f'model "{model}" of "{uri}" cannot be found',
             hint="add its parent folder to GZ_SIM_RESOURCE_PATH or give it with --resource-path",
         )
+
+
+def package_report(resolution: Resolution, uri: str) -> tuple[str, str, str | None, bool]:
+    """How to report a resolved ``package://`` URI: (code, message, hint, is a warning). Found only
+    beside the model, as PyBullet looks (MK504, a warning), or on the package search path (MK510, info)."""
+    if resolution.message:
+        return "MK504", resolution.message, resolution.hint, True
+    return "MK510", f'"{uri}" depends on the package search path; found at {resolution.path}', None, False
 
 
 def _split_paths(value: str) -> list[Path]:

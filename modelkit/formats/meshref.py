@@ -16,7 +16,7 @@ from pathlib import Path
 from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
 from modelkit.model import Mesh
-from modelkit.resources import Resolution, Resolver
+from modelkit.resources import Resolution, Resolver, package_report
 from modelkit.textio import UnreadableFile, check_regular
 
 MESH_FILE_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl"})
@@ -108,7 +108,8 @@ class MeshChecker:
             )
         elif path is not None:
             if resolution.scheme == "package":
-                self.sink.emit("MK510", f'"{uri}" depends on the package search path; found at {path}', loc)
+                code, message, hint, warning = package_report(resolution, uri)
+                self.sink.emit(code, message, loc, hint=hint, severity=Severity.WARNING if warning else None)
             suffix = path.suffix.lower()
             if not path.exists():
                 self.sink.emit("MK500", not_found(uri, path, usage), loc, severity=severity)

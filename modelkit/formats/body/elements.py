@@ -32,7 +32,7 @@ from modelkit.model import (
     TriangleMeshData,
     VisualMaterial,
 )
-from modelkit.resources import Resolver
+from modelkit.resources import Resolver, package_report
 from modelkit.rot3 import peek
 from modelkit.spatial import Pose
 from modelkit.yamltree import YamlDocument, YMap, YNode, YScalar, YSeq, parse_yaml, read_text
@@ -626,9 +626,9 @@ def _add_mesh_file(
     elif path is not None:
         suffix = path.suffix.lower()
         if resolution.scheme == "package":
-            ctx.sink.emit(
-                "MK510", f'"{uri}" depends on the package search path; found at {path}', uri_node.loc
-            )
+            code, message, hint, warning = package_report(resolution, uri)
+            severity_of_note = Severity.WARNING if warning else None
+            ctx.sink.emit(code, message, uri_node.loc, hint=hint, severity=severity_of_note)
         if not path.exists():
             ctx.sink.emit(
                 "MK500", f'resource "{uri}" not found at {path}{usage}', uri_node.loc, severity=severity
