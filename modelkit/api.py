@@ -17,13 +17,15 @@ from modelkit.model import Robot
 TARGET_REFUSALS: dict[str, frozenset[str]] = {
     # MuJoCo: inertia violating A + B >= C; a moving link, no mass; URDF parts its URDF import refuses (a
     # shape without its size or file, an incomplete inertia or inertial, a short rgba or mesh scale); a
-    # collision shape of size zero
-    "mjcf": frozenset({"MK303", "MK313", "MK143", "MK144", "MK145", "MK146", "MK420", "MK416"}),
+    # collision shape of size zero; a shape URDF does not have
+    "mjcf": frozenset(
+        {"MK303", "MK313", "MK143", "MK144", "MK145", "MK146", "MK420", "MK416", "MK412", "MK421"}
+    ),
     "sdf": frozenset({"MK303", "MK211"}),  # libsdformat: the same, and links and joints sharing a name
     "urdf": frozenset(),
     # PyBullet: a URDF visual or collision without a shape, a shape without its size or file, an
-    # inertial without mass value, inertia or a diagonal moment
-    "pybullet": frozenset({"MK122", "MK143", "MK145"}),
+    # inertial without mass value, inertia or a diagonal moment, a shape neither URDF nor PyBullet has
+    "pybullet": frozenset({"MK122", "MK143", "MK145", "MK412"}),
 }
 TARGETS = tuple(TARGET_REFUSALS)
 

@@ -697,7 +697,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "The last IndexedFaceSet polygon lacks its −1 terminator and is dropped.",
     ),
     CodeInfo("MK410", "face-set-empty", "error", "An IndexedFaceSet has no valid polygon."),
-    CodeInfo("MK412", "geometry-unknown", "error", "A geometry type is not known."),
+    CodeInfo(
+        "MK412",
+        "geometry-unknown",
+        "error",
+        "A geometry type is not known. Reference: in URDF a warning: urdfdom logs an error, drops the shape "
+        "and every later visual and collision of the link, and loads the file; PyBullet and MuJoCo refuse "
+        "the file (an error under `--target pybullet|mjcf`). PyBullet's own shapes are MK421.",
+    ),
     CodeInfo("MK413", "scale-ignored", "warning", "A scalar `scale` is ignored; give three numbers."),
     CodeInfo(
         "MK414", "non-uniform-scale", "info", "A non-uniform scale turns a primitive into a different shape."
@@ -733,12 +740,22 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK420",
         "mesh-scale-single-number",
         "warning",
-        "A URDF mesh `scale` has one or two numbers; URDF needs three. modelkit reads the first as a uniform "
-        "scale, as PyBullet does. Reference: urdfdom logs an error, drops the shape and every later visual "
+        "A URDF mesh `scale` has one or two numbers, or more than three; URDF needs three. modelkit reads "
+        "the first as a uniform scale (the first three when there are more), as PyBullet does. Reference: "
+        "urdfdom logs an error, drops the shape and every later visual "
         "and collision of the link, and loads the robot; MuJoCo refuses the file (an error under "
         "`--target mjcf`).",
     ),
-    # (urdf geometry MK421-MK429)
+    CodeInfo(
+        "MK421",
+        "urdf-shape-pybullet-only",
+        "warning",
+        "A URDF `<plane>` or `<cdf>` shape: PyBullet's own extension, which PyBullet reads; modelkit leaves "
+        "that visual or collision out. Reference: urdfdom logs an error, drops the shape and every later "
+        "visual and collision of the link, and loads the robot; MuJoCo refuses the file (an error under "
+        "`--target mjcf`).",
+    ),
+    # (urdf geometry MK422-MK429)
     # (sdf geometry MK430-MK439)
     CodeInfo(
         "MK430",
@@ -770,7 +787,12 @@ _TABLE: tuple[CodeInfo, ...] = (
         "fetch it).",
     ),
     CodeInfo(
-        "MK504", "package-not-found", "error", "A `package://` URI names a package that cannot be found."
+        "MK504",
+        "package-not-found",
+        "error",
+        "A `package://` URI names a package that cannot be found. A warning when `NAME/REL` lies beside the "
+        "model file, where PyBullet looks (it strips `package://`): the file is read, but ROS tools and "
+        "Gazebo will not find it.",
     ),
     CodeInfo("MK505", "path-variable-undefined", "error", "A `${VAR}` path variable is not defined."),
     CodeInfo("MK506", "resource-extension", "error", "A resource file type is not supported."),

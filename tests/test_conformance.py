@@ -1,9 +1,10 @@
 """Conformance: on every real model file, modelkit's verdict is the format's own loader's verdict.
 
 For each model file of the shared corpus (``../shared/corpus``, which grows: every file found is
-checked) and of ``samples/``, the reference loader runs live here and ``modelkit.api.validate`` runs
-with the same search paths; the verdicts must agree (the loader accepts the file <=> modelkit reports
-no error). The references:
+checked), of ``samples/`` and of pybullet's bundled models (``pybullet_data``: URDF, SDF and MJCF robots
+and objects that PyBullet users load; of its 1,000 generated ``random_urdfs`` only the first), the
+reference loader runs live here and ``modelkit.api.validate`` runs with the same search paths; the
+verdicts must agree (the loader accepts the file <=> modelkit reports no error). The references:
 
 - URDF: Debian's ``check_urdf`` (urdfdom);
 - xacro: the ``xacro`` package expands the file, ``check_urdf`` judges the expansion. A file whose
@@ -37,6 +38,7 @@ import pytest
 from modelkit.api import Validation, validate
 from modelkit.formats.common import ReadOptions
 from modelkit.formats.xacro.reader import expand_xacro
+from modelkit.model import Mesh
 from modelkit.resources import Resolver
 from modelkit.textio import read_head
 
@@ -145,6 +147,42 @@ EXCEPTIONS: dict[str, str] = {
 }
 
 
+def _pybullet_data() -> Path | None:
+    """pybullet's bundled models (robots and objects users load in PyBullet), when pybullet is installed."""
+    try:
+        import pybullet_data
+    except ImportError:  # pragma: no cover - pybullet is in the test environment
+        return None
+    return Path(pybullet_data.getDataPath())
+
+
+PYBULLET_DATA = _pybullet_data()
+ROOTS = (("corpus", CORPUS), ("samples", SAMPLES), ("pybullet_data", PYBULLET_DATA))
+_ROBOTS_PYBULLET_LOADS = (
+    "a zero or singular inertia on a link that moves (policy: not simulable, MK302/MK313; MuJoCo refuses "
+    "it); check_urdf and libsdformat do not look at inertia, PyBullet loads it"
+)
+_MISSING_IN_PYBULLET_DATA = (
+    "meshes/coarse/*.stl is not shipped in pybullet_data: the collision meshes are missing (MK500); the "
+    "reference loader never opens meshes"
+)
+EXCEPTIONS.update({
+    "pybullet_data/cube_no_rotation.urdf": _ROBOTS_PYBULLET_LOADS,
+    "pybullet_data/laikago/laikago.urdf": _ROBOTS_PYBULLET_LOADS,
+    "pybullet_data/laikago/laikago_toes.urdf": _ROBOTS_PYBULLET_LOADS,
+    "pybullet_data/laikago/laikago_toes_limits.urdf": _ROBOTS_PYBULLET_LOADS,
+    "pybullet_data/random_urdfs/000/000.urdf": _ROBOTS_PYBULLET_LOADS,
+    "pybullet_data/kuka_iiwa/kuka_with_gripper.sdf": (
+        "the model's root link has mass 0 and is not welded to the world (MK313; policy: a moving body "
+        "without mass cannot be simulated, MuJoCo refuses it; PyBullet makes a massless base static)"
+    ),
+    "pybullet_data/kuka_iiwa/kuka_with_gripper2.sdf": "as kuka_with_gripper.sdf",
+    "pybullet_data/kuka_iiwa/model.sdf": "as kuka_with_gripper.sdf",
+    "pybullet_data/kuka_iiwa/kuka_world.sdf": _MISSING_IN_PYBULLET_DATA,
+    "pybullet_data/kuka_iiwa/model_for_sdf.urdf": _MISSING_IN_PYBULLET_DATA,
+})
+
+
 def _kind(path: Path) -> str | None:
     if path.suffix in KINDS:
         return KINDS[path.suffix]
@@ -155,12 +193,15 @@ def _kind(path: Path) -> str | None:
 
 
 def model_files() -> list[tuple[str, Path]]:
-    """Every model file of the corpus and the samples, keyed corpus/... or samples/..."""
+    """Every model file of the corpus, the samples and pybullet_data, keyed corpus/..., samples/... or
+    pybullet_data/..."""
     found = []
-    for label, root in (("corpus", CORPUS), ("samples", SAMPLES)):
-        if not root.is_dir():
+    for label, root in ROOTS:
+        if root is None or not root.is_dir():
             continue
         for path in sorted(root.rglob("*")):
+            if label == "pybullet_data" and "random_urdfs" in path.parts and path.parent.name != "000":
+                continue  # 1,000 generated objects of one shape: the first stands for them
             if path.is_file() and _kind(path) is not None:
                 found.append((f"{label}/{path.relative_to(root)}", path))
     return found
@@ -226,8 +267,8 @@ def reference(kind: str, path: Path, oracle: Path, scratch: Path) -> tuple[bool 
 
 
 def _key(path: Path) -> str:
-    for label, root in (("corpus", CORPUS), ("samples", SAMPLES)):
-        if path.is_relative_to(root):
+    for label, root in ROOTS:
+        if root is not None and path.is_relative_to(root):
             return f"{label}/{path.relative_to(root)}"
     raise AssertionError(path)
 
@@ -364,6 +405,52 @@ def test_double_hyphen_in_a_comment_is_a_warning_as_tinyxml2_accepts_it(tmp_path
     assert d.severity.value == "warning" and d.location is not None and d.location.line == 2
     path.write_text(_BOX_MODEL.format(name="m").replace("</sdf>", "<bad></sdf>"))
     assert [d.code for d in validate(path).errors] == ["MK020"]  # real malformations stay errors
+
+
+@pytest.mark.parametrize(
+    ("head", "line", "said"),
+    [
+        ('<?xml version="0.0" ?>\n', 1, 'names version "0.0"'),  # 26 of pybullet_data's robots
+        ('\n<?xml version="1.0" ?>\n', 2, "not at the start"),
+    ],
+    ids=["version 0.0", "whitespace before it"],
+)
+def test_xml_declaration_as_tinyxml2_reads_it(tmp_path: Path, head: str, line: int, said: str) -> None:
+    """libxml2 refuses these declarations; urdfdom, libsdformat, MuJoCo, PyBullet (TinyXML2) ignore them."""
+    path = tmp_path / "r.urdf"
+    path.write_text(head + _TRIANGLE_URDF.split("\n", 1)[1])
+    assert check_urdf_accepts(path)[0]
+    v = validate(path)
+    assert v.errors == []
+    (d,) = [d for d in v.diagnostics if d.code == "MK020"]
+    assert d.severity.value == "warning" and said in d.message
+    assert d.location is not None and (d.location.line, d.location.col) == (line, 1)
+    assert [r.name for r in v.robots] == ["r"] and len(v.robots[0].links) == 2
+    path.write_text(head + _TRIANGLE_URDF.split("\n", 1)[1].replace("</robot>", "<bad></robot>"))
+    assert [d.code for d in validate(path).errors] == ["MK020"]  # a real malformation stays an error
+
+
+def test_package_uri_found_beside_the_model_as_pybullet_looks(tmp_path: Path) -> None:
+    """``package://NAME/REL`` with no package NAME anywhere: PyBullet reads NAME/REL beside the file."""
+    (tmp_path / "arm_description" / "meshes").mkdir(parents=True)
+    (tmp_path / "arm_description" / "meshes" / "m.stl").write_text(_TRIANGLE_STL)
+    path = tmp_path / "r.urdf"
+    path.write_text(_urdf(_part(
+        '<collision><geometry><mesh filename="package://arm_description/meshes/m.stl"/></geometry></collision>'
+    )))
+    assert check_urdf_accepts(path)[0]
+    command = [sys.executable, "-c", _PYBULLET_LOADS, str(path)]
+    loads = subprocess.run(command, capture_output=True, timeout=60)
+    assert loads.returncode == 0, loads.stderr[-400:]
+    v = validate(path)
+    assert v.errors == []
+    (d,) = [d for d in v.diagnostics if d.code == "MK504"]
+    assert d.severity.value == "warning" and "as PyBullet reads it" in d.message
+    geometries = [g.geometry for link in v.robots[0].links for g in link.collisions]
+    (mesh,) = [g for g in geometries if isinstance(g, Mesh)]
+    assert mesh.path == str(tmp_path / "arm_description" / "meshes" / "m.stl")
+    (tmp_path / "arm_description" / "meshes" / "m.stl").unlink()
+    assert [(d.code, d.severity.value) for d in validate(path).errors] == [("MK504", "error")]
 
 
 _TRIANGLE_URDF = """<?xml version="1.0"?>
@@ -925,6 +1012,18 @@ _URDFDOM_TOLERATED: dict[str, tuple[str, str, str, frozenset[str]]] = {
     "a mesh scale of two numbers": (
         _part(f'<collision><geometry><mesh filename="{_MESH}" scale="0.5 0.5"/></geometry></collision>'),
         "MK420", "warning", frozenset({"mjcf"}),
+    ),
+    "a mesh scale of four numbers": (
+        _part(f'<collision><geometry><mesh filename="{_MESH}" scale="1 1 1 1"/></geometry></collision>'),
+        "MK420", "warning", frozenset({"mjcf"}),
+    ),
+    "a shape URDF does not have": (
+        _part('<collision><geometry><ball radius="1"/></geometry></collision>'), "MK412", "warning",
+        frozenset({"pybullet", "mjcf"}),
+    ),
+    "PyBullet's plane shape": (
+        _part('<collision><geometry><plane normal="0 0 1"/></geometry></collision>'), "MK421", "warning",
+        frozenset({"mjcf"}),
     ),
     "an inertia without its off-diagonal terms": (
         _inertial('<inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1"/></inertial>'), "MK144",

@@ -181,7 +181,11 @@ def mesh_problem(
     if key is not None and key in _OUTCOMES:
         return _OUTCOMES[key]
     try:
-        load_mesh(path, fragment, metadata, max_bytes)
+        # the mesh libraries' own warnings (trimesh's texture statistics on an all-transparent image) are
+        # neither a finding nor something to print on stderr
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            load_mesh(path, fragment, metadata, max_bytes)
         outcome = None
     except MeshLoadError as exc:
         outcome = f"{exc.code}\t{exc}"

@@ -337,12 +337,25 @@ def read_geometry(
         return Sphere(radius)
     if tag == "mesh":
         return _mesh(ctx, shape, what, meshes, visual_only)
+    pybullet_shape = tag in PYBULLET_SHAPES
+    others = "PyBullet reads it, MuJoCo refuses the file" if pybullet_shape else "PyBullet, MuJoCo refuse it"
     ctx.emit(
-        "MK412",
-        f"unknown geometry type <{tag}> in the {what} (URDF has box, cylinder, sphere, capsule, mesh)",
+        "MK421" if pybullet_shape else "MK412",
+        f"{'PyBullet' if pybullet_shape else 'unknown'} geometry type <{tag}> in the {what}; URDF has box, "
+        f"cylinder, sphere, capsule and mesh, so modelkit leaves the {what} out ({UNKNOWN_SHAPE_CONSUMERS}; "
+        f"{others})",
         loc,
+        severity=Severity.WARNING,
     )
     return None
+
+
+# PyBullet's own URDF shapes (MK421), and what urdfdom does with a shape URDF does not have (MK412, MK421).
+PYBULLET_SHAPES = ("plane", "cdf")
+UNKNOWN_SHAPE_CONSUMERS = (
+    "urdfdom (check_urdf, libsdformat) logs an error, drops it and every later visual and collision of the "
+    "link, and loads the file"
+)
 
 
 def _not_positive(
@@ -395,7 +408,18 @@ def _mesh(ctx: Context, shape: Element, what: str, meshes: MeshChecker, visual_o
     text = shape.get("scale")
     if text is not None:
         numbers = parse_numbers(text)
-        if numbers is not None and len(numbers) in (1, 2) and all(math.isfinite(v) for v in numbers):
+        if numbers is not None and len(numbers) > 3 and all(math.isfinite(v) for v in numbers):
+            ctx.emit(
+                "MK420",
+                f'mesh of the {what}: `scale="{text}"` has {len(numbers)} numbers; URDF needs three. '
+                "modelkit reads the first three, as PyBullet does; urdfdom logs an error, drops the shape "
+                "and every later visual and collision of the link, and loads the robot; MuJoCo refuses the "
+                "file",
+                ctx.loc(shape, "scale"),
+                hint=f'write scale="{" ".join(f"{v:g}" for v in numbers[:3])}"',
+            )
+            scale = (numbers[0], numbers[1], numbers[2])
+        elif numbers is not None and len(numbers) in (1, 2) and all(math.isfinite(v) for v in numbers):
             value = numbers[0]
             ctx.emit(
                 "MK420",
