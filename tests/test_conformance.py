@@ -650,9 +650,48 @@ def test_zero_principal_moment_on_a_moving_link_is_an_error(tmp_path: Path) -> N
     assert check_urdf_accepts(path)[0]
     (d,) = validate(path).errors
     assert d.code == "MK302" and "zero principal moment" in d.message
-    path.write_text(_urdf(_URDF_BASE + finger + moving.replace('type="continuous"', 'type="fixed"')))
-    v = validate(path)  # welded to the base, whose inertia it is merged into: worth a warning only
-    assert v.errors == [] and _codes(v, "warning") == ["MK302"]
+    welded = moving.replace('type="continuous"', 'type="fixed"')
+    path.write_text(_urdf(_URDF_BASE + finger + welded))
+    v = validate(path)  # a rod welded to the base: engines merge it, and the merged body is sound
+    assert v.errors == [] and "MK302" not in _codes(v, "warning")
+
+
+def test_links_welded_by_fixed_joints_are_judged_as_the_body_engines_merge(tmp_path: Path) -> None:
+    """Issue 9: mass properties are judged after lumping fixed subtrees, as the engines do."""
+    def link(name: str, inertia: str, mass: str = "1") -> str:
+        moments = f'<inertia {inertia} ixy="0" ixz="0" iyz="0"/>'
+        return f'<link name="{name}"><inertial><mass value="{mass}"/>{moments}</inertial></link>'
+
+    def joint(kind: str, parent: str, child: str, xyz: str = "0 0 0") -> str:
+        return (f'<joint name="{parent}_{child}" type="{kind}"><parent link="{parent}"/>'
+                f'<child link="{child}"/><origin xyz="{xyz}"/><axis xyz="0 0 1"/></joint>')
+
+    rod = 'ixx="0" iyy="0.001" izz="0.001"'
+    point = 'ixx="0" iyy="0" izz="0"'
+    sound = 'ixx="0.01" iyy="0.01" izz="0.01"'
+    path = tmp_path / "r.urdf"
+    # a moving arm made of a point mass (tool frame, 0.01 kg) welded to a sound link: no finding
+    path.write_text(_urdf(_URDF_BASE + link("arm", sound) + link("tool", point, "0.01")
+                          + joint("continuous", "base", "arm") + joint("fixed", "arm", "tool", "0 0 0.5")))
+    v = validate(path)
+    assert v.errors == [] and [d for d in v.diagnostics if d.code == "MK302"] == []
+    # two rods along x welded together on the x axis: the merged body has no moment about x either
+    path.write_text(_urdf(_URDF_BASE + link("arm", rod) + link("tip", rod)
+                          + joint("continuous", "base", "arm") + joint("fixed", "arm", "tip", "0.5 0 0")))
+    (d,) = validate(path).errors
+    assert d.code == "MK302" and 'rigid body of link "arm"' in d.message
+    assert "zero principal moment" in d.message
+    assert d.location is not None and d.location.line > 0
+    # the same rods offset along y: merged, the body has a moment about x (parallel axes): sound
+    path.write_text(_urdf(_URDF_BASE + link("arm", rod) + link("tip", rod)
+                          + joint("continuous", "base", "arm") + joint("fixed", "arm", "tip", "0 0.5 0")))
+    assert validate(path).errors == []
+    # a member's own inertia that is impossible (a negative moment) is still worth a warning
+    negative = 'ixx="-0.001" iyy="0.01" izz="0.01"'
+    path.write_text(_urdf(_URDF_BASE + link("arm", sound) + link("tool", negative, "0.01")
+                          + joint("continuous", "base", "arm") + joint("fixed", "arm", "tool")))
+    v = validate(path)
+    assert v.errors == [] and _codes(v, "warning").count("MK302") == 1
 
 
 def test_singular_inertia_on_a_urdf_root_counts_as_moving(tmp_path: Path) -> None:

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from modelkit.model import WORLD_LINK, Joint, JointType, Robot
+from modelkit import rot3
+from modelkit.model import WORLD_LINK, Joint, JointType, Link, Robot
+from modelkit.spatial import Pose
 
 
 def subtree(children: dict[str, list[Joint]], start: str) -> list[str]:
@@ -40,3 +42,48 @@ def lumped_masses(robot: Robot, lump_into_world: bool = True) -> dict[str, float
                     mass += total.get(joint.child, 0.0)
         total[name] = mass
     return total
+
+
+def welded_bodies(robot: Robot) -> dict[str, list[tuple[str, Pose]]]:
+    """The rigid bodies engines simulate: links joined by fixed joints, keyed by the body's top link (the
+    root, or the child of a joint that moves), each member with its pose in the top link's frame."""
+    children = robot.children_of()
+    bodies: dict[str, list[tuple[str, Pose]]] = {}
+    heads = [robot.root] if robot.root else []
+    seen: set[str] = set()
+    while heads:
+        head = heads.pop()
+        if head in seen:
+            continue
+        members: list[tuple[str, Pose]] = []
+        stack = [(head, Pose())]
+        while stack:
+            name, pose = stack.pop()
+            if name in seen:
+                continue
+            seen.add(name)
+            members.append((name, pose))
+            for joint in children.get(name, []):
+                if joint.type is JointType.FIXED:
+                    stack.append((joint.child, pose @ joint.origin))
+                else:
+                    heads.append(joint.child)
+        bodies[head] = members
+    return bodies
+
+
+def body_mass_properties(
+    links: dict[str, Link], members: list[tuple[str, Pose]]
+) -> tuple[float, rot3.V3, rot3.M3]:
+    """Mass, centre of mass and inertia about it of one welded body, in its top link's frame (numpy-free)."""
+    parts = []
+    for name, pose in members:
+        link = links.get(name)
+        inertial = link.inertial if link is not None else None
+        if inertial is None or inertial.mass <= 0.0:
+            continue
+        rotation = pose.rotation_tuple
+        com = rot3.add(rot3.matvec(rotation, rot3.vec3(rot3.peek(inertial, "com"))), pose.translation_tuple)
+        inertia = rot3.rotate_inertia(rot3.mat3(rot3.peek(inertial, "inertia")), rotation)
+        parts.append((inertial.mass, com, inertia))
+    return rot3.combine_mass_properties(parts)

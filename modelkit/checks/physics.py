@@ -6,10 +6,11 @@ import math
 from collections.abc import Iterator
 
 from modelkit import rot3
-from modelkit.checks.masses import lumped_masses
+from modelkit.checks.masses import body_mass_properties, lumped_masses, welded_bodies
 from modelkit.checks.registry import rule
 from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
 from modelkit.model import SYNTHESISED, JointType, Link, Robot
+from modelkit.spatial import Pose
 
 # Who fills in missing mass properties, per source format (the wording of MK304).
 DEFAULTS_APPLIED_BY = {"body": "Choreonoid uses", "sdf": "SDFormat's defaults apply"}
@@ -140,26 +141,30 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
     """Inertia tensors are symmetric, positive definite and satisfy the triangle inequality.
 
     The tolerance is libsdformat's (gz-math ``MassMatrix3::IsValid``): ε = 10 · machine-ε · the
-    largest principal moment.
+    largest principal moment. Where the file's own loader does not judge inertia link by link (URDF,
+    ``.body``), links joined by fixed joints are judged as the one rigid body engines merge them into:
+    a point mass on a sensor frame or a tool flange welded to an arm is not a finding.
     """
     moving = _moving_links(robot)
     if robot.root is not None and robot.root_joint is None:
         # A root the format leaves open (a URDF root other than "world") floats in PyBullet and Gazebo
         # unless the loader is told to fix it: its inertia matters.
         moving.add(robot.root)
+    welded = welded_bodies(robot) if robot.source_format in MERGED_BY_ENGINES else {}
+    merged_into = {name: head for head, members in welded.items() if len(members) > 1 for name, _ in members}
     for link in robot.links:
         inertial = link.inertial
         if inertial is None or inertial.mass <= 0:
             continue
-        # A link welded to the world is never simulated dynamically: its inertia is still wrong, but
-        # harmless, so the finding is a warning there.
-        severity = None if link.name in moving else Severity.WARNING
-        static = "" if link.name in moving else " (the link does not move, so simulators ignore it)"
         where = inertial.sources.get("inertia", _mass_loc(link))
         tensor = rot3.mat3(rot3.peek(inertial, "inertia"))  # plain floats: no numpy on the validate path
         if not (rot3.all_finite(tensor) and math.isfinite(inertial.mass)):  # e.g. 1e400 in the file
             yield diag("MK302", f'link "{link.name}": the mass or inertia is not a finite number', where)
             continue
+        # A link welded to the world is never simulated dynamically: its inertia is still wrong, but
+        # harmless, so the finding is a warning there.
+        severity = None if link.name in moving else Severity.WARNING
+        static = "" if link.name in moving else " (the link does not move, so simulators ignore it)"
         skew = max(abs(tensor[i][j] - tensor[j][i]) for i in range(3) for j in range(3))
         if skew > ASYMMETRY_TOLERANCE * max(abs(tensor[i][i]) for i in range(3)):
             yield diag(
@@ -170,36 +175,93 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
                 severity=severity,
             )
             continue
-        moments = rot3.symmetric_eigenvalues(tensor)  # of the symmetric part: rounding asymmetry ignored
-        eps = rot3.inertia_tolerance(moments)
-        if all(abs(m) <= eps for m in moments):
-            yield diag(
-                "MK302",
-                f'link "{link.name}" has mass {inertial.mass:g} kg but a zero inertia{static}',
-                where,
-                severity=severity,
-            )
+        head = merged_into.get(link.name)
+        if head is None:
+            what = f'link "{link.name}"'
+            yield from _judge_inertia(robot, what, inertial.mass, tensor, where, severity, static)
+        else:
+            yield from _negative_moment_in_body(link, tensor, head, where)
+    links = {link.name: link for link in robot.links}
+    for head, members in welded.items():
+        if len(members) < 2:
             continue
-        if moments[0] <= eps:  # negative, or a zero moment: no finite acceleration about that axis
-            zero = " (a zero principal moment)" if moments[0] >= -eps else ""
-            yield diag(
-                "MK302",
-                f'link "{link.name}": the inertia is not positive definite{zero} (principal moments '
-                f"{', '.join(f'{m:.6g}' for m in moments)}){static}",
-                where,
-                severity=severity,
-            )
-            continue
-        a, b, c = moments
-        if a + b < c - eps:
-            yield diag(
-                "MK303",
-                f'link "{link.name}": principal moments {a:.6g}, {b:.6g}, {c:.6g} violate the '
-                f"triangle inequality ({a:.6g} + {b:.6g} < {c:.6g}){static}; "
-                f"{IMPOSSIBLE_INERTIA_CONSUMERS}",
-                where,
-                severity=_impossible_inertia_severity(robot),
-            )
+        total, _, tensor = body_mass_properties(links, members)
+        if total <= 0.0 or not rot3.all_finite(tensor):
+            continue  # a massless body is MK313's; a non-finite member was reported above
+        names = ", ".join(f'"{name}"' for name, _ in members)
+        what = f'the rigid body of link "{head}" (links {names} joined by fixed joints, merged as engines do)'
+        severity = None if head in moving else Severity.WARNING
+        static = "" if head in moving else " (the body does not move, so simulators ignore it)"
+        yield from _judge_inertia(robot, what, total, tensor, _body_loc(links, members), severity, static)
+
+
+# Source formats whose loader takes any inertia link by link: there links welded by fixed joints are judged
+# as one body (libsdformat refuses a bad inertia on any link; MuJoCo judges each MJCF body itself).
+MERGED_BY_ENGINES = frozenset({"urdf", "body"})
+
+
+def _judge_inertia(
+    robot: Robot,
+    what: str,
+    mass: float,
+    tensor: rot3.M3,
+    where: SourceLocation | None,
+    severity: Severity | None,
+    static: str,
+) -> Iterator[Diagnostic]:
+    """MK302 (zero or not positive definite) or MK303 (triangle inequality) for one link or welded body."""
+    moments = rot3.symmetric_eigenvalues(tensor)  # of the symmetric part: rounding asymmetry ignored
+    eps = rot3.inertia_tolerance(moments)
+    if all(abs(m) <= eps for m in moments):
+        said = f"{what} has mass {mass:g} kg but a zero inertia{static}"
+        yield diag("MK302", said, where, severity=severity)
+        return
+    if moments[0] <= eps:  # negative, or a zero moment: no finite acceleration about that axis
+        zero = " (a zero principal moment)" if moments[0] >= -eps else ""
+        yield diag(
+            "MK302",
+            f"{what}: the inertia is not positive definite{zero} (principal moments "
+            f"{', '.join(f'{m:.6g}' for m in moments)}){static}",
+            where,
+            severity=severity,
+        )
+        return
+    a, b, c = moments
+    if a + b < c - eps:
+        yield diag(
+            "MK303",
+            f"{what}: principal moments {a:.6g}, {b:.6g}, {c:.6g} violate the triangle inequality "
+            f"({a:.6g} + {b:.6g} < {c:.6g}){static}; {IMPOSSIBLE_INERTIA_CONSUMERS}",
+            where,
+            severity=_impossible_inertia_severity(robot),
+        )
+
+
+def _negative_moment_in_body(
+    link: Link, tensor: rot3.M3, head: str, where: SourceLocation | None
+) -> Iterator[Diagnostic]:
+    """A welded link's own inertia is judged only for impossible data (a negative principal moment); a
+    point mass or a rod welded to a body is physical."""
+    moments = rot3.symmetric_eigenvalues(tensor)
+    if moments[0] < -rot3.inertia_tolerance(moments):
+        yield diag(
+            "MK302",
+            f'link "{link.name}": the inertia is not positive definite (principal moments '
+            f"{', '.join(f'{m:.6g}' for m in moments)}); engines merge the link into the rigid body of "
+            f'"{head}", which is judged as a whole',
+            where,
+            severity=Severity.WARNING,
+        )
+
+
+def _body_loc(links: dict[str, Link], members: list[tuple[str, Pose]]) -> SourceLocation | None:
+    """Where a welded body's inertia is written: its heaviest link's inertia."""
+    heaviest = max(
+        (link for link in (links.get(name) for name, _ in members) if link is not None and link.inertial),
+        key=lambda link: link.inertial.mass if link.inertial else 0.0,
+    )
+    inertial = heaviest.inertial
+    return inertial.sources.get("inertia", _mass_loc(heaviest)) if inertial else heaviest.source
 
 
 @rule("joint-ranges", "MK307", "MK315")
