@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from modelkit.geometry.objcheck import UNDECIDED, obj_problem
 from modelkit.model import TriangleMeshData
 from modelkit.textio import DEFAULT_MAX_BYTES, UnreadableFile, read_regular
 
@@ -123,12 +124,7 @@ def load_mesh(
             f"mesh file type {shown}{extra} is not supported; supported: "
             + ", ".join(sorted(SUPPORTED_EXTENSIONS)),
         )
-    try:
-        data = read_regular(path, max_bytes)
-    except UnreadableFile as e:  # a FIFO, a device, a directory, a loop (MK501); too large (MK002)
-        code = "MK002" if e.code == "MK002" else "MK501"
-        reason = e.message.removeprefix("cannot read file: ")
-        raise MeshLoadError(code, f"cannot read {path.name}: {reason}") from e
+    data = _read_mesh_bytes(path, max_bytes)
     if not data.strip():
         raise MeshLoadError("MK501", f"{path.name} is empty")
     try:
@@ -149,6 +145,17 @@ def load_mesh(
         raise MeshLoadError("MK501", f"cannot load {path.name}: out of memory") from e
     except Exception as e:  # a parser library failed in a way we did not foresee
         raise MeshLoadError("MK501", f"cannot load {path.name}: {type(e).__name__}: {e}") from e
+
+
+def _read_mesh_bytes(path: Path, max_bytes: int) -> bytes:
+    """The bytes of a mesh file, read with the checks every input gets; :class:`MeshLoadError` if it
+    cannot be read (MK501) or is over ``max_bytes`` (MK002)."""
+    try:
+        return read_regular(path, max_bytes)
+    except UnreadableFile as e:  # a FIFO, a device, a directory, a loop (MK501); too large (MK002)
+        code = "MK002" if e.code == "MK002" else "MK501"
+        reason = e.message.removeprefix("cannot read file: ")
+        raise MeshLoadError(code, f"cannot read {path.name}: {reason}") from e
 
 
 # ---- per-run outcome cache --------------------------------------------------------------------
@@ -181,17 +188,28 @@ def mesh_problem(
     if key is not None and key in _OUTCOMES:
         return _OUTCOMES[key]
     try:
-        # the mesh libraries' own warnings (trimesh's texture statistics on an all-transparent image) are
-        # neither a finding nor something to print on stderr
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            load_mesh(path, fragment, metadata, max_bytes)
-        outcome = None
+        outcome = _fast_obj_problem(Path(path), fragment, metadata, max_bytes)
+        if outcome == UNDECIDED:
+            # the mesh libraries' own warnings (trimesh's texture statistics on an all-transparent image)
+            # are neither a finding nor something to print on stderr
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                load_mesh(path, fragment, metadata, max_bytes)
+            outcome = None
     except MeshLoadError as exc:
         outcome = f"{exc.code}\t{exc}"
     if key is not None:
         _OUTCOMES[key] = outcome
     return outcome
+
+
+def _fast_obj_problem(path: Path, fragment: str | None, metadata: MeshMetadata | None,
+                      max_bytes: int) -> str | None:
+    """:func:`mesh_problem`'s verdict on a plain OBJ file (no fragment, no metadata) without trimesh
+    (``objcheck``); the ``UNDECIDED`` sentinel for anything else or when the fast check cannot tell."""
+    if fragment is not None or metadata is not None or path.suffix.lower() != ".obj":
+        return UNDECIDED
+    return obj_problem(_read_mesh_bytes(path, max_bytes), path.name)
 
 
 def clear_mesh_cache() -> None:
