@@ -526,11 +526,11 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "An inertia tensor is not positive definite (a negative or a zero principal moment) on a link that "
         "moves: it cannot be simulated meaningfully. A URDF root not welded to `world` counts as moving "
-        "(it floats in PyBullet and Gazebo). A warning on a link welded to the world. In URDF and `.body` "
-        "(whose loaders take any inertia), links joined by fixed joints are judged as the one rigid body "
-        "engines merge them into: a point mass or a rod welded to a sound body is not reported, a welded "
-        "link's negative moment is a warning. Reference: MuJoCo refuses such a body; libsdformat refuses it "
-        "on any SDF link, moving or not.",
+        "(it floats in PyBullet and Gazebo). A warning on a link welded to the world. In URDF, `.body` and "
+        "MJCF (whose loaders do not judge a welded link's inertia), links joined by fixed joints are judged "
+        "as the one rigid body engines merge them into: a point mass or a rod welded to a sound body is not "
+        "reported, a welded link's negative moment is a warning. Reference: MuJoCo refuses such a body; "
+        "libsdformat refuses it on any SDF link, moving or not.",
     ),
     CodeInfo(
         "MK303",

@@ -7,8 +7,9 @@ Search order for ``package://NAME/REL`` (see docs/resources.md):
 3. each entry E of ``AMENT_PREFIX_PATH``: ``E/share/NAME/REL``;
 4. walking up from the model file: the first folder whose ``package.xml`` names NAME, or which holds
    ``NAME/package.xml``;
-5. as PyBullet does when none of those finds the package: ``NAME/REL`` beside the model file. That is
-   reported (a warning, MK504): ROS tools and Gazebo will not find the file.
+5. when none of those finds the package: ``NAME/REL`` beside the model file, as PyBullet looks, or in
+   the first folder above it that has it (a package folder copied without its ``package.xml``, as in
+   robosuite's assets). That is reported (a warning, MK504): ROS tools and Gazebo will not find it.
 
 ``model://NAME/REL`` looks in the ``--resource-path`` folders, then ``GZ_SIM_RESOURCE_PATH``,
 ``IGN_GAZEBO_RESOURCE_PATH``, ``SDF_PATH`` and ``GAZEBO_MODEL_PATH`` (:data:`MODEL_PATH_VARIABLES`); an SDF
@@ -94,15 +95,15 @@ class Resolver:
     def _resolve_package(self, uri: str, rest: str, model_file: Path) -> Resolution:
         package, _, relative = rest.partition("/")
         root = self.find_package(package, model_file.parent)
-        beside = _normal(model_file.parent / rest)
-        if root is None and relative and beside.is_file():
+        beside = _without_package(model_file.parent, rest) if root is None and relative else None
+        if beside is not None:
             return Resolution(
                 uri,
                 beside,
                 "package",
-                message=f'package "{package}" of "{uri}" cannot be found on the package paths; the file is '
-                f"read beside the model ({beside}), as PyBullet reads it, but ROS tools (RViz, "
-                "robot_state_publisher) and Gazebo will not find it",
+                message=f'package "{package}" of "{uri}" cannot be found on the package paths; "{rest}" is '
+                f"read from the model's folder or one above it ({beside}), as PyBullet reads it, but ROS "
+                "tools (RViz, robot_state_publisher) and Gazebo will not find it",
                 hint=f"give the package's folder with --package-path {package}=DIR, or add a package.xml "
                 f'naming "{package}"',
             )
@@ -183,6 +184,16 @@ def package_report(resolution: Resolution, uri: str) -> tuple[str, str, str | No
     if resolution.message:
         return "MK504", resolution.message, resolution.hint, True
     return "MK510", f'"{uri}" depends on the package search path; found at {resolution.path}', None, False
+
+
+def _without_package(folder: Path, rest: str) -> Path | None:
+    """``NAME/REL`` in the model's folder or the first folder above it that has the file, or None."""
+    start = Path(os.path.realpath(folder))  # never raises on a symlink loop
+    for candidate in (start, *start.parents):
+        path = _normal(candidate / rest)
+        if path.is_file():
+            return path
+    return None
 
 
 def _split_paths(value: str) -> list[Path]:

@@ -446,6 +446,11 @@ def test_package_uri_found_beside_the_model_as_pybullet_looks(tmp_path: Path) ->
     assert v.errors == []
     (d,) = [d for d in v.diagnostics if d.code == "MK504"]
     assert d.severity.value == "warning" and "as PyBullet reads it" in d.message
+    moved = tmp_path / "robot" / "urdf"  # the package folder above the model, without package.xml
+    moved.mkdir(parents=True)
+    (moved / "r.urdf").write_text(path.read_text())
+    v = validate(moved / "r.urdf")
+    assert v.errors == [] and [d.severity.value for d in v.diagnostics if d.code == "MK504"] == ["warning"]
     geometries = [g.geometry for link in v.robots[0].links for g in link.collisions]
     (mesh,) = [g for g in geometries if isinstance(g, Mesh)]
     assert mesh.path == str(tmp_path / "arm_description" / "meshes" / "m.stl")

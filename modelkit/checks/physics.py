@@ -195,9 +195,10 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
         yield from _judge_inertia(robot, what, total, tensor, _body_loc(links, members), severity, static)
 
 
-# Source formats whose loader takes any inertia link by link: there links welded by fixed joints are judged
-# as one body (libsdformat refuses a bad inertia on any link; MuJoCo judges each MJCF body itself).
-MERGED_BY_ENGINES = frozenset({"urdf", "body"})
+# Source formats whose loader does not judge a welded link's inertia on its own: there links welded by fixed
+# joints are judged as one body. MuJoCo judges only bodies with joints (and refuses the file itself, MK170,
+# where such a body alone is too light); libsdformat refuses a bad inertia on any SDF link.
+MERGED_BY_ENGINES = frozenset({"urdf", "body", "mjcf"})
 
 
 def _judge_inertia(
