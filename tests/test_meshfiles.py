@@ -693,3 +693,66 @@ def test_mesh_outcome_is_kept_per_file_version(tmp_path: Path) -> None:
     assert problem is not None and problem.startswith("MK501\t")
     assert mesh_problem(tmp_path / "missing.stl", None) is not None  # not a regular file: not kept
     clear_mesh_cache()
+
+
+def _binary_stl_files() -> list[Path]:
+    """Every binary STL with triangles in the corpus and pybullet's data."""
+    roots = [CORPUS]
+    try:
+        import pybullet_data
+
+        roots.append(Path(pybullet_data.getDataPath()))
+    except ImportError:  # pragma: no cover - pybullet is in the test environment
+        pass
+    found = []
+    for root in roots:
+        for path in sorted(root.rglob("*")) if root.is_dir() else []:
+            if path.suffix.lower() == ".stl" and path.is_file():
+                head = path.read_bytes()[:84]
+                count = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
+                if count > 0 and path.stat().st_size == 84 + 50 * count:
+                    found.append(path)
+    return found
+
+
+def test_binary_stl_reads_as_trimesh_reads_it() -> None:
+    """The binary STL reader (no trimesh import) gives trimesh's arrays, through the same merging."""
+    import io
+
+    from trimesh.exchange import stl as trimesh_stl
+
+    from modelkit.geometry.meshfiles import _load_stl, _merge_identical_vertices
+
+    files = _binary_stl_files()
+    if CORPUS.is_dir():
+        assert len(files) >= 100
+    for path in files:
+        data = path.read_bytes()
+        theirs = trimesh_stl.load_stl_binary(io.BytesIO(data))
+        vertices = np.asarray(theirs["vertices"], dtype=np.float64).reshape(-1, 3)
+        faces = np.asarray(theirs["faces"], dtype=np.int64).reshape(-1, 3)
+        expected_vertices, expected_faces = _merge_identical_vertices(vertices, faces)
+        ours = _load_stl(data, path.name)
+        assert np.array_equal(ours.vertices, expected_vertices), path
+        assert np.array_equal(ours.faces, expected_faces), path
+
+
+def test_binary_stl_without_triangles_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "empty.stl"
+    path.write_bytes(b"\0" * 80 + struct.pack("<I", 0))
+    with pytest.raises(MeshLoadError) as caught:
+        load_mesh(path)
+    assert caught.value.code == "MK501" and "no triangles" in str(caught.value)
+
+
+def test_binary_stl_does_not_import_trimesh(tmp_path: Path) -> None:
+    path = tmp_path / "t.stl"
+    triangle = struct.pack("<12fH", 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0)
+    path.write_bytes(b"\0" * 80 + struct.pack("<I", 1) + triangle)
+    child = (
+        "import sys; from modelkit.geometry.meshfiles import load_mesh; "
+        f"m = load_mesh({str(path)!r}); print(len(m.mesh.faces), 'trimesh' in sys.modules)"
+    )
+    done = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True, check=True,
+                          timeout=120)
+    assert done.stdout.split() == ["1", "False"]

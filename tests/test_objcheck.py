@@ -53,7 +53,6 @@ def _obj_files(root: Path | None) -> list[Path]:
 
 ROOTS = {
     "corpus": CORPUS,
-    "tests": PROJECT_ROOT / "tests",
     "pybullet_data": _pybullet_data(),
     "example-robot-data": EXAMPLE_ROBOT_DATA,
 }

@@ -519,17 +519,26 @@ class _Raw:
     notes: list[str] = field(default_factory=list)
 
 
+# One binary STL triangle: normal, three vertices, attribute bytes (little-endian, 50 bytes).
+_STL_RECORD = np.dtype([("normals", "<f4", (3,)), ("vertices", "<f4", (9,)), ("attributes", "<u2")])
+
+
 def _load_stl(data: bytes, name: str) -> _Raw:
     """STL, binary or ASCII. Like Choreonoid the kind is decided by the size: a file of exactly
-    84 + 50·n bytes (n = the header's triangle count) is binary, anything else must be ASCII."""
-    from trimesh.exchange import stl as trimesh_stl
+    84 + 50·n bytes (n = the header's triangle count) is binary, anything else must be ASCII.
 
+    A binary STL is read here (the same arrays as trimesh's ``load_stl_binary``, without importing
+    trimesh, which takes half a second); trimesh reads ASCII STL."""
     header_count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
     if header_count >= 0 and len(data) == 84 + 50 * header_count:
-        loaded = trimesh_stl.load_stl_binary(io.BytesIO(data))
-        kwargs = [loaded]
+        blob = np.frombuffer(data, dtype=_STL_RECORD, offset=84)
+        triangles = blob["vertices"].reshape((-1, 3))
+        faces_in_order = np.arange(len(triangles)).reshape((-1, 3))
+        kwargs: list[dict[str, Any]] = [{"vertices": triangles, "faces": faces_in_order}]
         kind = "binary"
     else:
+        from trimesh.exchange import stl as trimesh_stl
+
         text = data.decode("latin-1")
         if not text.lstrip().lower().startswith("solid"):
             expected = f"; its header announces {header_count} triangles = {84 + 50 * header_count} bytes" \
