@@ -398,7 +398,10 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK216",
         "subbody-invalid",
         "error",
-        "A SubBody cannot be loaded (missing uri, recursion, load failure).",
+        "A SubBody cannot be loaded (missing uri, recursion, load failure). Reference: Choreonoid refuses a "
+        "missing `uri` and a recursive sub-body; a sub-body file it cannot load is skipped with a message, "
+        "and the robot loads without that subtree (an error here, as a missing collision mesh is: the "
+        "result is not the robot the file describes).",
     ),
     CodeInfo(
         "MK217", "continuous-track-invalid", "error", "A ContinuousTrack node lacks a required key or value."

@@ -89,6 +89,12 @@ def read_body(path: Path, options: BodyOptions | None = None, display: str | Non
     return ReadResult(robot, sorted_diagnostics(sink.items))
 
 
+# What Choreonoid does with a SubBody it cannot load (MK216): the robot loses that whole subtree.
+SUBBODY_DROPPED = (
+    "Choreonoid prints \"cannot be loaded\" and loads the robot without that subtree (its links, masses and "
+    "collision shapes), which cannot be simulated as the robot it describes"
+)
+
 class _BodyReader:
     def __init__(
         self, path: Path, options: BodyOptions, sink: DiagnosticSink, display: str, stack: tuple[str, ...]
@@ -481,7 +487,11 @@ class _BodyReader:
             )
             return []
         if not path.exists():
-            self.sink.emit("MK216", f'SubBody "{uri}" cannot be loaded: not found at {path}', uri_node.loc)
+            self.sink.emit(
+                "MK216",
+                f'SubBody "{uri}" cannot be loaded: not found at {path}; {SUBBODY_DROPPED}',
+                uri_node.loc,
+            )
             return []
         sub_sink = DiagnosticSink()
         sub_reader = _BodyReader(path, self.options, sub_sink, str(path), self.stack)
@@ -489,7 +499,7 @@ class _BodyReader:
         for d in sub_sink.items:
             self.sink.add(d)
         if sub is None or sub.root is None:
-            self.sink.emit("MK216", f'SubBody "{uri}" cannot be loaded', uri_node.loc)
+            self.sink.emit("MK216", f'SubBody "{uri}" cannot be loaded; {SUBBODY_DROPPED}', uri_node.loc)
             return []
         prefix = v.get_text(node, "prefix") or ""
         suffix = v.get_text(node, "suffix") or ""
