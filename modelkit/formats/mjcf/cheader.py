@@ -22,7 +22,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-HEADERS = ("mjtype.h", "mjmodel.h", "mjvisualize.h", "mjspec.h", "mjxmacro.h")
+# The headers read, in include order. MuJoCo 4 moved the enums into mjtype.h; MuJoCo 3 has mjtnum.h.
+HEADERS = ("mjtnum.h", "mjtype.h", "mjmodel.h", "mjvisualize.h", "mjspec.h", "mjxmacro.h")
+REQUIRED = ("mjmodel.h", "mjspec.h", "mjxmacro.h")
 
 SCALARS: dict[str, Any] = {
     "double": ctypes.c_double,
@@ -102,8 +104,9 @@ def field_types(struct: type[ctypes.Structure]) -> dict[str, Any]:
 
 def read_headers(folder: Path) -> Headers:
     """Parse MuJoCo's headers in ``folder``; raises :class:`HeaderError` or ``OSError``."""
-    raw = {name: (folder / name).read_text(encoding="utf-8") for name in HEADERS}
-    text = "\n".join(_COMMENTS.sub(" ", raw[name]) for name in HEADERS if name != "mjxmacro.h")
+    raw = {name: (folder / name).read_text(encoding="utf-8") for name in HEADERS
+           if name in REQUIRED or (folder / name).is_file()}
+    text = "\n".join(_COMMENTS.sub(" ", body) for name, body in raw.items() if name != "mjxmacro.h")
     constants = {name: int(value) for name, value in _DEFINE.findall(text)}
     enums = {name: _enum_members(body) for body, name in _ENUM.findall(text)}
     layouts = _StructBuilder(text, constants, set(enums))

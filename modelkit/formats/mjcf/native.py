@@ -47,6 +47,7 @@ class Library:
 
     dll: ctypes.CDLL
     headers: Headers
+    fields: dict[str, tuple[int, Any]]  # offset and type of the spec fields used (see _spec_fields)
 
 
 def _library_file(folder: Path) -> Path | None:
@@ -72,12 +73,34 @@ def library() -> Library | None:
             continue
         try:
             headers = read_headers(include)
+            fields = _spec_fields(headers)
             dll = ctypes.CDLL(str(file))
+            _declare(dll)
         except (OSError, HeaderError, ValueError, KeyError, TypeError, AttributeError):
             return None
-        _declare(dll)
-        return Library(dll, headers)
+        return Library(dll, headers, fields)
     return None
+
+
+def _spec_fields(headers: Headers) -> dict[str, tuple[int, Any]]:
+    """Where the compiler flags, ``meshdir`` and a mesh's file name lie. A flag this MuJoCo version does
+    not have is left out (its compiler has no such step); ``meshdir`` moved into ``compiler`` in 3.3."""
+    fields: dict[str, tuple[int, Any]] = {}
+    for flag in COMPILER_FLAGS:
+        try:
+            fields[flag] = headers.offset("mjSpec", "compiler", flag)
+        except (AttributeError, KeyError):
+            continue
+    for path in (("compiler", "meshdir"), ("meshdir",)):
+        try:
+            fields["meshdir"] = headers.offset("mjSpec", *path)
+            break
+        except (AttributeError, KeyError):
+            continue
+    else:
+        raise HeaderError("mjSpec has no meshdir")
+    fields["mesh_file"] = headers.offset("mjsMesh", "file")
+    return fields
 
 
 def _declare(dll: ctypes.CDLL) -> None:
@@ -245,14 +268,14 @@ def compiled(path: Path) -> Iterator[Compiled | None]:
 
 def _set_compiler_flags(lib: Library, spec: int) -> None:
     for flag, value in COMPILER_FLAGS.items():
-        offset, kind = lib.headers.offset("mjSpec", "compiler", flag)
-        kind.from_address(spec + offset).value = value
+        if flag in lib.fields:
+            offset, kind = lib.fields[flag]
+            kind.from_address(spec + offset).value = value
 
 
 def _spec_view(lib: Library, spec: int) -> NativeSpec:
     dll, headers = lib.dll, lib.headers
-    meshdir_at, _ = headers.offset("mjSpec", "compiler", "meshdir")
-    file_at, _ = headers.offset("mjsMesh", "file")
+    meshdir_at, file_at = lib.fields["meshdir"][0], lib.fields["mesh_file"][0]
     mesh_kind = headers.enums["mjtObj"]["mjOBJ_MESH"]
     meshes = []
     element = dll.mjs_firstElement(spec, mesh_kind)
