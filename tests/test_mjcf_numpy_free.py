@@ -224,8 +224,6 @@ TUPLES_CHILD = PLAIN + textwrap.dedent("""\
     from modelkit.formats.common import ReadOptions
     from modelkit.formats.mjcf import reader
 
-    MODE = sys.argv[1]  # "reader": as it is; "builder": reader._world_geom read through tuples
-
 
     def tuples(value):
         return tuple(tuples(v) for v in value) if isinstance(value, list) else value
@@ -300,20 +298,6 @@ TUPLES_CHILD = PLAIN + textwrap.dedent("""\
             return self._names[f"{int(obj)}:{int(index)}"]
 
 
-    def world_geom(builder, geom):  # reader._world_geom, reading the pose without numpy
-        return {
-            "name": geom.name,
-            "type": geom.kind,
-            "size": [float(x) for x in geom.size],
-            "xyz": [float(x) for x in geom.pose.translation_tuple],
-            "rotation": [[float(x) for x in row] for row in geom.pose.rotation_tuple],
-            "source": str(builder.loc.geom(geom.index)),
-        }
-
-
-    if MODE == "builder" and hasattr(reader._MjcfReader, "_world_geom"):
-        reader._MjcfReader._world_geom = staticmethod(world_geom)
-
     snapshots = json.load(sys.stdin)
     out = {}
     for path, data in snapshots.items():
@@ -350,9 +334,9 @@ def bindings() -> dict[str, Any]:
 
 @pytest.fixture(scope="module")
 def from_tuples(bindings: dict[str, Any]) -> dict[str, Any]:
-    """The tuple-fed read with numpy refused; ``reader._world_geom`` replaced (see its test)."""
+    """The tuple-fed read with numpy refused, through the reader as it is."""
     snapshots = {path: {k: v for k, v in data.items() if k != "result"} for path, data in bindings.items()}
-    out: dict[str, Any] = _child(TUPLES_CHILD, ["builder"], json.dumps(snapshots))
+    out: dict[str, Any] = _child(TUPLES_CHILD, [], json.dumps(snapshots))
     return out
 
 
@@ -413,17 +397,7 @@ def test_the_comparison_sees_a_changed_value(bindings: dict[str, Any]) -> None:
     data = {k: v for k, v in bindings[path].items() if k != "result"}
     moments = data["model"]["body_inertia"]
     moments[1] = [moments[1][0] + 1e-9, *moments[1][1:]]
-    out = _child(TUPLES_CHILD, ["builder"], json.dumps({path: data}))
+    out = _child(TUPLES_CHILD, [], json.dumps({path: data}))
     assert "error" not in out[path]["result"]
     found = differences(bindings[path]["result"], out[path]["result"])
     assert found and all(".inertial.inertia[" in d for d in found), found
-
-
-def test_the_reader_itself_reads_tuples_without_numpy(bindings: dict[str, Any]) -> None:
-    """Also the reader's own code (``_from_compiled`` and what it calls in reader.py) as it is."""
-    snapshots = {path: {k: v for k, v in data.items() if k != "result"} for path, data in bindings.items()}
-    out = _child(TUPLES_CHILD, ["reader"], json.dumps(snapshots))
-    attempts = [a for path in bindings for a in out[path]["numpy"]]
-    assert attempts == [], attempts
-    for path in bindings:
-        assert "error" not in out[path]["result"], out[path]["result"]["error"]
