@@ -15,11 +15,11 @@ from modelkit.model import Robot
 # file's own loader accepts them: under that target they are errors, since that consumer (and
 # ``convert --to`` it) will meet them. Everywhere else they stay warnings that name the consumers.
 TARGET_REFUSALS: dict[str, frozenset[str]] = {
-    # MuJoCo: inertia violating A + B >= C; a moving link, no mass; URDF parts its URDF import refuses (a
-    # shape without its size or file, an incomplete inertia or inertial, a short rgba or mesh scale); a
-    # collision shape of size zero; a shape URDF does not have
+    # MuJoCo: a zero principal moment, inertia violating A + B >= C; a moving link, no mass; URDF parts
+    # its URDF import refuses (a shape without its size or file, an incomplete inertia or inertial, a
+    # short rgba or mesh scale); a collision shape of size zero; a shape URDF does not have
     "mjcf": frozenset(
-        {"MK303", "MK313", "MK143", "MK144", "MK145", "MK146", "MK420", "MK416", "MK412", "MK421"}
+        {"MK302", "MK303", "MK313", "MK143", "MK144", "MK145", "MK146", "MK420", "MK416", "MK412", "MK421"}
     ),
     "sdf": frozenset({"MK303", "MK211"}),  # libsdformat: the same, and links and joints sharing a name
     "urdf": frozenset(),

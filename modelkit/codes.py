@@ -527,13 +527,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK302",
         "inertia-not-positive-definite",
         "error",
-        "An inertia tensor is not positive definite (a negative or a zero principal moment) on a link that "
-        "moves: it cannot be simulated meaningfully. A URDF root not welded to `world` counts as moving "
-        "(it floats in PyBullet and Gazebo). A warning on a link welded to the world. In URDF, `.body` and "
-        "MJCF (whose loaders do not judge a welded link's inertia), links joined by fixed joints are judged "
-        "as the one rigid body engines merge them into: a point mass or a rod welded to a sound body is not "
-        "reported, a welded link's negative moment is a warning. Reference: MuJoCo refuses such a body; "
-        "libsdformat refuses it on any SDF link, moving or not.",
+        "An inertia tensor is not positive definite on a link that moves. A negative principal moment "
+        "cannot be simulated meaningfully: an error. A zero one (a rod, or a zero inertia with a mass: a "
+        "point mass) is a warning: Choreonoid, check_urdf, PyBullet and libsdformat load it, MuJoCo "
+        "refuses it (an error in MJCF and under `--target mjcf`). Moments within MuJoCo's 1e-15 count as "
+        "zero. A URDF root not welded to `world` counts as moving (it floats in PyBullet and Gazebo). A "
+        "warning on a link welded to the world. In URDF, `.body` and MJCF (whose loaders do not judge a "
+        "welded link's inertia), links joined by fixed joints are judged as the one rigid body engines "
+        "merge them into: a point mass or a rod welded to a sound body is not reported, a welded link's "
+        "negative moment is a warning.",
     ),
     CodeInfo(
         "MK303",
@@ -596,10 +598,12 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK313",
         "moving-link-massless",
         "error",
-        "A moving link has no mass after merging the links fixed to it. A zero mass cannot be simulated "
-        "(an error). Reference for a URDF link without `<inertial>`: check_urdf accepts kinematic-only "
-        "models, PyBullet gives 1 kg, MuJoCo refuses (a warning; an error under `--target mjcf`); MuJoCo "
-        "refuses a massless moving MJCF body.",
+        "A moving link has no mass after merging the links fixed to it. When nothing below it has mass "
+        "either, its joint moves nothing and cannot be simulated (an error). When links below it have mass, "
+        "articulated-body engines (PyBullet, Pinocchio) simulate it and MuJoCo refuses it: a warning (an "
+        "error under `--target mjcf`). Reference for a URDF link without `<inertial>`: check_urdf accepts "
+        "kinematic-only models, PyBullet gives 1 kg, MuJoCo refuses (a warning; an error under `--target "
+        "mjcf`); MuJoCo refuses a massless moving MJCF body.",
     ),
     CodeInfo("MK314", "inertia-count", "error", "An inertia list has neither 6 nor 9 elements."),
     CodeInfo(
@@ -775,7 +779,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK500",
         "resource-not-found",
         "error",
-        "A resource file does not exist (a warning when the mesh is visual-only).",
+        "A resource file does not exist (a warning when the mesh is visual-only). A warning also when an "
+        "absolute path does not exist but the same path under the model's folder does: PyBullet reads it "
+        "there, Gazebo and other tools do not.",
     ),
     CodeInfo("MK501", "resource-load-failed", "error", "A resource file exists but cannot be loaded."),
     CodeInfo(

@@ -14,7 +14,8 @@ Search order for ``package://NAME/REL`` (see docs/resources.md):
 ``model://NAME/REL`` looks in the ``--resource-path`` folders, then ``GZ_SIM_RESOURCE_PATH``,
 ``IGN_GAZEBO_RESOURCE_PATH``, ``SDF_PATH`` and ``GAZEBO_MODEL_PATH`` (:data:`MODEL_PATH_VARIABLES`); an SDF
 ``<include>`` looks a bare name or a relative path up there too when it is not beside the file.
-``file://`` and plain paths are relative to the referring file's folder.
+``file://`` and plain paths are relative to the referring file's folder. An absolute path that does not
+exist, but does under the model's folder, is read there, as PyBullet reads it (a warning, MK500).
 """
 
 from __future__ import annotations
@@ -38,9 +39,10 @@ MODEL_PATH_VARIABLES = ("GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH", "SDF
 @dataclass(frozen=True)
 class Resolution:
     """Where a URI points. ``path`` is None when it cannot be resolved; then ``code`` and
-    ``message`` say why (``path`` may also be set for a file that does not exist: check it). A
-    ``package://`` URI found only by PyBullet's rule has a ``path``, no ``code`` and a ``message``
-    (see :func:`package_report`)."""
+    ``message`` say why (``path`` may also be set for a file that does not exist: check it). A file
+    found only by PyBullet's rules (a ``package://`` URI beside the model, an absolute path that exists
+    only under the model's folder) has a ``path``, no ``code``, and the warning to give in
+    ``fallback_code`` and ``message`` (see :func:`found_report`)."""
 
     uri: str
     path: Path | None
@@ -48,6 +50,7 @@ class Resolution:
     code: str | None = None
     message: str | None = None
     hint: str | None = None
+    fallback_code: str | None = None
 
 
 @dataclass
@@ -79,7 +82,9 @@ class Resolver:
         match = _SCHEME_RE.match(text)
         if match is None:
             path = Path(text)
-            return Resolution(uri, _normal(path if path.is_absolute() else base_dir / path), "")
+            if path.is_absolute():
+                return _absolute(uri, path, base_dir)
+            return Resolution(uri, _normal(base_dir / path), "")
         scheme, rest = match.group(1).lower(), match.group(2)
         if scheme == "file":
             path = Path(rest)
@@ -101,6 +106,7 @@ class Resolver:
                 uri,
                 beside,
                 "package",
+                fallback_code="MK504",
                 message=f'package "{package}" of "{uri}" cannot be found on the package paths; "{rest}" is '
                 f"read from the model's folder or one above it ({beside}), as PyBullet reads it, but ROS "
                 "tools (RViz, robot_state_publisher) and Gazebo will not find it",
@@ -178,12 +184,34 @@ class Resolver:
         )
 
 
-def package_report(resolution: Resolution, uri: str) -> tuple[str, str, str | None, bool]:
-    """How to report a resolved ``package://`` URI: (code, message, hint, is a warning). Found only
-    beside the model, as PyBullet looks (MK504, a warning), or on the package search path (MK510, info)."""
-    if resolution.message:
-        return "MK504", resolution.message, resolution.hint, True
-    return "MK510", f'"{uri}" depends on the package search path; found at {resolution.path}', None, False
+def found_report(resolution: Resolution, uri: str) -> tuple[str, str, str | None, bool] | None:
+    """What to say of a resolved URI, if anything: (code, message, hint, is a warning). A file found only
+    by PyBullet's rules is a warning (MK504, MK500); one found on the package search path an info (MK510)."""
+    if resolution.fallback_code and resolution.message:
+        return resolution.fallback_code, resolution.message, resolution.hint, True
+    if resolution.scheme == "package":
+        return "MK510", f'"{uri}" depends on the package search path; found at {resolution.path}', None, False
+    return None
+
+
+def _absolute(uri: str, path: Path, base_dir: Path) -> Resolution:
+    """An absolute path; when it does not exist but the same path under the model's folder does, that
+    file, as PyBullet reads it (``/meshes/link_0.stl`` in pybullet's KUKA SDF files)."""
+    written = _normal(path)
+    if not written.exists():
+        beside = _normal(base_dir / str(path).lstrip("/\\"))
+        if beside.is_file():
+            return Resolution(
+                uri,
+                beside,
+                "",
+                fallback_code="MK500",
+                message=f'"{uri}" is an absolute path that does not exist; the file is read from the '
+                f"model's folder ({beside}), as PyBullet reads it, but Gazebo and other tools will not "
+                "find it",
+                hint="write the path relative to the model file",
+            )
+    return Resolution(uri, written, "")
 
 
 def _without_package(folder: Path, rest: str) -> Path | None:

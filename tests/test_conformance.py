@@ -137,13 +137,6 @@ EXCEPTIONS: dict[str, str] = {
         "the PR2 gripper and chair collision meshes it names are not in the snapshot (MK500); libsdformat "
         "never opens meshes"
     ),
-    "corpus/gazebo_ros_pkgs/gazebo_plugins/test2/large_models/large_model.urdf.xacro": (
-        "revolute links of mass 1 kg with an all-zero inertia (MK302): not simulable (policy: a "
-        "non-positive-definite inertia on a link that moves); check_urdf does not look at inertia"
-    ),
-    "corpus/gazebo_ros_pkgs/gazebo_plugins/test2/large_models/smaller_large_model.urdf.xacro": (
-        "as large_model.urdf.xacro: moving links of 1 kg with an all-zero inertia (MK302)"
-    ),
 }
 
 
@@ -158,26 +151,11 @@ def _pybullet_data() -> Path | None:
 
 PYBULLET_DATA = _pybullet_data()
 ROOTS = (("corpus", CORPUS), ("samples", SAMPLES), ("pybullet_data", PYBULLET_DATA))
-_ROBOTS_PYBULLET_LOADS = (
-    "a zero or singular inertia on a link that moves (policy: not simulable, MK302/MK313; MuJoCo refuses "
-    "it); check_urdf and libsdformat do not look at inertia, PyBullet loads it"
-)
 _MISSING_IN_PYBULLET_DATA = (
     "meshes/coarse/*.stl is not shipped in pybullet_data: the collision meshes are missing (MK500); the "
     "reference loader never opens meshes"
 )
 EXCEPTIONS.update({
-    "pybullet_data/cube_no_rotation.urdf": _ROBOTS_PYBULLET_LOADS,
-    "pybullet_data/laikago/laikago.urdf": _ROBOTS_PYBULLET_LOADS,
-    "pybullet_data/laikago/laikago_toes.urdf": _ROBOTS_PYBULLET_LOADS,
-    "pybullet_data/laikago/laikago_toes_limits.urdf": _ROBOTS_PYBULLET_LOADS,
-    "pybullet_data/random_urdfs/000/000.urdf": _ROBOTS_PYBULLET_LOADS,
-    "pybullet_data/kuka_iiwa/kuka_with_gripper.sdf": (
-        "the model's root link has mass 0 and is not welded to the world (MK313; policy: a moving body "
-        "without mass cannot be simulated, MuJoCo refuses it; PyBullet makes a massless base static)"
-    ),
-    "pybullet_data/kuka_iiwa/kuka_with_gripper2.sdf": "as kuka_with_gripper.sdf",
-    "pybullet_data/kuka_iiwa/model.sdf": "as kuka_with_gripper.sdf",
     "pybullet_data/kuka_iiwa/kuka_world.sdf": _MISSING_IN_PYBULLET_DATA,
     "pybullet_data/kuka_iiwa/model_for_sdf.urdf": _MISSING_IN_PYBULLET_DATA,
 })
@@ -458,6 +436,25 @@ def test_package_uri_found_beside_the_model_as_pybullet_looks(tmp_path: Path) ->
     assert [(d.code, d.severity.value) for d in validate(path).errors] == [("MK504", "error")]
 
 
+def test_absolute_path_found_under_the_model_folder_as_pybullet_looks(tmp_path: Path) -> None:
+    """``/meshes/m.stl`` (as in pybullet's KUKA SDF files): PyBullet reads it under the model's folder."""
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "m.stl").write_text(_TRIANGLE_STL)
+    written = "/meshes/m.stl"
+    assert not Path(written).exists()
+    path = tmp_path / "r.urdf"
+    path.write_text(_urdf(_part(f'<collision><geometry><mesh filename="{written}"/></geometry></collision>')))
+    command = [sys.executable, "-c", _PYBULLET_LOADS, str(path)]
+    loads = subprocess.run(command, capture_output=True, timeout=60)
+    assert loads.returncode == 0, loads.stderr[-400:]
+    v = validate(path)
+    assert v.errors == []
+    (d,) = [d for d in v.diagnostics if d.code == "MK500"]
+    assert d.severity.value == "warning" and "absolute path" in d.message
+    (tmp_path / "meshes" / "m.stl").unlink()
+    assert [(d.code, d.severity.value) for d in validate(path).errors] == [("MK500", "error")]
+
+
 _TRIANGLE_URDF = """<?xml version="1.0"?>
 <robot name="r">
   <link name="base"/>
@@ -641,7 +638,12 @@ def test_sdf_versions_as_libsdformat_reads_them(
         assert _codes(v, "info") == ["MK151"]
 
 
-def test_zero_principal_moment_on_a_moving_link_is_an_error(tmp_path: Path) -> None:
+def test_zero_principal_moment_on_a_moving_link_is_refused_by_mujoco_only(
+    tmp_path: Path, sdf_oracle: Path, monkeypatch: pytest.MonkeyPatch  # noqa: F811
+) -> None:
+    """Issue 9 §1: a zero principal moment (a rod, a point mass) is physically impossible; check_urdf,
+    PyBullet and libsdformat load it, MuJoCo refuses it: a warning naming MuJoCo, an error under
+    --target mjcf; a negative moment cannot be simulated at all: an error."""
     finger = (
         '<link name="finger"><inertial><mass value="0.1"/><inertia ixx="0" iyy="0.001" izz="0.001" ixy="0" '
         'ixz="0" iyz="0"/></inertial></link>'
@@ -650,11 +652,27 @@ def test_zero_principal_moment_on_a_moving_link_is_an_error(tmp_path: Path) -> N
         '<joint name="j" type="continuous"><parent link="base"/><child link="finger"/>'
         '<axis xyz="0 0 1"/></joint>'
     )
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes MUJOCO_LOG.TXT where it runs when it refuses a file
     path = tmp_path / "r.urdf"
     path.write_text(_urdf(_URDF_BASE + finger + moving))
     assert check_urdf_accepts(path)[0]
-    (d,) = validate(path).errors
-    assert d.code == "MK302" and "zero principal moment" in d.message
+    assert _consumers_refusing(path, sdf_oracle) == {"mjcf"}  # libsdformat's URDF conversion loads it
+    v = validate(path)
+    assert v.errors == []
+    (d,) = [d for d in v.warnings if d.code == "MK302"]
+    assert "zero principal moment" in d.message and "MuJoCo refuses it" in d.message
+    assert [d.code for d in validate(path, target="mjcf").errors] == ["MK302"]
+    for target in ("sdf", "urdf", "pybullet"):
+        assert validate(path, target=target).errors == [], target
+    path.write_text(_urdf(_URDF_BASE + finger.replace('ixx="0"', 'ixx="-0.001"') + moving))
+    assert [d.code for d in validate(path).errors] == ["MK302"]  # negative: an error whatever the target
+    # libsdformat takes a zero moment (gz-math: near-positive) in an SDF link too: a warning there as well
+    sdf = tmp_path / "r.sdf"
+    sdf.write_text(_BOX_MODEL.format(name="r").replace("<ixx>1</ixx>", "<ixx>0</ixx>"))
+    assert _libsdformat_accepts(sdf_oracle, sdf)
+    v = validate(sdf)
+    assert v.errors == [] and "MK302" in _codes(v, "warning")
+    assert [d.code for d in validate(sdf, target="mjcf").errors] == ["MK302"]
     welded = moving.replace('type="continuous"', 'type="fixed"')
     path.write_text(_urdf(_URDF_BASE + finger + welded))
     v = validate(path)  # a rod welded to the base: engines merge it, and the merged body is sound
@@ -683,9 +701,11 @@ def test_links_welded_by_fixed_joints_are_judged_as_the_body_engines_merge(tmp_p
     # two rods along x welded together on the x axis: the merged body has no moment about x either
     path.write_text(_urdf(_URDF_BASE + link("arm", rod) + link("tip", rod)
                           + joint("continuous", "base", "arm") + joint("fixed", "arm", "tip", "0.5 0 0")))
-    (d,) = validate(path).errors
-    assert d.code == "MK302" and 'rigid body of link "arm"' in d.message
-    assert "zero principal moment" in d.message
+    v = validate(path)
+    assert v.errors == []
+    (d,) = [d for d in v.warnings if d.code == "MK302"]
+    assert 'rigid body of link "arm"' in d.message and "zero principal moment" in d.message
+    assert [d.code for d in validate(path, target="mjcf").errors] == ["MK302"]
     assert d.location is not None and d.location.line > 0
     # the same rods offset along y: merged, the body has a moment about x (parallel axes): sound
     path.write_text(_urdf(_URDF_BASE + link("arm", rod) + link("tip", rod)
@@ -699,6 +719,34 @@ def test_links_welded_by_fixed_joints_are_judged_as_the_body_engines_merge(tmp_p
     assert v.errors == [] and _codes(v, "warning").count("MK302") == 1
 
 
+def test_a_massless_moving_link_is_an_error_only_when_it_moves_nothing_with_mass(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A massless link between two joints (a differential wrist, a floating root above the robot):
+    articulated-body engines simulate it, MuJoCo refuses it; a massless leaf moves nothing."""
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes MUJOCO_LOG.TXT where it runs when it refuses a file
+    zero = '<inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial>'
+    one = '<inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>'
+    joints = (
+        '<joint name="j1" type="continuous"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint>'
+        '<joint name="j2" type="continuous"><parent link="a"/><child link="b"/><origin xyz="1 0 0"/>'
+        '<axis xyz="1 0 0"/></joint>'
+    )
+    path = tmp_path / "r.urdf"
+    path.write_text(_urdf(_URDF_BASE + f'<link name="a">{zero}</link><link name="b">{one}</link>' + joints))
+    assert check_urdf_accepts(path)[0]
+    command = [sys.executable, "-c", _PYBULLET_LOADS, str(path)]
+    loads = subprocess.run(command, capture_output=True, timeout=60)
+    assert loads.returncode == 0, loads.stderr[-400:]
+    with pytest.raises(ValueError, match="mass and inertia of moving bodies"):
+        mujoco.MjModel.from_xml_path(str(path))
+    v = validate(path)
+    assert v.errors == [] and [d.code for d in v.warnings if d.code == "MK313"] == ["MK313"]
+    assert [d.code for d in validate(path, target="mjcf").errors] == ["MK313"]
+    path.write_text(_urdf(_URDF_BASE + f'<link name="a">{zero}</link><link name="b">{zero}</link>' + joints))
+    assert sorted(d.code for d in validate(path).errors) == ["MK313", "MK313"]  # nothing with mass moves
+
+
 def test_singular_inertia_on_a_urdf_root_counts_as_moving(tmp_path: Path) -> None:
     root = _URDF_BASE.replace('ixx="1" iyy="1" izz="1"', 'ixx="0" iyy="0" izz="0"')
     arm = _URDF_BASE.replace('"base"', '"arm"') + (
@@ -706,14 +754,17 @@ def test_singular_inertia_on_a_urdf_root_counts_as_moving(tmp_path: Path) -> Non
         '<axis xyz="0 0 1"/></joint>'
     )
     path = tmp_path / "r.urdf"
-    path.write_text(_urdf(root + arm))  # the root floats in PyBullet and Gazebo
-    assert [d.code for d in validate(path).errors] == ["MK302"]
+    path.write_text(_urdf(root + arm))  # the root floats in PyBullet and Gazebo: judged as moving
+    (d,) = [d for d in validate(path).warnings if d.code == "MK302"]
+    assert "MuJoCo refuses it" in d.message and "does not move" not in d.message
+    assert [d.code for d in validate(path, target="mjcf").errors] == ["MK302"]
     welded = (
         '<link name="world"/><joint name="w" type="fixed"><parent link="world"/><child link="base"/></joint>'
     )
     path.write_text(_urdf(welded + root + arm))
     v = validate(path)
     assert v.errors == [] and _codes(v, "warning") == ["MK302"]
+    assert "does not move" in v.warnings[0].message
 
 
 _BOX = "<box><size>1 1 1</size></box>"

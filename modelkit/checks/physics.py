@@ -6,7 +6,7 @@ import math
 from collections.abc import Iterator
 
 from modelkit import rot3
-from modelkit.checks.masses import body_mass_properties, lumped_masses, welded_bodies
+from modelkit.checks.masses import body_mass_properties, lumped_masses, subtree, welded_bodies
 from modelkit.checks.registry import rule
 from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
 from modelkit.model import SYNTHESISED, JointType, Link, Robot
@@ -65,6 +65,7 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
         return  # e.g. MuJoCo could not compile the file: masses it would infer from geoms are unknown
     moving = _moving_links(robot)
     merged = _merged_masses(robot)
+    carried: dict[str, float] | None = None  # subtree masses, computed when first needed
     for link in robot.links:
         inertial = link.inertial
         if link.extras.get(SYNTHESISED):
@@ -90,12 +91,39 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
                 "MK300", f'link "{link.name}" has a negative mass ({inertial.mass:g} kg)', _mass_loc(link)
             )
         elif inertial.mass == 0 and link.name in moving and merged.get(link.name, 0.0) <= 0.0:
+            if carried is None:
+                carried = _subtree_masses(robot)
+            if carried.get(link.name, 0.0) > 0.0:  # its joint moves the massive links below it
+                yield diag(
+                    "MK313",
+                    f'link "{link.name}" moves but its mass is zero; the links below it have mass, so its '
+                    f"joint can be simulated (PyBullet, Pinocchio), but {MASSLESS_BODY_REFUSED}",
+                    _mass_loc(link),
+                    severity=Severity.WARNING,
+                )
+                continue
             yield diag(
                 "MK313",
-                f'link "{link.name}" moves but its mass is zero: a body without mass cannot be simulated '
-                "(MuJoCo refuses it, PyBullet freezes its joint)",
+                f'link "{link.name}" moves but its mass is zero, and so does everything below it: its joint '
+                "moves nothing with mass, which cannot be simulated (MuJoCo refuses it, PyBullet freezes the "
+                "joint)",
                 _mass_loc(link),
             )
+
+
+# A massless body that moves links with mass (MK313, a warning): who refuses it. An error under --target mjcf.
+MASSLESS_BODY_REFUSED = "MuJoCo refuses a moving body without mass"
+
+
+def _subtree_masses(robot: Robot) -> dict[str, float]:
+    """Each link's mass plus the masses of every link below it, through any joint."""
+    children = robot.children_of()
+    own = {link.name: max(link.inertial.mass, 0.0) if link.inertial else 0.0 for link in robot.links}
+    order = subtree(children, robot.root) if robot.root else []
+    total: dict[str, float] = {}
+    for name in reversed(order):
+        total[name] = own.get(name, 0.0) + sum(total.get(j.child, 0.0) for j in children.get(name, []))
+    return total
 
 
 # MK313 for a moving link without <inertial> in a format whose loader accepts it (URDF: check_urdf
@@ -129,6 +157,24 @@ IMPOSSIBLE_INERTIA_CONSUMERS = (
 )
 # Source formats whose own loader refuses such an inertia: there MK303 is an error.
 IMPOSSIBLE_INERTIA_REFUSED_BY = frozenset({"mjcf", "sdf"})
+
+
+# A principal moment at or below MuJoCo's mjMINVAL (kg·m²) counts as zero, also when rounding made it
+# slightly negative (-2e-35 beside 2e-35 in a real URDF is a zero inertia, not a negative one).
+ZERO_MOMENT = 1e-15
+
+
+# Who loads a moving body with a zero principal moment (MK302), and who refuses it.
+SINGULAR_INERTIA_CONSUMERS = (
+    "Choreonoid, check_urdf, PyBullet and libsdformat (Gazebo) load it, MuJoCo refuses it"
+)
+
+
+def _singular_inertia_severity(robot: Robot, severity: Severity | None) -> Severity | None:
+    """MK302 for a zero principal moment: an error in MJCF (MuJoCo refuses it), else a warning."""
+    if severity is Severity.WARNING or robot.source_format != "mjcf":
+        return Severity.WARNING
+    return None
 
 
 def _impossible_inertia_severity(robot: Robot) -> Severity:
@@ -210,23 +256,31 @@ def _judge_inertia(
     severity: Severity | None,
     static: str,
 ) -> Iterator[Diagnostic]:
-    """MK302 (zero or not positive definite) or MK303 (triangle inequality) for one link or welded body."""
+    """MK302 (zero or not positive definite) or MK303 (triangle inequality) for one link or welded body.
+
+    A negative principal moment cannot be simulated meaningfully: an error where the body moves. A zero
+    one (a point mass, a rod) is physically impossible but loaded by Choreonoid, check_urdf, PyBullet and
+    libsdformat (gz-math takes a moment near zero) and refused by MuJoCo: an error in MJCF, else a
+    warning naming MuJoCo (``--target mjcf`` raises it).
+    """
     moments = rot3.symmetric_eigenvalues(tensor)  # of the symmetric part: rounding asymmetry ignored
-    eps = rot3.inertia_tolerance(moments)
-    if all(abs(m) <= eps for m in moments):
-        said = f"{what} has mass {mass:g} kg but a zero inertia{static}"
+    zero = max(rot3.inertia_tolerance(moments), ZERO_MOMENT)
+    listed = ", ".join(f"{m:.6g}" for m in moments)
+    if moments[0] < -zero:  # indefinite: a negative moment
+        said = f"{what}: the inertia is not positive definite (principal moments {listed}){static}"
         yield diag("MK302", said, where, severity=severity)
         return
-    if moments[0] <= eps:  # negative, or a zero moment: no finite acceleration about that axis
-        zero = " (a zero principal moment)" if moments[0] >= -eps else ""
-        yield diag(
-            "MK302",
-            f"{what}: the inertia is not positive definite{zero} (principal moments "
-            f"{', '.join(f'{m:.6g}' for m in moments)}){static}",
-            where,
-            severity=severity,
-        )
+    if moments[0] <= zero:  # no finite acceleration about that axis
+        singular = _singular_inertia_severity(robot, severity)
+        refused = f"; {SINGULAR_INERTIA_CONSUMERS}" if singular is Severity.WARNING and not static else ""
+        if all(abs(m) <= zero for m in moments):
+            said = f"{what} has mass {mass:g} kg but a zero inertia{static}{refused}"
+        else:
+            said = (f"{what}: the inertia is not positive definite (a zero principal moment) (principal "
+                    f"moments {listed}){static}{refused}")
+        yield diag("MK302", said, where, severity=singular)
         return
+    eps = rot3.inertia_tolerance(moments)
     a, b, c = moments
     if a + b < c - eps:
         yield diag(

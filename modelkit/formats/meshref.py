@@ -16,7 +16,7 @@ from pathlib import Path
 from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
 from modelkit.model import Mesh
-from modelkit.resources import Resolution, Resolver, package_report
+from modelkit.resources import Resolution, Resolver, found_report
 from modelkit.textio import UnreadableFile, check_regular
 
 MESH_FILE_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl"})
@@ -107,8 +107,9 @@ class MeshChecker:
                 severity=severity,
             )
         elif path is not None:
-            if resolution.scheme == "package":
-                code, message, hint, warning = package_report(resolution, uri)
+            report = found_report(resolution, uri)
+            if report is not None:
+                code, message, hint, warning = report
                 self.sink.emit(code, message, loc, hint=hint, severity=Severity.WARNING if warning else None)
             suffix = path.suffix.lower()
             if not path.exists():

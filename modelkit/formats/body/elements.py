@@ -32,7 +32,7 @@ from modelkit.model import (
     TriangleMeshData,
     VisualMaterial,
 )
-from modelkit.resources import Resolver, package_report
+from modelkit.resources import Resolver, found_report
 from modelkit.rot3 import peek
 from modelkit.spatial import Pose
 from modelkit.yamltree import YamlDocument, YMap, YNode, YScalar, YSeq, parse_yaml, read_text
@@ -625,8 +625,9 @@ def _add_mesh_file(
         )
     elif path is not None:
         suffix = path.suffix.lower()
-        if resolution.scheme == "package":
-            code, message, hint, warning = package_report(resolution, uri)
+        report = found_report(resolution, uri)
+        if report is not None:
+            code, message, hint, warning = report
             severity_of_note = Severity.WARNING if warning else None
             ctx.sink.emit(code, message, uri_node.loc, hint=hint, severity=severity_of_note)
         if not path.exists():
