@@ -417,13 +417,7 @@ def test_package_uri_found_beside_the_model_as_pybullet_looks(tmp_path: Path) ->
         '<collision><geometry><mesh filename="package://arm_description/meshes/m.stl"/></geometry></collision>'
     )))
     assert check_urdf_accepts(path)[0]
-    command = [sys.executable, "-c", _PYBULLET_LOADS, str(path)]
-    loads = subprocess.run(command, capture_output=True, timeout=60)
-    assert loads.returncode == 0, loads.stderr[-400:]
-    v = validate(path)
-    assert v.errors == []
-    (d,) = [d for d in v.diagnostics if d.code == "MK504"]
-    assert d.severity.value == "warning" and "as PyBullet reads it" in d.message
+    _pybullet_reads_it_and_we_warn(path, "MK504", "as PyBullet reads it")
     moved = tmp_path / "robot" / "urdf"  # the package folder above the model, without package.xml
     moved.mkdir(parents=True)
     (moved / "r.urdf").write_text(path.read_text())
@@ -436,6 +430,17 @@ def test_package_uri_found_beside_the_model_as_pybullet_looks(tmp_path: Path) ->
     assert [(d.code, d.severity.value) for d in validate(path).errors] == [("MK504", "error")]
 
 
+def _pybullet_reads_it_and_we_warn(path: Path, code: str, said: str) -> None:
+    """PyBullet loads the file (live); modelkit reports no error and one ``code`` warning saying ``said``."""
+    command = [sys.executable, "-c", _PYBULLET_LOADS, str(path)]
+    loads = subprocess.run(command, capture_output=True, timeout=60)
+    assert loads.returncode == 0, loads.stderr[-400:]
+    v = validate(path)
+    assert v.errors == []
+    (d,) = [d for d in v.diagnostics if d.code == code]
+    assert d.severity.value == "warning" and said in d.message, d
+
+
 def test_absolute_path_found_under_the_model_folder_as_pybullet_looks(tmp_path: Path) -> None:
     """``/meshes/m.stl`` (as in pybullet's KUKA SDF files): PyBullet reads it under the model's folder."""
     (tmp_path / "meshes").mkdir()
@@ -444,13 +449,7 @@ def test_absolute_path_found_under_the_model_folder_as_pybullet_looks(tmp_path: 
     assert not Path(written).exists()
     path = tmp_path / "r.urdf"
     path.write_text(_urdf(_part(f'<collision><geometry><mesh filename="{written}"/></geometry></collision>')))
-    command = [sys.executable, "-c", _PYBULLET_LOADS, str(path)]
-    loads = subprocess.run(command, capture_output=True, timeout=60)
-    assert loads.returncode == 0, loads.stderr[-400:]
-    v = validate(path)
-    assert v.errors == []
-    (d,) = [d for d in v.diagnostics if d.code == "MK500"]
-    assert d.severity.value == "warning" and "absolute path" in d.message
+    _pybullet_reads_it_and_we_warn(path, "MK500", "absolute path")
     (tmp_path / "meshes" / "m.stl").unlink()
     assert [(d.code, d.severity.value) for d in validate(path).errors] == [("MK500", "error")]
 
