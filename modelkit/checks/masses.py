@@ -22,13 +22,14 @@ def subtree(children: dict[str, list[Joint]], start: str) -> list[str]:
     return order
 
 
-def lumped_masses(robot: Robot, lump_into_world: bool = True) -> dict[str, float]:
+def lumped_masses(robot: Robot, lump_into_world: bool = True, every_joint: bool = False) -> dict[str, float]:
     """Each link's mass after fixed-joint lumping, for the links reachable from the root.
 
     A link's value is its own mass (a negative mass counts as 0) plus the lumped masses of the
     links attached below it by fixed joints, so the top link of a rigid body holds the body's total.
     With ``lump_into_world`` False, fixed joints from the world link lump nothing (libsdformat keeps
-    what is welded to the world as separate bodies).
+    what is welded to the world as separate bodies). With ``every_joint`` the sum goes through every
+    joint: each link's value is then the mass of its whole subtree.
     """
     children = robot.children_of()
     own = {link.name: (link.inertial.mass if link.inertial is not None else 0.0) for link in robot.links}
@@ -38,7 +39,7 @@ def lumped_masses(robot: Robot, lump_into_world: bool = True) -> dict[str, float
         mass = max(own.get(name, 0.0), 0.0)
         if lump_into_world or name != WORLD_LINK:
             for joint in children.get(name, []):
-                if joint.type is JointType.FIXED:
+                if every_joint or joint.type is JointType.FIXED:
                     mass += total.get(joint.child, 0.0)
         total[name] = mass
     return total

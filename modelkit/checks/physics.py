@@ -6,7 +6,7 @@ import math
 from collections.abc import Iterator
 
 from modelkit import rot3
-from modelkit.checks.masses import body_mass_properties, lumped_masses, subtree, welded_bodies
+from modelkit.checks.masses import body_mass_properties, lumped_masses, welded_bodies
 from modelkit.checks.registry import rule
 from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
 from modelkit.model import SYNTHESISED, JointType, Link, Robot
@@ -92,7 +92,7 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
             )
         elif inertial.mass == 0 and link.name in moving and merged.get(link.name, 0.0) <= 0.0:
             if carried is None:
-                carried = _subtree_masses(robot)
+                carried = lumped_masses(robot, every_joint=True)  # each link's subtree
             if carried.get(link.name, 0.0) > 0.0:  # its joint moves the massive links below it
                 yield diag(
                     "MK313",
@@ -113,17 +113,6 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
 
 # A massless body that moves links with mass (MK313, a warning): who refuses it. An error under --target mjcf.
 MASSLESS_BODY_REFUSED = "MuJoCo refuses a moving body without mass"
-
-
-def _subtree_masses(robot: Robot) -> dict[str, float]:
-    """Each link's mass plus the masses of every link below it, through any joint."""
-    children = robot.children_of()
-    own = {link.name: max(link.inertial.mass, 0.0) if link.inertial else 0.0 for link in robot.links}
-    order = subtree(children, robot.root) if robot.root else []
-    total: dict[str, float] = {}
-    for name in reversed(order):
-        total[name] = own.get(name, 0.0) + sum(total.get(j.child, 0.0) for j in children.get(name, []))
-    return total
 
 
 # MK313 for a moving link without <inertial> in a format whose loader accepts it (URDF: check_urdf

@@ -92,9 +92,13 @@ class _MjcfReader:
             return []
         with collected_warnings(mujoco) as warnings:  # never MUJOCO_LOG.TXT in the working directory
             robots = self._through_mujoco(mujoco, index, compiled)
-        for message in dict.fromkeys(warnings):
-            self.sink.emit("MK177", f"MuJoCo warned: {message}", index.top().loc())
+        self._report_warnings(warnings, index)
         return robots
+
+    def _report_warnings(self, messages: list[str], index: SourceIndex) -> None:
+        """MuJoCo's warnings (each once), whichever way MuJoCo was called."""
+        for message in dict.fromkeys(messages):
+            self.sink.emit("MK177", f"MuJoCo warned: {message}", index.top().loc())
 
     def _through_native(self, index: SourceIndex) -> list[Robot] | None:
         """The compiled model through MuJoCo's C library (:mod:`.native`); ``None`` when the bindings
@@ -108,8 +112,7 @@ class _MjcfReader:
                 name = self._model_name(index)
                 return self._from_compiled(result.mj, result.model, result.spec, index, name)
             finally:
-                for message in dict.fromkeys(result.warnings):
-                    self.sink.emit("MK177", f"MuJoCo warned: {message}", index.top().loc())
+                self._report_warnings(result.warnings, index)
 
     def _through_mujoco(self, mujoco: Any, index: SourceIndex, compiled: bool) -> list[Robot]:
         spec = self._spec(mujoco, index)
