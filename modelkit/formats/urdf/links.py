@@ -240,11 +240,13 @@ def _inertia(ctx: Context, element: Element, link: str) -> rot3.M3 | None:
     return rot3.inertia_from_moments(*(float(v or 0.0) for v in values))
 
 
-# A shape without its size or file (MK143): who loads the file and who refuses it.
-UNREADABLE_SHAPE_CONSUMERS = (
+# What urdfdom does with a shape it cannot read (MK143, MK412, MK421).
+URDFDOM_DROPS_SHAPE = (
     "urdfdom (check_urdf, libsdformat) logs an error, drops it and every later visual and collision of the "
-    "link, and loads the file; PyBullet and MuJoCo refuse the file"
+    "link, and loads the file"
 )
+# A shape without its size or file (MK143): who loads the file and who refuses it.
+UNREADABLE_SHAPE_CONSUMERS = f"{URDFDOM_DROPS_SHAPE}; PyBullet and MuJoCo refuse the file"
 
 
 def _unreadable_shape(ctx: Context, shape: Element, what: str, lacks: str) -> None:
@@ -342,7 +344,7 @@ def read_geometry(
     ctx.emit(
         "MK421" if pybullet_shape else "MK412",
         f"{'PyBullet' if pybullet_shape else 'unknown'} geometry type <{tag}> in the {what}; URDF has box, "
-        f"cylinder, sphere, capsule and mesh, so modelkit leaves the {what} out ({UNKNOWN_SHAPE_CONSUMERS}; "
+        f"cylinder, sphere, capsule and mesh, so modelkit leaves the {what} out ({URDFDOM_DROPS_SHAPE}; "
         f"{others})",
         loc,
         severity=Severity.WARNING,
@@ -350,12 +352,29 @@ def read_geometry(
     return None
 
 
-# PyBullet's own URDF shapes (MK421), and what urdfdom does with a shape URDF does not have (MK412, MK421).
+# PyBullet's own URDF shapes (MK421).
 PYBULLET_SHAPES = ("plane", "cdf")
-UNKNOWN_SHAPE_CONSUMERS = (
-    "urdfdom (check_urdf, libsdformat) logs an error, drops it and every later visual and collision of the "
-    "link, and loads the file"
-)
+
+
+def _scale_as_pybullet_reads_it(
+    ctx: Context, shape: Element, what: str, text: str, numbers: list[float]
+) -> tuple[float, float, float]:
+    """MK420: a mesh ``scale`` of another count than three, read as PyBullet reads it (the first three
+    numbers; one or two: the first as a uniform scale)."""
+    if len(numbers) > 3:
+        count, how, used = f"{len(numbers)} numbers", "the first three", (numbers[0], numbers[1], numbers[2])
+    else:
+        count = ("one number", "two numbers")[len(numbers) - 1]
+        how, used = "the first as a uniform scale", (numbers[0], numbers[0], numbers[0])
+    ctx.emit(
+        "MK420",
+        f'mesh of the {what}: `scale="{text}"` has {count}; URDF needs three. modelkit reads {how}, as '
+        "PyBullet does; urdfdom logs an error, drops the shape and every later visual and collision of the "
+        "link, and loads the robot; MuJoCo refuses the file",
+        ctx.loc(shape, "scale"),
+        hint=f'write scale="{" ".join(f"{v:g}" for v in used)}"',
+    )
+    return used
 
 
 def _not_positive(
@@ -408,29 +427,8 @@ def _mesh(ctx: Context, shape: Element, what: str, meshes: MeshChecker, visual_o
     text = shape.get("scale")
     if text is not None:
         numbers = parse_numbers(text)
-        if numbers is not None and len(numbers) > 3 and all(math.isfinite(v) for v in numbers):
-            ctx.emit(
-                "MK420",
-                f'mesh of the {what}: `scale="{text}"` has {len(numbers)} numbers; URDF needs three. '
-                "modelkit reads the first three, as PyBullet does; urdfdom logs an error, drops the shape "
-                "and every later visual and collision of the link, and loads the robot; MuJoCo refuses the "
-                "file",
-                ctx.loc(shape, "scale"),
-                hint=f'write scale="{" ".join(f"{v:g}" for v in numbers[:3])}"',
-            )
-            scale = (numbers[0], numbers[1], numbers[2])
-        elif numbers is not None and len(numbers) in (1, 2) and all(math.isfinite(v) for v in numbers):
-            value = numbers[0]
-            ctx.emit(
-                "MK420",
-                f'mesh of the {what}: `scale="{text}"` has {("one number", "two numbers")[len(numbers) - 1]}'
-                "; URDF needs three. modelkit reads the first as a uniform scale, as PyBullet does; urdfdom "
-                "logs an error, drops the shape and every later visual and collision of the link, and loads "
-                "the robot; MuJoCo refuses the file",
-                ctx.loc(shape, "scale"),
-                hint=f'write scale="{value:g} {value:g} {value:g}"',
-            )
-            scale = (value, value, value)
+        if numbers and len(numbers) != 3 and all(math.isfinite(v) for v in numbers):
+            scale = _scale_as_pybullet_reads_it(ctx, shape, what, text, numbers)
         else:
             values = vector(ctx, shape, "scale", f"mesh of the {what}")
             if values is None:
