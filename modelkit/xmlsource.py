@@ -16,6 +16,7 @@ from __future__ import annotations
 import re
 from array import array
 from bisect import bisect_right
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -354,21 +355,48 @@ def _blank_declaration(data: bytes) -> bytes | None:
     return data[:start] + bytes(b if b in b"\r\n" else 32 for b in data[start:end]) + data[end:]
 
 
-_COMMENT_HYPHENS = (
-    'a comment contains "--", which XML forbids: libsdformat, urdfdom and MuJoCo (TinyXML2) accept it, '
-    "strict XML tools (xacro, lxml, ROS launch) refuse it",
-    'write "- -" or "-" inside comments',
-)
-_DECLARATION_PROBLEM = (
-    "the XML declaration {problem}; libsdformat, urdfdom, MuJoCo and PyBullet (TinyXML2) ignore it, strict "
-    "XML tools (lxml, so urdf_parser_py and yourdfpy{expat}) refuse it",
-    'start the file with <?xml version="1.0"?> or leave the declaration out',
-)
-#: libxml2's complaint → (how TinyXML2 reads past it, what to say, the hint).
+_TINYXML2 = "libsdformat, urdfdom, MuJoCo and PyBullet (TinyXML2)"
+
+
+def _declared_version(text: str) -> str:
+    version = re.search(r"version\s*=\s*[\"']([^\"']*)", text)
+    return version.group(1) if version else ""
+
+
+@dataclass(frozen=True)
+class _Leniency:
+    """Something libxml2 refuses that TinyXML2 reads past: how to read past it, and what to say."""
+
+    repair: Callable[[bytes], bytes | None]
+    say: Callable[[str], str]  # the document's text → the warning
+    hint: str
+    at_declaration: bool  # located at the XML declaration (else where libxml2 stopped)
+
+
+_DECLARATION_HINT = 'start the file with <?xml version="1.0"?> or leave the declaration out'
+#: libxml2's complaint → how TinyXML2 reads past it.
 _TINYXML2_LENIENCY = {
-    "hyphen within comment": (_blank_comment_hyphens, *_COMMENT_HYPHENS),
-    "Unsupported version": (_blank_declaration, *_DECLARATION_PROBLEM),
-    "XML declaration allowed only at the start": (_blank_declaration, *_DECLARATION_PROBLEM),
+    "hyphen within comment": _Leniency(
+        _blank_comment_hyphens,
+        lambda text: 'a comment contains "--", which XML forbids: libsdformat, urdfdom and MuJoCo (TinyXML2) '
+        "accept it, strict XML tools (xacro, lxml, ROS launch) refuse it",
+        'write "- -" or "-" inside comments',
+        at_declaration=False,
+    ),
+    "Unsupported version": _Leniency(
+        _blank_declaration,
+        lambda text: f'the XML declaration names version "{_declared_version(text)}", not 1.0; {_TINYXML2} '
+        "ignore it, strict XML tools (lxml, so urdf_parser_py and yourdfpy) refuse it",
+        _DECLARATION_HINT,
+        at_declaration=True,
+    ),
+    "XML declaration allowed only at the start": _Leniency(
+        _blank_declaration,
+        lambda text: f"the XML declaration is not at the start of the file; {_TINYXML2} ignore it, strict "
+        "XML tools (lxml, so urdf_parser_py and yourdfpy, and xacro) refuse it",
+        _DECLARATION_HINT,
+        at_declaration=True,
+    ),
 }
 
 
@@ -389,21 +417,15 @@ def _as_tinyxml2_reads(
         if problem is None:
             break
         applied.add(problem)
-        repair, said, hint = _TINYXML2_LENIENCY[problem]
-        repaired = repair(data)
+        leniency = _TINYXML2_LENIENCY[problem]
+        repaired = leniency.repair(data)
         if repaired is None:
             break
-        if repair is _blank_declaration:
+        if leniency.at_declaration:
             declaration = _DECLARATION.match(data)
             at = declaration.start(3) if declaration else 0
             where = location_at(text, display, len(data[:at].decode("utf-8", "replace")))
-            version = re.search(r"version\s*=\s*[\"']([^\"']*)", text)
-            said = said.format(
-                problem=(f'names version "{version.group(1)}", not 1.0' if "version" in problem and version
-                         else "is not at the start of the file"),
-                expat="" if "version" in problem else ", and xacro",
-            )
-        sink.emit("MK020", said, where, hint=hint, severity=Severity.WARNING)
+        sink.emit("MK020", leniency.say(text), where, hint=leniency.hint, severity=Severity.WARNING)
         data = repaired
         try:
             return etree.fromstring(data, parser)
