@@ -36,14 +36,7 @@ def _detach(nodes: list[Any]) -> None:
     for old in parents.values():
         kept = [child for child in old.childNodes if id(child) not in moved]
         old.childNodes[:] = kept
-        previous = None
-        for child in kept:
-            child.previousSibling = previous
-            if previous is not None:
-                previous.nextSibling = child
-            previous = child
-        if previous is not None:
-            previous.nextSibling = None
+        _link_siblings(kept, None, None)
     for child in nodes:
         child.parentNode = child.previousSibling = child.nextSibling = None
 
@@ -62,9 +55,19 @@ def replace_node(node: Any, by: Any, content_only: bool = False) -> None:
     before = siblings[index - 1] if index > 0 else None
     after = siblings[index + 1] if index + 1 < len(siblings) else None
     siblings[index : index + 1] = new
-    previous = before
     for child in new:
         child.parentNode = parent
+    _link_siblings(new, before, after)
+    node.parentNode = node.previousSibling = node.nextSibling = None
+    if any(child.nodeType == Node.ELEMENT_NODE for child in new) or node.nodeType == Node.ELEMENT_NODE:
+        minidom._clear_id_cache(parent)  # type: ignore[attr-defined]  # as insertBefore/removeChild do
+
+
+def _link_siblings(nodes: list[Any], before: Any, after: Any) -> None:
+    """Set the sibling links of ``nodes``, which now stand in order between ``before`` and ``after``
+    (either may be None: the start or the end of the parent's children)."""
+    previous = before
+    for child in nodes:
         child.previousSibling = previous
         if previous is not None:
             previous.nextSibling = child
@@ -73,6 +76,3 @@ def replace_node(node: Any, by: Any, content_only: bool = False) -> None:
         previous.nextSibling = after
     if after is not None:
         after.previousSibling = previous
-    node.parentNode = node.previousSibling = node.nextSibling = None
-    if any(child.nodeType == Node.ELEMENT_NODE for child in new) or node.nodeType == Node.ELEMENT_NODE:
-        minidom._clear_id_cache(parent)  # type: ignore[attr-defined]  # as insertBefore/removeChild do
