@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from modelkit.verify.controllers import make_controllers
 from modelkit.verify.drive import Command, Drive, Profile, Trajectory
 
 MODELS = Path(__file__).resolve().parent.parent / "samples/choreonoid_ros2_mobile_robot_tutorial/model"
@@ -72,3 +73,16 @@ def assert_same_layer4(robot: Any, engine: str, per_step: str, tmp_path: Path, m
     runs = [(a, b) for a, b in zip(fast.trajectories, slow.trajectories, strict=True) if a.source == engine]
     assert runs and all(run_difference(a, b) <= ROUND_OFF for a, b in runs)
     return runs
+
+
+def no_affine_law(drive: dict[str, Any], scenario: dict[str, Any]) -> list[Any]:
+    """The seed's controllers without ``affine_law`` (a controller the driver must call every step)."""
+
+    class PerStep:
+        def __init__(self, inner: Any) -> None:
+            self.inner, self.name, self.joints, self.mode = inner, inner.name, inner.joints, inner.mode
+
+        def output(self, t: float, command: Command, q: Any, dq: Any) -> Any:
+            return self.inner.output(t, command, q, dq)
+
+    return [PerStep(c) for c in make_controllers(drive, scenario)]

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import modelkit
-from modelkit.verify import controllers, engine_mujoco, variant
-from modelkit.verify.drive import Command, Drive, Scenario
+from modelkit.verify import engine_mujoco, variant
+from modelkit.verify.drive import Drive, Scenario
 from tests.drivers_support import (
     DRIVE,
     PANTILT,
@@ -94,25 +94,12 @@ def test_an_implicit_damping_term_would_not_be_round_off(pantilt_files: Any) -> 
     assert largest > 1e3 * ROUND_OFF
 
 
-def _no_affine_law(drive: dict[str, Any], scenario: dict[str, Any]) -> list[Any]:
-    """The seed's controllers without ``affine_law`` (a controller the driver must call every step)."""
-
-    class PerStep:
-        def __init__(self, inner: Any) -> None:
-            self.inner, self.name, self.joints, self.mode = inner, inner.name, inner.joints, inner.mode
-
-        def output(self, t: float, command: Command, q: Any, dq: Any) -> Any:
-            return self.inner.output(t, command, q, dq)
-
-    return [PerStep(c) for c in controllers.make_controllers(drive, scenario)]
-
-
 def test_a_controller_without_an_affine_law_runs_per_step(pantilt_files: Any) -> None:
     files, maps = pantilt_files
     scenario = Scenario(profiles=PROFILES[1:2], controller="drive")
     fast, slow = _pair(files, maps, DRIVE, scenario)
     wrapped = engine_mujoco.driver(files["mjcf"], maps["mjcf"], drive=DRIVE, scenario=scenario,
-                                   factory=f"{__name__}:_no_affine_law")
+                                   factory="tests.drivers_support:no_affine_law")
     assert "per step" in wrapped.settings["control"] and wrapped.model.nu == 0
     a = wrapped.run(PROFILES[1], scenario, DRIVE)
     assert run_difference(a, slow.run(PROFILES[1], scenario, DRIVE)) == 0.0  # the very same computation

@@ -143,24 +143,11 @@ def test_tracks_velocity_targets_at_command_changes(tmp_path: Path) -> None:
         slow.close()
 
 
-def _no_affine_law(drive: dict[str, Any], scenario: dict[str, Any]) -> list[Any]:
-    """The seed's controllers without ``affine_law`` (a controller the driver must call every step)."""
-
-    class PerStep:
-        def __init__(self, inner: Any) -> None:
-            self.inner, self.name, self.joints, self.mode = inner, inner.name, inner.joints, inner.mode
-
-        def output(self, t: float, command: Command, q: Any, dq: Any) -> Any:
-            return self.inner.output(t, command, q, dq)
-
-    return [PerStep(c) for c in controllers.make_controllers(drive, scenario)]
-
-
 def test_a_controller_without_an_affine_law_runs_per_step(pantilt_files: Any) -> None:
     files, maps = pantilt_files
     scenario = Scenario(profiles=PROFILES[1:2], controller="drive")
     wrapped = engine_pybullet.driver(files["urdf"], maps["urdf"], drive=DRIVE, scenario=scenario,
-                                     factory=f"{__name__}:_no_affine_law",
+                                     factory="tests.drivers_support:no_affine_law",
                                      sys_path=HERE)
     slow = engine_pybullet.driver(files["urdf"], maps["urdf"], drive=DRIVE, scenario=scenario, fast=False)
     try:

@@ -848,16 +848,14 @@ class MujocoDriver:
         """The profile with the laws as actuators (see the class): Python only at samples and command
         changes, ``mj_step(nstep)`` in between."""
         m, d = self.model, self.data
-        qpos, applied, ctrl = d.qpos, d.qfrc_applied, d.ctrl
-        ra, rec = self.root_qadr, self._rec_qadr
+        applied, ctrl = d.qfrc_applied, d.ctrl
         stops = sorted({*range(0, steps + 1, every), *laws, steps})
         m.actuator_gear[self._law_actuators, 0] = 1.0
         try:
             s = 0
             for i, k in enumerate(stops):
-                if k % every == 0:  # the state after k steps (the free joint's qpos is the root's pose)
-                    base[s] = qpos[ra:ra + 7]
-                    qrec[s] = qpos[rec]
+                if k % every == 0:
+                    self._sample(base, qrec, s)
                     s += 1
                 if k == steps:
                     break
@@ -872,6 +870,12 @@ class MujocoDriver:
         finally:
             m.actuator_gear[self._law_actuators, 0] = 0.0
 
+    def _sample(self, base: np.ndarray, qrec: np.ndarray, s: int) -> None:
+        """Sample ``s``: the state after the steps so far (the free joint's qpos is the root's pose)."""
+        qpos, ra = self.data.qpos, self.root_qadr
+        base[s] = qpos[ra:ra + 7]
+        qrec[s] = qpos[self._rec_qadr]
+
     def _run_per_step(self, changes: dict[int, Any], steps: int, every: int, base: np.ndarray,
                       qrec: np.ndarray) -> None:
         """The profile with every controller's ``output`` called before every ``mj_step``."""
@@ -881,13 +885,11 @@ class MujocoDriver:
         dt = float(m.opt.timestep)
         step = mujoco.mj_step
         plan, qpos, qvel, applied, ctrl = self._plan, d.qpos, d.qvel, d.qfrc_applied, d.ctrl
-        ra, rec = self.root_qadr, self._rec_qadr
         command = Command(0.0)
         s = 0
         for k in range(steps + 1):
-            if k % every == 0:  # the state after k steps (the free joint's qpos is the root's pose)
-                base[s] = qpos[ra:ra + 7]
-                qrec[s] = qpos[rec]
+            if k % every == 0:
+                self._sample(base, qrec, s)
                 s += 1
             if k == steps:
                 break

@@ -29,6 +29,22 @@ from array import array
 from typing import Any, BinaryIO
 
 
+class _DriveLog:
+    """The samples of a driven run: the base pose (position, quaternion) and the recorded joints' q."""
+
+    def __init__(self, p: Any, body: int, client: int, rec_cols: list[int]) -> None:
+        self.base_pose = p.getBasePositionAndOrientation
+        self.body, self.client, self.rec_cols = body, client, rec_cols
+        self.base = array("d")
+        self.q = array("d")
+
+    def sample(self, states: Any) -> None:
+        pos, orn = self.base_pose(self.body, physicsClientId=self.client)
+        self.base.extend(pos)
+        self.base.extend(orn)
+        self.q.extend(states[i][0] for i in self.rec_cols)
+
+
 class Engine:
     """One DIRECT PyBullet client holding one fixed-base body."""
 
@@ -427,7 +443,6 @@ class Engine:
                                         settle, changes, sample_every)
         torque_mode, velocity_mode = p.TORQUE_CONTROL, p.VELOCITY_CONTROL
         set_array, step, get_states = p.setJointMotorControlArray, p.stepSimulation, p.getJointStates
-        base_pose = p.getBasePositionAndOrientation
         zeros_t = [0.0] * len(torque_ids)
         zeros_v = [0.0] * len(velocity_ids)
         max_force = [self.servo_limit] * len(velocity_ids)
@@ -441,16 +456,12 @@ class Engine:
             step(physicsClientId=c)
         settled = time.perf_counter() - start
         command = Command(0.0)
-        base_log = array("d")
-        q_log = array("d")
+        log = _DriveLog(p, body, c, rec_cols)
         asarray = np.array
         for k in range(steps + 1):
             states = get_states(body, read, physicsClientId=c)
             if k % sample_every == 0:
-                pos, orn = base_pose(body, physicsClientId=c)
-                base_log.extend(pos)
-                base_log.extend(orn)
-                q_log.extend(states[i][0] for i in rec_cols)
+                log.sample(states)
             if k == steps:
                 break
             if k in changes:
@@ -469,10 +480,11 @@ class Engine:
                           targetVelocities=[targets[i] for i in velocity_fan], forces=max_force,
                           physicsClientId=c)
             step(physicsClientId=c)
-        wall = time.perf_counter() - start
-        return {"base": base_log.tobytes(), "q": q_log.tobytes(), "wall": wall, "settle_wall": settled,
-                "base_inertial": self.base_inertial, "start_height": self.drive_start_height,
-                "law": "per-step"}
+        return self._drive_result(log, time.perf_counter() - start, settled, "per-step")
+
+    def _drive_result(self, log: _DriveLog, wall: float, settled: float, law: str) -> dict[str, Any]:
+        return {"base": log.base.tobytes(), "q": log.q.tobytes(), "wall": wall, "settle_wall": settled,
+                "base_inertial": self.base_inertial, "start_height": self.drive_start_height, "law": law}
 
     @staticmethod
     def _drive_laws(plan: list[Any], commands: list[Any], torque_ids: list[int]
@@ -535,7 +547,7 @@ class Engine:
         c, body = self.drive_client, self.drive_body
         torque_mode, velocity_mode = p.TORQUE_CONTROL, p.VELOCITY_CONTROL
         set_array, step, get_states = p.setJointMotorControlArray, p.stepSimulation, p.getJointStates
-        base_pose, change_dynamics = p.getBasePositionAndOrientation, p.changeDynamics
+        change_dynamics = p.changeDynamics
         max_force = [self.servo_limit] * len(velocity_ids)
         start = time.perf_counter()
         if velocity_ids:
@@ -547,17 +559,12 @@ class Engine:
         damping = [0.0] * len(torque_ids)
         targets: list[float] | None = None
         forces: list[float] = []
-        base_log = array("d")
-        q_log = array("d")
+        log = _DriveLog(p, body, c, rec_cols)
         events = sorted(set(range(0, steps + 1, sample_every)) | {k for k in changes if k < steps} | {steps})
         law = laws[next(iter(laws))]  # the zero command's, until the first change
         for at, until in zip(events, [*events[1:], steps], strict=True):
             if at % sample_every == 0:
-                states = get_states(body, read, physicsClientId=c)
-                pos, orn = base_pose(body, physicsClientId=c)
-                base_log.extend(pos)
-                base_log.extend(orn)
-                q_log.extend(states[i][0] for i in rec_cols)
+                log.sample(get_states(body, read, physicsClientId=c))
             if at == steps:
                 break
             if at in changes:
@@ -583,10 +590,7 @@ class Engine:
         for joint, gain in zip(torque_ids, damping, strict=True):
             if gain != 0.0:  # the world is rebuilt for every run; leave nothing acting anyway
                 change_dynamics(body, joint, jointDamping=0.0, physicsClientId=c)
-        wall = time.perf_counter() - start
-        return {"base": base_log.tobytes(), "q": q_log.tobytes(), "wall": wall, "settle_wall": settled,
-                "base_inertial": self.base_inertial, "start_height": self.drive_start_height,
-                "law": "bullet"}
+        return self._drive_result(log, time.perf_counter() - start, settled, "bullet")
 
     def drive_batch(self, runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
         """Several ``drive_run`` requests in one (one pipe round trip for all the profiles)."""
