@@ -81,10 +81,12 @@ class Headers:
     constants: dict[str, int]
     model_arrays: dict[str, ArrayShape]
     enum_values: dict[str, int] = field(default_factory=dict)  # every member of every enum
+    model_fields: dict[str, Any] = field(default_factory=dict)  # mjModel's fields by name, with their types
 
     def __post_init__(self) -> None:
         for members in self.enums.values():
             self.enum_values.update(members)
+        self.model_fields.update(field_types(self.structs["mjModel"]))
 
     def offset(self, struct: str, *path: str) -> tuple[int, Any]:
         """Byte offset and ctypes type of a (nested) field, e.g. ``("mjSpec", "compiler", "fusestatic")``."""

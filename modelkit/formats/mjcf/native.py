@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from modelkit.formats.mjcf.cheader import HeaderError, Headers, field_types, read_headers
+from modelkit.formats.mjcf.cheader import HeaderError, Headers, read_headers
 
 #: Set to ``bindings`` to always read MJCF through MuJoCo's Python bindings.
 ENVIRONMENT_SWITCH = "MODELKIT_MUJOCO"
@@ -198,8 +198,7 @@ class NativeModel:
         return int(getattr(self._headers.structs["mjModel"], name).offset)
 
     def _scalar(self, name: str) -> Any:
-        fields = field_types(self._headers.structs["mjModel"])
-        kind = fields.get(name)
+        kind = self._headers.model_fields.get(name)
         if kind is None or kind is ctypes.c_void_p or not hasattr(kind, "from_address"):
             raise AttributeError(name)
         return kind.from_address(self.address + self._offset(name)).value
