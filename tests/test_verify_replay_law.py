@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -110,3 +111,16 @@ def test_without_pinocchio_the_law_falls_back_to_the_subtree_inertia(monkeypatch
     waist = law.joints.index("waist")
     subtree, _ = _axis_inertia_and_gravity(robot, "waist", robot.world_poses({}), children)
     assert law.kd[waist] == pytest.approx(2 * 0.7 * math.sqrt(law.kp[waist] * subtree))
+
+
+def test_a_mimic_joint_is_held_not_left_free() -> None:
+    """The replay runs the open tree (limits and mimic couplings off), so a joint the law left out
+    would be free to be flung away (Panda's finger_joint2 reached 100 m/s, PyBullet's clamp, at
+    4.7 s). The mimic follower is in the law, held at q = 0 with its own gains."""
+    robot = modelkit.load(Path(__file__).parent / "replay" / "bead_mimic.urdf")
+    law = default_law(robot, DT)
+    follower = law.joints.index("finger_b_joint")
+    leader = law.joints.index("finger_a_joint")
+    assert law.amplitude[follower] == 0.0
+    assert law.kp[follower] > 0.0 and law.kd[follower] > 0.0
+    assert law.kp[follower] == pytest.approx(law.kp[leader])

@@ -453,7 +453,14 @@ class MujocoSimulator:
         return self.inner.dof_names()
 
     def replay(self, law: TorqueLaw, seconds: float, dt: float) -> Array:
-        """The law as MuJoCo actuators, stepped in C by ``mujoco.rollout``.
+        """The law as MuJoCo actuators, stepped in C by ``mujoco.rollout``, from q = dq = 0
+        (:meth:`replay_from`)."""
+        return self.replay_from(law, seconds, dt, None)
+
+    def replay_from(self, law: TorqueLaw, seconds: float, dt: float, start_q: Array | None) -> Array:
+        """The law as MuJoCo actuators, stepped in C by ``mujoco.rollout``, from q = ``start_q``
+        (one value per law joint, source order; None: q = 0) and dq = 0. Layer 3b replays from a
+        start perturbed by 1e-12 rad to measure how much the model itself amplifies a tiny difference.
 
         Each law joint's actuator gets gain kp and bias (0, −kp, −kd), so MuJoCo computes
         kp·q*(t_k) − kp·q − kd·q̇ from the state inside every ``mj_step`` (the law of
@@ -489,6 +496,8 @@ class MujocoSimulator:
             full = int(mujoco.mjtState.mjSTATE_FULLPHYSICS)
             start = np.empty(mujoco.mj_stateSize(m, full))
             mujoco.mj_getState(m, d, start, full)
+            if start_q is not None:
+                start[mujoco.mj_stateSize(m, int(mujoco.mjtState.mjSTATE_TIME)) + qadr] += np.asarray(start_q)
             state, _ = rollout.rollout(m, d, start, control)
         offset = mujoco.mj_stateSize(m, int(mujoco.mjtState.mjSTATE_TIME))  # the state: time, qpos, ...
         out = np.empty((steps + 1, len(names)))

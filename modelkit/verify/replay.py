@@ -138,7 +138,8 @@ def _effective_inverse(source: Robot, names: list[str]) -> Array | None:
 
 def default_law(source: Robot, dt: float = 1e-3) -> TorqueLaw:
     """A well-conditioned PD law for the replay at time step ``dt``, from the source model (joint
-    order = the source's moving joints, mimic joints left out).
+    order = the source's moving joints, mimic joints included: the replay runs the open tree, so a
+    mimic joint is held at q = 0 like any joint whose amplitude is 0).
 
     Per joint i, with I_i the **effective inertia** 1/(M⁻¹)_ii (M the joint-space mass matrix of
     the source at q = 0, root welded, armature zeroed as in the replay, computed with Pinocchio
@@ -147,7 +148,10 @@ def default_law(source: Robot, dt: float = 1e-3) -> TorqueLaw:
 
     * amplitude A_i: 1 rad (revolute) / 0.1 m (prismatic) when unlimited; otherwise half the
       distance from q = 0 to the nearer limit (capped at those values); 0 when q = 0 is not
-      strictly inside the limits (the joint is only held);
+      strictly inside the limits, and for a mimic joint (the joint is only held). Every joint is
+      driven or held: with the limits and the mimic couplings off, a free joint is flung without
+      bound (Panda's finger_joint2, left free, reached 100 m/s, PyBullet's velocity clamp, at 4.7 s
+      and the engines parted by 7.4e-2 rad);
     * kp_i = max(I_i·ω², 10·G_i / A_ref) with ω = 2π·2 Hz and A_ref = 1 rad or 0.1 m (gravity sags
       a joint by at most ~10 % of that), capped so that √(kp/I) ≤ 100 rad/s (ω·dt = 0.1 at 1 ms);
     * kd_i = 2·0.7·√(kp_i·I_i) (damping ratio 0.7);
@@ -166,8 +170,7 @@ def default_law(source: Robot, dt: float = 1e-3) -> TorqueLaw:
 
     A joint whose subtree has no mass (I_i ≈ 0) gets no torque at all.
     """
-    moving = [j for j in source.joints
-              if j.type in (JointType.REVOLUTE, JointType.PRISMATIC) and j.mimic is None]
+    moving = [j for j in source.joints if j.type in (JointType.REVOLUTE, JointType.PRISMATIC)]
     world = source.world_poses({})
     root = world.get(str(source.root)) if source.root is not None else None
     poses = {k: root.inverse() @ v for k, v in world.items()} if root is not None else world
@@ -184,7 +187,7 @@ def default_law(source: Robot, dt: float = 1e-3) -> TorqueLaw:
         revolute = joint.type is JointType.REVOLUTE
         reference = REVOLUTE_AMPLITUDE if revolute else PRISMATIC_AMPLITUDE
         lo, hi = joint.limits.lower, joint.limits.upper
-        amplitude = min(reference, 0.5 * min(-lo, hi)) if lo < 0.0 < hi else 0.0
+        amplitude = min(reference, 0.5 * min(-lo, hi)) if lo < 0.0 < hi and joint.mimic is None else 0.0
         if inertia <= MIN_INERTIA:
             gains = (0.0, 0.0)
             amplitude = 0.0
