@@ -41,8 +41,12 @@ the simulation went unstable are a failed ``stability`` check. Layer 3b itself i
 ``modelkit.verify.replay``, imported lazily like the engines (missing → Skip)::
 
     def default_law(source: Robot) -> TorqueLaw
-    def layer3b(source: Robot, sims: list[Simulator], law: TorqueLaw, seconds: float, dt: float
-                ) -> tuple[list[Check], list[Skip]]
+    def replay_layer(source: Robot, sims: list[Simulator], law: TorqueLaw, seconds: float, dt: float
+                     ) -> tuple[list[Check], list[Skip], dict[str, Any]]
+
+(the third value: the calibration of the tolerance per compared engine, ``report.json``'s
+``replay``). A simulator that also has ``replay_from(law, seconds, dt, start_q)`` (MuJoCo's) is the
+reference whose perturbed replays calibrate the tolerance.
 
 Fault injection (``--inject``) is ``modelkit.verify.inject:apply(spec: str, files: dict[str, Path],
 renames: dict[str, Renames]) -> str``: it perturbs the written files in place (``files`` maps "mjcf",
@@ -72,7 +76,7 @@ from modelkit.verify.report import VerifyReport
 Renames = dict[str, dict[str, str]]
 
 SUFFIX = {"mjcf": ".xml", "urdf": ".urdf", "sdf": ".sdf"}
-REPLAY = "modelkit.verify.replay:layer3b"
+REPLAY = "modelkit.verify.replay:replay_layer"
 INJECT = "modelkit.verify.inject:apply"
 
 CONFIGURATIONS = 50  # layer 2: q = 0 and this many random configurations
@@ -616,7 +620,9 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
             "PyBullet reads cannot hold it (MK820), so MuJoCo replays with it zeroed; MuJoCo's armature "
             "is verified by layer 3a (mass matrix against Pinocchio with armature)")))
     try:
-        checks, skips = layer3b(reference, sims, default_law(reference), REPLAY_SECONDS, REPLAY_DT)
+        checks, skips, calibration = layer3b(reference, sims, default_law(reference), REPLAY_SECONDS,
+                                             REPLAY_DT)
+        report.replay = calibration
     finally:
         for sim in sims:
             sim.close()

@@ -26,7 +26,8 @@ import numpy as np
 from modelkit.model import JointType, Robot
 from modelkit.verify.facts import Array, Check, Simulator, Skip, TorqueLaw
 
-TOLERANCE = 1e-8  # rad (m for prismatic joints) over the whole replay: verification.md §3
+TOLERANCE = 1e-8  # rad (m for prismatic joints): two engines, same ODE step, round-off apart
+PERTURBATION = 1e-12  # rad (m): the start moved by this to measure the model's own amplification
 GRAVITY = 9.81
 
 # The law's design constants (see default_law).
@@ -226,50 +227,159 @@ def _run(sim: Simulator, law: TorqueLaw, seconds: float, dt: float) -> tuple[Arr
     return q, wall, ""
 
 
+def first_nonfinite(q: Array) -> int | None:
+    """The first step whose state holds a NaN or an infinity, or None."""
+    bad = ~np.all(np.isfinite(q), axis=1)
+    return int(np.argmax(bad)) if bool(bad.any()) else None
+
+
+def envelope(sim: Simulator, law: TorqueLaw, seconds: float, dt: float, reference: Array) -> Array | None:
+    """The model's own sensitivity along the replay: per step, the running maximum over the joints
+    and over the perturbed runs of |q_perturbed − q_reference|, the same engine replaying the same
+    law from starts moved by ``PERTURBATION`` (every joint +1e-12, then alternating signs). None
+    when the engine cannot start from a given q (no ``replay_from``) or a perturbed run fails. A
+    perturbed run that turns non-finite makes the envelope infinite from that step on."""
+    replay_from = getattr(sim, "replay_from", None)
+    if replay_from is None:
+        return None
+    n = len(law.joints)
+    worst = np.zeros(len(reference))
+    for pattern in (np.ones(n), (-1.0) ** np.arange(n)):
+        try:
+            q = np.asarray(replay_from(law, seconds, dt, PERTURBATION * pattern), dtype=float)
+        except Exception:  # the calibration is not available: the strict tolerance stays
+            return None
+        if q.shape != reference.shape:
+            return None
+        with np.errstate(invalid="ignore"):
+            diff = np.abs(q - reference)
+        diff[~np.isfinite(diff)] = math.inf
+        worst = np.maximum(worst, diff.max(axis=1))
+    return np.maximum.accumulate(worst)
+
+
+def tolerances(env: Array | None, steps: int) -> Array:
+    """Per step, the replay's tolerance: ``TOLERANCE`` (1e-8 rad, the difference two engines may
+    accumulate from round-off) times the model's own amplification G(t) = envelope(t) / 1e-12 of a
+    start difference by then (at least 1): max(1e-8, 1e4 × envelope(t)). Without an envelope, 1e-8."""
+    if env is None:
+        return np.full(steps, TOLERANCE)
+    with np.errstate(invalid="ignore", over="ignore"):
+        return TOLERANCE * np.maximum(1.0, env / PERTURBATION)
+
+
+def _until(growth: Array, bound: float, dt: float) -> float:
+    """The last time (s) at which the amplification is still at most ``bound``."""
+    above = growth > bound
+    return (int(np.argmax(above)) - 1) * dt if bool(above.any()) else (len(growth) - 1) * dt
+
+
 def layer3b(source: Robot, sims: list[Simulator], law: TorqueLaw, seconds: float, dt: float
             ) -> tuple[list[Check], list[Skip]]:
+    """:func:`replay_layer` without the calibration record (checks and skips only)."""
+    checks, skips, _ = replay_layer(source, sims, law, seconds, dt)
+    return checks, skips
+
+
+def replay_layer(source: Robot, sims: list[Simulator], law: TorqueLaw, seconds: float, dt: float
+                 ) -> tuple[list[Check], list[Skip], dict[str, Any]]:
     """Replay ``law`` in every simulator; compare each one's joint trajectories with the first's
-    (MuJoCo by convention). One ``replay`` check per compared engine: the worst |Δq| over the
-    whole run and every joint, naming the joint (source name)."""
+    (MuJoCo by convention), step by step against the calibrated tolerance (:func:`tolerances`,
+    from the first engine's :func:`envelope`). One ``replay`` check per compared engine: the step
+    where |Δq| / tolerance is largest (its error, tolerance and time, naming the joint, source name),
+    with the worst |Δq| over the run, the envelope and the margin in the detail. An engine whose
+    state turns non-finite gets a failed ``engine-error`` check with the time; the run before it is
+    still compared. The third value is the calibration, per compared engine, for the report."""
     checks: list[Check] = []
     skips: list[Skip] = []
+    calibration: dict[str, Any] = {}
     names = "+".join(s.engine for s in sims) or "replay"
     if len(sims) < 2:
         skips.append(Skip(3, names, "layer 3b (replay) needs two engines that can integrate the model"))
-        return checks, skips
+        return checks, skips, calibration
     if not law.joints:
         skips.append(Skip(3, names, "layer 3b (replay): the model has no moving joint"))
-        return checks, skips
+        return checks, skips, calibration
     runs = [(sim, *_run(sim, law, seconds, dt)) for sim in sims]
     ref_sim, ref_q, _ref_wall, ref_error = runs[0]
     setting = f"{seconds:g} s at dt {dt:g} s, from q = dq = 0"
-    if ref_q is None or not np.all(np.isfinite(ref_q)):
-        why = ref_error or "the trajectory is not finite"
+    if ref_q is None:
         for sim, *_ in runs[1:]:
             checks.append(Check(3, sim.engine, "replay", "", math.inf, TOLERANCE,
-                                f"{ref_sim.engine} replay failed ({setting}): {why}"))
-        return checks, skips
-    travel = np.ptp(ref_q, axis=0)
+                                f"{ref_sim.engine} replay failed ({setting}): {ref_error}"))
+        return checks, skips, calibration
+    ref_bad = first_nonfinite(ref_q)
+    if ref_bad is not None:
+        checks.append(_nonfinite(ref_sim.engine, ref_q, ref_bad, law, dt, setting))
+    env = envelope(ref_sim, law, seconds, dt, ref_q)
+    tol = tolerances(env, len(ref_q))
+    growth = tol / TOLERANCE
     for sim, q, _wall, error in runs[1:]:
         if q is None:
             checks.append(Check(3, sim.engine, "replay", "", math.inf, TOLERANCE,
                                 f"{sim.engine} replay failed ({setting}): {error}"))
             continue
-        diff = np.abs(q - ref_q)
-        diff[~np.isfinite(diff)] = math.inf
-        per_joint = diff.max(axis=0)
-        worst = int(np.argmax(per_joint))
-        step = int(np.argmax(diff[:, worst]))
-        detail = (f"max |q_{sim.engine} − q_{ref_sim.engine}| over {setting}, "
-                  f"worst at t = {step * dt:.3f} s; per joint: "
-                  + ", ".join(f"{j} {e:.1e}" for j, e in zip(law.joints, per_joint, strict=True))
-                  + "; travel in " + ref_sim.engine + ": "
-                  + ", ".join(f"{j} {t:.3g}" for j, t in zip(law.joints, travel, strict=True)))
-        # (speed is a wall time: printed with the timings, never in a check, so report.json stays
-        # the same from run to run)
-        worst_error = float(per_joint[worst])
-        checks.append(Check(3, sim.engine, "replay", law.joints[worst], worst_error, TOLERANCE, detail))
-    return checks, skips
+        bad = first_nonfinite(q)
+        if bad is not None:
+            checks.append(_nonfinite(sim.engine, q, bad, law, dt, setting))
+        compared = min(x for x in (bad, ref_bad, len(q)) if x is not None)
+        if compared <= 1:  # nothing but the common start to compare
+            continue
+        check, record = _compare(ref_sim.engine, sim.engine, ref_q[:compared], q[:compared],
+                                 tol[:compared], growth[:compared], env, law, dt, setting)
+        checks.append(check)
+        calibration[sim.engine] = record
+    return checks, skips, calibration
+
+
+def _nonfinite(engine: str, q: Array, step: int, law: TorqueLaw, dt: float, setting: str) -> Check:
+    joints = [j for j, ok in zip(law.joints, np.isfinite(q[step]), strict=True) if not ok]
+    return Check(3, engine, "engine-error", joints[0] if joints else "", math.inf, 0.0,
+                 f"{engine}'s replay state turned non-finite (NaN or infinity) at t = {step * dt:.3f} s "
+                 f"({setting}; joints {', '.join(joints[:6])}): the engine failed there; the replay is "
+                 "compared up to that time only")
+
+
+def _compare(ref_engine: str, engine: str, ref_q: Array, q: Array, tol: Array, growth: Array,
+             env: Array | None, law: TorqueLaw, dt: float, setting: str) -> tuple[Check, dict[str, Any]]:
+    diff = np.abs(q - ref_q)
+    per_step = diff.max(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.where(per_step > 0.0, per_step / tol, 0.0)
+    step = int(np.argmax(ratio))
+    joint = int(np.argmax(diff[step]))
+    per_joint = diff.max(axis=0)
+    worst_step = int(np.argmax(per_step))
+    travel = np.ptp(ref_q, axis=0)
+    margin = float(1.0 / ratio[step]) if ratio[step] > 0.0 else math.inf
+    end = len(ref_q) - 1
+    if env is None:
+        how = (f"tolerance {TOLERANCE:g} rad throughout ({ref_engine} cannot replay from a perturbed "
+               "start: no calibration)")
+    else:
+        how = (f"tolerance 1e-8 rad × the model's own amplification: {ref_engine} replayed from starts "
+               f"moved by {PERTURBATION:g} rad parts by {float(env[end]):.2e} rad by t = {end * dt:.3f} s "
+               f"(×{float(growth[end]):.3g}); strict (amplification ≤ 10) up to t = "
+               f"{_until(growth, 10.0, dt):.3f} s")
+    detail = (f"|q_{engine} − q_{ref_engine}| over {setting} against the calibrated tolerance: worst "
+              f"ratio at t = {step * dt:.3f} s ({diff[step, joint]:.2e} rad against {tol[step]:.2e}, "
+              f"margin ×{margin:.3g}); {how}; largest difference {per_step[worst_step]:.2e} at "
+              f"t = {worst_step * dt:.3f} s; per joint: "
+              + ", ".join(f"{j} {e:.1e}" for j, e in zip(law.joints, per_joint, strict=True))
+              + "; travel in " + ref_engine + ": "
+              + ", ".join(f"{j} {t:.3g}" for j, t in zip(law.joints, travel, strict=True)))
+    record = {"reference": ref_engine, "perturbation": PERTURBATION, "scale": TOLERANCE / PERTURBATION,
+              "compared_seconds": end * dt,
+              "envelope_end": float(env[end]) if env is not None else None,
+              "amplification_end": float(growth[end]), "strict_until": _until(growth, 10.0, dt),
+              "worst_ratio_time": step * dt, "worst_ratio_error": float(diff[step, joint]),
+              "worst_ratio_tolerance": float(tol[step]),
+              "margin": margin if math.isfinite(margin) else None,
+              "largest_error": float(per_step[worst_step]), "largest_error_time": worst_step * dt}
+    # (speed is a wall time: printed with the timings, never in a check, so report.json stays
+    # the same from run to run)
+    check = Check(3, engine, "replay", law.joints[joint], float(diff[step, joint]), float(tol[step]), detail)
+    return check, record
 
 
 # ---- harness overhead (bench, docs; never asserted in tests) ---------------------------------------

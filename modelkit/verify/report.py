@@ -33,6 +33,7 @@ class VerifyReport:
     checks: list[Check] = field(default_factory=list)
     skips: list[Skip] = field(default_factory=list)
     observations: list[Observation] = field(default_factory=list)  # layer 4: reported, not graded
+    replay: dict[str, Any] = field(default_factory=dict)  # layer 3b: the tolerance's calibration per engine
     scenario: dict[str, Any] = field(default_factory=dict)  # layer 4: the scenario as run (plain data)
     drive: dict[str, Any] = field(default_factory=dict)  # layer 4: Drive.as_dict() of the model
     trajectories: list[Any] = field(default_factory=list)  # layer 4: drive.Trajectory, for the plots
@@ -101,6 +102,7 @@ def report_json(report: VerifyReport) -> str:
         "observations": [{"layer": o.layer, "engine": o.engine, "quantity": o.quantity, "where": o.where,
                           "value": _number(o.value), "unit": o.unit, "detail": o.detail}
                          for o in report.observations],
+        "replay": _plain(report.replay),
         "scenario": _plain(report.scenario),
         "drive": _plain(report.drive),
         "errors": list(report.errors),
