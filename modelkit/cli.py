@@ -514,18 +514,24 @@ def convert(
 @click.option("--cluster", metavar="ADDRESS", default=None,
               help="Many models: run each model as a Ray task on this cluster (ray://HOST:PORT, or local "
               "for a private Ray on this machine); needs modelkit[cluster].")
+@reading_options
 def verify(sources: tuple[Path, ...], output: Path | None, engines: str, mjcf: Path | None, urdf: Path | None,
            sdf: Path | None, inject: tuple[str, ...], seed: int, no_replay: bool, scenario: Path | None,
-           no_driven: bool, jobs: int | None, cluster: str | None) -> None:
+           no_driven: bool, jobs: int | None, cluster: str | None, **kwargs: Any) -> None:
     """Prove a conversion is the same robot: static facts, kinematics and dynamics in real engines.
 
     MODELS: one model file, or many (files, or folders: the model files directly inside), verified
-    in parallel with one report folder each and a summary.
+    in parallel with one report folder each and a summary. KEY:=VALUE words among them are xacro
+    arguments, and the reading options are those of validate and convert.
 
     Exit 0 every check passed; 1 a check failed; 2 could not run (unreadable input, bad option; with
     many models: any model that could not be verified, which takes precedence over a failed check).
     """
     names = tuple(e.strip() for e in engines.split(",") if e.strip())
+    sources, xacro_args = split_xacro_args(tuple(str(s) for s in sources))
+    if not sources:
+        raise click.UsageError("no model given (only xacro KEY:=VALUE arguments)")
+    reading = _reading(kwargs, xacro_args)
     if len(sources) == 1 and not sources[0].is_dir() and cluster is None:
         from modelkit.verify.api import verify as run_verify
         from modelkit.verify.many import progress_wanted, save
@@ -539,7 +545,7 @@ def verify(sources: tuple[Path, ...], output: Path | None, engines: str, mjcf: P
 
         report = run_verify(sources[0], output, names, mjcf, urdf, sdf, inject, seed, replay=not no_replay,
                             scenario=scenario, driven=not no_driven, progress=progress,
-                            artefacts=output is not None)
+                            artefacts=output is not None, reading=reading)
         click.echo(render_table(report), nl=False)
         if output is not None and not report.errors:
             progress("writing the report (plots, pictures, report.html)")
@@ -552,7 +558,27 @@ def verify(sources: tuple[Path, ...], output: Path | None, engines: str, mjcf: P
         raise click.UsageError("--mjcf/--urdf/--sdf name the conversion of one model: give one model")
     _verify_many(sources, output, {"engines": list(names), "inject": list(inject), "seed": seed,
                                    "replay": not no_replay, "driven": not no_driven,
-                                   "scenario": str(scenario.resolve()) if scenario else None}, jobs, cluster)
+                                   "scenario": str(scenario.resolve()) if scenario else None,
+                                   **({"reading": reading} if reading else {})}, jobs, cluster)
+
+
+def _reading(kwargs: dict[str, Any], xacro_args: dict[str, str]) -> dict[str, Any]:
+    """verify's reading options as plain data (``modelkit.verify.api.read_options`` builds the
+    ``ReadOptions`` from it, in this process or in a worker), only those that differ from the
+    defaults, so that report.json and summary.json name what the user chose."""
+    defaults = {"max_bytes": 64 * 1024 * 1024, "max_links": 10_000, "max_list_items": 250_000}
+    out: dict[str, Any] = {
+        "input_format": kwargs["input_format"],
+        "package_paths": {k: str(v) for k, v in _pairs(kwargs["package_paths"], "--package-path").items()},
+        "path_variables": {k: str(v) for k, v in _pairs(kwargs["path_variables"], "--path-variable").items()},
+        "resource_paths": [str(p) for p in kwargs["resource_paths"]],
+        "xacro_args": dict(xacro_args),
+        "legacy_xacro": kwargs["legacy_xacro"],
+        "materials": str(kwargs["materials"]) if kwargs["materials"] is not None else None,
+        "vrml_extrusion": bool(kwargs["vrml_extrusion"]),
+        **{k: kwargs[k] for k in defaults if kwargs[k] != defaults[k]},
+    }
+    return {k: v for k, v in out.items() if v not in (None, {}, [], False)}
 
 
 def _verify_many(sources: tuple[Path, ...], output: Path | None, options: dict[str, Any], jobs: int | None,

@@ -61,7 +61,7 @@ import dataclasses
 import importlib
 import tempfile
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -98,13 +98,36 @@ def _resolve(target: str) -> Any:
     return getattr(importlib.import_module(module), name)
 
 
-def _read(source: Path) -> Robot:
+def read_options(reading: Mapping[str, Any] | None) -> tuple[Any, str | None]:
+    """The ``ReadOptions`` and input format of verify's reading options given as plain data (the
+    keys of ``modelkit verify``'s options: input_format, package_paths {NAME: DIR}, path_variables,
+    resource_paths, xacro_args {KEY: VALUE}, legacy_xacro, materials, vrml_extrusion, max_bytes,
+    max_links, max_list_items; absent = the default, as in ``validate`` and ``convert``)."""
+    from modelkit.formats.common import ReadOptions
+    from modelkit.resources import Resolver
+
+    r = dict(reading or {})
+    resolver = Resolver(package_paths={k: Path(v) for k, v in r.get("package_paths", {}).items()},
+                        path_variables={k: Path(v) for k, v in r.get("path_variables", {}).items()},
+                        resource_paths=[Path(p) for p in r.get("resource_paths", [])])
+    options = ReadOptions(resolver=resolver, xacro_args=dict(r.get("xacro_args", {})),
+                          legacy_xacro=r.get("legacy_xacro"),
+                          materials_path=Path(r["materials"]) if r.get("materials") else None,
+                          faithful_extrusion=not r.get("vrml_extrusion", False))
+    for limit in ("max_bytes", "max_links", "max_list_items"):
+        if limit in r:
+            setattr(options, limit, int(r[limit]))
+    return options, r.get("input_format")
+
+
+def _read(source: Path, reading: Mapping[str, Any] | None = None) -> Robot:
     from modelkit.api import validate
     from modelkit.convert.api import CONVERTIBLE_ERRORS, UNREADABLE
 
     if not source.exists():
         raise VerifyError(f"{source}: no such file")
-    checked = validate(source)
+    options, fmt = read_options(reading)
+    checked = validate(source, options, fmt)
     if any(d.code in UNREADABLE for d in checked.diagnostics):
         raise VerifyError(f"{source}: cannot be read: "
                           + "; ".join(d.message for d in checked.diagnostics if d.code in UNREADABLE))
@@ -245,6 +268,7 @@ def verify(
     driven: bool = True,
     progress: Callable[[str], None] | None = None,
     artefacts: bool = False,
+    reading: Mapping[str, Any] | None = None,
 ) -> VerifyReport:
     """Convert ``source`` (or take the given files), load every engine, run layers 1–3, then layer 4
     (the driven scenarios with contact: ``scenario`` is a scenario file, None for the defaults;
@@ -257,15 +281,20 @@ def verify(
 
     ``artefacts`` True (the caller will write the report with ``many.save``, which needs ``out_dir``):
     the report's plotting processes and pictures start while the layers run (``report.prepared``).
+
+    ``reading``: the reading options of ``validate`` and ``convert`` as plain data (:func:`read_options`;
+    package paths, xacro arguments, ...), written into ``report.parameters["reading"]`` when given.
     """
     report = VerifyReport(str(source), seed=seed)
     report.parameters = {"configurations": configurations, "dynamics_samples": samples,
                          "tolerance": 1e-9, "replay_seconds": REPLAY_SECONDS, "replay_dt": REPLAY_DT,
                          "engines": list(engines)}
+    if reading:
+        report.parameters["reading"] = dict(reading)
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="modelkit-verify-") as tmp:
             _run(report, Path(source), Path(tmp), engines, mjcf, urdf, sdf, inject, seed,
-                 configurations, samples, replay, scenario, driven, progress or _silent)
+                 configurations, samples, replay, scenario, driven, progress or _silent, reading)
             return report
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -275,7 +304,7 @@ def verify(
         report.prepared = Prepared()
     try:
         _run(report, Path(source), out, engines, mjcf, urdf, sdf, inject, seed, configurations, samples,
-             replay, scenario, driven, progress or _silent)
+             replay, scenario, driven, progress or _silent, reading)
     finally:
         if report.prepared is not None and report.errors:  # no report to write (many.save)
             report.prepared.close()
@@ -290,7 +319,7 @@ def _silent(_: str) -> None:
 def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str], mjcf: str | Path | None,
          urdf: str | Path | None, sdf: str | Path | None, inject: Sequence[str], seed: int,
          configurations: int, samples: int, replay: bool, scenario_path: str | Path | None,
-         driven: bool, progress: Callable[[str], None]) -> None:
+         driven: bool, progress: Callable[[str], None], reading: Mapping[str, Any] | None = None) -> None:
     chosen = None
     if scenario_path is not None and driven:  # a bad scenario file stops the run before any layer
         from modelkit.diagnostics import render_text
@@ -303,7 +332,7 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
     progress(f"reading and converting {source.name}; layers 1-3 (static, kinematics, dynamics)")
     try:
         robot = _layers_1_to_3(report, source, out_dir, engines, mjcf, urdf, sdf, inject, seed,
-                               configurations, samples, replay)
+                               configurations, samples, replay, reading)
     except VerifyError as exc:
         report.errors.append(str(exc))
         return
@@ -347,15 +376,15 @@ def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence
 
 def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str],
                    mjcf: str | Path | None, urdf: str | Path | None, sdf: str | Path | None,
-                   inject: Sequence[str], seed: int, configurations: int, samples: int, replay: bool
-                   ) -> Robot | None:
+                   inject: Sequence[str], seed: int, configurations: int, samples: int, replay: bool,
+                   reading: Mapping[str, Any] | None = None) -> Robot | None:
     """Layers 1–3 on the welded model; returns the source model as read (None when nothing ran)."""
     from modelkit.verify import approximations, layers, shapes
     from modelkit.verify.reference import SourceModel, dof_joints, source_static
 
     t0 = time.perf_counter()
     try:
-        robot = _read(source)
+        robot = _read(source, reading)
         report.robot = robot.name
         welded, report.base = welded_copy(robot)
         reference = _reference(welded, report)
