@@ -151,14 +151,62 @@ def pybullet_defaults(urdf: Path, source: Robot, renames: Renames) -> dict[str, 
     return out
 
 
+# validate's codes of a tensor a URDF reader refuses: singular (a zero principal moment, MK302) or
+# violating the triangle inequality (MK303)
+REFUSED = ("MK302", "MK303")
+
+
+def refusal_code(moments: tuple[float, float, float]) -> str:
+    """MK302 when the smallest principal moment is zero within validate's tolerance, else MK303."""
+    from modelkit import rot3
+    from modelkit.checks.physics import ZERO_MOMENT
+
+    return "MK302" if moments[0] <= max(rot3.inertia_tolerance(list(moments)), ZERO_MOMENT) else "MK303"
+
+
+def refused_inertias(engine: str, fmt: str, source: Robot) -> dict[str, Approximated]:
+    """Links whose source inertia, taken alone, violates the triangle inequality (``validate``'s MK303,
+    or MK302 when a principal moment is zero: a source finding): the URDF keeps the source's tensor
+    as it is, and its readers refuse it. PyBullet
+    replaces it by zero ("Bad inertia tensor properties"; measured on ClosedLinkSample's WAIST and
+    Go1's ``base``, whose six terms are all 1e-6); Drake's URDF parser by its plausible-guess solid
+    sphere of the link's mass at water density. The engine is compared with that replacement (mass
+    and COM kept), so the source's fault is reported as the source's, not as a conversion FAIL."""
+    if fmt != "urdf" or engine not in ("pybullet", "drake-urdf"):
+        return {}
+    out: dict[str, Approximated] = {}
+    for link in source.links:
+        if link.inertial is None or link.inertial.mass <= 0.0:
+            continue
+        tensor = np.asarray(link.inertial.inertia, dtype=float)
+        moments = triangle_moments(tensor)
+        if moments is None:
+            continue
+        if engine == "pybullet":
+            fixed = np.zeros((3, 3))
+            by = "PyBullet, refusing it (\"Bad inertia tensor properties\"), holds zero"
+        else:
+            from modelkit.verify.engine_drake import substitute_moment
+
+            moment = substitute_moment(float(link.inertial.mass))
+            fixed = moment * np.eye(3)
+            by = ("Drake's URDF parser, refusing it, holds its plausible-guess solid sphere at water "
+                  f"density ({moment:.9g} kg·m² per axis)")
+        out[link.name] = Approximated(link.name, float(link.inertial.mass), 0.0, refusal_code(moments), by,
+                                      tuple(float(v) for v in fixed.ravel()))
+    return out
+
+
 def for_engine(engine: str, fmt: str, notes: Iterable[ConversionNote], file: Path, source: Robot,
                renames: Renames) -> dict[str, Approximated]:
-    """What ``engine`` (reading the written ``fmt`` file) holds instead of no mass, by source link."""
+    """What ``engine`` (reading the written ``fmt`` file) holds instead of no mass, or instead of a
+    source inertia it refuses (:func:`refused_inertias`), by source link."""
     notes = list(notes)
     out = from_notes(fmt, notes, renames)
     out.update(lifted_inertias(fmt, notes, renames, source))
     if engine == "pybullet" and fmt == "urdf":
         out.update(pybullet_defaults(file, source, renames))
+    out.update(refused_inertias(engine, fmt, source))
     return out
 
 
@@ -183,7 +231,13 @@ def skip(engine: str, approx: dict[str, Approximated]) -> Skip | None:
         return None
     groups: dict[tuple[str, str, float, float], list[str]] = {}
     lifts = []
+    findings = []
     for a in sorted(approx.values(), key=lambda a: a.link):
+        if a.code in REFUSED:
+            what = "is singular" if a.code == "MK302" else "violates the triangle inequality"
+            findings.append(f"source finding {a.code} (the source inertia of {a.link}, taken alone, {what}); "
+                            f"{a.by} for it: compared with that, not a conversion fault")
+            continue
         if a.tensor is None:
             groups.setdefault((a.by, a.code, a.mass, a.inertia), []).append(a.link)
             continue
@@ -197,6 +251,10 @@ def skip(engine: str, approx: dict[str, Approximated]) -> Skip | None:
         parts.append(f"{by} gives {len(links)} link(s) massless in the source {mass:g} kg and "
                      f"{inertia:g} kg·m² per axis at the link origin ({code}): {shown}")
     parts += lifts
+    if findings and not parts:
+        return Skip(1, engine, "; ".join(findings) + ". Layers 1 and 3 compare this engine with the source "
+                    "model with that tensor applied (layer 1 checks the engine holds it)")
+    parts += findings
     return Skip(1, engine, "approximation: " + "; ".join(parts) + ". Layers 1 and 3 compare this engine with "
                 "the source model with these values applied (layer 1 checks the engine holds them)")
 
