@@ -6,10 +6,12 @@ comparison is well conditioned; a non-finite state is the engine's failure, with
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 from typing import Any
 
+import jsonschema
 import pytest
 
 import modelkit
@@ -18,7 +20,9 @@ from modelkit.convert.notes import renames
 from modelkit.model import JointType
 from modelkit.verify import engine_mujoco, engine_pybullet
 from modelkit.verify.facts import TorqueLaw
+from modelkit.verify.html import render_html
 from modelkit.verify.replay import PERTURBATION, TOLERANCE, replay_layer
+from modelkit.verify.report import VerifyReport, report_json
 
 PENDULUM = Path(__file__).parent / "replay" / "double_pendulum.urdf"
 SECONDS, DT = 10.0, 1e-3
@@ -62,6 +66,14 @@ def test_a_chaotic_sound_conversion_passes_on_its_measured_envelope(written: Any
     assert record["largest_error"] > TOLERANCE, record
     assert record["margin"] > 1.0 and check.tolerance > TOLERANCE
     assert "margin" in check.detail and "amplification" in check.detail
+    # report.json (schema) and report.html carry the envelope and the margin
+    report = VerifyReport("p.urdf", checks=checks, replay=calibration)
+    schema = json.loads((Path(__file__).parents[1] / "schemas" / "verify-report.schema.json").read_text())
+    data = json.loads(report_json(report))
+    jsonschema.validate(data, schema)
+    assert data["replay"]["pybullet"]["envelope_end"] == record["envelope_end"]
+    page = render_html(report)
+    assert "the replay's tolerance" in page and f"{record['envelope_end']:.2e}" in page
 
 
 def test_the_envelope_does_not_swallow_a_one_percent_inertia_error(written: Any, tmp_path: Path) -> None:

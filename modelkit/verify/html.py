@@ -319,6 +319,32 @@ def _pictures_section(art: Artefacts) -> list[str]:
     return out
 
 
+def _replay_calibration(replay: dict[str, Any]) -> list[str]:
+    """Layer 3b's calibrated tolerance per compared engine: the envelope (the reference engine's own
+    spread from a start moved by 1e-12 rad), the amplification, the strict horizon and the margin."""
+    if not replay:
+        return []
+    rows = ["<h3>Layer 3b, the replay's tolerance</h3><p>1e-8 rad times the model's own amplification of "
+            "a start difference, measured at run time: the reference engine replays from starts moved by "
+            "1e-12 rad, and the tolerance at each step is 1e-8 × max(1, spread / 1e-12) by then.</p>"
+            "<table><tr><th>engine</th><th>against</th><th>envelope at the end</th><th>amplification</th>"
+            "<th>strict (≤ 10×) up to</th><th>worst ratio at</th><th>error / tolerance there</th>"
+            "<th>margin</th><th>largest difference</th></tr>"]
+    for engine, r in sorted(replay.items()):
+        envelope = r.get("envelope_end")
+        margin = r.get("margin")
+        rows.append(
+            f"<tr><td>{_e(engine)}</td><td>{_e(r['reference'])}</td>"
+            f"<td>{_num(envelope) if envelope is not None else 'not measured'}</td>"
+            f"<td>×{_num(r['amplification_end'])}</td><td>{r['strict_until']:.3f} s</td>"
+            f"<td>{r['worst_ratio_time']:.3f} s</td>"
+            f"<td>{_num(r['worst_ratio_error'])} / {_num(r['worst_ratio_tolerance'])}</td>"
+            f"<td>{'×' + _num(margin) if margin is not None else 'no difference'}</td>"
+            f"<td>{_num(r['largest_error'])} at {r['largest_error_time']:.3f} s</td></tr>")
+    rows.append("</table>")
+    return rows
+
+
 def render_html(report: VerifyReport, art: Artefacts | None = None) -> str:
     art = art or Artefacts()
     verdict = report.verdict
@@ -357,6 +383,7 @@ def render_html(report: VerifyReport, art: Artefacts | None = None) -> str:
                    + _checks_table(static) + "</details>")
     else:
         out.append("<p>No checks.</p>")
+    out += _replay_calibration(report.replay)
     out.append("<h2>Layer 4: driven on a floor</h2>")
     if driven:
         out.append(_checks_table(driven))
