@@ -186,7 +186,8 @@ def _mj_pose(data) -> tuple[float, float, float]:  # type: ignore[no-untyped-def
 # ---- PyBullet -----------------------------------------------------------------------------------
 
 
-def run_pybullet(urdf: Path, tracks: Tracks, profile: Profile) -> Path2D:
+def run_pybullet(urdf: Path, tracks: Tracks, profile: Profile, cone_friction: bool = True) -> Path2D:
+    """``cone_friction`` False: ``enableConeFriction=0`` (Bullet's box friction), for the bench only."""
     import pybullet as p
     import pybullet_data
 
@@ -194,6 +195,8 @@ def run_pybullet(urdf: Path, tracks: Tracks, profile: Profile) -> Path2D:
     try:
         p.setGravity(0, 0, -9.81, physicsClientId=client)
         p.setTimeStep(DT, physicsClientId=client)
+        if not cone_friction:
+            p.setPhysicsEngineParameter(enableConeFriction=0, physicsClientId=client)
         p.loadURDF(str(Path(pybullet_data.getDataPath()) / "plane.urdf"), physicsClientId=client)
         flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER
         body = p.loadURDF(str(urdf), [0, 0, 0], flags=flags, physicsClientId=client)
