@@ -5,7 +5,8 @@ What is checked: the reference's physics (the steady spin rate of point contacts
 ratio b²/(a² + b²) whatever μ; a straight run follows the belts after a friction-limited start; the
 static loads carry the weight at the COM), the tolerance's derivation, the straight profile of the
 written files in both engines against the reference and each other, and (strict xfail, the open
-part of issue 16 item 3) that the written files do not yet turn as the reference says.
+part of issue 16 item 3) the written files turning as the reference says: MuJoCo through the MJCF's
+``<option impratio>``, PyBullet with cone friction off as MK809 asks (and neither with its default).
 """
 
 from __future__ import annotations
@@ -145,16 +146,58 @@ def test_written_files_drive_straight_as_the_reference(written, tutorial) -> Non
     assert float(np.hypot(mj.x[:n] - pb.x[:n], mj.y[:n] - pb.y[:n]).max()) < tol.position
 
 
-@pytest.mark.xfail(strict=True, reason="issue 16 item 3 open: the rollers' contacts resist yaw far more than "
-                   "Coulomb sliding (MuJoCo 0.93 rad, PyBullet 1.42 rad of the reference's 3.25 on the spin)")
-@pytest.mark.parametrize("name", ["spin", "arc"])
-def test_written_files_turn_as_the_skid_reference(written, tutorial, name: str) -> None:  # type: ignore[no-untyped-def]
-    profile = next(p for p in support.PROFILES if p.name == name)
-    ref, tol = _as_reference(tutorial, profile)
-    for path in _engines(written, profile):
-        position, yaw = _gap(path, ref)
-        assert position < tol.position and yaw < tol.yaw
-        assert abs(path.yaw[-1]) > 0.5 * abs(profile.w) * profile.duration * B * B / (A * A + B * B)
+def test_written_mjcf_turns_as_the_skid_reference(written, tutorial) -> None:  # type: ignore[no-untyped-def]
+    """The MJCF's <option impratio> (MK809) makes MuJoCo's roller friction follow the slip."""
+    files, tracks = written
+    assert "<option impratio=" in files["mjcf"].read_text()
+    for profile in support.PROFILES[1:]:
+        ref, tol = _as_reference(tutorial, profile)
+        position, yaw = _gap(support.run_mujoco(files["mjcf"], tracks, profile), ref)
+        assert position < tol.position and yaw < tol.yaw  # measured: see docs/verify.md
+
+
+def test_mujoco_without_soft_friction_hardly_turns(written, tutorial) -> None:  # type: ignore[no-untyped-def]
+    """impratio 1 (MuJoCo's default): the end rollers' sideways friction holds, 0.93 rad of 3.25."""
+    files, tracks = written
+    spin = support.PROFILES[1]
+    ref, tol = _as_reference(tutorial, spin)
+    got = support.run_mujoco(files["mjcf"], tracks, spin, impratio=1.0)
+    assert ref.yaw[-1] - got.yaw[-1] > tol.yaw
+
+
+def test_pybullet_turns_as_the_skid_reference_without_cone_friction(  # type: ignore[no-untyped-def]
+        written, tutorial) -> None:
+    files, tracks = written
+    arc = support.PROFILES[2]
+    ref, tol = _as_reference(tutorial, arc)
+    position, yaw = _gap(support.run_pybullet(files["urdf"], tracks, arc), ref)
+    assert position < tol.position and yaw < tol.yaw  # measured 5.8 cm / 180 mrad (72 cm / 524 mrad)
+    spin = support.PROFILES[1]
+    ref, tol = _as_reference(tutorial, spin)
+    got = support.run_pybullet(files["urdf"], tracks, spin)
+    assert abs(got.yaw[-1] - ref.yaw[-1]) < tol.yaw  # measured 3.60 rad against 3.25 (± 0.88)
+    # with PyBullet's default cone friction it hardly turns: 1.42 rad
+    cone = support.run_pybullet(files["urdf"], tracks, spin, cone_friction=True)
+    assert ref.yaw[-1] - cone.yaw[-1] > tol.yaw
+
+
+@pytest.mark.xfail(strict=True, reason="open: PyBullet's box friction drifts differently on the spot: its "
+                   "spin path ends 12 cm from the reference's (tolerance 5.4 cm), yaw within tolerance")
+def test_pybullet_spin_path_as_the_skid_reference(written, tutorial) -> None:  # type: ignore[no-untyped-def]
+    files, tracks = written
+    spin = support.PROFILES[1]
+    ref, tol = _as_reference(tutorial, spin)
+    position, yaw = _gap(support.run_pybullet(files["urdf"], tracks, spin), ref)
+    assert position < tol.position and yaw < tol.yaw
+
+
+def test_engines_agree_on_the_arc(written, tutorial) -> None:  # type: ignore[no-untyped-def]
+    arc = support.PROFILES[2]
+    _, tol = _as_reference(tutorial, arc)
+    mj, pb = _engines(written, arc)
+    n = min(len(mj.t), len(pb.t))
+    assert float(np.hypot(mj.x[:n] - pb.x[:n], mj.y[:n] - pb.y[:n]).max()) < tol.position
+    assert float(np.abs(mj.yaw[:n] - pb.yaw[:n]).max()) < tol.yaw
 
 
 def test_path_difference_is_the_largest_gap() -> None:
@@ -162,3 +205,9 @@ def test_path_difference_is_the_largest_gap() -> None:
     assert path_difference(a, a) == (0.0, 0.0)
     assert math.isfinite(path_difference(a, skid_reference(_four_points(0.5), _profile("arc", 0.3, 0.3, 2.0),
                                                            SCENARIO, _box_drive()))[0])
+
+
+def test_only_a_tracked_robot_gets_an_mjcf_option(tmp_path: Path) -> None:
+    wheeled = support.TRACKS.with_name("mobile_robot_pantilt.body")
+    files = support.convert(tmp_path, wheeled)
+    assert "<option" not in files["mjcf"].read_text()

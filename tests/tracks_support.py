@@ -5,11 +5,12 @@ WRITTEN files are driven on a plain floor in real MuJoCo and PyBullet by the see
 * MuJoCo: the written MJCF plus a ``<geom type="plane">`` with default contact in the worldbody and
   ``priority="1"`` on the robot's colliding geoms (so their friction and condim win against the
   floor's; added only where the writer did not already), timestep 1 ms, ``implicitfast``, elliptic
-  cone.
+  cone; the file's own ``<option impratio>`` is kept.
 * PyBullet: pybullet_data's ``plane.urdf`` as shipped, ``loadURDF`` with
   ``URDF_USE_INERTIA_FROM_FILE | URDF_USE_IMPLICIT_CYLINDER``, gravity −9.81, dt 1 ms, every default
   motor off, damping 0; each roller link's lateral friction is the written ``<contact>`` value when
-  the URDF has one, else the model's floor friction (what ``convert`` records for the rollers).
+  the URDF has one, else the model's floor friction (what ``convert`` records for the rollers);
+  ``enableConeFriction`` as the MK809 note asks for tracks (0), unless told otherwise.
 
 Actuation (both engines the same law, the one Choreonoid's track realises): every roller of a track
 is held at the belt speed ``(v ∓ w·offset_y) / r`` by a velocity servo ``τ = kv·(target − q̇)`` bounded
@@ -29,6 +30,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
+from modelkit.convert.tracks import PYBULLET_CONE_FRICTION
 
 REPO = Path(__file__).resolve().parents[1]
 TRACKS = REPO / "samples/choreonoid_ros2_mobile_robot_tutorial/model/mobile_robot_tracks.body"
@@ -143,7 +146,9 @@ def mjcf_on_floor(text: str) -> str:
                         'size="0 0 1"/>', 1)
 
 
-def run_mujoco(mjcf: Path, tracks: Tracks, profile: Profile, kv: float = SERVO_GAIN) -> Path2D:
+def run_mujoco(mjcf: Path, tracks: Tracks, profile: Profile, kv: float = SERVO_GAIN,
+               impratio: float | None = None) -> Path2D:
+    """``impratio``: override the file's ``<option impratio>`` (None: keep what the file says)."""
     import mujoco
 
     staged = mjcf.with_name(mjcf.stem + "_on_floor.xml")  # beside it: the meshes resolve
@@ -152,6 +157,8 @@ def run_mujoco(mjcf: Path, tracks: Tracks, profile: Profile, kv: float = SERVO_G
     model.opt.timestep = DT
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     model.opt.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    if impratio is not None:
+        model.opt.impratio = impratio
     data = mujoco.MjData(model)
     sides = []
     for names in (tracks.left, tracks.right):
@@ -186,8 +193,10 @@ def _mj_pose(data) -> tuple[float, float, float]:  # type: ignore[no-untyped-def
 # ---- PyBullet -----------------------------------------------------------------------------------
 
 
-def run_pybullet(urdf: Path, tracks: Tracks, profile: Profile, cone_friction: bool = True) -> Path2D:
-    """``cone_friction`` False: ``enableConeFriction=0`` (Bullet's box friction), for the bench only."""
+def run_pybullet(urdf: Path, tracks: Tracks, profile: Profile,
+                 cone_friction: bool = bool(PYBULLET_CONE_FRICTION)) -> Path2D:
+    """``cone_friction``: Bullet's ``enableConeFriction``; by default what MK809 asks of a PyBullet
+    user for a tracked robot (off), True: PyBullet's own default."""
     import pybullet as p
     import pybullet_data
 
