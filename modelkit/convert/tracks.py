@@ -109,7 +109,9 @@ normal direction. A turning track skids sideways while its belt slips lengthwise
 so the lateral friction of the end rollers holds nearly their full μN and the vehicle hardly turns.
 Softer friction makes the force follow the slip (Coulomb). Measured on the tutorial's tracked robot,
 spin 0.5 rad/s for 10 s, MuJoCo elliptic cones, 1 ms: impratio 1 / 0.3 / 0.1 / 0.03 turn it
-0.93 / 1.32 / 2.94 / 3.22 rad; the skid-steer reference (``verify.reference_skid``) says 3.25 rad."""
+0.93 / 1.32 / 2.94 / 3.22 rad; the skid-steer reference (``verify.reference_skid``) says 3.25 rad.
+The cost: every friction contact of the model creeps more; parked on a 10° slope with its belts held,
+the robot slides 214 mm in 10 s (12 mm at impratio 1; docs/convert.md)."""
 
 PYBULLET_CONE_FRICTION = 0
 """What a PyBullet user must set (``setPhysicsEngineParameter(enableConeFriction=...)``) for the
