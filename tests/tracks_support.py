@@ -147,8 +147,9 @@ def mjcf_on_floor(text: str) -> str:
 
 
 def run_mujoco(mjcf: Path, tracks: Tracks, profile: Profile, kv: float = SERVO_GAIN,
-               impratio: float | None = None) -> Path2D:
-    """``impratio``: override the file's ``<option impratio>`` (None: keep what the file says)."""
+               impratio: float | None = None, elliptic: bool = True) -> Path2D:
+    """``impratio``: override the file's ``<option impratio>`` (None: keep what the file says);
+    ``elliptic`` False: MuJoCo's default pyramidal cone."""
     import mujoco
 
     staged = mjcf.with_name(mjcf.stem + "_on_floor.xml")  # beside it: the meshes resolve
@@ -156,7 +157,7 @@ def run_mujoco(mjcf: Path, tracks: Tracks, profile: Profile, kv: float = SERVO_G
     model = mujoco.MjModel.from_xml_path(str(staged))
     model.opt.timestep = DT
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    model.opt.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    model.opt.cone = mujoco.mjtCone.mjCONE_ELLIPTIC if elliptic else mujoco.mjtCone.mjCONE_PYRAMIDAL
     if impratio is not None:
         model.opt.impratio = impratio
     data = mujoco.MjData(model)
