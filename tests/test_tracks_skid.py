@@ -4,9 +4,10 @@ on a plain floor in real MuJoCo and PyBullet (tests/tracks_support.py: the files
 What is checked: the reference's physics (the steady spin rate of point contacts is the geometric
 ratio b²/(a² + b²) whatever μ; a straight run follows the belts after a friction-limited start; the
 static loads carry the weight at the COM), the tolerance's derivation, the straight profile of the
-written files in both engines against the reference and each other, and (strict xfail, the open
-part of issue 16 item 3) the written files turning as the reference says: MuJoCo through the MJCF's
-``<option impratio>``, PyBullet with cone friction off as MK809 asks (and neither with its default).
+written files in both engines against the reference and each other, and the written files turning
+as the reference says: MuJoCo through the MJCF's ``<option impratio>``, PyBullet with cone friction
+off as MK809 asks, and neither with its own default (the cause, undone). PyBullet's spin path (its
+yaw passes) is a strict xfail: the open part of issue 16 item 3.
 """
 
 from __future__ import annotations

@@ -22,7 +22,8 @@ Euler method (the friction Jacobian taken implicitly, so ε can be small) at the
 Contact layouts (the pressure distribution under a track is what the path is most sensitive to):
 
 * ``"rollers"`` — the converted model's own contacts: one line across the track's width (its two
-  edges) under each roller's bottom, i.e. what MuJoCo's and PyBullet's cylinder–plane contacts give;
+  edges) under each roller's bottom, i.e. what MuJoCo's and PyBullet's cylinder–plane contacts give
+  (for the tutorial's tracks, the ends of the flat bottom);
 * ``"uniform"`` — the track's flat belt on a uniformly stiff floor: :data:`PATCH_POINTS` lines
   evenly over the segment between the first and last roller bottoms (the track's flat bottom).
 
