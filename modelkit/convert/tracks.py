@@ -42,7 +42,13 @@ The approximation written here, for every target but ``.body``:
   tensor scaled by ``1 − TRACK_MASS_FRACTION`` and the note gives the assembly's inertia change;
 * ``robot.extras["tracks"][<track joint name>]`` records what was made, for controllers and the
   verification: ``rollers`` (joint names, roller 0 first), ``roller_links``, ``radius``, ``axis``
-  (unit, in the roller frames), ``forward``, ``track_link``, ``width``, ``length``, ``overlap``.
+  (unit, in the roller frames), ``forward``, ``track_link``, ``width``, ``length``, ``overlap``,
+  ``mujoco_impratio``;
+* turning: a tracked vehicle turns by skidding (its belts slip lengthwise while its ends slide
+  sideways), and both engines resolve such a combined slip with more sideways friction than
+  Coulomb's law gives, so with their defaults the robot hardly turns (:data:`TRACK_IMPRATIO`,
+  :data:`PYBULLET_CONE_FRICTION`). The MJCF writer writes ``<option impratio>`` (soft friction,
+  whose force follows the slip); for PyBullet the note says to turn cone friction off.
 
 Each track gets one MK809 warning saying what was written.
 """
@@ -95,6 +101,23 @@ ROLLER_CLEARANCE = 0.02
 
 TRACKS_KEY = "tracks"
 """``Robot.extras`` key of the per-track record."""
+
+TRACK_IMPRATIO = 0.03
+"""MuJoCo's ``<option impratio>`` for a robot with tracks: friction 1/0.03 ≈ 33 times softer than the
+normal direction. A turning track skids sideways while its belt slips lengthwise; MuJoCo's default
+(impratio 1) resolves that combined slip in the metric of the constraint's inertia, not along the slip,
+so the lateral friction of the end rollers holds nearly their full μN and the vehicle hardly turns.
+Softer friction makes the force follow the slip (Coulomb). Measured on the tutorial's tracked robot,
+spin 0.5 rad/s for 10 s, MuJoCo elliptic cones, 1 ms: impratio 1 / 0.3 / 0.1 / 0.03 turn it
+0.93 / 1.32 / 2.94 / 3.22 rad; the skid-steer reference (``verify.reference_skid``) says 3.25 rad.
+The cost: every friction contact of the model creeps more; parked on a 10° slope with its belts held,
+the robot slides 214 mm in 10 s (12 mm at impratio 1; docs/convert.md)."""
+
+PYBULLET_CONE_FRICTION = 0
+"""What a PyBullet user must set (``setPhysicsEngineParameter(enableConeFriction=...)``) for the
+rollers to skid: Bullet's cone friction holds the direction across the slip like a joint (measured:
+1.42 rad of the reference's 3.25 on the spin above; 3.60 rad with 0). A URDF cannot carry it: MK809
+says so."""
 
 
 @dataclass(frozen=True)
@@ -351,6 +374,7 @@ def _approximate(robot: Robot, joint: Joint, link: Link, notes: NoteSink) -> Non
         "width": shape.width,
         "length": shape.length,
         "overlap": overlap,
+        "mujoco_impratio": TRACK_IMPRATIO,
     }
     message = _message(joint, link, shape, joint_names, spacing, roller_mass, exact, overlap, material)
     notes.note("MK809", message, source, target)
@@ -377,10 +401,24 @@ def _message(joint: Joint, link: Link, shape: TrackShape, rollers: list[str], sp
         parts.append("the track has no mass, so the rollers have none")
     if material:
         parts.append(f"contact material {material} moved to the rollers")
+    parts.append(f"the tracks skid to turn: the MJCF gets <option impratio=\"{TRACK_IMPRATIO:g}\"> "
+                 "(softer friction, so that the rollers' friction follows their slip as Coulomb's does); "
+                 f"PyBullet needs setPhysicsEngineParameter(enableConeFriction={PYBULLET_CONE_FRICTION}) "
+                 "for the same, which a URDF cannot carry")
     if overlap:
         parts.append("the track is shorter than two roller diameters: the rollers overlap, so a target "
                      "that collides sibling bodies needs them excluded from each other")
     return "; ".join(parts)
+
+
+def track_impratio(robot: Robot) -> float | None:
+    """The MJCF ``<option impratio>`` the robot's tracks ask for (the smallest), None without tracks."""
+    records = robot.extras.get(TRACKS_KEY)
+    if not isinstance(records, dict):
+        return None
+    values = [float(r["mujoco_impratio"]) for r in records.values()
+              if isinstance(r, dict) and "mujoco_impratio" in r]
+    return min(values) if values else None
 
 
 def assembly_mass_properties(robot: Robot, track_link: str) -> tuple[float, Vec3, Mat3]:

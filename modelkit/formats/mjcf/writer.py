@@ -6,8 +6,10 @@ through :func:`modelkit.convert.numbers.fmt`. MuJoCo is not imported here.
 
 * ``<compiler angle="radian" autolimits="true" inertiafromgeom="false"/>``: angles in radians,
   a ``range`` makes a joint limited, and inertia comes from the ``<inertial>`` elements only (geoms
-  never add mass). No ``meshdir``: each mesh ``file`` is relative to the model file. No
-  ``<option>``: the timestep, integrator and gravity are MuJoCo's defaults.
+  never add mass). No ``meshdir``: each mesh ``file`` is relative to the model file.
+* ``<option>``: the timestep, integrator and gravity are MuJoCo's defaults; only a robot with
+  pseudo continuous tracks gets ``impratio`` (``convert.tracks.TRACK_IMPRATIO``: soft friction, so
+  that the track rollers skid as Coulomb friction says; MK809).
 * The body tree, joints and inertials: :mod:`.write_bodies`; geoms, meshes, colours and friction:
   :mod:`.write_geoms`; sensors and lights: :mod:`.write_devices`.
 * Mimic joints → ``<equality><joint joint1=follower joint2=leader polycoef="offset multiplier 0 0
@@ -32,6 +34,7 @@ from lxml import etree
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.tracks import track_impratio
 from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_geoms import GeomWriter
@@ -40,7 +43,7 @@ from modelkit.formats.mjcf.write_xml import set_pose, sub
 from modelkit.model import WORLD_LINK, JointType, LoopConstraint, Robot
 from modelkit.spatial import Pose
 
-SECTIONS = ("compiler", "asset", "worldbody", "equality", "actuator", "sensor")
+SECTIONS = ("compiler", "option", "asset", "worldbody", "equality", "actuator", "sensor")
 HINGE_HALF_SPAN = 0.05  # m: the two connects of a hinge loop sit this far either side of the joint
 
 
@@ -62,6 +65,9 @@ class MjcfWriter:
         self.geoms = GeomWriter(ctx, self.names, self.sections["asset"], floor_friction(robot))
         self.devices = DeviceWriter(ctx, self.names, self.sections["sensor"])
         self.tree = BodyTree(robot, ctx, self.names, self.geoms, self.devices)
+        impratio = track_impratio(robot)
+        if impratio is not None:  # skid-steered tracks (convert.tracks, MK809 says why)
+            self.sections["option"].set("impratio", fmt(impratio))
 
     def write(self) -> bytes:
         self.tree.write(self.sections["worldbody"])
@@ -80,7 +86,7 @@ class MjcfWriter:
         self._actuators()
         for tag in SECTIONS:
             el = self.sections[tag]
-            if tag not in ("compiler", "worldbody") and len(el) == 0:
+            if tag not in ("compiler", "worldbody") and len(el) == 0 and not el.attrib:
                 self.root.remove(el)
         etree.indent(self.root, space="  ")
         text: bytes = etree.tostring(self.root, xml_declaration=False, encoding="utf-8", pretty_print=True)
