@@ -526,6 +526,7 @@ def verify(sources: tuple[Path, ...], output: Path | None, engines: str, mjcf: P
     many models: any model that could not be verified, which takes precedence over a failed check).
     """
     names = tuple(e.strip() for e in engines.split(",") if e.strip())
+    _require_engines(names, output is not None)
     if len(sources) == 1 and not sources[0].is_dir() and cluster is None:
         from modelkit.verify.api import verify as run_verify
         from modelkit.verify.many import progress_wanted, save
@@ -553,6 +554,20 @@ def verify(sources: tuple[Path, ...], output: Path | None, engines: str, mjcf: P
     _verify_many(sources, output, {"engines": list(names), "inject": list(inject), "seed": seed,
                                    "replay": not no_replay, "driven": not no_driven,
                                    "scenario": str(scenario.resolve()) if scenario else None}, jobs, cluster)
+
+
+def _require_engines(names: tuple[str, ...], report: bool) -> None:
+    """Exit 2 with the pip line when the engines (or the report's plots) are not installed."""
+    from modelkit.verify.engines import install_line, missing_packages
+
+    source = click.get_current_context().get_parameter_source("engines")
+    named = source is not None and source is not click.core.ParameterSource.DEFAULT
+    missing = missing_packages(names, named, report)
+    if missing:
+        message = (f"verify needs {', '.join(sorted(missing))}, not installed: {install_line(missing)} "
+                   "(validate, tree and convert work without them)")
+        click.echo(render_text(diag("MK950", message, SourceLocation("modelkit verify"))), err=True)
+        sys.exit(2)
 
 
 def _verify_many(sources: tuple[Path, ...], output: Path | None, options: dict[str, Any], jobs: int | None,
