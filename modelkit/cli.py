@@ -528,6 +528,7 @@ def verify(sources: tuple[Path, ...], output: Path | None, engines: str, mjcf: P
     many models: any model that could not be verified, which takes precedence over a failed check).
     """
     names = tuple(e.strip() for e in engines.split(",") if e.strip())
+    _require_engines(names, output is not None)
     sources, xacro_args = split_xacro_args(tuple(str(s) for s in sources))
     if not sources:
         raise click.UsageError("no model given (only xacro KEY:=VALUE arguments)")
@@ -579,6 +580,20 @@ def _reading(kwargs: dict[str, Any], xacro_args: dict[str, str]) -> dict[str, An
         **{k: kwargs[k] for k in defaults if kwargs[k] != defaults[k]},
     }
     return {k: v for k, v in out.items() if v not in (None, {}, [], False)}
+
+
+def _require_engines(names: tuple[str, ...], report: bool) -> None:
+    """Exit 2 with the pip line when the engines (or the report's plots) are not installed."""
+    from modelkit.verify.engines import install_line, missing_packages
+
+    source = click.get_current_context().get_parameter_source("engines")
+    named = source is not None and source is not click.core.ParameterSource.DEFAULT
+    missing = missing_packages(names, named, report)
+    if missing:
+        message = (f"verify needs {', '.join(sorted(missing))}, not installed: {install_line(missing)} "
+                   "(validate, tree and convert work without them)")
+        click.echo(render_text(diag("MK950", message, SourceLocation("modelkit verify"))), err=True)
+        sys.exit(2)
 
 
 def _verify_many(sources: tuple[Path, ...], output: Path | None, options: dict[str, Any], jobs: int | None,

@@ -1168,6 +1168,14 @@ _TABLE: tuple[CodeInfo, ...] = (
     ),
     CodeInfo("MK903", "scenario-missing-key", "error", "A scenario entry lacks a key it needs."),
     CodeInfo("MK904", "scenario-unknown-profile", "error", "A scenario names an unknown built-in profile."),
+    # -- MK95x: verify could not run ------------------------------------------------------------------
+    CodeInfo(
+        "MK950",
+        "verify-needs-engines",
+        "error",
+        "`verify` needs packages that are not installed (the engines and plots of `modelkit[verify]`, or "
+        "Drake's `modelkit[drake]` when named); the message names them and the pip line that installs them.",
+    ),
 )
 
 CODES: dict[str, CodeInfo] = {c.code: c for c in _TABLE}
