@@ -607,6 +607,16 @@ _TABLE: tuple[CodeInfo, ...] = (
     ),
     CodeInfo("MK314", "inertia-count", "error", "An inertia list has neither 6 nor 9 elements."),
     CodeInfo(
+        "MK316",
+        "inertia-implausible",
+        "warning",
+        "A link's radius of gyration sqrt(I_max / m) is more than 3 times the largest distance from its "
+        "centre of mass to its shapes (boxes around its visuals and collisions; a mass inside its shapes "
+        "cannot exceed 1 time), e.g. a unit inertia on a 0.1 kg wheel. Every loader accepts it; the link "
+        "then turns far more sluggishly than its shapes suggest. Links with mesh files, no shapes or no mass "
+        "are not judged.",
+    ),
+    CodeInfo(
         "MK315",
         "joint-velocity-range-reversed",
         "warning",
@@ -745,6 +755,24 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A URDF or SDF visual box, sphere, cylinder, capsule or ellipsoid with a zero or negative size: it "
         "draws nothing. Reference: check_urdf, libsdformat, PyBullet and MuJoCo's URDF import (which drops "
         "visuals) load it; `convert` to MJCF leaves the shape out (MK871).",
+    ),
+    CodeInfo(
+        "MK418",
+        "collision-far-from-visual",
+        "warning",
+        "A collision shape lies apart from the link's visual shapes: the gap between their bounding boxes "
+        "exceeds half the larger one's half-diagonal (e.g. a collision origin that repeats the joint "
+        "origin). Every loader accepts it; the robot collides where it is not drawn. Links with mesh files "
+        "are not judged.",
+    ),
+    CodeInfo(
+        "MK419",
+        "collision-shape-differs",
+        "warning",
+        "A link's one collision is not its one visual's shape: two cylinders, capsules or cones whose axes "
+        "differ by more than 1°, or shapes whose extent along a link axis differs by more than a factor 2 "
+        "and by more than a quarter of the larger shape's half-diagonal. Every loader accepts it. Links "
+        "with mesh files or several visuals or collisions are not judged.",
     ),
     # (urdf/sdf/mjcf geometry MK420-MK439: urdf MK420-MK429)
     CodeInfo(
