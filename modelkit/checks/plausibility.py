@@ -36,6 +36,10 @@ PLACEHOLDER_FRACTION = 0.05
 # the largest distance from the centre of mass to the link's shapes (a mass inside the shapes cannot) by
 # more than this factor.
 GYRATION_FACTOR = 3.0
+# MK316 does not judge a body whose shapes cannot hold its mass even at the density of osmium, the densest
+# element (kg/m³), over their whole bounding box: such shapes are markers (Tiago's 1 mm spheres on 50 g finger
+# links, Cassie's 1 cm box on a 0.27 kg link), not the body's extent.
+DENSEST = 22_590.0
 
 AXIAL = (Cylinder, Capsule, Cone)
 
@@ -209,8 +213,11 @@ def _implausible_body(
     mass, com, tensor = body_mass_properties(links, members)
     if not mass > 0.0:
         return None
+    box = union(geoms)
+    if mass > DENSEST * 8.0 * box.half[0] * box.half[1] * box.half[2]:
+        return None  # the shapes are markers: they cannot hold the mass
     moment = rot3.symmetric_eigenvalues(tensor)[2]
-    reach = union(geoms).farthest(com)
+    reach = box.farthest(com)
     if not (moment > 0.0 and reach > 0.0):
         return None
     gyration = math.sqrt(moment / mass)
