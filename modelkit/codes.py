@@ -616,8 +616,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A link's radius of gyration sqrt(I_max / m) is more than 3 times the largest distance from its "
         "centre of mass to its shapes (boxes around its visuals and collisions; a mass inside its shapes "
         "cannot exceed 1 time), e.g. a unit inertia on a 0.1 kg wheel. Every loader accepts it; the link "
-        "then turns far more sluggishly than its shapes suggest. Links with mesh files, no shapes or no mass "
-        "are not judged.",
+        "then turns far more sluggishly than its shapes suggest. Not judged: bodies without shapes or mass, "
+        "with a mesh validate did not load (plain OBJ), or whose shapes cannot hold the mass at osmium's "
+        "density (markers).",
     ),
     CodeInfo(
         "MK315",
@@ -764,9 +765,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "collision-far-from-visual",
         "warning",
         "A collision shape lies apart from the link's visual shapes: the gap between their bounding boxes "
-        "exceeds half the larger one's half-diagonal (e.g. a collision origin that repeats the joint "
-        "origin). Every loader accepts it; the robot collides where it is not drawn. Links with mesh files "
-        "are not judged.",
+        "exceeds the larger one's half-diagonal (e.g. a collision origin that repeats the joint origin). "
+        "Every loader accepts it; the robot collides where it is not drawn. Meshes count when validate "
+        "loaded them (not plain OBJ files).",
     ),
     CodeInfo(
         "MK419",

@@ -86,13 +86,13 @@ def test_a_collision_touching_its_visual_is_not_far(tmp_path: Path) -> None:
 
 
 def test_far_is_relative_to_the_size(tmp_path: Path) -> None:
-    # a gap of 0.02 m beside shapes of half-diagonal 0.051 m: 0.39 of the size, below one half
-    near = _urdf(tmp_path, collision_origin='<origin xyz="0.12 0 0"/>')
+    # a gap of 0.06 m beside boxes of half-diagonal 0.0714 m (0.05, 0.05, 0.01): 0.84 of the size, not far
+    near = _urdf(tmp_path, collision_origin='<origin xyz="0.16 0 0"/>')
     assert _found(near, "MK418") == []
-    # a gap of 0.04 m: 0.78 of the size
-    far = _urdf(tmp_path, collision_origin='<origin xyz="0.14 0 0"/>')
+    # a gap of 0.1 m: 1.4 of the size
+    far = _urdf(tmp_path, collision_origin='<origin xyz="0.2 0 0"/>')
     ((_, message),) = _found(far, "MK418")
-    assert "0.04 m away" in message
+    assert "0.1 m away" in message
 
 
 # ---- MK419 collision shape differs from visual ------------------------------------------------------------
@@ -179,9 +179,35 @@ def test_marker_shapes_that_cannot_hold_the_mass_are_not_judged(tmp_path: Path) 
     assert "radius of gyration of 0.1 m, 5.77 times the 0.01732 m" in message
 
 
-def test_links_with_mesh_files_are_not_judged(tmp_path: Path) -> None:
-    path = _urdf(tmp_path, visual='<mesh filename="wheel.stl"/>', wheel_inertia=1.0)
+def test_links_with_mesh_files_validate_did_not_load_are_not_judged(tmp_path: Path) -> None:
+    path = _urdf(tmp_path, visual='<mesh filename="wheel.stl"/>', wheel_inertia=1.0)  # no such file
     assert _found(path, "MK316") == []
+
+
+def _box_stl(path: Path, half: tuple[float, float, float]) -> None:
+    """An ASCII STL of a box centred on the origin (12 triangles)."""
+    signs = [(sx, sy, sz) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+    corners = [(sx * half[0], sy * half[1], sz * half[2]) for sx, sy, sz in signs]
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
+             (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    lines = ["solid box"]
+    for face in faces:
+        lines += ["facet normal 0 0 0", "outer loop"]
+        lines += [f"vertex {' '.join(str(c) for c in corners[i])}" for i in face]
+        lines += ["endloop", "endfacet"]
+    path.write_text("\n".join([*lines, "endsolid box", ""]))
+
+
+def test_a_mesh_validate_loaded_counts_with_its_extent(tmp_path: Path) -> None:
+    _box_stl(tmp_path / "wheel.stl", (0.05, 0.05, 0.01))
+    mesh = '<mesh filename="wheel.stl" scale="2 2 2"/>'
+    ((_, message),) = _found(_urdf(tmp_path, visual=mesh, collision=mesh, wheel_inertia=1.0), "MK316")
+    assert "22.1 times the 0.1428 m" in message  # the scaled box: half extents 0.1, 0.1, 0.02
+    assert _found(_urdf(tmp_path, visual=mesh, collision=mesh, wheel_inertia=1e-3), "MK316") == []
+    # a box collision far beside the mesh visual
+    far = _urdf(tmp_path, visual=mesh, collision_origin='<origin xyz="0.5 0 0"/>')
+    ((_, message),) = _found(far, "MK418")
+    assert "the visuals at 0 0 0; sizes (half-diagonals) 0.07141 and 0.1428 m" in message
 
 
 # ---- MK306 axis not a unit vector ------------------------------------------------------------------------
@@ -265,6 +291,8 @@ def test_unicycle_has_none_of_these_faults() -> None:
 # Each hit on the corpus, read and judged a real fault of the file (none is on a sound file):
 # - SR1.body: 16 links with the identity inertia (1 kg·m²) as a placeholder, e.g. a 0.4 kg wrist of 8 cm;
 # - gazebo_ros_pkgs test files: an 8 cm link of 0.1 kg with 1 kg·m², a 1 m box of 1 kg with 100 kg·m²;
+#   the Pioneer 3-DX's caster swivel (0.1 kg, 0.01 kg·m² in 5.6 cm of mesh) and centre wheel (0.11 kg,
+#   0.031 kg·m²), 5.6 and 9.1 times;
 #   trimesh_collision.world's "collision_box" lies 1 m beside its visual (its 10 kg boxes of 5 cm with
 #   1 kg·m² are not judged: no material holds 10 kg in 5 cm, so the shapes cannot be the body);
 # - gz-sim ackermann_steering.sdf: 0.5 kg steering links of 6.6 cm with 0.025 kg·m² (3.4 times);
@@ -275,6 +303,7 @@ CORPUS_HITS = {
     ("gazebo_ros_pkgs/gazebo_plugins/test/test_worlds/gazebo_ros_block_laser_clipping.world", "MK316"),
     ("gazebo_ros_pkgs/gazebo_plugins/test/test_worlds/gazebo_ros_trimesh_collision.world", "MK418"),
     ("gazebo_ros_pkgs/gazebo_plugins/test2/urdf/box.urdf", "MK316"),
+    ("gazebo_ros_pkgs/gazebo_plugins/test/multi_robot_scenario/xacro/p3dx/pioneer3dx.xacro", "MK316"),
     ("gz_sim_worlds/examples/worlds/ackermann_steering.sdf", "MK316"),
     ("gz_sim_worlds/examples/worlds/world_joint.sdf", "MK316"),
     ("sdformat_urdf/sdformat_test_files/models/joint_revolute_axis/joint_revolute_axis.sdf", "MK306"),

@@ -1,13 +1,15 @@
 """Axis-aligned bounding boxes of a link's shapes in the link frame, in plain floats (no numpy, no meshes).
 
 A primitive's box is exact for its pose (a rotated box's box is the smallest axis-aligned box around it).
-A mesh counts only when its triangles are already in memory (generated geometry, ``.body`` shapes); a mesh
-that is only a file reference has no box here: validate does not load meshes a second time for this.
+A mesh counts when its triangles are in memory (generated geometry) or when the reader has already
+loaded its file to check it (:func:`modelkit.geometry.meshfiles.known_bounds`): validate never loads a
+mesh a second time for this, and a mesh it did not load (a plain OBJ, a file with unit metadata) has no box.
 """
 
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 
 from modelkit import rot3
@@ -64,11 +66,13 @@ def local_box(geometry: object) -> Aabb | None:
     if isinstance(geometry, Ellipsoid):
         a, b, c = (abs(float(v)) for v in rot3.peek(geometry, "radii"))
         return Aabb(rot3.ZERO3, (a, b, c))
-    if isinstance(geometry, Mesh) and geometry.data is not None and len(geometry.data.vertices):
-        vertices = geometry.data.vertices
+    if isinstance(geometry, Mesh):
+        corners = _mesh_corners(geometry)
+        if corners is None:
+            return None
         scale = [float(v) for v in rot3.peek(geometry, "scale")]
-        low = [float(vertices[:, i].min()) * scale[i] for i in range(3)]
-        high = [float(vertices[:, i].max()) * scale[i] for i in range(3)]
+        low = [corners[0][i] * scale[i] for i in range(3)]
+        high = [corners[1][i] * scale[i] for i in range(3)]
         lo = [min(low[i], high[i]) for i in range(3)]
         hi = [max(low[i], high[i]) for i in range(3)]
         return Aabb(
@@ -76,6 +80,23 @@ def local_box(geometry: object) -> Aabb | None:
             ((hi[0] - lo[0]) / 2, (hi[1] - lo[1]) / 2, (hi[2] - lo[2]) / 2),
         )
     return None
+
+
+def _mesh_corners(mesh: Mesh) -> tuple[rot3.V3, rot3.V3] | None:
+    """A mesh's lowest and highest corners in its file frame: from its triangles in memory, or from the
+    mesh file the reader already loaded (its check of the file; nothing is loaded here, and a reader that
+    loaded no mesh has not imported the mesh module)."""
+    if mesh.data is not None:
+        vertices = mesh.data.vertices
+        if not len(vertices):
+            return None
+        low, high = vertices.min(axis=0), vertices.max(axis=0)
+        return rot3.vec3(low), rot3.vec3(high)
+    meshfiles = sys.modules.get("modelkit.geometry.meshfiles")
+    if meshfiles is None or mesh.path is None or mesh.source_params.get("metadata"):
+        return None
+    found: tuple[rot3.V3, rot3.V3] | None = meshfiles.known_bounds(mesh.path, mesh.fragment)
+    return found
 
 
 def geom_box(geom: Geom, frame: Pose | None = None) -> Aabb | None:
