@@ -563,7 +563,10 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK306",
         "joint-axis-not-unit",
         "warning",
-        "A joint axis is not a unit vector (Choreonoid uses it as given).",
+        "A joint axis is not a unit vector, at the line where the file writes it: in `.body` off 1 by more "
+        "than 1e-6 (Choreonoid uses it as given), in URDF and SDF by more than 1e-3 (a rounded `0.7071 0 "
+        "0.7071` passes). Reference: urdfdom keeps it as written, PyBullet turns the joint about the "
+        "normalised axis, MuJoCo normalises it (so MJCF has no such warning); modelkit normalises it.",
     ),
     CodeInfo(
         "MK307",
@@ -606,6 +609,17 @@ _TABLE: tuple[CodeInfo, ...] = (
         "mjcf`); MuJoCo refuses a massless moving MJCF body.",
     ),
     CodeInfo("MK314", "inertia-count", "error", "An inertia list has neither 6 nor 9 elements."),
+    CodeInfo(
+        "MK316",
+        "inertia-implausible",
+        "warning",
+        "A link's radius of gyration sqrt(I_max / m) is more than 3 times the largest distance from its "
+        "centre of mass to its shapes (boxes around its visuals and collisions; a mass inside its shapes "
+        "cannot exceed 1 time), e.g. a unit inertia on a 0.1 kg wheel. Every loader accepts it; the link "
+        "then turns far more sluggishly than its shapes suggest. Not judged: bodies without shapes or mass, "
+        "with a mesh validate did not load (plain OBJ), or whose shapes cannot hold the mass at osmium's "
+        "density (markers).",
+    ),
     CodeInfo(
         "MK315",
         "joint-velocity-range-reversed",
@@ -745,6 +759,24 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A URDF or SDF visual box, sphere, cylinder, capsule or ellipsoid with a zero or negative size: it "
         "draws nothing. Reference: check_urdf, libsdformat, PyBullet and MuJoCo's URDF import (which drops "
         "visuals) load it; `convert` to MJCF leaves the shape out (MK871).",
+    ),
+    CodeInfo(
+        "MK418",
+        "collision-far-from-visual",
+        "warning",
+        "A collision shape lies apart from the link's visual shapes: the gap between their bounding boxes "
+        "exceeds the larger one's half-diagonal (e.g. a collision origin that repeats the joint origin). "
+        "Every loader accepts it; the robot collides where it is not drawn. Meshes count when validate "
+        "loaded them (not plain OBJ files).",
+    ),
+    CodeInfo(
+        "MK419",
+        "collision-shape-differs",
+        "warning",
+        "A link's one collision is not its one visual's shape: two cylinders, capsules or cones whose axes "
+        "differ by more than 1°, or shapes whose extent along a link axis differs by more than a factor 2 "
+        "and by more than a quarter of the larger shape's half-diagonal. Every loader accepts it. Links "
+        "with mesh files or several visuals or collisions are not judged.",
     ),
     # (urdf/sdf/mjcf geometry MK420-MK439: urdf MK420-MK429)
     CodeInfo(

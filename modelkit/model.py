@@ -36,6 +36,11 @@ SYNTHESISED = "synthesised"
 """The ``extras`` key (value True) of a link or joint the reader made up: not written in the source
 (an MJCF multi-joint body's intermediate frames, the world link a reader adds to hang joints from)."""
 
+AXIS_UNIT_TOLERANCE = 1e-3
+"""A written joint axis whose length is off 1 by more than this is not a rounded unit vector
+("0.7071 0 0.7071" has length 0.99999): URDF and SDF readers warn (MK306). The ``.body`` reader warns
+from 1e-6 on, since Choreonoid uses the axis unnormalised."""
+
 
 class JointType(StrEnum):
     FIXED = "fixed"

@@ -129,12 +129,19 @@ def test_corpus_is_complete(corpus: Path) -> None:
     assert sorted(p.stem for p in corpus_files()) == sorted(CORPUS_TREES)
 
 
+# The only warning on the sdformat_urdf corpus: a converter test whose revolute axis "0.1 1.23 4.567" is not a
+# unit vector (length 4.73; MK306 at its <xyz> line).
+CORPUS_WARNINGS = {"joint_revolute_axis": [("MK306", 64)]}
+
+
 @pytest.mark.parametrize("name", sorted(CORPUS_TREES))
 def test_corpus_tree(name: str, corpus: Path) -> None:
     path = SDF_MODELS / name / f"{name}.sdf"
     result = validate(path)
-    assert [d for d in result.diagnostics if d.severity.value != "info"] == []
-    assert {d.code for d in result.diagnostics} <= {"MK532"}  # model:// found beside the model
+    expected = CORPUS_WARNINGS.get(name, [])
+    assert [(d.code, d.location.line if d.location else None)
+            for d in result.diagnostics if d.severity.value != "info"] == expected
+    assert {d.code for d in result.diagnostics} <= {"MK532"} | {code for code, _ in expected}
     robot = robot_of(result)
     assert robot.source_format == "sdf" and robot.name == name
     assert robot.root_joint is JointType.FLOATING
@@ -478,7 +485,9 @@ def test_joint_details(tmp_path: Path) -> None:
     )
     result = read_text(tmp_path, model("1.11", body))
     robot = robot_of(result)
-    assert [d for d in result.diagnostics if d.severity.value != "info"] == []
+    # the one warning: the axis "0 0 2" of "lead" is not a unit vector (the model holds it normalised)
+    assert [(d.code, d.location.line if d.location else None)
+            for d in result.diagnostics if d.severity.value != "info"] == [("MK306", 9)]
     lead, follow, ball = robot.joints
     assert np.allclose(lead.axis, [0, 0, 1])
     assert (lead.limits.lower, lead.limits.upper, lead.limits.effort, lead.limits.velocity) == (

@@ -38,7 +38,7 @@ def rule(name: str, *codes: str) -> Callable[[RuleFunction], RuleFunction]:
 
 def run_rules(robot: Robot) -> list[Diagnostic]:
     # Importing the rule modules registers their rules.
-    from modelkit.checks import physics, portability, topology  # noqa: F401
+    from modelkit.checks import physics, plausibility, portability, topology  # noqa: F401
 
     out: list[Diagnostic] = []
     for r in RULES:

@@ -194,8 +194,10 @@ def mesh_problem(
             # are neither a finding nor something to print on stderr
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                load_mesh(path, fragment, metadata, max_bytes)
+                loaded = load_mesh(path, fragment, metadata, max_bytes)
             outcome = None
+            if key is not None and metadata is None:
+                _keep_bounds(str(path), key[1], key[2], fragment, loaded.mesh.vertices)
     except MeshLoadError as exc:
         outcome = f"{exc.code}\t{exc}"
     if key is not None:
@@ -215,6 +217,37 @@ def _fast_obj_problem(path: Path, fragment: str | None, metadata: MeshMetadata |
 def clear_mesh_cache() -> None:
     """Forget every outcome kept by :func:`mesh_problem` (benchmarks, long-running processes)."""
     _OUTCOMES.clear()
+    _BOUNDS.clear()
+
+
+Corners = tuple[tuple[float, float, float], tuple[float, float, float]]
+# (path as given, fragment) -> (mtime_ns, size, the lowest and highest corner of the triangles) of a mesh that
+# :func:`mesh_problem` loaded without metadata: the validation rules use a mesh's extent without loading it
+# again (a plain OBJ judged by ``objcheck`` has none).
+_BOUNDS: dict[tuple[str, str | None], tuple[int, int, Corners]] = {}
+
+
+def _keep_bounds(path: str, mtime: int, size: int, fragment: str | None,
+                 vertices: NDArray[np.float64]) -> None:
+    if len(vertices):
+        low, high = vertices.min(axis=0), vertices.max(axis=0)
+        _BOUNDS[(path, fragment)] = (mtime, size, (
+            (float(low[0]), float(low[1]), float(low[2])), (float(high[0]), float(high[1]), float(high[2]))))
+
+
+def known_bounds(path: str | Path, fragment: str | None = None) -> Corners | None:
+    """The corners of a mesh :func:`mesh_problem` has loaded in this process under the same path (None if
+    it has not, or if the file has changed since)."""
+    import os
+
+    kept = _BOUNDS.get((str(path), fragment))
+    if kept is None:
+        return None
+    try:
+        info = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return kept[2] if (info.st_mtime_ns, info.st_size) == kept[:2] else None
 
 
 # ---- shared scene graph ---------------------------------------------------------------------

@@ -25,7 +25,7 @@ from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import sensor_device
 from modelkit.formats.sdf.values import child, children
-from modelkit.model import WORLD_LINK, Device, Joint, JointLimits, JointType, Mimic
+from modelkit.model import AXIS_UNIT_TOLERANCE, WORLD_LINK, Device, Joint, JointLimits, JointType, Mimic
 from modelkit.spatial import Pose
 
 TYPES = {
@@ -214,9 +214,22 @@ def _axis(ctx: Context, graph: FrameGraph, data: JointData, axis_el: Element) ->
         frame = item.scope.frame  # SDF 1.4: axes are expressed in the model frame
     elif values.boolean(child(axis_el, "use_parent_model_frame")):
         frame = item.scope.frame
-    if rot3.norm(xyz) == 0.0 and data.joint.type.moves:
+    norm = rot3.norm(xyz)
+    if norm == 0.0 and data.joint.type.moves:
         ctx.sink.emit("MK305", f'joint "{item.local}": the axis is the zero vector', loc)
+    elif abs(norm - 1.0) > AXIS_UNIT_TOLERANCE and data.joint.type.moves:
+        ctx.sink.emit(
+            "MK306",
+            f'joint "{item.local}": the axis "{_fmt_axis(xyz)}" has length {norm:.6g}, not 1; modelkit and '
+            "MuJoCo (after conversion) normalise it",
+            loc,
+            hint="write a unit vector",
+        )
     return AxisSpec(xyz, frame, loc)
+
+
+def _fmt_axis(xyz: tuple[float, ...]) -> str:
+    return " ".join(f"{v:g}" for v in xyz)
 
 
 def _axis_details(ctx: Context, data: JointData, axis_el: Element) -> None:

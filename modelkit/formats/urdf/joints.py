@@ -13,7 +13,7 @@ from lxml.etree import _Element as Element
 from modelkit import rot3
 from modelkit.diagnostics import did_you_mean
 from modelkit.formats.urdf.values import Context, number, origin, vector
-from modelkit.model import Joint, JointLimits, JointType, Mimic
+from modelkit.model import AXIS_UNIT_TOLERANCE, Joint, JointLimits, JointType, Mimic
 
 JOINT_TYPES: dict[str, JointType] = {
     "revolute": JointType.REVOLUTE,
@@ -106,7 +106,22 @@ def _axis(ctx: Context, element: Element, joint: Joint, label: str) -> None:
             ctx.loc(axis_el, "xyz"),
         )
         return
+    if abs(norm - 1.0) > AXIS_UNIT_TOLERANCE:
+        ctx.emit(
+            "MK306",
+            f'{label}: the axis "{axis_el.get("xyz")}" has length {norm:.6g}, not 1; '
+            f"{AXIS_NOT_UNIT_CONSUMERS}",
+            ctx.loc(axis_el, "xyz"),
+            hint="write a unit vector",
+        )
     joint.axis = tuple(v / norm for v in values)
+
+
+# What the consumers do with such an axis (measured: PyBullet 3.2.7, MuJoCo 4.0).
+AXIS_NOT_UNIT_CONSUMERS = (
+    "urdfdom and check_urdf keep it as written, PyBullet reports it as written (getJointInfo) but turns the "
+    "joint by q about the normalised axis, MuJoCo and modelkit normalise it"
+)
 
 
 def _limit(ctx: Context, element: Element, joint: Joint, word: str | None, label: str) -> None:
