@@ -10,6 +10,7 @@ from modelkit.diagnostics import Diagnostic, Severity, sorted_diagnostics
 from modelkit.formats import read_model
 from modelkit.formats.common import ReadOptions
 from modelkit.model import Robot
+from modelkit.textio import OpenedFile
 
 # Consumers a file may be meant for (``validate --target``), and the findings each refuses although the
 # file's own loader accepts them: under that target they are errors, since that consumer (and
@@ -50,6 +51,7 @@ class Validation:
     robot: Robot | None
     diagnostics: list[Diagnostic]
     robots: list[Robot] = field(default_factory=list)
+    opened: list[OpenedFile] = field(default_factory=list)  # every file the read opened
 
     @property
     def errors(self) -> list[Diagnostic]:
@@ -82,7 +84,8 @@ def validate(
     unique: dict[tuple[object, ...], Diagnostic] = {}
     for d in diagnostics:
         unique.setdefault((d.code, d.location, d.message), d)
-    return Validation(display or str(path), result.robot, sorted_diagnostics(unique.values()), result.robots)
+    return Validation(display or str(path), result.robot, sorted_diagnostics(unique.values()), result.robots,
+                      result.opened)
 
 
 def _for_target(d: Diagnostic, target: str) -> Diagnostic:

@@ -449,7 +449,7 @@ def convert(
     """
     from modelkit.convert import WriteOptions
     from modelkit.convert import convert as run_convert
-    from modelkit.convert.report import render_summary, report_json
+    from modelkit.convert.report import render_summary
 
     files, xacro_args = split_xacro_args(words)
     if not files:
@@ -462,28 +462,52 @@ def convert(
         merge_fixed=merge_fixed,
         urdf_world_link=urdf_world_link,
     )
-    result = run_convert(
-        files, output, target, _read_options(kwargs, True, xacro_args), options, force, kwargs["input_format"]
-    )
+    with _interruptible("convert", output):
+        result = run_convert(files, output, target, _read_options(kwargs, True, xacro_args), options, force,
+                             kwargs["input_format"], report=report_path)
     for d in result.diagnostics:
         click.echo(render_text(d), err=True)
     click.echo(render_summary(result, quiet), err=True, nl=False)
-    if report_path is not None:
-        from modelkit.convert.output import OutputPlan
-
-        plan = OutputPlan(report_path.parent, {Path(f) for f in files}, True)
-        plan.add(report_path.name, report_json(result, [str(f) for f in files]).encode("utf-8"), "report")
-        problems = plan.problems()
-        if problems:
-            for d in problems:
-                click.echo(render_text(d), err=True)
-            sys.exit(2)
-        plan.commit()
     if result.status:
         sys.exit(result.status)
     threshold = Severity(strict_level).rank
     if strict and any(n.severity.rank >= threshold for n in result.notes):
         sys.exit(1)
+
+
+@contextmanager
+def _interruptible(command: str, where: Path | None, snapshot: Any = None) -> Iterator[None]:
+    """Ctrl-C, SIGTERM and SIGHUP end ``command`` with one MK896 line and exit 128 + the signal
+    (130, 143, 129), no traceback. What the command wrote is undone on the way out (convert's staged
+    commit does it itself; ``snapshot``, a :class:`modelkit.safewrite.Snapshot`, removes the files a
+    verify run added)."""
+    from modelkit.interrupt import Interrupted, interruptible
+
+    try:
+        with interruptible():
+            yield
+    except Interrupted as exc:
+        from modelkit.convert.commit import signals_held
+
+        with signals_held():  # a second Ctrl-C does not cut the clean-up short
+            if snapshot is not None:
+                snapshot.remove_new()
+            message = f"{command} stopped by {exc.name}; "
+            message += "what it had written is removed" if where is not None else "nothing was written"
+            click.echo(render_text(diag("MK896", message, SourceLocation(str(where or command)))), err=True)
+            sys.stdout.flush()
+            sys.stderr.flush()
+        sys.exit(exc.exit_code)
+
+
+def _unsafe_output(exc: Exception) -> None:
+    """A report file verify must not write through (a symlink, a path out of -o): MK892, exit 2."""
+    from modelkit.safewrite import UnsafeOutput
+
+    assert isinstance(exc, UnsafeOutput)
+    click.echo(render_text(diag("MK892", f"{exc.message}; the report is not written",
+                                SourceLocation(str(exc.path)))), err=True)
+    sys.exit(2)
 
 
 @main.command()
@@ -533,6 +557,27 @@ def verify(sources: tuple[Path, ...], output: Path | None, engines: str, mjcf: P
     if not sources:
         raise click.UsageError("no model given (only xacro KEY:=VALUE arguments)")
     reading = _reading(kwargs, xacro_args)
+    from modelkit import safewrite
+
+    snapshot = None
+    if output is not None:
+        try:  # refused before minutes of checks, not after
+            for name in ("report.json", "report.html", "pictures", "plots", "summary.json", "summary.html"):
+                safewrite.check(output, output / name, folder=name in ("pictures", "plots"))
+        except safewrite.UnsafeOutput as exc:
+            _unsafe_output(exc)
+        snapshot = safewrite.Snapshot(output)
+    with _interruptible("verify", output, snapshot):
+        _verify(sources, output, names, mjcf, urdf, sdf, inject, seed, no_replay, scenario, no_driven, jobs,
+                cluster, reading)
+
+
+def _verify(sources: tuple[Path, ...], output: Path | None, names: tuple[str, ...], mjcf: Path | None,
+            urdf: Path | None, sdf: Path | None, inject: tuple[str, ...], seed: int, no_replay: bool,
+            scenario: Path | None, no_driven: bool, jobs: int | None, cluster: str | None,
+            reading: dict[str, Any]) -> None:
+    from modelkit.safewrite import UnsafeOutput
+
     if len(sources) == 1 and not sources[0].is_dir() and cluster is None:
         from modelkit.verify.api import verify as run_verify
         from modelkit.verify.many import progress_wanted, save
@@ -550,7 +595,10 @@ def verify(sources: tuple[Path, ...], output: Path | None, engines: str, mjcf: P
         click.echo(render_table(report), nl=False)
         if output is not None and not report.errors:
             progress("writing the report (plots, pictures, report.html)")
-            save(report, output)
+            try:
+                save(report, output)
+            except UnsafeOutput as exc:
+                _unsafe_output(exc)
             click.echo(f"wrote {output / 'report.json'}")
             if "html" in report.artefacts:
                 click.echo(f"report: {output / report.artefacts['html']}")
@@ -623,7 +671,13 @@ def _verify_many(sources: tuple[Path, ...], output: Path | None, options: dict[s
         results = many.run_local(many.make_jobs(paths, options), output, workers, progress)
     click.echo(many.render_summary(results), nl=False)
     if output is not None:
-        for path in many.write_summary(results, options, output):
+        from modelkit.safewrite import UnsafeOutput
+
+        try:
+            written = many.write_summary(results, options, output)
+        except UnsafeOutput as exc:
+            _unsafe_output(exc)
+        for path in written:
             click.echo(f"wrote {path}")
     sys.exit(many.exit_code(results))
 

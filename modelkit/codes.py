@@ -1189,6 +1189,19 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "An input holds no robot (an xacro macro library, a world without models); nothing is written.",
     ),
+    CodeInfo(
+        "MK896",
+        "interrupted",
+        "error",
+        "`convert` or `verify` was stopped by a signal (Ctrl-C, SIGTERM, SIGHUP); what it had written is "
+        "removed and it exits with 128 + the signal's number (130, 143, 129).",
+    ),
+    CodeInfo(
+        "MK897",
+        "report-is-output",
+        "error",
+        "The `--report` file is (or is a link to) a file the conversion writes; nothing is written.",
+    ),
     # -- MK9xx: verify scenario files (layer 4 command profiles, `verify --scenario`) ------------------
     CodeInfo("MK900", "scenario-wrong-type", "error", "A value in a scenario file has the wrong type."),
     CodeInfo("MK901", "scenario-unknown-key", "error", "A scenario file has a key the schema lacks."),

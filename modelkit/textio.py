@@ -7,6 +7,10 @@ from __future__ import annotations
 
 import os
 import stat
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
 from pathlib import Path
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
@@ -43,6 +47,40 @@ _KINDS = (
 )
 
 
+@dataclass(frozen=True)
+class OpenedFile:
+    """A file a reader opened: its path as opened and its identity (device, inode), which names the
+    file whatever the spelling of its path (``..``, symlinks, hard links)."""
+
+    path: str
+    dev: int
+    ino: int
+
+    @property
+    def identity(self) -> tuple[int, int]:
+        return (self.dev, self.ino)
+
+
+_RECORD: ContextVar[list[OpenedFile] | None] = ContextVar("modelkit_opened_files", default=None)
+
+
+@contextmanager
+def recording() -> Iterator[list[OpenedFile]]:
+    """Record every regular file opened through this module while the block runs (model files,
+    includes, xacro includes, ``$(find)`` and ``load_yaml`` files, resources, materials, meshes,
+    asset files checked for MuJoCo): the list yielded fills as they are opened. Nested blocks each
+    get their own list and also report to the outer one."""
+    outer = _RECORD.get()
+    mine: list[OpenedFile] = []
+    token = _RECORD.set(mine)
+    try:
+        yield mine
+    finally:
+        _RECORD.reset(token)
+        if outer is not None:
+            outer.extend(mine)
+
+
 def _open_regular(path: Path | str) -> tuple[int, os.stat_result]:
     """An open descriptor on ``path`` and its ``fstat``, once it is known to be a regular file.
 
@@ -61,6 +99,9 @@ def _open_regular(path: Path | str) -> tuple[int, os.stat_result]:
         os.close(fd)
         kind = next((name for test, name in _KINDS if test(info.st_mode)), "a special file")
         raise UnreadableFile("MK001", f"cannot read file: it is {kind}, not a regular file")
+    record = _RECORD.get()
+    if record is not None:
+        record.append(OpenedFile(os.fspath(path), info.st_dev, info.st_ino))
     return fd, info
 
 

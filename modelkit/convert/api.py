@@ -8,11 +8,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from modelkit.convert.commit import CommitRefused, Entry, identity
 from modelkit.convert.context import WriteContext
 from modelkit.convert.meshes import MeshExporter
 from modelkit.convert.notes import ConversionNote, NoteSink
 from modelkit.convert.options import WriteOptions
-from modelkit.convert.output import OutputPlan, safe_file_name
+from modelkit.convert.output import OutputPlan, safe_file_name, target_problem
 from modelkit.convert.registry import TargetInfo, load_writer, target_for_path, target_info
 from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
 from modelkit.formats.common import ReadOptions
@@ -99,7 +100,11 @@ def write(robot: Robot, path: str | Path, fmt: str | None = None, options: Write
     if problems:
         exc = FileExistsError if all(p.code == "MK890" for p in problems) else PermissionError
         raise exc("; ".join(p.message for p in problems))
-    plan.commit()
+    try:
+        plan.commit()
+    except CommitRefused as refused:
+        code = refused.diagnostic.code
+        raise (FileExistsError if code == "MK890" else PermissionError)(refused.diagnostic.message) from None
     return notes
 
 
@@ -125,8 +130,13 @@ def convert(
     options: WriteOptions | None = None,
     force: bool = False,
     input_format: str | None = None,
+    report: str | Path | None = None,
 ) -> ConversionResult:
-    """Convert every robot of every input into ``output`` (a file, or a folder with ``to``)."""
+    """Convert every robot of every input into ``output`` (a file, or a folder with ``to``).
+
+    ``report``: also write the JSON report there, through the same guard as the outputs (never an
+    input, never a file this conversion writes, an existing file only with ``force``) and in the
+    same commit, last. Nothing is written when the report is refused."""
     from modelkit.api import validate
 
     result = ConversionResult()
@@ -142,10 +152,11 @@ def convert(
         result.status = 2
         return result
     folder = out if folder_mode else out.parent
-    plan = OutputPlan(folder, set(), force)
+    plan = OutputPlan(folder, {Path(item) for item in inputs}, force)
     for item in inputs:
         source = Path(item)
         checked = validate(source, read_options, input_format, str(source))
+        plan.opened |= {f.identity for f in checked.opened}
         blocking = [d for d in checked.errors if d.code not in CONVERTIBLE_ERRORS]
         result.diagnostics.extend(d for d in checked.diagnostics if d.severity is not Severity.INFO)
         if any(d.code in UNREADABLE for d in checked.diagnostics):
@@ -169,20 +180,53 @@ def convert(
         for robot, name in zip(robots, names, strict=True):
             result.notes.extend(render_model(robot, target.name, plan, name, options))
             result.outputs.append(str(folder / name))
+    report_path = Path(report) if report is not None else None
+    if report_path is not None:
+        refused = _report_problem(report_path, plan)
+        if refused is not None:  # checked before anything is written: nothing is
+            result.diagnostics.append(refused)
+            result.outputs = []
+            result.status = 2
+            return result
+    if not result.status:
+        problems = plan.problems()
+        if problems:
+            result.diagnostics.extend(problems)
+            result.status = 2
     if result.status:
         result.outputs = []
-        return result
-    problems = plan.problems()
-    if problems:
-        result.diagnostics.extend(problems)
+        plan.files = {}  # the report alone, if one was asked for
+    extra = [_report_entry(report_path, result, inputs)] if report_path is not None else []
+    try:
+        plan.commit(extra)
+    except CommitRefused as exc:
+        result.diagnostics.append(exc.diagnostic)
         result.outputs = []
         result.status = 2
-        return result
-    try:
-        plan.commit()
     except OSError as exc:
         result.diagnostics.append(diag("MK894", f"writing into {folder} failed: {exc}; nothing was written",
                                        SourceLocation(str(folder))))
         result.outputs = []
         result.status = 2
     return result
+
+
+def _report_problem(path: Path, plan: OutputPlan) -> Diagnostic | None:
+    """Why the report must not be written at ``path``: it is (or is a link to) a file this
+    conversion writes, an input, a symlink or special file, or it exists and ``force`` is off."""
+    where = SourceLocation(str(path))
+    mine = path.resolve()
+    ident = identity(path)
+    for relpath in plan.files:
+        target = plan.folder / relpath
+        if target.resolve() == mine or (ident is not None and identity(target) == ident):
+            return diag("MK897", f"--report {path} is {target}, a file this conversion writes; nothing is "
+                        "written", where, hint="name a report file outside the files written")
+    return target_problem(path, b"", "report", plan.force, plan.protected())
+
+
+def _report_entry(path: Path, result: ConversionResult, inputs: Sequence[str | Path]) -> Entry:
+    from modelkit.convert.report import report_json
+
+    data = report_json(result, [str(f) for f in inputs]).encode("utf-8")
+    return Entry(path.parent, path.name, data, "report")

@@ -1,20 +1,20 @@
 """The output folder: every file of a conversion staged first, then written atomically.
 
 Rules (the issue's "nothing is lost"): nothing is written outside the output folder, no input is
-ever overwritten, an existing file is replaced only with ``force`` (a mesh with the same bytes is
-simply kept), each file is written to a temporary name in its folder and renamed into place, and
+ever overwritten (judged by device and inode, so a hard link or another spelling of an input is
+refused too), an existing file is replaced only with ``force`` (a mesh with the same bytes is
+simply kept), and the files are written as one staged commit (:mod:`modelkit.convert.commit`):
 when any file fails nothing of the conversion is left behind.
 """
 
 from __future__ import annotations
 
 import hashlib
-import os
 import re
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from modelkit.convert.commit import Entry, commit, identity
 from modelkit.diagnostics import Diagnostic, SourceLocation, diag
 
 _SAFE = re.compile(r"[^A-Za-z0-9._-]+")
@@ -35,11 +35,13 @@ class StagedFile:
 
 @dataclass
 class OutputPlan:
-    """Files to write under ``folder``; ``inputs`` are the files the conversion read."""
+    """Files to write under ``folder``; ``inputs`` are the files the conversion read (paths) and
+    ``opened`` the identities (device, inode) of every file its readers opened."""
 
     folder: Path
     inputs: set[Path] = field(default_factory=set)
     force: bool = False
+    opened: set[tuple[int, int]] = field(default_factory=set)
     files: dict[str, StagedFile] = field(default_factory=dict)
     _by_digest: dict[tuple[str, str], str] = field(default_factory=dict)
 
@@ -62,46 +64,55 @@ class OutputPlan:
         self._by_digest.setdefault((folder, digest), candidate)
         return candidate
 
+    def protected(self) -> set[tuple[int, int]]:
+        """The identities (device, inode) no output may replace: every input file and every file the
+        readers opened (``protect``)."""
+        found = set(self.opened)
+        for path in self.inputs:
+            ident = identity(path)
+            if ident is not None:
+                found.add(ident)
+        return found
+
+    def entries(self) -> list[Entry]:
+        return [Entry(self.folder, s.relpath, s.data, s.what) for s in self.files.values()]
+
     def problems(self) -> list[Diagnostic]:
         """Why the plan must not be written (checked before anything touches the disk)."""
         found: list[Diagnostic] = []
         root = self.folder.resolve()
-        inputs = {p.resolve() for p in self.inputs}
+        protected = self.protected()
         for staged in self.files.values():
             target = (root / staged.relpath).resolve()
             where = SourceLocation(str(self.folder / staged.relpath))
             if root != target and root not in target.parents:
                 found.append(diag("MK892", f"{staged.relpath} would be written outside {self.folder}", where))
-            elif target in inputs:
-                found.append(diag("MK891", f"{target} is an input of this conversion; it is not overwritten",
-                                  where))
-            elif target.is_symlink() or (target.exists() and not target.is_file()):
-                found.append(diag("MK892", f"{target} exists and is not a regular file", where))
-            elif target.exists() and not self.force:
-                if staged.what != "model" and target.read_bytes() == staged.data:
-                    continue
-                found.append(diag("MK890", f"{target} exists; use --force to replace it", where))
+                continue
+            problem = target_problem(self.folder / staged.relpath, staged.data, staged.what, self.force,
+                                     protected)
+            if problem is not None:
+                found.append(problem)
         return found
 
-    def commit(self) -> None:
-        """Write every staged file: all to temporary names first, then all renamed into place.
+    def commit(self, extra: list[Entry] | None = None) -> None:
+        """Write every staged file (and ``extra``, a report elsewhere) as one staged commit
+        (:mod:`modelkit.convert.commit`); raises ``CommitRefused`` or ``OSError`` with nothing
+        left behind."""
+        commit(self.entries() + list(extra or ()), self.force, self.protected())
 
-        Raises OSError after removing every temporary file when any write fails.
-        """
-        temps: list[tuple[Path, Path]] = []
-        try:
-            for relpath in sorted(self.files):
-                staged = self.files[relpath]
-                target = self.folder / relpath
-                target.parent.mkdir(parents=True, exist_ok=True)
-                fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-                temps.append((Path(tmp_name), target))
-                with os.fdopen(fd, "wb") as out:
-                    out.write(staged.data)
-                os.chmod(tmp_name, 0o644)
-            for tmp, target in temps:
-                os.replace(tmp, target)
-        except OSError:
-            for tmp, _ in temps:
-                tmp.unlink(missing_ok=True)
-            raise
+
+def target_problem(path: Path, data: bytes, what: str, force: bool,
+                   protected: set[tuple[int, int]]) -> Diagnostic | None:
+    """Why ``path`` must not be written with ``data``: an input (by identity), a symlink or special
+    file, or an existing file without ``force`` (a mesh with the same bytes is simply kept)."""
+    where = SourceLocation(str(path))
+    ident = identity(path)
+    if ident is not None and ident in protected:
+        return diag("MK891", f"{path} is an input of this conversion; it is not overwritten", where)
+    if path.is_symlink() or (path.exists() and not path.is_file()):
+        return diag("MK892", f"{path} exists and is not a regular file", where)
+    if path.exists() and not force:
+        if what in ("mesh", "texture") and path.read_bytes() == data:
+            return None
+        return diag("MK890", f"{path} exists; use --force to replace it", where)
+    return None

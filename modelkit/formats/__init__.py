@@ -14,7 +14,7 @@ from pathlib import Path
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
 from modelkit.format_names import FORMAT_NAMES
 from modelkit.formats.common import ReadOptions, ReadResult
-from modelkit.textio import UnreadableFile, check_regular
+from modelkit.textio import OpenedFile, UnreadableFile, check_regular, recording
 
 
 @dataclass(frozen=True)
@@ -80,7 +80,26 @@ def detect_format(path: Path, explicit: str | None = None) -> str | None:
 def read_model(
     path: Path, options: ReadOptions | None = None, fmt: str | None = None, display: str | None = None
 ) -> ReadResult:
-    """Read any supported model file; an unknown format is a diagnostic, not an exception."""
+    """Read any supported model file; an unknown format is a diagnostic, not an exception.
+
+    ``ReadResult.opened`` lists every regular file the read opened (see :func:`modelkit.textio.recording`)."""
+    with recording() as opened:
+        result = _read_model(path, options, fmt, display)
+    result.opened = _unique(opened)
+    return result
+
+
+def _unique(opened: list[OpenedFile]) -> list[OpenedFile]:
+    seen: set[tuple[int, int]] = set()
+    out = []
+    for item in opened:
+        if item.identity not in seen:
+            seen.add(item.identity)
+            out.append(item)
+    return out
+
+
+def _read_model(path: Path, options: ReadOptions | None, fmt: str | None, display: str | None) -> ReadResult:
     shown = display or str(path)
     sink = DiagnosticSink()
     try:  # before any reader (or MuJoCo) opens it: only a regular file within the size limit

@@ -13,6 +13,7 @@ from modelkit.textio import (
     DEFAULT_MAX_BYTES,
     DEFAULT_MAX_LINKS,
     DEFAULT_MAX_LIST_ITEMS,
+    OpenedFile,
 )
 
 
@@ -49,6 +50,9 @@ class ReadResult:
     robot: Robot | None
     diagnostics: list[Diagnostic]
     more: list[Robot] = field(default_factory=list)
+    # Every regular file the read opened (filled by :func:`modelkit.formats.read_model`): the model,
+    # its includes, resources, materials and meshes; ``convert`` never writes over any of them.
+    opened: list[OpenedFile] = field(default_factory=list)
 
     @property
     def robots(self) -> list[Robot]:

@@ -39,6 +39,7 @@ from typing import IO, Any
 
 import numpy as np
 
+from modelkit.lifeline import preexec
 from modelkit.spatial import Pose
 from modelkit.verify.api import EngineError
 from modelkit.verify.facts import Array, JointFacts, LinkFacts, ShapeFacts, StaticFacts, TorqueLaw
@@ -102,7 +103,7 @@ class Worker:
         env = dict(os.environ, PYTHONUNBUFFERED="1")
         self.proc = subprocess.Popen(
             [sys.executable, str(WORKER)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-            stderr=self._stderr, env=env, close_fds=True,
+            stderr=self._stderr, env=env, close_fds=True, preexec_fn=preexec(),
         )
 
     def _stderr_tail(self, since: int = 0) -> str:

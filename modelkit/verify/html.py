@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from modelkit import safewrite
 from modelkit.verify.report import LAYER_NAMES, VerifyReport, _plain
 
 PICTURE_ENGINES = ("mujoco", "pybullet")
@@ -124,7 +125,9 @@ def write_artefacts(report: VerifyReport, out_dir: Path, robot: Any = None,
     from modelkit.verify.pictures import difference
 
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    safewrite.make_folder(out_dir, out_dir)
+    for name in ("report.html", "pictures", "plots"):  # refused before minutes of drawing, not after
+        safewrite.check(out_dir, out_dir / name, folder=name != "report.html")
     art = Artefacts()
     t0 = time.perf_counter()
     prepared = report.prepared if isinstance(report.prepared, Prepared) else Prepared()
@@ -146,10 +149,12 @@ def write_artefacts(report: VerifyReport, out_dir: Path, robot: Any = None,
                           *[j for rollers in drive.get("rollers", {}).values() for j in rollers]]
                 for profile, path, data in write_plots(report.trajectories, out_dir / "plots", tolerances,
                                                        wheels=[w for w in wheels if w],
-                                                       plotters=prepared.plotters):
+                                                       plotters=prepared.plotters, root=out_dir):
                     rel = path.relative_to(out_dir).as_posix()
                     art.plots.append((profile, rel, data))
                     report.artefacts[f"plot:{profile}"] = rel
+            except safewrite.UnsafeOutput:
+                raise
             except Exception as exc:
                 art.notes.append(f"plots could not be drawn: {type(exc).__name__}: {exc}")
         t1 = time.perf_counter()
@@ -166,12 +171,11 @@ def write_artefacts(report: VerifyReport, out_dir: Path, robot: Any = None,
             job.close()
     ps = art.pictures
     if ps is not None:
-        folder = out_dir / "pictures"
-        folder.mkdir(parents=True, exist_ok=True)
+        folder = safewrite.make_folder(out_dir, out_dir / "pictures")
         for p in ps.pictures:
             name = f"{p.kind}-q{p.config}-{p.engine}.png"
             data = png(p.image)
-            (folder / name).write_bytes(data)
+            safewrite.write_bytes(out_dir, folder / name, data)
             art.picture_files[(p.engine, p.kind, p.config)] = (f"pictures/{name}", data)
             report.artefacts[f"picture:{p.kind}:q{p.config}:{p.engine}"] = f"pictures/{name}"
             source = ps.get("source", p.kind, p.config)
@@ -179,12 +183,12 @@ def write_artefacts(report: VerifyReport, out_dir: Path, robot: Any = None,
                 img, size = difference(source.mask, p.mask)
                 dname = f"{p.kind}-q{p.config}-{p.engine}-difference.png"
                 ddata = png(img)
-                (folder / dname).write_bytes(ddata)
+                safewrite.write_bytes(out_dir, folder / dname, ddata)
                 art.differences[(p.engine, p.kind, p.config)] = (f"pictures/{dname}", ddata, size)
                 report.artefacts[f"picture:{p.kind}:q{p.config}:{p.engine}-difference"] = f"pictures/{dname}"
     path = out_dir / "report.html"
     report.artefacts["html"] = "report.html"
-    path.write_text(render_html(report, art), encoding="utf-8")
+    safewrite.write_text(out_dir, path, render_html(report, art))
     report.timings["report"] = time.perf_counter() - t0
     return path
 

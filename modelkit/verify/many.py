@@ -47,6 +47,9 @@ from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import IO, Any, cast
 
+from modelkit import safewrite
+from modelkit.lifeline import worker_started
+
 SUMMARY_SCHEMA_ID = "modelkit-verify-summary/1"
 RESERVED = {"summary.json", "summary.html"}
 
@@ -170,7 +173,7 @@ def save(report: Any, out_dir: Path, read_from: str | None = None) -> list[str]:
     remote worker reads an absolute path). Returns the report files written (sorted, relative)."""
     from modelkit.verify.report import report_json
 
-    out_dir.mkdir(parents=True, exist_ok=True)
+    safewrite.make_folder(out_dir, out_dir)
     write_artefacts: Callable[..., Any] | None = None
     try:
         from modelkit.verify.html import write_artefacts as html_writer
@@ -185,7 +188,7 @@ def save(report: Any, out_dir: Path, read_from: str | None = None) -> list[str]:
             write_artefacts(report, out_dir)
         finally:
             report.source = shown
-    (out_dir / "report.json").write_text(report_json(report), encoding="utf-8")
+    safewrite.write_text(out_dir, out_dir / "report.json", report_json(report))
     return sorted(p.relative_to(out_dir).as_posix() for p in out_dir.rglob("report*") if p.is_file())
 
 
@@ -206,6 +209,7 @@ def run_one(job: Job, out_root: Path | None) -> ModelResult:
             with tempfile.TemporaryDirectory(prefix="modelkit-verify-") as tmp:
                 result = _verify_into(job, Path(tmp) / job.folder)
         else:
+            safewrite.check(out_root, out_root / job.folder, folder=True)
             result = _verify_into(job, out_root / job.folder)
     except Exception as exc:
         last = traceback.extract_tb(exc.__traceback__)[-1:] if exc.__traceback__ else []
@@ -242,8 +246,7 @@ def unpack(files: Mapping[str, bytes], out_dir: Path) -> None:
         target = out_dir / name
         if ".." in Path(name).parts or Path(name).is_absolute():
             raise ValueError(f"refusing to write {name!r} outside {out_dir}")
-        target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_bytes(data)
+        safewrite.write_bytes(out_dir, target, data)
 
 
 def crashed(job: Job, how: str) -> ModelResult:
@@ -287,7 +290,8 @@ def warm_up(jobs: Sequence[Job]) -> None:
             continue
 
 
-def _child(job: Job, out_root: Path | None, conn: Connection) -> None:
+def _child(job: Job, out_root: Path | None, conn: Connection, parent: int) -> None:
+    worker_started(parent)  # killed with the parent; Ctrl-C is the parent's to handle
     result = run_one(job, out_root)
     conn.send(result)
     conn.close()
@@ -332,7 +336,8 @@ def run_local(jobs: Sequence[Job], out_root: Path | None, workers: int,
             while pending and len(running) < workers:
                 job = pending.pop(0)
                 receive, send = ctx.Pipe(duplex=False)
-                process = ctx.Process(target=_child, args=(job, out_root, send), name=f"verify {job.folder}")
+                process = ctx.Process(target=_child, args=(job, out_root, send, os.getpid()),
+                                      name=f"verify {job.folder}")
                 process.start()
                 send.close()  # the child holds the only write end: EOF when it dies
                 running[receive] = (process, job)
@@ -429,10 +434,9 @@ def summary_html(results: Iterable[ModelResult], parameters: Mapping[str, Any]) 
 
 def write_summary(results: Sequence[ModelResult], parameters: Mapping[str, Any], out_root: Path
                   ) -> list[Path]:
-    out_root.mkdir(parents=True, exist_ok=True)
     paths = [out_root / "summary.json", out_root / "summary.html"]
-    paths[0].write_text(summary_json(results, parameters), encoding="utf-8")
-    paths[1].write_text(summary_html(results, parameters), encoding="utf-8")
+    safewrite.write_text(out_root, paths[0], summary_json(results, parameters))
+    safewrite.write_text(out_root, paths[1], summary_html(results, parameters))
     return paths
 
 

@@ -16,6 +16,8 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from modelkit.lifeline import preexec
+
 
 def serve(work: Callable[[Any], Any]) -> int:
     """The child's side: the pickled request on stdin, ``work(request)``'s pickled reply on stdout.
@@ -39,7 +41,8 @@ class Child:
                  cwd: str | Path | None = None) -> None:
         self.proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE,
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     env=dict(env) if env is not None else None, cwd=cwd)
+                                     env=dict(env) if env is not None else None, cwd=cwd,
+                                     preexec_fn=preexec())
 
     def send(self, request: Any) -> None:
         """Send the one request (raises ``OSError``, ``ValueError`` or ``pickle.PicklingError``)."""

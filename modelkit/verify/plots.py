@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from modelkit import safewrite
 from modelkit.verify import oneshot
 
 Array = NDArray[np.float64]
@@ -304,12 +305,13 @@ def profiles(trajectories: Sequence[Any]) -> list[str]:
 
 
 def write_plots(trajectories: Sequence[Any], out_dir: Path, tolerances: dict[str, float] | None = None,
-                wheels: Iterable[str] = (), plotters: Plotters | None = None
+                wheels: Iterable[str] = (), plotters: Plotters | None = None, root: Path | None = None
                 ) -> list[tuple[str, Path, bytes]]:
     """One PNG per profile in ``out_dir`` (``<profile>.png``, a file-safe name): (profile, path,
     bytes). The figures are drawn by ``plotters`` (child processes, see :class:`Plotters`; started
     here when None and there are several profiles and cores), the same bytes as drawn here."""
-    out_dir.mkdir(parents=True, exist_ok=True)
+    root = out_dir if root is None else root  # nothing is written through a link below it
+    safewrite.make_folder(root, out_dir)
     names = profiles(trajectories)
     jobs = [(p, [t for t in trajectories if t.profile == p], tolerances, tuple(wheels)) for p in names]
     own = plotters is None and len(jobs) > 1 and _cores() > 1
@@ -323,7 +325,7 @@ def write_plots(trajectories: Sequence[Any], out_dir: Path, tolerances: dict[str
     written = []
     for profile, data in zip(names, figures, strict=True):
         path = out_dir / f"{safe_name(profile)}.png"
-        path.write_bytes(data)
+        safewrite.write_bytes(root, path, data)
         written.append((profile, path, data))
     return written
 
