@@ -13,6 +13,8 @@ The promise (issue 18 §1): nothing of an input is lost and nothing half-written
 * With ``force`` an existing file is kept aside (a hard link in the staging folder) until the
   whole commit succeeded. A file that is an input of the conversion (by device and inode: hard
   links and other spellings of the same file included) is never replaced.
+* Each change (a folder made, a file moved) is recorded as it is made, with SIGINT, SIGTERM and
+  SIGHUP held for that one step, so that an interruption always finds the record complete.
 * On any failure, and on any signal that reaches Python (Ctrl-C, SIGTERM, SIGHUP through
   :mod:`modelkit.interrupt`), everything already moved is undone, replaced files come back, the
   folders the commit created are removed and the staging folder goes. ``kill -9`` cannot be caught:
@@ -185,10 +187,13 @@ class _Commit:
     def prepare(self) -> None:
         roots = sorted({e.root for e in self.entries}, key=lambda p: str(p.resolve()))
         for root in roots:
-            self._mkdirs(root)
-            self._lock(root)
+            with signals_held():  # each change is recorded with it, so that the undo knows it
+                self._mkdirs(root)
+                self._lock(root)
             remove_stale_staging(root)
-            self.staging[root] = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{os.getpid()}-", dir=root))
+            with signals_held():
+                prefix = f"{STAGING_PREFIX}{os.getpid()}-"
+                self.staging[root] = Path(tempfile.mkdtemp(prefix=prefix, dir=root))
         for index, entry in enumerate(self.entries):
             path = self.staging[entry.root] / f"f{index}"
             _write_new(path, entry.data)
@@ -250,7 +255,8 @@ class _Commit:
         try:
             self.prepare()
             for index, entry in enumerate(self.entries):
-                self._place(index, entry)
+                with signals_held():  # a move and its record in ``done`` are one step for a signal
+                    self._place(index, entry)
             for folder in sorted({target.parent for target, _ in self.done}):
                 _fsync_dir(folder)
         except BaseException:
