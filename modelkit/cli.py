@@ -12,7 +12,7 @@ import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, NoReturn, TypeVar
 
 import click
 
@@ -481,23 +481,34 @@ def _interruptible(command: str, where: Path | None, snapshot: Any = None) -> It
     (130, 143, 129), no traceback. What the command wrote is undone on the way out (convert's staged
     commit does it itself; ``snapshot``, a :class:`modelkit.safewrite.Snapshot`, removes the files a
     verify run added)."""
-    from modelkit.interrupt import Interrupted, interruptible
+    from modelkit.interrupt import Interrupted, interruptible, pending, signals_held
 
-    try:
-        with interruptible():
-            yield
-    except Interrupted as exc:
-        from modelkit.convert.commit import signals_held
-
+    def stop(signum: int) -> NoReturn:
         with signals_held():  # a second Ctrl-C does not cut the clean-up short
             if snapshot is not None:
                 snapshot.remove_new()
+            exc = Interrupted(signum)
             message = f"{command} stopped by {exc.name}; "
             message += "what it had written is removed" if where is not None else "nothing was written"
             click.echo(render_text(diag("MK896", message, SourceLocation(str(where or command)))), err=True)
             sys.stdout.flush()
             sys.stderr.flush()
         sys.exit(exc.exit_code)
+
+    try:
+        with interruptible():
+            try:
+                yield
+            finally:
+                signum = pending()  # also when some library swallowed the exception and the run went on
+    except Interrupted as exc:
+        stop(exc.signum)
+    except SystemExit:
+        if signum is not None:
+            stop(signum)
+        raise
+    if signum is not None:
+        stop(signum)
 
 
 def _unsafe_output(exc: Exception) -> None:
@@ -576,6 +587,7 @@ def _verify(sources: tuple[Path, ...], output: Path | None, names: tuple[str, ..
             urdf: Path | None, sdf: Path | None, inject: tuple[str, ...], seed: int, no_replay: bool,
             scenario: Path | None, no_driven: bool, jobs: int | None, cluster: str | None,
             reading: dict[str, Any]) -> None:
+    from modelkit.interrupt import check
     from modelkit.safewrite import UnsafeOutput
 
     if len(sources) == 1 and not sources[0].is_dir() and cluster is None:
@@ -586,12 +598,14 @@ def _verify(sources: tuple[Path, ...], output: Path | None, names: tuple[str, ..
         shown = progress_wanted(sys.stderr)
 
         def progress(line: str) -> None:
+            check()  # between layers: a Ctrl-C a library swallowed stops the run here
             if shown:
                 click.echo(f"verify: {line} ...", err=True)
 
         report = run_verify(sources[0], output, names, mjcf, urdf, sdf, inject, seed, replay=not no_replay,
                             scenario=scenario, driven=not no_driven, progress=progress,
                             artefacts=output is not None, reading=reading)
+        check()
         click.echo(render_table(report), nl=False)
         if output is not None and not report.errors:
             progress("writing the report (plots, pictures, report.html)")

@@ -30,8 +30,45 @@ class Interrupted(BaseException):
         return 128 + self.signum
 
 
+_received: list[int] = []
+
+
 def _raise(signum: int, _frame: FrameType | None) -> None:
+    _received.append(signum)
     raise Interrupted(signum)
+
+
+def pending() -> int | None:
+    """The first signal received within :func:`interruptible`, if any. The exception a signal
+    raises can be swallowed by code it lands in (a C++ extension's module initialisation logs and
+    ignores it, a library's bare ``except``); the signal is remembered all the same."""
+    return _received[0] if _received else None
+
+
+def check() -> None:
+    """Raise :class:`Interrupted` again if a signal was received (see :func:`pending`): called
+    before each step that must not start once the user asked to stop (a commit, a report)."""
+    signum = pending()
+    if signum is not None:
+        raise Interrupted(signum)
+
+
+@contextmanager
+def signals_held() -> Iterator[None]:
+    """Hold SIGINT, SIGTERM and SIGHUP back while the block runs; they are delivered when it ends.
+    For a step that must not be cut in two (a file moved and its record), and for imports of
+    libraries that would swallow the exception (a C++ module's initialisation) or start child
+    processes of their own (which inherit the held mask and so never see a Ctrl-C meant for the
+    parent). Only the main thread can hold them; elsewhere this does nothing."""
+    try:
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    except (AttributeError, ValueError, OSError):
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 @contextmanager
@@ -41,9 +78,11 @@ def interruptible() -> Iterator[None]:
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    _received.clear()
     previous = {s: signal.signal(s, _raise) for s in SIGNALS}
     try:
         yield
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
+        _received.clear()  # outside the block nothing is pending

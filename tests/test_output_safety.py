@@ -337,3 +337,20 @@ def test_kill_9_of_verify_many_takes_its_children_along(tmp_path: Path) -> None:
         [c for c in children if _alive(c)]
     time.sleep(1.0)  # nothing writes a report afterwards
     assert not list(out.rglob("report.json")) and not list(out.rglob("summary.json"))
+
+
+def test_a_swallowed_interruption_is_remembered() -> None:
+    """A library that catches the exception (Drake's module initialisation logs and ignores it) does
+    not make the run forget the signal: ``check`` raises it again before the next step."""
+    from modelkit.interrupt import Interrupted, check, interruptible, pending
+
+    with interruptible():
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(1)
+        except BaseException:  # the swallowing library
+            pass
+        assert pending() == signal.SIGTERM
+        with pytest.raises(Interrupted) as caught:
+            check()
+    assert caught.value.exit_code == 143

@@ -27,19 +27,17 @@ import errno
 import fcntl
 import os
 import shutil
-import signal
 import stat
 import tempfile
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from modelkit.diagnostics import Diagnostic, SourceLocation, diag
+from modelkit.interrupt import check, signals_held
 
 STAGING_PREFIX = ".modelkit-staging-"
 ORDER = {"mesh": 0, "texture": 0, "model": 1, "report": 2}
-_SIGNALS = tuple(s for s in (signal.SIGINT, signal.SIGTERM, getattr(signal, "SIGHUP", None)) if s is not None)
 _NO_LINK = frozenset({errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV, errno.EMLINK})
 
 
@@ -104,21 +102,6 @@ def remove_stale_staging(folder: Path) -> list[Path]:
             shutil.rmtree(path, ignore_errors=True)
             removed.append(path)
     return removed
-
-
-@contextmanager
-def signals_held() -> Iterator[None]:
-    """Hold SIGINT, SIGTERM and SIGHUP back while the block runs (an undo must not be cut short);
-    they are delivered when it ends. Only the main thread can hold them; elsewhere this does nothing."""
-    try:
-        old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
-    except (AttributeError, ValueError, OSError):
-        yield
-        return
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def _fsync_dir(folder: Path) -> None:
@@ -253,6 +236,7 @@ class _Commit:
 
     def run(self) -> None:
         try:
+            check()  # a signal some library swallowed while the files were made: nothing is written
             self.prepare()
             for index, entry in enumerate(self.entries):
                 with signals_held():  # a move and its record in ``done`` are one step for a signal

@@ -94,8 +94,11 @@ class VerifyError(Exception):
 
 
 def _resolve(target: str) -> Any:
+    from modelkit.interrupt import signals_held
+
     module, _, name = target.partition(":")
-    return getattr(importlib.import_module(module), name)
+    with signals_held():  # Drake's initialisation would swallow a Ctrl-C; glfw's probe child would print it
+        return getattr(importlib.import_module(module), name)
 
 
 def read_options(reading: Mapping[str, Any] | None) -> tuple[Any, str | None]:

@@ -283,9 +283,12 @@ def warm_up(jobs: Sequence[Job]) -> None:
     for job in jobs:
         engines = job.options.get("engines", api.DEFAULT_ENGINES)
         modules |= {api.ENGINES[e].partition(":")[0] for e in engines if e in api.ENGINES}
+    from modelkit.interrupt import signals_held
+
     for name in sorted(modules):
         try:
-            importlib.import_module(name)
+            with signals_held():  # see verify.api._resolve
+                importlib.import_module(name)
         except Exception:  # not installed, or broken: the job says so in its own report
             continue
 
