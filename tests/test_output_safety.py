@@ -261,6 +261,17 @@ def test_verify_does_not_write_through_a_symlink(tmp_path: Path, name: str) -> N
     assert sorted(os.listdir(elsewhere)) == ["keep.txt"] and (elsewhere / "keep.txt").read_text() == "mine\n"
 
 
+def test_verify_does_not_write_a_model_through_a_symlink(tmp_path: Path) -> None:
+    elsewhere = tmp_path / "keep.xml"
+    elsewhere.write_text("mine\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / f"{SMALL.stem}.xml").symlink_to(elsewhere)
+    code, text = run("verify", str(SMALL), "-o", str(out), *QUICK)
+    assert code == 2 and "cannot write" in text, text
+    assert elsewhere.read_text() == "mine\n"
+
+
 def test_safewrite_refuses_links_and_escapes_and_writes_atomically(tmp_path: Path) -> None:
     root = tmp_path / "out"
     (tmp_path / "elsewhere").mkdir()

@@ -137,6 +137,7 @@ class MeshExporter:
         if as_is and (ext != "dae" or self.options.keep_collada):
             try:
                 data = path.read_bytes()
+                self.plan.protect(path)
             except OSError as exc:
                 self.notes.note("MK805", f"mesh {uri} cannot be read ({exc.strerror}); the shape is left out",
                                 source, target)

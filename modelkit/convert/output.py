@@ -64,6 +64,12 @@ class OutputPlan:
         self._by_digest.setdefault((folder, digest), candidate)
         return candidate
 
+    def protect(self, path: Path) -> None:
+        """Count ``path`` among the inputs: a writer read it (a texture, a mesh it copies)."""
+        ident = identity(path)
+        if ident is not None:
+            self.opened.add(ident)
+
     def protected(self) -> set[tuple[int, int]]:
         """The identities (device, inode) no output may replace: every input file and every file the
         readers opened (``protect``)."""

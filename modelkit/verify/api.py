@@ -194,7 +194,10 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
         if fmt not in needed:
             continue
         path = out_dir / f"{stem}{SUFFIX[fmt]}"
-        notes = write(welded, path, fmt, force=True)
+        try:
+            notes = write(welded, path, fmt, force=True)
+        except (FileExistsError, PermissionError) as exc:  # a symlink or an input where the file goes
+            raise VerifyError(f"cannot write {path}: {exc}") from exc
         if written is not None:
             written[fmt] = list(notes)
         files[fmt] = path

@@ -231,5 +231,6 @@ def _texture(texture: str, ctx: WriteContext, geom: Geom, target: str) -> str | 
     if data is None:
         ctx.note("MK818", f"texture {texture} cannot be read; it is left out", geom.source, target)
         return None
+    ctx.meshes.plan.protect(path)
     relpath = ctx.meshes.plan.add(f"meshes/{safe_file_name(path.name, 'texture')}", data, "texture")
     return ctx.meshes.prefix + relpath

@@ -129,6 +129,7 @@ def _texture(
         path = resolution.path if resolution.path is not None else path
     try:
         data = path.read_bytes()
+        ctx.meshes.plan.protect(path)
     except OSError:
         ctx.note("MK818", f'texture "{uri}" cannot be read; the visual keeps its colour only', source, target)
         return None
