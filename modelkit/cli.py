@@ -483,13 +483,15 @@ def _interruptible(command: str, where: Path | None, snapshot: Any = None) -> It
     verify run added)."""
     from modelkit.interrupt import Interrupted, interruptible, pending, signals_held
 
-    def stop(signum: int) -> NoReturn:
+    def stop(signum: int, finished: bool = False) -> NoReturn:
         with signals_held():  # a second Ctrl-C does not cut the clean-up short
             if snapshot is not None:
                 snapshot.remove_new()
+                finished = False
             exc = Interrupted(signum)
             message = f"{command} stopped by {exc.name}; "
-            message += "what it had written is removed" if where is not None else "nothing was written"
+            message += ("it had already finished: its files are written" if finished
+                        else "what it had written is removed")
             click.echo(render_text(diag("MK896", message, SourceLocation(str(where or command)))), err=True)
             sys.stdout.flush()
             sys.stderr.flush()
@@ -507,8 +509,8 @@ def _interruptible(command: str, where: Path | None, snapshot: Any = None) -> It
         if signum is not None:
             stop(signum)
         raise
-    if signum is not None:
-        stop(signum)
+    if signum is not None:  # the signal came as the work ended (or an exception was swallowed)
+        stop(signum, finished=True)
 
 
 def _unsafe_output(exc: Exception) -> None:

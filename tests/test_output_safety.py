@@ -242,6 +242,22 @@ def test_two_converts_into_one_folder_one_wins(tmp_path: Path) -> None:
     assert [n for n in os.listdir(out.parent) if n.startswith(STAGING_PREFIX)] == []
 
 
+def test_a_failed_forced_commit_brings_the_replaced_files_back(tmp_path: Path) -> None:
+    from modelkit.convert.commit import CommitRefused, Entry, commit
+
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "a.stl").write_bytes(b"old mesh")
+    (tmp_path / "robot.xml").mkdir()  # the model cannot go where a folder is
+    entries = [Entry(tmp_path, "meshes/a.stl", b"new mesh", "mesh"),
+               Entry(tmp_path, "meshes/b.stl", b"b", "mesh"),
+               Entry(tmp_path, "robot.xml", b"<mujoco/>", "model")]
+    with pytest.raises(CommitRefused) as caught:  # MK892: not a regular file
+        commit(entries, force=True)
+    assert caught.value.diagnostic.code == "MK892"
+    assert (tmp_path / "meshes" / "a.stl").read_bytes() == b"old mesh"
+    assert files_under(tmp_path) == ["meshes", "meshes/a.stl", "robot.xml"]
+
+
 # ---------------------------------------------------------------- verify
 
 SMALL = TUTORIAL / "mobile_robot_primitive.body"

@@ -172,7 +172,7 @@ class _Commit:
         for root in roots:
             with signals_held():  # each change is recorded with it, so that the undo knows it
                 self._mkdirs(root)
-                self._lock(root)
+            self._lock(root)  # may wait for another conversion into the folder: Ctrl-C still works
             remove_stale_staging(root)
             with signals_held():
                 prefix = f"{STAGING_PREFIX}{os.getpid()}-"
