@@ -484,7 +484,7 @@ def _interruptible(command: str, where: Path | None, snapshot: Any = None) -> It
     from modelkit.interrupt import Interrupted, interruptible, pending, signals_held
 
     def stop(signum: int, finished: bool = False) -> NoReturn:
-        with signals_held():  # a second Ctrl-C does not cut the clean-up short
+        with signals_held(deliver=False):  # a second Ctrl-C does not cut the clean-up short
             if snapshot is not None:
                 snapshot.remove_new()
                 finished = False

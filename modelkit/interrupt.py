@@ -31,10 +31,15 @@ class Interrupted(BaseException):
 
 
 _received: list[int] = []
+_held = [0]  # depth of signals_held blocks
+_deferred: list[int] = []  # signals whose handler ran inside one
 
 
 def _raise(signum: int, _frame: FrameType | None) -> None:
     _received.append(signum)
+    if _held[0]:  # the signal came just before the block: Python runs the handler inside it
+        _deferred.append(signum)
+        return
     raise Interrupted(signum)
 
 
@@ -54,21 +59,36 @@ def check() -> None:
 
 
 @contextmanager
-def signals_held() -> Iterator[None]:
+def signals_held(deliver: bool = True) -> Iterator[None]:
     """Hold SIGINT, SIGTERM and SIGHUP back while the block runs; they are delivered when it ends.
     For a step that must not be cut in two (a file moved and its record), and for imports of
     libraries that would swallow the exception (a C++ module's initialisation) or start child
     processes of their own (which inherit the held mask and so never see a Ctrl-C meant for the
-    parent). Only the main thread can hold them; elsewhere this does nothing."""
+    parent).
+
+    Two levels: the signals are blocked in the kernel (children started inside inherit that), and
+    a signal that arrived just before the block, whose Python handler only runs inside it, is
+    deferred by the handler itself; either is raised as :class:`Interrupted` when the outermost
+    block ends (``deliver`` False: dropped, for the clean-up after an interruption). Only the main
+    thread can block them in the kernel; elsewhere only the deferral applies."""
     try:
-        old = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+        old: set[int | signal.Signals] | None = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
     except (AttributeError, ValueError, OSError):
-        yield
-        return
+        old = None
+    _held[0] += 1
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        try:
+            if old is not None:
+                signal.pthread_sigmask(signal.SIG_SETMASK, old)  # a blocked signal's handler runs now
+        finally:
+            _held[0] -= 1
+        if not _held[0] and _deferred:
+            signum = _deferred[0]
+            _deferred.clear()
+            if deliver:
+                raise Interrupted(signum)
 
 
 @contextmanager
@@ -86,3 +106,4 @@ def interruptible() -> Iterator[None]:
         for s, handler in previous.items():
             signal.signal(s, handler)
         _received.clear()  # outside the block nothing is pending
+        _deferred.clear()
