@@ -1146,6 +1146,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "PyBullet, collides with a point there).",
     ),
     CodeInfo(
+        "MK872",
+        "mjcf-too-deep",
+        "warning",
+        "The bodies nest deeper than MuJoCo's XML parser reads (496 nested bodies; a serial chain of more "
+        "links): the file is written, but MuJoCo refuses it.",
+    ),
+    CodeInfo(
         "MK880",
         "body-shape-size-not-positive",
         "warning",

@@ -79,15 +79,13 @@ def dof_joints(robot: Robot) -> list[str]:
     """The 1-DOF joints of the tree, depth-first from the root in document order (Pinocchio's order)."""
     children = robot.children_of()
     out: list[str] = []
-
-    def walk(link: str) -> None:
-        for joint in children.get(link, []):
-            if joint.type in DOF_TYPES:
-                out.append(joint.name)
-            walk(joint.child)
-
-    if robot.root:
-        walk(robot.root)
+    # A stack, not recursion: a chain of thousands of links is as deep as a tree gets.
+    stack = list(reversed(children.get(robot.root, []))) if robot.root else []
+    while stack:
+        joint = stack.pop()
+        if joint.type in DOF_TYPES:
+            out.append(joint.name)
+        stack.extend(reversed(children.get(joint.child, [])))
     return out
 
 
