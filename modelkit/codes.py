@@ -535,7 +535,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning on a link welded to the world. In URDF, `.body` and MJCF (whose loaders do not judge a "
         "welded link's inertia), links joined by fixed joints are judged as the one rigid body engines "
         "merge them into: a point mass or a rod welded to a sound body is not reported, a welded link's "
-        "negative moment is a warning.",
+        "negative moment is a warning. A mass or inertia that is not a finite number, or above 1e100 (its "
+        "sums and products overflow: a 1e308 inertia), is an error on any link.",
     ),
     CodeInfo(
         "MK303",
