@@ -392,7 +392,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK215",
         "extra-joint-invalid",
         "error",
-        "An `extra_joints` entry is incomplete or names a missing link.",
+        "An `extra_joints` entry is incomplete, names a missing link, or joins a link to itself (written to "
+        "SDF, libsdformat and Drake refuse such a joint).",
     ),
     CodeInfo(
         "MK216",
@@ -1123,6 +1124,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "root-pose-dropped",
         "warning",
         "The robot's placement in the world cannot be written in the target (URDF has no root pose).",
+    ),
+    CodeInfo(
+        "MK824",
+        "joint-range-inverted-dropped",
+        "warning",
+        "A joint whose lower limit is above its upper (MK307: no position is within them) is written "
+        "without limits where the target needs lower < upper (MJCF's `range`).",
     ),
     CodeInfo(
         "MK860",

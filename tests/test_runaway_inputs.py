@@ -83,3 +83,52 @@ def test_the_steps_of_all_profiles_together_are_bounded(tmp_path: Path) -> None:
     path.write_text("simulation:\n  dt: 0.00001\n")  # the built-in profiles at 100 kHz: 4.2e6 steps
     scenario, found = load(path)
     assert scenario is not None and not found
+
+
+SELF_JOINT = """format: ChoreonoidBody
+format_version: 2.0
+name: r
+links:
+  - name: base
+    joint_type: free
+    mass: 1
+    inertia: [0.1, 0, 0, 0, 0.1, 0, 0, 0, 0.1]
+  - name: arm
+    parent: base
+    joint_type: revolute
+    joint_axis: [0, 0, 1]
+    joint_id: 0
+    mass: 1
+    inertia: [0.1, 0, 0, 0, 0.1, 0, 0, 0, 0.1]
+extra_joints:
+  - link1_name: arm
+    link2_name: {other}
+    joint_type: ball
+"""
+
+
+def test_a_body_extra_joint_from_a_link_to_itself_is_a_located_error(tmp_path: Path) -> None:
+    model = tmp_path / "self.body"
+    model.write_text(SELF_JOINT.format(other="arm"))
+    found = [d for d in validate(model).diagnostics if d.code == "MK215"]
+    assert len(found) == 1 and found[0].severity.value == "error", found
+    assert 'joins link "arm" to itself' in found[0].message
+    assert found[0].location is not None and (found[0].location.line, found[0].location.col) == (18, 17)
+    model.write_text(SELF_JOINT.format(other="base"))
+    assert not [d for d in validate(model).diagnostics if d.code == "MK215"]
+
+
+def test_an_inverted_range_has_its_own_note_in_the_mjcf(tmp_path: Path) -> None:
+    from modelkit.convert.api import write
+
+    model = tmp_path / "inv.urdf"
+    model.write_text(HUGE.format(v="0.1").replace(
+        'type="continuous"', 'type="revolute"').replace(
+        "</joint>", '<limit lower="1" upper="-1" effort="1" velocity="1"/></joint>'))
+    robot = validate(model).robot
+    assert robot is not None
+    notes = write(robot, tmp_path / "inv.xml", "mjcf")
+    inverted = [n for n in notes if n.code == "MK824"]
+    assert len(inverted) == 1 and "lower limit 1 is above upper limit -1" in inverted[0].message
+    assert not [n for n in notes if "one side" in n.message]
+    assert ' range=' not in (tmp_path / "inv.xml").read_text()

@@ -343,6 +343,14 @@ class BodyTree:
                 joint.loc("limits"),
                 target,
             )
+        elif math.isfinite(limits.lower) and math.isfinite(limits.upper) and limits.lower > limits.upper:
+            self.ctx.note(
+                "MK824",
+                f"joint {joint.name}: lower limit {fmt(limits.lower)} is above upper limit "
+                f"{fmt(limits.upper)} (no position is within them, MK307); written unlimited",
+                joint.loc("limits"),
+                target,
+            )
         elif limits.position_limited:
             self.ctx.note(
                 "MK820",
