@@ -132,3 +132,30 @@ def test_an_inverted_range_has_its_own_note_in_the_mjcf(tmp_path: Path) -> None:
     assert len(inverted) == 1 and "lower limit 1 is above upper limit -1" in inverted[0].message
     assert not [n for n in notes if "one side" in n.message]
     assert ' range=' not in (tmp_path / "inv.xml").read_text()
+
+
+SAMPLES = Path(__file__).resolve().parents[1] / "samples" / "choreonoid_ros2_mobile_robot_tutorial" / "model"
+
+
+def test_a_300_character_robot_name_gives_layer_4_files_it_can_write(tmp_path: Path) -> None:
+    from modelkit.verify.scenario import default_scenario
+    from modelkit.verify.variant import write_variant
+    from modelkit.verify.vehicle import find_drive
+
+    model = tmp_path / "long.body"
+    text = (SAMPLES / "mobile_robot.body").read_text()
+    model.write_text(text.replace("name: MobileRobot", "name: " + "R" * 300, 1))
+    robot = validate(model).robot
+    assert robot is not None and robot.name == "R" * 300
+    scenario = default_scenario()
+    files, _ = write_variant(robot, find_drive(robot, scenario), scenario, tmp_path / "out", "sphere")
+    assert all(path.is_file() and len(path.name) <= 120 for path in files.values()), files
+
+
+def test_an_output_name_of_245_characters_is_written(tmp_path: Path) -> None:
+    model = tmp_path / "huge.urdf"
+    model.write_text(HUGE.format(v="0.1"))
+    out = tmp_path / ("r" * 240 + ".urdf")
+    result = CliRunner().invoke(main, ["convert", str(model), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert out.is_file() and [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []

@@ -94,7 +94,8 @@ class OutputPlan:
                 staged = self.files[relpath]
                 target = self.folder / relpath
                 target.parent.mkdir(parents=True, exist_ok=True)
-                fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+                fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name[:100]}.", suffix=".tmp",
+                                                  dir=target.parent)  # a 245-byte name stays writable
                 temps.append((Path(tmp_name), target))
                 with os.fdopen(fd, "wb") as out:
                     out.write(staged.data)
