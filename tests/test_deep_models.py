@@ -88,3 +88,17 @@ def test_the_indentation_is_lxmls_up_to_its_cap() -> None:
     indent(deep, max_level=100)
     longest = max(len(line) - len(line.lstrip(b" ")) for line in etree.tostring(deep).split(b"\n"))
     assert longest == 200
+
+
+def test_mujoco_reads_exactly_the_depth_the_writer_allows(tmp_path: Path) -> None:
+    mujoco = pytest.importorskip("mujoco")
+    for links, loads in ((MUJOCO_MAX_BODY_DEPTH, True), (MUJOCO_MAX_BODY_DEPTH + 1, False)):
+        robot = validate(chain_support.write(tmp_path, "urdf", links)).robot
+        assert robot is not None
+        out = tmp_path / f"c{links}.xml"
+        write(robot, out, "mjcf")
+        if loads:
+            assert mujoco.MjModel.from_xml_path(str(out)).nbody == links + 1
+        else:
+            with pytest.raises(ValueError, match="XML_ELEMENT_DEPTH_EXCEEDED"):
+                mujoco.MjModel.from_xml_path(str(out))

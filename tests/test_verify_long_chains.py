@@ -96,3 +96,14 @@ def test_pybullets_joint_limit_is_its_own(tmp_path: Path) -> None:
             unchecked.link_poses({})
     finally:
         unchecked.close()
+
+
+def test_mujocos_refusal_of_a_deep_mjcf_is_explained(tmp_path: Path) -> None:
+    pytest.importorskip("mujoco")
+    from modelkit.formats.mjcf.writer import MUJOCO_MAX_BODY_DEPTH
+
+    source = chain_support.write(tmp_path, "urdf", MUJOCO_MAX_BODY_DEPTH + 1)
+    report = verify(source, tmp_path / "out", engines=("mujoco",), driven=False, replay=False)
+    [load_check] = [c for c in report.checks if c.quantity == "load"]
+    assert not load_check.passed and report.exit_code == 1
+    assert "XML_ELEMENT_DEPTH_EXCEEDED" in load_check.detail and "MK872" in load_check.detail

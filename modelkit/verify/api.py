@@ -230,8 +230,12 @@ def _load_engines(names: Sequence[str], reference: Robot, files: dict[str, Path]
                 report.skips.append(loop_skip)
                 continue
             what = "the source model" if kind == "robot" else f"the written {kind.upper()} {files[kind].name}"
+            why = str(exc)
+            if kind == "mjcf" and "XML_ELEMENT_DEPTH_EXCEEDED" in why:
+                why = (" ".join(why.split()) + " (its bodies nest deeper than MuJoCo's XML parser reads, 496 "
+                       "bodies: the conversion said so, MK872)")
             report.checks.append(Check(1, name, "load", "", float("inf"), 0.0,
-                                       f"{name} could not load {what}: {type(exc).__name__}: {exc}"))
+                                       f"{name} could not load {what}: {type(exc).__name__}: {why}"))
             continue
         report.engines[name] = dict(model.settings)
         loaded.append(Loaded(name, model, renames))
