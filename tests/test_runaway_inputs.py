@@ -159,3 +159,15 @@ def test_an_output_name_of_245_characters_is_written(tmp_path: Path) -> None:
     result = CliRunner().invoke(main, ["convert", str(model), "-o", str(out)])
     assert result.exit_code == 0, result.output
     assert out.is_file() and [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
+
+
+@pytest.mark.parametrize("target", ["mjcf", "sdf", "urdf", "body"])
+def test_the_library_writer_refuses_a_huge_inertia_with_a_clear_error(tmp_path: Path, target: str) -> None:
+    from modelkit.convert.api import write
+
+    model = tmp_path / "huge.urdf"
+    model.write_text(HUGE.format(v="1e308"))
+    robot = validate(model).robot
+    assert robot is not None
+    with pytest.raises(ValueError, match='link "a": mass or inertia 1e\\+308 cannot be written \\(MK302'):
+        write(robot, tmp_path / f"out.{target}", target)
