@@ -392,7 +392,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK215",
         "extra-joint-invalid",
         "error",
-        "An `extra_joints` entry is incomplete or names a missing link.",
+        "An `extra_joints` entry is incomplete, names a missing link, or joins a link to itself (written to "
+        "SDF, libsdformat and Drake refuse such a joint).",
     ),
     CodeInfo(
         "MK216",
@@ -535,7 +536,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning on a link welded to the world. In URDF, `.body` and MJCF (whose loaders do not judge a "
         "welded link's inertia), links joined by fixed joints are judged as the one rigid body engines "
         "merge them into: a point mass or a rod welded to a sound body is not reported, a welded link's "
-        "negative moment is a warning.",
+        "negative moment is a warning. A mass or inertia that is not a finite number, or above 1e100 (its "
+        "sums and products overflow: a 1e308 inertia), is an error on any link.",
     ),
     CodeInfo(
         "MK303",
@@ -1124,6 +1126,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "The robot's placement in the world cannot be written in the target (URDF has no root pose).",
     ),
     CodeInfo(
+        "MK824",
+        "joint-range-inverted-dropped",
+        "warning",
+        "A joint whose lower limit is above its upper (MK307: no position is within them) is written "
+        "without limits where the target needs lower < upper (MJCF's `range`).",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",
@@ -1144,6 +1153,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A shape with a zero or negative size, which MuJoCo refuses (\"size must be positive in geom\"), "
         "is left out; the note says whether it was a collision shape (a consumer that loads it, such as "
         "PyBullet, collides with a point there).",
+    ),
+    CodeInfo(
+        "MK872",
+        "mjcf-too-deep",
+        "warning",
+        "The bodies nest deeper than MuJoCo's XML parser reads (496 nested bodies; a serial chain of more "
+        "links): the file is written, but MuJoCo refuses it.",
     ),
     CodeInfo(
         "MK880",

@@ -140,6 +140,10 @@ def _no_mass_information(robot: Robot, link: Link) -> Diagnostic:
 # MK301: an inertia matrix is asymmetric when an off-diagonal pair differs by more than this fraction of
 # the largest diagonal moment (smaller differences are rounding in the source and are ignored).
 ASYMMETRY_TOLERANCE = 1e-4
+# Larger masses or inertia components are refused: the parallel-axis sums, the principal moments and
+# an engine's mass matrix square and add them, which overflows double precision near 1e154 (a 1e308
+# inertia made the eigenvalue solver fail, and its moments came out as zero). No real body is near.
+MAX_MASS_PROPERTY = 1e100
 # Who loads an inertia that breaks the triangle inequality (MK303), and who refuses it.
 IMPOSSIBLE_INERTIA_CONSUMERS = (
     "Choreonoid, check_urdf and PyBullet load it, MuJoCo and libsdformat (Gazebo) refuse it"
@@ -196,6 +200,15 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
         if not (rot3.all_finite(tensor) and math.isfinite(inertial.mass)):  # e.g. 1e400 in the file
             yield diag("MK302", f'link "{link.name}": the mass or inertia is not a finite number', where)
             continue
+        largest = max(inertial.mass, *(abs(x) for row in tensor for x in row))
+        if largest > MAX_MASS_PROPERTY:  # e.g. 1e308: finite, but no arithmetic on it stays finite
+            yield diag(
+                "MK302",
+                f'link "{link.name}": the mass or inertia is too large to compute with ({largest:.6g} > '
+                f"{MAX_MASS_PROPERTY:g}: sums and products of it overflow)",
+                where,
+            )
+            continue
         # A link welded to the world is never simulated dynamically: its inertia is still wrong, but
         # harmless, so the finding is a warning there.
         severity = None if link.name in moving else Severity.WARNING
@@ -221,8 +234,10 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
         if len(members) < 2:
             continue
         total, _, tensor = body_mass_properties(links, members)
-        if total <= 0.0 or not rot3.all_finite(tensor):
-            continue  # a massless body is MK313's; a non-finite member was reported above
+        if total <= 0.0 or total > MAX_MASS_PROPERTY or not rot3.all_finite(tensor) or max(
+            abs(x) for row in tensor for x in row
+        ) > MAX_MASS_PROPERTY:
+            continue  # a massless body is MK313's; a non-finite or huge member was reported above
         names = ", ".join(f'"{name}"' for name, _ in members)
         what = f'the rigid body of link "{head}" (links {names} joined by fixed joints, merged as engines do)'
         severity = None if head in moving else Severity.WARNING

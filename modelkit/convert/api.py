@@ -63,12 +63,32 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     from modelkit.convert.merge import merge_fixed_joints
     from modelkit.convert.tracks import approximate_tracks
 
+    _check_mass_properties(robot)
     out = copy.deepcopy(robot)
     if not target.tracks_native:
         approximate_tracks(out, notes)
     if options.merge_fixed:
         merge_fixed_joints(out, notes)
     return out
+
+
+def _check_mass_properties(robot: Robot) -> None:
+    """Raise ``ValueError`` for a mass or inertia no writer can compute with (validate's MK302 error:
+    not finite, or above 1e100), instead of a numerical failure deep in a writer (a library caller may
+    write a model it never validated; ``convert`` refuses such an input before)."""
+    import math
+
+    from modelkit.checks.physics import MAX_MASS_PROPERTY
+
+    for link in robot.links:
+        inertial = link.inertial
+        if inertial is None:
+            continue
+        values = [float(inertial.mass), *(float(x) for row in inertial.inertia for x in row)]
+        if not all(math.isfinite(x) and abs(x) <= MAX_MASS_PROPERTY for x in values):
+            worst = max(values, key=lambda x: abs(x) if math.isfinite(x) else math.inf)
+            raise ValueError(f'link "{link.name}": mass or inertia {worst:g} cannot be written (MK302: not '
+                             f"finite or above {MAX_MASS_PROPERTY:g}; validate reports it)")
 
 
 def render_model(robot: Robot, target: str, plan: OutputPlan, relpath: str,

@@ -356,11 +356,38 @@ class PyBulletModel:
         self.close()
 
 
+# PyBullet 3.2.7 answers getJointState for a fixed-base multibody of at most 127 moving joints (its
+# shared-memory status holds MAX_DEGREE_OF_FREEDOM values; measured on serial chains: 127 answer, 128
+# fail with "getJointState failed" for every joint).
+MAX_MOVING_JOINTS = 127
+
+
+class TooManyJoints(PyBulletError):
+    """The URDF has more moving joints than PyBullet reports states for."""
+
+    engine_limit = True  # verify reports a skip, not a failed load
+
+
+def _check_size(model: Path) -> None:
+    from lxml import etree
+
+    try:
+        root = etree.parse(str(model)).getroot()
+    except (OSError, etree.XMLSyntaxError):
+        return  # PyBullet's own load says what is wrong with the file
+    moving = sum(1 for joint in root.iterchildren("joint")
+                 if joint.get("type") in ("revolute", "continuous", "prismatic"))
+    if moving > MAX_MOVING_JOINTS:
+        raise TooManyJoints(f"{moving} moving joints: PyBullet reports the joint states of at most "
+                            f"{MAX_MOVING_JOINTS} (getJointState fails for every joint beyond that)")
+
+
 def load(model: Path, renames: Renames, *, root: str, pose_path: str = "com-frame",
          timeout: float = DEFAULT_TIMEOUT) -> PyBulletModel:
     """The engine plug-in entry point (see ``modelkit.verify.api``)."""
     if not isinstance(model, (str, Path)):
         raise PyBulletError("PyBullet reads a URDF file, not an in-memory model")
+    _check_size(Path(model))
     return PyBulletModel(Path(model), renames, root, pose_path=pose_path, timeout=timeout)
 
 
@@ -388,6 +415,7 @@ def render(urdfs: dict[str, Path], configurations: list[dict[str, float]], camer
 def simulator(model: Path, renames: Renames, *, root: str, dt: float,
               timeout: float = DEFAULT_TIMEOUT) -> PyBulletModel:
     """Layer 3b's entry point: the same adapter, time step ``dt``."""
+    _check_size(Path(model))
     return PyBulletModel(Path(model), renames, root, dt=dt, timeout=timeout)
 
 

@@ -79,15 +79,13 @@ def dof_joints(robot: Robot) -> list[str]:
     """The 1-DOF joints of the tree, depth-first from the root in document order (Pinocchio's order)."""
     children = robot.children_of()
     out: list[str] = []
-
-    def walk(link: str) -> None:
-        for joint in children.get(link, []):
-            if joint.type in DOF_TYPES:
-                out.append(joint.name)
-            walk(joint.child)
-
-    if robot.root:
-        walk(robot.root)
+    # A stack, not recursion: a chain of thousands of links is as deep as a tree gets.
+    stack = list(reversed(children.get(robot.root, []))) if robot.root else []
+    while stack:
+        joint = stack.pop()
+        if joint.type in DOF_TYPES:
+            out.append(joint.name)
+        stack.extend(reversed(children.get(joint.child, [])))
     return out
 
 
@@ -141,8 +139,9 @@ class YourdfpyModel:
         self.urdf = yourdfpy.URDF.load(str(path), load_meshes=False, build_scene_graph=True,
                                        load_collision_meshes=False, build_collision_scene_graph=False)
         self.root = root
-        self.settings: dict[str, Any] = {"version": getattr(yourdfpy, "__version__", "unknown"),
-                                         "load_meshes": False, "fk": "URDF.get_transform(link, root)"}
+        self.settings: dict[str, Any] = {
+            "version": getattr(yourdfpy, "__version__", "unknown"), "load_meshes": False,
+            "fk": "URDF.get_transform(child, parent) per joint, composed from the base link"}
         self._dofs = [j.name for j in self.urdf.robot.joints
                       if j.type in ("revolute", "continuous", "prismatic") and j.mimic is None]
 
@@ -172,10 +171,40 @@ class YourdfpyModel:
         return facts
 
     def link_poses(self, q: dict[str, float]) -> dict[str, Pose]:
-        self.urdf.update_cfg({name: q.get(name, 0.0) for name in self._dofs})
+        """Each link's pose in the root's frame, from yourdfpy's own joint transforms.
+
+        ``get_transform(link, root)`` multiplies the whole path with ``numpy.linalg.multi_dot``, whose
+        search for the best bracketing is cubic in the path's length: 0.02 s per link of a 100-link
+        chain, 74 s for layer 2, hours at 1000 links. Each joint's transform (yourdfpy's
+        ``get_transform(child, parent)``, one edge) is asked instead and the products are made here,
+        parent before child, from the URDF's base link: linear in the links."""
+        urdf = self.urdf
+        urdf.update_cfg({name: q.get(name, 0.0) for name in self._dofs})
+        children: dict[str, list[str]] = {}
+        for joint in urdf.robot.joints:
+            children.setdefault(joint.parent, []).append(joint.child)
+        base = urdf.base_link
+        in_base: dict[str, Array] = {base: np.eye(4)}
+        stack = [base]
+        while stack:
+            parent = stack.pop()
+            for child in children.get(parent, []):
+                if child not in in_base:
+                    edge = np.asarray(urdf.get_transform(child, parent), dtype=float)
+                    in_base[child] = in_base[parent] @ edge
+                    stack.append(child)
+        root_inverse = None
+        if self.root in in_base:  # the rigid inverse, exact up to one rounding
+            rotation, translation = in_base[self.root][:3, :3], in_base[self.root][:3, 3]
+            root_inverse = np.eye(4)
+            root_inverse[:3, :3] = rotation.T
+            root_inverse[:3, 3] = -rotation.T @ translation
         out: dict[str, Pose] = {}
-        for link in self.urdf.robot.links:
-            t = np.asarray(self.urdf.get_transform(link.name, self.root), dtype=float)
+        for link in urdf.robot.links:
+            if root_inverse is not None and link.name in in_base:
+                t = root_inverse @ in_base[link.name]
+            else:  # not below the base link: yourdfpy's own path search
+                t = np.asarray(urdf.get_transform(link.name, self.root), dtype=float)
             out[link.name] = Pose(t[:3, :3].copy(), t[:3, 3].copy())
         return out
 

@@ -80,6 +80,10 @@ def _axis_inertia_and_gravity(robot: Robot, joint_name: str,
     return inertia, load
 
 
+class UnstableLaw(ValueError):
+    """No PD gains make the replay's linearised step contract (:func:`stable_scale`)."""
+
+
 def step_growth(mass_matrix: Array, kp: Array, kd: Array, dt: float) -> float:
     """The per-step growth factor of semi-implicit Euler (v ← v + dt·a, q ← q + dt·v) on the PD loop
     u = kp·(q* − q) − kd·dq linearised with the mass matrix ``mass_matrix`` (joints in the order of
@@ -94,6 +98,15 @@ def step_growth(mass_matrix: Array, kp: Array, kd: Array, dt: float) -> float:
 
 def _growth(inverse: Array, kp: Array, kd: Array, dt: float) -> float:
     n = len(kp)
+    if n and not np.any(inverse - np.diag(np.diagonal(inverse))):
+        # Decoupled joints (the fallback without Pinocchio): the step matrix is n independent 2 × 2
+        # blocks, whose eigenvalues are those of the whole; linear in n instead of a (2n)³ solve.
+        a = np.diagonal(inverse)
+        ak, ad = a * kp, 1.0 - dt * a * kd
+        blocks = np.empty((n, 2, 2))
+        blocks[:, 0, 0], blocks[:, 0, 1] = 1.0 - dt * dt * ak, dt * ad
+        blocks[:, 1, 0], blocks[:, 1, 1] = -dt * ak, ad
+        return float(np.max(np.abs(np.linalg.eigvals(blocks))))
     eye = np.eye(n)
     ak = inverse @ np.diag(kp)
     ad = eye - dt * (inverse @ np.diag(kd))
@@ -104,13 +117,24 @@ def _growth(inverse: Array, kp: Array, kd: Array, dt: float) -> float:
 def stable_scale(inverse: Array, kp: Array, kd: Array, dt: float) -> float:
     """The bandwidth scale s (1, 1/2, 1/4, ...) that makes the gains (s²·kp, s·kd) stable at ``dt``
     (:func:`step_growth` below ``MAX_GROWTH``) for the inverse mass matrix ``inverse``; halving the
-    bandwidth keeps the damping ratio."""
+    bandwidth keeps the damping ratio.
+
+    Halving lowers the growth of the fast modes only: in a long chain the slowest modes contract by
+    less than 1e-6 per step whatever the gains (a 50-link chain: 1 − 3e-8 at s = 1), and halving makes
+    them slower still; run anyway, such a law let MuJoCo blow up at 100 links. When a halving no longer
+    lowers the growth, or none is left, :class:`UnstableLaw` says so (verify skips the replay)."""
     scale = 1.0
+    best = math.inf
     for _ in range(MAX_HALVINGS):
-        if _growth(inverse, kp * scale**2, kd * scale, dt) < MAX_GROWTH:
+        growth = _growth(inverse, kp * scale**2, kd * scale, dt)
+        if growth < MAX_GROWTH:
             return scale
+        if growth >= best:
+            break
+        best = growth
         scale *= 0.5
-    raise ValueError(f"no stable PD gains for the replay at dt {dt:g} s")
+    raise UnstableLaw(f"no PD gains make the linearised loop contract at dt {dt:g} s (its step grows by "
+                      f"{best:.9g} at best, {MAX_GROWTH:.9g} is needed: the slowest modes of a long chain)")
 
 
 def _effective_inverse(source: Robot, names: list[str]) -> Array | None:
@@ -122,7 +146,11 @@ def _effective_inverse(source: Robot, names: list[str]) -> Array | None:
         return None
     try:
         model = PinocchioModel(source)
-    except (ValueError, RuntimeError):
+    except (ValueError, RuntimeError) as exc:
+        if getattr(type(exc), "engine_limit", False):
+            # Too many joints for Pinocchio: the diagonal fallback ignores the couplings, which decide
+            # a long chain's stability (MuJoCo blew up at once on a 200-link chain with it).
+            raise UnstableLaw(f"its stability cannot be checked: {exc}") from exc
         return None
     model.model.armature = np.zeros(model.model.nv)
     dofs = model.dof_names()
@@ -164,7 +192,9 @@ def default_law(source: Robot, dt: float = 1e-3) -> TorqueLaw:
     * stability, checked: the per-step growth factor of semi-implicit Euler on the loop linearised
       with M at q = 0 (:func:`step_growth`: the spectral radius of the step matrix built from
       M⁻¹·K, M⁻¹·D and dt, the joints' couplings included) must be below 1 − 1e-6; while it is not,
-      every joint's bandwidth is halved (kp/4, kd/2: the damping ratio is kept);
+      every joint's bandwidth is halved (kp/4, kd/2: the damping ratio is kept); when a halving no
+      longer lowers it (a long chain's slowest modes) there is no law and the replay is skipped
+      (:func:`stable_scale`);
     * frequency 0.3 + 0.17·i Hz and phase 0.9·i rad: distinct, so the joints move out of step and
       the coupling terms of the mass matrix are excited. Peak speeds stay near A·2πf ≤ ~10 rad/s.
 

@@ -38,6 +38,10 @@ from modelkit.yamltree import YMap, YNode, YScalar, YSeq, locate, parse_yaml, re
 
 BUILTIN_DURATION = 10.0
 BUILTIN_SETTLE = 0.5
+# Physics steps the profiles may take together, per engine run (the built-in scenario: 42,000 at 1 ms).
+# Each number has its range in the schema; this bounds their combination (dt: 1e-5 with 100 profiles
+# of 600 s would be 6e9 steps, days of simulation).
+MAX_STEPS = 5_000_000
 
 # (t, v, w) of the built-in profiles (verification.md §1)
 _BUILTIN: dict[str, tuple[tuple[tuple[float, float, float], ...], bool, str]] = {
@@ -415,6 +419,27 @@ def _check_values(data: dict[str, Any], root: YMap, sink: DiagnosticSink) -> Non
             values = command if isinstance(command, list) else list(command.values())
             if any(isinstance(x, float) and not math.isfinite(x) for x in values):
                 sink.emit(CODES["value"], f"{_label(at)}: values must be finite", _loc(root, at))
+    _check_steps(data, root, sink)
+
+
+def _check_steps(data: dict[str, Any], root: YMap, sink: DiagnosticSink) -> None:
+    """MK902 when the profiles take more than :data:`MAX_STEPS` physics steps at the scenario's dt."""
+    simulation = data.get("simulation", {})
+    dt = float(simulation.get("dt", Scenario(profiles=()).dt))
+    seconds = 0.0
+    for entry in data.get("profiles", BUILTIN_PROFILES):
+        entry = {"name": entry} if isinstance(entry, str) else entry
+        seconds += float(entry.get("duration", BUILTIN_DURATION)) + float(entry.get("settle", BUILTIN_SETTLE))
+    steps = seconds / dt
+    if steps > MAX_STEPS:
+        where: tuple[str | int, ...] = ("simulation", "dt") if "dt" in simulation else ("profiles",)
+        sink.emit(
+            CODES["value"],
+            f"the profiles simulate {seconds:g} s at dt = {dt:g} s: {steps:.3g} physics steps, more than "
+            f"{MAX_STEPS:,} per engine run",
+            _loc(root, where),
+            hint="a larger dt, fewer or shorter profiles",
+        )
 
 
 def _build(data: dict[str, Any], source: str) -> Scenario:

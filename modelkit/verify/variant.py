@@ -146,7 +146,9 @@ def write_variant(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path,
 
 
 def _safe(name: str) -> str:
-    return "".join(c if c.isalnum() or c in "-_" else "_" for c in name) or "robot"
+    """The robot's name as a file stem: safe characters, at most 100 of them (a valid model may be
+    named with 300: the file name would pass the 255-byte limit of most file systems)."""
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in name)[:100] or "robot"
 
 
 

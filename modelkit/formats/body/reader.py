@@ -660,6 +660,15 @@ class _BodyReader:
                 self.sink.emit("MK215", f"extra joint {i}: {problem}", item.loc)
                 continue
             assert link1 is not None and link2 is not None and kind is not None
+            if link1 == link2:  # constrains nothing; libsdformat and Drake refuse such a joint in the SDF
+                where = item.get("link2_name", "link2Name")
+                self.sink.emit(
+                    "MK215",
+                    f'extra joint {i} joins link "{link1}" to itself: an extra joint closes a loop between '
+                    "two links",
+                    (where or item).loc,
+                )
+                continue
             axis = v.vector3(item.get("axis", "jointAxis"))
             loop = LoopConstraint(
                 name=v.get_text(item, "name") or f"extra_joint_{i}",

@@ -46,6 +46,10 @@ PLATE_MARGIN = 1e-10  # relative: how far above a + b = c a full tensor is raise
 SINGULAR = 1e-12  # below this a mass or principal moment counts as zero (MuJoCo's mjMINVAL is 1e-15)
 MOVING = (JointType.REVOLUTE, JointType.PRISMATIC, JointType.BALL, JointType.PLANAR, JointType.FLOATING)
 
+# A body still to write: (parent element, link, pose in the parent body, incoming joint, free_top,
+# detached); or a floating joint whose child is split off as a top-level body when its turn comes.
+_Pending = tuple[Element, str, Pose, Joint | None, bool, bool] | Joint
+
 
 def mujoco_valid_inertia(tensor: np.ndarray) -> tuple[np.ndarray, tuple[float, float, float], float]:
     """The tensor, or the nearest one with principal moments a + b ≥ c that MuJoCo accepts: the two
@@ -192,13 +196,34 @@ class BodyTree:
         free_top: bool = False,
         detached: bool = False,
     ) -> None:
+        """Write the body of ``link_name`` and its subtree, depth first, with a stack of its own: a
+        chain of 10,000 links is as deep as a tree gets, far beyond Python's recursion limit. The
+        order is that of a recursive pre-order walk (children in joint order), so names and notes are
+        claimed as before; a floating child joins ``split`` when its turn comes."""
+        stack: list[_Pending] = [(parent, link_name, pose, joint, free_top, detached)]
+        while stack:
+            item = stack.pop()
+            if isinstance(item, Joint):
+                split.append((item, Pose()))
+                continue
+            stack.extend(reversed(self._one_body(*item)))
+
+    def _one_body(
+        self,
+        parent: Element,
+        link_name: str,
+        pose: Pose,
+        joint: Joint | None,
+        free_top: bool,
+        detached: bool,
+    ) -> list[_Pending]:
+        """One body: its element, joint, inertial and contents; returns its children, still to write."""
         link = self.links.get(link_name)
         if link is None:
-            return
+            return []
         chain = self.chains.below(joint) if joint is not None and not (free_top or detached) else None
         if chain is not None:
-            self._chain_body(parent, chain, pose @ chain.entry.inverse(), split)
-            return
+            return self._chain_body(parent, chain, pose @ chain.entry.inverse())
         name = self.body_name[link_name]
         el = sub(parent, "body", name=name)
         set_pose(el, pose)
@@ -220,9 +245,9 @@ class BodyTree:
             moving = True
         else:
             moving = self._joint(el, joint, name)
-        self._fill(el, link, name, moving, split)
+        return self._fill(el, link, name, moving)
 
-    def _chain_body(self, parent: Element, chain: Chain, pose: Pose, split: list[tuple[Joint, Pose]]) -> None:
+    def _chain_body(self, parent: Element, chain: Chain, pose: Pose) -> list[_Pending]:
         """One body for a multi-joint MuJoCo body the reader made a chain of (:mod:`.write_chains`)."""
         link = self.links[chain.end]
         name = self.body_name[chain.end]
@@ -233,7 +258,7 @@ class BodyTree:
             self.frames[chain.end] = chain.shift
         for joint, anchor in zip(chain.joints, chain.positions, strict=True):
             self._joint(el, joint, name, anchor)
-        self._fill(el, shifted(link, chain.shift), name, True, split, chain.shift)
+        return self._fill(el, shifted(link, chain.shift), name, True, chain.shift)
 
     def _fill(
         self,
@@ -241,17 +266,20 @@ class BodyTree:
         link: Link,
         name: str,
         moving: bool,
-        split: list[tuple[Joint, Pose]],
         frame: Pose | None = None,
-    ) -> None:
-        """A body's inertial, geoms, devices and child bodies (``frame``: the link's frame in the body's)."""
+    ) -> list[_Pending]:
+        """A body's inertial, geoms and devices; returns its child bodies to write, in order (a floating
+        child as its joint, for ``split``). ``frame``: the link's frame in the body's."""
         self._inertial(el, link, name, moving)
         self._contents(el, link, name, static=False)
+        pending: list[_Pending] = []
         for child in self.children.get(link.name, []):
             if child.type is JointType.FLOATING:
-                split.append((child, Pose()))
+                pending.append(child)
                 continue
-            self._body(el, child.child, child.origin if frame is None else frame @ child.origin, child, split)
+            origin = child.origin if frame is None else frame @ child.origin
+            pending.append((el, child.child, origin, child, False, False))
+        return pending
 
     def _contents(self, el: Element, link: Link, name: str, static: bool) -> None:
         self.geoms.link_geoms(el, link, name)
@@ -312,6 +340,14 @@ class BodyTree:
                 f"joint {joint.name} is locked (both limits {fmt(limits.lower)}); MuJoCo needs "
                 "range[0] < range[1], so it is written unlimited and held at that value by a joint "
                 "equality",
+                joint.loc("limits"),
+                target,
+            )
+        elif math.isfinite(limits.lower) and math.isfinite(limits.upper) and limits.lower > limits.upper:
+            self.ctx.note(
+                "MK824",
+                f"joint {joint.name}: lower limit {fmt(limits.lower)} is above upper limit "
+                f"{fmt(limits.upper)} (no position is within them, MK307); written unlimited",
                 joint.loc("limits"),
                 target,
             )

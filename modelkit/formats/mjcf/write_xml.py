@@ -54,6 +54,33 @@ def sub(parent: Element, tag: str, **attributes: str) -> Element:
     return el
 
 
+# Indentation stops growing at this depth: a chain of 10,000 bodies written with ever deeper
+# indentation is quadratic in size (500 MB of spaces); every real model nests far less.
+MAX_INDENT_LEVEL = 100
+
+
+def indent(root: Element, space: str = "  ", max_level: int = MAX_INDENT_LEVEL) -> None:
+    """``etree.indent(root, space)`` without a walk that recurses per level, and with the indentation
+    of elements deeper than ``max_level`` held at that level: identical output for shallower trees,
+    linear size for deep ones. Whitespace-only text and tails are replaced, other text kept."""
+    stack: list[tuple[Element, int]] = [(root, 1)]
+    while stack:
+        el, level = stack.pop()
+        if len(el) == 0:
+            continue
+        inner = "\n" + space * min(level, max_level)
+        if not (el.text and el.text.strip()):
+            el.text = inner
+        for child in el:
+            if not (child.tail and child.tail.strip()):
+                child.tail = inner
+            if len(child):
+                stack.append((child, level + 1))
+        last = el[-1]
+        if not (last.tail and last.tail.strip()):
+            last.tail = "\n" + space * min(level - 1, max_level)
+
+
 def section(root: Element, tag: str) -> Element:
     """The top-level section ``tag`` of ``<mujoco>``, created on first use."""
     found = root.find(tag)

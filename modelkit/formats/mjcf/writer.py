@@ -39,12 +39,15 @@ from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_geoms import GeomWriter
 from modelkit.formats.mjcf.write_names import NameTable
-from modelkit.formats.mjcf.write_xml import set_pose, sub
+from modelkit.formats.mjcf.write_xml import Element, indent, set_pose, sub
 from modelkit.model import WORLD_LINK, JointType, LoopConstraint, Robot
 from modelkit.spatial import Pose
 
 SECTIONS = ("compiler", "option", "asset", "worldbody", "equality", "actuator", "sensor")
 HINGE_HALF_SPAN = 0.05  # m: the two connects of a hinge loop sit this far either side of the joint
+# MuJoCo's XML parser (TinyXML2, 500 levels) reads at most this many nested <body> elements inside
+# <mujoco><worldbody> (measured with MuJoCo 3.x and 4.0: 496 load, 497 are refused).
+MUJOCO_MAX_BODY_DEPTH = 496
 
 
 def write_mjcf(robot: Robot, ctx: WriteContext) -> bytes:
@@ -71,6 +74,7 @@ class MjcfWriter:
 
     def write(self) -> bytes:
         self.tree.write(self.sections["worldbody"])
+        self._depth()
         self._joint_ids()
         self._mimics()
         for joint, value in self.tree.locked:
@@ -88,9 +92,34 @@ class MjcfWriter:
             el = self.sections[tag]
             if tag not in ("compiler", "worldbody") and len(el) == 0 and not el.attrib:
                 self.root.remove(el)
-        etree.indent(self.root, space="  ")
+        indent(self.root, space="  ")
         text: bytes = etree.tostring(self.root, xml_declaration=False, encoding="utf-8", pretty_print=True)
         return text
+
+    def _depth(self) -> None:
+        """MK872 when the bodies nest deeper than MuJoCo reads: the file is written all the same."""
+        deepest: tuple[int, Element | None] = (0, None)
+        stack: list[tuple[Element, int]] = [(self.sections["worldbody"], 0)]
+        while stack:
+            el, depth = stack.pop()
+            for child in el.iterchildren("body"):
+                if depth + 1 > deepest[0]:
+                    deepest = (depth + 1, child)
+                stack.append((child, depth + 1))
+        depth, body = deepest
+        if depth <= MUJOCO_MAX_BODY_DEPTH or body is None:
+            return
+        name = body.get("name", "")
+        link = next((lk for lk, el in self.tree.bodies.items() if el is body), None)
+        found = self.robot.link(link) if link is not None else None
+        source = found.source if found is not None else self.robot.source
+        self.ctx.note(
+            "MK872",
+            f"the bodies nest {depth} deep (body {name}); MuJoCo's XML parser reads at most "
+            f"{MUJOCO_MAX_BODY_DEPTH} nested bodies and refuses this file",
+            source,
+            f"body[{name}]",
+        )
 
     # -- joints across the tree ----------------------------------------------------------------
 
