@@ -4,13 +4,17 @@ for the target, run the writer, stage every file, check the plan, write it atomi
 from __future__ import annotations
 
 import copy
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from modelkit.convert.context import WriteContext
 from modelkit.convert.meshes import MeshExporter
 from modelkit.convert.notes import ConversionNote, NoteSink
+from modelkit.convert.numbers import length_scale
 from modelkit.convert.options import WriteOptions
 from modelkit.convert.output import OutputPlan, safe_file_name
 from modelkit.convert.registry import TargetInfo, load_writer, target_for_path, target_info
@@ -70,6 +74,12 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     return out
 
 
+def length_scale_of(robot: Robot) -> float:
+    """The robot's size for cleaning positions: its longest joint offset (1 m when it has none)."""
+    lengths = [float(np.linalg.norm(j.origin.translation)) for j in robot.joints]
+    return max([v for v in lengths if math.isfinite(v)] or [1.0]) or 1.0
+
+
 def render_model(robot: Robot, target: str, plan: OutputPlan, relpath: str,
                  options: WriteOptions) -> list[ConversionNote]:
     """Run the writer for one robot, staging its model file at ``relpath`` and its meshes."""
@@ -77,7 +87,8 @@ def render_model(robot: Robot, target: str, plan: OutputPlan, relpath: str,
     notes = NoteSink()
     prepared = prepare(robot, info, options, notes)
     ctx = WriteContext(options, notes, MeshExporter(plan, relpath, options, notes), relpath)
-    data = load_writer(target)(prepared, ctx)
+    with length_scale(length_scale_of(prepared)):
+        data = load_writer(target)(prepared, ctx)
     plan.add(relpath, data, "model")
     return notes.items
 
