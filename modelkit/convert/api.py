@@ -154,6 +154,7 @@ def convert(
         return result
     folder = out if folder_mode else out.parent
     plan = OutputPlan(folder, set(), force)
+    input_errors = False  # errors the writer dealt with (a missing mesh left out): written, exit 1
     for item in inputs:
         source = Path(item)
         checked = validate(source, read_options, input_format, str(source))
@@ -170,6 +171,7 @@ def convert(
                 )
             result.status = max(result.status, 1)
             continue
+        input_errors = input_errors or bool(checked.errors)
         plan.inputs |= {p for r in robots for p in input_files(r, source)}
         names = _outputs_for(source, robots, out, target, folder_mode)
         if len(robots) > 1:
@@ -196,4 +198,7 @@ def convert(
                                        SourceLocation(str(folder))))
         result.outputs = []
         result.status = 2
+        return result
+    if input_errors or any(n.severity is Severity.ERROR for n in result.notes):
+        result.status = 1  # written, but not the whole robot: README's "an input has errors"
     return result
