@@ -142,3 +142,32 @@ def test_summary_counts_every_warning_printed(tmp_path: Path) -> None:
     assert printed >= 2
     assert f"notes: {printed} warning(s)" in output, output
     assert status == 0
+
+
+def test_a_flat_generated_mesh_keeps_its_visual_and_loses_its_collision(tmp_path: Path) -> None:
+    """A `.body` TriangleMesh (written by the writer, not copied) gets the same checks."""
+    source = tmp_path / "tri.body"
+    source.write_text("""\
+format: ChoreonoidBody
+format_version: 2.0
+angle_unit: degree
+name: tri
+root_link: base
+links:
+  -
+    name: base
+    joint_type: free
+    mass: 1.0
+    center_of_mass: [ 0, 0, 0 ]
+    inertia: [ 0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01 ]
+    elements:
+      - type: Shape
+        geometry: { type: TriangleMesh, vertices: [ 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0 ],
+                    faces: [ 0, 1, 2, 1, 3, 2 ] }
+""")
+    out = tmp_path / "out" / "tri.xml"
+    status, output = _convert(source, out)
+    assert status == 1, output
+    assert "error MK805" in output and "MK876" in output, output
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert model.ngeom == 1  # the visual plane

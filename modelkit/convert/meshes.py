@@ -112,10 +112,11 @@ def _text_corners(data: bytes, file_type: str) -> np.ndarray:
     return vertices[faces] if len(faces) else np.zeros((0, 3, 3))
 
 
-def _checked(corners: np.ndarray) -> np.ndarray:
+def _checked(corners: np.ndarray, stl: bool = True) -> np.ndarray:
+    """``corners`` (n × 3 × 3) if MuJoCo reads them (as an STL when ``stl``), else :class:`Unusable`."""
     if len(corners) == 0:
         raise Unusable("the mesh has no faces")
-    if len(corners) > MUJOCO_MAX_STL_FACES:
+    if stl and len(corners) > MUJOCO_MAX_STL_FACES:
         raise Unusable(f"the mesh has {len(corners):,} faces, over MuJoCo's {MUJOCO_MAX_STL_FACES:,} "
                        "for an STL")
     if not np.all(np.isfinite(corners)):
@@ -233,6 +234,8 @@ class MeshExporter:
         if geometry.data is not None and (geometry.path is None or geometry.generator):
             kind = geometry.generator or "in-memory mesh"
             self.notes.note("MK803", f"{kind} written as a mesh file", source, target)
+            if mujoco:
+                return self._mujoco_triangles(geometry.data, name, scale, kind, collision)
             return self.triangles(geometry.data, name, scale), ""
         uri = geometry.uri or ""
         if (self.options.keep_package_uris and uri.startswith(("package://", "model://"))
@@ -280,4 +283,22 @@ class MeshExporter:
         self.notes.note("MK804", f"mesh {path.name}{part} ({loaded.source_format}) converted to "
                         f"{self.options.mesh_format.upper()}{unit}", source, target)
         stem = path.stem + (f"_{geometry.fragment}" if geometry.fragment else "")
+        if mujoco:
+            return self._mujoco_triangles(loaded.mesh, stem, scale, f"mesh {uri}", collision)
         return self.triangles(loaded.mesh, stem, scale), ""
+
+    def _mujoco_triangles(self, mesh: TriangleMeshData, name: str, scale: Vec3, what: str,
+                          collision: bool) -> tuple[MeshRef | None, str]:
+        """Triangles written for MuJoCo: the checks of :func:`for_mujoco`, applied before staging."""
+        vertices = np.asarray(mesh.vertices, dtype=np.float64)
+        faces = np.asarray(mesh.faces, dtype=np.int64)
+        try:
+            corners = _checked(vertices[faces] if len(faces) else np.zeros((0, 3, 3)),
+                               stl=self.options.mesh_format == "stl")
+        except Unusable as exc:
+            return None, f"{what} cannot be read by MuJoCo ({exc})"
+        if collision and _flat(corners):
+            return None, (f"{what} is flat (all its vertices in one plane): MuJoCo cannot build the convex "
+                          "hull it collides with")
+        ref = self.triangles(mesh, name, scale)
+        return MeshRef(ref.uri, ref.scale, ref.file_format, _hollow(corners), False), ""
