@@ -53,7 +53,12 @@ def _huge_stl() -> bytes:
     return _binary_stl(np.asarray(sphere.vertices), np.asarray(sphere.faces))
 
 
+def _tiny_stl() -> bytes:  # a closed cube of 10 µm: 1e-15 m³, "mesh volume is too small" for MuJoCo
+    return _binary_stl(np.asarray(BOX.vertices) * 1e-4, np.asarray(BOX.faces))
+
+
 MESHES = {
+    "tiny": _tiny_stl,
     "ascii": _ascii_stl,
     "obj_text": lambda: str(BOX.export(file_type="obj")).encode(),
     "png": lambda: b"\x89PNG\r\n\x1a\n" + bytes(200),
@@ -70,6 +75,7 @@ CASES = {
     ("ascii", False): (0, "MK804", 1),
     ("obj_text", True): (0, "MK804", 2),  # read by its content, written as binary STL
     ("flat", False): (0, "MK876", 1),  # a visual plane: inertia="shell" on its asset
+    ("tiny", True): (0, "MK876", 2),
     ("flat", True): (1, "MK805", 1),  # the visual stays; MuJoCo cannot build a plane's convex hull
     ("png", True): (1, "MK805", 0),
     ("empty", True): (1, "MK805", 0),

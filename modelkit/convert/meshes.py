@@ -52,13 +52,13 @@ class Unusable(Exception):
     """A mesh file MuJoCo cannot use, with the reason."""
 
 
-def for_mujoco(data: bytes, ext: str) -> Prepared:
+def for_mujoco(data: bytes, ext: str, scale: Vec3 | None = None) -> Prepared:
     """``data`` (a file named ``*.ext``) made readable by MuJoCo, read by its content.
 
     A binary STL is checked (faces between 1 and 200,000, finite corners); an ASCII STL or OBJ text
     becomes a binary STL (MuJoCo reads only binary STL; an OBJ named ``.stl`` is read as what it is).
     Raises :class:`Unusable` for an empty file, something that is not a mesh (a PNG...), non-finite
-    coordinates or too many faces.
+    coordinates or too many faces. ``scale`` is the one the model applies (for :func:`_hollow`).
     """
     if not data.strip():
         raise Unusable("the file is empty")
@@ -67,7 +67,7 @@ def for_mujoco(data: bytes, ext: str) -> Prepared:
     count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
     if count >= 0 and len(data) == 84 + 50 * count:
         corners = _checked(_binary_stl_corners(data, count))
-        return Prepared(data, None, _hollow(corners), _flat(corners))
+        return Prepared(data, None, _hollow(corners, scale), _flat(corners))
     text = _text(data)
     if text is None:
         kind = "a PNG image" if data.startswith(b"\x89PNG") else "binary data that is no STL"
@@ -82,7 +82,7 @@ def for_mujoco(data: bytes, ext: str) -> Prepared:
     corners = _checked(_text_corners(data, file_type))
     faces = np.arange(len(corners) * 3, dtype=np.int64).reshape(-1, 3)
     mesh = TriangleMeshData(corners.reshape(-1, 3), faces)
-    return Prepared(triangles_to_bytes(mesh, "stl"), kind, _hollow(corners), _flat(corners))
+    return Prepared(triangles_to_bytes(mesh, "stl"), kind, _hollow(corners, scale), _flat(corners))
 
 
 def _binary_stl_corners(data: bytes, count: int) -> np.ndarray:
@@ -124,12 +124,14 @@ def _checked(corners: np.ndarray, stl: bool = True) -> np.ndarray:
     return corners
 
 
-def _hollow(corners: np.ndarray) -> bool:
-    """Whether the triangles enclose (almost) no volume: |V| below 1e-6 of their box's volume scale."""
+def _hollow(corners: np.ndarray, scale: Vec3 | None = None) -> bool:
+    """Whether the triangles, scaled, enclose (almost) no volume: |V| below 1e-6 of their box's
+    volume scale, or below 1e-12 m³ (MuJoCo refuses below 1e-15: "mesh volume is too small")."""
+    corners = corners * (np.ones(3) if scale is None else np.asarray(scale, dtype=float))
     triple = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2]))
     volume = abs(float(triple.sum())) / 6.0
     extent = float(np.max(corners.reshape(-1, 3).max(axis=0) - corners.reshape(-1, 3).min(axis=0)))
-    return volume <= 1e-6 * extent ** 3
+    return volume <= max(1e-6 * extent ** 3, 1e-12)
 
 
 def _flat(corners: np.ndarray) -> bool:
@@ -261,7 +263,7 @@ class MeshExporter:
             if not mujoco:
                 return MeshRef(self._stage(data, safe_file_name(path.name, "mesh")), scale, ext), ""
             try:
-                ready = for_mujoco(data, ext)
+                ready = for_mujoco(data, ext, scale)
             except Unusable as exc:
                 return None, f"mesh {uri} cannot be read by MuJoCo ({exc})"
             if ready.flat and collision:
@@ -301,4 +303,4 @@ class MeshExporter:
             return None, (f"{what} is flat (all its vertices in one plane): MuJoCo cannot build the convex "
                           "hull it collides with")
         ref = self.triangles(mesh, name, scale)
-        return MeshRef(ref.uri, ref.scale, ref.file_format, _hollow(corners), False), ""
+        return MeshRef(ref.uri, ref.scale, ref.file_format, _hollow(corners, scale), False), ""
