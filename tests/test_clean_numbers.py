@@ -8,15 +8,17 @@ import re
 from pathlib import Path
 
 import mujoco
+import numpy as np
 import pytest
+from lxml import etree
 
 from modelkit.api import validate
 from modelkit.convert.api import write
 from modelkit.convert.compare import compare_poses
 from modelkit.convert.notes import renames
 from modelkit.convert.numbers import clean_angle, clean_length, clean_rotation, fmt, length_scale
-from modelkit.formats.mjcf.write_xml import euler_text, quat_wxyz
-from modelkit.spatial import matrix_from_rpy
+from modelkit.formats.mjcf.write_xml import euler_text, quat_wxyz, set_pose, z_turn, zaxis_text
+from modelkit.spatial import Pose, matrix_from_rpy
 
 pybullet_data = pytest.importorskip("pybullet_data")
 DATA = Path(pybullet_data.getDataPath())
@@ -53,6 +55,23 @@ def test_quaternions_and_euler_angles_are_exact_values() -> None:
     assert " ".join(fmt(v) for v in quat_wxyz(quarter)) == "0.707106781186548 0.707106781186548 0 0"
     rotation = matrix_from_rpy(1.57079, 0.0, 1.57079)
     assert euler_text(rotation) == "1.57079 0 1.57079"
+
+
+def test_mjcf_rotations_take_the_shortest_exact_text() -> None:
+    def written(rotation: np.ndarray) -> dict[str, str]:
+        el = etree.Element("geom")
+        set_pose(el, Pose(rotation, np.zeros(3)))
+        return dict(el.attrib)
+
+    assert zaxis_text(matrix_from_rpy(math.pi / 2, 0.0, 0.0)) == "0 -1 0"
+    assert zaxis_text(matrix_from_rpy(0.0, 0.0, math.pi / 2)) is None  # a turn about Z: no zaxis
+    assert written(matrix_from_rpy(math.pi / 2, 0.0, 0.0)) == {"zaxis": "0 -1 0"}
+    assert written(matrix_from_rpy(math.pi, 0.0, 0.0)) == {"zaxis": "0 0 -1"}
+    assert written(matrix_from_rpy(1.57079, 0.0, 1.57079)) == {"euler": "1.57079 0 1.57079"}
+    assert written(matrix_from_rpy(0.0, 0.0, math.pi)) == {"quat": "0 0 0 1"}
+    for rotation in (matrix_from_rpy(0.3, -1.2, 2.9), matrix_from_rpy(math.pi, 0.0, 0.0)):
+        assert np.allclose(z_turn([0.0, 0.0, -1.0]) @ np.eye(3), matrix_from_rpy(math.pi, 0.0, 0.0))
+        assert written(rotation)  # never the identity for a turn
 
 
 @pytest.mark.parametrize("source", ROBOTS)

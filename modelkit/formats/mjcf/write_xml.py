@@ -8,7 +8,7 @@ import numpy as np
 from lxml import etree
 
 from modelkit.convert.numbers import SNAP, clean_angle, clean_length, clean_rotation, fmt, fmt_vec
-from modelkit.spatial import Mat3, Pose, matrix_from_rpy, rpy_from_matrix
+from modelkit.spatial import Mat3, Pose, axis_angle, matrix_from_rpy, rpy_from_matrix
 
 Element = etree._Element
 
@@ -40,24 +40,46 @@ EULER_SEQUENCE = "XYZ"  # <compiler eulerseq>: fixed axes x, then y, then z = UR
 
 
 def set_pose(el: Element, pose: Pose) -> None:
-    """``pos`` and ``quat`` (or ``euler``) attributes, each left out when it is the identity.
+    """``pos`` and ``quat`` (or ``zaxis``, ``euler``) attributes, each left out when it is the identity.
 
-    The rotation is written as ``euler`` (URDF's roll-pitch-yaw, with ``<compiler eulerseq="XYZ">``
-    that the writer adds) when that text is shorter than the quaternion's and gives the same matrix
-    to 1e-12: ``rpy="1.57079 0 1.57079"`` stays ``euler="1.57079 0 1.57079"`` instead of a
-    quaternion of four 15-digit numbers."""
+    The rotation is written in the shortest of three texts that give the same matrix to 1e-12:
+    ``quat``; ``zaxis`` when it is the shortest turn taking Z to a direction (``zaxis="0 1 0"``);
+    ``euler``, URDF's roll-pitch-yaw (with ``<compiler eulerseq="XYZ">``, which the writer adds):
+    ``rpy="1.57079 0 1.57079"`` stays ``euler="1.57079 0 1.57079"`` instead of a quaternion of
+    four 15-digit numbers."""
     t = np.array([clean_length(v) for v in np.asarray(pose.translation, dtype=float)])
     if np.any(t != 0.0):
         el.set("pos", fmt_vec(t))
     if not np.array_equal(np.asarray(pose.rotation, dtype=float), np.eye(3)):
         q = quat_wxyz(pose.rotation)
         if not (q[0] == 1.0 and not np.any(q[1:])):
-            quat = fmt_vec(q)
-            euler = euler_text(pose.rotation)
-            if euler is not None and len(euler) < len(quat):
-                el.set("euler", euler)
-            else:
-                el.set("quat", quat)
+            texts = {"quat": fmt_vec(q)}
+            for key, text in (("zaxis", zaxis_text(pose.rotation)), ("euler", euler_text(pose.rotation))):
+                if text is not None:
+                    texts[key] = text
+            key = min(texts, key=lambda k: len(texts[k]))  # the shortest exact one; quat on a tie
+            el.set(key, texts[key])
+
+
+def zaxis_text(rotation: Mat3) -> str | None:
+    """The rotation as MuJoCo's ``zaxis`` (the shortest turn taking Z to it), or None when that is
+    not this rotation to 1e-12 (a turn about the new Z as well)."""
+    r = np.asarray(rotation, dtype=float)
+    text = fmt_vec([clean_rotation(v) for v in r[:, 2]])
+    if float(np.max(np.abs(z_turn([float(v) for v in text.split()]) - r))) > SNAP:
+        return None
+    return text
+
+
+def z_turn(z: list[float]) -> np.ndarray:
+    """The rotation MuJoCo makes of ``zaxis="z"``: about Z × z, by the angle between them (about X by
+    π when z is −Z)."""
+    v = np.asarray(z, dtype=float) / float(np.linalg.norm(z))
+    cross = np.cross([0.0, 0.0, 1.0], v)
+    sine = float(np.linalg.norm(cross))
+    if sine < 1e-15:
+        return np.eye(3) if v[2] > 0.0 else axis_angle([1.0, 0.0, 0.0], math.pi)
+    return axis_angle(cross / sine, math.atan2(sine, float(v[2])))
 
 
 def euler_text(rotation: Mat3) -> str | None:
