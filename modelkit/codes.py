@@ -1021,7 +1021,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK805",
         "mesh-missing",
         "warning",
-        "A mesh file could not be found or read; the shape is left out and the rest is written.",
+        "A mesh file could not be found or read (or, for MJCF, MuJoCo cannot read it: an empty file, not a "
+        "mesh, non-finite coordinates, over 200,000 STL faces, a flat collision mesh); the shape is left out "
+        "and the rest is written. An error (`convert` exits 1) when it was a collision shape.",
     ),
     CodeInfo(
         "MK806",
@@ -1160,6 +1162,21 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "The bodies nest deeper than MuJoCo's XML parser reads (496 nested bodies; a serial chain of more "
         "links): the file is written, but MuJoCo refuses it.",
+    ),
+    CodeInfo(
+        "MK875",
+        "mjcf-camera-fovy-clamped",
+        "warning",
+        "A camera whose vertical field of view is 180° or more (a panoramic camera), which MuJoCo refuses "
+        "(\"fovy too large\"), is written with fovy 179°.",
+    ),
+    CodeInfo(
+        "MK876",
+        "mjcf-mesh-shell-inertia",
+        "info",
+        "A mesh that encloses no volume (flat, or open), for which MuJoCo refuses to compute an inertia "
+        "(\"mesh volume is too small\"), is given `inertia=\"shell\"` on its `<mesh>` asset; body inertias "
+        "are written explicitly, so nothing changes in the dynamics.",
     ),
     CodeInfo(
         "MK880",

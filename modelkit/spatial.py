@@ -134,13 +134,15 @@ def matrix_from_quat_wxyz(quat: Sequence[float] | NDArray[np.float64]) -> Mat3:
 
 
 def rpy_from_matrix(r: Mat3) -> Vec3:
-    """URDF/SDF fixed-axis roll-pitch-yaw of R = Rz(yaw)·Ry(pitch)·Rx(roll), pitch in [-π/2, π/2]."""
+    """URDF/SDF fixed-axis roll-pitch-yaw of R = Rz(yaw)·Ry(pitch)·Rx(roll), pitch in [-π/2, π/2].
+
+    The pitch is an atan2, not an asin: exact to the last digits near ±π/2 too (asin(1 - 1e-23)
+    is π/2, and a source's ``1.57079632679`` would come back 4.9e-12 away)."""
     import numpy as np
 
-    sy = -float(r[2, 0])
-    sy = max(-1.0, min(1.0, sy))
-    pitch = math.asin(sy)
-    if abs(sy) < 1.0 - 1e-12:
+    cos_pitch = math.hypot(float(r[0, 0]), float(r[1, 0]))
+    pitch = math.atan2(-float(r[2, 0]), cos_pitch)
+    if cos_pitch > 1e-12:
         roll = math.atan2(float(r[2, 1]), float(r[2, 2]))
         yaw = math.atan2(float(r[1, 0]), float(r[0, 0]))
     else:  # gimbal lock: put everything into yaw

@@ -33,9 +33,14 @@ def test_numbers_are_short_and_clean() -> None:
 
 
 @given(st.floats(allow_nan=False, allow_infinity=False))
-def test_numbers_round_trip_within_half_an_ulp_of_15_digits(x: float) -> None:
-    back = float(fmt(x))
-    assert back == x or abs(back - x) <= 5e-15 * abs(x)
+def test_numbers_round_trip_within_1e_12(x: float) -> None:
+    """Issue 17 §5: a value within 1e-12 (relative) of a shorter decimal is written as that decimal;
+    otherwise 15 significant digits (half an ulp of 15 digits: 5e-15)."""
+    text = fmt(x)
+    back = float(text)
+    assert back == x or abs(back - x) <= 1e-12 * abs(x)
+    if abs(back - x) > 5e-15 * abs(x):
+        assert len(text.split("e")[0].replace("-", "").replace(".", "").strip("0")) < 15
 
 
 @given(st.decimals(min_value=-1e6, max_value=1e6, places=6, allow_nan=False, allow_infinity=False))

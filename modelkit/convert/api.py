@@ -4,14 +4,18 @@ for the target, run the writer, stage every file, check the plan, write it atomi
 from __future__ import annotations
 
 import copy
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+
+import numpy as np
 
 from modelkit.convert.commit import CommitRefused, Entry, identity
 from modelkit.convert.context import WriteContext
 from modelkit.convert.meshes import MeshExporter
 from modelkit.convert.notes import ConversionNote, NoteSink
+from modelkit.convert.numbers import length_scale
 from modelkit.convert.options import WriteOptions
 from modelkit.convert.output import OutputPlan, safe_file_name, target_problem
 from modelkit.convert.registry import TargetInfo, load_writer, target_for_path, target_info
@@ -91,6 +95,12 @@ def _check_mass_properties(robot: Robot) -> None:
                              f"finite or above {MAX_MASS_PROPERTY:g}; validate reports it)")
 
 
+def length_scale_of(robot: Robot) -> float:
+    """The robot's size for cleaning positions: its longest joint offset (1 m when it has none)."""
+    lengths = [float(np.linalg.norm(j.origin.translation)) for j in robot.joints]
+    return max([v for v in lengths if math.isfinite(v)] or [1.0]) or 1.0
+
+
 def render_model(robot: Robot, target: str, plan: OutputPlan, relpath: str,
                  options: WriteOptions) -> list[ConversionNote]:
     """Run the writer for one robot, staging its model file at ``relpath`` and its meshes."""
@@ -98,7 +108,8 @@ def render_model(robot: Robot, target: str, plan: OutputPlan, relpath: str,
     notes = NoteSink()
     prepared = prepare(robot, info, options, notes)
     ctx = WriteContext(options, notes, MeshExporter(plan, relpath, options, notes), relpath)
-    data = load_writer(target)(prepared, ctx)
+    with length_scale(length_scale_of(prepared)):
+        data = load_writer(target)(prepared, ctx)
     plan.add(relpath, data, "model")
     return notes.items
 
@@ -173,6 +184,7 @@ def convert(
         return result
     folder = out if folder_mode else out.parent
     plan = OutputPlan(folder, {Path(item) for item in inputs}, force)
+    input_errors = False  # errors the writer dealt with (a missing mesh left out): written, exit 1
     for item in inputs:
         source = Path(item)
         checked = validate(source, read_options, input_format, str(source))
@@ -190,6 +202,7 @@ def convert(
                 )
             result.status = max(result.status, 1)
             continue
+        input_errors = input_errors or bool(checked.errors)
         plan.inputs |= {p for r in robots for p in input_files(r, source)}
         names = _outputs_for(source, robots, out, target, folder_mode)
         if len(robots) > 1:
@@ -223,11 +236,15 @@ def convert(
         result.diagnostics.append(exc.diagnostic)
         result.outputs = []
         result.status = 2
+        return result
     except OSError as exc:
         result.diagnostics.append(diag("MK894", f"writing into {folder} failed: {exc}; nothing was written",
                                        SourceLocation(str(folder))))
         result.outputs = []
         result.status = 2
+        return result
+    if not result.status and (input_errors or any(n.severity is Severity.ERROR for n in result.notes)):
+        result.status = 1  # written, but not the whole robot: README's "an input has errors"
     return result
 
 

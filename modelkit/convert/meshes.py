@@ -16,7 +16,7 @@ from modelkit.convert.notes import NoteSink
 from modelkit.convert.numbers import fmt
 from modelkit.convert.options import WriteOptions
 from modelkit.convert.output import OutputPlan, safe_file_name
-from modelkit.diagnostics import SourceLocation
+from modelkit.diagnostics import Severity, SourceLocation
 from modelkit.model import Capsule, Cone, Ellipsoid, Mesh, TriangleMeshData
 from modelkit.spatial import Vec3
 
@@ -31,6 +31,115 @@ class MeshRef:
     uri: str  # relative to the model file (or a kept package:// URI)
     scale: Vec3
     file_format: str  # "stl" | "obj" | "dae"
+    hollow: bool = False  # encloses no volume: MuJoCo needs inertia="shell" on its asset
+    flat: bool = False  # all vertices in a plane: MuJoCo cannot build the convex hull it collides with
+
+
+MUJOCO_MAX_STL_FACES = 200_000  # MuJoCo's STL decoder: "number of faces should be between 1 and 200000"
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """A mesh file as MuJoCo will read it: the bytes, what was done to them, whether it is hollow."""
+
+    data: bytes
+    converted: str | None  # what the bytes were ("an ASCII STL"), None when copied as is
+    hollow: bool
+    flat: bool
+
+
+class Unusable(Exception):
+    """A mesh file MuJoCo cannot use, with the reason."""
+
+
+def for_mujoco(data: bytes, ext: str, scale: Vec3 | None = None) -> Prepared:
+    """``data`` (a file named ``*.ext``) made readable by MuJoCo, read by its content.
+
+    A binary STL is checked (faces between 1 and 200,000, finite corners); an ASCII STL or OBJ text
+    becomes a binary STL (MuJoCo reads only binary STL; an OBJ named ``.stl`` is read as what it is).
+    Raises :class:`Unusable` for an empty file, something that is not a mesh (a PNG...), non-finite
+    coordinates or too many faces. ``scale`` is the one the model applies (for :func:`_hollow`).
+    """
+    if not data.strip():
+        raise Unusable("the file is empty")
+    if ext == "obj":
+        return Prepared(data, None, False, False)  # MuJoCo's own OBJ reader; nothing known to refuse
+    count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
+    if count >= 0 and len(data) == 84 + 50 * count:
+        corners = _checked(_binary_stl_corners(data, count))
+        return Prepared(data, None, _hollow(corners, scale), _flat(corners))
+    text = _text(data)
+    if text is None:
+        kind = "a PNG image" if data.startswith(b"\x89PNG") else "binary data that is no STL"
+        raise Unusable(f"the file is {kind}")
+    words = text.split(None, 2)
+    if words[:1] == ["solid"] and "facet" in text:
+        kind, file_type = "an ASCII STL", "stl"
+    elif any(line.startswith(("v ", "f ")) for line in text.splitlines()):
+        kind, file_type = "OBJ text", "obj"
+    else:
+        raise Unusable("the file is text that is neither an ASCII STL nor OBJ")
+    corners = _checked(_text_corners(data, file_type))
+    faces = np.arange(len(corners) * 3, dtype=np.int64).reshape(-1, 3)
+    mesh = TriangleMeshData(corners.reshape(-1, 3), faces)
+    return Prepared(triangles_to_bytes(mesh, "stl"), kind, _hollow(corners, scale), _flat(corners))
+
+
+def _binary_stl_corners(data: bytes, count: int) -> np.ndarray:
+    record = np.dtype([("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attribute", "<u2")])
+    return np.frombuffer(data, dtype=record, count=count, offset=84)["corners"].astype(np.float64)
+
+
+def _text(data: bytes) -> str | None:
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        return None
+    return None if "\x00" in text else text
+
+
+def _text_corners(data: bytes, file_type: str) -> np.ndarray:
+    import io
+
+    import trimesh
+
+    try:
+        loaded = trimesh.load(io.BytesIO(data), file_type=file_type, force="mesh", process=False)
+    except Exception as exc:
+        raise Unusable(f"the file cannot be parsed ({exc})") from exc
+    vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64)
+    faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.int64)
+    return vertices[faces] if len(faces) else np.zeros((0, 3, 3))
+
+
+def _checked(corners: np.ndarray, stl: bool = True) -> np.ndarray:
+    """``corners`` (n × 3 × 3) if MuJoCo reads them (as an STL when ``stl``), else :class:`Unusable`."""
+    if len(corners) == 0:
+        raise Unusable("the mesh has no faces")
+    if stl and len(corners) > MUJOCO_MAX_STL_FACES:
+        raise Unusable(f"the mesh has {len(corners):,} faces, over MuJoCo's {MUJOCO_MAX_STL_FACES:,} "
+                       "for an STL")
+    if not np.all(np.isfinite(corners)):
+        raise Unusable("the mesh has coordinates that are not finite (NaN or infinite)")
+    return corners
+
+
+def _hollow(corners: np.ndarray, scale: Vec3 | None = None) -> bool:
+    """Whether the triangles, scaled, enclose (almost) no volume: |V| below 1e-6 of their box's
+    volume scale, or below 1e-12 m³ (MuJoCo refuses below 1e-15: "mesh volume is too small")."""
+    corners = corners * (np.ones(3) if scale is None else np.asarray(scale, dtype=float))
+    triple = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2]))
+    volume = abs(float(triple.sum())) / 6.0
+    extent = float(np.max(corners.reshape(-1, 3).max(axis=0) - corners.reshape(-1, 3).min(axis=0)))
+    return volume <= max(1e-6 * extent ** 3, 1e-12)
+
+
+def _flat(corners: np.ndarray) -> bool:
+    """Whether every vertex lies in one plane (or line), to 1e-9 of the mesh's size."""
+    points = corners.reshape(-1, 3)
+    centred = points - points.mean(axis=0)
+    singular = np.linalg.svd(centred, compute_uv=False)
+    return bool(singular[-1] <= 1e-9 * max(float(singular[0]), 1e-300))
 
 
 STL_HEADER = b"modelkit binary STL".ljust(80, b" ")
@@ -106,26 +215,38 @@ class MeshExporter:
         return self.triangles(primitive_triangles(geometry), name)
 
     def mesh(self, geometry: Mesh, name: str, target: str, source: SourceLocation | None,
-             readable: tuple[str, ...]) -> MeshRef | None:
+             readable: tuple[str, ...], mujoco: bool = False, collision: bool = False) -> MeshRef | None:
         """A reference for ``geometry`` that the target reads (``readable``: "stl", "obj", "dae").
 
-        Returns None (with an MK805 note) when the mesh is missing or unreadable.
+        Returns None (with an MK805 note) when the mesh is missing or unreadable; the note is an error
+        (``convert`` exits 1) for a ``collision`` shape. With ``mujoco``, a file copied as is is made
+        readable by MuJoCo first (:func:`for_mujoco`).
         """
+        ref, missing = self._mesh(geometry, name, target, source, readable, mujoco, collision)
+        if ref is None:
+            role = "collision shape" if collision else "shape"
+            self.notes.note("MK805", f"{missing}; the {role} is left out", source, target,
+                            severity=Severity.ERROR if collision else None)
+        return ref
+
+    def _mesh(self, geometry: Mesh, name: str, target: str, source: SourceLocation | None,
+              readable: tuple[str, ...], mujoco: bool, collision: bool) -> tuple[MeshRef | None, str]:
+        """The reference, or None and why the mesh is left out."""
         scale = np.asarray(geometry.scale, dtype=float)
         if geometry.data is not None and (geometry.path is None or geometry.generator):
             kind = geometry.generator or "in-memory mesh"
             self.notes.note("MK803", f"{kind} written as a mesh file", source, target)
-            return self.triangles(geometry.data, name, scale)
+            if mujoco:
+                return self._mujoco_triangles(geometry.data, name, scale, kind, collision)
+            return self.triangles(geometry.data, name, scale), ""
         uri = geometry.uri or ""
         if (self.options.keep_package_uris and uri.startswith(("package://", "model://"))
                 and not geometry.fragment):
             ext = Path(uri).suffix.lower().lstrip(".")
             if ext in readable:
-                return MeshRef(uri, scale, ext)
+                return MeshRef(uri, scale, ext), ""
         if geometry.path is None:
-            self.notes.note("MK805", f"mesh {uri or '(no uri)'} was not found; the shape is left out",
-                            source, target)
-            return None
+            return None, f"mesh {uri or '(no uri)'} was not found"
         from modelkit.geometry.meshfiles import MeshLoadError, MeshMetadata, load_mesh
 
         meta = geometry.source_params.get("metadata")
@@ -139,19 +260,48 @@ class MeshExporter:
                 data = path.read_bytes()
                 self.plan.protect(path)
             except OSError as exc:
-                self.notes.note("MK805", f"mesh {uri} cannot be read ({exc.strerror}); the shape is left out",
-                                source, target)
-                return None
-            return MeshRef(self._stage(data, safe_file_name(path.name, "mesh")), scale, ext)
+                return None, f"mesh {uri} cannot be read ({exc.strerror})"
+            if not mujoco:
+                return MeshRef(self._stage(data, safe_file_name(path.name, "mesh")), scale, ext), ""
+            try:
+                ready = for_mujoco(data, ext, scale)
+            except Unusable as exc:
+                return None, f"mesh {uri} cannot be read by MuJoCo ({exc})"
+            if ready.flat and collision:
+                return None, (f"mesh {uri} is flat (all its vertices in one plane): MuJoCo cannot build "
+                              "the convex hull it collides with")
+            file_name = safe_file_name(path.name, "mesh")
+            if ready.converted is not None:
+                file_name = f"{safe_file_name(path.stem, 'mesh')}.stl"
+                self.notes.note("MK804", f"mesh {path.name} ({ready.converted}) converted to binary STL, "
+                                "the only STL MuJoCo reads", source, target)
+            return MeshRef(self._stage(ready.data, file_name), scale, "stl" if ready.converted else ext,
+                           ready.hollow, ready.flat), ""
         try:
             loaded = load_mesh(path, geometry.fragment, metadata)
         except MeshLoadError as exc:
-            self.notes.note("MK805", f"mesh {uri} cannot be loaded ({exc.message}); the shape is left out",
-                            source, target)
-            return None
+            return None, f"mesh {uri} cannot be loaded ({exc.message})"
         part = f"#{geometry.fragment}" if geometry.fragment else ""
         unit = f", unit scale {loaded.unit_scale:g} applied" if loaded.unit_scale != 1.0 else ""
         self.notes.note("MK804", f"mesh {path.name}{part} ({loaded.source_format}) converted to "
                         f"{self.options.mesh_format.upper()}{unit}", source, target)
         stem = path.stem + (f"_{geometry.fragment}" if geometry.fragment else "")
-        return self.triangles(loaded.mesh, stem, scale)
+        if mujoco:
+            return self._mujoco_triangles(loaded.mesh, stem, scale, f"mesh {uri}", collision)
+        return self.triangles(loaded.mesh, stem, scale), ""
+
+    def _mujoco_triangles(self, mesh: TriangleMeshData, name: str, scale: Vec3, what: str,
+                          collision: bool) -> tuple[MeshRef | None, str]:
+        """Triangles written for MuJoCo: the checks of :func:`for_mujoco`, applied before staging."""
+        vertices = np.asarray(mesh.vertices, dtype=np.float64)
+        faces = np.asarray(mesh.faces, dtype=np.int64)
+        try:
+            corners = _checked(vertices[faces] if len(faces) else np.zeros((0, 3, 3)),
+                               stl=self.options.mesh_format == "stl")
+        except Unusable as exc:
+            return None, f"{what} cannot be read by MuJoCo ({exc})"
+        if collision and _flat(corners):
+            return None, (f"{what} is flat (all its vertices in one plane): MuJoCo cannot build the convex "
+                          "hull it collides with")
+        ref = self.triangles(mesh, name, scale)
+        return MeshRef(ref.uri, ref.scale, ref.file_format, _hollow(corners, scale), False), ""

@@ -1,31 +1,66 @@
-"""Numbers as writers print them: short, exact for what a person wrote, never ``-0``.
+"""Numbers as writers print them: short, clean, exact to 1e-12, never ``-0``.
 
-``fmt(x)`` prints at most 15 significant digits, which reproduces every decimal a person wrote
-(at most 15 digits round-trip through a double) and removes the noise of arithmetic
-(``1.0000000000000002`` → ``1``, ``6.123233995736766e-17`` stays as is: it is a real value).
-Printing never rounds beyond the 15th digit, so a read-back differs from the model by at most
-5e-15 relative (and is exact for anything written with 15 digits or fewer).
+``fmt(x)`` prints the shortest decimal that is ``x`` up to arithmetic dust (within 1e-12 relative,
+and 10⁴ below the decimal's last digit): a number a person wrote comes back as written, and the
+dust goes (``0.0615250000000001`` → ``0.061525``, ``1.0000000000000002`` → ``1``); other values
+get at most 15 significant digits. A read-back differs from the model by at most 1e-12 relative.
+
+Near-zero values are a question of scale, which ``fmt`` cannot know (``6.123233995736766e-17``
+is dust in a position, a real value in an inertia of a milligram part). Writers settle it where
+they know the quantity: :func:`clean_rotation` for quaternion components, Euler angles and matrix
+entries (dimensionless: below 1e-12 is 0, and within 1e-12 of ±1, ±0.5 or ±√½ is that value),
+:func:`clean_angle` for angles (within 1e-12 of a multiple of π/4 is that multiple), and
+:func:`clean_length` for positions (below 1e-12 of the model's length scale is 0; the scale is set
+with :func:`length_scale` around a write, 1 m by default).
 """
 
 from __future__ import annotations
 
+import contextvars
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 
 import numpy as np
 
+SNAP = 1e-12  # relative: what a written number may differ from the model's
+_LENGTH_SCALE: contextvars.ContextVar[float] = contextvars.ContextVar("length_scale", default=1.0)
+_EXACT_ROTATION_VALUES = (0.0, 1.0, 0.5, math.sqrt(0.5))
+
 
 def fmt(value: float) -> str:
-    """One number: shortest of ``repr`` and 15 significant digits; integers without ``.0``."""
+    """One number: the shortest decimal that is ``x`` up to dust (see :func:`_short`), else at most
+    15 significant digits; integers without ``.0``."""
     x = float(value)
     if not math.isfinite(x):
         raise ValueError(f"cannot write a non-finite number ({x})")
     if x == 0.0:
         return "0"
-    text = repr(x)
-    short = f"{x:.15g}"
-    if len(short) < len(text) and math.isfinite(float(short)):  # near DBL_MAX, rounding up overflows
-        text = short
+    text = _short(x) or repr(x)
+    fifteen = f"{x:.15g}"
+    if len(fifteen) < len(text) and math.isfinite(float(fifteen)):  # near DBL_MAX, rounding overflows
+        text = fifteen
+    return _tidy(text)
+
+
+def _short(x: float) -> str | None:
+    """The shortest decimal of at most 14 digits that differs from ``x`` by dust: at most 1e-12
+    relative, and at least 10⁴ times less than its own last digit (``0.0615250000000001`` →
+    ``0.061525``; ``1/3`` stays ``0.333333333333333``, which is not a decimal with a dusty tail)."""
+    exponent = math.floor(math.log10(abs(x)))
+    for digits in range(1, 15):
+        short = f"{x:.{digits}g}"
+        y = float(short)
+        if not math.isfinite(y):
+            continue
+        error = abs(y - x)
+        if error <= SNAP * abs(x) and error * 1e4 <= 10.0 ** (exponent - digits + 1):
+            return f"{y:.15g}"  # the same decimal, laid out as before (1000000, not 1e+06)
+    return None
+
+
+def _tidy(text: str) -> str:
+    """Trailing zeros, ``e+05`` and ``-0`` removed from a Python number text."""
     if "e" in text:
         mantissa, exponent = text.split("e")
         if "." in mantissa:
@@ -46,3 +81,38 @@ def fmt_vec(values: Iterable[float] | np.ndarray) -> str:
 def clean(value: float, tol: float = 1e-15) -> float:
     """``value`` with arithmetic dust below ``tol`` (absolute) set to exactly 0 (rotation matrices)."""
     return 0.0 if abs(value) < tol else float(value)
+
+
+def clean_rotation(value: float) -> float:
+    """A dimensionless rotation number (quaternion component, angle, matrix entry) with dust removed:
+    within 1e-12 of 0, ±1, ±0.5 or ±√½ it is that value exactly."""
+    x = float(value)
+    for exact in _EXACT_ROTATION_VALUES:
+        if abs(abs(x) - exact) <= SNAP:
+            return math.copysign(exact, x) if exact else 0.0
+    return x
+
+
+def clean_angle(value: float) -> float:
+    """An angle in radians with dust removed: within 1e-12 of a multiple of π/4 it is that
+    multiple (``2.07e-13`` → 0, ``-3.14159265358959`` → -π)."""
+    x = float(value)
+    quarter = round(x / (math.pi / 4.0))
+    exact = quarter * (math.pi / 4.0)
+    return exact + 0.0 if abs(x - exact) <= SNAP else x
+
+
+def clean_length(value: float) -> float:
+    """A position coordinate with dust below 1e-12 of the model's length scale set to 0."""
+    x = float(value)
+    return 0.0 if abs(x) <= SNAP * _LENGTH_SCALE.get() else x
+
+
+@contextmanager
+def length_scale(scale: float) -> Iterator[None]:
+    """Positions written inside the block take ``scale`` (metres) as the model's size."""
+    token = _LENGTH_SCALE.set(scale if math.isfinite(scale) and scale > 0.0 else 1.0)
+    try:
+        yield
+    finally:
+        _LENGTH_SCALE.reset(token)

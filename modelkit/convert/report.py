@@ -14,10 +14,13 @@ REPORT_VERSION = 1
 def render_summary(result: ConversionResult, quiet: bool = False) -> str:
     """Notes one per line (info notes left out when ``quiet``), then a count line."""
     lines = [n.render() for n in result.notes if not (quiet and n.severity is Severity.INFO)]
-    counts = Counter(n.severity.value for n in result.notes)
+    # every finding printed counts: the reading's diagnostics (printed before) and the notes
+    counts = Counter([n.severity.value for n in result.notes]
+                     + [d.severity.value for d in result.diagnostics])
     written = ", ".join(result.outputs) if result.outputs else "nothing"
+    errors = f"{counts['error']} error(s), " if counts.get("error") else ""
     lines.append(
-        f"wrote {written}; notes: {counts.get('warning', 0)} warning(s), {counts.get('info', 0)} info"
+        f"wrote {written}; notes: {errors}{counts.get('warning', 0)} warning(s), {counts.get('info', 0)} info"
     )
     return "\n".join(lines) + "\n"
 

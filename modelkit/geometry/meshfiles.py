@@ -573,6 +573,11 @@ def _load_stl(data: bytes, name: str) -> _Raw:
         from trimesh.exchange import stl as trimesh_stl
 
         text = data.decode("latin-1")
+        if not text.lstrip().lower().startswith("solid") and _looks_like_obj(text):
+            raw = _load_obj(data, name)
+            raw.notes.append("OBJ text in a file named .stl (read by its content; tools that go by the "
+                             "suffix, e.g. MuJoCo, refuse it)")
+            return raw
         if not text.lstrip().lower().startswith("solid"):
             expected = f"; its header announces {header_count} triangles = {84 + 50 * header_count} bytes" \
                 if header_count >= 0 else ""
@@ -606,6 +611,14 @@ def _load_stl(data: bytes, name: str) -> _Raw:
     v_all, f_all = _merge_identical_vertices(v_all, f_all)
     return _Raw("stl", v_all, f_all, ["ASCII STL (some tools, e.g. MuJoCo, read only binary STL)"]
                 if kind == "ASCII" else [])
+
+
+def _looks_like_obj(text: str) -> bool:
+    """Wavefront OBJ text: no NUL byte, and vertex and face lines."""
+    if "\x00" in text:
+        return False
+    lines = text.splitlines()
+    return any(line.startswith("v ") for line in lines) and any(line.startswith("f ") for line in lines)
 
 
 def _load_obj(data: bytes, name: str) -> _Raw:

@@ -339,9 +339,12 @@ def _mjcf_rotation(root: Element, geom: Element, where: str) -> Mat3:
         values = _floats(geom.get("axisangle"))
         return axis_angle(values[:3], values[3] * scale)
     if geom.get("euler") is not None:
-        if compiler is not None and compiler.get("eulerseq", "xyz") != "xyz":
-            raise _NotApplicable(f"{where}: euler with eulerseq other than xyz is not supported")
+        sequence = compiler.get("eulerseq", "xyz") if compiler is not None else "xyz"
         r, p, y = (a * scale for a in _floats(geom.get("euler")))
+        if sequence == "XYZ":  # fixed axes: what our writer uses (URDF's rpy)
+            return matrix_from_rpy(r, p, y)
+        if sequence != "xyz":
+            raise _NotApplicable(f"{where}: euler with eulerseq other than xyz or XYZ is not supported")
         return rot_x(r) @ axis_angle([0, 1, 0], p) @ axis_angle([0, 0, 1], y)  # intrinsic x-y-z
     if geom.get("zaxis") is not None:
         z = np.array(_floats(geom.get("zaxis")), dtype=float)

@@ -59,6 +59,10 @@ def vertical_fov(hfov: float, width: float | None, height: float | None) -> floa
     return hfov
 
 
+MAX_FOVY = 180.0  # MuJoCo refuses a camera fovy of 180° or more
+MAX_FOVY_WRITTEN = 179.0
+
+
 @dataclass
 class DeviceWriter:
     ctx: WriteContext
@@ -91,7 +95,13 @@ class DeviceWriter:
         hfov = p.get("horizontal_fov")
         width, height = p.get("width"), p.get("height")
         if hfov is not None:
-            el.set("fovy", fmt(math.degrees(vertical_fov(float(hfov), width, height))))
+            fovy = math.degrees(vertical_fov(float(hfov), width, height))
+            if fovy >= MAX_FOVY:  # MuJoCo: "fovy too large" (a panoramic camera's 180° or 360°)
+                self.ctx.note("MK875", f"camera {device.name}: vertical field of view {fmt(fovy)}° is "
+                              f"written as {fmt(MAX_FOVY_WRITTEN)}° (MuJoCo's cameras are pinhole cameras, "
+                              "below 180°; a panoramic camera has no MJCF equivalent)", device.source, target)
+                fovy = MAX_FOVY_WRITTEN
+            el.set("fovy", fmt(fovy))
         if width and height:
             el.set("resolution", f"{int(width)} {int(height)}")
         lost = [k for k in ("near", "far", "update_rate", "noise_stddev") if p.get(k) is not None]

@@ -36,6 +36,7 @@ import numpy as np
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import FLOOR_MATERIAL, PairFriction
 from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.diagnostics import SourceLocation
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, set_pose, sub
 from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere
@@ -77,7 +78,7 @@ class GeomWriter:
             )
             return
         shape = self.shape(
-            geom, target, f"{link.name}_{target.rsplit('/', 1)[1].replace('[', '').rstrip(']')}"
+            geom, target, f"{link.name}_{target.rsplit('/', 1)[1].replace('[', '').rstrip(']')}", collision
         )
         if shape is None:
             return
@@ -97,7 +98,8 @@ class GeomWriter:
         if collision and link.name in self.friction:
             self.set_friction(el, link, target)
 
-    def shape(self, geom: Geom, target: str, file_stem: str) -> dict[str, str] | None:
+    def shape(self, geom: Geom, target: str, file_stem: str,
+              collision: bool = False) -> dict[str, str] | None:
         g = geom.geometry
         if isinstance(g, Box):
             return {"type": "box", "size": fmt_vec(np.asarray(g.size, dtype=float) / 2.0)}
@@ -114,15 +116,18 @@ class GeomWriter:
         if isinstance(g, Cone):
             ref = self.ctx.meshes.primitive(g, file_stem, target, geom.source)
         elif isinstance(g, Mesh):
-            found = self.ctx.meshes.mesh(g, file_stem, target, geom.source, readable=MESH_READABLE)
+            found = self.ctx.meshes.mesh(g, file_stem, target, geom.source, readable=MESH_READABLE,
+                                         mujoco=True, collision=collision)
             if found is None:
                 return None
             ref = found
         else:  # pragma: no cover - the model has no other geometry
             return None
-        return {"type": "mesh", "mesh": self.mesh_asset(ref.uri, np.asarray(ref.scale, dtype=float), target)}
+        asset = self.mesh_asset(ref.uri, np.asarray(ref.scale, dtype=float), target, ref.hollow, geom.source)
+        return {"type": "mesh", "mesh": asset}
 
-    def mesh_asset(self, uri: str, scale: np.ndarray, target: str) -> str:
+    def mesh_asset(self, uri: str, scale: np.ndarray, target: str, hollow: bool = False,
+                   source: SourceLocation | None = None) -> str:
         key = (uri, tuple(float(x) for x in scale))
         known = self.mesh_assets.get(key)
         if known is not None:
@@ -132,6 +137,10 @@ class GeomWriter:
         el = sub(self.asset, "mesh", name=name, file=uri)
         if np.any(scale != 1.0):
             el.set("scale", fmt_vec(scale))
+        if hollow:  # MuJoCo: "mesh volume is too small"; body inertias are explicit, nothing changes
+            el.set("inertia", "shell")
+            self.ctx.note("MK876", f"mesh {stem} encloses no volume: its asset gets inertia=\"shell\", "
+                          "which MuJoCo needs to load it", source, f"asset/mesh[{name}]")
         self.mesh_assets[key] = name
         return name
 

@@ -7,14 +7,16 @@ import math
 import numpy as np
 from lxml import etree
 
-from modelkit.convert.numbers import clean, fmt, fmt_vec
-from modelkit.spatial import Mat3, Pose
+from modelkit.convert.numbers import SNAP, clean_angle, clean_length, clean_rotation, fmt, fmt_vec
+from modelkit.spatial import Mat3, Pose, axis_angle, matrix_from_rpy, rpy_from_matrix
 
 Element = etree._Element
 
 
 def quat_wxyz(rotation: Mat3) -> np.ndarray:
-    """The unit quaternion (w, x, y, z), w ≥ 0, of a rotation matrix (Shepperd's method)."""
+    """The unit quaternion (w, x, y, z), first non-zero component > 0, of a rotation matrix
+    (Shepperd's method); components within 1e-12 of 0, ±1, ±0.5 or ±√½ are that value
+    (:func:`clean_rotation`)."""
     r = np.asarray(rotation, dtype=float)
     trace = r[0, 0] + r[1, 1] + r[2, 2]
     if trace > 0.0:
@@ -29,21 +31,65 @@ def quat_wxyz(rotation: Mat3) -> np.ndarray:
     else:
         s = 2.0 * math.sqrt(1.0 + r[2, 2] - r[0, 0] - r[1, 1])
         q = np.array([(r[1, 0] - r[0, 1]) / s, (r[0, 2] + r[2, 0]) / s, (r[1, 2] + r[2, 1]) / s, 0.25 * s])
-    q = q / float(np.linalg.norm(q))
-    if q[0] < 0.0:
-        q = -q
-    return np.array([clean(x) for x in q])
+    q = np.array([clean_rotation(x) for x in q / float(np.linalg.norm(q))])
+    leading = next(x for x in q if x != 0.0)  # w ≥ 0; a half turn (w = 0) with its first axis ≥ 0
+    return -q + 0.0 if leading < 0.0 else q
+
+
+EULER_SEQUENCE = "XYZ"  # <compiler eulerseq>: fixed axes x, then y, then z = URDF's and SDF's rpy
 
 
 def set_pose(el: Element, pose: Pose) -> None:
-    """``pos`` and ``quat`` attributes, each left out when it is the identity (MuJoCo's default)."""
-    t = np.asarray(pose.translation, dtype=float)
+    """``pos`` and ``quat`` (or ``zaxis``, ``euler``) attributes, each left out when it is the identity.
+
+    The rotation is written in the shortest of three texts that give the same matrix to 1e-12:
+    ``quat``; ``zaxis`` when it is the shortest turn taking Z to a direction (``zaxis="0 1 0"``);
+    ``euler``, URDF's roll-pitch-yaw (with ``<compiler eulerseq="XYZ">``, which the writer adds):
+    ``rpy="1.57079 0 1.57079"`` stays ``euler="1.57079 0 1.57079"`` instead of a quaternion of
+    four 15-digit numbers."""
+    t = np.array([clean_length(v) for v in np.asarray(pose.translation, dtype=float)])
     if np.any(t != 0.0):
         el.set("pos", fmt_vec(t))
     if not np.array_equal(np.asarray(pose.rotation, dtype=float), np.eye(3)):
         q = quat_wxyz(pose.rotation)
         if not (q[0] == 1.0 and not np.any(q[1:])):
-            el.set("quat", fmt_vec(q))
+            texts = {"quat": fmt_vec(q)}
+            for key, text in (("zaxis", zaxis_text(pose.rotation)), ("euler", euler_text(pose.rotation))):
+                if text is not None:
+                    texts[key] = text
+            key = min(texts, key=lambda k: len(texts[k]))  # the shortest exact one; quat on a tie
+            el.set(key, texts[key])
+
+
+def zaxis_text(rotation: Mat3) -> str | None:
+    """The rotation as MuJoCo's ``zaxis`` (the shortest turn taking Z to it), or None when that is
+    not this rotation to 1e-12 (a turn about the new Z as well)."""
+    r = np.asarray(rotation, dtype=float)
+    text = fmt_vec([clean_rotation(v) for v in r[:, 2]])
+    if float(np.max(np.abs(z_turn([float(v) for v in text.split()]) - r))) > SNAP:
+        return None
+    return text
+
+
+def z_turn(z: list[float]) -> np.ndarray:
+    """The rotation MuJoCo makes of ``zaxis="z"``: about Z × z, by the angle between them (about X by
+    π when z is −Z)."""
+    v = np.asarray(z, dtype=float) / float(np.linalg.norm(z))
+    cross = np.cross([0.0, 0.0, 1.0], v)
+    sine = float(np.linalg.norm(cross))
+    if sine < 1e-15:
+        return np.eye(3) if v[2] > 0.0 else axis_angle([1.0, 0.0, 0.0], math.pi)
+    return axis_angle(cross / sine, math.atan2(sine, float(v[2])))
+
+
+def euler_text(rotation: Mat3) -> str | None:
+    """The rotation as fixed-axis x-y-z angles (``eulerseq="XYZ"``), or None when the printed angles
+    do not give back the matrix to 1e-12."""
+    text = fmt_vec([clean_angle(a) for a in rpy_from_matrix(rotation)])
+    back = matrix_from_rpy(*(float(v) for v in text.split()))
+    if float(np.max(np.abs(back - np.asarray(rotation, dtype=float)))) > SNAP:
+        return None
+    return text
 
 
 def sub(parent: Element, tag: str, **attributes: str) -> Element:

@@ -39,7 +39,7 @@ from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_geoms import GeomWriter
 from modelkit.formats.mjcf.write_names import NameTable
-from modelkit.formats.mjcf.write_xml import Element, indent, set_pose, sub
+from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, set_pose, sub
 from modelkit.model import WORLD_LINK, JointType, LoopConstraint, Robot
 from modelkit.spatial import Pose
 
@@ -88,6 +88,8 @@ class MjcfWriter:
         for loop in self.robot.loops:
             self._loop(loop)
         self._actuators()
+        if any(el.get("euler") is not None for el in self.root.iter()):
+            self.sections["compiler"].set("eulerseq", EULER_SEQUENCE)  # set_pose's euler: URDF's rpy
         for tag in SECTIONS:
             el = self.sections[tag]
             if tag not in ("compiler", "worldbody") and len(el) == 0 and not el.attrib:

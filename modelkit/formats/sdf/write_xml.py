@@ -9,7 +9,7 @@ import numpy as np
 from lxml import etree
 from lxml.etree import _Element as Element
 
-from modelkit.convert.numbers import clean, fmt, fmt_vec
+from modelkit.convert.numbers import clean_angle, clean_length, fmt, fmt_vec
 from modelkit.spatial import Mat3, Pose
 
 
@@ -37,11 +37,11 @@ def rpy(rotation: Mat3) -> tuple[float, float, float]:
     else:  # gimbal lock: everything into yaw
         roll = 0.0
         yaw = math.atan2(-float(r[0, 1]), float(r[1, 1]))
-    return clean(roll), clean(pitch), clean(yaw)
+    return clean_angle(roll), clean_angle(pitch), clean_angle(yaw)
 
 
 def pose_text(pose: Pose) -> str:
-    t = [clean(float(v)) for v in pose.translation]
+    t = [clean_length(float(v)) for v in pose.translation]
     return fmt_vec([*t, *rpy(pose.rotation)])
 
 

@@ -17,7 +17,7 @@ from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.meshes import MeshRef
-from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.numbers import clean_angle, clean_length, fmt, fmt_vec
 from modelkit.convert.output import safe_file_name
 from modelkit.diagnostics import SourceLocation
 from modelkit.model import (
@@ -40,8 +40,8 @@ TEXTURE_FOLDER = "textures"
 
 def origin_element(parent: Element, pose: Pose, always: bool = False) -> None:
     """``<origin xyz rpy>`` for ``pose`` (left out when it is the identity, unless ``always``)."""
-    xyz = fmt_vec(pose.translation)
-    rpy = fmt_vec(rpy_from_matrix(pose.rotation))
+    xyz = fmt_vec([clean_length(v) for v in pose.translation])
+    rpy = fmt_vec([clean_angle(v) for v in rpy_from_matrix(pose.rotation)])
     if always or xyz != "0 0 0" or rpy != "0 0 0":
         etree.SubElement(parent, "origin", xyz=xyz, rpy=rpy)
 

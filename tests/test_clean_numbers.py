@@ -1,0 +1,99 @@
+"""Issue 17 §5: every writer prints clean numbers (no arithmetic dust, readable rotations) and a
+read-back is still the same robot to 1e-9, on real robots nobody here wrote (pybullet_data)."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+from lxml import etree
+
+from modelkit.api import validate
+from modelkit.convert.api import write
+from modelkit.convert.compare import compare_poses
+from modelkit.convert.notes import renames
+from modelkit.convert.numbers import clean_angle, clean_length, clean_rotation, fmt, length_scale
+from modelkit.formats.mjcf.write_xml import euler_text, quat_wxyz, set_pose, z_turn, zaxis_text
+from modelkit.spatial import Pose, matrix_from_rpy
+
+pybullet_data = pytest.importorskip("pybullet_data")
+DATA = Path(pybullet_data.getDataPath())
+ROBOTS = ["franka_panda/panda.urdf", "kuka_iiwa/model.urdf", "laikago/laikago_toes_zup.urdf", "a1/a1.urdf",
+          "quadruped/minitaur.urdf"]
+TARGETS = ["xml", "urdf", "sdf"]
+NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e-?\d+)?")
+DUST = re.compile(r"e-1[0-9]$|\.\d*(?:0{7,}[1-9]|9{7,})\d*$")  # near zero, or a 0000000x/9999999 tail
+
+
+def test_dust_goes_and_written_decimals_stay() -> None:
+    assert fmt(0.0615250000000001) == "0.061525"
+    assert fmt(0.30000000000000004) == "0.3"
+    assert fmt(0.9999999999999999) == "1"
+    assert fmt(1 / 3) == "0.333333333333333"  # a value, not a decimal with a dusty tail
+    assert fmt(0.499999999989993) == "0.499999999989993"  # 1e-11 from 0.5: a real rotation
+    assert fmt(3.14159265359) == "3.14159265359"
+    assert fmt(6.123233995736766e-17) == "6.12323399573677e-17"  # fmt alone cannot call it dust
+    assert clean_rotation(1.03411553555107e-13) == 0.0
+    assert clean_rotation(-0.707106781186547) == -math.sqrt(0.5)
+    assert clean_rotation(0.7071067811) == 0.7071067811
+    assert clean_angle(-3.14159265358959) == -math.pi
+    assert clean_angle(2.06823107110214e-13) == 0.0
+    assert clean_angle(1.5708) == 1.5708
+    assert clean_length(-2.0e-13) == 0.0
+    with length_scale(1e-3):  # a millimetre robot: 2e-13 m is no longer dust below 1e-12 of it
+        assert clean_length(-2.0e-13) == -2.0e-13
+
+
+def test_quaternions_and_euler_angles_are_exact_values() -> None:
+    half_turn = matrix_from_rpy(3.14159265359, 0.0, 0.0)  # a source's 12-digit π
+    assert " ".join(fmt(v) for v in quat_wxyz(half_turn)) == "0 1 0 0"
+    quarter = matrix_from_rpy(math.pi / 2, 0.0, 0.0) @ matrix_from_rpy(0.0, 0.0, 1e-13)
+    assert " ".join(fmt(v) for v in quat_wxyz(quarter)) == "0.707106781186548 0.707106781186548 0 0"
+    rotation = matrix_from_rpy(1.57079, 0.0, 1.57079)
+    assert euler_text(rotation) == "1.57079 0 1.57079"
+
+
+def test_mjcf_rotations_take_the_shortest_exact_text() -> None:
+    def written(rotation: np.ndarray) -> dict[str, str]:
+        el = etree.Element("geom")
+        set_pose(el, Pose(rotation, np.zeros(3)))
+        return dict(el.attrib)
+
+    assert zaxis_text(matrix_from_rpy(math.pi / 2, 0.0, 0.0)) == "0 -1 0"
+    assert zaxis_text(matrix_from_rpy(0.0, 0.0, math.pi / 2)) is None  # a turn about Z: no zaxis
+    assert written(matrix_from_rpy(math.pi / 2, 0.0, 0.0)) == {"zaxis": "0 -1 0"}
+    assert written(matrix_from_rpy(math.pi, 0.0, 0.0)) == {"zaxis": "0 0 -1"}
+    assert written(matrix_from_rpy(1.57079, 0.0, 1.57079)) == {"euler": "1.57079 0 1.57079"}
+    assert written(matrix_from_rpy(0.0, 0.0, math.pi)) == {"quat": "0 0 0 1"}
+    for rotation in (matrix_from_rpy(0.3, -1.2, 2.9), matrix_from_rpy(math.pi, 0.0, 0.0)):
+        assert np.allclose(z_turn([0.0, 0.0, -1.0]) @ np.eye(3), matrix_from_rpy(math.pi, 0.0, 0.0))
+        assert written(rotation)  # never the identity for a turn
+
+
+@pytest.mark.parametrize("source", ROBOTS)
+def test_real_robots_are_written_clean_and_read_back_equal(source: str, tmp_path: Path) -> None:
+    robot = validate(DATA / source).robots[0]
+    masses = {link.name: link.inertial.mass for link in robot.links
+              if link.inertial is not None and link.inertial.mass > 0.0}
+    for target in TARGETS:
+        path = tmp_path / target / f"robot.{target}"
+        path.parent.mkdir()
+        notes = write(robot, path)
+        text = path.read_text()
+        dusty = sorted({n for n in NUMBER.findall(text) if DUST.search(n)})
+        # the SDF writer's tiny inertial of a massless frame (writer.TINY_INERTIA) is a chosen value
+        dusty = [n for n in dusty if not (target == "sdf" and n == "1e-12")]
+        assert dusty == [], f"{source} → {target}: {dusty}"
+        if target == "xml":
+            mujoco.MjModel.from_xml_path(str(path))
+        back = validate(path).robots[0]
+        names = renames(notes, "link")
+        assert compare_poses(robot, back, names, tol=1e-9) == []
+        # massless links are given a writer's minimum mass (MK816 notes): compare the real ones
+        back_masses = {link.name: link.inertial.mass for link in back.links if link.inertial is not None}
+        for name, mass in masses.items():
+            assert back_masses.get(names.get(name, name)) == pytest.approx(mass, rel=1e-9), (target, name)

@@ -1,0 +1,179 @@
+"""Issue 17 §8: every MJCF ``convert`` writes loads in MuJoCo, or ``convert`` exits 1 naming why.
+
+Each case is a small generated robot in a tmp folder, converted with the CLI; the output is then
+loaded with ``mujoco.MjModel.from_xml_path``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+import trimesh
+from click.testing import CliRunner
+
+from modelkit.cli import main
+
+BOX = trimesh.creation.box([0.1, 0.1, 0.1])
+INERTIAL = ('<inertial><mass value="1"/>'
+            '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>')
+
+
+def _urdf(mesh: str, collision: bool) -> str:
+    geometry = f'<geometry><mesh filename="{mesh}"/></geometry>'
+    shapes = f"<visual>{geometry}</visual>" + (f"<collision>{geometry}</collision>" if collision else "")
+    return f'<robot name="r"><link name="base">{INERTIAL}{shapes}</link></robot>'
+
+
+def _ascii_stl() -> bytes:
+    text = BOX.export(file_type="stl_ascii")
+    return text.encode() if isinstance(text, str) else bytes(text)
+
+
+def _binary_stl(vertices: np.ndarray, faces: np.ndarray) -> bytes:
+    data = trimesh.Trimesh(vertices, faces, process=False).export(file_type="stl")
+    return bytes(data)
+
+
+def _nan_stl() -> bytes:
+    vertices = np.array(BOX.vertices)
+    vertices[0, 0] = np.nan
+    return _binary_stl(vertices, np.asarray(BOX.faces))
+
+
+def _flat_stl() -> bytes:
+    return _binary_stl(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], dtype=float),
+                       np.array([[0, 1, 2], [1, 3, 2]]))
+
+
+def _huge_stl() -> bytes:
+    sphere = trimesh.creation.icosphere(subdivisions=7)  # 327,680 faces
+    return _binary_stl(np.asarray(sphere.vertices), np.asarray(sphere.faces))
+
+
+def _tiny_stl() -> bytes:  # a closed cube of 10 µm: 1e-15 m³, "mesh volume is too small" for MuJoCo
+    return _binary_stl(np.asarray(BOX.vertices) * 1e-4, np.asarray(BOX.faces))
+
+
+MESHES = {
+    "tiny": _tiny_stl,
+    "ascii": _ascii_stl,
+    "obj_text": lambda: str(BOX.export(file_type="obj")).encode(),
+    "png": lambda: b"\x89PNG\r\n\x1a\n" + bytes(200),
+    "empty": lambda: b"",
+    "nan": _nan_stl,
+    "flat": _flat_stl,
+    "huge": _huge_stl,
+}
+
+# (mesh, collision: the mesh is the visual and the collision shape, else visual only)
+#   → (exit code, a code the output must print, geoms MuJoCo loads)
+CASES = {
+    ("ascii", True): (0, "MK804", 2),  # converted to binary STL
+    ("ascii", False): (0, "MK804", 1),
+    ("obj_text", True): (0, "MK804", 2),  # read by its content, written as binary STL
+    ("flat", False): (0, "MK876", 1),  # a visual plane: inertia="shell" on its asset
+    ("tiny", True): (0, "MK876", 2),
+    ("flat", True): (1, "MK805", 1),  # the visual stays; MuJoCo cannot build a plane's convex hull
+    ("png", True): (1, "MK805", 0),
+    ("empty", True): (1, "MK805", 0),
+    ("nan", True): (1, "MK805", 0),
+    ("huge", True): (1, "MK805", 0),
+    ("missing", True): (1, "MK500", 0),
+}
+
+
+def _convert(source: Path, out: Path) -> tuple[int, str]:
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(out)])
+    return result.exit_code, result.output  # stdout and stderr, each line once
+
+
+@pytest.mark.parametrize(("mesh", "collision"), list(CASES))
+def test_each_mesh_case_loads_in_mujoco_or_exits_1(mesh: str, collision: bool, tmp_path: Path) -> None:
+    if mesh in MESHES:
+        (tmp_path / f"{mesh}.stl").write_bytes(MESHES[mesh]())
+    source = tmp_path / "robot.urdf"
+    source.write_text(_urdf(f"{mesh}.stl", collision))
+    out = tmp_path / "out" / "robot.xml"
+    status, output = _convert(source, out)
+    expected_status, code, geoms = CASES[(mesh, collision)]
+    assert status == expected_status, output
+    assert code in output, output
+    if expected_status == 1:
+        assert f"error {code}" in output and "error(s)" in output.splitlines()[-1], output
+    model = mujoco.MjModel.from_xml_path(str(out))  # what is written always loads
+    assert int(model.ngeom) == geoms, output
+    if mesh in ("ascii", "obj_text"):
+        written = next((out.parent / "meshes").glob("*.stl")).read_bytes()
+        assert len(written) == 84 + 50 * int.from_bytes(written[80:84], "little")  # binary STL
+
+
+def test_panoramic_camera_is_clamped_with_a_note(tmp_path: Path) -> None:
+    source = tmp_path / "pano.body"
+    source.write_text("""\
+format: ChoreonoidBody
+format_version: 2.0
+angle_unit: degree
+name: pano
+root_link: base
+links:
+  -
+    name: base
+    joint_type: free
+    mass: 1.0
+    center_of_mass: [ 0, 0, 0 ]
+    inertia: [ 0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01 ]
+    elements:
+      - { type: Shape, geometry: { type: Box, size: [ 0.1, 0.1, 0.1 ] } }
+      - { type: Camera, name: Panorama, format: COLOR, translation: [ 0.1, 0, 0 ], field_of_view: 180,
+          width: 640, height: 480 }
+""")
+    out = tmp_path / "out" / "pano.xml"
+    status, output = _convert(source, out)
+    assert status == 0, output
+    assert "MK875" in output
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert model.ncam == 1 and model.cam_fovy[0] == pytest.approx(179.0)
+
+
+def test_summary_counts_every_warning_printed(tmp_path: Path) -> None:
+    (tmp_path / "robot.urdf").write_text(
+        '<robot name="r"><link name="base">' + INERTIAL
+        + '<visual><geometry><mesh filename="gone.stl"/></geometry></visual>'
+        + '<visual><geometry><box size="1 1 1"/></geometry><bogus/></visual></link></robot>')
+    status, output = _convert(tmp_path / "robot.urdf", tmp_path / "out" / "robot.xml")
+    printed = sum(" warning MK" in line for line in output.splitlines())
+    assert printed >= 2
+    assert f"notes: {printed} warning(s)" in output, output
+    assert status == 0
+
+
+def test_a_flat_generated_mesh_keeps_its_visual_and_loses_its_collision(tmp_path: Path) -> None:
+    """A `.body` TriangleMesh (written by the writer, not copied) gets the same checks."""
+    source = tmp_path / "tri.body"
+    source.write_text("""\
+format: ChoreonoidBody
+format_version: 2.0
+angle_unit: degree
+name: tri
+root_link: base
+links:
+  -
+    name: base
+    joint_type: free
+    mass: 1.0
+    center_of_mass: [ 0, 0, 0 ]
+    inertia: [ 0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01 ]
+    elements:
+      - type: Shape
+        geometry: { type: TriangleMesh, vertices: [ 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0 ],
+                    faces: [ 0, 1, 2, 1, 3, 2 ] }
+""")
+    out = tmp_path / "out" / "tri.xml"
+    status, output = _convert(source, out)
+    assert status == 1, output
+    assert "error MK805" in output and "MK876" in output, output
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert model.ngeom == 1  # the visual plane
