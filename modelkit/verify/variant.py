@@ -118,28 +118,37 @@ def prepare_variant(robot: Robot, drive: Drive, proxy: WheelProxy) -> tuple[Robo
     return prepared, spheres
 
 
+WRITE_CHOICE: dict[str, str] = {"sphere": "auto", "native": "cylinder"}
+"""The ``--wheel-collision`` each layer-4 run writes with: the graded run reads exactly what
+``convert`` writes by default (``auto``: sphere wheels for MJCF and URDF, MK824); the report-only
+native run what ``convert --wheel-collision cylinder`` writes."""
+
+
 def write_variant(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path, proxy: WheelProxy
                   ) -> tuple[dict[str, Path], dict[str, Renames]]:
-    """Write the floating-base verification variant of ``robot`` (the source model, root not welded)
-    as MJCF and URDF into ``out_dir`` (``<name>_<proxy>.xml`` / ``.urdf``, meshes in ``meshes/``).
+    """Write the floating-base ``robot`` (the source model, root not welded) as MJCF and URDF into
+    ``out_dir`` exactly as ``convert`` writes it (``<name>.xml`` / ``.urdf``; the native run's
+    ``<name>_cylinder.*``; meshes in ``meshes/``): no edit of the written files, the engines load
+    them as they are.
 
     Returns the files (``"mjcf"``, ``"urdf"``) and each file's renames (``{"link": {source:
-    written}, "joint": {...}}``, from the writers' MK800 notes), as ``verify``'s conversion does.
-    ``scenario`` is not needed to write the files (friction is applied by the drivers); it is taken
-    so that a later variant option (another proxy shape) has its place."""
+    written}, "joint": {...}}``, from the writers' MK800 notes), as ``verify``'s conversion does."""
     from modelkit.convert.api import write
     from modelkit.convert.notes import renames
+    from modelkit.convert.options import WriteOptions
 
-    del scenario
-    prepared, _ = prepare_variant(robot, drive, proxy)
+    del scenario, drive
+    if proxy not in WRITE_CHOICE:
+        raise ValueError(f"wheel proxy must be 'sphere' or 'native', not {proxy!r}")
+    options = WriteOptions(wheel_collision=WRITE_CHOICE[proxy])
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    stem = f"{_safe(robot.name or 'robot')}_{proxy}"
+    stem = _safe(robot.name or "robot") + ("" if proxy == "sphere" else "_cylinder")
     files: dict[str, Path] = {}
     maps: dict[str, Renames] = {}
     for fmt in ("mjcf", "urdf"):
         path = out_dir / f"{stem}{SUFFIX[fmt]}"
-        notes = write(prepared, path, fmt, force=True)
+        notes = write(robot, path, fmt, options=options, force=True)
         files[fmt] = path
         maps[fmt] = {"link": renames(notes, "link"), "joint": renames(notes, "joint")}
     return files, maps
