@@ -20,11 +20,16 @@ a report-only profile (``steps``: slip-dominated reversals), and the **native** 
 (§2.2: MuJoCo and PyBullet model a cylinder on a plane differently, so that run has no meaningful
 tolerance).
 
-Tracked robots are driven through the rollers ``convert`` writes (sphere proxies at the roller
-centres in the verification variant). Their no-slip reference is the ideal velocity servo: only
-straight profiles (w = 0 throughout) are compared with it; a turning tracked robot skids sideways
-(skid steering), which no rigid no-slip model describes, so turning profiles compare the engines
-with each other only, report-only (each engine's friction cone decides the skid).
+**Graded = written.** The graded runs load exactly the MJCF and URDF ``modelkit convert`` writes
+with its default options (wheels: sphere collisions, MK824; the contact parameters, priority and
+``<option>`` in the file, MK825), unmodified: MuJoCo gets a default plane added to the world,
+PyBullet loads pybullet_data's ``plane.urdf`` as shipped (see the drivers for the engine settings).
+``report.json`` names the files (``engines.layer4.files``).
+
+Tracked robots are driven through the rollers ``convert`` writes. Their no-slip reference is the
+ideal velocity servo: only straight profiles (w = 0 throughout) are compared with it; a turning
+tracked robot skids sideways (skid steering), which no rigid no-slip model describes, so turning
+profiles compare the engines with each other only, report-only (the verdict line says so).
 """
 
 from __future__ import annotations
@@ -56,7 +61,8 @@ NATIVE_WARNING = (
     "(MuJoCo: two contacts, one on each rim edge, so a yawing wheel scrubs; PyBullet's implicit cylinder: "
     "one contact at whichever rim edge its support mapping picks, so the first acceleration yaws the robot); "
     "verification.md §2.2 measured up to 2.6 m and π rad between them on the arc. Choreonoid's own contact "
-    "model (not run here) is a third meaning. The graded runs use sphere proxies of the wheel radius."
+    "model (not run here) is a third meaning. This run reads what convert --wheel-collision cylinder writes; "
+    "the graded runs read convert's default files (sphere wheels, MK824)."
 )
 TRACK_SKIP = (
     "tracks: the no-slip reference is compared only on straight profiles (w = 0): a turning tracked robot "
@@ -274,6 +280,8 @@ def _setup(
             )
         return
     result.settings.setdefault("variant", {})[proxy] = {k: p.name for k, p in sorted(files.items())}
+    if proxy == "sphere":  # the graded run: the files convert writes by default, as they are
+        result.settings["files"] = {k: p.name for k, p in sorted(files.items())}
     for spec in inject:
         apply = _resolve("modelkit.verify.inject:apply")
         try:
