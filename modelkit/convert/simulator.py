@@ -58,8 +58,14 @@ A time constant of 4 ms (≥ 2 timesteps at 1 ms) and impedance 0.99–0.999 kee
 
 
 def mujoco_contact(robot: Robot) -> dict[str, str]:
-    """solref/solimp for every collision geom of a driven robot (wheels or tracks); {} otherwise."""
-    return dict(CONTACT) if mujoco_options(robot)[0] else {}
+    """solref/solimp for every collision geom of a wheeled robot; {} otherwise. Tracks keep MuJoCo's
+    default contact: their skid turning (TRACK_IMPRATIO) was measured with it, and the stiff contact
+    changes it (the tutorial's tracked robot's arc then ends 2.2 m from the skid reference)."""
+    from modelkit.convert.tracks import track_impratio
+    from modelkit.convert.wheels import WHEELS_KEY
+
+    wheels = robot.extras.get(WHEELS_KEY)
+    return dict(CONTACT) if track_impratio(robot) is None and isinstance(wheels, dict) and wheels else {}
 
 
 def pybullet_settings(robot: Robot) -> dict[str, str]:

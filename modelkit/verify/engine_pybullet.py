@@ -395,6 +395,13 @@ def simulator(model: Path, renames: Renames, *, root: str, dt: float,
 SOLVER_ITERATIONS = 50
 FLOOR_FRICTION = 1.0
 DEFAULT_LINK_FRICTION = 1.0  # a link the URDF gives no friction: MuJoCo's default geom friction
+FLOOR = "plane.urdf"
+"""Layer 4's floor: pybullet_data's plane.urdf as shipped (what a user loads)."""
+ANALYTIC_FLOOR = "analytic"
+"""A GEOM_PLANE body of lateral friction 1 (plane.urdf's), for the tests that compare two control
+paths to round-off: plane.urdf's collision is a 200 m box, and Bullet's box–sphere contact amplifies
+a one-ulp torque difference to 1e-5 m over 10 s (measured), where the analytic plane keeps it at
+1e-13; the floor is not what those tests are about."""
 
 
 def urdf_friction(path: Path) -> dict[str, float]:
@@ -421,7 +428,7 @@ class PyBulletDriver:
 
     def __init__(self, model: Path, renames: Renames, drive: Any, scenario: Any, factory: str | None = None,
                  sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT,
-                 fast: bool = True) -> None:
+                 fast: bool = True, floor: str = FLOOR) -> None:
         from modelkit.verify import variant as v
 
         self.fast = fast
@@ -452,7 +459,7 @@ class PyBulletDriver:
                 contact_friction=scenario.friction,
                 drive=drive.as_dict(), scenario=v.scenario_data(scenario), factory=self.factory,
                 joint_names=joint_names, roller_radius=drive.roller_radius or drive.radius, sys_path=sys_path,
-                engine_parameters=self.engine_parameters)
+                engine_parameters=self.engine_parameters, floor=floor)
         except BaseException:
             self._worker.close()
             raise
@@ -482,7 +489,8 @@ class PyBulletDriver:
                                "roller 0's target; the rollers of a track coupled by a JOINT_GEAR constraint "
                                "(ratio −1: equal speeds), the URDF's <mimic> that PyBullet ignores")
             if velocity else "none",
-            "floor": "pybullet_data's plane.urdf as shipped (lateral_friction 1)",
+            "floor": ("pybullet_data's plane.urdf as shipped (lateral_friction 1)" if floor == FLOOR
+                      else "an analytic GEOM_PLANE of lateral friction 1 (a test of the control path)"),
             "friction": dict(sorted(info["friction"].items())),
             "friction_rule": "Bullet multiplies the two bodies' values: plane.urdf's 1 × the link's",
             "friction_source": "the URDF as written: each link's <contact> (the contact materials against "
@@ -584,9 +592,10 @@ class PyBulletDriver:
 
 
 def driver(model: Path, renames: Renames, *, drive: Any, scenario: Any, factory: str | None = None,
-           sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT, fast: bool = True
-           ) -> PyBulletDriver:
+           sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT, fast: bool = True,
+           floor: str = FLOOR) -> PyBulletDriver:
     """Layer 4's entry point (:class:`modelkit.verify.drive.Driver`, plus ``start``/``result``).
     ``fast`` False: the controllers' ``output`` every step even when they have affine laws (the
-    reference the fast path is tested against, ``tests/test_verify_drivers_pybullet_fast.py``)."""
-    return PyBulletDriver(Path(model), renames, drive, scenario, factory, sys_path, timeout, fast)
+    reference the fast path is tested against, ``tests/test_verify_drivers_pybullet_fast.py``).
+    ``floor``: :data:`FLOOR` (layer 4's) or :data:`ANALYTIC_FLOOR` (see there; tests only)."""
+    return PyBulletDriver(Path(model), renames, drive, scenario, factory, sys_path, timeout, fast, floor)

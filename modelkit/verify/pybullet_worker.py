@@ -272,7 +272,8 @@ class Engine:
                     drive: dict[str, Any], scenario: dict[str, Any], factory: str,
                     joint_names: dict[str, str], roller_radius: float,
                     sys_path: list[str] | None = None,
-                    engine_parameters: dict[str, Any] | None = None) -> dict[str, Any]:
+                    engine_parameters: dict[str, Any] | None = None,
+                    floor: str = "plane.urdf") -> dict[str, Any]:
         """Keep the layer-4 set-up and build the controllers here, from plain data, with the same
         factory the parent uses (``module:function``), so the stepping loop never crosses the pipe.
         ``joint_names``: source joint name → the URDF's. ``friction``: link → its friction against
@@ -291,7 +292,7 @@ class Engine:
                           "friction": dict(friction), "default_friction": default_friction,
                           "floor_friction": floor_friction, "roller_radius": roller_radius,
                           "contact_joints": list(contact_joints), "contact_friction": contact_friction,
-                          "engine_parameters": dict(engine_parameters or {})}
+                          "engine_parameters": dict(engine_parameters or {}), "floor": floor}
         self.drive_rollers = {k: list(v) for k, v in drive.get("rollers", {}).items()}
         self.drive_names = dict(joint_names)
         self.controllers = make(drive, scenario)
@@ -316,9 +317,15 @@ class Engine:
         p.setPhysicsEngineParameter(numSolverIterations=cfg["iterations"], physicsClientId=c)
         if cfg["engine_parameters"]:
             p.setPhysicsEngineParameter(**cfg["engine_parameters"], physicsClientId=c)
-        import pybullet_data
+        if cfg["floor"] == "analytic":  # engine_pybullet.ANALYTIC_FLOOR: tests of the control path
+            shape = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c)
+            self.floor = p.createMultiBody(0.0, shape, physicsClientId=c)
+            p.changeDynamics(self.floor, -1, lateralFriction=1.0, physicsClientId=c)
+        else:
+            import pybullet_data
 
-        self.floor = p.loadURDF(os.path.join(pybullet_data.getDataPath(), "plane.urdf"), physicsClientId=c)
+            self.floor = p.loadURDF(os.path.join(pybullet_data.getDataPath(), cfg["floor"]),
+                                    physicsClientId=c)
         flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER
         body = p.loadURDF(cfg["path"], useFixedBase=False, flags=flags, physicsClientId=c)
         self.drive_body = body

@@ -71,11 +71,12 @@ class MjcfWriter:
         for key, value in options.items():
             self.sections["option"].set(key, value)
         if options:
+            stiff = (f"; the collision geoms have solref {CONTACT['solref']!r} and solimp "
+                     f"{CONTACT['solimp']!r} (stiff contact: the wheels keep their rolling radius)"
+                     if mujoco_contact(robot) else "")
             ctx.note(
                 "MK825",
-                f"<option {' '.join(f'{k}={v!r}' for k, v in options.items())}>: {why}; the collision geoms "
-                f"have solref {CONTACT['solref']!r} and solimp {CONTACT['solimp']!r} (stiff contact, the "
-                "wheels keep their rolling radius); a scene that "
+                f"<option {' '.join(f'{k}={v!r}' for k, v in options.items())}>: {why}{stiff}; a scene that "
                 "includes this file keeps these settings (MuJoCo merges <option>), and the robot drives "
                 "like its source with them (docs/convert.md)",
                 robot.source,
