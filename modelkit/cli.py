@@ -16,7 +16,7 @@ from typing import Any, NoReturn, TypeVar
 
 import click
 
-from modelkit.convert.options import MESH_FORMATS, SDF_VERSIONS
+from modelkit.convert.options import MESH_FORMATS, SDF_VERSIONS, WHEEL_COLLISIONS
 from modelkit.convert.registry import TARGET_NAMES
 from modelkit.diagnostics import (
     Diagnostic,
@@ -424,6 +424,9 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
 @click.option("--merge-fixed", is_flag=True, help="Fuse links on fixed joints into their parents.")
 @click.option("--urdf-world-link", is_flag=True,
               help="URDF: add a `world` link and the root's fixed or floating joint to it.")
+@click.option("--wheel-collision", type=click.Choice(WHEEL_COLLISIONS), default="auto", show_default=True,
+              help="Collision shape of wheels (auto: a sphere for MJCF and URDF, the cylinder for SDF and "
+                   ".body; MK826).")
 @reading_options
 def convert(
     words: tuple[str, ...],
@@ -440,6 +443,7 @@ def convert(
     keep_package_uris: bool,
     merge_fixed: bool,
     urdf_world_link: bool,
+    wheel_collision: str,
     **kwargs: Any,
 ) -> None:
     """Convert model files to URDF, SDF, MJCF or .body; every approximation is reported.
@@ -461,6 +465,7 @@ def convert(
         keep_package_uris=keep_package_uris,
         merge_fixed=merge_fixed,
         urdf_world_link=urdf_world_link,
+        wheel_collision=wheel_collision,
     )
     with _interruptible("convert", output):
         result = run_convert(files, output, target, _read_options(kwargs, True, xacro_args), options, force,

@@ -1135,6 +1135,20 @@ _TABLE: tuple[CodeInfo, ...] = (
         "without limits where the target needs lower < upper (MJCF's `range`).",
     ),
     CodeInfo(
+        "MK825",
+        "simulator-options-written",
+        "info",
+        "Simulator settings the robot needs to drive like its source (MJCF <option>: timestep, integrator, "
+        "friction cone, impratio) are written in the file, or named when the target cannot hold them.",
+    ),
+    CodeInfo(
+        "MK826",
+        "wheel-collision-approximated",
+        "info",
+        "A wheel's collision cylinder is written as a sphere or ellipsoid (--wheel-collision), the shape "
+        "MuJoCo and PyBullet roll alike on a floor.",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",

@@ -59,12 +59,15 @@ class Written:
     data: bytes
 
 
-def render(robot: Robot, folder: Path, name: str = "model.xml") -> Written:
+def render(
+    robot: Robot, folder: Path, name: str = "model.xml", options: WriteOptions | None = None
+) -> Written:
     """Run the writer the way ``convert`` does and commit the files to ``folder``."""
     notes = NoteSink()
-    prepared = prepare(robot, target_info("mjcf"), WriteOptions(), notes)
+    options = options or WriteOptions()
+    prepared = prepare(robot, target_info("mjcf"), options, notes)
     plan = OutputPlan(folder, set(), True)
-    ctx = WriteContext(WriteOptions(), notes, MeshExporter(plan, name, WriteOptions(), notes), name)
+    ctx = WriteContext(options, notes, MeshExporter(plan, name, options, notes), name)
     data = write_mjcf(prepared, ctx)
     plan.add(name, data, "model")
     plan.commit()
@@ -532,7 +535,8 @@ def test_two_runs_are_byte_identical(tmp_path: Path) -> None:
 )
 def test_tutorial_robot(tmp_path: Path, name: str) -> None:
     (robot,) = convertible(TUTORIAL / name)
-    written = render(robot, tmp_path)
+    # --wheel-collision cylinder: the source's wheel cylinders (the default writes spheres, MK826)
+    written = render(robot, tmp_path, options=WriteOptions(wheel_collision="cylinder"))
     model = mujoco.MjModel.from_xml_path(str(written.path))
     source = written.source
     moving = [j for j in source.joints if j.type.moves]
@@ -564,6 +568,27 @@ def test_tutorial_robot(tmp_path: Path, name: str) -> None:
     zaxis = np.zeros(9)
     mujoco.mju_quat2Mat(zaxis, quat)
     assert np.allclose(zaxis.reshape(3, 3)[:, 2] * np.sign(zaxis.reshape(3, 3)[1, 2]), [0, 1, 0], atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "name", ["mobile_robot.body", "mobile_robot_primitive.body", "mobile_robot_pantilt.body"]
+)
+def test_tutorial_wheels_default_to_spheres(tmp_path: Path, name: str) -> None:
+    """--wheel-collision auto: each wheel's collision is a sphere of the wheel radius at the cylinder's
+    centre (MK826), with priority 1, and the file has the wheeled robot's <option> (MK825)."""
+    (robot,) = convertible(TUTORIAL / name)
+    written = render(robot, tmp_path)
+    model = mujoco.MjModel.from_xml_path(str(written.path))
+    assert [n.code for n in written.notes].count("MK826") == 2
+    assert "MK825" in [n.code for n in written.notes]
+    assert model.opt.timestep == 0.001 and model.opt.impratio == 10.0
+    assert model.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
+    for link in ("LeftWheel", "RightWheel"):
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, link)
+        spheres = [g for g in range(model.ngeom) if model.geom_bodyid[g] == body and model.geom_contype[g]]
+        assert len(spheres) == 1 and model.geom_type[spheres[0]] == mujoco.mjtGeom.mjGEOM_SPHERE
+        assert model.geom_size[spheres[0]][0] == pytest.approx(0.076, abs=1e-15)
+        assert model.geom_priority[spheres[0]] == 1
 
 
 def test_tutorial_sensors_appear(tmp_path: Path) -> None:

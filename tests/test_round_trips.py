@@ -29,6 +29,7 @@ from modelkit.api import validate
 from modelkit.convert import convert, write
 from modelkit.convert.compare import Difference, compare_robots
 from modelkit.convert.notes import ConversionNote, renames
+from modelkit.convert.options import WriteOptions
 from modelkit.convert.registry import target_info
 from modelkit.model import Cylinder, JointType, Robot
 
@@ -168,6 +169,17 @@ def test_tutorial_robot_loads_in_pybullet_and_mujoco(name: str, tmp_path: Path) 
     assert math.isclose(loaded["mass"], _total_mass(source), rel_tol=1e-9)
     joint_names = renames(result.notes, "joint")  # the wheel joints share their links' names
     assert sorted(loaded["moving"]) == sorted(joint_names.get(j, j) for j in _moving(source))
+    for link, (radius, _length) in wheels.items():  # --wheel-collision auto: a sphere (MK826)
+        (geom_type, dims), = loaded["shapes"][link]
+        assert geom_type == 2  # GEOM_SPHERE: PyBullet reports (radius, radius, radius)
+        assert np.allclose(dims[:1], [radius], rtol=1e-6)
+    kept = convert([TUTORIAL / f"{name}.body"], tmp_path / "kept" / f"{name}.urdf",
+                   options=WriteOptions(wheel_collision="cylinder"))
+    assert kept.status == 0
+    run = subprocess.run([sys.executable, "-c", PYBULLET_CHILD, str(tmp_path / "kept" / f"{name}.urdf")],
+                         capture_output=True, text=True, timeout=120, check=False)
+    assert run.returncode == 0, run.stderr
+    loaded = json.loads(run.stdout.strip().splitlines()[-1])
     for link, (radius, length) in wheels.items():
         (geom_type, dims), = loaded["shapes"][link]
         assert geom_type == 4  # GEOM_CYLINDER: PyBullet reports (length, radius, 0)
@@ -181,12 +193,12 @@ def test_tutorial_robot_loads_in_pybullet_and_mujoco(name: str, tmp_path: Path) 
                    if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE}
     assert hinge_names == set(_moving(source))
     assert int(np.sum(model.jnt_type == mujoco.mjtJoint.mjJNT_FREE)) == 1
-    for link, (radius, length) in wheels.items():
+    for link, (radius, _length) in wheels.items():
         body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, link)
-        cylinders = [g for g in range(model.ngeom) if model.geom_bodyid[g] == body
-                     and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_CYLINDER and model.geom_contype[g]]
-        assert len(cylinders) == 1
-        assert np.allclose(model.geom_size[cylinders[0]][:2], [radius, length / 2], rtol=1e-12)
+        spheres = [g for g in range(model.ngeom) if model.geom_bodyid[g] == body
+                   and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_SPHERE and model.geom_contype[g]]
+        assert len(spheres) == 1
+        assert np.allclose(model.geom_size[spheres[0]][:1], [radius], rtol=1e-12)
 
 
 def test_tracks_become_meshes_of_the_readers_volume(tmp_path: Path) -> None:

@@ -150,7 +150,7 @@ def test_written_files_drive_straight_as_the_reference(written, tutorial) -> Non
 def test_written_mjcf_turns_as_the_skid_reference(written, tutorial) -> None:  # type: ignore[no-untyped-def]
     """The MJCF's <option impratio> (MK809) makes MuJoCo's roller friction follow the slip."""
     files, tracks = written
-    assert "<option impratio=" in files["mjcf"].read_text()
+    assert 'impratio="0.03"' in files["mjcf"].read_text()
     for profile in support.PROFILES[1:]:
         ref, tol = _as_reference(tutorial, profile)
         position, yaw = _gap(support.run_mujoco(files["mjcf"], tracks, profile), ref)
@@ -208,7 +208,8 @@ def test_path_difference_is_the_largest_gap() -> None:
                                                            SCENARIO, _box_drive()))[0])
 
 
-def test_only_a_tracked_robot_gets_an_mjcf_option(tmp_path: Path) -> None:
+def test_only_a_tracked_robot_gets_the_soft_impratio(tmp_path: Path) -> None:
+    """A wheeled robot gets the wheels' <option> (impratio 10, MK825), not the tracks' 0.03."""
     wheeled = support.TRACKS.with_name("mobile_robot_pantilt.body")
     files = support.convert(tmp_path, wheeled)
-    assert "<option" not in files["mjcf"].read_text()
+    assert 'impratio="10"' in files["mjcf"].read_text() and 'impratio="0.03"' not in files["mjcf"].read_text()

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 SDF_VERSIONS = ("1.6", "1.7", "1.8", "1.9", "1.10", "1.11")
 MESH_FORMATS = ("stl", "obj")
+WHEEL_COLLISIONS = ("auto", "cylinder", "sphere", "ellipsoid")  # convert.wheels says what each means
 
 
 @dataclass(frozen=True)
@@ -16,3 +17,4 @@ class WriteOptions:
     keep_package_uris: bool = False  # keep package:// and model:// references instead of copying
     merge_fixed: bool = False  # fuse links on fixed joints into their parents
     urdf_world_link: bool = False  # URDF: write a `world` link and the root's fixed/floating joint
+    wheel_collision: str = "auto"  # auto|cylinder|sphere|ellipsoid: the wheels' collision (convert.wheels)

@@ -516,8 +516,6 @@ def simulator(model: Path, renames: Renames, *, root: str, dt: float, armature: 
 
 # ---- layer 4: the floating-base robot driven on a floor ----------------------------------------
 
-CONTACT_SOLREF = (0.004, 1.0)
-CONTACT_SOLIMP = (0.99, 0.999, 0.001, 0.5, 2.0)
 VELOCITY_KV = 100.0
 """Gain (N·m·s/rad) of the velocity servo of a velocity-mode joint (the track rollers): MuJoCo's
 ``velocity`` actuator, force ``kv·(target − q̇)`` bounded by ``variant.servo_torque_limit`` (the
@@ -583,15 +581,12 @@ class MujocoDriver:
       command, ``fast=False``): ``output`` called before every ``mj_step``, torques through
       ``qfrc_applied``, velocity targets through the servo's ``ctrl``.
 
-    Edits (MjSpec, then the compiled model; the file is not changed): the options; a floor plane
-    (``modelkit_floor``, z = 0); the file's actuators deleted (torques go through ``qfrc_applied``
-    on the controlled dofs, not clamped; a velocity-mode joint gets a ``velocity`` actuator of gain
-    :data:`VELOCITY_KV`); on every robot geom that collides with the floor and on the floor itself
-    solref/solimp (MuJoCo averages a pair's values: set on both, the pair gets exactly these);
-    friction: the floor's is 0 so MuJoCo's max rule leaves each geom's own (the contact material's,
-    as the writer put it; ``Scenario.friction`` replaces the wheel geoms'); torsional and rolling
-    coefficients 0; condim 3 where a geom has friction, 1 where it has none (the slider, the chassis)
-    and on the floor (MuJoCo takes the pair's max)."""
+    The robot is loaded as written (its ``<option>``, contact parameters and collision filters
+    untouched, MK825); the world around it: a floor plane with MuJoCo's default contact
+    (``modelkit_floor``, z = 0: what a user adds); the timestep set to the scenario's ``dt`` only when
+    the file's differs (said in the settings); the file's actuators deleted, as a controller takes
+    the joints (torques go through ``qfrc_applied`` on the controlled dofs, not clamped; a
+    velocity-mode joint gets a ``velocity`` actuator, the tracks' servo)."""
 
     engine = "mujoco"
 
@@ -625,17 +620,12 @@ class MujocoDriver:
             """The world's spec compiled: options, floor, servos; ``with_laws``: the law actuators."""
             spec = mujoco.MjSpec.from_file(str(self.path))
             o = spec.option
-            o.timestep = scenario.dt
-            o.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-            o.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-            o.impratio = 10.0
-            o.solver = mujoco.mjtSolver.mjSOL_NEWTON
-            o.iterations = 100
-            o.tolerance = 1e-8
-            o.gravity = list(GRAVITY)
+            self.file_timestep = float(o.timestep)
+            if o.timestep != scenario.dt:  # the scenario's step; said in the settings
+                o.timestep = scenario.dt
             for actuator in list(spec.actuators):
                 spec.delete(actuator)
-            floor = spec.worldbody.add_geom()
+            floor = spec.worldbody.add_geom()  # MuJoCo's default contact: what a user's floor has
             floor.name, floor.type = "modelkit_floor", mujoco.mjtGeom.mjGEOM_PLANE
             floor.size = [0.0, 0.0, 1.0]
             for name in servoed:
@@ -681,30 +671,22 @@ class MujocoDriver:
                     prepared_links.add(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.jnt_bodyid[jid])))
         wheel_bodies = {mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, links.get(n, n))
                         for n in prepared_links}
+        # The contacts as the file makes them against the default floor (nothing edited): a pair's
+        # friction is the higher-priority geom's (the writer's priority 1), else the larger.
         self.friction: dict[str, float] = {}
         contact_mu = 0.0
+        fp = int(m.geom_priority[self.floor])
         for g in range(m.ngeom):
-            if g != self.floor and not (int(m.geom_contype[g]) | int(m.geom_conaffinity[g])):
+            if g == self.floor or not (int(m.geom_contype[g]) & int(m.geom_conaffinity[self.floor])
+                                       or int(m.geom_conaffinity[g]) & int(m.geom_contype[self.floor])):
                 continue
-            m.geom_solref[g] = CONTACT_SOLREF
-            m.geom_solimp[g] = CONTACT_SOLIMP
-            # Robot geoms collide with the floor only, never with each other: PyBullet leaves a
-            # body's self-collision off (no URDF_USE_SELF_COLLISION), while MuJoCo filters only
-            # parent/child pairs, so a roller's sphere proxy (wider than the roller) would hit the
-            # chassis two bodies up. (a & b) || (b & a): robot 2/1 with floor 1/2 → yes; robot-robot → no.
-            m.geom_contype[g], m.geom_conaffinity[g] = (1, 2) if g == self.floor else (2, 1)
-            m.geom_friction[g, 1:] = 0.0
-            if g == self.floor:
-                m.geom_friction[g, 0] = 0.0
-            elif int(m.geom_bodyid[g]) in wheel_bodies and scenario.friction is not None:
-                m.geom_friction[g, 0] = scenario.friction
-            mu = float(m.geom_friction[g, 0])
+            own, floor_mu = float(m.geom_friction[g, 0]), float(m.geom_friction[self.floor, 0])
+            gp = int(m.geom_priority[g])
+            mu = own if gp > fp else floor_mu if gp < fp else max(own, floor_mu)
             if int(m.geom_bodyid[g]) in wheel_bodies:
                 contact_mu = max(contact_mu, mu)
-            m.geom_condim[g] = 3 if mu > 0 else 1
-            if g != self.floor:
-                body = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g])) or ""
-                self.friction[body] = max(self.friction.get(body, 0.0), mu)
+            body = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g])) or ""
+            self.friction[body] = max(self.friction.get(body, 0.0), mu)
         self.servo_limit = v.servo_torque_limit(float(m.body_subtreemass[self.root_body]), contact_mu,
                                                 drive.roller_radius or drive.radius, len(servoed))
         servos = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, f"modelkit_servo_{n}") for n in servoed]
@@ -745,17 +727,18 @@ class MujocoDriver:
             self._start = self._initial_state()
         self.settings: dict[str, Any] = {
             "version": mujoco.__version__, "file": self.path.name, "base": "free joint (floating)",
-            "timestep": scenario.dt, "integrator": "implicitfast", "cone": "elliptic", "impratio": 10.0,
-            "solver": "Newton", "iterations": 100, "tolerance": 1e-8, "gravity": list(GRAVITY),
-            "floor": "plane z = 0, friction 0 (MuJoCo's max rule keeps each geom's own), condim 1",
-            "contact_solref": list(CONTACT_SOLREF), "contact_solimp": list(CONTACT_SOLIMP),
-            "contact_params_on": "every robot geom that collides and the floor (a pair averages them)",
-            "self_collision": ("off, as in PyBullet: robot geoms contype 2 / conaffinity 1, the floor 1 / 2, "
-                               "so robot geoms touch the floor only"),
+            "timestep": float(m.opt.timestep) if self.file_timestep == scenario.dt
+            else f"{scenario.dt:g} (the scenario's dt; the file says {self.file_timestep:g})",
+            "option": ("the file's <option> as written (MK825): integrator "
+                       f"{mujoco.mjtIntegrator(int(m.opt.integrator)).name}, cone "
+                       f"{mujoco.mjtCone(int(m.opt.cone)).name}, impratio {float(m.opt.impratio):g}, solver "
+                       f"{mujoco.mjtSolver(int(m.opt.solver)).name}, iterations {int(m.opt.iterations)}"),
+            "gravity": [float(x) for x in m.opt.gravity],
+            "floor": "plane z = 0 with MuJoCo's default contact (friction 1, priority 0): what a user adds",
+            "contact": "the file's geoms as written: priority, friction, condim, solref, solimp, collision "
+                       "filters (nothing edited)",
             "friction": dict(sorted(self.friction.items())),
-            "friction_source": ("Scenario.friction on the wheel geoms" if scenario.friction is not None
-                                else "the file's geom friction (the contact materials against the floor)"),
-            "torsional_rolling": 0.0, "condim": "3 on geoms with friction, 1 without (slider, chassis)",
+            "friction_rule": "the higher-priority geom's values, else the larger (MuJoCo's rule)",
             "torque": "qfrc_applied on the controlled dofs (see control), not clamped",
             "control": (("the laws u = offset - gain·dq as MuJoCo computes them: offset in qfrc_applied "
                          "and velocity targets in the servos' ctrl, set at each command change; -gain·dq "

@@ -424,6 +424,13 @@ def simulator(model: Path, renames: Renames, *, root: str, dt: float,
 SOLVER_ITERATIONS = 50
 FLOOR_FRICTION = 1.0
 DEFAULT_LINK_FRICTION = 1.0  # a link the URDF gives no friction: MuJoCo's default geom friction
+FLOOR = "plane.urdf"
+"""Layer 4's floor: pybullet_data's plane.urdf as shipped (what a user loads)."""
+ANALYTIC_FLOOR = "analytic"
+"""A GEOM_PLANE body of lateral friction 1 (plane.urdf's), for the tests that compare two control
+paths to round-off: plane.urdf's collision is a 200 m box, and Bullet's box–sphere contact amplifies
+a one-ulp torque difference to 1e-5 m over 10 s (measured), where the analytic plane keeps it at
+1e-13; the floor is not what those tests are about."""
 
 
 def urdf_friction(path: Path) -> dict[str, float]:
@@ -450,7 +457,7 @@ class PyBulletDriver:
 
     def __init__(self, model: Path, renames: Renames, drive: Any, scenario: Any, factory: str | None = None,
                  sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT,
-                 fast: bool = True) -> None:
+                 fast: bool = True, floor: str = FLOOR) -> None:
         from modelkit.verify import variant as v
 
         self.fast = fast
@@ -461,6 +468,11 @@ class PyBulletDriver:
         self.dt = float(scenario.dt)
         self.factory = factory or v.CONTROLLERS
         self.friction = urdf_friction(self.path)
+        # The engine setting a user sets for this robot (the URDF's MK825 note; a URDF cannot carry it).
+        from modelkit.convert.tracks import PYBULLET_CONE_FRICTION
+
+        self.engine_parameters = ({"enableConeFriction": PYBULLET_CONE_FRICTION} if drive.kind == "tracks"
+                                  else {})
         joint_names = dict(renames.get("joint", {}))
         for rollers in drive.rollers.values():
             for j in rollers:
@@ -475,7 +487,8 @@ class PyBulletDriver:
                 contact_joints=[joint_names.get(j, j) for j in self._contact_joints(drive)],
                 contact_friction=scenario.friction,
                 drive=drive.as_dict(), scenario=v.scenario_data(scenario), factory=self.factory,
-                joint_names=joint_names, roller_radius=drive.roller_radius or drive.radius, sys_path=sys_path)
+                joint_names=joint_names, roller_radius=drive.roller_radius or drive.radius, sys_path=sys_path,
+                engine_parameters=self.engine_parameters, floor=floor)
         except BaseException:
             self._worker.close()
             raise
@@ -487,8 +500,11 @@ class PyBulletDriver:
             "version": "pybullet (child process)", "file": self.path.name, "useFixedBase": False,
             "flags": "URDF_USE_INERTIA_FROM_FILE|URDF_USE_IMPLICIT_CYLINDER", "gravity": [0.0, 0.0, GRAVITY],
             "timestep": self.dt, "numSolverIterations": SOLVER_ITERATIONS,
-            "enableConeFriction": "default (1)",
-            "damping": ("linearDamping, angularDamping, jointDamping 0 on every link"
+            "enableConeFriction": (f"{self.engine_parameters['enableConeFriction']} (the setting the "
+                                   "URDF's MK825 note names for tracks)"
+                                   if self.engine_parameters else "default (1)"),
+            "damping": ("linearDamping, angularDamping (PyBullet's own default 0.04, no URDF field) and "
+                        "jointDamping 0 on every link: the only changeDynamics on the robot"
                         + ("; while a profile's commands run, the torque-law joints' jointDamping is the "
                            "controller's gain (the law's −gain·q̇, see control), nothing else"
                            if fast else "")),
@@ -502,13 +518,13 @@ class PyBulletDriver:
                                "roller 0's target; the rollers of a track coupled by a JOINT_GEAR constraint "
                                "(ratio −1: equal speeds), the URDF's <mimic> that PyBullet ignores")
             if velocity else "none",
-            "floor": f"plane z = 0 (createCollisionShape GEOM_PLANE), lateralFriction {FLOOR_FRICTION:g}",
+            "floor": ("pybullet_data's plane.urdf as shipped (lateral_friction 1)" if floor == FLOOR
+                      else "an analytic GEOM_PLANE of lateral friction 1 (a test of the control path)"),
             "friction": dict(sorted(info["friction"].items())),
-            "friction_rule": "Bullet multiplies the two bodies' values: floor 1 × the link's",
-            "friction_source": ("Scenario.friction on the wheel links" if scenario.friction is not None
-                                else "the URDF's <gazebo><mu1> (the contact materials against the floor); "
-                                     f"{DEFAULT_LINK_FRICTION:g} for a link without"),
-            "rolling_spinning": 0.0,
+            "friction_rule": "Bullet multiplies the two bodies' values: plane.urdf's 1 × the link's",
+            "friction_source": "the URDF as written: each link's <contact> (the contact materials against "
+                               "the floor), PyBullet's default for a link without",
+            "rolling_spinning": "the URDF's <contact> values",
             "base_pose": "getBasePositionAndOrientation (COM frame) moved to the root link frame with "
                          "getDynamicsInfo(-1)[3:5] (the local inertial frame)",
             "start_height": info["start_height"],
@@ -605,9 +621,10 @@ class PyBulletDriver:
 
 
 def driver(model: Path, renames: Renames, *, drive: Any, scenario: Any, factory: str | None = None,
-           sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT, fast: bool = True
-           ) -> PyBulletDriver:
+           sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT, fast: bool = True,
+           floor: str = FLOOR) -> PyBulletDriver:
     """Layer 4's entry point (:class:`modelkit.verify.drive.Driver`, plus ``start``/``result``).
     ``fast`` False: the controllers' ``output`` every step even when they have affine laws (the
-    reference the fast path is tested against, ``tests/test_verify_drivers_pybullet_fast.py``)."""
-    return PyBulletDriver(Path(model), renames, drive, scenario, factory, sys_path, timeout, fast)
+    reference the fast path is tested against, ``tests/test_verify_drivers_pybullet_fast.py``).
+    ``floor``: :data:`FLOOR` (layer 4's) or :data:`ANALYTIC_FLOOR` (see there; tests only)."""
+    return PyBulletDriver(Path(model), renames, drive, scenario, factory, sys_path, timeout, fast, floor)

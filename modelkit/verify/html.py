@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from modelkit import safewrite
-from modelkit.verify.report import LAYER_NAMES, VerifyReport, _plain
+from modelkit.verify.report import LAYER_NAMES, VerifyReport, _plain, scope
 
 PICTURE_ENGINES = ("mujoco", "pybullet")
 
@@ -349,6 +349,11 @@ def _replay_calibration(replay: dict[str, Any]) -> list[str]:
     return rows
 
 
+def _scope(report: VerifyReport) -> str:
+    what = scope(report)
+    return f" ({what})" if what else ""
+
+
 def render_html(report: VerifyReport, art: Artefacts | None = None) -> str:
     art = art or Artefacts()
     verdict = report.verdict
@@ -361,7 +366,7 @@ def render_html(report: VerifyReport, art: Artefacts | None = None) -> str:
            f"<style>{CSS}</style></head><body>",
            f"<h1>modelkit verify: {_e(report.robot or '(no robot)')}</h1>",
            f'<div class="verdict {verdict}">{_e(headline)}, {len(report.skips)} skipped, '
-           f"{len(report.observations)} observations</div>",
+           f"{len(report.observations)} observations{_e(_scope(report))}</div>",
            '<table class="meta">',
            f"<tr><td>source</td><td>{_e(report.source)}</td></tr>",
            f"<tr><td>base</td><td>{_e(report.base)}</td></tr>",

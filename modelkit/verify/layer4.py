@@ -20,11 +20,16 @@ a report-only profile (``steps``: slip-dominated reversals), and the **native** 
 (§2.2: MuJoCo and PyBullet model a cylinder on a plane differently, so that run has no meaningful
 tolerance).
 
-Tracked robots are driven through the rollers ``convert`` writes (sphere proxies at the roller
-centres in the verification variant). Their no-slip reference is the ideal velocity servo: only
-straight profiles (w = 0 throughout) are compared with it; a turning tracked robot skids sideways
-(skid steering), which no rigid no-slip model describes, so turning profiles compare the engines
-with each other only, report-only (each engine's friction cone decides the skid).
+**Graded = written.** The graded runs load exactly the MJCF and URDF ``modelkit convert`` writes
+with its default options (wheels: sphere collisions, MK826; the contact parameters, priority and
+``<option>`` in the file, MK825), unmodified: MuJoCo gets a default plane added to the world,
+PyBullet loads pybullet_data's ``plane.urdf`` as shipped (see the drivers for the engine settings).
+``report.json`` names the files (``engines.layer4.files``).
+
+Tracked robots are driven through the rollers ``convert`` writes. Their no-slip reference is the
+ideal velocity servo: only straight profiles (w = 0 throughout) are compared with it; a turning
+tracked robot skids sideways (skid steering), which no rigid no-slip model describes, so turning
+profiles compare the engines with each other only, report-only (the verdict line says so).
 """
 
 from __future__ import annotations
@@ -56,22 +61,19 @@ NATIVE_WARNING = (
     "(MuJoCo: two contacts, one on each rim edge, so a yawing wheel scrubs; PyBullet's implicit cylinder: "
     "one contact at whichever rim edge its support mapping picks, so the first acceleration yaws the robot); "
     "verification.md §2.2 measured up to 2.6 m and π rad between them on the arc. Choreonoid's own contact "
-    "model (not run here) is a third meaning. The graded runs use sphere proxies of the wheel radius."
+    "model (not run here) is a third meaning. This run reads what convert --wheel-collision cylinder writes; "
+    "the graded runs read convert's default files (sphere wheels, MK826)."
 )
 TRACK_SKIP = (
-    "tracks: the no-slip reference is compared only on straight profiles (w = 0): a turning tracked robot "
-    "must skid sideways (skid steering), which no rigid no-slip model describes; turning profiles compare "
-    "MuJoCo with PyBullet report-only (each engine's friction cone decides the skid). Continuous tracks "
-    "themselves are not simulated by either engine: both drive the rollers convert writes (MK809), as "
-    "spheres of the roller radius at the roller centres, each track's rollers coupled like its belt (MuJoCo: "
-    "the file's mimic equality; PyBullet: a gear constraint). The rollers are velocity-servoed with a torque "
-    "bound of half what friction can pass (variant.SERVO_FRICTION_SHARE), so a start is torque-limited and "
-    "slip-free, and the no-slip reference models that servo and its start-up ramp. The same bound limits "
-    "turning: the belts' yaw moment (n·τ_max/r·b, half of μ·m·g·b) can be smaller than the scrub moment of "
-    "the rollers' point contacts at the track ends (up to μ·m·g times their fore-aft arm), and then the "
-    "robot does not turn on the spot in either engine (the tutorial robot: 13 N·m against 19 N·m), where "
-    "Choreonoid's track, which imposes its surface speed with no torque bound and spreads its contact over "
-    "the track's length, turns; the turning profiles show the two engines' agreement on that, report-only"
+    "tracks: turning profiles (spin, arc) are NOT graded: they compare MuJoCo with PyBullet report-only; "
+    "the no-slip reference is compared on straight profiles (w = 0) only, since a turning tracked robot "
+    "must skid sideways, which no rigid no-slip model describes (grading turning against the skid-steer "
+    "reference, modelkit.verify.reference_skid, is not done yet). Continuous tracks themselves are not "
+    "simulated by either engine: both drive the cylinder rollers convert writes (MK809), each track's "
+    "rollers coupled like its belt (MuJoCo: the file's mimic equality; PyBullet: a gear constraint), "
+    "velocity-servoed with a torque bound of half what friction can pass (variant.SERVO_FRICTION_SHARE); "
+    "MuJoCo with the file's <option impratio> and PyBullet with enableConeFriction=0, as the files' notes "
+    "(MK809, MK825) ask a user to"
 )
 
 
@@ -136,6 +138,11 @@ def run(
     )
     result.settings["reference"] = {"noslip": model.as_dict(), "unicycle": "exact, from the commanded (v, w)"}
     wanted = [e for e in engines if e in DRIVERS]
+    if scenario.friction is not None and wanted:
+        result.skips.append(Skip(LAYER, "all", (
+            f"the scenario's friction {scenario.friction:g} is used by the no-slip reference only: the "
+            "engines drive the files convert wrote, unmodified, whose friction is the contact materials' "
+            "against the floor (MK817)")))
     for e in engines:
         if e not in DRIVERS:
             result.skips.append(Skip(LAYER, e, "layer 4 runs MuJoCo and PyBullet only"))
@@ -274,6 +281,8 @@ def _setup(
             )
         return
     result.settings.setdefault("variant", {})[proxy] = {k: p.name for k, p in sorted(files.items())}
+    if proxy == "sphere":  # the graded run: the files convert writes by default, as they are
+        result.settings["files"] = {k: p.name for k, p in sorted(files.items())}
     for spec in inject:
         apply = _resolve("modelkit.verify.inject:apply")
         try:

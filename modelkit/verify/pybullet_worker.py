@@ -271,7 +271,9 @@ class Engine:
                     contact_joints: list[str], contact_friction: float | None,
                     drive: dict[str, Any], scenario: dict[str, Any], factory: str,
                     joint_names: dict[str, str], roller_radius: float,
-                    sys_path: list[str] | None = None) -> dict[str, Any]:
+                    sys_path: list[str] | None = None,
+                    engine_parameters: dict[str, Any] | None = None,
+                    floor: str = "plane.urdf") -> dict[str, Any]:
         """Keep the layer-4 set-up and build the controllers here, from plain data, with the same
         factory the parent uses (``module:function``), so the stepping loop never crosses the pipe.
         ``joint_names``: source joint name → the URDF's. ``friction``: link → its friction against
@@ -289,7 +291,8 @@ class Engine:
                           "path": path, "gravity": gravity, "dt": dt, "iterations": solver_iterations,
                           "friction": dict(friction), "default_friction": default_friction,
                           "floor_friction": floor_friction, "roller_radius": roller_radius,
-                          "contact_joints": list(contact_joints), "contact_friction": contact_friction}
+                          "contact_joints": list(contact_joints), "contact_friction": contact_friction,
+                          "engine_parameters": dict(engine_parameters or {}), "floor": floor}
         self.drive_rollers = {k: list(v) for k, v in drive.get("rollers", {}).items()}
         self.drive_names = dict(joint_names)
         self.controllers = make(drive, scenario)
@@ -299,9 +302,11 @@ class Engine:
 
     def _drive_world(self) -> dict[str, Any]:
         """A fresh world (``resetSimulation``: no contact cache or warm start survives a run, so every
-        run starts from the same state): gravity, dt, solver iterations, a floor plane built in code,
-        the URDF floating, damping zeroed, default motors off, friction per link, the root link frame
-        at the origin lowered until the closest point touches the floor."""
+        run starts from the same state): gravity, dt, solver iterations, the engine parameters the
+        robot's notes name (MK825), pybullet_data's ``plane.urdf`` as shipped, the URDF as written
+        (floating; its contact, friction and link damping untouched: no ``changeDynamics`` on it but
+        the control law's joint damping, zero until a profile's law sets it), default motors off, the
+        root link frame at the origin lowered until the closest point touches the floor."""
         p, cfg = self.p, self.drive_cfg
         if getattr(self, "drive_client", -1) < 0:
             self.drive_client = p.connect(p.DIRECT)
@@ -310,10 +315,17 @@ class Engine:
         p.setGravity(0.0, 0.0, cfg["gravity"], physicsClientId=c)
         p.setTimeStep(cfg["dt"], physicsClientId=c)
         p.setPhysicsEngineParameter(numSolverIterations=cfg["iterations"], physicsClientId=c)
-        plane = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c)
-        self.floor = p.createMultiBody(0.0, plane, physicsClientId=c)
-        p.changeDynamics(self.floor, -1, lateralFriction=cfg["floor_friction"], rollingFriction=0.0,
-                         spinningFriction=0.0, physicsClientId=c)
+        if cfg["engine_parameters"]:
+            p.setPhysicsEngineParameter(**cfg["engine_parameters"], physicsClientId=c)
+        if cfg["floor"] == "analytic":  # engine_pybullet.ANALYTIC_FLOOR: tests of the control path
+            shape = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c)
+            self.floor = p.createMultiBody(0.0, shape, physicsClientId=c)
+            p.changeDynamics(self.floor, -1, lateralFriction=1.0, physicsClientId=c)
+        else:
+            import pybullet_data
+
+            self.floor = p.loadURDF(os.path.join(pybullet_data.getDataPath(), cfg["floor"]),
+                                    physicsClientId=c)
         flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER
         body = p.loadURDF(cfg["path"], useFixedBase=False, flags=flags, physicsClientId=c)
         self.drive_body = body
@@ -324,15 +336,14 @@ class Engine:
         joint_index = {j[1].decode(): j[0] for j in joints}
         friction = {}
         contact = {j[12].decode() for j in joints if j[1].decode() in cfg["contact_joints"]}
+        floor_mu = float(p.getDynamicsInfo(self.floor, -1, physicsClientId=c)[1])
         for name, link in link_index.items():
+            # PyBullet's own default velocity damping (0.04 on every link: no URDF field holds it, an
+            # engine setting a torque-driven robot's user turns off); contact and friction untouched
             p.changeDynamics(body, link, linearDamping=0.0, angularDamping=0.0, jointDamping=0.0,
                              physicsClientId=c)
-            mu = cfg["friction"].get(name, cfg["default_friction"])
-            if name in contact and cfg["contact_friction"] is not None:
-                mu = cfg["contact_friction"]
-            p.changeDynamics(body, link, lateralFriction=mu, rollingFriction=0.0, spinningFriction=0.0,
-                             physicsClientId=c)
-            friction[name] = mu
+            # Bullet multiplies the two bodies' lateral friction: the contact's value against the floor
+            friction[name] = float(p.getDynamicsInfo(body, link, physicsClientId=c)[1]) * floor_mu
         for j in range(n):
             p.setJointMotorControl2(body, j, p.VELOCITY_CONTROL, targetVelocity=0.0, force=0.0,
                                     physicsClientId=c)

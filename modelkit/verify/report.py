@@ -120,6 +120,27 @@ def _fmt(x: float) -> str:
     return f"{x:.2e}"
 
 
+COMPARISONS = frozenset({"path-position", "path-yaw", "wheel-angle", "pan-tilt-angle", "noslip-position",
+                         "noslip-yaw"})
+"""Layer 4's comparison quantities: graded as checks, or reported as observations (then said so)."""
+
+
+def scope(report: VerifyReport) -> str:
+    """What layer 4 graded and what it only reported, for the verdict line (so that nothing
+    report-only hides inside a PASS); "" when layer 4 did not run."""
+    graded = sorted({c.where for c in report.checks if c.layer == 4})
+    reported = sorted({o.where for o in report.observations
+                       if o.layer == 4 and o.quantity.removeprefix("native-") in COMPARISONS} - set(graded))
+    files = report.engines.get("layer4", {}).get("files", {})
+    parts = []
+    if graded:
+        on = f" on the written {', '.join(str(v) for _, v in sorted(files.items()))}" if files else ""
+        parts.append(f"layer 4 graded {', '.join(graded)}{on}")
+    if reported:
+        parts.append(f"not graded (reported only): {', '.join(reported)}")
+    return "; ".join(parts)
+
+
 def render_table(report: VerifyReport) -> str:
     """The verdict table: one row per layer × engine × quantity, then the skips and the verdict."""
     lines = [f"verify {report.source} ({report.robot}): {report.base}"]
@@ -150,5 +171,6 @@ def render_table(report: VerifyReport) -> str:
     verdict = {"pass": f"PASS: {len(report.checks)} checks passed",
                "fail": f"FAIL: {n_fail} of {len(report.checks)} checks failed",
                "error": "could not run"}[report.verdict]
-    lines.append(f"{verdict}, {len(report.skips)} skipped")
+    what = scope(report)
+    lines.append(f"{verdict}, {len(report.skips)} skipped" + (f" ({what})" if what else ""))
     return "\n".join(lines) + "\n"

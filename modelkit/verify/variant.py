@@ -1,5 +1,9 @@
-"""The verification variant of a converted mobile robot (layer 4): the floating-base model written as
-MJCF and URDF, its wheels' collision shapes replaced by spheres.
+"""The files layer 4 drives: the floating-base model written as MJCF and URDF exactly as ``convert``
+writes them (no edit afterwards), and what the two drivers share.
+
+The graded run reads ``convert``'s default output, whose wheels are spheres (``--wheel-collision
+auto``, :mod:`modelkit.convert.wheels`, MK826) for the reasons below; the report-only ``native``
+run reads what ``convert --wheel-collision cylinder`` writes.
 
 Why spheres (verification.md §2.2): MuJoCo and PyBullet give a cylinder lying on a plane different
 meanings. MuJoCo's cylinder–plane collision makes two contacts, one on each rim edge, so a yawing
@@ -12,26 +16,17 @@ meets an obstacle sideways, which never happens on a flat floor; the oversized s
 the chassis (MuJoCo filters parent/child contacts, PyBullet leaves self-collision off).
 
 Tracks: ``convert`` writes each pseudo continuous track as a row of driven rollers (cylinders of the
-track's half height, ``convert/tracks.py``), and those rollers are the contact geometry. A cylinder
-roller on the floor is the same line contact as a cylinder wheel, with the same two meanings, so
-each roller becomes a sphere of the roller radius at its centre too: every roller then touches the
-floor at one point under its hub, in both engines. The track's footprint is thereby reduced to the
-rollers' contact points (two per track for the tutorial robot, 0.22 m apart): the fore–aft spread
-that resists skid-steer turning is kept, the lateral spread across the 6 cm width is not. Neither
-the cylinder rollers nor the spheres are Choreonoid's track (a surface velocity over the whole
-track shape); the spheres are the approximation both engines agree on.
+track's half height, ``convert/tracks.py``, MK809); the files keep those cylinders (a roller is not a
+wheel for ``--wheel-collision``).
 
-``proxy="native"``: the converted geometry as is (the report-only run that shows the disagreement).
-
-Friction stays the contact materials' (the writers put each link's friction against the floor
-material into the files: MuJoCo geom ``friction``, URDF ``<gazebo><mu1>``); the drivers read it
-from the files, override the wheels' with ``Scenario.friction`` when set, and make the floor's
-combination rule leave each value as it is (``engine_mujoco.driver``, ``engine_pybullet.driver``).
+Friction, contact parameters and simulator options are the files' (the contact materials against the
+floor; MJCF ``priority``/``condim``/``solref``/``<option>``, URDF ``<contact>``); the drivers read them
+and edit nothing (``engine_mujoco.driver``, ``engine_pybullet.driver``). ``Scenario.friction`` is not
+applied to the engines: layer 4 says so with a Skip (the graded files carry the materials' values).
 """
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import importlib
 import math
@@ -41,105 +36,44 @@ from typing import Any
 
 import numpy as np
 
-from modelkit.model import Capsule, Cylinder, Ellipsoid, Geom, Link, Robot, Sphere
-from modelkit.spatial import Pose
+from modelkit.model import Robot
 from modelkit.verify.drive import Array, Drive, Profile, Scenario, Trajectory, WheelProxy
 
 Renames = dict[str, dict[str, str]]
 SUFFIX = {"mjcf": ".xml", "urdf": ".urdf"}
 
 
-def _centre(link: Link) -> Pose:
-    """The wheel (or roller) centre in its link frame: the centre of its largest round collision
-    shape (a cylinder, sphere, capsule or ellipsoid), else the link origin (the joint axis passes
-    through it)."""
-    best: tuple[float, Geom] | None = None
-    for geom in link.collisions:
-        g = geom.geometry
-        size = (g.radius if isinstance(g, (Cylinder, Sphere, Capsule))
-                else max(g.radii) if isinstance(g, Ellipsoid) else -1.0)
-        if size > 0 and (best is None or size > best[0]):
-            best = (size, geom)
-    return Pose(translation=best[1].pose.translation.copy()) if best is not None else Pose()
-
-
-def contact_links(prepared: Robot, drive: Drive) -> list[str]:
-    """The links whose collision shapes roll on the floor, source names of the prepared model: the
-    wheel links, or for tracks every roller link ``convert`` wrote (roller 0 first)."""
-    if drive.kind == "wheels":
-        return list(drive.wheel_links)
-    tracks = prepared.extras.get("tracks", {})
-    out: list[str] = []
-    for track in (drive.left, drive.right):
-        record = tracks.get(track)
-        if record is not None:
-            out.extend(record.get("roller_links", []))
-        else:  # the rollers named in the drive: their child links
-            children = {j.name: j.child for j in prepared.joints}
-            out.extend(children[j] for j in drive.rollers.get(track, ()) if j in children)
-    return out
-
-
-def sphere_proxies(prepared: Robot, drive: Drive) -> dict[str, float]:
-    """Replace, in place, the collision shapes of every contact link by one sphere at the wheel
-    centre: radius ``drive.radius`` for wheels, the roller's own radius for track rollers. Returns
-    link → sphere radius."""
-    by_name = {link.name: link for link in prepared.links}
-    out: dict[str, float] = {}
-    for name in contact_links(prepared, drive):
-        link = by_name.get(name)
-        if link is None:
-            raise ValueError(f"the drive names the wheel link {name!r}, which the model does not have")
-        if drive.kind == "wheels":
-            radius = drive.radius
-        else:
-            round_shapes = [g.geometry.radius for g in link.collisions if isinstance(g.geometry, Cylinder)]
-            radius = max(round_shapes) if round_shapes else drive.roller_radius
-        if radius <= 0:
-            raise ValueError(f"no radius for the sphere proxy of {name!r}")
-        centre = _centre(link)
-        source = link.collisions[0].source if link.collisions else link.source
-        link.collisions = [Geom(Sphere(radius), centre, name=f"{name}_proxy", source=source)]
-        out[name] = radius
-    return out
-
-
-def prepare_variant(robot: Robot, drive: Drive, proxy: WheelProxy) -> tuple[Robot, dict[str, float]]:
-    """A deep copy of the floating-base ``robot`` with its tracks approximated as ``convert`` does and,
-    for ``proxy="sphere"``, the sphere proxies in place (link → radius)."""
-    from modelkit.convert.notes import NoteSink
-    from modelkit.convert.tracks import approximate_tracks
-
-    if proxy not in ("sphere", "native"):
-        raise ValueError(f"wheel proxy must be 'sphere' or 'native', not {proxy!r}")
-    prepared = copy.deepcopy(robot)
-    approximate_tracks(prepared, NoteSink())  # what the writers' prepare() would do; a no-op after it
-    spheres = sphere_proxies(prepared, drive) if proxy == "sphere" else {}
-    return prepared, spheres
+WRITE_CHOICE: dict[str, str] = {"sphere": "auto", "native": "cylinder"}
+"""The ``--wheel-collision`` each layer-4 run writes with: the graded run reads exactly what
+``convert`` writes by default (``auto``: sphere wheels for MJCF and URDF, MK826); the report-only
+native run what ``convert --wheel-collision cylinder`` writes."""
 
 
 def write_variant(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path, proxy: WheelProxy
                   ) -> tuple[dict[str, Path], dict[str, Renames]]:
-    """Write the floating-base verification variant of ``robot`` (the source model, root not welded)
-    as MJCF and URDF into ``out_dir`` (``<name>_<proxy>.xml`` / ``.urdf``, meshes in ``meshes/``).
+    """Write the floating-base ``robot`` (the source model, root not welded) as MJCF and URDF into
+    ``out_dir`` exactly as ``convert`` writes it (``<name>.xml`` / ``.urdf``; the native run's
+    ``<name>_cylinder.*``; meshes in ``meshes/``): no edit of the written files, the engines load
+    them as they are.
 
     Returns the files (``"mjcf"``, ``"urdf"``) and each file's renames (``{"link": {source:
-    written}, "joint": {...}}``, from the writers' MK800 notes), as ``verify``'s conversion does.
-    ``scenario`` is not needed to write the files (friction is applied by the drivers); it is taken
-    so that a later variant option (another proxy shape) has its place."""
+    written}, "joint": {...}}``, from the writers' MK800 notes), as ``verify``'s conversion does."""
     from modelkit.convert.api import write
     from modelkit.convert.notes import renames
+    from modelkit.convert.options import WriteOptions
 
-    del scenario
-    prepared, _ = prepare_variant(robot, drive, proxy)
+    del scenario, drive
+    if proxy not in WRITE_CHOICE:
+        raise ValueError(f"wheel proxy must be 'sphere' or 'native', not {proxy!r}")
+    options = WriteOptions(wheel_collision=WRITE_CHOICE[proxy])
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    stem = f"{_safe(robot.name or 'robot')}_{proxy}"
+    stem = _safe(robot.name or "robot") + ("" if proxy == "sphere" else "_cylinder")
     files: dict[str, Path] = {}
     maps: dict[str, Renames] = {}
     for fmt in ("mjcf", "urdf"):
         path = out_dir / f"{stem}{SUFFIX[fmt]}"
-        notes = write(prepared, path, fmt, force=True)
+        notes = write(robot, path, fmt, options=options, force=True)
         files[fmt] = path
         maps[fmt] = {"link": renames(notes, "link"), "joint": renames(notes, "joint")}
     return files, maps

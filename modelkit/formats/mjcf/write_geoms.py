@@ -20,10 +20,12 @@
 * Friction: a link with a contact material gets, on each collision geom, its friction against
   Choreonoid's floor material ``Ground`` (the pair table's dynamic friction, or Choreonoid's
   √roughness rule) with MuJoCo's default torsional and rolling values, ``friction="mu 0.005
-  0.0001"``, and an MK817 note: MuJoCo combines the two geoms of a contact by max(), so the value
-  holds against a floor whose friction is ≤ mu (set the floor's friction to 0, or add a
-  ``<contact><pair>``, to reproduce Choreonoid's pair table exactly). The robot file holds no
-  floor, so no ``<pair>`` is written.
+  0.0001"``, ``condim`` 3 (1 for a frictionless material such as the tutorial's caster ``Slider``),
+  and an MK817 note. Every collision geom has ``priority="1"``: MuJoCo otherwise combines the two
+  geoms of a contact by max(), so a default floor's friction 1 would replace the caster's 0 (measured:
+  the tutorial robot then spins 0.06 of 5 rad); with the higher priority the robot geom's friction,
+  condim, solref and solimp are the contact's against any floor of MuJoCo's default priority 0.
+  The robot file holds no floor, so no ``<pair>`` is written.
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ MESH_READABLE = ("stl", "obj")
 COLLISION_GROUP = "3"
 VISUAL_GROUP = "1"
 TORSIONAL, ROLLING = 0.005, 0.0001  # MuJoCo's defaults, written out with the sliding friction
+CONTACT_PRIORITY = "1"  # above a floor's default 0: the robot geom's friction, condim, solref win
 
 
 @dataclass
@@ -53,6 +56,7 @@ class GeomWriter:
     names: NameTable
     asset: Element
     friction: dict[str, PairFriction]
+    contact: dict[str, str] = field(default_factory=dict)  # solref/solimp for every collision geom
     mesh_assets: dict[tuple[str, tuple[float, ...]], str] = field(default_factory=dict)
 
     def link_geoms(self, body: Element, link: Link, body_name: str) -> None:
@@ -90,6 +94,9 @@ class GeomWriter:
         set_pose(el, geom.pose)
         if collision:
             el.set("group", COLLISION_GROUP)
+            el.set("priority", CONTACT_PRIORITY)
+            for key, value in self.contact.items():
+                el.set(key, value)
         else:
             el.set("contype", "0")
             el.set("conaffinity", "0")
@@ -173,6 +180,7 @@ class GeomWriter:
     def set_friction(self, el: Element, link: Link, target: str) -> None:
         pair = self.friction[link.name]
         el.set("friction", f"{fmt(pair.dynamic)} {fmt(TORSIONAL)} {fmt(ROLLING)}")
+        el.set("condim", "3" if pair.dynamic > 0.0 else "1")
         how = "Choreonoid's pair table" if pair.from_table else "Choreonoid's √(roughness·roughness) rule"
         static = (
             f" (static {fmt(pair.static)} not held: MuJoCo has one coefficient)"
@@ -182,9 +190,9 @@ class GeomWriter:
         self.ctx.note(
             "MK817",
             f"material {pair.material} against {FLOOR_MATERIAL}: sliding friction {fmt(pair.dynamic)} from "
-            f"{how}{static}; MuJoCo takes the max of both geoms' values, so it holds against a floor with "
-            f"friction ≤ {fmt(pair.dynamic)} (friction 0 on the floor reproduces the pair value; restitution "
-            f"{fmt(pair.restitution)} is not written)",
+            f"{how}{static}; the geom has priority {CONTACT_PRIORITY}, so MuJoCo uses its friction and "
+            f"condim {'3' if pair.dynamic > 0.0 else '1 (frictionless)'} against any floor of priority 0 "
+            f"(MuJoCo's default); restitution {fmt(pair.restitution)} is not written",
             link.loc("material"),
             f"body[{target.split('[', 1)[1].split(']', 1)[0]}]",
         )

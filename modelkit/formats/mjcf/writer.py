@@ -7,9 +7,10 @@ through :func:`modelkit.convert.numbers.fmt`. MuJoCo is not imported here.
 * ``<compiler angle="radian" autolimits="true" inertiafromgeom="false"/>``: angles in radians,
   a ``range`` makes a joint limited, and inertia comes from the ``<inertial>`` elements only (geoms
   never add mass). No ``meshdir``: each mesh ``file`` is relative to the model file.
-* ``<option>``: the timestep, integrator and gravity are MuJoCo's defaults; only a robot with
-  pseudo continuous tracks gets ``impratio`` (``convert.tracks.TRACK_IMPRATIO``: soft friction, so
-  that the track rollers skid as Coulomb friction says; MK809).
+* ``<option>``: MuJoCo's defaults, except for a driven robot: wheels get timestep 1 ms,
+  ``implicitfast``, elliptic cones and ``impratio`` 10; pseudo continuous tracks the same with their
+  ``impratio`` (``convert.tracks.TRACK_IMPRATIO``: soft friction, so that the track rollers skid as
+  Coulomb friction says; MK809). One writer merges both: :mod:`modelkit.convert.simulator` (MK825).
 * The body tree, joints and inertials: :mod:`.write_bodies`; geoms, meshes, colours and friction:
   :mod:`.write_geoms`; sensors and lights: :mod:`.write_devices`.
 * Mimic joints → ``<equality><joint joint1=follower joint2=leader polycoef="offset multiplier 0 0
@@ -34,7 +35,7 @@ from lxml import etree
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.numbers import fmt, fmt_vec
-from modelkit.convert.tracks import track_impratio
+from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_geoms import GeomWriter
@@ -65,12 +66,25 @@ class MjcfWriter:
         compiler.set("angle", "radian")
         compiler.set("autolimits", "true")
         compiler.set("inertiafromgeom", "false")
-        self.geoms = GeomWriter(ctx, self.names, self.sections["asset"], floor_friction(robot))
+        self.geoms = GeomWriter(ctx, self.names, self.sections["asset"], floor_friction(robot),
+                                mujoco_contact(robot))
         self.devices = DeviceWriter(ctx, self.names, self.sections["sensor"])
         self.tree = BodyTree(robot, ctx, self.names, self.geoms, self.devices)
-        impratio = track_impratio(robot)
-        if impratio is not None:  # skid-steered tracks (convert.tracks, MK809 says why)
-            self.sections["option"].set("impratio", fmt(impratio))
+        options, why = mujoco_options(robot)  # wheels or tracks (convert.simulator says why)
+        for key, value in options.items():
+            self.sections["option"].set(key, value)
+        if options:
+            stiff = (f"; the collision geoms have solref {CONTACT['solref']!r} and solimp "
+                     f"{CONTACT['solimp']!r} (stiff contact: the wheels keep their rolling radius)"
+                     if mujoco_contact(robot) else "")
+            ctx.note(
+                "MK825",
+                f"<option {' '.join(f'{k}={v!r}' for k, v in options.items())}>: {why}{stiff}; a scene that "
+                "includes this file keeps these settings (MuJoCo merges <option>), and the robot drives "
+                "like its source with them (docs/convert.md)",
+                robot.source,
+                "option",
+            )
 
     def write(self) -> bytes:
         self.tree.write(self.sections["worldbody"])

@@ -117,14 +117,21 @@ class GeomWriter:
         surface = sub(collision, "surface")
         if friction.restitution > 0.0:
             num(sub(surface, "bounce"), "restitution_coefficient", friction.restitution)
-        ode = sub(sub(surface, "friction"), "ode")
+        friction_el = sub(surface, "friction")
+        ode = sub(friction_el, "ode")
         num(ode, "mu", friction.static)
         num(ode, "mu2", friction.static)
+        bullet = sub(friction_el, "bullet")
+        num(bullet, "friction", friction.static)
+        num(bullet, "friction2", friction.static)
+        num(bullet, "rolling_friction", 0.0)
         how = "from Choreonoid's material table" if friction.from_table else "by Choreonoid's √ rule"
         self.ctx.note(
             "MK817",
             f'link "{link.name}" (material {friction.material}): friction against {friction.against} '
-            f"({how}) is written as this collision's <mu>/<mu2> = {fmt(friction.static)}"
+            f"({how}) is written as this collision's <mu>/<mu2> (ode) and <friction>/<friction2> "
+            "(bullet, rolling 0) = "
+            f"{fmt(friction.static)}"
             + (
                 f" (dynamic {fmt(friction.dynamic)} has no field)"
                 if friction.dynamic != friction.static

@@ -128,8 +128,9 @@ def write_extensions(robot_el: Element, robot: Robot, names: NameTable, ctx: Wri
                 f'link "{link.name}": contact material "{pair.material}" against the floor '
                 f'material "{pair.against}" ({how}) is written as Gazebo mu1 = mu2 = {fmt(pair.dynamic)} '
                 f"(dynamic friction; static {fmt(pair.static)}, restitution {fmt(pair.restitution)} left "
-                "out); Gazebo/ODE uses the smaller of the two shapes' values and PyBullet multiplies "
-                "them, so contacts with other materials differ",
+                "out), and as PyBullet's <contact> lateral_friction (rolling and spinning 0); Gazebo/ODE "
+                "uses the smaller of the two shapes' values and PyBullet multiplies them (pybullet_data's "
+                "plane.urdf has 1), so contacts with other materials differ",
                 link.loc("material"),
                 f"gazebo[{name}]",
             )

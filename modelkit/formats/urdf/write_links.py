@@ -16,6 +16,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.friction import PairFriction
 from modelkit.convert.meshes import MeshRef
 from modelkit.convert.numbers import clean_angle, clean_length, fmt, fmt_vec
 from modelkit.convert.output import safe_file_name
@@ -181,9 +182,11 @@ def _dropped_appearance(material: VisualMaterial) -> list[str]:
 
 
 def link_element(
-    robot_el: Element, link: Link, name: str, robot: Robot, ctx: WriteContext, materials: MaterialTable
+    robot_el: Element, link: Link, name: str, robot: Robot, ctx: WriteContext, materials: MaterialTable,
+    friction: PairFriction | None = None,
 ) -> Element:
-    """The ``<link>`` element with its inertial, visuals and collisions."""
+    """The ``<link>`` element with its inertial, visuals, collisions and (with ``friction``, the link's
+    contact material against the floor) PyBullet's ``<contact>``."""
     el = etree.SubElement(robot_el, "link", name=name)
     target = f"link[{name}]"
     inertial_element(el, link, ctx, target)
@@ -205,4 +208,16 @@ def link_element(
                     if what not in materials.appearance_dropped:
                         materials.appearance_dropped.append(what)
             el.append(item)
+    if friction is not None and link.collisions:
+        contact_element(el, friction)
     return el
+
+
+def contact_element(link_el: Element, friction: PairFriction) -> None:
+    """PyBullet's ``<contact>``: lateral friction = the pair's dynamic friction (Bullet multiplies the
+    two bodies' values, and pybullet_data's plane.urdf has 1, so the product is the pair's); rolling
+    and spinning friction 0, as MuJoCo with condim 3 and Choreonoid have none."""
+    contact = etree.SubElement(link_el, "contact")
+    etree.SubElement(contact, "lateral_friction", value=fmt(friction.dynamic))
+    etree.SubElement(contact, "rolling_friction", value="0")
+    etree.SubElement(contact, "spinning_friction", value="0")

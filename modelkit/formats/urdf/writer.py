@@ -22,7 +22,9 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.friction import floor_friction
 from modelkit.convert.notes import ConversionNote, renames
+from modelkit.convert.simulator import pybullet_settings
 from modelkit.formats.urdf.write_gazebo import write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
 from modelkit.formats.urdf.write_links import MaterialTable, link_element, origin_element
@@ -107,8 +109,9 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
     links = etree.Element("links")
     if add_world:
         etree.SubElement(links, "link", name=WORLD_LINK)
+    friction = floor_friction(robot)
     for index, link in enumerate(robot.links):
-        link_element(links, link, names.links[index], robot, ctx, materials)
+        link_element(links, link, names.links[index], robot, ctx, materials, friction.get(link.name))
         _link_extras(link.extras, link.name, names.links[index], ctx)
     joints: list[Element] = []
     extra_links: list[str] = []
@@ -137,6 +140,16 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
     write_extensions(out, robot, names, ctx)
     _massless(robot, names, ctx)
     _notes(robot, ctx)
+    settings = pybullet_settings(robot)
+    if settings:
+        ctx.note(
+            "MK825",
+            "a URDF cannot carry simulator settings; in PyBullet set "
+            + ", ".join(f"setPhysicsEngineParameter({k}={v})" for k, v in settings.items())
+            + " for this robot to drive like its source (the tracks' rollers skid only then; MK809)",
+            robot.source,
+            "robot",
+        )
     etree.indent(out, space="  ")
     text = etree.tostring(out, encoding="unicode")
     return ('<?xml version="1.0"?>\n' + text + "\n").encode("utf-8")
