@@ -424,6 +424,9 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
 @click.option("--merge-fixed", is_flag=True, help="Fuse links on fixed joints into their parents.")
 @click.option("--urdf-world-link", is_flag=True,
               help="URDF: add a `world` link and the root's fixed or floating joint to it.")
+@click.option("--base", type=click.Choice(["auto", "fixed", "floating"]), default="auto", show_default=True,
+              help="Weld the root to the world or let it float; auto keeps the source's answer and, where "
+                   "it has none (URDF), floats robots with wheels or legs and welds the others.")
 @reading_options
 def convert(
     words: tuple[str, ...],
@@ -440,6 +443,7 @@ def convert(
     keep_package_uris: bool,
     merge_fixed: bool,
     urdf_world_link: bool,
+    base: str,
     **kwargs: Any,
 ) -> None:
     """Convert model files to URDF, SDF, MJCF or .body; every approximation is reported.
@@ -461,6 +465,7 @@ def convert(
         keep_package_uris=keep_package_uris,
         merge_fixed=merge_fixed,
         urdf_world_link=urdf_world_link,
+        base=base,
     )
     result = run_convert(
         files, output, target, _read_options(kwargs, True, xacro_args), options, force, kwargs["input_format"]

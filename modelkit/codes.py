@@ -1124,6 +1124,20 @@ _TABLE: tuple[CodeInfo, ...] = (
         "The robot's placement in the world cannot be written in the target (URDF has no root pose).",
     ),
     CodeInfo(
+        "MK830",
+        "base-decided",
+        "info",
+        "The source leaves open whether the root is welded or free (a URDF without `world`): `--base` "
+        "decided, `auto` by whether the robot moves itself (wheels, legs) or not (an arm is welded).",
+    ),
+    CodeInfo(
+        "MK831",
+        "base-overridden",
+        "info",
+        "`--base fixed|floating` overrides the source's own answer (a root joint type, a world joint, a "
+        "free joint).",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",

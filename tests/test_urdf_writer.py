@@ -340,9 +340,13 @@ def test_world_link_option_and_root_notes(tmp_path: Path) -> None:
     arm = Joint("j", JointType.REVOLUTE, "base", "arm")
     robot = _robot(arm, root_joint=JointType.FIXED)
     robot.root_pose = Pose(matrix_from_rpy(0, 0, 0.5), np.array([1.0, 2.0, 0.0]))
-    data, notes = write_to(robot, tmp_path / "plain")
-    assert {n.code for n in notes} >= {"MK814", "MK823"}
-    assert b'"world"' not in data
+    data, notes = write_to(robot, tmp_path / "plain")  # a welded root always hangs from `world`
+    assert "MK823" not in {n.code for n in notes}
+    assert _joint_el(data, "world_to_base").get("type") == "fixed"
+    robot.root_joint = JointType.FLOATING
+    data, notes = write_to(robot, tmp_path / "free")  # a floating root only with the option
+    assert "MK823" in {n.code for n in notes} and b'"world"' not in data
+    robot.root_joint = JointType.FIXED
     data, notes = write_to(robot, tmp_path / "world", WriteOptions(urdf_world_link=True))
     assert "MK823" not in {n.code for n in notes}
     root = etree.fromstring(data)

@@ -16,3 +16,4 @@ class WriteOptions:
     keep_package_uris: bool = False  # keep package:// and model:// references instead of copying
     merge_fixed: bool = False  # fuse links on fixed joints into their parents
     urdf_world_link: bool = False  # URDF: write a `world` link and the root's fixed/floating joint
+    base: str = "auto"  # fixed | floating | auto: how the root meets the world (modelkit/convert/base.py)

@@ -8,9 +8,10 @@ extensions. Pretty-printed with two-space indentation, numbers through
 and ``write_gazebo`` (sensors, friction, kept extension blocks).
 
 How the root meets the world: URDF has no root pose and its consumers float the root unless it
-hangs from a link named ``world``. With ``WriteOptions.urdf_world_link`` a ``world`` link is written
-with a fixed (or floating) joint to the root at ``root_pose``; otherwise a welded root is an MK814
-note and a placement an MK823 note. Links the tree does not reach (an SDF model's free links) hang
+hangs from a link named ``world``. A welded root (``--base``, settled in ``modelkit/convert/base.py``)
+hangs from a ``world`` link by a fixed joint at ``root_pose``; with ``WriteOptions.urdf_world_link`` a
+floating root hangs from it by a floating joint too; otherwise a floating root's placement is an
+MK823 note. Links the tree does not reach (an SDF model's free links) hang
 from the root by ``floating`` joints (MK813), since a URDF has exactly one root.
 """
 
@@ -97,8 +98,10 @@ def urdf_renames(notes: Iterable[ConversionNote]) -> dict[str, str]:
 
 def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
     """The URDF file of ``robot``; meshes and textures are staged through ``ctx``."""
+    # A welded root always hangs from `world` (URDF consumers float a root that does not); a floating
+    # one does so only with the option.
     add_world = (
-        ctx.options.urdf_world_link
+        (ctx.options.urdf_world_link or robot.root_joint is JointType.FIXED)
         and robot.root not in (None, WORLD_LINK)
         and robot.root_joint in (JointType.FIXED, JointType.FLOATING)
     )

@@ -1,0 +1,214 @@
+"""How the robot's root meets the world in the output: welded (fixed) or free (floating).
+
+Settled once here, before any writer runs, so every target carries the same answer (MJCF: a body
+without joint or ``<freejoint/>``; SDF: a joint to ``world`` or a free model; URDF: a ``world`` link
+with a fixed joint, or no ``world`` link; .body: ``jointType: fixed|free``).
+
+* The source's own answer wins (Choreonoid's root ``jointType``, an SDF world joint or free model, an
+  MJCF root body with or without a free joint, a URDF ``world`` link) unless the user asks otherwise
+  with ``--base fixed|floating``; then an MK831 note says the source's answer was overridden.
+* Where the source is silent (a URDF without ``world``: ``Robot.root_joint is None``), ``--base`` decides;
+  ``auto`` floats a robot that moves itself and welds the others (MK830 says which and why):
+
+  - a robot whose root's own rigid body (the root and what is fixed to it) touches the lowest level
+    rests on its base: welded (arms, fixtures);
+  - wheels: at least two revolute joints with a horizontal axis whose child's shapes touch the lowest
+    level with a round section about that axis (a cylinder or sphere on the axis, or any shape whose
+    extents across the axis are equal within 10 % and centred on it): floating;
+  - legs: at least two branches (from different first moving joints below the root) whose shapes
+    touch the lowest level through two or more moving joints: floating;
+  - a robot without mass is welded (it cannot float in a simulator); so is one without any shape
+    to stand on.
+
+"The lowest level" is the lowest point of the collision shapes (visual shapes when the robot has no
+collision shape) at q = 0, and "touches" means within 2 % of the robot's height (at least 1 mm).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from modelkit.convert.notes import NoteSink
+from modelkit.convert.tracks import extent
+from modelkit.model import WORLD_LINK, Cylinder, Geom, Joint, JointType, Robot, Sphere
+from modelkit.spatial import Pose
+
+BASE_CHOICES = ("auto", "fixed", "floating")
+_UP = np.array([0.0, 0.0, 1.0])
+
+
+@dataclass(frozen=True)
+class BaseDecision:
+    """What ``auto`` found for a source that leaves the root open."""
+
+    kind: JointType  # FIXED or FLOATING
+    reason: str
+
+
+def settle_base(robot: Robot, choice: str, notes: NoteSink) -> None:
+    """Set ``robot.root_joint`` (and the joints from a ``world`` root) to the base the output gets."""
+    if choice not in BASE_CHOICES:
+        raise ValueError(f"base must be one of {', '.join(BASE_CHOICES)}, not {choice!r}")
+    if robot.root is None:
+        return
+    where = robot.extras.get("root_joint_source") or robot.source
+    if robot.root == WORLD_LINK:
+        _settle_world_root(robot, choice, notes)
+        return
+    if robot.root_joint is not None:
+        asked = _asked(choice)
+        if asked is not None and asked is not robot.root_joint:
+            notes.note("MK831", f'the source {_word(robot.root_joint)} the root "{robot.root}"; written '
+                       f"{_past(asked)} as asked (--base {choice})", where, f"link[{robot.root}]")
+            robot.root_joint = asked
+        return
+    asked = _asked(choice)
+    if asked is not None:
+        robot.root_joint = asked
+        notes.note("MK830", f'the source leaves the root "{robot.root}" open; it is {_past(asked)} '
+                   f"as asked (--base {choice})", where, f"link[{robot.root}]")
+        return
+    decision = decide(robot)
+    robot.root_joint = decision.kind
+    how = _past(decision.kind)
+    notes.note("MK830", f'the source leaves the root "{robot.root}" open; --base auto: {how}: '
+               f"{decision.reason}", where, f"link[{robot.root}]")
+
+
+def _asked(choice: str) -> JointType | None:
+    return {"fixed": JointType.FIXED, "floating": JointType.FLOATING}.get(choice)
+
+
+def _word(kind: JointType) -> str:
+    return "welds" if kind is JointType.FIXED else "floats"
+
+
+def _past(kind: JointType) -> str:
+    return "welded" if kind is JointType.FIXED else "floating"
+
+
+def _settle_world_root(robot: Robot, choice: str, notes: NoteSink) -> None:
+    """A ``world`` root link: the joints that hang from it carry the base (fixed or floating)."""
+    asked = _asked(choice)
+    if asked is None:
+        return
+    for joint in robot.joints:
+        if joint.parent != WORLD_LINK or joint.type not in (JointType.FIXED, JointType.FLOATING):
+            continue
+        if joint.type is not asked:
+            notes.note("MK831", f'the source {_word(joint.type)} "{joint.child}" to the world by the joint '
+                       f'"{joint.name}"; written {_past(asked)} as asked (--base {choice})',
+                       joint.source, f"joint[{joint.name}]")
+            joint.type = asked
+
+
+# ---- auto ------------------------------------------------------------------------------------
+
+
+def decide(robot: Robot) -> BaseDecision:
+    """Float a robot that moves itself (wheels, legs), weld the others (see the module docstring)."""
+    if sum(max(link.inertial.mass, 0.0) for link in robot.links if link.inertial is not None) <= 0.0:
+        return BaseDecision(JointType.FIXED, "the robot has no mass to float")
+    poses = robot.world_poses()
+    use_collisions = any(link.collisions for link in robot.links)
+    lows: dict[str, tuple[float, float]] = {}
+    for link in robot.links:
+        geoms = link.collisions if use_collisions else link.visuals
+        pose = poses.get(link.name)
+        if pose is None or not geoms:
+            continue
+        span = extent(geoms, pose.rotation.T @ _UP)
+        if span is not None:
+            z = float(pose.translation[2])
+            lows[link.name] = (z + span[0], z + span[1])
+    if not lows:
+        return BaseDecision(JointType.FIXED, "it has no shape to stand on")
+    ground = min(low for low, _ in lows.values())
+    height = max(high for _, high in lows.values()) - ground
+    tolerance = max(1e-3, 0.02 * height)
+    touching = {name for name, (low, _) in lows.items() if low - ground <= tolerance}
+    parent_joint = {joint.child: joint for joint in robot.joints}
+    above = {name: _moving_above(parent_joint, name) for name in sorted(touching)}
+    if any(not moving for moving in above.values()):
+        return BaseDecision(JointType.FIXED, "the root's own body rests on the ground (an arm or a fixture)")
+    wheels = _wheels(robot, poses, touching, use_collisions)
+    if len(wheels) >= 2:
+        shown = ", ".join(f'"{j.name}"' for j in wheels[:4]) + (" ..." if len(wheels) > 4 else "")
+        return BaseDecision(JointType.FLOATING, f"it drives on wheels (joint(s) {shown}: a round shape "
+                            "on a horizontal axis touching the ground)")
+    feet = _feet(above)
+    if len(feet) >= 2:
+        shown = ", ".join(f'"{name}"' for name in feet[:6])
+        return BaseDecision(JointType.FLOATING, f"it stands on {len(feet)} legs (feet {shown} touch the "
+                            "ground, the root's body does not)")
+    return BaseDecision(JointType.FIXED, "no wheels or legs touch the ground (an arm or a fixture)")
+
+
+def _wheels(robot: Robot, poses: dict[str, Pose], touching: set[str], use_collisions: bool) -> list[Joint]:
+    out: list[Joint] = []
+    links = {link.name: link for link in robot.links}
+    for joint in robot.joints:
+        if joint.type is not JointType.REVOLUTE or joint.child not in touching or joint.child not in poses:
+            continue
+        link = links[joint.child]
+        axis = np.asarray(joint.axis, dtype=float)
+        norm = float(np.linalg.norm(axis))
+        if norm == 0.0:
+            continue
+        axis = axis / norm  # in the child frame
+        world_axis = poses[joint.child].rotation @ axis
+        if abs(float(world_axis[2])) > 0.2:
+            continue
+        geoms = link.collisions if use_collisions else link.visuals
+        if any(_round_about(geom, axis) for geom in geoms):
+            out.append(joint)
+    return out
+
+
+def _round_about(geom: Geom, axis: np.ndarray) -> bool:
+    """Whether the shape's section across ``axis`` (child frame, through the origin) is a disc about it."""
+    offset = np.asarray(geom.pose.translation, dtype=float)
+    off_axis = offset - axis * float(axis @ offset)
+    if isinstance(geom.geometry, Sphere):
+        return bool(np.linalg.norm(off_axis) <= 0.1 * geom.geometry.radius)
+    if isinstance(geom.geometry, Cylinder):
+        along = geom.pose.rotation @ _UP
+        near = np.linalg.norm(off_axis) <= 0.1 * geom.geometry.radius
+        return bool(abs(float(along @ axis)) > 0.95 and near)
+    side = np.cross(axis, _UP if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0]))
+    side = side / np.linalg.norm(side)
+    other = np.cross(axis, side)
+    spans = [extent([geom], d) for d in (side, other)]
+    if spans[0] is None or spans[1] is None:
+        return False
+    widths = [hi - lo for lo, hi in spans]  # type: ignore[misc]
+    centres = [(hi + lo) / 2 for lo, hi in spans]  # type: ignore[misc]
+    radius = max(widths) / 2
+    return bool(radius > 0.0 and min(widths) >= 0.9 * max(widths)
+                and max(abs(c) for c in centres) <= 0.1 * radius)
+
+
+def _moving_above(parent_joint: dict[str, Joint], name: str) -> list[Joint]:
+    """The moving joints from the link up to the root, nearest first."""
+    moving: list[Joint] = []
+    current = name
+    seen: set[str] = set()
+    while current in parent_joint and current not in seen:
+        seen.add(current)
+        joint = parent_joint[current]
+        if joint.type.moves:
+            moving.append(joint)
+        current = joint.parent
+    return moving
+
+
+def _feet(above: dict[str, list[Joint]]) -> list[str]:
+    """One touching link per branch (named by its first moving joint below the root) that reaches the
+    ground through ≥ 2 moving joints."""
+    by_branch: dict[str, str] = {}
+    for name, moving in above.items():
+        if len(moving) >= 2:
+            by_branch.setdefault(moving[-1].name, name)
+    return [by_branch[key] for key in sorted(by_branch)]
