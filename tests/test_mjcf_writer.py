@@ -756,9 +756,9 @@ def test_names_are_unique_and_renames_noted(tmp_path: Path) -> None:
 def test_root_conventions(tmp_path: Path) -> None:
     robot = _chain(_hinge("j", "base", "arm"))
     robot.root_pose = Pose(np.eye(3), np.array([0.0, 0.0, 1.0]))
-    # A root the source leaves open is settled by --base auto before the writer (MK830): no wheels
-    # or legs, so welded.
-    for kind, free in ((JointType.FIXED, False), (JointType.FLOATING, True), (None, False)):
+    # A root the source leaves open is settled by --base auto before the writer (MK830): no shape to
+    # judge by, so it floats (URDF's convention).
+    for kind, free in ((JointType.FIXED, False), (JointType.FLOATING, True), (None, True)):
         variant = copy.deepcopy(robot)
         variant.root_joint = kind
         written = render(variant, tmp_path / str(kind))

@@ -17,8 +17,8 @@ with a fixed joint, or no ``world`` link; .body: ``jointType: fixed|free``).
     extents across the axis are equal within 10 % and centred on it): floating;
   - legs: at least two branches (from different first moving joints below the root) whose shapes
     touch the lowest level through two or more moving joints: floating;
-  - a robot without mass is welded (it cannot float in a simulator); so is one without any shape
-    to stand on.
+  - a robot without mass is welded (it cannot float in a simulator); one without any shape floats
+    (nothing to judge by: URDF's own convention, so a URDF round trip keeps a floating root).
 
 "The lowest level" is the lowest point of the collision shapes (visual shapes when the robot has no
 collision shape) at q = 0, and "touches" means within 2 % of the robot's height (at least 1 mm).
@@ -124,7 +124,8 @@ def decide(robot: Robot) -> BaseDecision:
             z = float(pose.translation[2])
             lows[link.name] = (z + span[0], z + span[1])
     if not lows:
-        return BaseDecision(JointType.FIXED, "it has no shape to stand on")
+        return BaseDecision(JointType.FLOATING, "it has no shape to judge by, so URDF's own convention "
+                            "(a root that does not hang from `world` floats)")
     ground = min(low for low, _ in lows.values())
     height = max(high for _, high in lows.values()) - ground
     tolerance = max(1e-3, 0.02 * height)
