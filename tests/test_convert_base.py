@@ -27,6 +27,8 @@ A1 = DATA / "a1" / "a1.urdf"
 LAIKAGO = DATA / "laikago" / "laikago_toes_zup.urdf"
 RACECAR = DATA / "racecar" / "racecar.urdf"
 R2D2 = DATA / "r2d2.urdf"
+VISION60 = DATA / "quadruped" / "vision60.urdf"  # legs sideways at q = 0: its body is the lowest point
+CUBE = DATA / "cube.urdf"
 
 
 def _convert(source: Path, out: Path, base: str = "auto") -> list[tuple[str, str]]:
@@ -63,8 +65,9 @@ def test_arm_is_welded_by_default_and_does_not_fall(source: Path, tmp_path: Path
 
 @pytest.mark.parametrize(
     ("source", "why"),
-    [(A1, "legs"), (LAIKAGO, "legs"), (RACECAR, "wheels"), (R2D2, "wheels")],
-    ids=["a1", "laikago", "racecar", "r2d2"],
+    [(A1, "legs"), (LAIKAGO, "legs"), (RACECAR, "wheels"), (R2D2, "wheels"), (VISION60, "4 limbs"),
+     (CUBE, "no moving joint")],
+    ids=["a1", "laikago", "racecar", "r2d2", "vision60", "cube"],
 )
 def test_robots_that_move_themselves_float(source: Path, why: str, tmp_path: Path) -> None:
     out = tmp_path / "robot.xml"

@@ -17,6 +17,10 @@ with a fixed joint, or no ``world`` link; .body: ``jointType: fixed|free``).
     extents across the axis are equal within 10 % and centred on it): floating;
   - legs: at least two branches (from different first moving joints below the root) whose shapes
     touch the lowest level through two or more moving joints: floating;
+  - legs that do not reach the ground at q = 0 (folded or sideways, as some quadrupeds are modelled):
+    four or more limbs of two or more moving joints in a row hanging from the root's rigid body (four
+    legs, or two legs and two arms; an arm has one, a dual-arm torso two or three): floating;
+  - a robot without moving joints (an object: a cube, a mug) floats, as URDF's convention has it;
   - a robot without mass is welded (it cannot float in a simulator); one without any shape floats
     (nothing to judge by: URDF's own convention, so a URDF round trip keeps a floating root).
 
@@ -36,6 +40,7 @@ from modelkit.model import WORLD_LINK, Cylinder, Geom, Joint, JointType, Robot, 
 from modelkit.spatial import Pose
 
 BASE_CHOICES = ("auto", "fixed", "floating")
+LIMBS = 4  # limbs of ≥ 2 moving joints from the root's body that make a robot legged (4 legs, or 2 + 2 arms)
 _UP = np.array([0.0, 0.0, 1.0])
 
 
@@ -111,6 +116,10 @@ def decide(robot: Robot) -> BaseDecision:
     """Float a robot that moves itself (wheels, legs), weld the others (see the module docstring)."""
     if sum(max(link.inertial.mass, 0.0) for link in robot.links if link.inertial is not None) <= 0.0:
         return BaseDecision(JointType.FIXED, "the robot has no mass to float")
+    if not any(joint.type.moves for joint in robot.joints):
+        return BaseDecision(JointType.FLOATING, "it has no moving joint (an object), so URDF's own "
+                            "convention (a root that does not hang from `world` floats)")
+    limbs = _limbs(robot)
     poses = robot.world_poses()
     use_collisions = any(link.collisions for link in robot.links)
     lows: dict[str, tuple[float, float]] = {}
@@ -133,7 +142,7 @@ def decide(robot: Robot) -> BaseDecision:
     parent_joint = {joint.child: joint for joint in robot.joints}
     above = {name: _moving_above(parent_joint, name) for name in sorted(touching)}
     if any(not moving for moving in above.values()):
-        return BaseDecision(JointType.FIXED, "the root's own body rests on the ground (an arm or a fixture)")
+        return _by_limbs(limbs, "the root's own body rests on the ground (an arm or a fixture)")
     wheels = _wheels(robot, poses, touching, use_collisions)
     if len(wheels) >= 2:
         shown = ", ".join(f'"{j.name}"' for j in wheels[:4]) + (" ..." if len(wheels) > 4 else "")
@@ -144,7 +153,48 @@ def decide(robot: Robot) -> BaseDecision:
         shown = ", ".join(f'"{name}"' for name in feet[:6])
         return BaseDecision(JointType.FLOATING, f"it stands on {len(feet)} legs (feet {shown} touch the "
                             "ground, the root's body does not)")
-    return BaseDecision(JointType.FIXED, "no wheels or legs touch the ground (an arm or a fixture)")
+    return _by_limbs(limbs, "no wheels or legs touch the ground (an arm or a fixture)")
+
+
+def _by_limbs(limbs: list[str], otherwise: str) -> BaseDecision:
+    """Legs that do not reach the ground at q = 0 (folded, or sideways): four or more limbs."""
+    if len(limbs) >= LIMBS:
+        shown = ", ".join(f'"{name}"' for name in limbs[:6])
+        return BaseDecision(JointType.FLOATING, f"it has {len(limbs)} limbs of two or more moving joints "
+                            f"each from its body (first joints {shown}): a legged robot")
+    return BaseDecision(JointType.FIXED, otherwise)
+
+
+def _limbs(robot: Robot) -> list[str]:
+    """The first moving joints below the root's rigid body whose subtree holds ≥ 2 moving joints in a row."""
+    children = robot.children_of()
+    body = [robot.root or ""]
+    starts: list[Joint] = []
+    while body:  # the root's rigid body: the root and what hangs from it by fixed joints
+        for joint in children.get(body.pop(), []):
+            if joint.type.moves:
+                starts.append(joint)
+            else:
+                body.append(joint.child)
+    return sorted(joint.name for joint in starts if _depth(children, joint.child) >= 1)
+
+
+def _depth(children: dict[str, list[Joint]], link: str) -> int:
+    """The most moving joints on a path down from ``link``."""
+    best: dict[str, int] = {}
+    order: list[str] = []
+    stack = [link]
+    while stack:
+        name = stack.pop()
+        if name in best:
+            continue
+        best[name] = 0
+        order.append(name)
+        stack.extend(j.child for j in children.get(name, []))
+    for name in reversed(order):
+        best[name] = max((best.get(j.child, 0) + (1 if j.type.moves else 0) for j in children.get(name, [])),
+                         default=0)
+    return best[link]
 
 
 def _wheels(robot: Robot, poses: dict[str, Pose], touching: set[str], use_collisions: bool) -> list[Joint]:
