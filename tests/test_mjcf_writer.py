@@ -215,17 +215,18 @@ SET_ASIDE: dict[str, tuple[str, frozenset[str]]] = {
     ),
     **{
         f"kuka_experimental/kuka_lbr_iiwa_support/urdf/lbr_iiwa_14_r820.{suffix}#0": (
-            "no link has an inertial: each moving one gets 1e-6 kg (MK816)",
-            frozenset({"mass base_link", *(f"mass link_{i}" for i in range(1, 8))}),
+            "no link has an inertial: the root is welded (--base auto: no mass to float, MK830), each "
+            "moving link gets 1e-6 kg (MK816)",
+            frozenset({f"mass link_{i}" for i in range(1, 8)}),
         )
         for suffix in ("urdf", "xacro")
     },
     "urdf_tutorial/urdf/06-flexible.urdf#0": (
-        "no link has an inertial: each moving one gets 1e-6 kg (MK816)",
+        "no link has an inertial: the root is welded (--base auto: no mass to float, MK830), each moving "
+        "link gets 1e-6 kg (MK816)",
         frozenset(
             f"mass {name}"
             for name in (
-                "base_link",
                 "gripper_pole",
                 "head",
                 "left_back_wheel",
