@@ -58,6 +58,8 @@ def settle_base(robot: Robot, choice: str, notes: NoteSink) -> None:
         raise ValueError(f"base must be one of {', '.join(BASE_CHOICES)}, not {choice!r}")
     if robot.root is None:
         return
+    if robot.root == WORLD_LINK:
+        _weld_of_world(robot)
     where = robot.extras.get("root_joint_source") or robot.source
     if robot.root == WORLD_LINK:
         _settle_world_root(robot, choice, notes)
@@ -80,6 +82,33 @@ def settle_base(robot: Robot, choice: str, notes: NoteSink) -> None:
     how = _past(decision.kind)
     notes.note("MK830", f'the source leaves the root "{robot.root}" open; --base auto: {how}: '
                f"{decision.reason}", where, f"link[{robot.root}]")
+
+
+def _weld_of_world(robot: Robot) -> None:
+    """An empty ``world`` link with one fixed joint to the robot (a URDF's way of welding it) is the
+    root welded at that joint's origin; the joint's name is kept (``extras["root_joint_name"]``) for the
+    targets that write the weld as a joint (URDF, SDF)."""
+    world = robot.link(WORLD_LINK)
+    hanging = [joint for joint in robot.joints if joint.parent == WORLD_LINK]
+    if (
+        world is None
+        or world.visuals or world.collisions or world.devices
+        or (world.inertial is not None and world.inertial.mass > 0.0)
+        or len(hanging) != 1
+        or hanging[0].type is not JointType.FIXED
+        or any(j.child == WORLD_LINK for j in robot.joints)
+        or any(WORLD_LINK in (loop.link1, loop.link2) for loop in robot.loops)
+    ):
+        return
+    weld = hanging[0]
+    robot.links.remove(world)
+    robot.joints.remove(weld)
+    robot.root, robot.root_joint = weld.child, JointType.FIXED
+    robot.root_pose = robot.root_pose @ weld.origin
+    robot.extras["root_joint_name"] = weld.name
+    if weld.source is not None:
+        robot.extras["root_joint_source"] = weld.source
+    robot.extras.pop("world_link", None)
 
 
 def _asked(choice: str) -> JointType | None:

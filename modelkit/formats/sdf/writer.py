@@ -201,7 +201,8 @@ class _ModelWriter:
             return
         if robot.root_joint is JointType.FIXED:
             info = robot.extras.get("sdf_world_joint")
-            wanted = info.get("name") if isinstance(info, dict) and info.get("name") else "world_joint"
+            wanted = (info.get("name") if isinstance(info, dict) and info.get("name")
+                      else robot.extras.get("root_joint_name") or "world_joint")
             name = self.names.claim("joint", str(wanted), robot.extras.get("root_joint_source"))
             joint = sub(model, "joint", name=name, type="fixed")
             sub(joint, "parent", WORLD_LINK)

@@ -40,6 +40,7 @@ SILENT_EXTRAS = frozenset(
         "urdf_version",
         "world_link",
         "root_joint_source",
+        "root_joint_name",
         "materials_path",
         "masses_unknown",
         "sdf_canonical_link",
@@ -154,7 +155,8 @@ def _root(robot: Robot, names: NameTable, ctx: WriteContext, add_world: bool) ->
     where = robot.extras.get("root_joint_source") or robot.source
     if add_world:
         word = "fixed" if robot.root_joint is JointType.FIXED else "floating"
-        el = etree.Element("joint", name=names.fresh(f"{WORLD_LINK}_to_{root}"), type=word)
+        wanted = robot.extras.get("root_joint_name") or f"{WORLD_LINK}_to_{root}"
+        el = etree.Element("joint", name=names.fresh(str(wanted)), type=word)
         origin_element(el, robot.root_pose)
         etree.SubElement(el, "parent", link=WORLD_LINK)
         etree.SubElement(el, "child", link=root)
