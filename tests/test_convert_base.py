@@ -165,3 +165,44 @@ def test_cli_base_option(tmp_path: Path) -> None:
     assert "MK830" in run.output
     bad = CliRunner().invoke(main, ["convert", str(A1), "-o", str(out), "--base", "welded", "--force"])
     assert bad.exit_code == 2 and "welded" in bad.output
+
+
+WELDED_URDF = """\
+<robot name="r">
+  <link name="world"/>
+  <joint name="fix_base" type="fixed"><parent link="world"/><child link="base"/>
+    <origin xyz="0 0 0.5"/></joint>
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+def test_urdf_world_weld_is_the_source_answer_and_keeps_its_name(tmp_path: Path) -> None:
+    source = tmp_path / "r.urdf"
+    source.write_text(WELDED_URDF)
+    sdf = tmp_path / "sdf" / "r.sdf"
+    notes = _convert(source, sdf)
+    assert not [c for c, _ in notes if c in ("MK830", "MK831")]
+    model = etree.parse(str(sdf)).getroot().find("model")
+    assert model is not None
+    (weld,) = [j for j in model.findall("joint") if j.findtext("parent") == "world"]
+    assert weld.get("name") == "fix_base" and weld.get("type") == "fixed"
+    urdf = tmp_path / "urdf" / "r.urdf"
+    _convert(source, urdf)
+    back = validate(urdf).robot
+    assert back is not None and back.root == "world"
+    assert [(j.name, j.child) for j in back.joints if j.parent == "world"] == [("fix_base", "base")]
+    mjcf = tmp_path / "mjcf" / "r.xml"
+    _convert(source, mjcf)
+    body = etree.parse(str(mjcf)).getroot().find("worldbody/body")
+    assert body is not None and body.get("name") == "base" and body.find("freejoint") is None
+    assert body.get("pos") == "0 0 0.5"
+    free = tmp_path / "free" / "r.xml"
+    notes = _convert(source, free, "floating")
+    assert b"<freejoint" in free.read_bytes()
+    assert [c for c, _ in notes if c == "MK831"] == ["MK831"]
