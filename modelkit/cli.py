@@ -464,7 +464,7 @@ def convert(
         keep_collada=keep_collada,
         keep_package_uris=keep_package_uris,
         merge_fixed=merge_fixed,
-        urdf_world_link=urdf_world_link,
+        urdf_world_link=True if urdf_world_link else None,
         base=base,
     )
     result = run_convert(

@@ -102,7 +102,8 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
     # A welded root always hangs from `world` (URDF consumers float a root that does not); a floating
     # one does so only with the option.
     add_world = (
-        (ctx.options.urdf_world_link or robot.root_joint is JointType.FIXED)
+        (ctx.options.urdf_world_link
+         or (ctx.options.urdf_world_link is None and robot.root_joint is JointType.FIXED))
         and robot.root not in (None, WORLD_LINK)
         and robot.root_joint in (JointType.FIXED, JointType.FLOATING)
     )
