@@ -423,7 +423,7 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
               help="Keep package:// and model:// mesh references instead of copying the meshes.")
 @click.option("--merge-fixed", is_flag=True, help="Fuse links on fixed joints into their parents.")
 @click.option("--urdf-world-link", is_flag=True,
-              help="URDF: add a `world` link and the root's fixed or floating joint to it.")
+              help="URDF: hang a floating root from a `world` link too (a welded root always does).")
 @click.option("--base", type=click.Choice(["auto", "fixed", "floating"]), default="auto", show_default=True,
               help="Weld the root to the world or let it float; auto keeps the source's answer and, where "
                    "it has none (URDF), floats robots with wheels or legs and welds the others.")
