@@ -423,10 +423,13 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
               help="Keep package:// and model:// mesh references instead of copying the meshes.")
 @click.option("--merge-fixed", is_flag=True, help="Fuse links on fixed joints into their parents.")
 @click.option("--urdf-world-link", is_flag=True,
-              help="URDF: add a `world` link and the root's fixed or floating joint to it.")
+              help="URDF: hang a floating root from a `world` link too (a welded root always does).")
 @click.option("--wheel-collision", type=click.Choice(WHEEL_COLLISIONS), default="auto", show_default=True,
               help="Collision shape of wheels (auto: a sphere for MJCF and URDF, the cylinder for SDF and "
                    ".body; MK826).")
+@click.option("--base", type=click.Choice(["auto", "fixed", "floating"]), default="auto", show_default=True,
+              help="Weld the root to the world or let it float; auto keeps the source's answer and, where "
+                   "it has none (URDF), floats robots with wheels or legs and welds the others.")
 @reading_options
 def convert(
     words: tuple[str, ...],
@@ -444,6 +447,7 @@ def convert(
     merge_fixed: bool,
     urdf_world_link: bool,
     wheel_collision: str,
+    base: str,
     **kwargs: Any,
 ) -> None:
     """Convert model files to URDF, SDF, MJCF or .body; every approximation is reported.
@@ -464,8 +468,9 @@ def convert(
         keep_collada=keep_collada,
         keep_package_uris=keep_package_uris,
         merge_fixed=merge_fixed,
-        urdf_world_link=urdf_world_link,
+        urdf_world_link=True if urdf_world_link else None,
         wheel_collision=wheel_collision,
+        base=base,
     )
     with _interruptible("convert", output):
         result = run_convert(files, output, target, _read_options(kwargs, True, xacro_args), options, force,

@@ -1149,6 +1149,20 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MuJoCo and PyBullet roll alike on a floor.",
     ),
     CodeInfo(
+        "MK830",
+        "base-decided",
+        "info",
+        "The source leaves open whether the root is welded or free (a URDF without `world`): `--base` "
+        "decided, `auto` by whether the robot moves itself (wheels, legs) or not (an arm is welded).",
+    ),
+    CodeInfo(
+        "MK831",
+        "base-overridden",
+        "info",
+        "`--base fixed|floating` overrides the source's own answer (a root joint type, a world joint, a "
+        "free joint).",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",

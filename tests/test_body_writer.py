@@ -338,9 +338,10 @@ def test_fixed_root_and_open_root(tmp_path: Path) -> None:
     assert np.allclose(back.root_pose.rotation, pose.rotation) and np.allclose(back.root_pose.translation,
                                                                                 pose.translation)
     assert not [n for n in notes if n.code == "MK814"]
-    # A root the source leaves open floats, with a note; a root body without mass is welded instead.
+    # A root the source leaves open is settled by --base auto (MK830): this one has no shape to judge
+    # by, so it floats (URDF's convention); a root body without mass is welded instead.
     _, back, notes = _write_and_read(_robot(root_joint=None), tmp_path / "open" / "m.body")
-    assert back.root_joint is JointType.FLOATING and [n.code for n in notes] == ["MK814"]
+    assert back.root_joint is JointType.FLOATING and [n.code for n in notes] == ["MK830"]
     massless = _robot(root_joint=None)
     massless.links[0].inertial = None
     text, back, notes = _write_and_read(massless, tmp_path / "massless" / "m.body")

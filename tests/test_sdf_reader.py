@@ -496,7 +496,7 @@ def test_joint_details(tmp_path: Path) -> None:
         math.inf,
         3.0,
     )
-    assert (lead.damping, lead.friction, lead.extras["sdf_spring"]["stiffness"]) == (0.5, 0.2, 4.0)
+    assert (lead.damping, lead.friction, lead.spring_stiffness) == (0.5, 0.2, 4.0)
     assert follow.mimic is not None and follow.mimic.joint == "lead"
     assert (follow.mimic.multiplier, follow.mimic.offset) == (2.0, pytest.approx(0.1 - 2 * 0.5))
     assert ball.type is JointType.BALL

@@ -352,8 +352,8 @@ def test_fixed_root_is_a_world_joint(tmp_path: Path) -> None:
     assert np.allclose(back.root_pose.rotation, robot.root_pose.rotation, atol=1e-12)
     assert np.allclose(back.root_pose.translation, robot.root_pose.translation, atol=1e-12)
     notes = write(arm(None), tmp_path / "b.sdf")
-    assert "MK814" in codes(notes)
-    assert validate(tmp_path / "b.sdf").robots[0].root_joint is JointType.FLOATING
+    assert "MK830" in codes(notes)  # --base auto settles the open root: no wheels or legs, welded
+    assert validate(tmp_path / "b.sdf").robots[0].root_joint is JointType.FIXED
 
 
 def test_full_inertia_and_joint_details_round_trip(tmp_path: Path) -> None:

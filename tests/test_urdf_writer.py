@@ -157,8 +157,15 @@ def test_pybullet_loads_every_output(converted: list[Converted]) -> None:
 
 def expected_after_urdf(robot: Robot) -> Robot:
     """The model with the writer's documented substitutions: URDF needs both position bounds of a
-    prismatic joint (and of a revolute joint limited on one side only), ±1e16 where there is none."""
+    prismatic joint (and of a revolute joint limited on one side only), ±1e16 where there is none;
+    a welded root hangs from a `world` link by a fixed joint at the robot's placement."""
     out = copy.deepcopy(robot)
+    if out.root_joint is JointType.FIXED and out.root not in (None, "world"):
+        root = str(out.root)
+        out.links.insert(0, Link("world"))
+        name = str(out.extras.get("root_joint_name") or f"world_to_{root}")
+        out.joints.append(Joint(name, JointType.FIXED, "world", root, origin=out.root_pose))
+        out.root, out.root_pose = "world", Pose()
     for joint in out.joints:
         limits = joint.limits
         if joint.type is JointType.PRISMATIC or (
@@ -273,7 +280,7 @@ def _inertial(mass: float = 1.0) -> Inertial:
     )
 
 
-def _robot(*joints: Joint, root_joint: JointType | None = None) -> Robot:
+def _robot(*joints: Joint, root_joint: JointType | None = JointType.FLOATING) -> Robot:
     robot = Robot("unit", root="base", root_joint=root_joint, source_format="body")
     robot.links = [Link("base", _inertial(2.0))] + [Link(j.child, _inertial()) for j in joints]
     robot.joints = list(joints)
@@ -340,9 +347,13 @@ def test_world_link_option_and_root_notes(tmp_path: Path) -> None:
     arm = Joint("j", JointType.REVOLUTE, "base", "arm")
     robot = _robot(arm, root_joint=JointType.FIXED)
     robot.root_pose = Pose(matrix_from_rpy(0, 0, 0.5), np.array([1.0, 2.0, 0.0]))
-    data, notes = write_to(robot, tmp_path / "plain")
-    assert {n.code for n in notes} >= {"MK814", "MK823"}
-    assert b'"world"' not in data
+    data, notes = write_to(robot, tmp_path / "plain")  # a welded root always hangs from `world`
+    assert "MK823" not in {n.code for n in notes}
+    assert _joint_el(data, "world_to_base").get("type") == "fixed"
+    robot.root_joint = JointType.FLOATING
+    data, notes = write_to(robot, tmp_path / "free")  # a floating root only with the option
+    assert "MK823" in {n.code for n in notes} and b'"world"' not in data
+    robot.root_joint = JointType.FIXED
     data, notes = write_to(robot, tmp_path / "world", WriteOptions(urdf_world_link=True))
     assert "MK823" not in {n.code for n in notes}
     root = etree.fromstring(data)
@@ -493,7 +504,9 @@ def test_devices_materials_and_loops(tmp_path: Path) -> None:
     assert {"MK806", "MK810", "MK818"} <= codes
     back = read_back(tmp_path / "robot.urdf")
     assert [d.name for d in back.links[1].devices] == ["cam", "g"]
-    again, _ = write_to(back, tmp_path / "again")
+    # The floating root reads back open (URDF's convention); --base auto would weld this shape resting on
+    # its base, so the second write asks for the floating root the first one had.
+    again, _ = write_to(back, tmp_path / "again", WriteOptions(base="floating"))
     assert again == data
     run_check_urdf(tmp_path / "robot.urdf")
 

@@ -24,6 +24,7 @@ import modelkit  # noqa: E402
 from modelkit.convert import write  # noqa: E402
 from modelkit.convert.compare import random_configuration  # noqa: E402
 from modelkit.convert.notes import renames  # noqa: E402
+from modelkit.convert.options import WriteOptions  # noqa: E402
 from modelkit.model import JointType, Robot  # noqa: E402
 from modelkit.verify import engine_pybullet  # noqa: E402
 from modelkit.verify.engine_pybullet import PyBulletError, PyBulletModel  # noqa: E402
@@ -61,12 +62,16 @@ class Converted:
         return self.urdf_renames[kind].get(name, name)
 
 
+# As verify writes the engines' files: the root is PyBullet's base, welded by the engine (no `world` link).
+ENGINE_FILE = WriteOptions(urdf_world_link=False)
+
+
 @pytest.fixture(scope="module")
 def pantilt(tmp_path_factory: pytest.TempPathFactory) -> Converted:
     robot = modelkit.load(PANTILT)
     robot.root_joint = JointType.FIXED
     out = tmp_path_factory.mktemp("pantilt")
-    urdf_notes = write(robot, out / "x.urdf")
+    urdf_notes = write(robot, out / "x.urdf", options=ENGINE_FILE)
     mjcf_notes = write(robot, out / "x.xml")
     maps = [{"link": renames(n, "link"), "joint": renames(n, "joint")} for n in (urdf_notes, mjcf_notes)]
     return Converted(robot, out / "x.urdf", out / "x.xml", maps[0], maps[1])
@@ -289,7 +294,7 @@ def test_replay_catches_a_one_percent_mass_error(tmp_path: Path) -> None:
     robot.root_joint = JointType.FIXED
     out = tmp_path / "out"
     out.mkdir()
-    urdf_notes, mjcf_notes = write(robot, out / "r.urdf"), write(robot, out / "r.xml")
+    urdf_notes, mjcf_notes = write(robot, out / "r.urdf", options=ENGINE_FILE), write(robot, out / "r.xml")
     maps = [{"link": renames(n, "link"), "joint": renames(n, "joint")} for n in (urdf_notes, mjcf_notes)]
     converted = Converted(robot, out / "r.urdf", out / "r.xml", maps[0], maps[1])
     (good,), _ = _replay(converted, converted.urdf)

@@ -17,6 +17,7 @@ import pytest
 import modelkit
 from modelkit.convert import write
 from modelkit.convert.notes import renames
+from modelkit.convert.options import WriteOptions
 from modelkit.model import JointType
 from modelkit.verify import engine_mujoco, engine_pybullet
 from modelkit.verify.facts import TorqueLaw
@@ -35,7 +36,9 @@ def written(tmp_path_factory: pytest.TempPathFactory) -> Written:
     robot = modelkit.load(PENDULUM)
     robot.root_joint = JointType.FIXED
     out = tmp_path_factory.mktemp("pendulum")
-    urdf_notes, mjcf_notes = write(robot, out / "p.urdf"), write(robot, out / "p.xml")
+    # as verify writes the engines' files: the root is PyBullet's base (no `world` link)
+    urdf_notes = write(robot, out / "p.urdf", options=WriteOptions(urdf_world_link=False))
+    mjcf_notes = write(robot, out / "p.xml")
     maps = [{"link": renames(n, "link"), "joint": renames(n, "joint")} for n in (urdf_notes, mjcf_notes)]
     return robot, out / "p.urdf", out / "p.xml", maps[0], maps[1]
 

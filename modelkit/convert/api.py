@@ -63,14 +63,16 @@ def input_files(robot: Robot, model_path: Path) -> set[Path]:
 
 def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: NoteSink) -> Robot:
     """A copy of ``robot`` shaped for the target: tracks approximated where the target has none,
-    wheel collisions as ``options.wheel_collision`` says (MK826), fixed joints merged on request. The
-    source model is never changed."""
+    wheel collisions as ``options.wheel_collision`` says (MK826), fixed joints merged on request, the
+    base settled (welded or free). The source model is never changed."""
+    from modelkit.convert.base import settle_base
     from modelkit.convert.merge import merge_fixed_joints
     from modelkit.convert.tracks import approximate_tracks
     from modelkit.convert.wheels import approximate_wheels
 
     _check_mass_properties(robot)
     out = copy.deepcopy(robot)
+    settle_base(out, options.base, notes)
     if not target.tracks_native:
         approximate_tracks(out, notes)
     approximate_wheels(out, options.wheel_collision, target.name, notes)

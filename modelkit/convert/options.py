@@ -16,5 +16,8 @@ class WriteOptions:
     keep_collada: bool = False  # URDF/SDF: copy COLLADA files as they are instead of converting
     keep_package_uris: bool = False  # keep package:// and model:// references instead of copying
     merge_fixed: bool = False  # fuse links on fixed joints into their parents
-    urdf_world_link: bool = False  # URDF: write a `world` link and the root's fixed/floating joint
+    # URDF `world` link and the root's joint to it: None (default) for a welded root only; True for a
+    # floating root too; False never (a consumer that welds the root itself: verify's engines)
+    urdf_world_link: bool | None = None
     wheel_collision: str = "auto"  # auto|cylinder|sphere|ellipsoid: the wheels' collision (convert.wheels)
+    base: str = "auto"  # fixed | floating | auto: how the root meets the world (modelkit/convert/base.py)

@@ -179,10 +179,17 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
     """Write the files the engines read; ``written`` receives each written file's notes."""
     from modelkit.convert.api import output_stem, write
     from modelkit.convert.notes import renames
+    from modelkit.convert.options import WriteOptions
 
     files: dict[str, Path] = {}
     maps: dict[str, Renames] = {}
     stem = output_stem(Path(report.source)) if report.source else "robot"
+    # Joint springs are passive terms layers 1-3 leave out (MuJoCo's are zeroed on the compiled model);
+    # Drake turns an SDF spring into a force element, and then cannot remove the file's world joint to
+    # weld the root. The engines' files are written without them.
+    welded = copy.deepcopy(welded)
+    for joint in welded.joints:
+        joint.spring_stiffness = joint.spring_reference = 0.0
     for fmt in ("mjcf", "urdf", "sdf"):
         user = given.get(fmt)
         if user is not None:
@@ -194,8 +201,9 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
         if fmt not in needed:
             continue
         path = out_dir / f"{stem}{SUFFIX[fmt]}"
+        # The engines weld the root themselves (fixed base): no URDF `world` link, the root is the base.
         try:
-            notes = write(welded, path, fmt, force=True)
+            notes = write(welded, path, fmt, WriteOptions(urdf_world_link=False), force=True)
         except (FileExistsError, PermissionError) as exc:  # a symlink or an input where the file goes
             raise VerifyError(f"cannot write {path}: {exc}") from exc
         if written is not None:

@@ -249,7 +249,8 @@ def _joint(joint: Joint, node: dict[str, Any], names: _Names, ctx: WriteContext)
             node["joint_axis_inertia"] = num(joint.armature)
     if joint.actuation_mode in ACTUATION_WORDS:
         node["actuation_mode"] = ACTUATION_WORDS[joint.actuation_mode]
-    dropped = [f"{k} {v:g}" for k, v in (("damping", joint.damping), ("friction", joint.friction)) if v]
+    dropped = [f"{k} {v:g}" for k, v in (("damping", joint.damping), ("friction", joint.friction),
+                                         ("spring", joint.spring_stiffness)) if v]
     if dropped:
         ctx.note("MK820", f'joint "{joint.name}": Choreonoid\'s body format has no joint '
                  f"{' or '.join(k.split()[0] for k in dropped)} ({', '.join(dropped)}); left out",

@@ -47,6 +47,7 @@ class MjJoint:
     stiffness: float = 0.0
     springref: float = 0.0
     actfrc: tuple[float, float] | None = None
+    qpos_address: int | None = None  # where the joint's values start in qpos (compiled models)
 
 
 @dataclass

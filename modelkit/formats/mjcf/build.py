@@ -303,8 +303,10 @@ class RobotBuilder:
         extras = {"mjcf_joint_id": mj.index, "mjcf_type": mj.kind}
         if mj.ref:
             extras["mjcf_ref"] = mj.ref
-        if mj.stiffness:
-            extras["mjcf_stiffness"] = mj.stiffness
+        if mj.stiffness and mj.kind in ("hinge", "slide"):
+            joint.spring_stiffness, joint.spring_reference = mj.stiffness, mj.springref
+        elif mj.stiffness:
+            extras["mjcf_stiffness"] = mj.stiffness  # a ball joint's spring: MJCF's own
             extras["mjcf_springref"] = mj.springref
         joint.extras.update(extras)
         self.joints[mj.index] = joint

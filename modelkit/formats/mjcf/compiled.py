@@ -119,6 +119,7 @@ class CompiledModel:
             actfrc=(float(m.jnt_actfrcrange[j][0]), float(m.jnt_actfrcrange[j][1]))
             if bool(m.jnt_actfrclimited[j])
             else None,
+            qpos_address=qadr,
         )
 
     def geom(self, g: int) -> MjGeom:

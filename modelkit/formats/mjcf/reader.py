@@ -35,7 +35,7 @@ from modelkit.formats.mjcf.files import check_asset_files, check_sizes
 from modelkit.formats.mjcf.quiet import collected_warnings
 from modelkit.formats.mjcf.source import SourceIndex, TreeShape, locate, pair
 from modelkit.formats.mjcf.uncompiled import SpecReader
-from modelkit.model import Robot
+from modelkit.model import Joint, Robot
 from modelkit.xmlsource import read_xml
 
 MUJOCO_DEFAULT_NAME = "MuJoCo Model"
@@ -176,6 +176,7 @@ class _MjcfReader:
         where = self._item_locations(index, "equality", [e["name"] for e in equalities])
         refs = {j.index: j.ref for b in bodies for j in b.joints}
         apply_joint_equalities(equalities, built.joints, refs, self.sink, where)
+        _home_positions(reader.keyframes(), bodies, built.joints)
         tendons = reader.tendons()
         self._report_unsupported(equalities, tendons, index, where)
         data: dict[str, list[dict[str, Any]]] = {
@@ -357,3 +358,17 @@ def _shapes(bodies: list[MjBody]) -> list[TreeShape]:
         for b in bodies
     ]
 
+
+def _home_positions(keyframes: list[dict[str, Any]], bodies: list[MjBody], joints: dict[int, Joint]) -> None:
+    """A keyframe named ``home`` holds the initial joint positions (as modelkit's MJCF writer puts them)."""
+    home = next((k for k in keyframes if k.get("name") == "home"), None)
+    if home is None:
+        return
+    qpos = home["qpos"]
+    for body in bodies:
+        for mj in body.joints:
+            joint = joints.get(mj.index)
+            address = mj.qpos_address
+            if joint is None or address is None or mj.kind not in ("hinge", "slide") or address >= len(qpos):
+                continue
+            joint.initial_position = float(qpos[address])

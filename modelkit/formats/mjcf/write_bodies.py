@@ -12,7 +12,8 @@
   (MK813). MuJoCo allows a free joint on top-level bodies only, so a floating joint inside the tree
   makes its subtree a top-level body with ``<freejoint/>`` at its pose in the world at q = 0 (as
   Choreonoid's own MuJoCo plugin does; MK813).
-* ``damping``, ``frictionloss``, ``armature`` as given; a finite effort limit → ``actuatorfrcrange``.
+* ``damping``, ``frictionloss``, ``armature``, ``stiffness``/``springref`` as given; a finite effort limit →
+  ``actuatorfrcrange``; initial positions → the ``home`` keyframe (writer.py).
 * Inertials: ``<inertial pos mass diaginertia>`` when the tensor is diagonal, else ``fullinertia="Ixx
   Iyy Izz Ixy Ixz Iyz"``; MuJoCo never recomputes them (``inertiafromgeom="false"``). A massless
   link on a fixed joint is a body without ``<inertial>`` (MK816). MuJoCo refuses a moving body
@@ -84,6 +85,8 @@ class BodyTree:
     bodies: dict[str, Element] = field(default_factory=dict)
     locked: list[tuple[str, float]] = field(default_factory=list)  # written joint, value it is held at
     frames: dict[str, Pose] = field(default_factory=dict)  # link frame in its body's frame, when not equal
+    home: dict[str, float] = field(default_factory=dict)  # written hinge/slide → initial position
+    body_pose: dict[Element, Pose] = field(default_factory=dict)  # body → its pose in its parent
 
     def __post_init__(self) -> None:
         self.children = self.robot.children_of()
@@ -227,6 +230,7 @@ class BodyTree:
         name = self.body_name[link_name]
         el = sub(parent, "body", name=name)
         set_pose(el, pose)
+        self.body_pose[el] = pose
         self.bodies[link_name] = el
         if free_top and joint is None:
             sub(el, "freejoint")
@@ -360,6 +364,8 @@ class BodyTree:
                 target,
             )
         self._dynamics(el, joint, target)
+        if joint.initial_position:
+            self.home[name] = joint.initial_position  # the `home` keyframe (writer.py)
         return True
 
     @staticmethod
@@ -396,6 +402,9 @@ class BodyTree:
             el.set("frictionloss", fmt(joint.friction))
         if joint.armature:
             el.set("armature", fmt(joint.armature))
+        if (joint.spring_stiffness or joint.spring_reference) and joint.type is not JointType.BALL:
+            el.set("stiffness", fmt(joint.spring_stiffness))
+            el.set("springref", fmt(joint.spring_reference))
         effort = joint.limits.effort
         if math.isfinite(effort) and effort > 0.0 and joint.type is not JointType.BALL:
             el.set("actuatorfrcrange", f"{fmt(-effort)} {fmt(effort)}")
@@ -410,8 +419,6 @@ class BodyTree:
         lost = []
         if math.isfinite(joint.limits.velocity) or math.isfinite(joint.limits.velocity_upper):
             lost.append("velocity limit")
-        if joint.initial_position:
-            lost.append(f"initial position {fmt(joint.initial_position)}")
         if lost:
             self.ctx.note(
                 "MK820",

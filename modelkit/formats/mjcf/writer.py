@@ -1,7 +1,7 @@
 """The MJCF (MuJoCo XML) writer: ``write_mjcf(robot, ctx) -> bytes``.
 
 The file is built with lxml, 2-space indented, sections in a fixed order (``compiler``,
-``asset``, ``worldbody``, ``equality``, ``actuator``, ``sensor``; empty ones left out); numbers
+``asset``, ``worldbody``, ``equality``, ``actuator``, ``sensor``, ``keyframe``; empty ones left out); numbers
 through :func:`modelkit.convert.numbers.fmt`. MuJoCo is not imported here.
 
 * ``<compiler angle="radian" autolimits="true" inertiafromgeom="false"/>``: angles in radians,
@@ -40,11 +40,11 @@ from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_geoms import GeomWriter
 from modelkit.formats.mjcf.write_names import NameTable
-from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, set_pose, sub
+from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, quat_wxyz, set_pose, sub
 from modelkit.model import WORLD_LINK, JointType, LoopConstraint, Robot
 from modelkit.spatial import Pose
 
-SECTIONS = ("compiler", "option", "asset", "worldbody", "equality", "actuator", "sensor")
+SECTIONS = ("compiler", "option", "asset", "worldbody", "equality", "actuator", "sensor", "keyframe")
 HINGE_HALF_SPAN = 0.05  # m: the two connects of a hinge loop sit this far either side of the joint
 # MuJoCo's XML parser (TinyXML2, 500 levels) reads at most this many nested <body> elements inside
 # <mujoco><worldbody> (measured with MuJoCo 3.x and 4.0: 496 load, 497 are refused).
@@ -102,6 +102,7 @@ class MjcfWriter:
         for loop in self.robot.loops:
             self._loop(loop)
         self._actuators()
+        self._home()
         if any(el.get("euler") is not None for el in self.root.iter()):
             self.sections["compiler"].set("eulerseq", EULER_SEQUENCE)  # set_pose's euler: URDF's rpy
         for tag in SECTIONS:
@@ -138,6 +139,26 @@ class MjcfWriter:
         )
 
     # -- joints across the tree ----------------------------------------------------------------
+
+    def _home(self) -> None:
+        """Initial joint positions as the ``home`` keyframe. MuJoCo wants every qpos value of a key,
+        in its order (joints in document order): a free joint gets its body's pose, a ball joint the
+        identity, the other hinges and slides 0."""
+        home = self.tree.home
+        if not home:
+            return
+        qpos: list[float] = []
+        for el in self.sections["worldbody"].iter("joint", "freejoint"):
+            kind = "free" if el.tag == "freejoint" else el.get("type", "hinge")
+            if kind == "free":
+                parent = el.getparent()
+                pose = self.tree.body_pose.get(parent, Pose()) if parent is not None else Pose()
+                qpos.extend([*np.asarray(pose.translation, dtype=float), *quat_wxyz(pose.rotation)])
+            elif kind == "ball":
+                qpos.extend([1.0, 0.0, 0.0, 0.0])
+            else:
+                qpos.append(home.get(el.get("name", ""), 0.0))
+        sub(self.sections["keyframe"], "key", name="home", qpos=fmt_vec(np.asarray(qpos)))
 
     def _joint_ids(self) -> None:
         ids = [j for j in self.robot.joints if j.joint_id is not None]

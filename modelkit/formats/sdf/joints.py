@@ -256,8 +256,7 @@ def _axis_details(ctx: Context, data: JointData, axis_el: Element) -> None:
         joint.friction = values.child_number(dynamics, "friction", 0.0) or 0.0
         stiffness = values.child_number(dynamics, "spring_stiffness", 0.0) or 0.0
         reference = values.child_number(dynamics, "spring_reference", 0.0) or 0.0
-        if stiffness or reference:
-            joint.extras["sdf_spring"] = {"stiffness": stiffness, "reference": reference}
+        joint.spring_stiffness, joint.spring_reference = stiffness, reference
     initial = child(axis_el, "initial_position")
     if initial is not None:
         joint.initial_position = values.number(initial, 0.0) or 0.0

@@ -201,7 +201,8 @@ class _ModelWriter:
             return
         if robot.root_joint is JointType.FIXED:
             info = robot.extras.get("sdf_world_joint")
-            wanted = info.get("name") if isinstance(info, dict) and info.get("name") else "world_joint"
+            wanted = (info.get("name") if isinstance(info, dict) and info.get("name")
+                      else robot.extras.get("root_joint_name") or "world_joint")
             name = self.names.claim("joint", str(wanted), robot.extras.get("root_joint_source"))
             joint = sub(model, "joint", name=name, type="fixed")
             sub(joint, "parent", WORLD_LINK)
@@ -437,14 +438,14 @@ class _ModelWriter:
                 num(limit, "effort", lim.effort)
             if math.isfinite(lim.velocity):
                 num(limit, "velocity", lim.velocity)
-        spring = joint.extras.get("sdf_spring") if self.robot.source_format == "sdf" else None
+        spring = joint.spring_stiffness or joint.spring_reference
         if joint.damping or joint.friction or spring:
             dyn = sub(axis, "dynamics")
             num(dyn, "damping", joint.damping)
             num(dyn, "friction", joint.friction)
-            if isinstance(spring, dict):
-                num(dyn, "spring_reference", float(spring.get("reference", 0.0)))
-                num(dyn, "spring_stiffness", float(spring.get("stiffness", 0.0)))
+            if spring:
+                num(dyn, "spring_reference", joint.spring_reference)
+                num(dyn, "spring_stiffness", joint.spring_stiffness)
         if joint.mimic is not None:
             leader = self.names.joints.get(joint.mimic.joint) or self._leader_name(joint.mimic.joint)
             if self.version >= (1, 11) and leader is not None:

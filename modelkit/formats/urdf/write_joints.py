@@ -112,10 +112,8 @@ def _dropped_values(joint: Joint, dropped: list[str]) -> None:
         dropped.append(f"actuation mode {joint.actuation_mode}")
     if "limit" in joint.extras:
         dropped.append("URDF 1.2 acceleration/deceleration/jerk limits")
-    for key in ("sdf_spring", "mjcf_stiffness", "mjcf_springref"):
-        if joint.extras.get(key):
-            dropped.append("spring (stiffness, reference)")
-            break
+    if joint.spring_stiffness or joint.spring_reference or joint.extras.get("mjcf_stiffness"):
+        dropped.append("spring (stiffness, reference)")
 
 
 def _extras(parent: Element, joint: Joint) -> None:

@@ -8,9 +8,10 @@ extensions. Pretty-printed with two-space indentation, numbers through
 and ``write_gazebo`` (sensors, friction, kept extension blocks).
 
 How the root meets the world: URDF has no root pose and its consumers float the root unless it
-hangs from a link named ``world``. With ``WriteOptions.urdf_world_link`` a ``world`` link is written
-with a fixed (or floating) joint to the root at ``root_pose``; otherwise a welded root is an MK814
-note and a placement an MK823 note. Links the tree does not reach (an SDF model's free links) hang
+hangs from a link named ``world``. A welded root (``--base``, settled in ``modelkit/convert/base.py``)
+hangs from a ``world`` link by a fixed joint at ``root_pose``; with ``WriteOptions.urdf_world_link`` a
+floating root hangs from it by a floating joint too; otherwise a floating root's placement is an
+MK823 note. Links the tree does not reach (an SDF model's free links) hang
 from the root by ``floating`` joints (MK813), since a URDF has exactly one root.
 """
 
@@ -41,6 +42,7 @@ SILENT_EXTRAS = frozenset(
         "urdf_version",
         "world_link",
         "root_joint_source",
+        "root_joint_name",
         "materials_path",
         "masses_unknown",
         "sdf_canonical_link",
@@ -99,8 +101,11 @@ def urdf_renames(notes: Iterable[ConversionNote]) -> dict[str, str]:
 
 def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
     """The URDF file of ``robot``; meshes and textures are staged through ``ctx``."""
+    # A welded root always hangs from `world` (URDF consumers float a root that does not); a floating
+    # one does so only with the option.
     add_world = (
-        ctx.options.urdf_world_link
+        (ctx.options.urdf_world_link
+         or (ctx.options.urdf_world_link is None and robot.root_joint is JointType.FIXED))
         and robot.root not in (None, WORLD_LINK)
         and robot.root_joint in (JointType.FIXED, JointType.FLOATING)
     )
@@ -164,7 +169,8 @@ def _root(robot: Robot, names: NameTable, ctx: WriteContext, add_world: bool) ->
     where = robot.extras.get("root_joint_source") or robot.source
     if add_world:
         word = "fixed" if robot.root_joint is JointType.FIXED else "floating"
-        el = etree.Element("joint", name=names.fresh(f"{WORLD_LINK}_to_{root}"), type=word)
+        wanted = robot.extras.get("root_joint_name") or f"{WORLD_LINK}_to_{root}"
+        el = etree.Element("joint", name=names.fresh(str(wanted)), type=word)
         origin_element(el, robot.root_pose)
         etree.SubElement(el, "parent", link=WORLD_LINK)
         etree.SubElement(el, "child", link=root)

@@ -1,0 +1,294 @@
+"""How the robot's root meets the world in the output: welded (fixed) or free (floating).
+
+Settled once here, before any writer runs, so every target carries the same answer (MJCF: a body
+without joint or ``<freejoint/>``; SDF: a joint to ``world`` or a free model; URDF: a ``world`` link
+with a fixed joint, or no ``world`` link; .body: ``jointType: fixed|free``).
+
+* The source's own answer wins (Choreonoid's root ``jointType``, an SDF world joint or free model, an
+  MJCF root body with or without a free joint, a URDF ``world`` link) unless the user asks otherwise
+  with ``--base fixed|floating``; then an MK831 note says the source's answer was overridden.
+* Where the source is silent (a URDF without ``world``: ``Robot.root_joint is None``), ``--base`` decides;
+  ``auto`` floats a robot that moves itself and welds the others (MK830 says which and why):
+
+  - a robot whose root's own rigid body (the root and what is fixed to it) touches the lowest level
+    rests on its base: welded (arms, fixtures);
+  - wheels: at least two revolute joints with a horizontal axis whose child's shapes touch the lowest
+    level with a round section about that axis (a cylinder or sphere on the axis, or any shape whose
+    extents across the axis are equal within 10 % and centred on it): floating;
+  - legs: at least two branches (from different first moving joints below the root) whose shapes
+    touch the lowest level through two or more moving joints: floating;
+  - legs that do not reach the ground at q = 0 (folded or sideways, as some quadrupeds are modelled):
+    four or more limbs of two or more moving joints in a row hanging from the root's rigid body (four
+    legs, or two legs and two arms; an arm has one, a dual-arm torso two or three): floating;
+  - a robot without moving joints (an object: a cube, a mug) floats, as URDF's convention has it;
+  - a robot without mass is welded (it cannot float in a simulator); one without any shape floats
+    (nothing to judge by: URDF's own convention, so a URDF round trip keeps a floating root).
+
+"The lowest level" is the lowest point of the collision shapes (visual shapes when the robot has no
+collision shape) at q = 0, and "touches" means within 2 % of the robot's height (at least 1 mm).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from modelkit.convert.notes import NoteSink
+from modelkit.convert.tracks import extent
+from modelkit.model import WORLD_LINK, Cylinder, Geom, Joint, JointType, Robot, Sphere
+from modelkit.spatial import Pose
+
+BASE_CHOICES = ("auto", "fixed", "floating")
+LIMBS = 4  # limbs of ≥ 2 moving joints from the root's body that make a robot legged (4 legs, or 2 + 2 arms)
+_UP = np.array([0.0, 0.0, 1.0])
+
+
+@dataclass(frozen=True)
+class BaseDecision:
+    """What ``auto`` found for a source that leaves the root open."""
+
+    kind: JointType  # FIXED or FLOATING
+    reason: str
+
+
+def settle_base(robot: Robot, choice: str, notes: NoteSink) -> None:
+    """Set ``robot.root_joint`` (and the joints from a ``world`` root) to the base the output gets."""
+    if choice not in BASE_CHOICES:
+        raise ValueError(f"base must be one of {', '.join(BASE_CHOICES)}, not {choice!r}")
+    if robot.root is None:
+        return
+    if robot.root == WORLD_LINK:
+        _weld_of_world(robot)
+    where = robot.extras.get("root_joint_source") or robot.source
+    if robot.root == WORLD_LINK:
+        _settle_world_root(robot, choice, notes)
+        return
+    if robot.root_joint is not None:
+        asked = _asked(choice)
+        if asked is not None and asked is not robot.root_joint:
+            notes.note("MK831", f'the source {_word(robot.root_joint)} the root "{robot.root}"; written '
+                       f"{_past(asked)} as asked (--base {choice})", where, f"link[{robot.root}]")
+            robot.root_joint = asked
+        return
+    asked = _asked(choice)
+    if asked is not None:
+        robot.root_joint = asked
+        notes.note("MK830", f'the source leaves the root "{robot.root}" open; it is {_past(asked)} '
+                   f"as asked (--base {choice})", where, f"link[{robot.root}]")
+        return
+    decision = decide(robot)
+    robot.root_joint = decision.kind
+    how = _past(decision.kind)
+    notes.note("MK830", f'the source leaves the root "{robot.root}" open; --base auto: {how}: '
+               f"{decision.reason}", where, f"link[{robot.root}]")
+
+
+def _weld_of_world(robot: Robot) -> None:
+    """An empty ``world`` link with one fixed joint to the robot (a URDF's way of welding it) is the
+    root welded at that joint's origin; the joint's name is kept (``extras["root_joint_name"]``) for the
+    targets that write the weld as a joint (URDF, SDF)."""
+    world = robot.link(WORLD_LINK)
+    hanging = [joint for joint in robot.joints if joint.parent == WORLD_LINK]
+    if (
+        world is None
+        or world.visuals or world.collisions or world.devices
+        or (world.inertial is not None and world.inertial.mass > 0.0)
+        or len(hanging) != 1
+        or hanging[0].type is not JointType.FIXED
+        or any(j.child == WORLD_LINK for j in robot.joints)
+        or any(WORLD_LINK in (loop.link1, loop.link2) for loop in robot.loops)
+    ):
+        return
+    weld = hanging[0]
+    robot.links.remove(world)
+    robot.joints.remove(weld)
+    robot.root, robot.root_joint = weld.child, JointType.FIXED
+    robot.root_pose = robot.root_pose @ weld.origin
+    robot.extras["root_joint_name"] = weld.name
+    if weld.source is not None:
+        robot.extras["root_joint_source"] = weld.source
+    robot.extras.pop("world_link", None)
+
+
+def _asked(choice: str) -> JointType | None:
+    return {"fixed": JointType.FIXED, "floating": JointType.FLOATING}.get(choice)
+
+
+def _word(kind: JointType) -> str:
+    return "welds" if kind is JointType.FIXED else "floats"
+
+
+def _past(kind: JointType) -> str:
+    return "welded" if kind is JointType.FIXED else "floating"
+
+
+def _settle_world_root(robot: Robot, choice: str, notes: NoteSink) -> None:
+    """A ``world`` root link: the joints that hang from it carry the base (fixed or floating)."""
+    asked = _asked(choice)
+    if asked is None:
+        return
+    for joint in robot.joints:
+        if joint.parent != WORLD_LINK or joint.type not in (JointType.FIXED, JointType.FLOATING):
+            continue
+        if joint.type is not asked:
+            notes.note("MK831", f'the source {_word(joint.type)} "{joint.child}" to the world by the joint '
+                       f'"{joint.name}"; written {_past(asked)} as asked (--base {choice})',
+                       joint.source, f"joint[{joint.name}]")
+            joint.type = asked
+
+
+# ---- auto ------------------------------------------------------------------------------------
+
+
+def decide(robot: Robot) -> BaseDecision:
+    """Float a robot that moves itself (wheels, legs), weld the others (see the module docstring)."""
+    if sum(max(link.inertial.mass, 0.0) for link in robot.links if link.inertial is not None) <= 0.0:
+        return BaseDecision(JointType.FIXED, "the robot has no mass to float")
+    if not any(joint.type.moves for joint in robot.joints):
+        return BaseDecision(JointType.FLOATING, "it has no moving joint (an object), so URDF's own "
+                            "convention (a root that does not hang from `world` floats)")
+    limbs = _limbs(robot)
+    poses = robot.world_poses()
+    use_collisions = any(link.collisions for link in robot.links)
+    lows: dict[str, tuple[float, float]] = {}
+    for link in robot.links:
+        geoms = link.collisions if use_collisions else link.visuals
+        pose = poses.get(link.name)
+        if pose is None or not geoms:
+            continue
+        span = extent(geoms, pose.rotation.T @ _UP)
+        if span is not None:
+            z = float(pose.translation[2])
+            lows[link.name] = (z + span[0], z + span[1])
+    if not lows:
+        return BaseDecision(JointType.FLOATING, "it has no shape to judge by, so URDF's own convention "
+                            "(a root that does not hang from `world` floats)")
+    ground = min(low for low, _ in lows.values())
+    height = max(high for _, high in lows.values()) - ground
+    tolerance = max(1e-3, 0.02 * height)
+    touching = {name for name, (low, _) in lows.items() if low - ground <= tolerance}
+    parent_joint = {joint.child: joint for joint in robot.joints}
+    above = {name: _moving_above(parent_joint, name) for name in sorted(touching)}
+    if any(not moving for moving in above.values()):
+        return _by_limbs(limbs, "the root's own body rests on the ground (an arm or a fixture)")
+    wheels = _wheels(robot, poses, touching, use_collisions)
+    if len(wheels) >= 2:
+        shown = ", ".join(f'"{j.name}"' for j in wheels[:4]) + (" ..." if len(wheels) > 4 else "")
+        return BaseDecision(JointType.FLOATING, f"it drives on wheels (joint(s) {shown}: a round shape "
+                            "on a horizontal axis touching the ground)")
+    feet = _feet(above)
+    if len(feet) >= 2:
+        shown = ", ".join(f'"{name}"' for name in feet[:6])
+        return BaseDecision(JointType.FLOATING, f"it stands on {len(feet)} legs (feet {shown} touch the "
+                            "ground, the root's body does not)")
+    return _by_limbs(limbs, "no wheels or legs touch the ground (an arm or a fixture)")
+
+
+def _by_limbs(limbs: list[str], otherwise: str) -> BaseDecision:
+    """Legs that do not reach the ground at q = 0 (folded, or sideways): four or more limbs."""
+    if len(limbs) >= LIMBS:
+        shown = ", ".join(f'"{name}"' for name in limbs[:6])
+        return BaseDecision(JointType.FLOATING, f"it has {len(limbs)} limbs of two or more moving joints "
+                            f"each from its body (first joints {shown}): a legged robot")
+    return BaseDecision(JointType.FIXED, otherwise)
+
+
+def _limbs(robot: Robot) -> list[str]:
+    """The first moving joints below the root's rigid body whose subtree holds ≥ 2 moving joints in a row."""
+    children = robot.children_of()
+    body = [robot.root or ""]
+    starts: list[Joint] = []
+    while body:  # the root's rigid body: the root and what hangs from it by fixed joints
+        for joint in children.get(body.pop(), []):
+            if joint.type.moves:
+                starts.append(joint)
+            else:
+                body.append(joint.child)
+    return sorted(joint.name for joint in starts if _depth(children, joint.child) >= 1)
+
+
+def _depth(children: dict[str, list[Joint]], link: str) -> int:
+    """The most moving joints on a path down from ``link``."""
+    best: dict[str, int] = {}
+    order: list[str] = []
+    stack = [link]
+    while stack:
+        name = stack.pop()
+        if name in best:
+            continue
+        best[name] = 0
+        order.append(name)
+        stack.extend(j.child for j in children.get(name, []))
+    for name in reversed(order):
+        best[name] = max((best.get(j.child, 0) + (1 if j.type.moves else 0) for j in children.get(name, [])),
+                         default=0)
+    return best[link]
+
+
+def _wheels(robot: Robot, poses: dict[str, Pose], touching: set[str], use_collisions: bool) -> list[Joint]:
+    out: list[Joint] = []
+    links = {link.name: link for link in robot.links}
+    for joint in robot.joints:
+        if joint.type is not JointType.REVOLUTE or joint.child not in touching or joint.child not in poses:
+            continue
+        link = links[joint.child]
+        axis = np.asarray(joint.axis, dtype=float)
+        norm = float(np.linalg.norm(axis))
+        if norm == 0.0:
+            continue
+        axis = axis / norm  # in the child frame
+        world_axis = poses[joint.child].rotation @ axis
+        if abs(float(world_axis[2])) > 0.2:
+            continue
+        geoms = link.collisions if use_collisions else link.visuals
+        if any(_round_about(geom, axis) for geom in geoms):
+            out.append(joint)
+    return out
+
+
+def _round_about(geom: Geom, axis: np.ndarray) -> bool:
+    """Whether the shape's section across ``axis`` (child frame, through the origin) is a disc about it."""
+    offset = np.asarray(geom.pose.translation, dtype=float)
+    off_axis = offset - axis * float(axis @ offset)
+    if isinstance(geom.geometry, Sphere):
+        return bool(np.linalg.norm(off_axis) <= 0.1 * geom.geometry.radius)
+    if isinstance(geom.geometry, Cylinder):
+        along = geom.pose.rotation @ _UP
+        near = np.linalg.norm(off_axis) <= 0.1 * geom.geometry.radius
+        return bool(abs(float(along @ axis)) > 0.95 and near)
+    side = np.cross(axis, _UP if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0]))
+    side = side / np.linalg.norm(side)
+    other = np.cross(axis, side)
+    spans = [extent([geom], d) for d in (side, other)]
+    if spans[0] is None or spans[1] is None:
+        return False
+    widths = [hi - lo for lo, hi in spans]  # type: ignore[misc]
+    centres = [(hi + lo) / 2 for lo, hi in spans]  # type: ignore[misc]
+    radius = max(widths) / 2
+    return bool(radius > 0.0 and min(widths) >= 0.9 * max(widths)
+                and max(abs(c) for c in centres) <= 0.1 * radius)
+
+
+def _moving_above(parent_joint: dict[str, Joint], name: str) -> list[Joint]:
+    """The moving joints from the link up to the root, nearest first."""
+    moving: list[Joint] = []
+    current = name
+    seen: set[str] = set()
+    while current in parent_joint and current not in seen:
+        seen.add(current)
+        joint = parent_joint[current]
+        if joint.type.moves:
+            moving.append(joint)
+        current = joint.parent
+    return moving
+
+
+def _feet(above: dict[str, list[Joint]]) -> list[str]:
+    """One touching link per branch (named by its first moving joint below the root) that reaches the
+    ground through ≥ 2 moving joints."""
+    by_branch: dict[str, str] = {}
+    for name, moving in above.items():
+        if len(moving) >= 2:
+            by_branch.setdefault(moving[-1].name, name)
+    return [by_branch[key] for key in sorted(by_branch)]

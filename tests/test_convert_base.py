@@ -1,0 +1,208 @@
+"""``--base fixed|floating|auto``: arms stay welded, robots that move themselves float, in every target."""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import mujoco
+import pybullet_data
+import pytest
+from click.testing import CliRunner
+from lxml import etree
+
+from modelkit.api import validate
+from modelkit.cli import main
+from modelkit.convert.api import convert
+from modelkit.convert.base import decide
+from modelkit.convert.options import WriteOptions
+from modelkit.model import JointType
+from tests.conftest import require_tool
+from tests.test_sdf_reader import oracle_has_errors, sdf_oracle  # noqa: F401 (the fixture)
+
+DATA = Path(pybullet_data.getDataPath())
+KUKA = DATA / "kuka_iiwa" / "model.urdf"
+PANDA = DATA / "franka_panda" / "panda.urdf"
+A1 = DATA / "a1" / "a1.urdf"
+LAIKAGO = DATA / "laikago" / "laikago_toes_zup.urdf"
+RACECAR = DATA / "racecar" / "racecar.urdf"
+R2D2 = DATA / "r2d2.urdf"
+VISION60 = DATA / "quadruped" / "vision60.urdf"  # legs sideways at q = 0: its body is the lowest point
+CUBE = DATA / "cube.urdf"
+
+
+def _convert(source: Path, out: Path, base: str = "auto") -> list[tuple[str, str]]:
+    result = convert([source], out, options=WriteOptions(base=base), force=True)
+    assert result.status == 0, [str(d) for d in result.diagnostics]
+    return [(n.code, n.message) for n in result.notes]
+
+
+def _drop(path: Path, seconds: float = 1.0) -> float:
+    """How far the first top-level body falls in ``seconds`` of zero-control simulation."""
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    body = next(i for i in range(1, model.nbody) if model.body_parentid[i] == 0)
+    start = float(data.xpos[body][2])
+    while data.time < seconds:
+        mujoco.mj_step(model, data)
+    return start - float(data.xpos[body][2])
+
+
+@pytest.mark.parametrize("source", [KUKA, PANDA], ids=["kuka_iiwa", "panda"])
+def test_arm_is_welded_by_default_and_does_not_fall(source: Path, tmp_path: Path) -> None:
+    out = tmp_path / "arm.xml"
+    notes = _convert(source, out)
+    assert b"freejoint" not in out.read_bytes()
+    decided = [m for c, m in notes if c == "MK830"]
+    assert len(decided) == 1 and "welded" in decided[0] and "rests on the ground" in decided[0]
+    assert abs(_drop(out)) < 1e-9
+    floating = tmp_path / "floating.xml"
+    _convert(source, floating, "floating")
+    assert b"<freejoint" in floating.read_bytes()
+    assert _drop(floating) > 4.0  # the same arm set free falls (no floor in the output): the test can fail
+
+
+@pytest.mark.parametrize(
+    ("source", "why"),
+    [(A1, "legs"), (LAIKAGO, "legs"), (RACECAR, "wheels"), (R2D2, "wheels"), (VISION60, "4 limbs"),
+     (CUBE, "no moving joint")],
+    ids=["a1", "laikago", "racecar", "r2d2", "vision60", "cube"],
+)
+def test_robots_that_move_themselves_float(source: Path, why: str, tmp_path: Path) -> None:
+    out = tmp_path / "robot.xml"
+    notes = _convert(source, out)
+    root = etree.parse(str(out)).getroot()
+    top = root.find("worldbody/body")
+    assert top is not None and top.find("freejoint") is not None
+    decided = [m for c, m in notes if c == "MK830"]
+    assert len(decided) == 1 and "floating" in decided[0] and why in decided[0]
+    fixed = tmp_path / "fixed.xml"
+    notes = _convert(source, fixed, "fixed")
+    assert b"freejoint" not in fixed.read_bytes()
+    assert any(c == "MK830" and "as asked" in m for c, m in notes)
+
+
+def test_decide_reports_feet_and_wheels() -> None:
+    a1 = validate(A1).robot
+    assert a1 is not None
+    decision = decide(a1)
+    assert decision.kind is JointType.FLOATING
+    assert all(f'"{leg}_toe"' in decision.reason for leg in ("FL", "FR", "RL", "RR"))
+    car = validate(RACECAR).robot
+    assert car is not None
+    assert "left_rear_wheel_joint" in decide(car).reason
+
+
+def test_source_answer_wins_unless_overridden(tmp_path: Path) -> None:
+    floating = tmp_path / "a1.xml"
+    _convert(A1, floating)
+    back = tmp_path / "again" / "again.xml"
+    notes = _convert(floating, back)  # MJCF with a free joint: the source says floating
+    assert b"<freejoint" in back.read_bytes() and not [c for c, _ in notes if c in ("MK830", "MK831")]
+    welded = tmp_path / "welded" / "welded.xml"
+    notes = _convert(floating, welded, "fixed")
+    assert b"freejoint" not in welded.read_bytes()
+    overridden = [m for c, m in notes if c == "MK831"]
+    assert len(overridden) == 1 and "floats" in overridden[0] and "welded as asked" in overridden[0]
+
+
+def test_urdf_output_carries_the_base(tmp_path: Path) -> None:
+    arm = tmp_path / "arm" / "arm.urdf"
+    _convert(KUKA, arm)
+    root = etree.parse(str(arm)).getroot()
+    weld = [j for j in root.findall("joint") if j.find("parent").get("link") == "world"]  # type: ignore[union-attr]
+    assert root.find("link").get("name") == "world"  # type: ignore[union-attr]
+    assert len(weld) == 1 and weld[0].get("type") == "fixed"
+    back = validate(arm).robot
+    assert back is not None and back.root == "world" and back.root_joint is JointType.FIXED
+    legged = tmp_path / "legged" / "a1.urdf"
+    _convert(A1, legged)
+    assert b'"world"' not in legged.read_bytes()
+    free = tmp_path / "free" / "arm.urdf"
+    _convert(KUKA, free, "floating")
+    assert b'"world"' not in free.read_bytes()
+    tool = require_tool("check_urdf")
+    for path in (arm, legged, free):
+        run = subprocess.run([tool, str(path)], capture_output=True, timeout=120)
+        assert run.returncode == 0, run.stderr
+
+
+def test_sdf_output_carries_the_base(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+    arm = tmp_path / "arm" / "arm.sdf"
+    _convert(KUKA, arm)
+    model = etree.parse(str(arm)).getroot().find("model")
+    assert model is not None
+    welds = [j for j in model.findall("joint") if j.findtext("parent") == "world"]
+    assert len(welds) == 1 and welds[0].get("type") == "fixed"
+    legged = tmp_path / "legged" / "a1.sdf"
+    _convert(A1, legged)
+    legged_model = etree.parse(str(legged)).getroot().find("model")
+    assert legged_model is not None
+    assert not [j for j in legged_model.findall("joint") if j.findtext("parent") == "world"]
+    for path in (arm, legged):
+        assert not oracle_has_errors(sdf_oracle, path)
+    back = validate(arm).robot
+    assert back is not None and back.root_joint is JointType.FIXED
+
+
+def test_body_output_carries_the_base(tmp_path: Path) -> None:
+    arm = tmp_path / "arm" / "arm.body"
+    _convert(KUKA, arm)
+    back = validate(arm).robot
+    assert back is not None and back.root_joint is JointType.FIXED
+    legged = tmp_path / "legged" / "a1.body"
+    _convert(A1, legged)
+    back = validate(legged).robot
+    assert back is not None and back.root_joint is JointType.FLOATING
+
+
+def test_cli_base_option(tmp_path: Path) -> None:
+    out = tmp_path / "a1.xml"
+    run = CliRunner().invoke(main, ["convert", str(A1), "-o", str(out), "--base", "fixed"])
+    assert run.exit_code == 0, run.output
+    assert b"freejoint" not in out.read_bytes()
+    assert "MK830" in run.output
+    bad = CliRunner().invoke(main, ["convert", str(A1), "-o", str(out), "--base", "welded", "--force"])
+    assert bad.exit_code == 2 and "welded" in bad.output
+
+
+WELDED_URDF = """\
+<robot name="r">
+  <link name="world"/>
+  <joint name="fix_base" type="fixed"><parent link="world"/><child link="base"/>
+    <origin xyz="0 0 0.5"/></joint>
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+def test_urdf_world_weld_is_the_source_answer_and_keeps_its_name(tmp_path: Path) -> None:
+    source = tmp_path / "r.urdf"
+    source.write_text(WELDED_URDF)
+    sdf = tmp_path / "sdf" / "r.sdf"
+    notes = _convert(source, sdf)
+    assert not [c for c, _ in notes if c in ("MK830", "MK831")]
+    model = etree.parse(str(sdf)).getroot().find("model")
+    assert model is not None
+    (weld,) = [j for j in model.findall("joint") if j.findtext("parent") == "world"]
+    assert weld.get("name") == "fix_base" and weld.get("type") == "fixed"
+    urdf = tmp_path / "urdf" / "r.urdf"
+    _convert(source, urdf)
+    back = validate(urdf).robot
+    assert back is not None and back.root == "world"
+    assert [(j.name, j.child) for j in back.joints if j.parent == "world"] == [("fix_base", "base")]
+    mjcf = tmp_path / "mjcf" / "r.xml"
+    _convert(source, mjcf)
+    body = etree.parse(str(mjcf)).getroot().find("worldbody/body")
+    assert body is not None and body.get("name") == "base" and body.find("freejoint") is None
+    assert body.get("pos") == "0 0 0.5"
+    free = tmp_path / "free" / "r.xml"
+    notes = _convert(source, free, "floating")
+    assert b"<freejoint" in free.read_bytes()
+    assert [c for c, _ in notes if c == "MK831"] == ["MK831"]
