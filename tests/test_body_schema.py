@@ -146,9 +146,8 @@ def test_corpus_file_has_only_the_expected_findings(path: Path) -> None:
     assert found == EXPECTED_CORPUS_FINDINGS.get(str(path.relative_to(CORPUS)), set())
 
 
-def test_corpus_is_present_and_complete() -> None:
-    if not CORPUS.is_dir():
-        pytest.skip("shared corpus not available")
+def test_corpus_is_present_and_complete(corpus: Path) -> None:
+    assert corpus == CORPUS
     names = {str(p.relative_to(CORPUS)) for p in corpus_bodies()}
     assert set(EXPECTED_CORPUS_FINDINGS) <= names
     assert len(names) >= 19

@@ -9,7 +9,6 @@ from __future__ import annotations
 import itertools
 import math
 from collections import Counter
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -27,7 +26,8 @@ from modelkit.geometry.generated import (
 )
 from modelkit.model import TriangleMeshData
 
-CORPUS = Path("/work/shared/corpus")
+from .conftest import CORPUS
+
 TRACKS_BODY = CORPUS / "choreonoid_ros2_mobile_robot_tutorial/model/mobile_robot_tracks.body"
 
 VRML_SQUARE = [1, 1, 1, -1, -1, -1, -1, 1, 1, 1]  # clockwise in (u, v)

@@ -22,7 +22,8 @@ from modelkit.geometry.meshfiles import (
     triangulate_polygons,
 )
 
-CORPUS = Path("/work/shared/corpus")
+from .conftest import CORPUS
+
 MODEL = CORPUS / "choreonoid/share/model"
 GR001_PARTS = sorted((MODEL / "GR001/parts").glob("*.stl"))
 PA10_PARTS = sorted((MODEL / "PA10/parts").glob("*.wrl"))
@@ -715,7 +716,7 @@ def _binary_stl_files() -> list[Path]:
     return found
 
 
-def test_binary_stl_reads_as_trimesh_reads_it() -> None:
+def test_binary_stl_reads_as_trimesh_reads_it(corpus: Path) -> None:
     """The binary STL reader (no trimesh import) gives trimesh's arrays, through the same merging."""
     import io
 
@@ -724,8 +725,7 @@ def test_binary_stl_reads_as_trimesh_reads_it() -> None:
     from modelkit.geometry.meshfiles import _load_stl, _merge_identical_vertices
 
     files = _binary_stl_files()
-    if CORPUS.is_dir():
-        assert len(files) >= 100
+    assert len(files) >= 100
     for path in files:
         data = path.read_bytes()
         theirs = trimesh_stl.load_stl_binary(io.BytesIO(data))

@@ -679,12 +679,20 @@ def test_no_traceback_when_any_element_is_removed() -> None:
 
 
 def test_no_traceback_on_truncated_files() -> None:
+    """Every truncation of the lecture's unicycle is refused with a coded error at a position in the file."""
     text = UNICYCLE.read_text()
     with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "cut.sdf"
         for cut in range(0, len(text), max(1, len(text) // 60)):
-            path = Path(folder) / "cut.sdf"
             path.write_text(text[:cut])
-            validate(path)
+            result = validate(path)
+            errors = [d for d in result.diagnostics if d.severity.value == "error"]
+            assert errors, f"a file cut at {cut} of {len(text)} characters was accepted"
+            for error in errors:
+                assert re.fullmatch(r"MK\d{3}", error.code), error
+                assert error.location is not None and error.location.file == str(path), error
+            if cut:  # a non-empty cut is malformed XML: the error points into the text
+                assert any(e.location is not None and e.location.line >= 1 for e in errors), errors
 
 
 def test_bad_values_are_reported_not_raised(tmp_path: Path) -> None:
