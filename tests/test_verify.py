@@ -69,9 +69,17 @@ def test_tracks_say_what_is_skipped(tmp_path: Path) -> None:
 
 def test_armature_the_urdf_cannot_hold_is_said(tmp_path: Path) -> None:
     # PA10's rotor inertias reach MuJoCo (armature) and Pinocchio, not URDF: said, per engine
-    report = verify(CHOREONOID / "PA10" / "PA10.body", tmp_path, ("mujoco", "pinocchio"), replay=False)
+    from modelkit.api import validate
+
+    source = CHOREONOID / "PA10" / "PA10.body"
+    with_armature = [j.name for j in validate(source).robots[0].joints if j.armature != 0.0]
+    assert with_armature  # the case this test is about
+    report = verify(source, tmp_path, ("mujoco", "pinocchio", "pybullet"), replay=False)
     assert report.exit_code == 0
-    assert not any("armature" in s.reason for s in report.skips)  # MuJoCo holds it: compared with it
+    said = [s for s in report.skips if "armature" in s.reason]
+    assert [s.engine for s in said] == ["pybullet"]  # MuJoCo holds it: compared with it, not excused
+    assert all(name in said[0].reason for name in with_armature) and "MK820" in said[0].reason
+    assert any(c.layer == 3 and c.engine == "mujoco" and c.quantity == "mass-matrix" for c in report.checks)
 
 
 def test_report_json_valid_and_reproducible(tmp_path: Path) -> None:
