@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import shutil
 from collections.abc import Iterator
 from pathlib import Path
@@ -46,6 +47,22 @@ links:
 """
 
 
+def example_robot_data() -> Path | None:
+    """The `robots` folder of the example-robot-data wheel (PyPI; a test dependency), or None."""
+    import sysconfig
+
+    for key in ("purelib", "platlib"):
+        robots = Path(sysconfig.get_paths()[key]) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
+        if robots.is_dir():
+            return robots
+    return None
+
+
+# Skips that are answers, not missing tools: a corpus file that is not text for a test that reads
+# text. In CI (MODELKIT_REQUIRE_ORACLES) every other skip fails the run (see pytest_sessionfinish).
+SKIPS_ALLOWED_IN_CI = (r"^not UTF-8 text$",)
+
+
 def corpus_bodies() -> list[Path]:
     return sorted(CORPUS.rglob("*.body")) if CORPUS.is_dir() else []
 
@@ -85,3 +102,26 @@ def _mujoco_warnings_without_log_file() -> Iterator[list[str]]:
         yield collected
     finally:
         mujoco.set_mju_user_warning(previous)
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    """In CI a skipped test is a test that did not run: a missing oracle, engine, corpus or data
+    package. Fail the run for every skip whose reason is not in ``SKIPS_ALLOWED_IN_CI``."""
+    if not os.environ.get("MODELKIT_REQUIRE_ORACLES"):
+        return
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    if reporter is None:
+        return
+    unexplained = []
+    for report in reporter.stats.get("skipped", []):
+        longrepr = report.longrepr
+        reason = str(longrepr[2]) if isinstance(longrepr, tuple) else str(longrepr)
+        reason = reason.removeprefix("Skipped: ")
+        if not any(re.search(allowed, reason) for allowed in SKIPS_ALLOWED_IN_CI):
+            unexplained.append(f"{report.nodeid}: {reason}")
+    if unexplained:
+        count = len(unexplained)
+        reporter.write_line(f"CI (MODELKIT_REQUIRE_ORACLES) does not accept {count} skip(s):", red=True)
+        for line in unexplained:
+            reporter.write_line("  " + line, red=True)
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED

@@ -21,9 +21,11 @@ from modelkit.geometry import meshfiles
 from modelkit.geometry.meshfiles import MeshLoadError, MeshMetadata, load_mesh, mesh_problem
 from modelkit.geometry.objcheck import UNDECIDED, obj_problem
 
+from .conftest import example_robot_data
+
 PROJECT_ROOT = Path(__file__).resolve().parents[1]
 CORPUS = PROJECT_ROOT.parent / "shared" / "corpus"
-EXAMPLE_ROBOT_DATA = Path("/tmp/erd/x")
+EXAMPLE_ROBOT_DATA = example_robot_data()
 
 
 def reference(path: Path) -> str | None:
