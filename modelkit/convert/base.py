@@ -59,7 +59,7 @@ def settle_base(robot: Robot, choice: str, notes: NoteSink) -> None:
     if robot.root is None:
         return
     if robot.root == WORLD_LINK:
-        _weld_of_world(robot)
+        absorb_world_weld(robot)
     where = robot.extras.get("root_joint_source") or robot.source
     if robot.root == WORLD_LINK:
         _settle_world_root(robot, choice, notes)
@@ -84,7 +84,7 @@ def settle_base(robot: Robot, choice: str, notes: NoteSink) -> None:
                f"{decision.reason}", where, f"link[{robot.root}]")
 
 
-def _weld_of_world(robot: Robot) -> None:
+def absorb_world_weld(robot: Robot) -> None:
     """An empty ``world`` link with one fixed joint to the robot (a URDF's way of welding it) is the
     root welded at that joint's origin; the joint's name is kept (``extras["root_joint_name"]``) for the
     targets that write the weld as a joint (URDF, SDF)."""

@@ -143,12 +143,18 @@ def _read(source: Path, reading: Mapping[str, Any] | None = None) -> Robot:
 
 
 def welded_copy(robot: Robot) -> tuple[Robot, str]:
-    """The robot with its root welded to the world at the identity, and the sentence that says so."""
+    """The robot with its root welded to the world at the identity, and the sentence that says so.
+
+    A URDF's empty ``world`` link welded to the robot is absorbed first, as ``convert`` does (the
+    written files' root is the robot's first link, so the reference's must be too)."""
+    from modelkit.convert.base import absorb_world_weld
+
     out = copy.deepcopy(robot)
-    was = robot.root_joint.value if robot.root_joint is not None else "left open by the format"
+    absorb_world_weld(out)
+    was = out.root_joint.value if out.root_joint is not None else "left open by the format"
     out.root_joint = JointType.FIXED
     out.root_pose = Pose()
-    return out, (f"root link {robot.root!r} ({was} in the source) welded to the world at the identity "
+    return out, (f"root link {out.root!r} ({was} in the source) welded to the world at the identity "
                  "for layers 1-3")
 
 
