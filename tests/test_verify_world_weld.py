@@ -18,7 +18,8 @@ WELDED_ARM = """<?xml version="1.0"?>
   </joint>
   <link name="link00">
     <collision><geometry><cylinder radius="0.03" length="0.05"/></geometry></collision>
-    <inertial><mass value="0.5"/><inertia ixx="4e-4" iyy="4e-4" izz="5e-4" ixy="0" ixz="0" iyz="0"/></inertial>
+    <inertial><mass value="0.5"/>
+      <inertia ixx="4e-4" iyy="4e-4" izz="5e-4" ixy="0" ixz="0" iyz="0"/></inertial>
   </link>
   <joint name="joint1" type="revolute"><origin xyz="0 0 0.06"/><parent link="link00"/><child link="link01"/>
     <axis xyz="0 0 1"/><limit lower="-2.6" upper="2.6" effort="30" velocity="3"/></joint>
