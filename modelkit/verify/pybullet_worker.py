@@ -169,10 +169,18 @@ class Engine:
         """Joint limits out of the replay (MuJoCo's side: ``mjDSBL_LIMIT``). PyBullet keeps a limit
         constraint per limited joint whatever ``changeDynamics`` is given (lower > upper is ignored:
         measured, the joint still stops at its URDF limit); bounds at ±1e30 and a zero limit force
-        make it inert (measured: the joint runs through its old limit)."""
+        make it inert (measured: the joint runs through its old limit).
+
+        PyBullet's velocity clamp goes too (``maxJointVelocity``, 100 rad/s by default, one value per
+        body, set through the base: given per link, the same call changed the links' dynamics and
+        parted the engines by 3e-2 rad in 0.1 s; MuJoCo has no clamp): a light wrist whipped by the
+        arm above it passes 100 rad/s under a well-conditioned law (example-robot-data's G1: 157 rad/s
+        at 3.3 s), and the clamp then parted the engines by 3.7 rad on a sound model (3e-9 rad
+        without it)."""
         for j in self.movable:
             self.p.changeDynamics(self.body, j, jointLowerLimit=-1e30, jointUpperLimit=1e30,
                                   jointLimitForce=0.0, physicsClientId=self.client)
+        self.p.changeDynamics(self.body, -1, maxJointVelocity=1e4, physicsClientId=self.client)
 
     def replay(self, kp: list[float], kd: list[float], amplitude: list[float], frequency: list[float],
                phase: list[float], steps: int, dt: float) -> dict[str, Any]:

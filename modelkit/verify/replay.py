@@ -13,11 +13,12 @@ times the amplification of a 1e-12 rad start difference that MuJoCo measures on 
 not failed for its own chaos while a model difference, visible from the first steps, still is.
 
 The law (:func:`default_law`) is chosen from the source model so that the replay is well
-conditioned: every moving joint is excited, the motion stays inside the joint limits and far
-from PyBullet's 100 rad/s velocity clamp, gravity cannot drag a joint far from its target, and
-the closed loop is inside semi-implicit Euler's stability limit at 1 ms: the gains come from each
-joint's effective inertia 1/(M⁻¹)ᵢᵢ (Pinocchio on the source), and the growth factor of the
-linearised step (:func:`step_growth`) is checked below 1, the bandwidth halved until it is.
+conditioned: every moving joint is excited, the motion stays inside the joint limits (PyBullet's 100
+rad/s velocity clamp is lifted for the replay: a light wrist can be whipped past it), gravity cannot
+drag a joint far from its target, and the closed loop is inside semi-implicit Euler's stability
+limit at 1 ms: the gains come from each joint's effective inertia 1/(M⁻¹)ᵢᵢ (Pinocchio on the
+source), and the growth factor of the linearised step (:func:`step_growth`) is checked below 1, the
+bandwidth halved until it is.
 """
 
 from __future__ import annotations
