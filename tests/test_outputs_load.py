@@ -177,3 +177,38 @@ links:
     assert "error MK805" in output and "MK876" in output, output
     model = mujoco.MjModel.from_xml_path(str(out))
     assert model.ngeom == 1  # the visual plane
+
+
+TWO_OBJECTS_OBJ = (
+    "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nv 0.3 0 0\nv 0.4 0 0\nv 0.3 0.1 0\nv 0.3 0 0.1\n"
+    "o first\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\no second\nf 5 7 6\nf 5 6 8\nf 5 8 7\nf 6 7 8\n"
+)
+
+
+def test_an_obj_of_several_objects_reaches_mujoco_whole(tmp_path: Path) -> None:
+    """MuJoCo's OBJ reader keeps only a file's first object (4 of these 8 faces): the MJCF writer asks
+    MuJoCo, converts such a file to a binary STL and says so (MK804); MuJoCo then reads all 8."""
+    (tmp_path / "two.obj").write_text(TWO_OBJECTS_OBJ)
+    direct = mujoco.MjModel.from_xml_string(
+        f'<mujoco><asset><mesh name="m" file="{tmp_path / "two.obj"}" inertia="shell"/></asset>'
+        "<worldbody/></mujoco>")
+    assert direct.mesh_facenum[0] == 4  # the reader's behaviour this conversion exists for
+    source = tmp_path / "robot.urdf"
+    source.write_text(_urdf("two.obj", collision=True))
+    out = tmp_path / "out" / "robot.xml"
+    status, output = _convert(source, out)
+    assert status == 0, output
+    assert "MK804" in output and "keeps 4 of its 8 triangles" in output, output
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert model.nmesh == 1 and model.mesh_facenum[0] == 8
+
+
+def test_an_obj_of_one_object_is_copied_as_is(tmp_path: Path) -> None:
+    one = TWO_OBJECTS_OBJ.replace("o second\n", "")
+    (tmp_path / "one.obj").write_text(one)
+    source = tmp_path / "robot.urdf"
+    source.write_text(_urdf("one.obj", collision=True))
+    out = tmp_path / "out" / "robot.xml"
+    status, output = _convert(source, out)
+    assert status == 0 and "MK804" not in output, output
+    assert (out.parent / "meshes" / "one.obj").read_text() == one

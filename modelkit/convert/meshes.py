@@ -63,7 +63,7 @@ def for_mujoco(data: bytes, ext: str, scale: Vec3 | None = None) -> Prepared:
     if not data.strip():
         raise Unusable("the file is empty")
     if ext == "obj":
-        return Prepared(data, None, False, False)  # MuJoCo's own OBJ reader; nothing known to refuse
+        return _obj_for_mujoco(data, scale)
     count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
     if count >= 0 and len(data) == 84 + 50 * count:
         corners = _checked(_binary_stl_corners(data, count))
@@ -83,6 +83,41 @@ def for_mujoco(data: bytes, ext: str, scale: Vec3 | None = None) -> Prepared:
     faces = np.arange(len(corners) * 3, dtype=np.int64).reshape(-1, 3)
     mesh = TriangleMeshData(corners.reshape(-1, 3), faces)
     return Prepared(triangles_to_bytes(mesh, "stl"), kind, _hollow(corners, scale), _flat(corners))
+
+
+def _obj_for_mujoco(data: bytes, scale: Vec3 | None) -> Prepared:
+    """An OBJ file kept as is, unless MuJoCo's own OBJ reader reads fewer triangles than it holds
+    (measured on files of several objects: example-robot-data's ``nub.obj`` gives 29 of 1,404, its
+    laikago ``trunk.obj`` 5,368 of 22,246); then its triangles become a binary STL, read whole. Only
+    files of two or more ``o``/``g`` groups are put to MuJoCo (:mod:`modelkit.formats.mjcf.meshprobe`,
+    ~0.1 s for a 10,000-face file): every OBJ measured that MuJoCo reads short has them, and none of
+    the single-group ones (84 files of example-robot-data and the corpus)."""
+    triangles, groups = _obj_counts(data)
+    if groups < 2:
+        return Prepared(data, None, False, False)
+    from modelkit.formats.mjcf.meshprobe import faces_mujoco_reads
+
+    read = faces_mujoco_reads(data, "obj")
+    if read is None or read >= triangles:
+        return Prepared(data, None, False, False)
+    corners = _checked(_text_corners(data, "obj"))
+    faces = np.arange(len(corners) * 3, dtype=np.int64).reshape(-1, 3)
+    mesh = TriangleMeshData(corners.reshape(-1, 3), faces)
+    why = (f"an OBJ file of {groups} objects of which MuJoCo's OBJ reader keeps {read:,} of its "
+           f"{triangles:,} triangles")
+    return Prepared(triangles_to_bytes(mesh, "stl"), why, _hollow(corners, scale), _flat(corners))
+
+
+def _obj_counts(data: bytes) -> tuple[int, int]:
+    """The triangles an OBJ file's faces make (a face of k corners makes k − 2) and its ``o``/``g``
+    lines, counted without parsing the numbers."""
+    triangles = groups = 0
+    for line in data.splitlines():
+        if line.startswith(b"f "):
+            triangles += max(len(line.split()) - 3, 0)
+        elif line.startswith((b"o ", b"g ")):
+            groups += 1
+    return triangles, groups
 
 
 def _binary_stl_corners(data: bytes, count: int) -> np.ndarray:
@@ -273,8 +308,9 @@ class MeshExporter:
             file_name = safe_file_name(path.name, "mesh")
             if ready.converted is not None:
                 file_name = f"{safe_file_name(path.stem, 'mesh')}.stl"
+                why = "the only STL MuJoCo reads" if ext == "stl" else "which MuJoCo reads whole"
                 self.notes.note("MK804", f"mesh {path.name} ({ready.converted}) converted to binary STL, "
-                                "the only STL MuJoCo reads", source, target)
+                                f"{why}", source, target)
             return MeshRef(self._stage(ready.data, file_name), scale, "stl" if ready.converted else ext,
                            ready.hollow, ready.flat), ""
         try:
