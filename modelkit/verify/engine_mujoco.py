@@ -232,9 +232,24 @@ class MujocoModel:
     def dof_names(self) -> list[str]:
         return list(self._dofs)
 
+    def _locked(self) -> dict[int, float]:
+        """Joints held at one value by a joint equality of constant ``polycoef`` (no second joint):
+        how the MJCF writer writes a source range whose lower and upper limits are equal, which
+        MuJoCo's ``range`` cannot hold (its autolimits read ``0 0`` as no limit)."""
+        m = self.model
+        locked: dict[int, float] = {}
+        for e in range(m.neq):
+            if int(m.eq_type[e]) != int(mujoco.mjtEq.mjEQ_JOINT) or int(m.eq_obj2id[e]) != -1:
+                continue
+            coef = np.asarray(m.eq_data[e][:5], dtype=float)
+            if not np.any(coef[1:]):
+                locked[int(m.eq_obj1id[e])] = float(coef[0])
+        return locked
+
     def static(self) -> StaticFacts:
         m = self.model
         facts = StaticFacts()
+        locked = self._locked()
         if self._world_is_root:
             facts.links["world"] = LinkFacts(0.0, np.zeros(3), np.zeros((3, 3)))
         for body in self._bodies:
@@ -254,6 +269,8 @@ class MujocoModel:
                 lower, upper = -math.inf, math.inf
                 if moving and m.jnt_limited[j]:
                     lower, upper = float(m.jnt_range[j][0]), float(m.jnt_range[j][1])
+                elif moving and j in locked:
+                    lower = upper = locked[j]
                 axis = np.array(m.jnt_axis[j], dtype=float) if moving else np.zeros(3)
                 facts.joints[self._jname(j)] = JointFacts(jtype, parent, child, axis, lower, upper)
                 parent = child
