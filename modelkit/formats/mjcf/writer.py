@@ -1,12 +1,16 @@
 """The MJCF (MuJoCo XML) writer: ``write_mjcf(robot, ctx) -> bytes``.
 
-The file is built with lxml, 2-space indented, sections in a fixed order (``compiler``,
-``asset``, ``worldbody``, ``equality``, ``actuator``, ``sensor``, ``keyframe``; empty ones left out); numbers
-through :func:`modelkit.convert.numbers.fmt`. MuJoCo is not imported here.
+The file is built with lxml, 2-space indented, sections in a fixed order (``compiler``, ``option``,
+``default``, ``asset``, ``worldbody``, ``equality``, ``actuator``, ``sensor``, ``keyframe``; empty ones
+left out); numbers through :func:`modelkit.convert.numbers.fmt`. MuJoCo is not imported here. The
+style is MuJoCo Menagerie's (docs/convert.md, "MJCF style").
 
-* ``<compiler angle="radian" autolimits="true" inertiafromgeom="false"/>``: angles in radians,
-  a ``range`` makes a joint limited, and inertia comes from the ``<inertial>`` elements only (geoms
-  never add mass). No ``meshdir``: each mesh ``file`` is relative to the model file.
+* ``<compiler angle="radian" autolimits="true" inertiafromgeom="false" meshdir="meshes"/>``: angles
+  in radians, a ``range`` makes a joint limited, and inertia comes from the ``<inertial>`` elements
+  only (geoms never add mass). ``meshdir`` when every mesh file is in the written ``meshes/`` folder
+  (each ``file`` is then a name in it); otherwise each ``file`` is relative to the model file.
+* ``<default>``: a class named after the robot, with the ``visual`` and ``collision`` classes its
+  geoms name (:mod:`.write_geoms`).
 * ``<option>``: MuJoCo's defaults, except for a driven robot: wheels get timestep 1 ms,
   ``implicitfast``, elliptic cones and ``impratio`` 10; pseudo continuous tracks the same with their
   ``impratio`` (``convert.tracks.TRACK_IMPRATIO``: soft friction, so that the track rollers skid as
@@ -34,17 +38,20 @@ from lxml import etree
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
+from modelkit.convert.meshes import MESH_FOLDER
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_devices import DeviceWriter
-from modelkit.formats.mjcf.write_geoms import GeomWriter
+from modelkit.formats.mjcf.write_geoms import GeomWriter, shared_stems
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, quat_wxyz, set_pose, sub
 from modelkit.model import WORLD_LINK, JointType, LoopConstraint, Robot
 from modelkit.spatial import Pose
 
-SECTIONS = ("compiler", "option", "asset", "worldbody", "equality", "actuator", "sensor", "keyframe")
+SECTIONS = (
+    "compiler", "option", "default", "asset", "worldbody", "equality", "actuator", "sensor", "keyframe"
+)
 HINGE_HALF_SPAN = 0.05  # m: the two connects of a hinge loop sit this far either side of the joint
 # MuJoCo's XML parser (TinyXML2, 500 levels) reads at most this many nested <body> elements inside
 # <mujoco><worldbody> (measured with MuJoCo 3.x and 4.0: 496 load, 497 are refused).
@@ -67,7 +74,7 @@ class MjcfWriter:
         compiler.set("autolimits", "true")
         compiler.set("inertiafromgeom", "false")
         self.geoms = GeomWriter(ctx, self.names, self.sections["asset"], floor_friction(robot),
-                                mujoco_contact(robot))
+                                mujoco_contact(robot), shared_stems=shared_stems(robot.links))
         self.devices = DeviceWriter(ctx, self.names, self.sections["sensor"])
         self.tree = BodyTree(robot, ctx, self.names, self.geoms, self.devices)
         options, why = mujoco_options(robot)  # wheels or tracks (convert.simulator says why)
@@ -103,6 +110,8 @@ class MjcfWriter:
             self._loop(loop)
         self._actuators()
         self._home()
+        self.geoms.defaults(self.sections["default"], self.robot.name)
+        self._meshdir()
         if any(el.get("euler") is not None for el in self.root.iter()):
             self.sections["compiler"].set("eulerseq", EULER_SEQUENCE)  # set_pose's euler: URDF's rpy
         for tag in SECTIONS:
@@ -112,6 +121,18 @@ class MjcfWriter:
         indent(self.root, space="  ")
         text: bytes = etree.tostring(self.root, xml_declaration=False, encoding="utf-8", pretty_print=True)
         return text
+
+    def _meshdir(self) -> None:
+        """``<compiler meshdir="meshes">`` when every mesh file is in the written ``meshes/`` folder
+        (a kept ``package://`` URI, or a file elsewhere, leaves every path as it is)."""
+        meshes = list(self.sections["asset"].iter("mesh"))
+        prefix = f"{MESH_FOLDER}/"
+        files = [el.get("file", "") for el in meshes]
+        if not meshes or not all(f.startswith(prefix) and "/" not in f[len(prefix):] for f in files):
+            return
+        self.sections["compiler"].set("meshdir", MESH_FOLDER)
+        for el, name in zip(meshes, files, strict=True):
+            el.set("file", name[len(prefix):])
 
     def _depth(self) -> None:
         """MK872 when the bodies nest deeper than MuJoCo reads: the file is written all the same."""
