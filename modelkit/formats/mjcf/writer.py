@@ -28,7 +28,10 @@ style is MuJoCo Menagerie's (docs/convert.md, "MJCF style").
   is finite. With zero control a motor applies no force, so the passive model is unchanged.
 * A multi-joint MuJoCo body that the MJCF reader made a chain of links is written back as one body
   with its joints (:mod:`.write_chains`).
-* Self-collision follows MuJoCo's defaults (parent–child and welded pairs never collide).
+* Self-collision follows MuJoCo's defaults (parent–child and welded pairs never collide), and any
+  other body pair whose collision shapes MuJoCo finds touching at q = 0 or at the ``home`` keyframe
+  gets ``<contact><exclude>`` (MK832; :mod:`modelkit.convert.self_contact` compiles the file; MK833
+  when it cannot).
 """
 
 from __future__ import annotations
@@ -40,17 +43,19 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.meshes import MESH_FOLDER
 from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.self_contact import touching_pairs
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_devices import DeviceWriter
-from modelkit.formats.mjcf.write_geoms import GeomWriter, shared_stems
+from modelkit.formats.mjcf.write_geoms import COLLISION, GeomWriter, shared_stems
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, quat_wxyz, set_pose, sub
 from modelkit.model import WORLD_LINK, JointType, LoopConstraint, Robot
 from modelkit.spatial import Pose
 
 SECTIONS = (
-    "compiler", "option", "default", "asset", "worldbody", "equality", "actuator", "sensor", "keyframe"
+    "compiler", "option", "default", "asset", "worldbody", "contact", "equality", "actuator", "sensor",
+    "keyframe",
 )
 HINGE_HALF_SPAN = 0.05  # m: the two connects of a hinge loop sit this far either side of the joint
 # MuJoCo's XML parser (TinyXML2, 500 levels) reads at most this many nested <body> elements inside
@@ -114,6 +119,10 @@ class MjcfWriter:
         self._meshdir()
         if any(el.get("euler") is not None for el in self.root.iter()):
             self.sections["compiler"].set("eulerseq", EULER_SEQUENCE)  # set_pose's euler: URDF's rpy
+        self._self_contact()
+        return self._text()
+
+    def _text(self) -> bytes:
         for tag in SECTIONS:
             el = self.sections[tag]
             if tag not in ("compiler", "worldbody") and len(el) == 0 and not el.attrib:
@@ -121,6 +130,45 @@ class MjcfWriter:
         indent(self.root, space="  ")
         text: bytes = etree.tostring(self.root, xml_declaration=False, encoding="utf-8", pretty_print=True)
         return text
+
+    def _self_contact(self) -> None:
+        """``<contact><exclude>`` for body pairs touching at rest (MK832), found by compiling the file
+        as written so far with MuJoCo (MK833 when that fails)."""
+        if not any(g.get("class") == COLLISION for g in self.sections["worldbody"].iter("geom")):
+            return  # nothing collides
+        draft = etree.tostring(self.root, encoding="utf-8")
+        checked = touching_pairs(draft, self._assets())
+        if checked.failure is not None:
+            self.ctx.note("MK833", f"self-contact at rest not checked: {checked.failure}", self.robot.source,
+                          "contact")
+            return
+        links = {el.get("name"): link for link, el in self.tree.bodies.items()}
+        for pair in checked.pairs:
+            sub(self.sections["contact"], "exclude", body1=pair.body1, body2=pair.body2)
+            link = self.robot.link(links.get(pair.body2) or "")
+            mm = fmt(round(pair.depth * 1000.0, 3))
+            depth = f"overlapping by {mm} mm" if pair.depth > 0.0 else "touching"
+            self.ctx.note(
+                "MK832",
+                f"bodies {pair.body1} and {pair.body2} collide at rest ({pair.where}: MuJoCo finds their "
+                f"collision shapes {depth}); MuJoCo would push them apart, so the pair is excluded",
+                link.source if link is not None else self.robot.source,
+                f"contact/exclude[{pair.body1},{pair.body2}]",
+            )
+
+    def _assets(self) -> dict[str, bytes]:
+        """The staged files as MuJoCo resolves the model's references (``meshes/link0.stl``)."""
+        folder = self.ctx.model_relpath.rpartition("/")[0]
+        out: dict[str, bytes] = {}
+        for relpath, staged in self.ctx.meshes.plan.files.items():
+            if staged.what == "model":
+                continue
+            if folder:
+                ups = folder.count("/") + 1
+                out["../" * ups + relpath] = staged.data
+            else:
+                out[relpath] = staged.data
+        return out
 
     def _meshdir(self) -> None:
         """``<compiler meshdir="meshes">`` when every mesh file is in the written ``meshes/`` folder
