@@ -44,6 +44,13 @@ def touching_pairs(xml: bytes, assets: dict[str, bytes]) -> Checked:
         import mujoco
     except ImportError as exc:  # pragma: no cover - mujoco-core is a core dependency
         return Checked([], f"MuJoCo's Python bindings cannot be imported ({exc})")
+    from modelkit.formats.mjcf.quiet import collected_warnings
+
+    with collected_warnings(mujoco):  # never MUJOCO_LOG.TXT in the working directory, nor stderr
+        return _touching(mujoco, xml, assets)
+
+
+def _touching(mujoco: Any, xml: bytes, assets: dict[str, bytes]) -> Checked:
     try:
         model = mujoco.MjModel.from_xml_string(xml.decode("utf-8"), assets)
     except Exception as exc:  # MuJoCo raises ValueError with its compiler's message

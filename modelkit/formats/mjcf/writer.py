@@ -146,8 +146,8 @@ class MjcfWriter:
         for pair in checked.pairs:
             sub(self.sections["contact"], "exclude", body1=pair.body1, body2=pair.body2)
             link = self.robot.link(links.get(pair.body2) or "")
-            mm = fmt(round(pair.depth * 1000.0, 3))
-            depth = f"overlapping by {mm} mm" if pair.depth > 0.0 else "touching"
+            mm = round(pair.depth * 1000.0, 3)
+            depth = f"overlapping by {fmt(mm)} mm" if mm > 0.0 else "touching (overlap below 0.001 mm)"
             self.ctx.note(
                 "MK832",
                 f"bodies {pair.body1} and {pair.body2} collide at rest ({pair.where}: MuJoCo finds their "
