@@ -1166,9 +1166,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK832",
         "self-contact-excluded",
         "info",
-        "Two bodies whose collision shapes MuJoCo finds touching at the reference configuration (q = 0 "
-        "or the home keyframe), and which MuJoCo does not already exclude, get a `<contact><exclude>`: "
-        "otherwise the robot pushes itself apart at rest.",
+        "Two bodies whose collision shapes MuJoCo finds touching at the reference configuration (the home "
+        "keyframe, or q = 0 without one), and which MuJoCo does not already exclude, get a "
+        "`<contact><exclude>` (in every pose): otherwise the robot pushes itself apart at rest.",
     ),
     CodeInfo(
         "MK833",

@@ -101,3 +101,36 @@ def test_grandparent_overlaps_are_found_and_mujoco_refusal_is_noted(tmp_path: Pa
     unchecked = [n for n in result.notes if n.code == "MK833"]
     assert len(unchecked) == 1 and "did not compile" in unchecked[0].message
     assert "<contact>" not in (tmp_path / "deep.xml").read_text()
+
+
+SLIDER = """<robot name="slider">
+<link name="base"><inertial><mass value="1"/>
+<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+<link name="cart"><inertial><mass value="1"/>
+<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+<joint name="x" type="prismatic"><parent link="base"/><child link="cart"/><axis xyz="1 0 0"/>
+<limit lower="-2" upper="2" effort="10" velocity="1"/></joint>
+</robot>
+"""
+
+
+def test_the_home_pose_is_the_reference_when_there_is_one(tmp_path: Path) -> None:
+    """A cart on a slide overlaps its base at q = 0 (the base is welded to the world, so MuJoCo does not
+    filter the pair); started 1 m away (its initial position, the ``home`` keyframe) it touches nothing,
+    and nothing is excluded."""
+    from modelkit.api import validate
+    from modelkit.convert.api import write
+
+    source = tmp_path / "slider.urdf"
+    source.write_text(SLIDER)
+    robot = validate(source).robot
+    assert robot is not None
+    at_zero = [n for n in write(robot, tmp_path / "zero" / "s.xml") if n.code == "MK832"]
+    assert len(at_zero) == 1 and "base and cart" in at_zero[0].message and "q = 0" in at_zero[0].message
+    next(j for j in robot.joints if j.name == "x").initial_position = 1.0
+    notes = write(robot, tmp_path / "home" / "s.xml")
+    assert [n for n in notes if n.code in ("MK832", "MK833")] == []
+    text = (tmp_path / "home" / "s.xml").read_text()
+    assert "<contact>" not in text and '<key name="home" qpos="1"/>' in text

@@ -7,8 +7,9 @@ together; any other pair that touches at rest pushes the robot apart at the firs
 writer gives each such pair a ``<contact><exclude>`` (MK832).
 
 The model is compiled from memory (the writer's XML and the mesh files staged for the output, MuJoCo's
-virtual file system), the reference configurations are applied (``qpos0``, i.e. q = 0, and the
-``home`` keyframe when there is one) and ``mj_forward`` runs collision detection: every contact there is
+virtual file system), the reference configuration is applied (the ``home`` keyframe, the robot's
+initial joint positions, when there is one; else ``qpos0``, i.e. q = 0) and ``mj_forward`` runs
+collision detection: every contact there is
 between two of the robot's own bodies, since the file holds no floor. MuJoCo's Python bindings come with
 the core install (``mujoco-core``); when they cannot be imported or the compiler refuses the file,
 :func:`touching_pairs` says why and the writer notes that nothing was checked (MK833).
@@ -27,7 +28,7 @@ class Touching:
     body1: str
     body2: str
     depth: float  # m: the deepest penetration between their geoms (0 when they only touch)
-    where: str  # "q = 0", "home" or "q = 0 and home"
+    where: str  # "home" or "q = 0"
 
 
 @dataclass(frozen=True)
@@ -37,7 +38,8 @@ class Checked:
 
 
 def touching_pairs(xml: bytes, assets: dict[str, bytes]) -> Checked:
-    """The body pairs of the MJCF ``xml`` whose collision geoms touch at q = 0 or at the ``home`` key.
+    """The body pairs of the MJCF ``xml`` whose collision geoms touch at the ``home`` key, or at q = 0
+    when it has none.
 
     ``assets`` maps each file name as MuJoCo resolves it (``meshes/link0.stl``) to its bytes."""
     try:
@@ -57,10 +59,8 @@ def _touching(mujoco: Any, xml: bytes, assets: dict[str, bytes]) -> Checked:
         return Checked([], f"MuJoCo did not compile the written file ({' '.join(str(exc).split())})")
     data = mujoco.MjData(model)
     found: dict[tuple[int, int], tuple[float, set[str]]] = {}
-    states: list[tuple[str, Any]] = [("q = 0", None)]
     home = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "home")
-    if home >= 0:
-        states.append(("home", home))
+    states: list[tuple[str, Any]] = [("home", home)] if home >= 0 else [("q = 0", None)]
     for label, key in states:
         if key is None:
             mujoco.mj_resetData(model, data)

@@ -29,7 +29,7 @@ style is MuJoCo Menagerie's (docs/convert.md, "MJCF style").
 * A multi-joint MuJoCo body that the MJCF reader made a chain of links is written back as one body
   with its joints (:mod:`.write_chains`).
 * Self-collision follows MuJoCo's defaults (parent–child and welded pairs never collide), and any
-  other body pair whose collision shapes MuJoCo finds touching at q = 0 or at the ``home`` keyframe
+  other body pair whose collision shapes MuJoCo finds touching at the ``home`` keyframe (q = 0 without one)
   gets ``<contact><exclude>`` (MK832; :mod:`modelkit.convert.self_contact` compiles the file; MK833
   when it cannot).
 """
@@ -151,7 +151,8 @@ class MjcfWriter:
             self.ctx.note(
                 "MK832",
                 f"bodies {pair.body1} and {pair.body2} collide at rest ({pair.where}: MuJoCo finds their "
-                f"collision shapes {depth}); MuJoCo would push them apart, so the pair is excluded",
+                f"collision shapes {depth}); MuJoCo would push them apart, so the pair is excluded (in "
+                "every pose)",
                 link.source if link is not None else self.robot.source,
                 f"contact/exclude[{pair.body1},{pair.body2}]",
             )
