@@ -1,9 +1,10 @@
 """The MJCF (MuJoCo XML) writer: ``write_mjcf(robot, ctx) -> bytes``.
 
 The file is built with lxml, 2-space indented, sections in a fixed order (``compiler``, ``option``,
-``default``, ``asset``, ``worldbody``, ``equality``, ``actuator``, ``sensor``, ``keyframe``; empty ones
-left out); numbers through :func:`modelkit.convert.numbers.fmt`. MuJoCo is not imported here. The
-style is MuJoCo Menagerie's (docs/convert.md, "MJCF style").
+``default``, ``asset``, ``worldbody``, ``contact``, ``equality``, ``actuator``, ``sensor``,
+``keyframe``; empty ones left out); numbers through :func:`modelkit.convert.numbers.fmt`. MuJoCo is
+not imported here; :mod:`modelkit.convert.self_contact` compiles the finished file once to find the
+body pairs touching at rest. The style is MuJoCo Menagerie's (docs/convert.md, "MJCF style").
 
 * ``<compiler angle="radian" autolimits="true" inertiafromgeom="false" meshdir="meshes"/>``: angles
   in radians, a ``range`` makes a joint limited, and inertia comes from the ``<inertial>`` elements
