@@ -1163,6 +1163,21 @@ _TABLE: tuple[CodeInfo, ...] = (
         "free joint).",
     ),
     CodeInfo(
+        "MK832",
+        "self-contact-excluded",
+        "info",
+        "Two bodies whose collision shapes MuJoCo finds touching at the reference configuration (the home "
+        "keyframe, or q = 0 without one), and which MuJoCo does not already exclude, get a "
+        "`<contact><exclude>` (in every pose): otherwise the robot pushes itself apart at rest.",
+    ),
+    CodeInfo(
+        "MK833",
+        "self-contact-unchecked",
+        "info",
+        "The written MJCF could not be compiled by MuJoCo while converting (the bindings are missing or "
+        "the compiler refused it), so touching body pairs were not looked for and none is excluded.",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",

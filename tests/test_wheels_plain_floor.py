@@ -83,10 +83,11 @@ def test_written_files_carry_their_contact(written: dict[tuple[str, str], Path])
     the MJCF's <option>, PyBullet's <contact>."""
     mjcf = written[("pantilt", "xml")].read_text()
     assert '<option timestep="0.001" integrator="implicitfast" cone="elliptic" impratio="10"/>' in mjcf
-    contact = 'priority="1" solref="0.004 1" solimp="0.99 0.999 0.001 0.5 2"'
-    wheel = f'type="sphere" size="0.076" group="3" {contact} friction="3 0.005 0.0001" condim="3"'
+    contact = 'group="3" priority="1" solref="0.004 1" solimp="0.99 0.999 0.001 0.5 2"'
+    assert f'<default class="collision">\n        <geom {contact}/>' in mjcf  # the geoms' class
+    wheel = 'type="sphere" size="0.076" class="collision" friction="3 0.005 0.0001" condim="3"'
     assert mjcf.count(wheel) == 2
-    assert f'{contact} friction="0 0.005 0.0001" condim="1"' in mjcf
+    assert 'class="collision" friction="0 0.005 0.0001" condim="1"' in mjcf
     urdf = written[("pantilt", "urdf")].read_text()
     assert urdf.count('<lateral_friction value="3"/>') == 2 and '<lateral_friction value="0"/>' in urdf
     assert urdf.count('<sphere radius="0.076"/>') == 2

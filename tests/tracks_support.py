@@ -137,7 +137,7 @@ def mjcf_on_floor(text: str) -> str:
     """The written MJCF with a default plane and ``priority="1"`` on colliding robot geoms."""
     def prioritise(match: re.Match[str]) -> str:
         tag = match.group(0)
-        if "priority=" in tag or 'contype="0"' in tag:
+        if "priority=" in tag or 'contype="0"' in tag or 'class="' in tag:
             return tag
         return tag.replace("<geom ", '<geom priority="1" ', 1)
 

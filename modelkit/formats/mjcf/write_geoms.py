@@ -1,9 +1,11 @@
 """Geoms and mesh assets of the MJCF writer.
 
-* Collision geoms keep MuJoCo's default ``contype="1" conaffinity="1"`` (not written) and go in
-  ``group="3"``; visual geoms get ``contype="0" conaffinity="0" group="1"`` (MuJoCo's own URDF
-  importer uses group 1 for visuals). The viewer shows groups 0–2 by default, so a converted robot
-  looks like its visual model; MuJoCo collides geoms whatever their group.
+* Geoms name a ``<default>`` class, as MuJoCo Menagerie's models do: ``class="collision"`` (MuJoCo's
+  default ``contype="1" conaffinity="1"``, ``group="3"``, ``priority="1"`` and, for a driven robot,
+  the stiff ``solref``/``solimp``) or ``class="visual"`` (``contype="0" conaffinity="0"
+  group="1"``; MuJoCo's own URDF importer uses group 1 for visuals). Both are children of a class
+  named after the robot (:meth:`GeomWriter.defaults`). The viewer shows groups 0–2 by default, so a
+  converted robot looks like its visual model; MuJoCo collides geoms whatever their group.
 * Geoms never add mass: the compiler is told ``inertiafromgeom="false"`` and every body's mass
   comes from its ``<inertial>`` (or is zero), so ``body_mass`` is the model's mass exactly.
 * Box ``size`` = half extents; sphere ``r``; cylinder and capsule ``r h/2`` (the model's capsule
@@ -12,9 +14,11 @@
 * A primitive with a zero or negative size is left out (MK871): MuJoCo refuses any such geom ("size 0
   must be positive in geom"). A tiny stand-in would invent a contact the source does not mean (a zero
   box is how Gazebo models say "no collision"), and geoms add no mass here, so nothing else changes.
-* A mesh asset is named after its file (``wheel``), made unique with ``_2``... (MK800); one asset
-  per (file, scale). Each ``file`` is a path relative to the model file (no ``meshdir``), so the
-  output folder can be moved as a whole.
+* A mesh asset is named after its source file's stem (``wheel`` for ``wheel.dae``); when a collision
+  and a visual mesh come from different files of the same stem (``link0.stl`` and ``link0.dae``), the
+  collision one is ``<stem>_collision``; any other clash gets ``_2``... (MK800). One asset per
+  (written file, scale). Each ``file`` is relative to the model file; the writer then moves the
+  common ``meshes/`` folder into ``<compiler meshdir>`` (:mod:`.writer`).
 * Colour: ``rgba`` = (diffuse, 1 − transparency); specular, emissive and textures are not written
   (MK818).
 * Friction: a link with a contact material gets, on each collision geom, its friction against
@@ -46,6 +50,7 @@ from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, 
 MESH_READABLE = ("stl", "obj")
 COLLISION_GROUP = "3"
 VISUAL_GROUP = "1"
+VISUAL, COLLISION = "visual", "collision"  # the <default> classes the geoms name
 TORSIONAL, ROLLING = 0.005, 0.0001  # MuJoCo's defaults, written out with the sliding friction
 CONTACT_PRIORITY = "1"  # above a floor's default 0: the robot geom's friction, condim, solref win
 
@@ -58,6 +63,23 @@ class GeomWriter:
     friction: dict[str, PairFriction]
     contact: dict[str, str] = field(default_factory=dict)  # solref/solimp for every collision geom
     mesh_assets: dict[tuple[str, tuple[float, ...]], str] = field(default_factory=dict)
+    shared_stems: set[str] = field(default_factory=set)  # stems of both a collision and a visual file
+    used: set[str] = field(default_factory=set)  # the classes (VISUAL, COLLISION) a geom names
+
+    def defaults(self, section: Element, robot_name: str) -> None:
+        """``<default class=robot>`` with the ``visual`` and ``collision`` classes the geoms use."""
+        if not self.used:
+            return
+        top = sub(section, "default", **{"class": self.names.claim("default", robot_name or "robot",
+                                                                    note=False)})
+        if COLLISION in self.used:
+            geom = sub(sub(top, "default", **{"class": COLLISION}), "geom", group=COLLISION_GROUP,
+                       priority=CONTACT_PRIORITY)
+            for key, value in self.contact.items():
+                geom.set(key, value)
+        if VISUAL in self.used:
+            sub(sub(top, "default", **{"class": VISUAL}), "geom", contype="0", conaffinity="0",
+                group=VISUAL_GROUP)
 
     def link_geoms(self, body: Element, link: Link, body_name: str) -> None:
         for i, geom in enumerate(link.collisions):
@@ -92,15 +114,9 @@ class GeomWriter:
         for key, value in shape.items():
             el.set(key, value)
         set_pose(el, geom.pose)
-        if collision:
-            el.set("group", COLLISION_GROUP)
-            el.set("priority", CONTACT_PRIORITY)
-            for key, value in self.contact.items():
-                el.set(key, value)
-        else:
-            el.set("contype", "0")
-            el.set("conaffinity", "0")
-            el.set("group", VISUAL_GROUP)
+        role = COLLISION if collision else VISUAL
+        el.set("class", role)
+        self.used.add(role)
         self.appearance(el, geom, target)
         if collision and link.name in self.friction:
             self.set_friction(el, link, target)
@@ -130,16 +146,22 @@ class GeomWriter:
             ref = found
         else:  # pragma: no cover - the model has no other geometry
             return None
-        asset = self.mesh_asset(ref.uri, np.asarray(ref.scale, dtype=float), target, ref.hollow, geom.source)
+        stem = source_stem(g) if isinstance(g, Mesh) else None
+        if stem is not None and collision and stem in self.shared_stems:
+            stem = f"{stem}_{COLLISION}"
+        asset = self.mesh_asset(ref.uri, np.asarray(ref.scale, dtype=float), target, ref.hollow, geom.source,
+                                stem)
         return {"type": "mesh", "mesh": asset}
 
     def mesh_asset(self, uri: str, scale: np.ndarray, target: str, hollow: bool = False,
-                   source: SourceLocation | None = None) -> str:
+                   source: SourceLocation | None = None, stem: str | None = None) -> str:
+        """The asset of the written file ``uri`` at ``scale``, named ``stem`` (the source file's) or
+        after ``uri``."""
         key = (uri, tuple(float(x) for x in scale))
         known = self.mesh_assets.get(key)
         if known is not None:
             return known
-        stem = PurePosixPath(uri).stem or "mesh"
+        stem = stem or PurePosixPath(uri).stem or "mesh"
         name = self.names.claim("mesh", stem, None, f"asset/mesh[{stem}] (for {target})")
         el = sub(self.asset, "mesh", name=name, file=uri)
         if np.any(scale != 1.0):
@@ -217,3 +239,29 @@ def refused_by_mujoco(g: object) -> bool:
     if isinstance(g, Capsule):
         return sizes[0] <= 0.0 or sizes[1] < 0.0
     return bool(sizes) and min(sizes) <= 0.0
+
+
+def source_stem(mesh: Mesh) -> str | None:
+    """The stem of the file a mesh came from (with its fragment: ``robot_arm``), None when generated."""
+    if not mesh.uri:
+        return None
+    stem = PurePosixPath(mesh.uri.replace("\\", "/")).stem
+    if not stem:
+        return None
+    return f"{stem}_{mesh.fragment}" if mesh.fragment else stem
+
+
+def shared_stems(links: list[Link]) -> set[str]:
+    """Stems that name different collision and visual files (``link0.stl`` and ``link0.dae``)."""
+    files: dict[tuple[str, bool], set[str]] = {}
+    for link in links:
+        for collision, geoms in ((True, link.collisions), (False, link.visuals)):
+            for geom in geoms:
+                g = geom.geometry
+                if not isinstance(g, Mesh):
+                    continue
+                stem = source_stem(g)
+                if stem is not None:
+                    files.setdefault((stem, collision), set()).add(g.uri or "")
+    return {stem for (stem, collision), uris in files.items()
+            if collision and files.get((stem, False), set()) - uris}

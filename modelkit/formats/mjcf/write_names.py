@@ -14,7 +14,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.names import unique_name
 from modelkit.diagnostics import SourceLocation
 
-RESERVED = {"body": {"world"}}
+RESERVED = {"body": {"world"}, "default": {"main", "visual", "collision"}}
 MODEL_KIND = {"body": "link"}  # MuJoCo's word → the model's, in rename records
 
 

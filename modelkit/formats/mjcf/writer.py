@@ -1,12 +1,17 @@
 """The MJCF (MuJoCo XML) writer: ``write_mjcf(robot, ctx) -> bytes``.
 
-The file is built with lxml, 2-space indented, sections in a fixed order (``compiler``,
-``asset``, ``worldbody``, ``equality``, ``actuator``, ``sensor``, ``keyframe``; empty ones left out); numbers
-through :func:`modelkit.convert.numbers.fmt`. MuJoCo is not imported here.
+The file is built with lxml, 2-space indented, sections in a fixed order (``compiler``, ``option``,
+``default``, ``asset``, ``worldbody``, ``contact``, ``equality``, ``actuator``, ``sensor``,
+``keyframe``; empty ones left out); numbers through :func:`modelkit.convert.numbers.fmt`. MuJoCo is
+not imported here; :mod:`modelkit.convert.self_contact` compiles the finished file once to find the
+body pairs touching at rest. The style is MuJoCo Menagerie's (docs/convert.md, "MJCF style").
 
-* ``<compiler angle="radian" autolimits="true" inertiafromgeom="false"/>``: angles in radians,
-  a ``range`` makes a joint limited, and inertia comes from the ``<inertial>`` elements only (geoms
-  never add mass). No ``meshdir``: each mesh ``file`` is relative to the model file.
+* ``<compiler angle="radian" autolimits="true" inertiafromgeom="false" meshdir="meshes"/>``: angles
+  in radians, a ``range`` makes a joint limited, and inertia comes from the ``<inertial>`` elements
+  only (geoms never add mass). ``meshdir`` when every mesh file is in the written ``meshes/`` folder
+  (each ``file`` is then a name in it); otherwise each ``file`` is relative to the model file.
+* ``<default>``: a class named after the robot, with the ``visual`` and ``collision`` classes its
+  geoms name (:mod:`.write_geoms`).
 * ``<option>``: MuJoCo's defaults, except for a driven robot: wheels get timestep 1 ms,
   ``implicitfast``, elliptic cones and ``impratio`` 10; pseudo continuous tracks the same with their
   ``impratio`` (``convert.tracks.TRACK_IMPRATIO``: soft friction, so that the track rollers skid as
@@ -24,7 +29,10 @@ through :func:`modelkit.convert.numbers.fmt`. MuJoCo is not imported here.
   is finite. With zero control a motor applies no force, so the passive model is unchanged.
 * A multi-joint MuJoCo body that the MJCF reader made a chain of links is written back as one body
   with its joints (:mod:`.write_chains`).
-* Self-collision follows MuJoCo's defaults (parent–child and welded pairs never collide).
+* Self-collision follows MuJoCo's defaults (parent–child and welded pairs never collide), and any
+  other body pair whose collision shapes MuJoCo finds touching at the ``home`` keyframe (q = 0 without one)
+  gets ``<contact><exclude>`` (MK832; :mod:`modelkit.convert.self_contact` compiles the file; MK833
+  when it cannot).
 """
 
 from __future__ import annotations
@@ -34,17 +42,22 @@ from lxml import etree
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
+from modelkit.convert.meshes import MESH_FOLDER
 from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.self_contact import touching_pairs
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_devices import DeviceWriter
-from modelkit.formats.mjcf.write_geoms import GeomWriter
+from modelkit.formats.mjcf.write_geoms import COLLISION, GeomWriter, shared_stems
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, quat_wxyz, set_pose, sub
 from modelkit.model import WORLD_LINK, JointType, LoopConstraint, Robot
 from modelkit.spatial import Pose
 
-SECTIONS = ("compiler", "option", "asset", "worldbody", "equality", "actuator", "sensor", "keyframe")
+SECTIONS = (
+    "compiler", "option", "default", "asset", "worldbody", "contact", "equality", "actuator", "sensor",
+    "keyframe",
+)
 HINGE_HALF_SPAN = 0.05  # m: the two connects of a hinge loop sit this far either side of the joint
 # MuJoCo's XML parser (TinyXML2, 500 levels) reads at most this many nested <body> elements inside
 # <mujoco><worldbody> (measured with MuJoCo 3.x and 4.0: 496 load, 497 are refused).
@@ -67,7 +80,7 @@ class MjcfWriter:
         compiler.set("autolimits", "true")
         compiler.set("inertiafromgeom", "false")
         self.geoms = GeomWriter(ctx, self.names, self.sections["asset"], floor_friction(robot),
-                                mujoco_contact(robot))
+                                mujoco_contact(robot), shared_stems=shared_stems(robot.links))
         self.devices = DeviceWriter(ctx, self.names, self.sections["sensor"])
         self.tree = BodyTree(robot, ctx, self.names, self.geoms, self.devices)
         options, why = mujoco_options(robot)  # wheels or tracks (convert.simulator says why)
@@ -103,8 +116,14 @@ class MjcfWriter:
             self._loop(loop)
         self._actuators()
         self._home()
+        self.geoms.defaults(self.sections["default"], self.robot.name)
+        self._meshdir()
         if any(el.get("euler") is not None for el in self.root.iter()):
             self.sections["compiler"].set("eulerseq", EULER_SEQUENCE)  # set_pose's euler: URDF's rpy
+        self._self_contact()
+        return self._text()
+
+    def _text(self) -> bytes:
         for tag in SECTIONS:
             el = self.sections[tag]
             if tag not in ("compiler", "worldbody") and len(el) == 0 and not el.attrib:
@@ -112,6 +131,58 @@ class MjcfWriter:
         indent(self.root, space="  ")
         text: bytes = etree.tostring(self.root, xml_declaration=False, encoding="utf-8", pretty_print=True)
         return text
+
+    def _self_contact(self) -> None:
+        """``<contact><exclude>`` for body pairs touching at rest (MK832), found by compiling the file
+        as written so far with MuJoCo (MK833 when that fails)."""
+        if not any(g.get("class") == COLLISION for g in self.sections["worldbody"].iter("geom")):
+            return  # nothing collides
+        draft = etree.tostring(self.root, encoding="utf-8")
+        checked = touching_pairs(draft, self._assets())
+        if checked.failure is not None:
+            self.ctx.note("MK833", f"self-contact at rest not checked: {checked.failure}", self.robot.source,
+                          "contact")
+            return
+        links = {el.get("name"): link for link, el in self.tree.bodies.items()}
+        for pair in checked.pairs:
+            sub(self.sections["contact"], "exclude", body1=pair.body1, body2=pair.body2)
+            link = self.robot.link(links.get(pair.body2) or "")
+            mm = round(pair.depth * 1000.0, 3)
+            depth = f"overlapping by {fmt(mm)} mm" if mm > 0.0 else "touching (overlap below 0.001 mm)"
+            self.ctx.note(
+                "MK832",
+                f"bodies {pair.body1} and {pair.body2} collide at rest ({pair.where}: MuJoCo finds their "
+                f"collision shapes {depth}); MuJoCo would push them apart, so the pair is excluded (in "
+                "every pose)",
+                link.source if link is not None else self.robot.source,
+                f"contact/exclude[{pair.body1},{pair.body2}]",
+            )
+
+    def _assets(self) -> dict[str, bytes]:
+        """The staged files as MuJoCo resolves the model's references (``meshes/link0.stl``)."""
+        folder = self.ctx.model_relpath.rpartition("/")[0]
+        out: dict[str, bytes] = {}
+        for relpath, staged in self.ctx.meshes.plan.files.items():
+            if staged.what == "model":
+                continue
+            if folder:
+                ups = folder.count("/") + 1
+                out["../" * ups + relpath] = staged.data
+            else:
+                out[relpath] = staged.data
+        return out
+
+    def _meshdir(self) -> None:
+        """``<compiler meshdir="meshes">`` when every mesh file is in the written ``meshes/`` folder
+        (a kept ``package://`` URI, or a file elsewhere, leaves every path as it is)."""
+        meshes = list(self.sections["asset"].iter("mesh"))
+        prefix = f"{MESH_FOLDER}/"
+        files = [el.get("file", "") for el in meshes]
+        if not meshes or not all(f.startswith(prefix) and "/" not in f[len(prefix):] for f in files):
+            return
+        self.sections["compiler"].set("meshdir", MESH_FOLDER)
+        for el, name in zip(meshes, files, strict=True):
+            el.set("file", name[len(prefix):])
 
     def _depth(self) -> None:
         """MK872 when the bodies nest deeper than MuJoCo reads: the file is written all the same."""
