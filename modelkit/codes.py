@@ -1163,6 +1163,36 @@ _TABLE: tuple[CodeInfo, ...] = (
         "free joint).",
     ),
     CodeInfo(
+        "MK840",
+        "actuator-gains-made-up",
+        "info",
+        "A position or velocity actuator the source gave no gains for (URDF transmissions and ros2_control, "
+        "Choreonoid actuation modes, `--actuators position|velocity`) gets gains from the documented rule "
+        "(docs/convert.md: a stated bandwidth on each joint's reflected inertia at home); the note gives "
+        "them.",
+    ),
+    CodeInfo(
+        "MK841",
+        "actuators-chosen",
+        "info",
+        "The source says nothing about actuation: every hinge and slide joint that is not a mimic follower "
+        "gets the actuator `--actuators` names (motor by default), or none with `--actuators none`.",
+    ),
+    CodeInfo(
+        "MK842",
+        "actuator-not-written",
+        "warning",
+        "A source actuator drives a joint the target cannot drive with one actuator (a fixed, ball or "
+        "planar joint, a mimic follower, a locked joint): it is left out.",
+    ),
+    CodeInfo(
+        "MK843",
+        "actuator-reduction-folded",
+        "info",
+        "A transmission reduction or rotor inertia is not written as such: the actuator acts at the joint "
+        "(forces and controls in joint units) and the rotor's reflected inertia is the joint's armature.",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",
