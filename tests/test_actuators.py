@@ -117,6 +117,8 @@ def test_mjcf_actuators_survive_a_round_trip(tmp_path: Path) -> None:
     }
     assert again["j1"].force_range == (-20.0, 20.0)
     assert not [n for n in notes if n.code == "MK840"]  # every gain came from the source
+    (left,) = [n for n in notes if n.code == "MK842"]
+    assert left.message.startswith("1 MJCF actuator(s)")  # the intvelocity
 
 
 URDF = """<robot name="two">

@@ -74,12 +74,28 @@ class ActuatorWriter:
             assert joint is not None and target is not None
             self._one(actuator, joint, target[0], home.get(target[0], 0.0))
             written += 1
+        self._uncanonical()
         if made_up and self.robot.joints:
             choice = self.ctx.options.actuators
             element = ELEMENTS.get(CHOICES.get(choice, ActuatorKind.EFFORT))
             what = "no actuators" if choice == "none" else f"{written} <{element}> actuator(s)"
             self.ctx.note("MK841", f"the source names no actuators: {what} written (--actuators {choice})",
                           self.robot.source, "actuator")
+
+    def _uncanonical(self) -> None:
+        """MK842 for an MJCF source's actuators that the model could not hold (activation dynamics,
+        tendon or site transmissions, other gain and bias laws): they are not written."""
+        kept = self.robot.extras.get("mjcf_actuators") or []
+        canonical = sum(1 for a in self.robot.actuators if a.source_kind != "track roller")
+        left = len(kept) - canonical
+        if left > 0:
+            self.ctx.note(
+                "MK842",
+                f"{left} MJCF actuator(s) of the source left out: not a motor, position or velocity law on "
+                "one hinge or slide (activation dynamics, tendon or site transmission, another law)",
+                self.robot.source,
+                "actuator",
+            )
 
     def _constrained(self) -> set[str]:
         followers = {j.name for j in self.robot.joints if j.mimic is not None}
