@@ -1193,6 +1193,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "(forces and controls in joint units) and the rotor's reflected inertia is the joint's armature.",
     ),
     CodeInfo(
+        "MK844",
+        "actuator-details-dropped",
+        "info",
+        "An actuator is written where the target has no place for its gains, gear or ranges (a URDF "
+        "`<transmission>` holds the joint, the interface and the reduction): the note lists what is left "
+        "out.",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",

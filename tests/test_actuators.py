@@ -293,3 +293,24 @@ def test_pa10_holds_home(tmp_path: Path) -> None:
     moving = [j for j in robot.joints if j.type.moves and j.mimic is None]
     assert count == len(moving)
     assert error < HOLD_TOLERANCE, f"PA10 moved {error * 1e3:.3f} mm"
+
+
+# -- other targets -----------------------------------------------------------------------------
+
+
+def test_mjcf_actuators_reach_urdf_and_body_as_their_kinds(tmp_path: Path) -> None:
+    """MJCF → URDF writes one ``<transmission>`` per canonical actuator (MK844 lists the gains it cannot
+    hold) and MJCF → .body an ``actuation_mode``; both read back as the same kinds."""
+    path = tmp_path / "four.xml"
+    path.write_text(MJCF)
+    robot = load(path)
+    kinds = {a.joint: a.kind for a in robot.actuators}
+    urdf = tmp_path / "urdf" / "four.urdf"
+    notes = write(robot, urdf, force=True)
+    assert {a.joint: a.kind for a in load(urdf).actuators} == kinds
+    (lost,) = [n for n in notes if n.code == "MK844"]
+    assert "j1 (kp 100, kv 5" in lost.message
+    assert "1 MJCF actuators" in " ".join(n.message for n in notes if n.code == "MK808")  # the intvelocity
+    body = tmp_path / "body" / "four.body"
+    write(robot, body, force=True)
+    assert {a.joint: a.kind for a in load(body).actuators} == kinds
