@@ -75,7 +75,8 @@ class ActuatorWriter:
             self._one(actuator, joint, target[0], home.get(target[0], 0.0))
             written += 1
         self._uncanonical()
-        if made_up and self.robot.joints:
+        movable = any(j.type in (JointType.REVOLUTE, JointType.PRISMATIC) for j in self.robot.joints)
+        if made_up and movable:
             choice = self.ctx.options.actuators
             element = ELEMENTS.get(CHOICES.get(choice, ActuatorKind.EFFORT))
             what = "no actuators" if choice == "none" else f"{written} <{element}> actuator(s)"
