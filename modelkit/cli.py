@@ -16,7 +16,7 @@ from typing import Any, NoReturn, TypeVar
 
 import click
 
-from modelkit.convert.options import MESH_FORMATS, SDF_VERSIONS, WHEEL_COLLISIONS
+from modelkit.convert.options import ACTUATOR_CHOICES, MESH_FORMATS, SDF_VERSIONS, WHEEL_COLLISIONS
 from modelkit.convert.registry import TARGET_NAMES
 from modelkit.diagnostics import (
     Diagnostic,
@@ -430,6 +430,10 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
 @click.option("--base", type=click.Choice(["auto", "fixed", "floating"]), default="auto", show_default=True,
               help="Weld the root to the world or let it float; auto keeps the source's answer and, where "
                    "it has none (URDF), floats robots with wheels or legs and welds the others.")
+@click.option("--actuators", type=click.Choice(ACTUATOR_CHOICES), default="motor", show_default=True,
+              help="MJCF: the actuator of every hinge and slide joint when the source has no actuators "
+                   "(position/velocity servos get gains from each joint's reflected inertia; MK840, MK841). "
+                   "A source's own actuators are always written.")
 @reading_options
 def convert(
     words: tuple[str, ...],
@@ -448,6 +452,7 @@ def convert(
     urdf_world_link: bool,
     wheel_collision: str,
     base: str,
+    actuators: str,
     **kwargs: Any,
 ) -> None:
     """Convert model files to URDF, SDF, MJCF or .body; every approximation is reported.
@@ -471,6 +476,7 @@ def convert(
         urdf_world_link=True if urdf_world_link else None,
         wheel_collision=wheel_collision,
         base=base,
+        actuators=actuators,
     )
     with _interruptible("convert", output):
         result = run_convert(files, output, target, _read_options(kwargs, True, xacro_args), options, force,

@@ -1178,6 +1178,44 @@ _TABLE: tuple[CodeInfo, ...] = (
         "the compiler refused it), so touching body pairs were not looked for and none is excluded.",
     ),
     CodeInfo(
+        "MK840",
+        "actuator-gains-made-up",
+        "info",
+        "A position or velocity actuator the source gave no gains for (URDF transmissions and ros2_control, "
+        "Choreonoid actuation modes, `--actuators position|velocity`) gets gains from the documented rule "
+        "(docs/convert.md: a stated bandwidth on each joint's reflected inertia at home); the note gives "
+        "them.",
+    ),
+    CodeInfo(
+        "MK841",
+        "actuators-chosen",
+        "info",
+        "The source says nothing about actuation: every hinge and slide joint that is not a mimic follower "
+        "gets the actuator `--actuators` names (motor by default), or none with `--actuators none`.",
+    ),
+    CodeInfo(
+        "MK842",
+        "actuator-not-written",
+        "warning",
+        "A source actuator drives a joint the target cannot drive with one actuator (a fixed, ball or "
+        "planar joint, a mimic follower, a locked joint): it is left out.",
+    ),
+    CodeInfo(
+        "MK843",
+        "actuator-reduction-folded",
+        "info",
+        "A transmission reduction or rotor inertia is not written as such: the actuator acts at the joint "
+        "(forces and controls in joint units) and the rotor's reflected inertia is the joint's armature.",
+    ),
+    CodeInfo(
+        "MK844",
+        "actuator-details-dropped",
+        "info",
+        "An actuator is written where the target has no place for its gains, gear or ranges (a URDF "
+        "`<transmission>` holds the joint, the interface and the reduction): the note lists what is left "
+        "out.",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",

@@ -295,6 +295,43 @@ class Joint:
         return self.sources.get(attribute, self.source)
 
 
+class ActuatorKind(StrEnum):
+    """What an actuator's control means: a force or torque, a target velocity, a target position."""
+
+    EFFORT = "effort"
+    VELOCITY = "velocity"
+    POSITION = "position"
+
+
+@dataclass(eq=False)
+class Actuator:
+    """One actuator driving one joint, in the source's own terms (canonical across formats).
+
+    ``gear`` scales the control into joint force (MJCF ``gear``); ``kp`` (N·m/rad or N/m) and ``kv``
+    (N·m·s/rad or N·s/m) are the servo gains of a position or velocity actuator, None when the
+    source gave none (a writer then makes them up and says so). ``force_range`` bounds the force at
+    the joint, ``ctrl_range`` the control; None = unbounded or not given. ``reduction`` is the
+    transmission's mechanical reduction (URDF ``mechanicalReduction``, Choreonoid ``gearRatio``),
+    ``rotor_inertia`` the motor rotor's inertia before the reduction (kg·m²; the joint's armature
+    already holds reduction² · rotor inertia where the reader knew both). ``source_kind`` names what the
+    source wrote (``PositionJointInterface``, ``ros2_control position``, ``jointDisplacement``,
+    ``position``, ``general``...).
+    """
+
+    joint: str
+    kind: ActuatorKind = ActuatorKind.EFFORT
+    name: str | None = None
+    gear: float = 1.0
+    kp: float | None = None
+    kv: float | None = None
+    force_range: tuple[float, float] | None = None
+    ctrl_range: tuple[float, float] | None = None
+    reduction: float = 1.0
+    rotor_inertia: float = 0.0
+    source_kind: str = ""
+    source: SourceLocation | None = None
+
+
 @dataclass(eq=False)
 class LoopConstraint:
     """A closed-loop joint between two links of the tree (Choreonoid ``extra_joints``)."""
@@ -318,6 +355,8 @@ class Robot:
     (``FLOATING``) or is welded to the world (``FIXED``) at ``root_pose``, or is None when the format
     leaves it open (URDF).
 
+    ``actuators`` are the source's own actuators (none: the source says nothing about actuation).
+
     ``extras["masses_unknown"]`` is True when the reader could not tell the masses (an MJCF file
     MuJoCo could not compile: the masses it would infer from geoms); mass rules then say nothing.
     """
@@ -329,6 +368,7 @@ class Robot:
     root_joint: JointType | None = None
     root_pose: Pose = field(default_factory=Pose)
     loops: list[LoopConstraint] = field(default_factory=list)
+    actuators: list[Actuator] = field(default_factory=list)
     source_format: str = ""
     source: SourceLocation | None = None
     extras: dict[str, Any] = field(default_factory=dict)

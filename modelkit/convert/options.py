@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 SDF_VERSIONS = ("1.6", "1.7", "1.8", "1.9", "1.10", "1.11")
 MESH_FORMATS = ("stl", "obj")
+ACTUATOR_CHOICES = ("motor", "position", "velocity", "none")  # where the source has no actuators
 WHEEL_COLLISIONS = ("auto", "cylinder", "sphere", "ellipsoid")  # convert.wheels says what each means
 
 
@@ -21,3 +22,6 @@ class WriteOptions:
     urdf_world_link: bool | None = None
     wheel_collision: str = "auto"  # auto|cylinder|sphere|ellipsoid: the wheels' collision (convert.wheels)
     base: str = "auto"  # fixed | floating | auto: how the root meets the world (modelkit/convert/base.py)
+    # actuators for a source without any (MJCF): motor (default) | position | velocity | none; the
+    # source's own actuators are always written as they are (docs/convert.md, "Actuators")
+    actuators: str = "motor"

@@ -65,6 +65,8 @@ from modelkit.convert.names import unique_name
 from modelkit.convert.notes import NoteSink
 from modelkit.model import (
     SYNTHESISED,
+    Actuator,
+    ActuatorKind,
     Box,
     Capsule,
     Cone,
@@ -355,6 +357,9 @@ def _approximate(robot: Robot, joint: Joint, link: Link, notes: NoteSink) -> Non
         if i == 0:
             roller_joint.joint_id = joint.joint_id
             roller_joint.actuation_mode = joint.actuation_mode or "velocity"
+            if robot.actuators:  # a source with actuators: the driven roller keeps its motor
+                robot.actuators.append(Actuator(joint_name, ActuatorKind.EFFORT, source_kind="track roller",
+                                                source=joint.source))
         else:
             roller_joint.mimic = Mimic(joint_names[0], 1.0, 0.0, joint.source)
         robot.links.insert(index + i, roller)

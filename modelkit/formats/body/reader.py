@@ -19,7 +19,17 @@ from modelkit.formats.body.materials import MaterialTable, load_materials
 from modelkit.formats.body.values import IDENTITY_AFFINE
 from modelkit.formats.common import ReadOptions, ReadResult
 from modelkit.limits import too_many_links
-from modelkit.model import Inertial, Joint, JointLimits, JointType, Link, LoopConstraint, Robot
+from modelkit.model import (
+    Actuator,
+    ActuatorKind,
+    Inertial,
+    Joint,
+    JointLimits,
+    JointType,
+    Link,
+    LoopConstraint,
+    Robot,
+)
 from modelkit.spatial import Pose
 from modelkit.textio import real_path
 from modelkit.yamltree import (
@@ -54,6 +64,11 @@ ACTUATION_MODES = {
     "link_position": "link_position",
     "linkPosition": "link_position",
     "jointSurfaceVelocity": "velocity",
+}
+BODY_ACTUATOR_KINDS = {
+    "effort": ActuatorKind.EFFORT,
+    "displacement": ActuatorKind.POSITION,
+    "velocity": ActuatorKind.VELOCITY,
 }
 # Keys that limit a joint's motion: meaningless on a fixed joint.
 LIMIT_KEYS = (
@@ -106,6 +121,7 @@ class _BodyReader:
         self.stack = (*stack, str(real_path(path)))
         self.angle_scale = math.pi / 180.0
         self.materials: MaterialTable | None = None
+        self.drives: dict[int, tuple[float, float]] = {}  # id(joint) → (rotor inertia, gear ratio)
 
     # -- top level ---------------------------------------------------------------------------
 
@@ -155,7 +171,30 @@ class _BodyReader:
             return None
         self._assemble(robot, root, records)
         self._extra_joints(robot, root)
+        self._actuators(robot)
         return robot
+
+    def _actuators(self, robot: Robot) -> None:
+        """One actuator per moving joint with an ``actuation_mode`` (effort, displacement → position,
+        velocity), with its ``gear_ratio`` as reduction and ``rotor_inertia`` (the joint's armature
+        is already gear_ratio² · rotor_inertia). Choreonoid gives no gains."""
+        for joint in robot.joints:
+            kind = BODY_ACTUATOR_KINDS.get(joint.actuation_mode or "")
+            if kind is None or joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
+                continue
+            rotor, gear = self.drives.get(id(joint), (0.0, 1.0))
+            effort = joint.limits.effort
+            robot.actuators.append(
+                Actuator(
+                    joint=joint.name,
+                    kind=kind,
+                    reduction=gear,
+                    rotor_inertia=rotor,
+                    force_range=(-effort, effort) if math.isfinite(effort) and effort > 0 else None,
+                    source_kind=f"actuation_mode {joint.actuation_mode}",
+                    source=joint.loc("actuation_mode"),
+                )
+            )
 
     def _check_schema(self, root: YMap) -> None:
         from modelkit.formats.body.schema import check_schema
@@ -296,6 +335,8 @@ class _BodyReader:
         if joint_type_node is not None:
             joint.sources["type"] = joint_type_node.loc
         joint.actuation_mode = ACTUATION_MODES.get(mode_word or "")
+        if mode_node is not None:
+            joint.sources["actuation_mode"] = mode_node.loc
         self._joint_details(node, joint, word)
         parent_node = node.get("parent")
         parent = v.scalar_text(parent_node)
@@ -381,6 +422,7 @@ class _BodyReader:
             rotor = v.get_number(node, "rotor_inertia", "rotorInertia", default=0.0) or 0.0
             gear = v.get_number(node, "gear_ratio", "gearRatio", default=1.0)
             armature = (gear if gear is not None else 1.0) ** 2 * rotor
+            self.drives[id(joint)] = (rotor, gear if gear is not None else 1.0)
         joint.armature = armature
         displacement = v.number(node.get("joint_displacement", "jointDisplacement"))
         angle_node = node.get("joint_angle", "jointAngle")

@@ -191,6 +191,8 @@ def _link_node(robot: Robot, link: Link, joint: Joint | None, names: _Names, ctx
         _root(robot, node, link, ctx, target)
     else:
         _joint(joint, node, names, ctx)
+        if "actuation_mode" not in node:
+            _actuation_from_actuators(robot, joint, node)
     _inertial(link.inertial, node)
     if link.contact_material:
         node["material"] = link.contact_material
@@ -218,6 +220,19 @@ def _root(robot: Robot, node: dict[str, Any], link: Link, ctx: WriteContext, tar
     else:
         node["joint_type"] = "fixed" if robot.root_joint is JointType.FIXED else "free"
     put_pose(node, robot.root_pose.rotation, robot.root_pose.translation)
+
+
+KIND_WORDS = {"effort": "joint_effort", "position": "joint_displacement", "velocity": "joint_velocity"}
+
+
+def _actuation_from_actuators(robot: Robot, joint: Joint, node: dict[str, Any]) -> None:
+    """A canonical actuator of another format's source as the joint's ``actuation_mode`` (its kind:
+    effort, position → joint_displacement, velocity); gains have no place in the body format."""
+    if not joint.type.moves:
+        return
+    actuator = next((a for a in robot.actuators if a.joint == joint.name), None)
+    if actuator is not None:
+        node["actuation_mode"] = KIND_WORDS[actuator.kind.value]
 
 
 def _joint(joint: Joint, node: dict[str, Any], names: _Names, ctx: WriteContext) -> None:

@@ -26,6 +26,7 @@ from typing import Any
 from modelkit.diagnostics import DiagnosticSink, SourceLocation, sorted_diagnostics
 from modelkit.formats.common import ReadOptions, ReadResult
 from modelkit.formats.meshref import not_found
+from modelkit.formats.mjcf.actuators import read_actuators
 from modelkit.formats.mjcf.bodies import MjBody, MjGeom
 from modelkit.formats.mjcf.build import Built, RobotBuilder, apply_joint_equalities, quoted
 from modelkit.formats.mjcf.compiled import CompiledModel, mesh_path
@@ -189,6 +190,7 @@ class _MjcfReader:
             "mjcf_world_sites": builder.sites(reader.world_sites(), 0),
         }
         self._tag_actuators(index, data["mjcf_actuators"])
+        self._canonical_actuators(reader, built, data["mjcf_actuators"])
         self._keep(reader, built, builder, bodies, data)
         if model.nflex:
             self.sink.emit(
@@ -231,6 +233,17 @@ class _MjcfReader:
                 "(kept as data)",
                 where.get(i, top),
             )
+
+    @staticmethod
+    def _canonical_actuators(reader: CompiledModel, built: Built, kept: list[dict[str, Any]]) -> None:
+        """The actuators the model can hold, on the robot of their joint's body (:mod:`.actuators`)."""
+        m = reader.m
+        for a, j, actuator in read_actuators(reader.mj, m, built.joints):
+            entry = kept[a] if a < len(kept) else {}
+            actuator.source_kind = entry.get("element", actuator.source_kind)
+            robot = built.robot_of_body.get(int(m.jnt_bodyid[j]))
+            if robot is not None:
+                robot.actuators.append(actuator)
 
     def _tag_actuators(self, index: SourceIndex, actuators: list[dict[str, Any]]) -> None:
         """Add the written element (``motor``, ``position``...) to each actuator when it is known."""

@@ -524,6 +524,14 @@ class _ModelWriter:
                     robot.source,
                     "model",
                 )
+        if robot.actuators and not robot.extras.get("transmissions"):
+            ctx.note(
+                "MK808",
+                f"{len(robot.actuators)} actuator(s) of the source: SDF has no actuator element (Gazebo "
+                "drives joints through plugins); not carried over",
+                robot.source,
+                "model",
+            )
         world = robot.extras.get("sdf_world")
         if isinstance(world, dict) and (world.get("lights") or world.get("plugins")):
             ctx.note(

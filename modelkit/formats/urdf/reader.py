@@ -19,6 +19,7 @@ from lxml.etree import _Element as Element
 from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation, did_you_mean, sorted_diagnostics
 from modelkit.formats.common import ReadOptions, ReadResult
 from modelkit.formats.meshref import MeshChecker
+from modelkit.formats.urdf.actuators import read_actuators
 from modelkit.formats.urdf.extensions import canonical_xml, read_gazebo, read_transmission
 from modelkit.formats.urdf.joints import read_joint
 from modelkit.formats.urdf.links import Materials, read_link
@@ -205,6 +206,7 @@ def _extensions(ctx: Context, root: Element, robot: Robot) -> None:
         ]
         if blocks:
             robot.extras[key] = blocks
+    read_actuators(ctx, root, robot)
 
 
 def _newer_features(ctx: Context) -> None:

@@ -20,6 +20,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.numbers import fmt
 from modelkit.diagnostics import SourceLocation
+from modelkit.formats.urdf.write_actuators import write_transmissions
 from modelkit.formats.urdf.write_names import NameTable
 from modelkit.model import Device, DeviceKind, Link, Robot
 
@@ -145,6 +146,7 @@ def write_extensions(robot_el: Element, robot: Robot, names: NameTable, ctx: Wri
         written_ref = names.link(reference) if reference in names.link_map else reference
         _kept_blocks(robot_el, [entry], written_ref, ctx, "the robot")
     _transmissions(robot_el, robot, names, ctx)
+    write_transmissions(robot_el, robot, names.joint_map, ctx)
     for key in ("ros2_control", "mujoco", "sensor"):
         for entry in robot.extras.get(key, []) or []:
             block = parse_block(entry.get("xml", "")) if isinstance(entry, dict) else None

@@ -289,6 +289,11 @@ def _notes(robot: Robot, ctx: WriteContext) -> None:
             value = [v for v in value if (v.get("link"), v.get("name")) not in on_links]
         if key in SILENT_EXTRAS or not value:
             continue
+        if key == "mjcf_actuators" and isinstance(value, list):
+            # the canonical ones are written as transmissions: only the others are left out
+            value = value[len(robot.actuators):] if len(value) > len(robot.actuators) else []
+            if not value:
+                continue
         code, what = DROPPED_EXTRAS.get(key, ("MK808", f"extension data {key}"))
         count = f"{len(value)} " if isinstance(value, list) else ""
         ctx.note(code, f"{count}{what}: URDF has no equivalent; left out", robot.source, "robot")

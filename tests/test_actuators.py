@@ -1,0 +1,316 @@
+"""Actuators (issue 17 item 2): read from each format into ``Robot.actuators``, written to MJCF, and
+held under MuJoCo.
+
+The hold test is the acceptance check: an arm converted to MJCF with position actuators, reset to its
+``home`` keyframe (which carries ``ctrl`` = the home positions), stays within 1 mm at every body
+(the end effector included) for 2 s of MuJoCo; the actuator count equals the joints the source actuates.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+from modelkit.api import load
+from modelkit.convert.api import write
+from modelkit.convert.options import WriteOptions
+from modelkit.formats.common import ReadOptions
+from modelkit.model import ActuatorKind, Robot
+from tests.conftest import CORPUS, PENDULUM_BODY, example_robot_data
+
+mujoco = pytest.importorskip("mujoco")
+np = pytest.importorskip("numpy")
+
+HOLD_SECONDS = 2.0
+HOLD_TOLERANCE = 1e-3  # m, at every body
+
+
+def hold_error(path: Path) -> tuple[int, float]:
+    """(actuator count, the largest distance in m any body moves from its home position in 2 s)."""
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home")
+    assert key >= 0, "no home keyframe"
+    mujoco.mj_resetDataKeyframe(m, d, key)
+    mujoco.mj_forward(m, d)
+    start = d.xpos.copy()
+    worst = 0.0
+    for _ in range(round(HOLD_SECONDS / m.opt.timestep)):
+        mujoco.mj_step(m, d)
+        worst = max(worst, float(np.linalg.norm(d.xpos - start, axis=1).max()))
+    return int(m.nu), worst
+
+
+def convert(robot: Robot, folder: Path, actuators: str = "motor") -> tuple[Path, list]:
+    out = folder / f"{robot.name or 'model'}.xml"
+    notes = write(robot, out, options=WriteOptions(actuators=actuators), force=True)
+    return out, notes
+
+
+def actuator_elements(path: Path) -> list[ET.Element]:
+    section = ET.parse(path).getroot().find("actuator")
+    return [] if section is None else list(section)
+
+
+def srdf_pose(srdf: Path, state: str) -> dict[str, float]:
+    root = ET.parse(srdf).getroot()
+    for group in root.iter("group_state"):
+        if group.get("name") == state:
+            return {j.get("name", ""): float(j.get("value", "0")) for j in group.iter("joint")}
+    raise AssertionError(f"no group_state {state} in {srdf}")
+
+
+def robots_dir() -> Path:
+    found = example_robot_data()
+    if found is None:
+        pytest.skip("example-robot-data is not installed")
+    return found
+
+
+# -- reading -------------------------------------------------------------------------------------
+
+MJCF = """<mujoco model="four">
+  <worldbody><body name="b"><joint name="j1" axis="0 0 1" range="-1 1"/><geom size=".1" mass="1"/>
+  <body name="c" pos="0 0 .3"><joint name="j2" axis="0 1 0"/><geom size=".1" mass="1"/>
+  <body name="d" pos="0 0 .3"><joint name="j3" axis="0 1 0"/><geom size=".1" mass="1"/>
+  <body name="e" pos="0 0 .3"><joint name="j4" axis="0 1 0"/><geom size=".1" mass="1"/>
+  <body name="f" pos="0 0 .3"><joint name="j5" axis="0 1 0"/><geom size=".1" mass="1"/>
+  </body></body></body></body></body></worldbody>
+  <actuator>
+    <position name="p" joint="j1" kp="100" kv="5" ctrlrange="-1 1" forcerange="-20 20"/>
+    <velocity joint="j2" kv="3"/>
+    <motor joint="j3" gear="2" ctrlrange="-1 1"/>
+    <general joint="j4" gainprm="50" biastype="affine" biasprm="0 -50 -4"/>
+    <intvelocity joint="j5" kp="10" actrange="-1 1"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def test_mjcf_actuators_are_read_by_what_they_compute(tmp_path: Path) -> None:
+    path = tmp_path / "four.xml"
+    path.write_text(MJCF)
+    robot = load(path)
+    got = {a.joint: a for a in robot.actuators}
+    assert set(got) == {"j1", "j2", "j3", "j4"}  # intvelocity has activation dynamics: not canonical
+    p, v, motor, general = got["j1"], got["j2"], got["j3"], got["j4"]
+    assert (p.kind, p.kp, p.kv, p.ctrl_range, p.force_range, p.name) == (
+        ActuatorKind.POSITION, 100.0, 5.0, (-1.0, 1.0), (-20.0, 20.0), "p")
+    assert (v.kind, v.kv) == (ActuatorKind.VELOCITY, 3.0)
+    assert (motor.kind, motor.gear, motor.ctrl_range) == (ActuatorKind.EFFORT, 2.0, (-1.0, 1.0))
+    assert (general.kind, general.kp, general.kv, general.source_kind) == (ActuatorKind.POSITION, 50.0, 4.0,
+                                                                          "general")
+
+
+def test_mjcf_actuators_survive_a_round_trip(tmp_path: Path) -> None:
+    path = tmp_path / "four.xml"
+    path.write_text(MJCF)
+    out, notes = convert(load(path), tmp_path / "out")
+    again = {a.joint: a for a in load(out).actuators}
+    assert {j: (a.kind, a.kp, a.kv, a.gear) for j, a in again.items()} == {
+        "j1": (ActuatorKind.POSITION, 100.0, 5.0, 1.0),
+        "j2": (ActuatorKind.VELOCITY, None, 3.0, 1.0),
+        "j3": (ActuatorKind.EFFORT, None, None, 2.0),
+        "j4": (ActuatorKind.POSITION, 50.0, 4.0, 1.0),
+    }
+    assert again["j1"].force_range == (-20.0, 20.0)
+    assert not [n for n in notes if n.code == "MK840"]  # every gain came from the source
+    (left,) = [n for n in notes if n.code == "MK842"]
+    assert left.message.startswith("1 MJCF actuator(s)")  # the intvelocity
+
+
+URDF = """<robot name="two">
+  <link name="base"/>
+  <link name="a">INERTIAL</link>
+  <link name="b">INERTIAL</link>
+  <link name="c">INERTIAL</link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="a"/><child link="b"/><origin xyz="0 0 0.3"/>
+    <axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+  <joint name="j3" type="revolute"><parent link="b"/><child link="c"/><origin xyz="0 0 0.3"/>
+    <axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+  <transmission name="t1"><type>transmission_interface/SimpleTransmission</type>
+    <joint name="j1">
+      <hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface></joint>
+    <actuator name="m1"><mechanicalReduction>50</mechanicalReduction></actuator></transmission>
+  <transmission name="t2" type="pr2_mechanism_model/SimpleTransmission">
+    <joint name="j2"/>
+    <actuator name="m2"><hardwareInterface>VelocityJointInterface</hardwareInterface></actuator>
+  </transmission>
+  <ros2_control name="hw" type="system">
+    <joint name="j3"><command_interface name="position"><param name="min">-0.5</param>
+      <param name="max">0.5</param></command_interface><command_interface name="velocity"/>
+      <state_interface name="position"/></joint>
+  </ros2_control>
+</robot>
+"""
+
+
+INERTIAL = ('<inertial><mass value="1"/>'
+            '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>')
+URDF = URDF.replace("INERTIAL", INERTIAL)
+
+
+def test_urdf_transmissions_and_ros2_control_become_actuators(tmp_path: Path) -> None:
+    path = tmp_path / "two.urdf"
+    path.write_text(URDF)
+    got = {a.joint: a for a in load(path).actuators}
+    assert (got["j1"].kind, got["j1"].reduction, got["j1"].name) == (ActuatorKind.EFFORT, 50.0, "m1")
+    assert got["j2"].kind is ActuatorKind.VELOCITY  # the old PR2 form: the interface in <actuator>
+    assert (got["j3"].kind, got["j3"].ctrl_range) == (ActuatorKind.POSITION, (-0.5, 0.5))  # the first one
+    out, notes = convert(load(path), tmp_path / "out")
+    tags = {el.get("joint"): el.tag for el in actuator_elements(out)}
+    assert tags == {"j1": "motor", "j2": "velocity", "j3": "position"}
+    codes = sorted(n.code for n in notes if n.code.startswith("MK84"))
+    assert codes == ["MK840", "MK840", "MK843"]  # j2's kv and j3's kp/kv made up; j1's reduction folded
+
+
+def test_body_actuation_mode_becomes_an_actuator(tmp_path: Path) -> None:
+    extra = "    actuation_mode: joint_displacement\n    rotor_inertia: 1.0e-4\n    gear_ratio: 100\n"
+    text = PENDULUM_BODY.replace("    joint_id: 0\n", "    joint_id: 0\n" + extra)
+    path = tmp_path / "pendulum.body"
+    path.write_text(text)
+    robot = load(path)
+    (actuator,) = robot.actuators
+    assert (actuator.joint, actuator.kind, actuator.reduction, actuator.rotor_inertia) == (
+        "ARM", ActuatorKind.POSITION, 100.0, 1.0e-4)
+    assert robot.joints[0].armature == pytest.approx(1.0)  # 100² · 1e-4: the reflected rotor inertia
+    out, _ = convert(robot, tmp_path / "out")
+    assert [el.tag for el in actuator_elements(out)] == ["position"]
+
+
+# -- the --actuators choice where the source has none ------------------------------------------
+
+
+@pytest.mark.parametrize(("choice", "tags"), [("motor", ["motor"]), ("velocity", ["velocity"]),
+                                              ("position", ["position"]), ("none", [])])
+def test_actuators_option_decides_for_a_source_without_any(tmp_path: Path, choice: str,
+                                                           tags: list[str]) -> None:
+    path = tmp_path / "pendulum.body"
+    path.write_text(PENDULUM_BODY)
+    robot = load(path)
+    assert robot.actuators == []
+    out, notes = convert(robot, tmp_path / "out", choice)
+    assert [el.tag for el in actuator_elements(out)] == tags
+    assert [n.code for n in notes if n.code == "MK841"] == ["MK841"]
+    assert len([n for n in notes if n.code == "MK840"]) == (1 if choice in ("position", "velocity") else 0)
+    m = mujoco.MjModel.from_xml_path(str(out))
+    assert m.nu == len(tags)
+
+
+def test_made_up_gains_follow_the_rule(tmp_path: Path) -> None:
+    """The pendulum's arm: 1 kg, COM 0.5 m from the axis, Ixx 0.0835417 → I = 0.3335417 kg·m² about the
+    joint; kp = I (2π·30)², kv = 2 I (2π·30)."""
+    path = tmp_path / "pendulum.body"
+    path.write_text(PENDULUM_BODY)
+    out, _ = convert(load(path), tmp_path / "out", "position")
+    (el,) = actuator_elements(out)
+    wn = 2 * np.pi * 30.0
+    inertia = 0.0835417 + 1.0 * 0.5**2
+    assert float(el.get("kp")) == pytest.approx(inertia * wn**2, rel=1e-9)
+    assert float(el.get("kv")) == pytest.approx(2 * inertia * wn, rel=1e-9)
+    m = mujoco.MjModel.from_xml_path(str(out))
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    assert m.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    # MuJoCo's own mass matrix at home agrees with the reflected inertia the rule used
+    full = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, full)
+    assert full[0, 0] == pytest.approx(inertia, rel=1e-6)
+
+
+# -- holding a home pose (the acceptance check) --------------------------------------------------
+
+
+def test_ur5_holds_home_under_its_own_position_actuators(tmp_path: Path) -> None:
+    """UR5 (example-robot-data) names a PositionJointInterface transmission on each of its 6 joints; its
+    home is q = 0, the arm stretched out horizontally (the most gravity torque it meets)."""
+    robot = load(robots_dir() / "ur_description" / "urdf" / "ur5_robot.urdf")
+    assert [a.kind for a in robot.actuators] == [ActuatorKind.POSITION] * 6
+    out, _ = convert(robot, tmp_path)  # the default option: the source's own actuators decide
+    count, error = hold_error(out)
+    assert count == 6
+    assert [el.tag for el in actuator_elements(out)] == ["position"] * 6
+    assert error < HOLD_TOLERANCE, f"UR5 moved {error * 1e3:.3f} mm"
+
+
+def test_panda_holds_its_reference_pose(tmp_path: Path) -> None:
+    """Panda (example-robot-data) has no transmissions: ``--actuators position`` gives one servo per
+    actuated joint (7 arm joints and finger 1; finger 2 mimics it); home = the SRDF's ``default`` state."""
+    robots = robots_dir()
+    robot = load(robots / "panda_description" / "urdf" / "panda.urdf")
+    pose = srdf_pose(robots / "panda_description" / "srdf" / "panda.srdf", "default")
+    by_name = {j.name: j for j in robot.joints}
+    for joint in robot.joints:
+        joint.initial_position = pose.get(joint.name, joint.initial_position)
+    for joint in robot.joints:  # the SRDF gives finger 1 only: finger 2 where its mimic equality puts it
+        if joint.mimic is not None:
+            leader = by_name[joint.mimic.joint].initial_position
+            joint.initial_position = joint.mimic.multiplier * leader + joint.mimic.offset
+    out, _ = convert(robot, tmp_path, "position")
+    count, error = hold_error(out)
+    actuated = [j for j in robot.joints if j.type.moves and j.mimic is None]
+    assert count == len(actuated) == 8
+    assert error < HOLD_TOLERANCE, f"Panda moved {error * 1e3:.3f} mm"
+
+
+def test_fr3_holds_the_pose_its_ros2_control_starts_in(tmp_path: Path) -> None:
+    """Franka FR3 (corpus, xacro with ``ros2_control:=true``): its ros2_control names position, velocity
+    and effort command interfaces on the 7 arm joints (position first: position servos) and the start
+    pose as each joint's ``initial_value``; the hand's fingers are not actuated by it."""
+    path = CORPUS / "franka_description" / "robots" / "fr3" / "fr3.urdf.xacro"
+    if not path.is_file():
+        pytest.skip("shared corpus not available")
+    robot = load(path, ReadOptions(xacro_args={"ros2_control": "true", "use_fake_hardware": "true"}))
+    assert [a.joint for a in robot.actuators] == [f"fr3_joint{i}" for i in range(1, 8)]
+    assert {a.kind for a in robot.actuators} == {ActuatorKind.POSITION}
+    joint4 = next(j for j in robot.joints if j.name == "fr3_joint4")
+    assert joint4.initial_position == pytest.approx(-3 * np.pi / 4)
+    out, _ = convert(robot, tmp_path)
+    count, error = hold_error(out)
+    assert count == 7
+    assert error < HOLD_TOLERANCE, f"FR3 moved {error * 1e3:.3f} mm"
+
+
+def test_pa10_holds_home(tmp_path: Path) -> None:
+    """Choreonoid's PA10 (corpus): no actuation mode, so ``--actuators position``; rotor inertias are in
+    the joints' armature, which the gain rule adds to the reflected inertia. Its zero pose stands
+    upright (no gravity torque, nothing to hold), so home is bent: J2 30°, J4 60°, J6 30°."""
+    path = CORPUS / "choreonoid" / "share" / "model" / "PA10" / "PA10.body"
+    if not path.is_file():
+        pytest.skip("shared corpus not available")
+    robot = load(path)
+    bent = {"J2": np.pi / 6, "J4": np.pi / 3, "J6": np.pi / 6}
+    for joint in robot.joints:
+        joint.initial_position = bent.get(joint.name, joint.initial_position)
+    out, _ = convert(robot, tmp_path, "position")
+    count, error = hold_error(out)
+    moving = [j for j in robot.joints if j.type.moves and j.mimic is None]
+    assert count == len(moving)
+    assert error < HOLD_TOLERANCE, f"PA10 moved {error * 1e3:.3f} mm"
+
+
+# -- other targets -----------------------------------------------------------------------------
+
+
+def test_mjcf_actuators_reach_urdf_and_body_as_their_kinds(tmp_path: Path) -> None:
+    """MJCF → URDF writes one ``<transmission>`` per canonical actuator (MK844 lists the gains it cannot
+    hold) and MJCF → .body an ``actuation_mode``; both read back as the same kinds."""
+    path = tmp_path / "four.xml"
+    path.write_text(MJCF)
+    robot = load(path)
+    kinds = {a.joint: a.kind for a in robot.actuators}
+    urdf = tmp_path / "urdf" / "four.urdf"
+    notes = write(robot, urdf, force=True)
+    assert {a.joint: a.kind for a in load(urdf).actuators} == kinds
+    (lost,) = [n for n in notes if n.code == "MK844"]
+    assert "j1 (kp 100, kv 5" in lost.message
+    assert "1 MJCF actuators" in " ".join(n.message for n in notes if n.code == "MK808")  # the intvelocity
+    body = tmp_path / "body" / "four.body"
+    write(robot, body, force=True)
+    assert {a.joint: a.kind for a in load(body).actuators} == kinds
