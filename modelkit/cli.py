@@ -394,9 +394,12 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
     for chunks in reports:  # streamed: a deep chain's report is far larger than the model
         for text in chunks:
             click.echo(text, nl=False)
-    errors = len(result.errors)
-    if errors:
-        click.echo(f"note: {file} has {errors} other error(s); run `modelkit validate {file}`", err=True)
+    if result.errors:  # printed as far as it could be built, but the file is not valid: exit 1
+        for d in result.errors:
+            click.echo(render_text(d), err=True)
+        click.echo(f"ERROR: {file} has {len(result.errors)} error(s); the tree above is what could be built",
+                   err=True)
+        sys.exit(1)
 
 
 @main.command()

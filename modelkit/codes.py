@@ -45,6 +45,21 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "A YAML list has more items than the limit (`--max-list-items`); the document is refused.",
     ),
+    CodeInfo(
+        "MK007",
+        "mjcf-size-too-large",
+        "error",
+        "An MJCF `<size>` count (`nkey`, `nuserdata`, `nuser_*`) is over modelkit's cap; refused before "
+        "MuJoCo compiles (MuJoCo would build or allocate every one).",
+    ),
+    CodeInfo(
+        "MK008",
+        "xacro-include-work",
+        "error",
+        "xacro includes processed for one file (each inclusion of the same file counted) pass 10,000, or the "
+        "expanded document passes `--max-bytes` of text: an include diamond; refused where the next "
+        "include stands.",
+    ),
     CodeInfo("MK010", "yaml-syntax", "error", "The YAML is malformed."),
     CodeInfo(
         "MK011",
