@@ -123,3 +123,51 @@ def test_tree_exits_1_with_the_codes_when_the_file_has_errors(
     assert printed.exit_code == 1 and code in printed.stderr, printed.output
     status, _ = validate_json(model, seconds=10)
     assert status == 1
+
+
+# ---- a resource that is not what it claims: the problem and the path, never its content ----------
+
+RESOURCE = "  - name: base\n    elements:\n      - type: Resource\n        "
+SECRET = "root:x:0:0:SECRET-CONTENT:/root:/bin/bash\nsecond { line [ SECRET-TWO\n"
+
+
+@pytest.mark.parametrize("how", ["symlink_out", "copy_without_header"])
+@pytest.mark.parametrize("uri", ["x.wrl", "x.stl", "x.obj", "x.dae"])
+def test_body_resource_content_is_never_quoted(tmp_path: Path, how: str, uri: str) -> None:
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "passwd").write_text(SECRET)
+    folder = tmp_path / "model"
+    folder.mkdir()
+    if how == "symlink_out":
+        (folder / uri).symlink_to(outside / "passwd")
+    else:
+        (folder / uri).write_text(SECRET)
+    model = folder / "m.body"
+    model.write_text(BODY_HEAD + RESOURCE + f"uri: {uri}\n")
+    found = assert_refused(model, {"MK501"}, tree=False, seconds=10)
+    error = next(d for d in found if d["code"] == "MK501")
+    assert error["line"] == 8, error
+    if how == "symlink_out":
+        message = str(error["message"])
+        assert "symbolic link out of its folder" in message and "passwd" in message
+    outputs = [run("validate", str(model)).output, run("tree", str(model)).output]
+    converted = tmp_path / "out.urdf"
+    outputs.append(run("convert", str(model), "-o", str(converted), seconds=20).output)
+    for output in outputs:
+        assert "SECRET" not in output and "root:x" not in output, output
+
+
+def test_a_vrml_resource_linked_from_outside_still_loads(tmp_path: Path) -> None:
+    outside = tmp_path / "shared"
+    outside.mkdir()
+    (outside / "box.wrl").write_text(
+        "#VRML V2.0 utf8\nShape { geometry Box { size 1 1 1 } }\n"
+    )
+    folder = tmp_path / "model"
+    folder.mkdir()
+    (folder / "box.wrl").symlink_to(outside / "box.wrl")
+    model = folder / "m.body"
+    model.write_text(BODY_HEAD + RESOURCE + "uri: box.wrl\n")
+    status, found = validate_json(model, seconds=10)
+    assert status == 0 and not [d for d in found if d["severity"] == "error"], found
