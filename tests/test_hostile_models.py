@@ -171,3 +171,143 @@ def test_a_vrml_resource_linked_from_outside_still_loads(tmp_path: Path) -> None
     model.write_text(BODY_HEAD + RESOURCE + "uri: box.wrl\n")
     status, found = validate_json(model, seconds=10)
     assert status == 0 and not [d for d in found if d["severity"] == "error"], found
+
+
+# ---- xacro: an include diamond and a power tower -------------------------------------------------
+
+XACRO_NS = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+
+
+def test_xacro_include_diamond_is_bounded(tmp_path: Path) -> None:
+    """Each of 30 files includes the next one twice: 2^30 inclusions of files read once each."""
+    levels = 30
+    for i in range(levels - 1):
+        include = f'<xacro:include filename="l{i + 1}.xacro"/>'
+        (tmp_path / f"l{i}.xacro").write_text(f"<robot {XACRO_NS}>\n  {include}\n  {include}\n</robot>\n")
+    (tmp_path / f"l{levels - 1}.xacro").write_text(f'<robot {XACRO_NS}><link name="x"/></robot>\n')
+    model = tmp_path / "top.xacro"
+    model.write_text(f'<robot name="r" {XACRO_NS}>\n  <xacro:include filename="l0.xacro"/>\n</robot>\n')
+    found = assert_refused(model, {"MK008"}, seconds=10)
+    error = next(d for d in found if d["code"] == "MK008")
+    assert str(error["file"]).endswith(".xacro") and error["line"] == 2, error
+
+
+def test_xacro_includes_of_a_real_robot_size_pass(tmp_path: Path) -> None:
+    """Twenty parts each included by a macro file used twice: 40 inclusions, far below the bound."""
+    for i in range(20):
+        (tmp_path / f"p{i}.xacro").write_text(f'<robot {XACRO_NS}><link name="p{i}_${{side}}"/></robot>\n')
+    parts = "".join(f'<xacro:include filename="p{i}.xacro"/>' for i in range(20))
+    (tmp_path / "arm.xacro").write_text(
+        f'<robot {XACRO_NS}><xacro:macro name="arm" params="side">{parts}</xacro:macro></robot>\n'
+    )
+    model = tmp_path / "top.xacro"
+    model.write_text(
+        f'<robot name="r" {XACRO_NS}><xacro:include filename="arm.xacro"/><link name="base"/>'
+        '<xacro:arm side="l"/><xacro:arm side="r"/></robot>\n'
+    )
+    _, found = validate_json(model, seconds=20)
+    assert not [d for d in found if d["code"] == "MK008"], found
+
+
+def test_xacro_power_tower_is_bounded(tmp_path: Path) -> None:
+    model = tmp_path / "tower.xacro"
+    model.write_text(f'<robot name="r" {XACRO_NS}>\n  <link name="${{9**9**9**9}}"/>\n</robot>\n')
+    found = assert_refused(model, {"MK709"}, seconds=10)
+    assert next(d for d in found if d["code"] == "MK709")["line"] == 2
+
+
+# ---- SDF: a deep chain of frames, an element with 100,000 attributes, an empty mass --------------
+
+
+def _frame_chain(path: Path, n: int) -> None:
+    pose = "<pose>0 0 0.001 0 0 0</pose>"
+    frames = "".join(
+        f'<frame name="f{i}" attached_to="{"a" if i == 0 else f"f{i - 1}"}">{pose}</frame>' for i in range(n)
+    )
+    path.write_text(f'<sdf version="1.9"><model name="m"><link name="a"/>{frames}</model></sdf>')
+
+
+def test_sdf_frame_chain_is_resolved_in_linear_time(tmp_path: Path) -> None:
+    """Each frame's link was found by walking the whole chain again: 5,000 frames never finished."""
+    import time
+
+    from modelkit.api import validate
+
+    times = []
+    for n in (2500, 10000):
+        model = tmp_path / f"frames{n}.sdf"
+        _frame_chain(model, n)
+        start = time.perf_counter()
+        with_codes = validate(model)
+        times.append(time.perf_counter() - start)
+        assert not with_codes.errors, with_codes.errors[:3]
+    assert times[1] < 8 * times[0] + 0.5, times  # 4× the frames: about 4× the time, never 16×
+    model = tmp_path / "frames5000.sdf"
+    _frame_chain(model, 5000)
+    assert run("tree", str(model), seconds=10).exit_code == 0
+
+
+@pytest.mark.parametrize("suffix", [".sdf", ".urdf", ".xml", ".xacro"])
+def test_an_element_with_100000_attributes_is_refused_unread(tmp_path: Path, suffix: str) -> None:
+    attributes = " ".join(f'a{i}="1"' for i in range(100_000))
+    root = {".sdf": '<sdf version="1.9"><model name="m">', ".urdf": '<robot name="r">',
+            ".xml": '<mujoco model="m"><worldbody>',
+            ".xacro": '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'}[suffix]
+    end = {".sdf": "</model></sdf>", ".xml": "</worldbody></mujoco>"}.get(suffix, "</robot>")
+    tag = {".xml": "body"}.get(suffix, "link")
+    model = tmp_path / f"m{suffix}"
+    model.write_text(f'{root}\n<{tag} name="a" {attributes}/>\n{end}\n')
+    found = assert_refused(model, {"MK024"}, seconds=10)
+    assert next(d for d in found if d["code"] == "MK024")["line"] == 2
+
+
+def test_sdf_element_with_a_few_unknown_attributes_is_still_read(tmp_path: Path) -> None:
+    attributes = " ".join(f'a{i}="1"' for i in range(999))  # with its name: 1,000, the most allowed
+    model = tmp_path / "m.sdf"
+    model.write_text(f'<sdf version="1.9"><model name="m"><link name="a" {attributes}/></model></sdf>')
+    status, found = validate_json(model, seconds=10)
+    assert status == 0 and sum(d["code"] == "MK123" for d in found) == 999
+
+
+@pytest.mark.parametrize("element", ["<mass></mass>", "<mass/>", "<mass>  </mass>"])
+def test_sdf_empty_mass_is_a_located_warning(tmp_path: Path, element: str) -> None:
+    model = tmp_path / "m.sdf"
+    model.write_text(
+        '<sdf version="1.9">\n<model name="m">\n<link name="a">\n<inertial>\n'
+        f"{element}<inertia><ixx>1</ixx><iyy>1</iyy><izz>1</izz></inertia>\n</inertial>\n</link>\n</model>\n</sdf>\n"
+    )
+    status, found = validate_json(model, seconds=10)
+    empty = [d for d in found if d["code"] == "MK025"]
+    assert [(d["line"], d["severity"]) for d in empty] == [(5, "warning")], found
+    assert "1 kg" in str(empty[0]["message"]) and status == 0
+    assert run("validate", "--strict", str(model)).exit_code == 1
+
+
+# ---- a 50 MB XML file: under --max-bytes, so read; one huge value is the parser's limit -----------
+
+
+@pytest.mark.parametrize(
+    "where",
+    ["text", "attribute", "comment", "whitespace"],
+)
+def test_a_50_mb_urdf_with_one_huge_value_gets_its_own_code(tmp_path: Path, where: str) -> None:
+    big = "x" * (50 * 1024 * 1024) if where != "whitespace" else " " * (50 * 1024 * 1024)
+    body = {
+        "text": f'<link name="a">{big}</link>',
+        "attribute": f'<link name="{big}"/>',
+        "comment": f'<!-- {big} --><link name="a"/>',
+        "whitespace": f'<link name="a"/>{big}',
+    }[where]
+    model = tmp_path / "big.urdf"
+    model.write_text(f'<robot name="r">\n{body}\n</robot>\n')
+    found = assert_refused(model, {"MK026"}, seconds=10)
+    error = next(d for d in found if d["code"] == "MK026")
+    assert error["line"] == 2 and int(error["column"]) > 10_000_000, error  # type: ignore[call-overload]
+
+
+def test_a_urdf_over_max_bytes_is_mk002_and_exit_2(tmp_path: Path) -> None:
+    model = tmp_path / "huge.urdf"
+    model.write_text('<robot name="r"><link name="a"/>' + " " * (65 * 1024 * 1024) + "</robot>")
+    status, found = validate_json(model, seconds=10)
+    assert status == 2 and [d["code"] for d in found] == ["MK002"], found
+    assert run("tree", str(model), seconds=10).exit_code == 2
