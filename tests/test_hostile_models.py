@@ -189,7 +189,8 @@ def test_xacro_include_diamond_is_bounded(tmp_path: Path) -> None:
     model.write_text(f'<robot name="r" {XACRO_NS}>\n  <xacro:include filename="l0.xacro"/>\n</robot>\n')
     found = assert_refused(model, {"MK008"}, seconds=10)
     error = next(d for d in found if d["code"] == "MK008")
-    assert str(error["file"]).endswith(".xacro") and error["line"] == 2, error
+    # located at the include that passed the bound: one of the two include lines of a level's file
+    assert str(error["file"]).endswith(".xacro") and error["line"] in (2, 3), error
 
 
 def test_xacro_includes_of_a_real_robot_size_pass(tmp_path: Path) -> None:
