@@ -87,6 +87,18 @@ def test_body_yaml_nan_spellings_are_refused_too(tmp_path: Path) -> None:
     assert status == 1 and [d["line"] for d in found if d["code"] == "MK100"] == [6, 7], found
 
 
+def test_body_infinite_joint_limits_mean_unlimited_but_nan_does_not(tmp_path: Path) -> None:
+    arm = "  - name: arm\n    parent: base\n    jointType: revolute\n    jointAxis: Z\n"
+    model = tmp_path / "limits.body"
+    limits = "    jointRange: [-inf, inf]\n    maxJointVelocity: inf\n"
+    model.write_text(BODY_HEAD + "  - name: base\n" + arm + limits)
+    _, found = validate_json(model, seconds=10)
+    assert not [d for d in found if d["code"] == "MK100"], found
+    model.write_text(BODY_HEAD + "  - name: base\n" + arm + "    jointRange: [nan, 1]\n")
+    status, found = validate_json(model, seconds=10)
+    assert status == 1 and [d["line"] for d in found if d["code"] == "MK100"] == [10], found
+
+
 def test_body_a_link_may_be_called_nan(tmp_path: Path) -> None:
     model = tmp_path / "named.body"
     model.write_text(BODY_HEAD + "  - name: nan\n    mass: 1\n  - name: inf\n    parent: nan\n")

@@ -2,8 +2,9 @@
 
 Choreonoid reads numbers with C's ``strtod``, which takes ``nan``, ``inf`` and ``1e400`` (infinity)
 as numbers, so the schema lets them through as numbers; a mass, pose, axis or size made of them is
-no model at all. YAML's own ``.nan``/``.inf`` are not numbers to ``strtod``: the schema reports
-those. Text values (names, parents, types, file names) are not numbers and are left alone.
+no model at all. A joint limit may be infinite (it reads as ``unlimited``), never not-a-number.
+YAML's own ``.nan``/``.inf`` are not numbers to ``strtod``: the schema reports those. Text values
+(names, parents, types, file names) are not numbers and are left alone.
 """
 
 from __future__ import annotations
@@ -19,6 +20,12 @@ from modelkit.yamltree import YMap, YNode, YNumbers, YScalar, YSeq
 _TEXT_KEYS = frozenset(
     "name parent type jointType joint_type jointName joint_name uri file url format root_link rootLink "
     "link link1 link2 joint material texture sensor title description id".split()
+)
+
+# Limits where infinity means what ``unlimited`` means (Choreonoid's strtod reads it so): allowed there.
+_LIMIT_KEYS = frozenset(
+    "joint_range jointRange max_joint_velocity maxJointVelocity joint_velocity_range jointVelocityRange "
+    "max_joint_effort maxJointEffort".split()
 )
 
 
@@ -38,11 +45,11 @@ def _walk(root: YNode) -> Iterator[Diagnostic]:
         seen.add(id(node))
         if isinstance(node, YScalar):
             value = parse_float(node.value)
-            if value is not None and not math.isfinite(value) and key not in _TEXT_KEYS:
+            if value is not None and _refused(value, key):
                 found.append(_error(key, node.value, node))
         elif isinstance(node, YNumbers):
             for index, value in enumerate(node.values):
-                if not math.isfinite(value):
+                if _refused(value, key):
                     item = node.items[index]
                     found.append(_error(key, item.value if isinstance(item, YScalar) else "", item))
         elif isinstance(node, YSeq):
@@ -50,6 +57,12 @@ def _walk(root: YNode) -> Iterator[Diagnostic]:
         elif isinstance(node, YMap):
             stack.extend((value, name) for name, (_, value) in reversed(node.entries.items()))
     yield from sorted(found, key=lambda d: (d.location.line, d.location.col) if d.location else (0, 0))
+
+
+def _refused(value: float, key: str) -> bool:
+    if math.isfinite(value) or key in _TEXT_KEYS:
+        return False
+    return math.isnan(value) or key not in _LIMIT_KEYS
 
 
 def _error(key: str, text: str, node: YNode) -> Diagnostic:
