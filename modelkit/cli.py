@@ -394,9 +394,18 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
     for chunks in reports:  # streamed: a deep chain's report is far larger than the model
         for text in chunks:
             click.echo(text, nl=False)
-    errors = len(result.errors)
-    if errors:
-        click.echo(f"note: {file} has {errors} other error(s); run `modelkit validate {file}`", err=True)
+    # Printed as far as it could be built; an error in the model itself (a cycle, a second parent, a
+    # value that is not a number) still fails the command. Meshes and textures (MK5xx) are not the tree's.
+    faults = [d for d in result.errors if not d.code.startswith("MK5")]
+    if faults:
+        for d in faults:
+            click.echo(render_text(d), err=True)
+        click.echo(f"ERROR: {file} has {len(faults)} error(s); the tree above is what could be built",
+                   err=True)
+        sys.exit(1)
+    if result.errors:
+        click.echo(f"note: {file} has {len(result.errors)} resource error(s); run `modelkit validate {file}`",
+                   err=True)
 
 
 @main.command()

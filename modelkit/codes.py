@@ -45,6 +45,21 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "A YAML list has more items than the limit (`--max-list-items`); the document is refused.",
     ),
+    CodeInfo(
+        "MK007",
+        "mjcf-size-too-large",
+        "error",
+        "An MJCF `<size>` count (`nkey`, `nuserdata`, `nuser_*`) is over modelkit's cap; refused before "
+        "MuJoCo compiles (MuJoCo would build or allocate every one).",
+    ),
+    CodeInfo(
+        "MK008",
+        "xacro-include-work",
+        "error",
+        "xacro includes processed for one file (each inclusion of the same file counted) pass 2,000, or the "
+        "expanded document passes `--max-bytes` of text: an include diamond; refused where the next "
+        "include stands.",
+    ),
     CodeInfo("MK010", "yaml-syntax", "error", "The YAML is malformed."),
     CodeInfo(
         "MK011",
@@ -86,6 +101,26 @@ _TABLE: tuple[CodeInfo, ...] = (
         "xml-too-deep",
         "error",
         "XML elements nest deeper than 250 levels (modelkit's own limit, below lxml's 256); refused unread.",
+    ),
+    CodeInfo(
+        "MK024",
+        "xml-too-many-attributes",
+        "error",
+        "An XML element has more than 1,000 attributes (modelkit's own limit); the document is refused "
+        "unread.",
+    ),
+    CodeInfo(
+        "MK025",
+        "empty-mass-value",
+        "warning",
+        "An SDF `<mass>` is written empty; libsdformat silently takes its default, 1 kg.",
+    ),
+    CodeInfo(
+        "MK026",
+        "xml-value-too-long",
+        "error",
+        "One XML text, attribute value, name or comment is longer than 10,000,000 bytes (libxml2's limit, "
+        "below `--max-bytes`); the document is refused unread.",
     ),
     # -- MK1xx: schema and header ----------------------------------------------------------
     # MK100-MK119: .body schema and header; MK120-MK129: XML elements and attributes (all XML

@@ -82,6 +82,9 @@ class XmlDocument:
     origins: dict[Element, SourceLocation] = field(default_factory=dict)
     _starts: dict[Element, int] = field(default_factory=dict, repr=False)
     _line_offsets: array[int] = field(default_factory=lambda: array("q", [0]), repr=False)
+    # Offsets of each element's attributes, found on the first look-up of one (an element with 100,000
+    # attributes, each diagnosed, is scanned once, not once per attribute).
+    _attribute_offsets: dict[Element, dict[str, int]] = field(default_factory=dict, repr=False)
 
     def _position(self, offset: int) -> tuple[int, int]:
         line = bisect_right(self._line_offsets, offset)
@@ -109,12 +112,22 @@ class XmlDocument:
             line = element.sourceline if isinstance(element.sourceline, int) else 0
             return SourceLocation(self.display, line, 1 if line else 0)
         if attribute and element.get(attribute) is not None:
+            offset = self._attributes_of(element, start).get(attribute)
+            if offset is not None:
+                return SourceLocation(self.display, *self._position(offset))
+        return SourceLocation(self.display, *self._position(start))
+
+    def _attributes_of(self, element: Element, start: int) -> dict[str, int]:
+        """Where each attribute of the start tag at ``start`` is written (the first spelling)."""
+        offsets = self._attribute_offsets.get(element)
+        if offsets is None:
+            offsets = {}
             name = _START_TAG.match(self.text, start)
             end = tag_end(self.text, start)
             for match in _ATTRIBUTE.finditer(self.text, name.end() if name else start, end):
-                if match.group(1) == attribute:
-                    return SourceLocation(self.display, *self._position(match.start()))
-        return SourceLocation(self.display, *self._position(start))
+                offsets.setdefault(match.group(1), match.start())
+            self._attribute_offsets[element] = offsets
+        return offsets
 
     def text_loc(self, element: Element) -> SourceLocation:
         """Where the text content of ``element`` starts (just after its start tag), found when first read."""
@@ -244,6 +257,8 @@ def _index_positions(doc: XmlDocument) -> None:
 # Our own nesting limit, below libxml2's (256 without XML_PARSE_HUGE), so that it is always ours that
 # answers (MK023), whatever the lxml build; TinyXML2 (urdfdom, libsdformat, MuJoCo) stops at 500.
 MAX_XML_DEPTH = 250
+# Attributes on one element (real models: a few dozen; each unknown one is a diagnostic of its own).
+MAX_XML_ATTRIBUTES = 1000
 
 
 def parse_xml_bytes(
@@ -298,6 +313,15 @@ def parse_xml_bytes(
         if message.startswith("Excessive depth"):  # libxml2's own limit (256) behind ours
             _too_deep(sink, where)
             return None
+        if "XML_PARSE_HUGE" in message or message.startswith("Comment too big"):
+            sink.emit(
+                "MK026",
+                "one text, attribute value, name or comment is longer than 10,000,000 bytes (the XML "
+                "parser's limit); the document is refused unread",
+                where,
+                hint="no robot model holds one value this long: is the file generated wrongly?",
+            )
+            return None
         root = _as_tinyxml2_reads(data, parser, message, where, text, display, sink)
         if root is None:
             return None
@@ -309,6 +333,17 @@ def parse_xml_bytes(
         first = deep[0].sourceline
         at = SourceLocation(display, first, 1) if isinstance(first, int) else SourceLocation(display)
         _too_deep(sink, at)
+        return None
+    crowded = next((e for e in root.iter() if len(e.attrib) > MAX_XML_ATTRIBUTES), None)
+    if crowded is not None:
+        line = crowded.sourceline if isinstance(crowded.sourceline, int) else 0
+        sink.emit(
+            "MK024",
+            f"the element <{crowded.tag}> has {len(crowded.attrib):,} attributes, over the limit of "
+            f"{MAX_XML_ATTRIBUTES:,}; the document is refused unread",
+            SourceLocation(display, line, 1 if line else 0),
+            hint="no robot model element has more than a few dozen attributes",
+        )
         return None
     doc = XmlDocument(root=root, display=display, text=text, path=path)
     if positions:

@@ -499,6 +499,10 @@ def test_fuzz_corpus(tmp_path: Path) -> None:
     cases = make_cases(tmp_path / "cases")
     assert len(cases) >= 1000
     batches = [cases[0::2], cases[1::2]]
+    # The children import this checkout's modelkit, not whichever one the environment installed
+    # (an editable install may point at another worktree).
+    source = str(Path(__file__).resolve().parents[1])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [source, os.environ.get("PYTHONPATH")]))}
     children = [
         subprocess.Popen(
             [sys.executable, str(RUNNER), str(ADDRESS_SPACE), *map(str, batch)],
@@ -506,6 +510,7 @@ def test_fuzz_corpus(tmp_path: Path) -> None:
             stderr=subprocess.PIPE,
             text=True,
             cwd=tmp_path,
+            env=env,
         )
         for batch in batches
     ]

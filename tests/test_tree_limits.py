@@ -93,7 +93,7 @@ def test_ladder_report_is_check_urdfs(rungs: int, tmp_path: Path) -> None:
     urdf.write_text(ladder_urdf(rungs))
     expected = subprocess.run([check_urdf, str(urdf)], capture_output=True, check=True).stdout
     result = CliRunner().invoke(main, ["tree", str(urdf)])
-    assert result.exit_code == 0
+    assert result.exit_code == 1 and "MK220" in result.stderr  # printed, but two-parent links are errors
     assert result.stdout_bytes == expected
     assert len(expected.splitlines()) == 3 + 2 ** (rungs + 2) - 2
 

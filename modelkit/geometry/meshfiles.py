@@ -128,6 +128,43 @@ def load_mesh(
     if not data.strip():
         raise MeshLoadError("MK501", f"{path.name} is empty")
     try:
+        return _load_data(path, ext, data, fragment, metadata)
+    except MeshLoadError as e:
+        withheld = _withheld(path, ext, data)
+        if withheld is None or e.code != "MK501":
+            raise
+        raise MeshLoadError("MK501", withheld) from None
+
+
+def _withheld(path: Path, ext: str, data: bytes) -> str | None:
+    """The message that replaces a parser's own (which may quote the file) when the file is not one to
+    quote: reached through a symbolic link out of its folder (``x.wrl`` → ``/etc/passwd``), or a VRML
+    file without the ``#VRML`` header. None when the parser's message may be shown."""
+    try:
+        real = path.resolve(strict=True)
+        folder = path.absolute().parent.resolve(strict=True)
+    except (OSError, RuntimeError):
+        return None
+    if not real.is_relative_to(folder) and path.is_symlink():
+        return (f"{path.name} is a symbolic link out of its folder (to {real}) and cannot be loaded as a "
+                f"{ext[1:].upper()} mesh; nothing of its content is shown")
+    if ext == ".wrl" and not _VRML_START.match(data):
+        return (f"{path.name} is not a VRML file (no '#VRML' header and it does not begin with a node); "
+                "nothing of its content is shown")
+    return None
+
+
+# The start of a VRML file: its header, or (headerless) a first node "[DEF name] Type {" after comments.
+_VRML_START = re.compile(
+    rb"^(?:\xef\xbb\xbf)?\s*(?:#VRML|(?:#[^\n]*\n\s*)*(?:DEF\s+[^\s{}\[\]]+\s+)?[A-Za-z_][A-Za-z0-9_]*\s*\{)"
+)
+
+
+def _load_data(
+    path: Path, ext: str, data: bytes, fragment: str | None, metadata: MeshMetadata | None
+) -> LoadedMesh:
+    """:func:`load_mesh` once the bytes are read: :class:`MeshLoadError` for anything that fails."""
+    try:
         # overflow/invalid values in hostile files end up as non-finite vertices, reported below
         with np.errstate(all="ignore"):
             if ext == ".stl":

@@ -127,6 +127,20 @@ EXTRA: dict[str, list[tuple[str, str]]] = {
             '<link name="b"><pose relative_to="a"/></link></model></sdf>',
         ),
         (
+            "frame_chain",
+            '<sdf version="1.9"><model name="m"><link name="a"/>'
+            + "".join(f'<frame name="f{i}" attached_to="{f"f{i - 1}" if i else "a"}"/>' for i in range(5000))
+            + "</model></sdf>",
+        ),
+        (
+            "attributes",
+            '<sdf version="1.9"><model name="m"><link name="a" '
+            + " ".join(f'a{i}="1"' for i in range(100_000))
+            + "/></model></sdf>",
+        ),
+        ("empty_mass", '<sdf version="1.9"><model name="m"><link name="a"><inertial><mass></mass></inertial>'
+                       "</link></model></sdf>"),
+        (
             "include_self",
             '<sdf version="1.9"><world name="w"><include><uri>case.sdf</uri></include></world></sdf>',
         ),
@@ -140,6 +154,16 @@ EXTRA: dict[str, list[tuple[str, str]]] = {
         (
             "pow",
             '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="${9**9**9}"/></robot>',
+        ),
+        (
+            "power_tower",
+            '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+            '<link name="${9**9**9**9}"/></robot>',
+        ),
+        (
+            "include_twice_self",
+            '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+            '<xacro:include filename="case.xacro"/><xacro:include filename="case.xacro"/></robot>',
         ),
         (
             "passwd",
@@ -167,6 +191,9 @@ EXTRA: dict[str, list[tuple[str, str]]] = {
             '<mujoco><asset><hfield name="h" nrow="99999" ncol="99999" size="1 1 1 1"/></asset>'
             "<worldbody/></mujoco>",
         ),
+        ("size_nkey", '<mujoco><size nkey="100000000"/><worldbody><body><joint/><geom size="1"/></body>'
+                      "</worldbody></mujoco>"),
+        ("size_nuserdata", '<mujoco><size nuserdata="1000000000"/><worldbody/></mujoco>'),
     ],
     "body": [
         (
@@ -177,6 +204,11 @@ EXTRA: dict[str, list[tuple[str, str]]] = {
             "g: [*f, *f, *f, *f, *f, *f, *f, *f, *f]\n",
         ),
         ("recursive_alias", "a: &a [*a]\n"),
+        (
+            "nan_pose",
+            "format: ChoreonoidBody\nformat_version: 2.0\nname: r\nlinks:\n  - name: r\n"
+            "    translation: [nan, inf, -inf]\n    mass: 1e400\n    jointAxis: [NaN, 0, 1]\n",
+        ),
         (
             "cycle",
             "format: ChoreonoidBody\nformat_version: 2.0\nname: r\nlinks:\n  - name: r\n"

@@ -197,10 +197,12 @@ class _BodyReader:
             )
 
     def _check_schema(self, root: YMap) -> None:
+        from modelkit.formats.body.finite import non_finite
         from modelkit.formats.body.schema import check_schema
 
         try:
             self.sink.extend(check_schema(root, self.display))
+            self.sink.extend(non_finite(root))
         except RecursionError:
             self.sink.emit("MK104", "the document is nested too deeply to check against the schema", root.loc)
 

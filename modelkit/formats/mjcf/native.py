@@ -187,12 +187,18 @@ class NativeModel:
             columns = self._count(shape.columns)
             start = ctypes.c_void_p.from_address(self.address + self._offset(name)).value
             flat = (shape.element * (rows * columns)).from_address(start)[:] if rows * columns else []
-            if columns == 1:
+            if columns == 1 and not self._is_model_size(shape.columns):
                 value = tuple(flat)
             else:
                 value = tuple(tuple(flat[r * columns : (r + 1) * columns]) for r in range(rows))
         self.__dict__[name] = value
         return value
+
+    def _is_model_size(self, token: str) -> bool:
+        """True when ``token`` is a count of the model (``nq``...), not a fixed width: an ``nkey × nq``
+        array stays a tuple of rows even when this model's ``nq`` is 1."""
+        headers = self._headers
+        return not token.isdigit() and token not in headers.constants and token not in headers.enum_values
 
     def _offset(self, name: str) -> int:
         return int(getattr(self._headers.structs["mjModel"], name).offset)

@@ -26,7 +26,7 @@ from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.geometry import element_data, read_geometry, read_material
 from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import light_device, plugin_data, sensor_device
-from modelkit.formats.sdf.values import child, children
+from modelkit.formats.sdf.values import Values, child, children
 from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Inertial, Link, Sphere
 from modelkit.spatial import Mat3, Pose, Vec3
 
@@ -143,6 +143,19 @@ def _unique(
         seen[name] = values.loc(el).line
 
 
+def _empty_mass_value(values: Values, element: Element | None, default: str) -> None:
+    """An empty ``<mass>`` is read by libsdformat as its default, silently: said here (MK025), located,
+    since a mass nobody wrote changes every dynamic check. (An empty ``<ixx>`` is MK121: libsdformat
+    refuses it.)"""
+    if element is not None and not (element.text or "").strip():
+        values.sink.emit(
+            "MK025",
+            f"<{element.tag}> is empty: libsdformat takes its default, {default}",
+            values.text_loc(element),
+            hint=f"write the value, or leave out <{element.tag}> to mean the default",
+        )
+
+
 def _inertial(ctx: Context, graph: FrameGraph, item: Item, to_link: Pose, data: LinkData) -> Inertial:
     src = item.src
     values = src.values
@@ -151,6 +164,7 @@ def _inertial(ctx: Context, graph: FrameGraph, item: Item, to_link: Pose, data: 
         return Inertial(1.0, rot3.ZERO3, rot3.IDENTITY, defaulted=True, source=values.loc(item.element))
     inertial = Inertial(1.0, source=values.loc(el))
     mass_el = child(el, "mass")
+    _empty_mass_value(values, mass_el, "1 kg")
     mass = values.number(mass_el, 1.0)
     inertial.mass = 1.0 if mass is None else mass
     if mass_el is not None:

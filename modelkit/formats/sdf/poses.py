@@ -345,19 +345,24 @@ class FrameGraph:
         if name in self._link_of:
             return self._link_of[name]
         path: list[str] = []
+        on_path: set[str] = set()
         current: str | None = name
         result: str | None = None
         while current is not None:
+            if current in self._link_of:  # resolved before: a chain of frames is walked once in all
+                result = self._link_of[current]
+                break
             vertex = self.vertices.get(current)
             if vertex is None:
                 break
             if vertex.kind == "link":
                 result = current
                 break
-            if current in path:
+            if current in on_path:
                 self._report_attached_cycle(path[path.index(current) :])
                 break
             path.append(current)
+            on_path.add(current)
             nxt = vertex.attached_to
             if nxt is not None and nxt not in self.vertices and vertex.kind == "frame":
                 item = vertex.item

@@ -111,6 +111,11 @@ def legacy_diagnostic(construct: LegacyConstruct, mode: bool | None) -> Diagnost
     return diag("MK701", construct.message(), construct.origin.loc(), hint=hint, severity=severity)
 
 
+# Includes processed for one top file (each inclusion counted; real robots: a few dozen; each costs
+# about 0.5 ms, so the bound is about 1 s of work).
+MAX_INCLUDES = 2_000
+
+
 class _Run:
     """One expansion: what xacro's hooks share while it runs."""
 
@@ -128,6 +133,8 @@ class _Run:
         self.last_directive: minidom.Element | None = None
         self.xacro: Any = None
         self.sandbox = _sandbox(path, options)
+        self.parses = 0  # files parsed by xacro (the top file and every include processed)
+        self.parsed_bytes = 0
 
     # -- files ---------------------------------------------------------------------------------
 
@@ -169,6 +176,7 @@ class _Run:
             self.files.docs[key] = doc
             self.files.macro_names |= macro_names(doc)
             self.report_legacy(self.files.add_constructs(find_legacy(doc, self.files.macro_names)))
+        self._count_parse(filename, len(doc.text))
         try:
             dom = minidom.parseString(doc.text)
         except xml.parsers.expat.ExpatError as exc:
@@ -183,6 +191,24 @@ class _Run:
                 if element in self.files.legacy_elements:
                     node.tagName = node.nodeName = "xacro:" + node.tagName
         return dom
+
+    def _count_parse(self, filename: str, size: int) -> None:
+        """Bound the work of includes (MK008): a file included twice by each of 30 nested files is
+        parsed 2^30 times though each file is read once."""
+        self.parses += 1
+        self.parsed_bytes += size
+        limit = self.options.max_bytes
+        if self.parses - 1 > MAX_INCLUDES or self.parsed_bytes > limit:
+            what = (f"more than {MAX_INCLUDES:,} includes" if self.parses - 1 > MAX_INCLUDES
+                    else f"more than {limit:,} bytes of included text")
+            self.sink.emit(
+                "MK008",
+                f'including "{os.path.basename(filename)}" here would make {what} processed for this file '
+                "(the same file included over and over, e.g. a diamond of includes); expansion stopped",
+                self.here(),
+                hint="include each file once (xacro files are usually included once and their macros called)",
+            )
+            raise Reported()
 
     # -- hooks ---------------------------------------------------------------------------------
 
