@@ -751,7 +751,8 @@ class MujocoDriver:
             "law_actuators": dict(sorted(law_gain.items())),
             "velocity_servo": (f"MuJoCo velocity actuator kv {self.servo_kv:.4g} N·m·s/rad (m·r²/(n·dt)), "
                                "force within "
-                               f"±{self.servo_limit:.4g} N·m (½·m·g·μ·r / rollers), on every roller of a "
+                               f"±{self.servo_limit:.4g} N·m (SERVO_FRICTION_SHARE·m·g·μ·r / rollers), "
+                               "on every roller of a "
                                "track, all with roller 0's target (roller i > 0 also keeps the file's "
                                "mimic equality)") if servoed else "none",
             "file_actuators": "deleted", "start_height": self._start_height,

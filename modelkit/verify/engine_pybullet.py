@@ -513,7 +513,8 @@ class PyBulletDriver:
             "control": self._control_setting(fast),
             "velocity_servo": ("VELOCITY_CONTROL (a velocity constraint), max force "
                                f"{info['servo_limit']:.4g} "
-                               "N·m (½·m·g·μ·r / rollers, as MuJoCo's bound), on every roller of a track "
+                               "N·m (SERVO_FRICTION_SHARE·m·g·μ·r / rollers, as MuJoCo's bound), "
+                               "on every roller of a track "
                                "with "
                                "roller 0's target; the rollers of a track coupled by a JOINT_GEAR constraint "
                                "(ratio −1: equal speeds), the URDF's <mimic> that PyBullet ignores")

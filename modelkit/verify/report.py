@@ -121,7 +121,7 @@ def _fmt(x: float) -> str:
 
 
 COMPARISONS = frozenset({"path-position", "path-yaw", "wheel-angle", "pan-tilt-angle", "noslip-position",
-                         "noslip-yaw"})
+                         "noslip-yaw", "skid-position", "skid-yaw"})
 """Layer 4's comparison quantities: graded as checks, or reported as observations (then said so)."""
 
 
