@@ -88,19 +88,8 @@ def _id(path: Path) -> str:
     return path.name
 
 
-TRACKS_ROLLER_GAP = pytest.mark.xfail(
-    strict=True,
-    reason="open (issue 16 item 3, tracks): layer 4 now drives the written rollers; MuJoCo's roller 0 "
-    "takes a fixed 0.085 rad offset from the no-slip reference during the torque-limited spin-up (0-0.2 s; "
-    "PyBullet 0.004-0.009 rad), so mujoco~pybullet wheel-angle straight is 0.086 rad against 0.02 while the "
-    "paths agree (5.5 mm apart); cause not yet found (suspect: the file's impratio 0.03 lets the "
-    "saturated roller creep)",
-)
-
-
 def _models() -> list[object]:
-    return [pytest.param(m, marks=TRACKS_ROLLER_GAP) if m.name == "mobile_robot_tracks.body" else m
-            for m in MODELS]
+    return list(MODELS)
 
 
 def _require(what: str) -> None:

@@ -194,10 +194,11 @@ def test_bench_reports_harness_overhead(pantilt: Any, tmp_path: Path) -> None:
         assert figures[f"{engine}_realtime"] > 10  # measured ≈ 100× (MuJoCo), ≈ 55× (PyBullet)
 
 
-@pytest.mark.xfail(strict=True, reason="open (issue 16 item 3, tracks): the written cylinder rollers with "
-                   "MuJoCo's default contact end the 10 s straight at 4.969 m of 5.0 (bound 3 cm); the "
-                   "engines "
-                   "agree within 0.56 cm / 0.07 mrad")
+@pytest.mark.xfail(strict=True, reason="the wheeled robot's 1 cm pair bound does not hold for tracks since "
+                   "their servos impose the belt speed (bound 3 x the friction limit): the start is "
+                   "friction-limited, MuJoCo's soft friction lags, and the engines' straight paths are "
+                   "1.18 cm apart; layer 4 grades a tracked robot at the skid tolerance (1.5 cm on the "
+                   "straight) and passes, tests/test_verify_tracks.py")
 def test_tracked_robot_rollers_velocity_servoed(tmp_path: Path) -> None:
     """The tracked robot through convert's roller approximation (the written cylinder rollers),
     roller 0 of each track velocity-servoed by the seed's track controller, the other rollers given

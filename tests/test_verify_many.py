@@ -195,10 +195,6 @@ def test_progress_on_a_terminal_only_outside_ci(tmp_path: Path) -> None:
     assert "[1/2]" not in run("true")
 
 
-@pytest.mark.xfail(strict=True,
-                   reason="open (issue 16 item 3, tracks): verify of the tracked robot FAILs layer 4's "
-                   "mujoco~pybullet roller angle (0.086 rad against 0.02; see test_verify_acceptance's "
-                   "TRACKS_ROLLER_GAP), so the run exits 1 before the numbers are compared")
 def test_same_numbers_whatever_j_at_defaults(tmp_path: Path) -> None:
     """End to end at the defaults (every engine, the replay): -j 1 in-process, -j 2 in processes."""
     outs = {}

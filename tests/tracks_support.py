@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from modelkit.convert.tracks import PYBULLET_CONE_FRICTION
+from modelkit.convert.tracks import PYBULLET_CONE_FRICTION, PYBULLET_SOLVER_ITERATIONS
 
 REPO = Path(__file__).resolve().parents[1]
 TRACKS = REPO / "samples/choreonoid_ros2_mobile_robot_tutorial/model/mobile_robot_tracks.body"
@@ -195,9 +195,11 @@ def _mj_pose(data) -> tuple[float, float, float]:  # type: ignore[no-untyped-def
 
 
 def run_pybullet(urdf: Path, tracks: Tracks, profile: Profile,
-                 cone_friction: bool = bool(PYBULLET_CONE_FRICTION)) -> Path2D:
+                 cone_friction: bool = bool(PYBULLET_CONE_FRICTION),
+                 iterations: int | None = PYBULLET_SOLVER_ITERATIONS) -> Path2D:
     """``cone_friction``: Bullet's ``enableConeFriction``; by default what MK809 asks of a PyBullet
-    user for a tracked robot (off), True: PyBullet's own default."""
+    user for a tracked robot (off), True: PyBullet's own default. ``iterations``: Bullet's
+    ``numSolverIterations``, by default what MK809 asks (None: PyBullet's default, 50)."""
     import pybullet as p
     import pybullet_data
 
@@ -207,6 +209,8 @@ def run_pybullet(urdf: Path, tracks: Tracks, profile: Profile,
         p.setTimeStep(DT, physicsClientId=client)
         if not cone_friction:
             p.setPhysicsEngineParameter(enableConeFriction=0, physicsClientId=client)
+        if iterations:  # what MK809 asks of a PyBullet user for a tracked robot
+            p.setPhysicsEngineParameter(numSolverIterations=iterations, physicsClientId=client)
         p.loadURDF(str(Path(pybullet_data.getDataPath()) / "plane.urdf"), physicsClientId=client)
         flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER
         body = p.loadURDF(str(urdf), [0, 0, 0], flags=flags, physicsClientId=client)

@@ -121,6 +121,14 @@ rollers to skid: Bullet's cone friction holds the direction across the slip like
 1.42 rad of the reference's 3.25 on the spin above; 3.60 rad with 0). A URDF cannot carry it: MK809
 says so."""
 
+PYBULLET_SOLVER_ITERATIONS = 400
+"""What a PyBullet user must set (``setPhysicsEngineParameter(numSolverIterations=...)``) for the
+rollers' velocity motors to hold the belt speed while the tracks skid: Bullet solves motors, the
+belt's gear constraints and the sliding contacts together by projected Gauss–Seidel, and at its
+default 50 iterations a motor under a skid turn's load stays unconverged (measured on the tutorial's
+spin, 1 rad/s for 10 s: a roller 0.31 rad behind its target; at 400 within 0.004 rad). A URDF cannot
+carry it: MK809 says so."""
+
 
 @dataclass(frozen=True)
 class TrackShape:
@@ -409,7 +417,8 @@ def _message(joint: Joint, link: Link, shape: TrackShape, rollers: list[str], sp
     parts.append(f"the tracks skid to turn: the MJCF gets <option impratio=\"{TRACK_IMPRATIO:g}\"> "
                  "(softer friction, so that the rollers' friction follows their slip as Coulomb's does); "
                  f"PyBullet needs setPhysicsEngineParameter(enableConeFriction={PYBULLET_CONE_FRICTION}) "
-                 "for the same, which a URDF cannot carry")
+                 f"for the same and numSolverIterations={PYBULLET_SOLVER_ITERATIONS} for the roller "
+                 "motors to hold the belt speed while skidding, which a URDF cannot carry")
     if overlap:
         parts.append("the track is shorter than two roller diameters: the rollers overlap, so a target "
                      "that collides sibling bodies needs them excluded from each other")

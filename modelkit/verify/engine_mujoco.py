@@ -540,6 +540,15 @@ same bound as PyBullet's VELOCITY_CONTROL maximum force), its damping integrated
 ``implicitfast``. Choreonoid's velocity mode and PyBullet's motor are velocity constraints; at this
 gain the speed error under a load of 1 N·m is 0.01 rad/s (0.1 % at 0.5 m/s)."""
 
+SERVO_INTEGRAL_TIME = 0.05
+"""s: the integral time of the roller servos (an ``intvelocity`` actuator beside the ``velocity`` one:
+force ``kp·(∫target − q)``, ``kp = kv / SERVO_INTEGRAL_TIME``). A proportional velocity servo turns
+slower than its target by ``τ / kv`` under a load τ: a skidding track's roller carries up to μ·N·r
+(about 1.1 N·m on the tutorial's spin), so MuJoCo's rollers lost 0.08–0.7 rad over 10 s against
+PyBullet's velocity constraint, which keeps the speed exactly. With the integral part the roller's
+angle follows ``∫target`` to ``τ / kp`` (under 5 mrad), as a velocity constraint's does. Stable
+explicitly: ``sqrt(kp / J)·dt`` is 0.9 on a roller alone (J 0.36 g·m², kp 317), below 2."""
+
 LAW_PLUGIN = "mujoco.pid"
 """MuJoCo's bundled PID actuator plugin (``plugin/libactuator.so``, loaded by ``import mujoco``): with
 only ``kd`` set its force is ``kd·(0 − q̇)``, computed in C inside every ``mj_step``. It is the one
@@ -650,6 +659,11 @@ class MujocoDriver:
                 act.name, act.target, act.trntype = f"modelkit_servo_{name}", joints.get(name, name), \
                     mujoco.mjtTrn.mjTRN_JOINT
                 act.set_to_velocity(kv=VELOCITY_KV)
+                act = spec.add_actuator()  # the servo's integral part (see SERVO_INTEGRAL_TIME)
+                act.name, act.target, act.trntype = f"modelkit_servoint_{name}", joints.get(name, name), \
+                    mujoco.mjtTrn.mjTRN_JOINT
+                act.set_to_intvelocity(kp=1.0)
+                act.actlimited = mujoco.mjtLimited.mjLIMITED_FALSE
             if with_laws:
                 spec.activate_plugin(LAW_PLUGIN)
             for name, gain in (law_gain if with_laws else {}).items():
@@ -715,6 +729,17 @@ class MujocoDriver:
                                      float(m.opt.timestep)) if servoed else 0.0
         m.actuator_gainprm[servos, 0] = self.servo_kv
         m.actuator_biasprm[servos, 2] = -self.servo_kv
+        # The integral part, kp = kv / SERVO_INTEGRAL_TIME, bounded like the proportional one (each
+        # actuator bounded on its own: a joint-level bound on their sum slowed the friction-limited
+        # start, 1.5 cm behind the reference at 0.1 s, since implicitfast still damps through the
+        # velocity actuator's kv while the joint clamps its force).
+        self.servo_kp = self.servo_kv / SERVO_INTEGRAL_TIME
+        integral = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, f"modelkit_servoint_{n}")
+                    for n in servoed]
+        m.actuator_gainprm[integral, 0] = self.servo_kp
+        m.actuator_biasprm[integral, 1] = -self.servo_kp
+        m.actuator_forcelimited[integral] = 1
+        m.actuator_forcerange[integral] = (-self.servo_limit, self.servo_limit)
         # The law actuators, gear 0 (inert) until a profile runs them (``_run_laws``).
         self._law_gain = law_gain if probe is not None else None
         actuator = mujoco.mjtObj.mjOBJ_ACTUATOR
@@ -733,8 +758,8 @@ class MujocoDriver:
             qadr = np.array([int(m.jnt_qposadr[i]) for i in ids])
             vadr = np.array([int(m.jnt_dofadr[i]) for i in ids])
             if c.mode == "velocity":
-                groups = [[servo_of[f"modelkit_servo_{g}"] for g in v.driven_groups(drive, j)]
-                          for j in c.joints]
+                groups = [[servo_of[f"modelkit_{part}_{g}"] for g in v.driven_groups(drive, j)
+                           for part in ("servo", "servoint")] for j in c.joints]
                 self._plan.append((c, qadr, vadr, None, groups))
             else:
                 self._plan.append((c, qadr, vadr, vadr.copy(), []))
@@ -768,9 +793,12 @@ class MujocoDriver:
             "law_actuators": dict(sorted(law_gain.items())),
             "velocity_servo": (f"MuJoCo velocity actuator kv {self.servo_kv:.4g} N·m·s/rad (m·r²/(n·dt)), "
                                "force within "
-                               f"±{self.servo_limit:.4g} N·m (½·m·g·μ·r / rollers), on every roller of a "
+                               f"±{self.servo_limit:.4g} N·m (SERVO_FRICTION_SHARE·m·g·μ·r / rollers), "
+                               "on every roller of a "
                                "track, all with roller 0's target (roller i > 0 also keeps the file's "
-                               "mimic equality)") if servoed else "none",
+                               "mimic equality); beside each, an intvelocity actuator kp "
+                               f"{self.servo_kp:.4g} N·m/rad (kv / SERVO_INTEGRAL_TIME), same bound: the "
+                               "servo's integral part") if servoed else "none",
             "file_actuators": "deleted", "start_height": self._start_height,
             "settle": "zero torque; velocity servos held at 0",
             "controllers": [f"{c.name} ({c.mode}: {', '.join(c.joints)})" for c in self.controllers],

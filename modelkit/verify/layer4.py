@@ -26,10 +26,15 @@ with its default options (wheels: sphere collisions, MK826; the contact paramete
 PyBullet loads pybullet_data's ``plane.urdf`` as shipped (see the drivers for the engine settings).
 ``report.json`` names the files (``engines.layer4.files``).
 
-Tracked robots are driven through the rollers ``convert`` writes. Their no-slip reference is the
-ideal velocity servo: only straight profiles (w = 0 throughout) are compared with it; a turning
-tracked robot skids sideways (skid steering), which no rigid no-slip model describes, so turning
-profiles compare the engines with each other only, report-only (the verdict line says so).
+Tracked robots are driven through the rollers ``convert`` writes, their velocity servos bounded
+high enough to impose the belt speed (as Choreonoid does; ``variant.SERVO_FRICTION_SHARE``). A tracked
+robot skids to turn, which no rigid no-slip model describes, so every profile of a tracked robot is
+graded against the **skid-steer** reference instead (:mod:`modelkit.verify.reference_skid`):
+``skid-position``, ``skid-yaw`` for each engine, at the tolerance ``skid_tolerance`` derives per profile
+(the spread of the skid path over the pressure distribution under the belt and μ × 0.5 … 2), and the
+pair ``mujoco~pybullet`` at the same derived tolerance (docs/verify.md, "Tracked robots": the two
+engines differ in how their rigid solvers split the weight among the rollers, which is the
+pressure-distribution uncertainty again) and the roller angles at 0.02 rad.
 """
 
 from __future__ import annotations
@@ -49,6 +54,13 @@ from modelkit.model import JointType, Robot
 from modelkit.verify.drive import Array, Drive, Profile, Scenario, Trajectory, WheelProxy
 from modelkit.verify.facts import Check, Observation, Skip
 from modelkit.verify.reference_drive import PlanarModel, noslip, odometry, planar_model, unicycle
+from modelkit.verify.reference_skid import (
+    SkidModel,
+    SkidTolerance,
+    skid_model,
+    skid_reference,
+    skid_tolerance,
+)
 
 LAYER = 4
 DRIVERS = {
@@ -65,15 +77,15 @@ NATIVE_WARNING = (
     "the graded runs read convert's default files (sphere wheels, MK826)."
 )
 TRACK_SKIP = (
-    "tracks: turning profiles (spin, arc) are NOT graded: they compare MuJoCo with PyBullet report-only; "
-    "the no-slip reference is compared on straight profiles (w = 0) only, since a turning tracked robot "
-    "must skid sideways, which no rigid no-slip model describes (grading turning against the skid-steer "
-    "reference, modelkit.verify.reference_skid, is not done yet). Continuous tracks themselves are not "
-    "simulated by either engine: both drive the cylinder rollers convert writes (MK809), each track's "
-    "rollers coupled like its belt (MuJoCo: the file's mimic equality; PyBullet: a gear constraint), "
-    "velocity-servoed with a torque bound of half what friction can pass (variant.SERVO_FRICTION_SHARE); "
-    "MuJoCo with the file's <option impratio> and PyBullet with enableConeFriction=0, as the files' notes "
-    "(MK809, MK825) ask a user to"
+    "tracks: graded against the skid-steer reference (modelkit.verify.reference_skid: the planar rigid "
+    "body on Coulomb friction under the rollers with the belt speeds imposed), not the no-slip one, at "
+    "the tolerance derived per profile from the pressure distribution under the belt and μ (docs/verify.md, "
+    "\"Tracked robots\"); the continuous tracks themselves are not simulated by either engine: both drive "
+    "the cylinder rollers convert writes (MK809), each track's rollers coupled like its belt (MuJoCo: the "
+    "file's mimic equality; PyBullet: a gear constraint), velocity-servoed with a torque bound of "
+    "variant.SERVO_FRICTION_SHARE × what the weight lets friction pass (the belt speed is imposed and the "
+    "belt slips, as in Choreonoid); MuJoCo with the file's <option>, PyBullet with the engine parameters "
+    "the files' notes (MK809, MK825) ask a user to set"
 )
 
 
@@ -137,6 +149,10 @@ def run(
         prepared if drive.kind == "tracks" and prepared is not None else robot, drive, scenario.friction
     )
     result.settings["reference"] = {"noslip": model.as_dict(), "unicycle": "exact, from the commanded (v, w)"}
+    skid: Skid | None = None
+    if drive.kind == "tracks" and prepared is not None:
+        skid = Skid(prepared, skid_model(prepared, drive, scenario.friction))
+        result.settings["reference"]["skid"] = skid.model.as_dict()
     wanted = [e for e in engines if e in DRIVERS]
     if scenario.friction is not None and wanted:
         result.skips.append(Skip(LAYER, "all", (
@@ -159,7 +175,7 @@ def run(
         t1 = time.perf_counter()
         for job in jobs:  # MuJoCo here while PyBullet's children step their batches
             job.run_here(scenario, drive, result)
-        references = {p.name: _references(model, p, scenario, drive) for p in scenario.profiles}
+        references = {p.name: _references(model, p, scenario, drive, skid) for p in scenario.profiles}
         t2 = time.perf_counter()
         for job in jobs:
             job.collect(result)
@@ -178,7 +194,11 @@ def run(
                 continue
             result.trajectories.extend(runs.values())
             graded = profile.graded and job.proxy == scenario.wheel_proxy
-            _compare(profile, job.proxy, graded, runs, ref, model, drive, scenario, result)
+            _compare(profile, job.proxy, graded, runs, ref, model, drive, scenario, result,
+                     skid.tolerances.get(profile.name) if skid is not None else None)
+    if skid is not None:
+        result.settings["reference"]["skid_tolerances"] = {
+            k: v.as_dict() for k, v in sorted(skid.tolerances.items())}
     t4 = time.perf_counter()
     result.timings.update(
         {
@@ -364,13 +384,29 @@ def _warnings(engine: str, proxy: str, messages: list[str], result: Layer4Result
 # references and comparisons
 
 
+@dataclass
+class Skid:
+    """A tracked robot's skid-steer reference: its model and the tolerance derived per graded profile."""
+
+    prepared: Robot
+    model: SkidModel
+    tolerances: dict[str, SkidTolerance] = field(default_factory=dict)
+
+
 def _references(
-    model: PlanarModel, profile: Profile, scenario: Scenario, drive: Drive
+    model: PlanarModel, profile: Profile, scenario: Scenario, drive: Drive, skid: Skid | None = None
 ) -> dict[str, Trajectory]:
-    return {
+    out = {
         "noslip": noslip(model, profile, scenario, drive),
         "unicycle": unicycle(model, profile, scenario, drive),
     }
+    if skid is not None:
+        out["skid"] = skid_reference(skid.model, profile, scenario, drive)
+        if profile.graded:
+            skid.tolerances[profile.name] = skid_tolerance(
+                skid.model, profile, scenario, drive, skid.prepared, out["skid"]
+            )
+    return out
 
 
 def wrap(angle: Array) -> Array:
@@ -431,10 +467,6 @@ def effective_radius(trajectory: Trajectory, model: PlanarModel, drive: Drive) -
     return out[0], out[1]
 
 
-def _turns(profile: Profile) -> bool:
-    return any(c.w != 0.0 for c in profile.commands)
-
-
 def _compare(
     profile: Profile,
     proxy: str,
@@ -445,6 +477,7 @@ def _compare(
     drive: Drive,
     scenario: Scenario,
     result: Layer4Result,
+    skid_tol: SkidTolerance | None = None,
 ) -> None:
     tol = scenario.tolerances
     where = profile.name if proxy == "sphere" else f"{profile.name} ({proxy} wheels)"
@@ -455,8 +488,11 @@ def _compare(
         if native
         else ("report-only profile: " + profile.description + ". " if not profile.graded else "")
     )
-    tracks_turning = drive.kind == "tracks" and _turns(profile)
-    pair_graded = graded and not tracks_turning
+    pair_graded = graded
+    # tracks: the pair's paths at the skid tolerance (docs/verify.md, "Tracked robots")
+    pair_position, pair_yaw = (
+        (skid_tol.position, skid_tol.yaw) if skid_tol is not None else (tol.engines_position, tol.engines_yaw)
+    )
 
     def record(
         engine: str,
@@ -481,19 +517,20 @@ def _compare(
             PAIR,
             "path-position",
             d.position,
-            tol.engines_position,
+            pair_position,
             f"MuJoCo's and PyBullet's root paths differ by up to {_cm(d.position)} "
             f"(t = {d.position_t:.2f} s; "
-            f"{_cm(d.final)} at the end; tolerance {_cm(tol.engines_position)})",
+            f"{_cm(d.final)} at the end; tolerance {_cm(pair_position)}"
+            + (", the skid tolerance" if skid_tol is not None else "") + ")",
             grade=pair_graded,
         )
         record(
             PAIR,
             "path-yaw",
             d.yaw,
-            tol.engines_yaw,
+            pair_yaw,
             f"MuJoCo's and PyBullet's headings differ by up to {_mrad(d.yaw)} (t = {d.yaw_t:.2f} s; "
-            f"tolerance {_mrad(tol.engines_yaw)})",
+            f"tolerance {_mrad(pair_yaw)}" + (", the skid tolerance" if skid_tol is not None else "") + ")",
             "rad",
             grade=pair_graded,
         )
@@ -537,8 +574,8 @@ def _compare(
             f"effective rolling radius from its own path: left {_mm(radii[0])}, right {_mm(radii[1])} "
             f"(model {_mm(model.radius)})" + _radius_hint(radii, model.radius, drive)
         )
-        if drive.kind == "tracks" and _turns(profile):
-            pass  # not meaningful (TRACK_SKIP)
+        if "skid" in ref:
+            _skid_checks(engine, name, trajectory, ref["skid"], skid_tol if graded else None, record)
         else:
             d = difference(trajectory, reference)
             record(
@@ -618,6 +655,44 @@ def _compare(
                 note + f"{name}'s heading vs the ideal unicycle (advisory)",
             )
         )
+
+
+def _skid_checks(
+    engine: str,
+    name: str,
+    trajectory: Trajectory,
+    reference: Trajectory,
+    tol: SkidTolerance | None,
+    record: Any,
+) -> None:
+    """A tracked robot's path against the skid-steer reference (``tol`` None: not graded, reported)."""
+    d = difference(trajectory, reference)
+    position, yaw = (tol.position, tol.yaw) if tol is not None else (math.inf, math.inf)
+    spread = (
+        "; ".join(f"{k}: {_cm(p)} / {_mrad(q)}" for k, (p, q) in sorted(tol.parts.items()))
+        if tol is not None
+        else "not derived for a report-only profile"
+    )
+    record(
+        engine,
+        "skid-position",
+        d.position,
+        position,
+        f"{name}'s path is up to {_cm(d.position)} from the skid-steer reference (t = {d.position_t:.2f} s; "
+        f"{_cm(d.final)} at the end; tolerance {_cm(position)}, the largest spread of the reference: "
+        f"{spread})",
+        grade=tol is not None,
+    )
+    record(
+        engine,
+        "skid-yaw",
+        d.yaw,
+        yaw,
+        f"{name}'s heading is up to {_mrad(d.yaw)} from the skid-steer reference (t = {d.yaw_t:.2f} s; "
+        f"tolerance {_mrad(yaw)})",
+        "rad",
+        grade=tol is not None,
+    )
 
 
 RADIUS_HINT = 0.02  # an effective radius this far (relative) from the model's is pointed out

@@ -366,7 +366,8 @@ class Engine:
         p.resetBasePositionAndOrientation(body, com, inertial[4], physicsClientId=c)
         self.drive_start_height = -gap
         self.drive_joint_index = joint_index
-        # The velocity servos' bound, ½·m·g·μ·r / rollers (``variant.servo_torque_limit``; MuJoCo's too).
+        # The velocity servos' bound, SERVO_FRICTION_SHARE·m·g·μ·r / rollers
+        # (``variant.servo_torque_limit``; MuJoCo's too).
         mass = sum(p.getDynamicsInfo(body, link, physicsClientId=c)[0] for link in range(-1, n))
         mu = max((friction[name] for name in contact), default=0.0)
         count = sum(len(g) for g in self.drive_rollers.values())

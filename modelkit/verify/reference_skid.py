@@ -257,7 +257,7 @@ def path_difference(a: Trajectory, b: Trajectory) -> tuple[float, float]:
 
 
 def skid_tolerance(model: SkidModel, profile: Profile, scenario: Scenario, drive: Drive,
-                   robot: Robot | None = None) -> SkidTolerance:
+                   robot: Robot | None = None, nominal: Trajectory | None = None) -> SkidTolerance:
     """How far the skid path of ``profile`` moves within the uncertainty of what decides it:
 
     * the pressure distribution under the belt: the reference's layout against the other one
@@ -266,8 +266,10 @@ def skid_tolerance(model: SkidModel, profile: Profile, scenario: Scenario, drive
     * the friction coefficient: μ × each factor of :data:`MU_RANGE`.
 
     The tolerance is the largest of these spreads (position and yaw separately), at least
-    :data:`FLOOR_POSITION` / :data:`FLOOR_YAW` (what the engines reach on a no-slip path)."""
-    nominal = skid_reference(model, profile, scenario, drive)
+    :data:`FLOOR_POSITION` / :data:`FLOOR_YAW` (what the engines reach on a no-slip path).
+    ``nominal``: ``skid_reference(model, profile, ...)`` when already computed."""
+    if nominal is None:
+        nominal = skid_reference(model, profile, scenario, drive)
     parts: dict[str, tuple[float, float]] = {}
     if robot is not None:
         other: Layout = "uniform" if model.layout == "rollers" else "rollers"

@@ -121,7 +121,7 @@ def _fmt(x: float) -> str:
 
 
 COMPARISONS = frozenset({"path-position", "path-yaw", "wheel-angle", "pan-tilt-angle", "noslip-position",
-                         "noslip-yaw"})
+                         "noslip-yaw", "skid-position", "skid-yaw"})
 """Layer 4's comparison quantities: graded as checks, or reported as observations (then said so)."""
 
 
@@ -135,7 +135,9 @@ def scope(report: VerifyReport) -> str:
     parts = []
     if graded:
         on = f" on the written {', '.join(str(v) for _, v in sorted(files.items()))}" if files else ""
-        parts.append(f"layer 4 graded {', '.join(graded)}{on}")
+        skid = any(c.layer == 4 and c.quantity.startswith("skid-") for c in report.checks)
+        against = " against the skid-steer reference" if skid else ""
+        parts.append(f"layer 4 graded {', '.join(graded)}{against}{on}")
     if reported:
         parts.append(f"not graded (reported only): {', '.join(reported)}")
     return "; ".join(parts)

@@ -209,16 +209,18 @@ def bench(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path, profile
     return out
 
 
-SERVO_FRICTION_SHARE = 0.5
-"""The share of the friction limit a roller servo may use. At 1 (the whole ``m·g·μ·r / n``) a start
-is a friction-limit manoeuvre: any roller carrying less than the average load slips, and the split
-of the weight among four coplanar supports is not determined for a rigid solver (PyBullet split the
-tutorial robot's 172 N as 16/70/65/21 N), nor is the load transfer while accelerating — so the two
-engines slipped differently (MuJoCo 0.7 cm, PyBullet none but a lighter roller saturated) and no
-no-slip reference describes either (verification.md §2.1: slip-dominated manoeuvres make poor
-verification cases). At 0.5 a side's belt passes at most half what its weight can carry, so a
-start is torque-limited (acceleration ``n·τ_max / (r·M_eff)``, about μg/2), slip-free, and the
-no-slip reference models it exactly (``reference_drive``). Steady driving needs no torque at all."""
+SERVO_FRICTION_SHARE = 3.0
+"""The roller servos' torque bound as a multiple of the average friction limit ``m·g·μ·r / n`` (the
+track rollers are the only velocity-servoed joints). Choreonoid imposes a track's surface speed
+without a bound, and the skid-steer reference (``reference_skid``) assumes the same: a turning track's
+belt slips lengthwise while it slides sideways, so each roller must keep its speed against the whole
+Coulomb force of the load it carries. That load is not the average: a rigid solver's split of the
+weight among the coplanar roller contacts is not determined (PyBullet split the tutorial robot's
+172 N as 16/70/65/21 N, 1.63 × the average on the heaviest); 3 × the average covers it, and the servo
+still bounds MuJoCo's reaction at a speed step (``servo_torque_limit``). Was ½ (a torque-limited,
+slip-free start for the no-slip reference); at ½ no roller can pass the force a skid turn needs
+(about 0.58 μN on the tutorial's spin) and neither engine turned the robot on the spot. A straight
+start is now friction-limited, as in the skid reference (lag v²/2μg)."""
 
 
 def servo_torque_limit(mass: float, mu: float, radius: float, count: int, gravity: float = 9.81,
