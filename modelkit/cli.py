@@ -424,6 +424,9 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
 @click.option("--merge-fixed", is_flag=True, help="Fuse links on fixed joints into their parents.")
 @click.option("--urdf-world-link", is_flag=True,
               help="URDF: hang a floating root from a `world` link too (a welded root always does).")
+@click.option("--urdf-distinct-names", is_flag=True,
+              help="URDF: rename a joint named like a link <name>_joint (libsdformat's URDF to SDF "
+                   "conversion refuses the shared name, which URDF and ROS allow; MK846).")
 @click.option("--wheel-collision", type=click.Choice(WHEEL_COLLISIONS), default="auto", show_default=True,
               help="Collision shape of wheels (auto: a sphere for MJCF and URDF, the cylinder for SDF and "
                    ".body; MK826).")
@@ -446,6 +449,7 @@ def convert(
     keep_package_uris: bool,
     merge_fixed: bool,
     urdf_world_link: bool,
+    urdf_distinct_names: bool,
     wheel_collision: str,
     base: str,
     **kwargs: Any,
@@ -469,6 +473,7 @@ def convert(
         keep_package_uris=keep_package_uris,
         merge_fixed=merge_fixed,
         urdf_world_link=True if urdf_world_link else None,
+        urdf_distinct_names=urdf_distinct_names,
         wheel_collision=wheel_collision,
         base=base,
     )

@@ -1163,6 +1163,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "free joint).",
     ),
     CodeInfo(
+        "MK846",
+        "joint-keeps-link-name",
+        "info",
+        "URDF: a joint keeps the name of a link, as in the source and as URDF and ROS allow; libsdformat's "
+        "URDF to SDF conversion refuses such a file (`--urdf-distinct-names` renames the joints).",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",

@@ -231,8 +231,7 @@ def test_tutorial_body_matches_the_hand_written_urdf(tmp_path: Path) -> None:
     fixed joints (the .body has them as devices of TiltLink: here they are Gazebo sensors of TiltLink
     at the same translations; the hand-written RealSense link has an optical-frame rotation
     (rpy -1.57 0 -1.57, Z forward) where the sensor frame is +X forward); its LeftWheel joint is at
-    y = 0.146 where the .body says 0.145; its wheel joints are named like their links (a clash the
-    writer avoids by naming them LeftWheel_joint / RightWheel_joint).
+    y = 0.146 where the .body says 0.145. Its wheel joints are named like their links, as ours are.
     """
     body = read_back(TUTORIAL / "mobile_robot_sensors.body")
     data, notes = write_to(body, tmp_path)
@@ -252,7 +251,7 @@ def test_tutorial_body_matches_the_hand_written_urdf(tmp_path: Path) -> None:
         assert np.allclose(joint.origin.translation, expected, atol=1e-12), child
         assert np.allclose(joint.origin.rotation, other.origin.rotation, atol=1e-12)
         assert np.allclose(joint.axis, other.axis)
-    assert {j.name for j in ours.joints} >= {"LeftWheel_joint", "RightWheel_joint", "PanJoint", "TiltJoint"}
+    assert {j.name for j in ours.joints} >= {"LeftWheel", "RightWheel", "PanJoint", "TiltJoint"}
     for link in ours.links:
         other_link = hand.link(link.name)
         assert other_link is not None and link.inertial is not None and other_link.inertial is not None
@@ -368,7 +367,9 @@ def test_world_link_option_and_root_notes(tmp_path: Path) -> None:
     assert _joint_el(data, "world_to_base").get("type") == "floating"
 
 
-def test_link_joint_name_clash_is_renamed_and_mimic_follows(tmp_path: Path) -> None:
+def test_link_joint_name_clash_is_kept_or_renamed_on_request_and_mimic_follows(tmp_path: Path) -> None:
+    """URDF allows a joint named like a link and ROS finds joints by name: the name is kept (MK846);
+    option urdf_distinct_names renames the joint <name>_joint (MK800) and the mimic follows."""
     leader = Joint(
         "finger", JointType.REVOLUTE, "base", "finger", limits=JointLimits(0.0, 1.0, 2.0, -2.0, 2.0, 3.0)
     )
@@ -381,9 +382,19 @@ def test_link_joint_name_clash_is_renamed_and_mimic_follows(tmp_path: Path) -> N
         mimic=Mimic("finger", -1.0, 0.25),
     )
     robot = _robot(leader, follower)
-    data, notes = write_to(robot, tmp_path)
+    data, notes = write_to(robot, tmp_path / "kept")
+    assert not [n for n in notes if n.code == "MK800"]
+    kept = [n for n in notes if n.code == "MK846"]
+    assert len(kept) == 1 and '"finger"' in kept[0].message
+    assert _child(_joint_el(data, "finger"), "child").get("link") == "finger"
+    assert _child(_joint_el(data, "other"), "mimic").get("joint") == "finger"
+    assert compare_robots(robot, read_back(tmp_path / "kept" / "robot.urdf")) == []
+    run_check_urdf(tmp_path / "kept" / "robot.urdf")
+
+    data, notes = write_to(robot, tmp_path, WriteOptions(urdf_distinct_names=True))
     renamed = [n for n in notes if n.code == "MK800"]
     assert len(renamed) == 1 and '"finger"' in renamed[0].message and '"finger_joint"' in renamed[0].message
+    assert "MK846" not in {n.code for n in notes}
     assert urdf_renames(notes) == {}  # links keep their names
     mimic = _child(_joint_el(data, "other"), "mimic")
     assert mimic.attrib == {"joint": "finger_joint", "multiplier": "-1", "offset": "0.25"}

@@ -19,5 +19,8 @@ class WriteOptions:
     # URDF `world` link and the root's joint to it: None (default) for a welded root only; True for a
     # floating root too; False never (a consumer that welds the root itself: verify's engines)
     urdf_world_link: bool | None = None
+    # URDF: rename a joint named like a link `<name>_joint` (libsdformat's URDF to SDF conversion
+    # refuses the shared name, which URDF and ROS allow and the default keeps; MK846)
+    urdf_distinct_names: bool = False
     wheel_collision: str = "auto"  # auto|cylinder|sphere|ellipsoid: the wheels' collision (convert.wheels)
     base: str = "auto"  # fixed | floating | auto: how the root meets the world (modelkit/convert/base.py)
