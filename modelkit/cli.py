@@ -16,7 +16,13 @@ from typing import Any, NoReturn, TypeVar
 
 import click
 
-from modelkit.convert.options import ACTUATOR_CHOICES, MESH_FORMATS, SDF_VERSIONS, WHEEL_COLLISIONS
+from modelkit.convert.options import (
+    ACTUATOR_CHOICES,
+    GAZEBO_CHOICES,
+    MESH_FORMATS,
+    SDF_VERSIONS,
+    WHEEL_COLLISIONS,
+)
 from modelkit.convert.registry import TARGET_NAMES
 from modelkit.diagnostics import (
     Diagnostic,
@@ -433,6 +439,17 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
 @click.option("--merge-fixed", is_flag=True, help="Fuse links on fixed joints into their parents.")
 @click.option("--urdf-world-link", is_flag=True,
               help="URDF: hang a floating root from a `world` link too (a welded root always does).")
+@click.option("--urdf-distinct-names", is_flag=True,
+              help="URDF: rename a joint named like a link <name>_joint (libsdformat's URDF to SDF "
+                   "conversion refuses the shared name, which URDF and ROS allow; MK846).")
+@click.option("--urdf-sensor-links/--no-urdf-sensor-links", default=True, show_default=True,
+              help="URDF: each camera, LiDAR and IMU a massless link on a fixed joint, cameras with a "
+                   "REP-103 optical frame (MK847); --no-urdf-sensor-links keeps them on their links "
+                   "(PyBullet gives a massless link 1 kg).")
+@click.option("--gazebo", type=click.Choice(GAZEBO_CHOICES), default="auto", show_default=True,
+              help="URDF <gazebo> blocks and SDF sensors for Gazebo classic (ray, depth, gazebo_ros plugins) "
+                   "or Gazebo Sim (gpu_lidar, rgbd_camera, gz-sim systems); auto: what the source used, "
+                   "Sim when it says nothing (MK848).")
 @click.option("--wheel-collision", type=click.Choice(WHEEL_COLLISIONS), default="auto", show_default=True,
               help="Collision shape of wheels (auto: a sphere for MJCF and URDF, the cylinder for SDF and "
                    ".body; MK826).")
@@ -459,6 +476,9 @@ def convert(
     keep_package_uris: bool,
     merge_fixed: bool,
     urdf_world_link: bool,
+    urdf_distinct_names: bool,
+    urdf_sensor_links: bool,
+    gazebo: str,
     wheel_collision: str,
     base: str,
     actuators: str,
@@ -483,6 +503,9 @@ def convert(
         keep_package_uris=keep_package_uris,
         merge_fixed=merge_fixed,
         urdf_world_link=True if urdf_world_link else None,
+        urdf_distinct_names=urdf_distinct_names,
+        urdf_sensor_links=urdf_sensor_links,
+        gazebo=gazebo,
         wheel_collision=wheel_collision,
         base=base,
         actuators=actuators,

@@ -1251,6 +1251,34 @@ _TABLE: tuple[CodeInfo, ...] = (
         "out.",
     ),
     CodeInfo(
+        "MK846",
+        "joint-keeps-link-name",
+        "info",
+        "URDF: a joint keeps the name of a link, as in the source and as URDF and ROS allow; libsdformat's "
+        "URDF to SDF conversion refuses such a file (`--urdf-distinct-names` renames the joints).",
+    ),
+    CodeInfo(
+        "MK847",
+        "sensor-links",
+        "info",
+        "URDF: cameras, LiDARs and IMUs are written as massless links on fixed joints (their TF frames; "
+        "cameras with a REP-103 optical frame), the `<gazebo reference>` naming them; the note lists them.",
+    ),
+    CodeInfo(
+        "MK848",
+        "gazebo-plugin-other-family",
+        "warning",
+        "A sensor plugin written for the other Gazebo (classic `gazebo_ros` plugins, Gazebo Sim systems) is "
+        "left out; `--gazebo` chooses which family the file is written for.",
+    ),
+    CodeInfo(
+        "MK849",
+        "sensor-parameter-dropped",
+        "warning",
+        "A sensor parameter with no element in an SDF sensor (Choreonoid's `detection_rate`, a depth "
+        "camera's range...) is left out; the note names each with its value.",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",

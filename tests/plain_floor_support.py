@@ -98,7 +98,7 @@ def drive_pybullet(urdf: Path, v: float, w: float, r: float, b: float, dt: float
                           physicsClientId=c)
         written = {p.getJointInfo(body, j, physicsClientId=c)[1].decode(): j
                    for j in range(p.getNumJoints(body, physicsClientId=c))}
-        # the URDF writer renames a joint that shares its link's name (MK800): LeftWheel_joint
+        # the URDF writer keeps a joint named like its link (MK846); with urdf_distinct_names: LeftWheel_joint
         index = {n: written.get(n, written.get(f"{n}_joint", -1)) for n in (*wheels, *head)}
         index = {n: j for n, j in index.items() if j >= 0}
         used = [n for n in (*wheels, *head) if n in index]

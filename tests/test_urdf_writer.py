@@ -19,6 +19,7 @@ from lxml import etree
 from modelkit.api import validate
 from modelkit.convert.api import CONVERTIBLE_ERRORS, prepare, render_model
 from modelkit.convert.compare import Difference, compare_robots
+from modelkit.convert.names import unique_name
 from modelkit.convert.notes import ConversionNote, NoteSink
 from modelkit.convert.options import WriteOptions
 from modelkit.convert.output import OutputPlan
@@ -26,6 +27,7 @@ from modelkit.convert.registry import target_info
 from modelkit.formats.urdf.write_joints import SYNTHESISED_EFFORT, SYNTHESISED_POSITION, SYNTHESISED_VELOCITY
 from modelkit.formats.urdf.writer import urdf_renames
 from modelkit.model import (
+    CAMERA_KINDS,
     Box,
     Capsule,
     Device,
@@ -158,8 +160,26 @@ def test_pybullet_loads_every_output(converted: list[Converted]) -> None:
 def expected_after_urdf(robot: Robot) -> Robot:
     """The model with the writer's documented substitutions: URDF needs both position bounds of a
     prismatic joint (and of a revolute joint limited on one side only), ±1e16 where there is none;
-    a welded root hangs from a `world` link by a fixed joint at the robot's placement."""
+    a welded root hangs from a `world` link by a fixed joint at the robot's placement; a camera, LiDAR
+    or IMU is a massless link on a fixed joint at its pose, a camera's optical frame one more (MK847)."""
+    from modelkit.formats.urdf.write_frames import FRAMED_KINDS
+
     out = copy.deepcopy(robot)
+    taken = {lk.name for lk in out.links} | {j.name for j in out.joints}
+    for link in list(out.links):
+        for device in link.devices:
+            if device.canonical not in FRAMED_KINDS or device.name == link.name or "xml" in device.params:
+                continue
+            frame = unique_name(device.name, taken)
+            out.links.append(Link(frame))
+            out.joints.append(Joint(unique_name(f"{frame}_joint", taken), JointType.FIXED, link.name, frame,
+                                    origin=device.pose))
+            if device.canonical in CAMERA_KINDS:  # REP-103: z forward, x right, y down
+                optical = unique_name(f"{frame}_optical", taken)
+                rep103 = Pose(matrix_from_rpy(-math.pi / 2, 0.0, -math.pi / 2), np.zeros(3))
+                out.links.append(Link(optical))
+                out.joints.append(Joint(unique_name(f"{optical}_joint", taken), JointType.FIXED, frame,
+                                        optical, origin=rep103))
     if out.root_joint is JointType.FIXED and out.root not in (None, "world"):
         root = str(out.root)
         out.links.insert(0, Link("world"))
@@ -227,22 +247,24 @@ def read_back_source(item: Converted) -> Robot:
 def test_tutorial_body_matches_the_hand_written_urdf(tmp_path: Path) -> None:
     """mobile_robot_sensors.body against the tutorial's own mobile_robot_sensors.urdf.
 
-    Known differences, all on the hand-written side: it models the LiDAR and the RealSense as links on
-    fixed joints (the .body has them as devices of TiltLink: here they are Gazebo sensors of TiltLink
-    at the same translations; the hand-written RealSense link has an optical-frame rotation
-    (rpy -1.57 0 -1.57, Z forward) where the sensor frame is +X forward); its LeftWheel joint is at
-    y = 0.146 where the .body says 0.145; its wheel joints are named like their links (a clash the
-    writer avoids by naming them LeftWheel_joint / RightWheel_joint).
+    Both model the LiDAR and the RealSense as links on fixed joints from TiltLink at the same places
+    and name the wheel joints like their links. Known differences: the hand-written RealSense link is
+    itself the optical frame (rpy -1.57 0 -1.57, Z forward) where ours is the sensor frame (+X forward,
+    as the Gazebo sensor on it) with a child RealSense_optical at rpy -π/2 0 -π/2; its sensor links
+    carry the visuals (here they stay on TiltLink, as in the .body) and its LeftWheel joint is at
+    y = 0.146 where the .body says 0.145.
     """
     body = read_back(TUTORIAL / "mobile_robot_sensors.body")
     data, notes = write_to(body, tmp_path)
     ours = read_back(tmp_path / "robot.urdf")
     hand = read_back(TUTORIAL / "mobile_robot_sensors.urdf")
-    assert {lk.name for lk in ours.links} == {lk.name for lk in hand.links} - {"LiDAR", "RealSense"}
+    assert {lk.name for lk in ours.links} == {lk.name for lk in hand.links} | {"RealSense_optical"}
     assert urdf_renames(notes) == {}
     ours_joints = {j.child: j for j in ours.joints}
     hand_joints = {j.child: j for j in hand.joints}
     for child, joint in ours_joints.items():
+        if child == "RealSense_optical":
+            continue
         other = hand_joints[child]
         assert joint.parent == other.parent and joint.type is other.type
         expected = other.origin.translation.copy()
@@ -250,11 +272,19 @@ def test_tutorial_body_matches_the_hand_written_urdf(tmp_path: Path) -> None:
             assert expected[1] == 0.146
             expected[1] = 0.145
         assert np.allclose(joint.origin.translation, expected, atol=1e-12), child
-        assert np.allclose(joint.origin.rotation, other.origin.rotation, atol=1e-12)
+        if child != "RealSense":
+            assert np.allclose(joint.origin.rotation, other.origin.rotation, atol=1e-12)
         assert np.allclose(joint.axis, other.axis)
-    assert {j.name for j in ours.joints} >= {"LeftWheel_joint", "RightWheel_joint", "PanJoint", "TiltJoint"}
+    ours_poses, hand_poses = ours.world_poses(), hand.world_poses()
+    optical, hand_camera = ours_poses["RealSense_optical"], hand_poses["RealSense"]
+    assert np.allclose(optical.translation, hand_camera.translation, atol=1e-12)
+    assert np.allclose(optical.rotation, hand_camera.rotation, atol=1e-3)  # 1.57 against π/2
+    assert {j.name for j in ours.joints} >= {"LeftWheel", "RightWheel", "PanJoint", "TiltJoint"}
     for link in ours.links:
         other_link = hand.link(link.name)
+        if link.name in ("LiDAR", "RealSense", "RealSense_optical"):
+            assert link.inertial is None and not link.visuals and not link.collisions
+            continue
         assert other_link is not None and link.inertial is not None and other_link.inertial is not None
         assert link.inertial.mass == other_link.inertial.mass
         assert np.allclose(link.inertial.com, other_link.inertial.com, atol=1e-12)
@@ -262,11 +292,9 @@ def test_tutorial_body_matches_the_hand_written_urdf(tmp_path: Path) -> None:
     sensors = {s.get("name"): s for s in etree.fromstring(data).iter("sensor")}
     assert sensors["LiDAR"].get("type") == "gpu_lidar" and sensors["RealSense"].get("type") == "rgbd_camera"
     for name in ("LiDAR", "RealSense"):
-        pose = [float(v) for v in (sensors[name].findtext("pose") or "").split()]
-        origin = hand_joints[name].origin.translation
-        assert np.allclose(pose[:3], origin, atol=1e-12), name
-    holder = sensors["LiDAR"].getparent()
-    assert holder is not None and holder.get("reference") == "TiltLink"
+        holder = sensors[name].getparent()
+        assert holder is not None and holder.get("reference") == name
+        assert sensors[name].find("pose") is None
 
 
 # ---- unit cases ---------------------------------------------------------------------------------------
@@ -368,7 +396,9 @@ def test_world_link_option_and_root_notes(tmp_path: Path) -> None:
     assert _joint_el(data, "world_to_base").get("type") == "floating"
 
 
-def test_link_joint_name_clash_is_renamed_and_mimic_follows(tmp_path: Path) -> None:
+def test_link_joint_name_clash_is_kept_or_renamed_on_request_and_mimic_follows(tmp_path: Path) -> None:
+    """URDF allows a joint named like a link and ROS finds joints by name: the name is kept (MK846);
+    option urdf_distinct_names renames the joint <name>_joint (MK800) and the mimic follows."""
     leader = Joint(
         "finger", JointType.REVOLUTE, "base", "finger", limits=JointLimits(0.0, 1.0, 2.0, -2.0, 2.0, 3.0)
     )
@@ -381,9 +411,19 @@ def test_link_joint_name_clash_is_renamed_and_mimic_follows(tmp_path: Path) -> N
         mimic=Mimic("finger", -1.0, 0.25),
     )
     robot = _robot(leader, follower)
-    data, notes = write_to(robot, tmp_path)
+    data, notes = write_to(robot, tmp_path / "kept")
+    assert not [n for n in notes if n.code == "MK800"]
+    kept = [n for n in notes if n.code == "MK846"]
+    assert len(kept) == 1 and '"finger"' in kept[0].message
+    assert _child(_joint_el(data, "finger"), "child").get("link") == "finger"
+    assert _child(_joint_el(data, "other"), "mimic").get("joint") == "finger"
+    assert compare_robots(robot, read_back(tmp_path / "kept" / "robot.urdf")) == []
+    run_check_urdf(tmp_path / "kept" / "robot.urdf")
+
+    data, notes = write_to(robot, tmp_path, WriteOptions(urdf_distinct_names=True))
     renamed = [n for n in notes if n.code == "MK800"]
     assert len(renamed) == 1 and '"finger"' in renamed[0].message and '"finger_joint"' in renamed[0].message
+    assert "MK846" not in {n.code for n in notes}
     assert urdf_renames(notes) == {}  # links keep their names
     mimic = _child(_joint_el(data, "other"), "mimic")
     assert mimic.attrib == {"joint": "finger_joint", "multiplier": "-1", "offset": "0.25"}
@@ -498,12 +538,16 @@ def test_devices_materials_and_loops(tmp_path: Path) -> None:
     sensors = {s.get("name"): s for s in root.iter("sensor")}
     assert set(sensors) == {"cam", "g"}
     assert sensors["cam"].get("type") == "camera" and sensors["cam"].findtext("camera/image/width") == "640"
-    assert sensors["cam"].findtext("pose") == "0.1 0 0.2 0 0 0"
-    assert sensors["g"].findtext("update_rate") == "5"
+    # the camera is its own link at the device pose (MK847); the kept block stays on its link
+    assert sensors["cam"].findtext("pose") is None and sensors["cam"].getparent().get("reference") == "cam"
+    assert _child(_joint_el(data, "cam_joint"), "origin").get("xyz") == "0.1 0 0.2"
+    assert _child(_joint_el(data, "cam_optical_joint"), "parent").get("link") == "cam"
+    assert sensors["g"].findtext("update_rate") == "5" and sensors["g"].getparent().get("reference") == "arm"
     codes = {n.code for n in notes}
-    assert {"MK806", "MK810", "MK818"} <= codes
+    assert {"MK806", "MK810", "MK818", "MK847"} <= codes
     back = read_back(tmp_path / "robot.urdf")
-    assert [d.name for d in back.links[1].devices] == ["cam", "g"]
+    assert [d.name for d in back.links[1].devices] == ["g"]
+    assert [d.name for d in next(lk for lk in back.links if lk.name == "cam").devices] == ["cam"]
     # The floating root reads back open (URDF's convention); --base auto would weld this shape resting on
     # its base, so the second write asks for the floating root the first one had.
     again, _ = write_to(back, tmp_path / "again", WriteOptions(base="floating"))

@@ -251,7 +251,7 @@ def test_apply_perturbs_every_file_and_describes_it(written: Written, tmp_path: 
     line = apply("axis:LeftWheel:flip", files, written.renames)
     assert line.startswith("axis:LeftWheel:flip: ")
     assert "x.sdf: joint[LeftWheel_joint]/axis/xyz: 0 1 0 → 0 -1 0" in line
-    assert "x.urdf: joint[LeftWheel_joint]/axis xyz: 0 1 0 → 0 -1 0" in line
+    assert "x.urdf: joint[LeftWheel]/axis xyz: 0 1 0 → 0 -1 0" in line  # URDF keeps the name (MK846)
     assert "x.xml: joint[LeftWheel] axis: 0 1 0 → 0 -1 0" in line
     # the rest of each file is kept byte for byte: only the injected line differs
     for fmt_name, name in FORMATS.items():

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 SDF_VERSIONS = ("1.6", "1.7", "1.8", "1.9", "1.10", "1.11")
 MESH_FORMATS = ("stl", "obj")
 ACTUATOR_CHOICES = ("motor", "position", "velocity", "none")  # where the source has no actuators
+GAZEBO_CHOICES = ("auto", "classic", "sim")  # convert.gazebo says what each means
 WHEEL_COLLISIONS = ("auto", "cylinder", "sphere", "ellipsoid")  # convert.wheels says what each means
 
 
@@ -20,6 +21,15 @@ class WriteOptions:
     # URDF `world` link and the root's joint to it: None (default) for a welded root only; True for a
     # floating root too; False never (a consumer that welds the root itself: verify's engines)
     urdf_world_link: bool | None = None
+    # URDF: rename a joint named like a link `<name>_joint` (libsdformat's URDF to SDF conversion
+    # refuses the shared name, which URDF and ROS allow and the default keeps; MK846)
+    urdf_distinct_names: bool = False
+    # URDF: each camera, LiDAR and IMU a massless link on a fixed joint (a TF frame for ROS; cameras
+    # with a REP-103 optical frame); False keeps the sensors on their links (MK847)
+    urdf_sensor_links: bool = True
+    # URDF <gazebo> blocks and SDF sensors: auto|classic|sim, the Gazebo whose sensor types and plugins
+    # are written (auto: the source's; modelkit/convert/gazebo.py)
+    gazebo: str = "auto"
     wheel_collision: str = "auto"  # auto|cylinder|sphere|ellipsoid: the wheels' collision (convert.wheels)
     base: str = "auto"  # fixed | floating | auto: how the root meets the world (modelkit/convert/base.py)
     # actuators for a source without any (MJCF): motor (default) | position | velocity | none; the

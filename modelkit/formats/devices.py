@@ -30,6 +30,12 @@ from modelkit.xmlsource import parse_number, parse_numbers
 GL_IN_ROBOTICS: rot3.M3 = ((0.0, 0.0, -1.0), (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
 
 
+# The REP-103 optical frame (ROS ``*_optical_frame``; Choreonoid's ``optical_frame: cv``): +Z forward,
+# +X right, +Y down. Columns are its axes written in the canonical sensor frame; as URDF roll-pitch-yaw
+# this is (-π/2, 0, -π/2), the rotation ROS camera descriptions give their optical frame.
+OPTICAL_IN_ROBOTICS: rot3.M3 = ((0.0, 0.0, 1.0), (-1.0, 0.0, 0.0), (0.0, -1.0, 0.0))
+
+
 def canonical_from_gl(gl_rotation: Any) -> rot3.M3:
     """The canonical sensor frame's rotation, given the rotation of a GL-style camera frame.
 

@@ -208,8 +208,10 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
             continue
         path = out_dir / f"{stem}{SUFFIX[fmt]}"
         # The engines weld the root themselves (fixed base): no URDF `world` link, the root is the base.
+        # Sensors stay on their links: PyBullet reads a massless sensor link as 1 kg (MK816, MK847).
         try:
-            notes = write(welded, path, fmt, WriteOptions(urdf_world_link=False), force=True)
+            notes = write(welded, path, fmt, WriteOptions(urdf_world_link=False, urdf_sensor_links=False),
+                          force=True)
         except (FileExistsError, PermissionError) as exc:  # a symlink or an input where the file goes
             raise VerifyError(f"cannot write {path}: {exc}") from exc
         if written is not None:

@@ -15,7 +15,7 @@ from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.names import unique_name
-from modelkit.convert.numbers import fmt_vec
+from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.formats.sdf.sensors import CONFIG_ELEMENT
 from modelkit.formats.sdf.write_xml import add_pose, data_to_element, num, parse_fragment, rgba, sub
 from modelkit.model import CAMERA_KINDS, LIGHT_KINDS, Device, DeviceKind
@@ -46,6 +46,27 @@ IMAGE_FORMATS_19 = frozenset(
         "BAYER_GRBG8",
     }
 )
+# Gazebo classic's names where they differ from Gazebo Sim's (modelkit/convert/gazebo.py).
+CLASSIC_SENSOR = {
+    DeviceKind.LIDAR: "ray",
+    DeviceKind.DEPTH_CAMERA: "depth",
+    DeviceKind.RGBD_CAMERA: "depth",
+}
+# The canonical parameters each sensor writes; any other is an MK849 note.
+WRITTEN_PARAMS = {
+    "camera": frozenset({"width", "height", "horizontal_fov", "near", "far", "noise_stddev", "format"}),
+    "lidar": frozenset(
+        {
+            "horizontal_samples", "horizontal_min_angle", "horizontal_max_angle",
+            "vertical_samples", "vertical_min_angle", "vertical_max_angle",
+            "range_min", "range_max", "range_resolution", "noise_stddev",
+        }
+    ),
+    "imu": frozenset(),
+    "other": frozenset(),
+}
+# Limits already noted as MK807 by the IMU and force-torque code.
+NOTED_PARAMS = frozenset({"max_force", "max_torque", "max_acceleration", "max_angular_velocity"})
 LIGHT_TYPE = {
     DeviceKind.SPOT_LIGHT: "spot",
     DeviceKind.POINT_LIGHT: "point",
@@ -63,10 +84,13 @@ def is_sdf_native(device: Device, source_format: str) -> bool:
 
 
 class DeviceWriter:
-    def __init__(self, ctx: WriteContext, version: tuple[int, int], source_format: str) -> None:
+    def __init__(
+        self, ctx: WriteContext, version: tuple[int, int], source_format: str, gazebo: str = "sim"
+    ) -> None:
         self.ctx = ctx
         self.version = version
         self.source_format = source_format
+        self.gazebo = gazebo  # "classic" | "sim": sensor types and plugins (modelkit/convert/gazebo.py)
 
     def device(
         self, parent: Element, device: Device, pose: Pose, relative_to: str | None, owner: str, used: set[str]
@@ -100,7 +124,10 @@ class DeviceWriter:
                 target,
             )
             return
-        sensor = sub(parent, "sensor", name=name, type=CANONICAL_SENSOR[kind])
+        wanted = CLASSIC_SENSOR.get(kind) if self.gazebo == "classic" else None
+        if wanted == "ray" and device.kind == "gpu_ray":
+            wanted = "gpu_ray"
+        sensor = sub(parent, "sensor", name=name, type=wanted or CANONICAL_SENSOR[kind])
         add_pose(sensor, pose, relative_to)
         sub(sensor, "always_on", "true")
         rate = params.get("update_rate")
@@ -132,6 +159,48 @@ class DeviceWriter:
                 device.source,
                 target,
             )
+        self._unmapped(device, kind, params, target)
+        self._plugins(sensor, device, target)
+
+    def _unmapped(self, device: Device, kind: DeviceKind, params: dict[str, Any], target: str) -> None:
+        """One MK849 note naming the canonical parameters the sensor has no element for."""
+        group = "camera" if kind in CAMERA_KINDS else "lidar" if kind is DeviceKind.LIDAR else "other"
+        if kind in (DeviceKind.IMU, DeviceKind.ACCELEROMETER, DeviceKind.GYRO):
+            group = "imu"
+        written = WRITTEN_PARAMS[group] | NOTED_PARAMS | {"update_rate"}
+        left = {k: v for k, v in sorted(params.items()) if k not in written}
+        for axis in ("horizontal", "vertical"):  # the scan's resolution is written as 1
+            if group == "lidar" and left.get(f"{axis}_resolution") == 1.0:
+                del left[f"{axis}_resolution"]
+        if left:
+            self.ctx.note(
+                "MK849",
+                f'{kind.value} "{device.name}": an SDF sensor has no element for '
+                + ", ".join(f"{k} {_value(v)}" for k, v in left.items())
+                + "; left out",
+                device.source,
+                target,
+            )
+
+    def _plugins(self, sensor: Element, device: Device, target: str) -> None:
+        """The source sensor's plugins of the Gazebo written for (or of neither); others an MK848 note."""
+        from modelkit.convert.gazebo import plugin_family
+
+        for plugin in device.params.get("plugins") or []:
+            if not isinstance(plugin, dict):
+                continue
+            family = plugin_family(str(plugin.get("filename", "")))
+            if family in (None, self.gazebo):
+                self.plugin(sensor, plugin, target)
+                continue
+            self.ctx.note(
+                "MK848",
+                f'plugin "{plugin.get("name", "")}" ({plugin.get("filename", "")}) of sensor "{device.name}" '
+                f"is Gazebo {family} code and this file is written for Gazebo {self.gazebo} "
+                f"(--gazebo {family} keeps it); left out",
+                device.source,
+                target,
+            )
 
     # -- canonical sensors ---------------------------------------------------------------------
 
@@ -151,7 +220,8 @@ class DeviceWriter:
         _noise(camera, p.get("noise_stddev"))
 
     def _lidar(self, sensor: Element, p: dict[str, Any]) -> None:
-        lidar = sub(sensor, "lidar" if self.version >= (1, 7) else "ray")
+        # Gazebo classic reads <ray> only; <lidar> is the SDF ≥ 1.7 name Gazebo Sim reads
+        lidar = sub(sensor, "lidar" if self.version >= (1, 7) and self.gazebo == "sim" else "ray")
         scan = sub(lidar, "scan")
         for axis, samples in (("horizontal", 640), ("vertical", 1)):
             if axis == "vertical" and not p.get("vertical_samples"):
@@ -270,6 +340,12 @@ def _sdf_light_params(params: dict[str, Any]) -> dict[str, Any]:
     if "diffuse" in params:
         out["color"] = params["diffuse"]
     return out
+
+
+def _value(value: Any) -> str:
+    if isinstance(value, list | tuple):
+        return fmt_vec(value)
+    return fmt(value) if isinstance(value, float) else str(value)
 
 
 def _noise(parent: Element, stddev: Any) -> None:

@@ -37,6 +37,7 @@ from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
+from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
 from modelkit.formats.sdf.write_geometry import GeomWriter
@@ -102,7 +103,9 @@ class _ModelWriter:
         self.frames_ok = self.version >= (1, 7)
         self.names = Names(ctx)
         self.geoms = GeomWriter(ctx, self.version)
-        self.devices = DeviceWriter(ctx, self.version, robot.source_format)
+        self.devices = DeviceWriter(
+            ctx, self.version, robot.source_format, gazebo_family(robot, ctx.options.gazebo)
+        )
         self.children = robot.children_of()
         self.joint_of = {j.child: j for j in robot.joints}
         self.links = {lk.name: lk for lk in robot.links}

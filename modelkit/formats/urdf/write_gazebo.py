@@ -3,8 +3,9 @@ the other kept extension elements.
 
 URDF has no sensors; Gazebo (and libsdformat's URDF → SDF conversion) reads SDF ``<sensor>``
 elements inside ``<gazebo reference="link">`` and copies them into the link. A device in the
-shared vocabulary (:class:`modelkit.model.DeviceKind`) is written as such a sensor, its ``<pose>``
-the device frame in the link frame (+X forward, as SDF). A device read from a URDF ``<gazebo>``
+shared vocabulary (:class:`modelkit.model.DeviceKind`) is written as such a sensor, on its own sensor
+link (``write_frames``) or on its link with its ``<pose>`` the device frame in the link frame (+X
+forward, as SDF). A device read from a URDF ``<gazebo>``
 block (its SDF kept in ``params["xml"]``) is written back as it was. Lights and devices without a
 meaning elsewhere are dropped (MK806).
 """
@@ -18,11 +19,14 @@ from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
+from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.numbers import fmt
 from modelkit.diagnostics import SourceLocation
 from modelkit.formats.urdf.write_actuators import write_transmissions
+from modelkit.formats.urdf.write_frames import SensorFrames
 from modelkit.formats.urdf.write_names import NameTable
 from modelkit.model import Device, DeviceKind, Link, Robot
+from modelkit.spatial import Pose
 
 # Gazebo reads the SDF inside a URDF's <gazebo> blocks; sensors are written as SDF 1.6 describes them
 # (`<ray>` for lidars), which Gazebo classic and Gazebo Sim both read.
@@ -45,15 +49,19 @@ def parse_block(xml: str) -> Element | None:
     return element
 
 
-def sensor_element(device: Device, ctx: WriteContext, owner: str) -> Element | None:
-    """An SDF ``<sensor>`` for a device of the shared vocabulary, written by the SDF writer's own
-    device code (None: the kind has no sensor)."""
+def sensor_element(
+    device: Device, ctx: WriteContext, owner: str, pose: Pose | None = None, gazebo: str = "sim"
+) -> Element | None:
+    """An SDF ``<sensor>`` for a device of the shared vocabulary at ``pose`` in the referenced link
+    (default: the device pose) for Gazebo ``gazebo`` (classic or sim), written by the SDF writer's own
+    device code (None: no sensor)."""
     from modelkit.formats.sdf.write_devices import CANONICAL_SENSOR, DeviceWriter
 
     if device.canonical not in CANONICAL_SENSOR:
         return None
     holder = etree.Element("gazebo")
-    DeviceWriter(ctx, GAZEBO_SDF_VERSION, "urdf").device(holder, device, device.pose, None, owner, set())
+    where = device.pose if pose is None else pose
+    DeviceWriter(ctx, GAZEBO_SDF_VERSION, "urdf", gazebo).device(holder, device, where, None, owner, set())
     return holder[0] if len(holder) else None
 
 
@@ -91,14 +99,24 @@ def _kept_blocks(
     return sensors
 
 
-def _device(robot_el: Element, link: Link, name: str, device: Device, ctx: WriteContext) -> None:
+def _device(
+    robot_el: Element,
+    link: Link,
+    name: str,
+    device: Device,
+    ctx: WriteContext,
+    place: tuple[str, Pose],
+    gazebo: str,
+) -> None:
+    """One device: its kept block on its link, or a sensor on ``place`` (its frame link and pose)."""
     xml = device.params.get("xml")
     if isinstance(xml, str):
         block = parse_block(xml)
         if block is not None and block.tag == "sensor":
             _gazebo(robot_el, name).append(block)
             return
-    sensor = sensor_element(device, ctx, f"gazebo[{name}]")
+    reference, pose = place
+    sensor = sensor_element(device, ctx, f"gazebo[{reference}]", pose, gazebo)
     if sensor is None:
         what = device.canonical.value if device.canonical is not DeviceKind.OTHER else device.kind
         ctx.note(
@@ -109,12 +127,16 @@ def _device(robot_el: Element, link: Link, name: str, device: Device, ctx: Write
             f"link[{name}]",
         )
         return
-    _gazebo(robot_el, name).append(sensor)
+    _gazebo(robot_el, reference).append(sensor)
 
 
-def write_extensions(robot_el: Element, robot: Robot, names: NameTable, ctx: WriteContext) -> None:
+def write_extensions(
+    robot_el: Element, robot: Robot, names: NameTable, frames: SensorFrames, ctx: WriteContext
+) -> None:
     """Every ``<gazebo>`` block (per link, per joint, robot level), then the other kept extensions."""
     friction = floor_friction(robot)
+    gazebo = gazebo_family(robot, ctx.options.gazebo)
+    framed: list[tuple[Link, str, Device, tuple[str, Pose]]] = []
     for index, link in enumerate(robot.links):
         name = names.links[index]
         written = _kept_blocks(robot_el, link.extras.get("gazebo"), name, ctx, f'link "{link.name}"')
@@ -135,16 +157,23 @@ def write_extensions(robot_el: Element, robot: Robot, names: NameTable, ctx: Wri
                 link.loc("material"),
                 f"gazebo[{name}]",
             )
-        for device in link.devices:
+        for device_index, device in enumerate(link.devices):
             if device.name in written and isinstance(device.params.get("xml"), str):
                 continue
-            _device(robot_el, link, name, device, ctx)
+            place = frames.place(index, device_index, name, device)
+            if place[0] != name:  # on its sensor link, which comes after the model's links
+                framed.append((link, name, device, place))
+                continue
+            _device(robot_el, link, name, device, ctx, place, gazebo)
+    for link, name, device, place in framed:
+        _device(robot_el, link, name, device, ctx, place, gazebo)
     for index, joint in enumerate(robot.joints):
         _kept_blocks(robot_el, joint.extras.get("gazebo"), names.joints[index], ctx, f'joint "{joint.name}"')
     for entry in robot.extras.get("gazebo", []) or []:
         reference = entry.get("reference") if isinstance(entry, dict) else None
         written_ref = names.link(reference) if reference in names.link_map else reference
         _kept_blocks(robot_el, [entry], written_ref, ctx, "the robot")
+    _model_plugins(robot_el, robot, gazebo, ctx)
     _transmissions(robot_el, robot, names, ctx)
     write_transmissions(robot_el, robot, names.joint_map, ctx)
     for key in ("ros2_control", "mujoco", "sensor"):
@@ -157,6 +186,30 @@ def write_extensions(robot_el: Element, robot: Robot, names: NameTable, ctx: Wri
                 if joint_el.get("name") in names.joint_map:
                     joint_el.set("name", names.joint(joint_el.get("name", "")))
             robot_el.append(block)
+
+
+def _model_plugins(robot_el: Element, robot: Robot, gazebo: str, ctx: WriteContext) -> None:
+    """An SDF source's model plugins as robot-level ``<gazebo>`` blocks (libsdformat's URDF import
+    copies them into the model), those of the other Gazebo left out with an MK848 note."""
+    from modelkit.convert.gazebo import plugin_family
+
+    for entry in robot.extras.get("sdf_plugins") or []:
+        if not isinstance(entry, dict):
+            continue
+        name, filename = entry.get("name", ""), str(entry.get("filename", ""))
+        family = plugin_family(filename)
+        block = parse_block(str(entry.get("xml", "")))
+        if family not in (None, gazebo) or block is None:
+            why = (
+                f"is Gazebo {family} code and this file is written for Gazebo {gazebo} "
+                f"(--gazebo {family} keeps it)"
+                if block is not None
+                else "cannot be copied on its own"
+            )
+            ctx.note("MK848" if block is not None else "MK808", f'model plugin "{name}" ({filename}) {why}; '
+                     "left out", robot.source, "gazebo")
+            continue
+        _gazebo(robot_el, None).append(block)
 
 
 def _transmissions(robot_el: Element, robot: Robot, names: NameTable, ctx: WriteContext) -> None:

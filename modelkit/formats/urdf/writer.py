@@ -4,8 +4,9 @@ Element order: robot-level materials, links (model order, then links the writer 
 (model order, then joints the writer adds), ``<gazebo>`` blocks, transmissions and other kept
 extensions. Pretty-printed with two-space indentation, numbers through
 :func:`modelkit.convert.numbers.fmt`. The parts live in ``write_names`` (unique names, MK800),
-``write_links`` (inertials, geometry, materials), ``write_joints`` (joint types, synthesised limits)
-and ``write_gazebo`` (sensors, friction, kept extension blocks).
+``write_links`` (inertials, geometry, materials), ``write_joints`` (joint types, synthesised limits),
+``write_frames`` (sensor links and optical frames, MK847) and ``write_gazebo`` (sensors, friction,
+kept extension blocks).
 
 How the root meets the world: URDF has no root pose and its consumers float the root unless it
 hangs from a link named ``world``. A welded root (``--base``, settled in ``modelkit/convert/base.py``)
@@ -26,6 +27,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.notes import ConversionNote, renames
 from modelkit.convert.simulator import pybullet_settings
+from modelkit.formats.urdf.write_frames import sensor_frames
 from modelkit.formats.urdf.write_gazebo import write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
 from modelkit.formats.urdf.write_links import MaterialTable, link_element, origin_element
@@ -56,6 +58,7 @@ SILENT_EXTRAS = frozenset(
         "ros2_control",
         "mujoco",
         "sensor",
+        "sdf_plugins",  # written as <gazebo> blocks (write_gazebo)
     }
 )
 # Robot extras that do: the note that says they are left out.
@@ -70,7 +73,6 @@ DROPPED_EXTRAS = {
     "mjcf_keyframes": ("MK820", "MJCF keyframes (stored joint positions)"),
     "mjcf_world_geoms": ("MK822", "MJCF world geoms"),
     "mjcf_world_sites": ("MK822", "MJCF world sites"),
-    "sdf_plugins": ("MK808", "SDF model plugins"),
     "sdf_world": ("MK822", "the SDF world around the model"),
 }
 SILENT_LINK_EXTRAS = frozenset(
@@ -124,7 +126,9 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
         joints.extend(joint_elements(joint, index, names, ctx, extra_links))
     joints.extend(_root(robot, names, ctx, add_world))
     joints.extend(_free_links(robot, names, ctx))
-    for name in extra_links:
+    frames = sensor_frames(robot, names, ctx)
+    joints.extend(frames.joints)
+    for name in extra_links + frames.links:
         etree.SubElement(links, "link", name=name)
 
     out = etree.Element("robot", name=robot.name or "robot")
@@ -142,8 +146,8 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
         out.append(el)
     for el in joints:
         out.append(el)
-    write_extensions(out, robot, names, ctx)
-    _massless(robot, names, ctx)
+    write_extensions(out, robot, names, frames, ctx)
+    _massless(robot, names, ctx, frames.links)
     _notes(robot, ctx)
     settings = pybullet_settings(robot)
     if settings:
@@ -231,13 +235,13 @@ def _free_links(robot: Robot, names: NameTable, ctx: WriteContext) -> list[Eleme
     return out
 
 
-def _massless(robot: Robot, names: NameTable, ctx: WriteContext) -> None:
+def _massless(robot: Robot, names: NameTable, ctx: WriteContext, added: list[str]) -> None:
     """One note for the links written without ``<inertial>`` (frames), with what peers do to them."""
     massless = [
         names.links[i]
         for i, link in enumerate(robot.links)
         if (link.inertial is None or link.inertial.mass <= 0.0) and link.name != WORLD_LINK
-    ]
+    ] + added
     if not massless:
         return
     shown = ", ".join(f'"{n}"' for n in massless[:8]) + (

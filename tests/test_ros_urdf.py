@@ -1,0 +1,240 @@
+"""URDF that ROS tools take (issue 17 item 7): the source's joint names, sensors as TF frames.
+
+Oracles: ``check_urdf`` (urdfdom, what robot_state_publisher parses with), yourdfpy forward kinematics
+(the transforms robot_state_publisher would publish), libsdformat 12 (what Gazebo spawns a URDF with).
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+from lxml import etree
+
+from modelkit.api import validate
+from modelkit.convert.api import render_model
+from modelkit.convert.gazebo import plugin_family, source_family
+from modelkit.convert.notes import ConversionNote
+from modelkit.convert.options import WriteOptions
+from modelkit.convert.output import OutputPlan
+from modelkit.model import Robot
+from tests.conftest import SAMPLES, TUTORIAL, require_tool
+from tests.test_sdf_reader import oracle_has_errors, sdf_oracle  # noqa: F401 (the fixture)
+
+PANTILT = TUTORIAL / "mobile_robot_pantilt.body"
+SENSORS = TUTORIAL / "mobile_robot_sensors.body"
+
+
+def _read(path: Path) -> Robot:
+    checked = validate(path)
+    assert checked.robot is not None, [str(d) for d in checked.diagnostics]
+    return checked.robot
+
+
+def _write(
+    robot: Robot, folder: Path, options: WriteOptions | None = None
+) -> tuple[Path, list[ConversionNote]]:
+    plan = OutputPlan(folder)
+    notes = render_model(robot, "urdf", plan, "robot.urdf", options or WriteOptions())
+    assert not plan.problems()
+    plan.commit()
+    return folder / "robot.urdf", notes
+
+
+def _check_urdf(path: Path) -> str:
+    run = subprocess.run([require_tool("check_urdf"), str(path)], capture_output=True, text=True, timeout=30)
+    assert run.returncode == 0, run.stderr
+    return run.stdout
+
+
+def _joints(path: Path) -> dict[str, tuple[str, str]]:
+    root = etree.parse(str(path)).getroot()
+    out: dict[str, tuple[str, str]] = {}
+    for joint in root.iter("joint"):
+        parent, child = joint.find("parent"), joint.find("child")
+        assert parent is not None and child is not None
+        out[joint.get("name", "")] = (parent.get("link", ""), child.get("link", ""))
+    return out
+
+
+def test_pantilt_wheel_joints_keep_their_source_names(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+    """The wheel joints are LeftWheel / RightWheel as in the .body (joint_states drives them in rviz);
+    check_urdf takes the file; libsdformat refuses the shared name, which MK846 says and
+    urdf_distinct_names avoids."""
+    robot = _read(PANTILT)
+    path, notes = _write(robot, tmp_path / "kept")
+    joints = _joints(path)
+    assert joints["LeftWheel"] == ("Chassis", "LeftWheel")
+    assert joints["RightWheel"] == ("Chassis", "RightWheel")
+    assert {"PanJoint", "TiltJoint"} <= set(joints) and not any(n.endswith("_joint") for n in joints)
+    assert "MK800" not in {n.code for n in notes}
+    kept = [n for n in notes if n.code == "MK846"]
+    assert len(kept) == 1 and '"LeftWheel", "RightWheel"' in kept[0].message
+    tree = _check_urdf(path)
+    assert "root Link: Chassis has 3 child(ren)" in tree and "child(1):  LeftWheel" in tree
+    assert oracle_has_errors(sdf_oracle, path)  # libsdformat: "Non-unique name", a frame-graph cycle
+
+    distinct, notes = _write(robot, tmp_path / "distinct", WriteOptions(urdf_distinct_names=True))
+    assert {"LeftWheel_joint", "RightWheel_joint"} <= set(_joints(distinct))
+    assert "MK846" not in {n.code for n in notes} and sum(n.code == "MK800" for n in notes) == 2
+    _check_urdf(distinct)
+    assert not oracle_has_errors(sdf_oracle, distinct)
+
+
+def _elements(path: Path, tag: str) -> list[bytes]:
+    return [etree.tostring(el) for el in etree.parse(str(path)).getroot().iter(tag)]
+
+
+def _rot(axis: str, degrees: float) -> np.ndarray:
+    c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+    return {
+        "x": np.array([[1, 0, 0], [0, c, -s], [0, s, c]]),
+        "y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
+        "z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]),
+    }[axis]
+
+
+def _pose(rotation: np.ndarray, translation: tuple[float, float, float]) -> np.ndarray:
+    out = np.eye(4)
+    out[:3, :3], out[:3, 3] = rotation, translation
+    return out
+
+
+def test_sensors_are_tf_frames_where_the_body_file_puts_them(tmp_path: Path) -> None:
+    """The acceptance case: mobile_robot_sensors.body → URDF has links LiDAR, RealSense and
+    RealSense_optical on fixed joints; check_urdf shows them, and yourdfpy's forward kinematics (what
+    robot_state_publisher publishes) puts them where the .body file does, at a pan/tilt pose.
+
+    Expected poses come from the .body's numbers by hand: PanLink at (-0.02, 0, 0.165) turning about Z,
+    TiltLink 0.12 above it turning about Y; the LiDAR 0.025 above TiltLink; the RealSense at
+    (0.06, 0, -0.02) with rotation [0 1 0 90°][0 0 1 -90°] and `optical_frame: cv`, which is the
+    REP-103 optical frame itself (z forward, x right, y down), the camera link the same point, x forward.
+    """
+    yourdfpy = pytest.importorskip("yourdfpy")
+    robot = _read(SENSORS)
+    path, notes = _write(robot, tmp_path)
+    framed = [n for n in notes if n.code == "MK847"]
+    assert len(framed) == 1 and '"RealSense_optical"' in framed[0].message
+    tree = _check_urdf(path)
+    for line in ("child(1):  LiDAR", "child(2):  RealSense", "child(1):  RealSense_optical"):
+        assert line in tree, tree
+    joints = _joints(path)
+    assert joints["LiDAR_joint"] == ("TiltLink", "LiDAR")
+    assert joints["RealSense_joint"] == ("TiltLink", "RealSense")
+    assert joints["RealSense_optical_joint"] == ("RealSense", "RealSense_optical")
+    root = etree.parse(str(path)).getroot()
+    references = {g.get("reference"): [s.get("name") for s in g.iter("sensor")] for g in root.iter("gazebo")}
+    assert references["LiDAR"] == ["LiDAR"] and references["RealSense"] == ["RealSense"]
+
+    pan, tilt = 23.0, -17.0
+    model = yourdfpy.URDF.load(str(path), build_scene_graph=True, load_meshes=False)
+    model.update_cfg({"PanJoint": math.radians(pan), "TiltJoint": math.radians(tilt),
+                      "LeftWheel": 0.3, "RightWheel": -0.2})
+    tilt_link = _pose(_rot("z", pan), (-0.02, 0.0, 0.165)) @ _pose(_rot("y", tilt), (0.0, 0.0, 0.12))
+    optical = tilt_link @ _pose(_rot("y", 90.0) @ _rot("z", -90.0), (0.06, 0.0, -0.02))
+    expected = {
+        "LiDAR": tilt_link @ _pose(np.eye(3), (0.0, 0.0, 0.025)),
+        "RealSense": tilt_link @ _pose(np.eye(3), (0.06, 0.0, -0.02)),
+        "RealSense_optical": optical,
+    }
+    for frame, pose in expected.items():
+        got = model.get_transform(frame_to=frame, frame_from="Chassis")
+        assert np.allclose(got, pose, atol=1e-12), (frame, got, pose)
+    # REP-103 in the world: the optical z axis is the camera link's x (where it looks), y is its -z
+    camera = model.get_transform(frame_to="RealSense", frame_from="Chassis")
+    assert np.allclose(optical[:3, 2], camera[:3, 0]) and np.allclose(optical[:3, 1], -camera[:3, 2])
+
+
+def test_sensor_links_round_trip_and_can_be_left_out(tmp_path: Path) -> None:
+    """Read back, a sensor link keeps its sensor and is written again unchanged (no LiDAR_2, no mass);
+    validate finds no error in the output; --no-urdf-sensor-links keeps the sensors on TiltLink."""
+    robot = _read(SENSORS)
+    path, _ = _write(robot, tmp_path / "first")
+    checked = validate(path)
+    assert not [d for d in checked.diagnostics if d.severity.value == "error"]
+    back = checked.robot
+    assert back is not None
+    lidar = back.link("LiDAR")
+    assert lidar is not None and lidar.inertial is None and [d.name for d in lidar.devices] == ["LiDAR"]
+    # the floating root reads back open (URDF's convention): ask for the floating root it had
+    again, notes = _write(back, tmp_path / "again", WriteOptions(base="floating"))
+    for tag in ("joint", "gazebo"):  # (the PyBullet <contact> of the links is not read back: MK123)
+        assert _elements(again, tag) == _elements(path, tag), tag
+    assert [lk.get("name") for lk in etree.parse(str(again)).getroot().iter("link")] == [
+        lk.get("name") for lk in etree.parse(str(path)).getroot().iter("link")
+    ]
+    assert "MK847" not in {n.code for n in notes}  # the frames are the model's links now
+
+    plain, notes = _write(robot, tmp_path / "plain", WriteOptions(urdf_sensor_links=False))
+    assert "MK847" not in {n.code for n in notes}
+    assert not {"LiDAR", "RealSense", "RealSense_optical"} & {lk.get("name") for lk in
+                                                             etree.parse(str(plain)).getroot().iter("link")}
+    sensors = {s.get("name"): s for s in etree.parse(str(plain)).getroot().iter("sensor")}
+    assert sensors["LiDAR"].findtext("pose") == "0 0 0.025 0 0 0"
+    assert sensors["RealSense"].getparent().get("reference") == "TiltLink"
+
+
+UNICYCLE = SAMPLES / "gazebo_unicycle" / "unicycle.sdf"
+
+
+def _sensors(path: Path) -> dict[str, tuple[str | None, str | None, list[str]]]:
+    """reference → (sensor name, type, plugin files) of each <gazebo> block holding a sensor."""
+    out = {}
+    for block in etree.parse(str(path)).getroot().iter("gazebo"):
+        for sensor in block.iter("sensor"):
+            plugins = [p.get("filename", "") for p in sensor.iter("plugin")]
+            out[block.get("reference", "")] = (sensor.get("name"), sensor.get("type"), plugins)
+    return out
+
+
+def test_gazebo_family_follows_the_source_or_the_option(tmp_path: Path) -> None:
+    """The lecture's unicycle SDF is Gazebo classic (`ray` sensors, gazebo_ros plugins): its URDF keeps
+    the sensor types and the three plugins; --gazebo sim writes gz-sim types and notes each dropped
+    plugin (MK848). plugin_family tells the families apart by file name."""
+    robot = _read(UNICYCLE)
+    assert source_family(robot) == "classic"
+    path, notes = _write(robot, tmp_path / "auto")
+    assert _sensors(path) == {
+        "sensor": ("sensor", "ray", ["libgazebo_ros_velodyne_laser.so"]),
+        "sensor_2": ("sensor", "ray", ["libgazebo_ros_velodyne_laser.so"]),
+        "camera1": ("camera1", "camera", ["libgazebo_ros_camera.so"]),
+    }
+    assert "MK848" not in {n.code for n in notes}
+    _check_urdf(path)
+    sim, notes = _write(robot, tmp_path / "sim", WriteOptions(gazebo="sim"))
+    assert {ref: (t, files) for ref, (_, t, files) in _sensors(sim).items()} == {
+        "sensor": ("gpu_lidar", []), "sensor_2": ("gpu_lidar", []), "camera1": ("camera", [])}
+    dropped = [n for n in notes if n.code == "MK848"]
+    assert len(dropped) == 3 and all("Gazebo classic code" in n.message for n in dropped)
+    assert plugin_family("libgazebo_ros_camera.so") == "classic"
+    assert plugin_family("gz-sim-diff-drive-system") == "sim"
+    assert plugin_family("ignition-gazebo-sensors-system") == "sim"
+    assert plugin_family("libmy_controller.so") is None
+
+
+def test_unmapped_sensor_parameters_are_notes_and_classic_sdf_loads(
+    tmp_path: Path, sdf_oracle: Path  # noqa: F811
+) -> None:
+    """Choreonoid's detection_rate (and the RealSense's depth range) have no SDF element: an MK849 note
+    each, with the value. --gazebo classic writes `ray` with a <ray> element and `depth` (Gazebo 11's
+    names) in URDF and SDF; libsdformat 12 loads the SDF."""
+    robot = _read(SENSORS)
+    path, notes = _write(robot, tmp_path / "sim")
+    unmapped = {n.message.split('"')[1]: n.message for n in notes if n.code == "MK849"}
+    assert set(unmapped) == {"LiDAR", "RealSense"}
+    assert "detection_rate 0.9" in unmapped["LiDAR"]
+    assert "range_max 10" in unmapped["RealSense"] and "detection_rate 0.9" in unmapped["RealSense"]
+    types = {ref: t for ref, (_, t, _) in _sensors(path).items()}
+    assert types == {"LiDAR": "gpu_lidar", "RealSense": "rgbd_camera"}
+    classic, _ = _write(robot, tmp_path / "classic", WriteOptions(gazebo="classic"))
+    assert {ref: t for ref, (_, t, _) in _sensors(classic).items()} == {"LiDAR": "ray", "RealSense": "depth"}
+    plan = OutputPlan(tmp_path / "sdf")
+    render_model(robot, "sdf", plan, "robot.sdf", WriteOptions(gazebo="classic"))
+    plan.commit()
+    sdf = etree.parse(str(tmp_path / "sdf" / "robot.sdf")).getroot()
+    lidar = next(s for s in sdf.iter("sensor") if s.get("name") == "LiDAR")
+    assert lidar.get("type") == "ray" and lidar.find("ray") is not None and lidar.find("lidar") is None
+    assert not oracle_has_errors(sdf_oracle, tmp_path / "sdf" / "robot.sdf")
