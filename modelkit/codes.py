@@ -185,8 +185,10 @@ _TABLE: tuple[CodeInfo, ...] = (
     CodeInfo(
         "MK136",
         "urdf-material-unnamed",
-        "error",
-        "A `<material>` in a visual has no `name` (urdfdom drops the visual; PyBullet refuses the file).",
+        "warning",
+        "A `<material>` in a visual has no `name`. Reference: check_urdf loads the file and urdfdom drops "
+        "the visual; PyBullet refuses the file (an error under `--target pybullet`); modelkit keeps "
+        "the visual with its inline colour.",
     ),
     CodeInfo(
         "MK137",
@@ -604,7 +606,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "moving-link-massless",
         "error",
         "A moving link has no mass after merging the links fixed to it. When nothing below it has mass "
-        "either, its joint moves nothing and cannot be simulated (an error). When links below it have mass, "
+        "either, its joint moves nothing and cannot be simulated: an error, except in URDF, whose loader "
+        "accepts it (check_urdf loads it, PyBullet freezes the joint, MuJoCo refuses it: a warning, an error "
+        "under `--target mjcf`). When links below it have mass, "
         "articulated-body engines (PyBullet, Pinocchio) simulate it and MuJoCo refuses it: a warning (an "
         "error under `--target mjcf`). Reference for a URDF link without `<inertial>`: check_urdf accepts "
         "kinematic-only models, PyBullet gives 1 kg, MuJoCo refuses (a warning; an error under `--target "

@@ -102,17 +102,36 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
                     severity=Severity.WARNING,
                 )
                 continue
-            yield diag(
-                "MK313",
-                f'link "{link.name}" moves but its mass is zero, and so does everything below it: its joint '
-                "moves nothing with mass, which cannot be simulated (MuJoCo refuses it, PyBullet freezes the "
-                "joint)",
-                _mass_loc(link),
-            )
+            yield _massless_chain(robot, link)
 
 
 # A massless body that moves links with mass (MK313, a warning): who refuses it. An error under --target mjcf.
 MASSLESS_BODY_REFUSED = "MuJoCo refuses a moving body without mass"
+
+
+# Who loads a moving link whose mass is zero, like everything below it (MK313). Where the file's own loader
+# takes it (URDF: check_urdf) it is a warning, an error under --target mjcf; elsewhere an error.
+MASSLESS_CHAIN_CONSUMERS = (
+    "check_urdf accepts it (urdfdom keeps the zero mass), PyBullet loads it and freezes the joint (a "
+    "velocity motor leaves it at 0), MuJoCo refuses it"
+)
+
+
+def _massless_chain(robot: Robot, link: Link) -> Diagnostic:
+    """MK313 for a moving link whose joint moves nothing with mass."""
+    what = (
+        f'link "{link.name}" moves but its mass is zero, and so does everything below it: its joint moves '
+        "nothing with mass"
+    )
+    if robot.source_format == "urdf":
+        return diag(
+            "MK313",
+            f"{what}; {MASSLESS_CHAIN_CONSUMERS}",
+            _mass_loc(link),
+            hint="give the link its mass and inertia, or make its joint fixed",
+            severity=Severity.WARNING,
+        )
+    return diag("MK313", f"{what}, which cannot be simulated (MuJoCo refuses it)", _mass_loc(link))
 
 
 # MK313 for a moving link without <inertial> in a format whose loader accepts it (URDF: check_urdf
