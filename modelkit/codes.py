@@ -521,10 +521,11 @@ _TABLE: tuple[CodeInfo, ...] = (
     CodeInfo(
         "MK301",
         "inertia-asymmetric",
-        "error",
+        "warning",
         "A 9-element inertia matrix is not symmetric: an off-diagonal pair differs by more than 1e-4 of "
         "the largest diagonal moment (less is rounding, ignored). Reference: only .body has 9 elements; "
-        "Choreonoid uses the matrix as given, which no rigid body has.",
+        "Choreonoid loads the file and uses the matrix as given (no rigid body has such a matrix), so a "
+        "warning; formats of six numbers get its upper triangle (xy, xz, yz) from `convert`.",
     ),
     CodeInfo(
         "MK302",

@@ -1387,3 +1387,19 @@ def test_nameless_visual_material_is_judged_like_check_urdf_and_an_error_for_pyb
     assert d.code == "MK136" and "PyBullet refuses the file" in d.message
     assert d.location is not None and d.location.line == 3
     assert validate(path, target="mjcf").errors == []
+
+
+def test_asymmetric_body_inertia_is_a_warning_and_converts_its_upper_triangle(tmp_path: Path) -> None:
+    """MK301 (issue 18 item 3): Choreonoid loads a 9-element inertia that is not symmetric and uses it as
+    given; validate warns and passes, convert writes the upper triangle (the row-major xy, xz, yz)."""
+    from click.testing import CliRunner
+
+    from modelkit.cli import main
+
+    source = REPO / "tests" / "broken_body" / "inertia_asymmetric.body"  # arm: xy 0.005, yx 0
+    v = validate(source)
+    assert v.errors == [] and _codes(v, "warning") == ["MK301"]
+    out = tmp_path / "p.urdf"
+    result = CliRunner().invoke(main, ["convert", "-o", str(out), str(source)])
+    assert result.exit_code == 0, result.output
+    assert 'ixx="0.021" ixy="0.005" ixz="0" iyy="0.021" iyz="0" izz="0.0005"' in out.read_text()

@@ -159,6 +159,10 @@ def _no_mass_information(robot: Robot, link: Link) -> Diagnostic:
 # MK301: an inertia matrix is asymmetric when an off-diagonal pair differs by more than this fraction of
 # the largest diagonal moment (smaller differences are rounding in the source and are ignored).
 ASYMMETRY_TOLERANCE = 1e-4
+# What a loader does with an asymmetric 9-element inertia (MK301, a warning: Choreonoid loads the file).
+ASYMMETRIC_INERTIA_CONSUMERS = (
+    "Choreonoid uses the matrix as given, which no rigid body has; convert writes its upper triangle"
+)
 # Larger masses or inertia components are refused: the parallel-axis sums, the principal moments and
 # an engine's mass matrix square and add them, which overflows double precision near 1e154 (a 1e308
 # inertia made the eigenvalue solver fail, and its moments came out as zero). No real body is near.
@@ -237,9 +241,9 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
             yield diag(
                 "MK301",
                 f'link "{link.name}": the inertia matrix is not symmetric (off-diagonal pairs differ by up '
-                f"to {skew:.6g}){static}",
+                f"to {skew:.6g}); {ASYMMETRIC_INERTIA_CONSUMERS}{static}",
                 where,
-                severity=severity,
+                hint="give the same value to each off-diagonal pair (row-major: xy = yx, xz = zx, yz = zy)",
             )
             continue
         head = merged_into.get(link.name)
