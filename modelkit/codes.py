@@ -349,6 +349,16 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "MuJoCo warned while reading the file (its message is given; nothing goes to MUJOCO_LOG.TXT).",
     ),
+    # -- MK18x: .body values -----------------------------------------------------------------
+    CodeInfo(
+        "MK181",
+        "body-number-trailing-text",
+        "warning",
+        "A `.body` number is followed by text (a C-style suffix such as `0.001f`, a unit). Reference: "
+        "Choreonoid reads a list element or `mass` by its leading number (C strtod) and ignores the rest; "
+        "other keys it reads only when the whole text is a number, else it keeps the default. modelkit reads "
+        "both the same way and names the value it took.",
+    ),
     # -- MK2xx: kinematic tree --------------------------------------------------------------
     CodeInfo("MK200", "no-root", "error", "No root link can be found (every link has a parent, or a cycle)."),
     CodeInfo("MK201", "multiple-roots", "error", "More than one link has no parent."),
