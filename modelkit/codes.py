@@ -299,6 +299,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "Valid SDF that the robot model cannot hold (actor, world joint, nested static model ...); skipped.",
     ),
+    CodeInfo(
+        "MK156",
+        "sdf-joint-model-frame",
+        "error",
+        "A joint's `<parent>` or `<child>` is the model frame `__model__` (libsdformat refuses it: a joint "
+        "joins links or frames of the model, not the model itself).",
+    ),
     # -- MK17x: MJCF ------------------------------------------------------------------------
     # (mjcf section)
     CodeInfo(

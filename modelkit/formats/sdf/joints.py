@@ -20,7 +20,7 @@ from lxml.etree import _Element as Element
 
 from modelkit import rot3
 from modelkit.diagnostics import Severity, SourceLocation, did_you_mean
-from modelkit.formats.sdf.collect import Item
+from modelkit.formats.sdf.collect import MODEL_FRAME, Item
 from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import sensor_device
@@ -145,6 +145,16 @@ def _ends(ctx: Context, graph: FrameGraph, data: JointData, what: str) -> None:
                 continue
             data.parent_link = WORLD_LINK
             joint.parent = WORLD_LINK
+            continue
+        if text == MODEL_FRAME:  # the graph knows the frame, but a joint may not use it
+            ctx.sink.emit(
+                "MK156",
+                f'the {end} of {what} is the model frame "{MODEL_FRAME}": libsdformat refuses it '
+                f'("{end} frame with name[{MODEL_FRAME}] ... not found in model"); a joint joins links or '
+                "frames of the model",
+                loc,
+                hint="name the link the joint is meant to join (the canonical link for the model frame)",
+            )
             continue
         vertex = graph.lookup(item.scope, text)
         link = graph.link_of(vertex) if vertex is not None else None
