@@ -909,6 +909,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "info",
         "A visual's colour comes from an OGRE material script; only the script name is kept.",
     ),
+    CodeInfo(
+        "MK535",
+        "sdf-include-no-model-config",
+        "error",
+        "An `<include>` names a model folder without `model.config` (or the older `manifest.xml`): "
+        "libsdformat cannot resolve it and refuses the file. modelkit still reads the folder's `model.sdf` "
+        "to check it.",
+    ),
     # -- MK6xx: devices and scene nodes ----------------------------------------------------------
     CodeInfo(
         "MK600",

@@ -814,3 +814,28 @@ def test_validate_agrees_with_libsdformat(path: Path, sdf_oracle: Path) -> None:
 def test_oracle_exclusions_are_real_case_files() -> None:
     for name in NO_ORACLE_OPINION:
         assert (BROKEN / name).is_file(), name
+
+
+def test_model_uri_include_without_model_config_is_refused_like_libsdformat(
+    tmp_path: Path, sdf_oracle: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """MK535 (issue 18 item 3): a model:// folder on the resource path with model.sdf but no model.config
+    is refused by libsdformat (error code 13); with a model.config both accept it."""
+    models = tmp_path / "models"
+    for name in ("bare", "configured"):
+        (models / name).mkdir(parents=True)
+        (models / name / "model.sdf").write_text((BROKEN / "support" / "clean.sdf").read_text())
+    (models / "configured" / "model.config").write_text(
+        '<?xml version="1.0"?>\n<model><name>configured</name><sdf version="1.9">model.sdf</sdf></model>\n'
+    )
+    monkeypatch.setenv("SDF_PATH", str(models))
+    monkeypatch.setenv("GZ_SIM_RESOURCE_PATH", str(models))
+    for name, refused in (("bare", True), ("configured", False)):
+        world = tmp_path / f"{name}.world"
+        world.write_text(
+            f'<?xml version="1.0"?>\n<sdf version="1.9"><world name="w"><include><uri>model://{name}</uri>'
+            "</include></world></sdf>\n"
+        )
+        assert oracle_has_errors(sdf_oracle, world) is refused, name
+        errors = [d.code for d in validate(world).errors]
+        assert errors == (["MK535"] if refused else []), name
