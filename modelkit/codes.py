@@ -297,7 +297,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK155",
         "sdf-not-modelled",
         "warning",
-        "Valid SDF that the robot model cannot hold (actor, world joint, nested static model ...); skipped.",
+        "Valid SDF that the robot model cannot hold as written: an actor, a world joint ... (skipped); "
+        "a static model nested in a moving one (libsdformat accepts it; its links stay fixed in the "
+        "world, held apart from the moving tree; convert writes them as separate bodies).",
     ),
     CodeInfo(
         "MK156",

@@ -839,3 +839,32 @@ def test_model_uri_include_without_model_config_is_refused_like_libsdformat(
         assert oracle_has_errors(sdf_oracle, world) is refused, name
         errors = [d.code for d in validate(world).errors]
         assert errors == (["MK535"] if refused else []), name
+
+
+_NESTED_STATIC = """
+    <model name="fixture">
+      <static>true</static>
+      <pose>1 0 0 0 0 0</pose>
+      <link name="post">
+        <collision name="post_collision"><geometry><box><size>0.1 0.1 0.5</size></box></geometry></collision>
+      </link>
+    </model>
+  </model>
+</sdf>"""
+
+
+def test_nested_static_model_is_accepted_like_libsdformat(tmp_path: Path, sdf_oracle: Path) -> None:
+    """MK155 (issue 18 item 3): a static model nested in a moving one is valid SDF; its links stay fixed in
+    the world. No error, and the message no longer claims the model is skipped or that its links float."""
+    clean = (BROKEN / "support" / "clean.sdf").read_text()
+    path = tmp_path / "nested_static.sdf"
+    path.write_text(clean.replace("  </model>\n</sdf>", _NESTED_STATIC))
+    assert not oracle_has_errors(sdf_oracle, path)
+    v = validate(path)
+    assert v.errors == []
+    (note,) = [d for d in v.diagnostics if d.code == "MK155"]
+    assert note.severity.value == "warning" and "libsdformat accepts it" in note.message
+    assert "skipped" not in note.message
+    (detached,) = [d for d in v.diagnostics if d.code == "MK201"]
+    assert detached.severity.value == "info" and 'nested model "fixture" is static' in detached.message
+    assert "floats freely" not in detached.message

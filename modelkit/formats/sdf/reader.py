@@ -179,11 +179,12 @@ class _Reader:
             self._not_modelled(src, el, f'<{el.tag}> of model "{scope.path}" is not part of the robot model')
         for scope in _scopes(tree):
             if scope.static and not model.static and scope is not tree.scope:
-                self._not_modelled(
-                    scope.src,
-                    scope.element,
-                    f'nested model "{scope.path}" is static (fixed in the world) inside a model that moves; '
-                    "the robot model cannot weld part of a floating model to the world",
+                self.sink.emit(
+                    "MK155",
+                    f'nested model "{scope.path}" is static inside a model that moves: valid SDF '
+                    "(libsdformat accepts it) whose links stay fixed in the world; the robot model keeps "
+                    "them apart from the moving tree, and convert writes them as separate bodies (MK813)",
+                    scope.src.values.loc(scope.element),
                 )
         if model.world is not None:
             robot.extras["sdf_world"] = model.world
