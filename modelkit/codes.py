@@ -308,6 +308,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A joint's `<parent>` or `<child>` is the model frame `__model__` (libsdformat refuses it: a joint "
         "joins links or frames of the model, not the model itself).",
     ),
+    CodeInfo(
+        "MK157",
+        "sdf-placement-frame-without-pose",
+        "error",
+        "An `<include>` has a `<placement_frame>` but no `<pose>` (libsdformat refuses it: the pose says "
+        "where the placement frame goes).",
+    ),
     # -- MK17x: MJCF ------------------------------------------------------------------------
     # (mjcf section)
     CodeInfo(

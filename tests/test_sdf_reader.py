@@ -868,3 +868,16 @@ def test_nested_static_model_is_accepted_like_libsdformat(tmp_path: Path, sdf_or
     (detached,) = [d for d in v.diagnostics if d.code == "MK201"]
     assert detached.severity.value == "info" and 'nested model "fixture" is static' in detached.message
     assert "floats freely" not in detached.message
+
+
+def test_include_placement_frame_with_pose_is_accepted(tmp_path: Path, sdf_oracle: Path) -> None:
+    """The counterpart of broken_sdf/include_placement_without_pose.world (MK157): with a <pose>,
+    libsdformat and modelkit accept it."""
+    (tmp_path / "clean.sdf").write_text((BROKEN / "support" / "clean.sdf").read_text())
+    world = tmp_path / "w.world"
+    world.write_text(
+        '<?xml version="1.0"?>\n<sdf version="1.9"><world name="w"><include><uri>clean.sdf</uri>'
+        "<pose>0 0 1 0 0 0</pose><placement_frame>upper</placement_frame></include></world></sdf>\n"
+    )
+    assert not oracle_has_errors(sdf_oracle, world)
+    assert validate(world).errors == []
