@@ -315,6 +315,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "An `<include>` has a `<placement_frame>` but no `<pose>` (libsdformat refuses it: the pose says "
         "where the placement frame goes).",
     ),
+    CodeInfo(
+        "MK158",
+        "sdf-world-name-shared",
+        "warning",
+        "A world's light or actor has the name of one of its models (or a light and an actor share a name). "
+        "Reference: libsdformat loads the world and warns that the names of the world's children are not "
+        "unique.",
+    ),
     # -- MK17x: MJCF ------------------------------------------------------------------------
     # (mjcf section)
     CodeInfo(

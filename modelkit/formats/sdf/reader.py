@@ -243,6 +243,7 @@ class _Reader:
                 frames.add(model.entry)
             models.append(model)
         self._world_names(world)
+        self._world_shared_names(world, names)
         for entry in world_frame_entries(src, world):
             attached = entry.default
             if attached != WORLD_LINK and not frames.exists(attached):
@@ -273,6 +274,37 @@ class _Reader:
                 )
             else:
                 seen[key] = values.loc(el).line or 0
+
+
+    def _world_shared_names(self, world: Element, models: dict[str, int]) -> None:
+        """MK158: a light or actor named like a model or like another light or actor of the world.
+
+        libsdformat loads such a world and only warns ("Non-unique name[a] detected 2 times in XML children
+        of world"); names must be unique among a world's children for Gazebo's entities and for `gz sdf`.
+        """
+        values = self.src.values
+        first: dict[str, tuple[str, int]] = {name: ("model", line) for name, line in models.items()}
+        for el in world:
+            tag, name = el.tag, el.get("name")
+            if not isinstance(tag, str) or tag not in SHARED_NAME_TAGS or not name:
+                continue
+            earlier = first.get(name)
+            if earlier is None:
+                first[name] = (tag, values.loc(el).line or 0)
+            elif earlier[0] != tag:  # the same type twice is MK237's
+                self.sink.emit(
+                    "MK158",
+                    f'<{tag}> "{name}" of world "{world.get("name") or ""}" has the name of the '
+                    f"<{earlier[0]}> at line {earlier[1]}; libsdformat loads the world but warns that the "
+                    "names of a world's children are not unique",
+                    values.loc(el, "name"),
+                    hint="give every model, light and actor of the world its own name",
+                )
+
+
+# World children that libsdformat only warns about when one shares a name with a model or with another of
+# them (MK158); frames and joints share the frame graph's namespace and are judged there.
+SHARED_NAME_TAGS = ("light", "actor")
 
 
 def _scopes(tree: ModelTree) -> list[Scope]:
