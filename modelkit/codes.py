@@ -304,9 +304,10 @@ _TABLE: tuple[CodeInfo, ...] = (
     CodeInfo(
         "MK156",
         "sdf-joint-model-frame",
-        "error",
-        "A joint's `<parent>` or `<child>` is the model frame `__model__` (libsdformat refuses it: a joint "
-        "joins links or frames of the model, not the model itself).",
+        "warning",
+        "A joint's `<parent>` or `<child>` is the model frame `__model__`. Reference: libsdformat 13 and "
+        "later resolve it to the model's canonical link (so does modelkit); libsdformat 12 (Gazebo "
+        "Fortress) refuses it.",
     ),
     CodeInfo(
         "MK157",

@@ -146,16 +146,17 @@ def _ends(ctx: Context, graph: FrameGraph, data: JointData, what: str) -> None:
             data.parent_link = WORLD_LINK
             joint.parent = WORLD_LINK
             continue
-        if text == MODEL_FRAME:  # the graph knows the frame, but a joint may not use it
+        if text == MODEL_FRAME:  # current libsdformat resolves it to the canonical link, 12 refuses it
+            canonical = graph.link_of(graph.lookup(item.scope, text) or "")
+            resolved = f' "{canonical}"' if canonical else ""
             ctx.sink.emit(
                 "MK156",
-                f'the {end} of {what} is the model frame "{MODEL_FRAME}": libsdformat refuses it '
-                f'("{end} frame with name[{MODEL_FRAME}] ... not found in model"); a joint joins links or '
-                "frames of the model",
+                f'the {end} of {what} is the model frame "{MODEL_FRAME}": libsdformat 13 and later resolve '
+                f"it to the canonical link{resolved} (as modelkit does), libsdformat 12 (Gazebo Fortress) "
+                f'refuses it ("{end} frame with name[{MODEL_FRAME}] ... not found in model")',
                 loc,
-                hint="name the link the joint is meant to join (the canonical link for the model frame)",
+                hint="name the link the joint is meant to join, which every libsdformat reads",
             )
-            continue
         vertex = graph.lookup(item.scope, text)
         link = graph.link_of(vertex) if vertex is not None else None
         if vertex is None:
