@@ -25,8 +25,9 @@ TARGET_REFUSALS: dict[str, frozenset[str]] = {
     "sdf": frozenset({"MK303", "MK211"}),  # libsdformat: the same, and links and joints sharing a name
     "urdf": frozenset(),
     # PyBullet: a URDF visual or collision without a shape, a shape without its size or file, an
-    # inertial without mass value, inertia or a diagonal moment, a shape neither URDF nor PyBullet has
-    "pybullet": frozenset({"MK122", "MK143", "MK145", "MK412"}),
+    # inertial without mass value, inertia or a diagonal moment, a shape neither URDF nor PyBullet has, a
+    # visual's <material> without a name
+    "pybullet": frozenset({"MK122", "MK136", "MK143", "MK145", "MK412"}),
 }
 TARGETS = tuple(TARGET_REFUSALS)
 

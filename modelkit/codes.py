@@ -220,8 +220,10 @@ _TABLE: tuple[CodeInfo, ...] = (
     CodeInfo(
         "MK136",
         "urdf-material-unnamed",
-        "error",
-        "A `<material>` in a visual has no `name` (urdfdom drops the visual; PyBullet refuses the file).",
+        "warning",
+        "A `<material>` in a visual has no `name`. Reference: check_urdf loads the file and urdfdom drops "
+        "the visual; PyBullet refuses the file (an error under `--target pybullet`); modelkit keeps "
+        "the visual with its inline colour.",
     ),
     CodeInfo(
         "MK137",
@@ -330,7 +332,32 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK155",
         "sdf-not-modelled",
         "warning",
-        "Valid SDF that the robot model cannot hold (actor, world joint, nested static model ...); skipped.",
+        "Valid SDF that the robot model cannot hold as written: an actor, a world joint ... (skipped); "
+        "a static model nested in a moving one (libsdformat accepts it; its links stay fixed in the "
+        "world, held apart from the moving tree; convert writes them as separate bodies).",
+    ),
+    CodeInfo(
+        "MK156",
+        "sdf-joint-model-frame",
+        "warning",
+        "A joint's `<parent>` or `<child>` is the model frame `__model__`. Reference: libsdformat 13 and "
+        "later resolve it to the model's canonical link (so does modelkit); libsdformat 12 (Gazebo "
+        "Fortress) refuses it.",
+    ),
+    CodeInfo(
+        "MK157",
+        "sdf-placement-frame-without-pose",
+        "error",
+        "An `<include>` has a `<placement_frame>` but no `<pose>` (libsdformat refuses it: the pose says "
+        "where the placement frame goes).",
+    ),
+    CodeInfo(
+        "MK158",
+        "sdf-world-name-shared",
+        "warning",
+        "A world's light or actor has the name of one of its models (or a light and an actor share a name). "
+        "Reference: libsdformat loads the world and warns that the names of the world's children are not "
+        "unique.",
     ),
     # -- MK17x: MJCF ------------------------------------------------------------------------
     # (mjcf section)
@@ -381,6 +408,16 @@ _TABLE: tuple[CodeInfo, ...] = (
         "mjcf-warning",
         "warning",
         "MuJoCo warned while reading the file (its message is given; nothing goes to MUJOCO_LOG.TXT).",
+    ),
+    # -- MK18x: .body values -----------------------------------------------------------------
+    CodeInfo(
+        "MK181",
+        "body-number-trailing-text",
+        "warning",
+        "A `.body` number is followed by text (a C-style suffix such as `0.001f`, a unit). Reference: "
+        "Choreonoid reads a list element or `mass` by its leading number (C strtod) and ignores the rest; "
+        "other keys it reads only when the whole text is a number, else it keeps the default. modelkit reads "
+        "both the same way and names the value it took.",
     ),
     # -- MK2xx: kinematic tree --------------------------------------------------------------
     CodeInfo("MK200", "no-root", "error", "No root link can be found (every link has a parent, or a cycle)."),
@@ -554,10 +591,11 @@ _TABLE: tuple[CodeInfo, ...] = (
     CodeInfo(
         "MK301",
         "inertia-asymmetric",
-        "error",
+        "warning",
         "A 9-element inertia matrix is not symmetric: an off-diagonal pair differs by more than 1e-4 of "
         "the largest diagonal moment (less is rounding, ignored). Reference: only .body has 9 elements; "
-        "Choreonoid uses the matrix as given, which no rigid body has.",
+        "Choreonoid loads the file and uses the matrix as given (no rigid body has such a matrix), so a "
+        "warning; formats of six numbers get its upper triangle (xy, xz, yz) from `convert`.",
     ),
     CodeInfo(
         "MK302",
@@ -639,7 +677,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "moving-link-massless",
         "error",
         "A moving link has no mass after merging the links fixed to it. When nothing below it has mass "
-        "either, its joint moves nothing and cannot be simulated (an error). When links below it have mass, "
+        "either, its joint moves nothing and cannot be simulated: an error, except in URDF, whose loader "
+        "accepts it (check_urdf loads it, PyBullet freezes the joint, MuJoCo refuses it: a warning, an error "
+        "under `--target mjcf`). When links below it have mass, "
         "articulated-body engines (PyBullet, Pinocchio) simulate it and MuJoCo refuses it: a warning (an "
         "error under `--target mjcf`). Reference for a URDF link without `<inertial>`: check_urdf accepts "
         "kinematic-only models, PyBullet gives 1 kg, MuJoCo refuses (a warning; an error under `--target "
@@ -921,6 +961,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "sdf-material-script",
         "info",
         "A visual's colour comes from an OGRE material script; only the script name is kept.",
+    ),
+    CodeInfo(
+        "MK535",
+        "sdf-include-no-model-config",
+        "error",
+        "An `<include>` names a model folder without `model.config` (or the older `manifest.xml`): "
+        "libsdformat cannot resolve it and refuses the file. modelkit still reads the folder's `model.sdf` "
+        "to check it.",
     ),
     # -- MK6xx: devices and scene nodes ----------------------------------------------------------
     CodeInfo(

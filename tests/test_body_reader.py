@@ -470,3 +470,44 @@ def test_nested_rotation_and_translation_lists_with_aliases(tmp_path: Path) -> N
     rz = np.array([[0, 1, 0], [-1, 0, 0], [0, 0, 1]], dtype=float)
     np.testing.assert_allclose(joint.origin.rotation, ry @ rz, atol=1e-12)
     np.testing.assert_allclose(joint.origin.translation, [0.1, 0.2, 0.0])
+
+
+_SUFFIXED_NUMBERS = """\
+format: ChoreonoidBody
+format_version: 2.0
+name: Suffixed
+links:
+  - name: base
+    joint_type: free
+    mass: 2.0f
+    center_of_mass: [0, 0, 0.001f]
+    inertia: [0.02, 0, 0, 0, 0.02, 0, 0, 0, 0.02]
+  - name: arm
+    parent: base
+    joint_type: revolute
+    joint_axis: [0, 1, 0]
+    joint_range: [-90, 90]
+    joint_displacement: 30f
+    mass: 1.0
+    inertia: [0.02, 0, 0, 0, 0.02, 0, 0, 0, 0.02]
+"""
+
+
+def test_a_number_with_a_c_suffix_is_read_as_choreonoid_reads_it(tmp_path: Path) -> None:
+    """MK181 (issue 18 item 3): Choreonoid's strtod-based "to" accessors (mass, list elements) read the
+    leading number of "2.0f"; its "read" accessors (joint_displacement) ignore "30f" and keep the default.
+    Each is a warning at the value, and the model holds what Choreonoid would."""
+    path = write(tmp_path, _SUFFIXED_NUMBERS)
+    result = read_body(path, BodyOptions())
+    assert result.robot is not None
+    base = result.robot.link("base")
+    assert base.inertial is not None and base.inertial.mass == 2.0 and base.inertial.com[2] == 0.001
+    found = [(d.code, d.severity.value, d.location.line if d.location else 0) for d in result.diagnostics]
+    assert [f for f in found if f[0] == "MK181"] == [("MK181", "warning", n) for n in (7, 8, 15)]
+    v = validate(path)
+    assert v.errors == []
+    (ignored,) = [d for d in v.warnings if d.code == "MK181" and "30f" in d.message]
+    assert "keeps the default" in ignored.message and ignored.location is not None
+    assert ignored.location.line == 15 and "2.0" not in ignored.message
+    (read,) = [d for d in v.warnings if d.code == "MK181" and '"2.0f"' in d.message]
+    assert 'Choreonoid reads 2 and ignores "f"' in read.message

@@ -251,8 +251,11 @@ FAULTS: list[tuple[str, str, str, int, int, str, str | None]] = [
      '"joint_range"[1]: expected a number or "unlimited", got "infinite"', None),
     ("joint-range-three", HEAD + "    joint_range: [-1, 1, 2]\n", "MK100", 5, 18,
      '"joint_range": expected two numbers [lower, upper]', None),
-    ("radius-with-unit", SHAPE + "        geometry: {type: Sphere, radius: 0.1m}\n", "MK100", 7, 42,
-     '"radius": expected a number, got "0.1m"', None),
+    # Choreonoid loads it: its "read" accessor ignores "0.1m" and the sphere keeps radius 1 (MK181, a warning)
+    ("radius-with-unit", SHAPE + "        geometry: {type: Sphere, radius: 0.1m}\n", "MK181", 7, 42,
+     '"radius": "0.1m" is a number followed by text: Choreonoid ignores the value', "write 0.1 alone"),
+    ("radius-not-a-number", SHAPE + "        geometry: {type: Sphere, radius: big}\n", "MK100", 7, 42,
+     '"radius": expected a number, got "big"', None),
     ("type-not-a-scalar", ELEMENTS + "      - type: {a: 1}\n", "MK100", 6, 15,
      '"type": expected a string, got {a: 1}', None),
     ("extra-joint-type", HEAD + "extra_joints:\n  - {link1_name: a, link2_name: b, joint_type: slider}\n",
@@ -382,10 +385,19 @@ def test_strtod_numbers_are_accepted(text: str) -> None:
     assert check(HEAD + f"    joint_displacement: {json.dumps(text)}\n") == []
 
 
-@pytest.mark.parametrize("text", ["abc", "1e", "0x", "1.2.3", "", "1,5", "--1", "e5", "2kg", "."])
+@pytest.mark.parametrize("text", ["abc", "", "--1", "e5", "."])
 def test_non_numbers_are_rejected(text: str) -> None:
     (d,) = check(HEAD + f"    joint_displacement: {json.dumps(text)}\n")
     assert d.code == "MK100" and "expected a number" in d.message
+
+
+@pytest.mark.parametrize(("text", "leading"), [("1e", "1"), ("0x", "0"), ("1.2.3", "1.2"), ("1,5", "1"),
+                                               ("2kg", "2"), ("0.001f", "0.001")])
+def test_numbers_followed_by_text_are_ignored_with_a_warning(text: str, leading: str) -> None:
+    """Choreonoid's "read" accessor ignores such a value and keeps the default (MK181, a warning)."""
+    (d,) = check(HEAD + f"    joint_displacement: {json.dumps(text)}\n")
+    assert d.code == "MK181" and d.severity.value == "warning" and "keeps the default" in d.message
+    assert d.hint == f"write {leading} alone (no C-style suffix such as f, no unit)"
 
 
 @pytest.mark.parametrize(

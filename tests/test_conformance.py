@@ -742,8 +742,14 @@ def test_a_massless_moving_link_is_an_error_only_when_it_moves_nothing_with_mass
     v = validate(path)
     assert v.errors == [] and [d.code for d in v.warnings if d.code == "MK313"] == ["MK313"]
     assert [d.code for d in validate(path, target="mjcf").errors] == ["MK313"]
+    # nothing with mass moves: check_urdf still accepts it, so a warning; MuJoCo refuses it (--target mjcf)
     path.write_text(_urdf(_URDF_BASE + f'<link name="a">{zero}</link><link name="b">{zero}</link>' + joints))
-    assert sorted(d.code for d in validate(path).errors) == ["MK313", "MK313"]  # nothing with mass moves
+    assert check_urdf_accepts(path)[0]
+    with pytest.raises(ValueError, match="mass and inertia of moving bodies"):
+        mujoco.MjModel.from_xml_path(str(path))
+    v = validate(path)
+    assert v.errors == [] and sorted(d.code for d in v.warnings if d.code == "MK313") == ["MK313", "MK313"]
+    assert sorted(d.code for d in validate(path, target="mjcf").errors) == ["MK313", "MK313"]
 
 
 def test_singular_inertia_on_a_urdf_root_counts_as_moving(tmp_path: Path) -> None:
@@ -1003,14 +1009,25 @@ def test_kinematic_only_urdf_is_a_warning_and_an_error_for_mujoco(tmp_path: Path
     for target, code in (("mjcf", 1), ("pybullet", 0), ("urdf", 0)):
         result = runner.invoke(main, ["validate", "--target", target, str(path)])
         assert result.exit_code == code, (target, result.output)
-    # an explicit zero mass on a link that moves stays an error: MuJoCo refuses it, PyBullet freezes it
+    # an explicit zero mass on a leaf that moves: check_urdf accepts it, PyBullet loads it and freezes the
+    # joint (a velocity motor leaves it at 0), MuJoCo refuses it: a warning, an error for --target mjcf
     path.write_text(
         _urdf(_URDF_BASE + '<link name="arm"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" '
               'ixy="0" ixz="0" iyz="0"/></inertial></link><joint name="j" type="continuous">'
               '<parent link="base"/><child link="arm"/><axis xyz="0 0 1"/></joint>')
     )
     assert check_urdf_accepts(path)[0]
-    assert [d.code for d in validate(path).errors] == ["MK313"]
+    frozen = subprocess.run(
+        [sys.executable, "-c", _PYBULLET_FROZEN, str(path)], capture_output=True, timeout=60
+    )
+    assert frozen.returncode == 0 and frozen.stdout.split() == [b"0.0"], frozen.stderr[-400:]
+    v = validate(path)
+    assert v.errors == [] and [d.code for d in v.warnings if d.code == "MK313"] == ["MK313"]
+    (d,) = [d for d in v.warnings if d.code == "MK313"]
+    assert "check_urdf accepts it" in d.message and "freezes the joint" in d.message
+    for target, code in (("mjcf", 1), ("pybullet", 0), ("urdf", 0)):
+        result = runner.invoke(main, ["validate", "--target", target, str(path)])
+        assert result.exit_code == code, (target, result.output)
     # MJCF: MuJoCo itself refuses a moving body without mass, and so does modelkit
     mjcf = tmp_path / "m.xml"
     mjcf.write_text(
@@ -1185,6 +1202,19 @@ except pybullet.error:
     sys.exit(3)
 """
 
+# PyBullet on a URDF whose only joint moves a massless leaf: the joint position after one second of a
+# velocity motor asking for 1 rad/s (printed; 0.0 when the engine freezes the joint).
+_PYBULLET_FROZEN = """
+import sys
+import pybullet
+pybullet.connect(pybullet.DIRECT)
+body = pybullet.loadURDF(sys.argv[1], useFixedBase=True)
+pybullet.setJointMotorControl2(body, 0, pybullet.VELOCITY_CONTROL, targetVelocity=1, force=10)
+for _ in range(240):
+    pybullet.stepSimulation()
+print(pybullet.getJointState(body, 0)[0])
+"""
+
 
 def _consumers_refusing(path: Path, oracle: Path) -> set[str]:
     """Which of PyBullet, MuJoCo's URDF import and libsdformat's URDF conversion refuse the file, live."""
@@ -1336,3 +1366,40 @@ def test_unreadable_urdf_parts_keep_the_rest_of_the_link(tmp_path: Path) -> None
     assert robot is not None
     b2 = next(link for link in robot.links if link.name == "b2")
     assert len(b2.visuals) == 2 and len(b2.collisions) == 1  # modelkit keeps the readable parts
+
+
+def test_nameless_visual_material_is_judged_like_check_urdf_and_an_error_for_pybullet(tmp_path: Path) -> None:
+    """MK136 (issue 18 item 3): check_urdf loads a visual <material> without a name (urdfdom drops that
+    visual), PyBullet refuses the file: a warning, an error under --target pybullet."""
+    path = tmp_path / "r.urdf"
+    path.write_text(_urdf(
+        _URDF_BASE.replace('"base">', '"base"><visual><geometry><box size="1 1 1"/></geometry>'
+                           '<material><color rgba="1 0 0 1"/></material></visual>', 1)
+    ))
+    accepted, said = check_urdf_accepts(path)
+    assert accepted and "Visual material must contain a name attribute" in said
+    command = [sys.executable, "-c", _PYBULLET_LOADS, str(path)]
+    loads = subprocess.run(command, capture_output=True, timeout=60)
+    assert loads.returncode == 3, loads.stderr[-400:]  # PyBullet refuses it
+    v = validate(path)
+    assert v.errors == [] and _codes(v, "warning") == ["MK136"]
+    (d,) = validate(path, target="pybullet").errors
+    assert d.code == "MK136" and "PyBullet refuses the file" in d.message
+    assert d.location is not None and d.location.line == 3
+    assert validate(path, target="mjcf").errors == []
+
+
+def test_asymmetric_body_inertia_is_a_warning_and_converts_its_upper_triangle(tmp_path: Path) -> None:
+    """MK301 (issue 18 item 3): Choreonoid loads a 9-element inertia that is not symmetric and uses it as
+    given; validate warns and passes, convert writes the upper triangle (the row-major xy, xz, yz)."""
+    from click.testing import CliRunner
+
+    from modelkit.cli import main
+
+    source = REPO / "tests" / "broken_body" / "inertia_asymmetric.body"  # arm: xy 0.005, yx 0
+    v = validate(source)
+    assert v.errors == [] and _codes(v, "warning") == ["MK301"]
+    out = tmp_path / "p.urdf"
+    result = CliRunner().invoke(main, ["convert", "-o", str(out), str(source)])
+    assert result.exit_code == 0, result.output
+    assert 'ixx="0.021" ixy="0.005" ixz="0" iyy="0.021" iyz="0" izz="0.0005"' in out.read_text()

@@ -755,6 +755,8 @@ NO_ORACLE_OPINION = {
     "mimic_undefined.sdf": "SDFormat 1.11, newer than libsdformat 12 reads",
     "include_cycle.sdf": "libsdformat 12 recurses without end on include cycles",
     "expressed_in_undefined.sdf": "libsdformat 12 resolves expressed_in only when asked (Root::Load passes)",
+    "joint_parent_model_frame.sdf": "libsdformat 12 refuses __model__ as a joint end; 13 and later accept it",
+    "joint_child_model_frame.sdf": "libsdformat 12 refuses __model__ as a joint end; 13 and later accept it",
 }
 
 
@@ -814,3 +816,70 @@ def test_validate_agrees_with_libsdformat(path: Path, sdf_oracle: Path) -> None:
 def test_oracle_exclusions_are_real_case_files() -> None:
     for name in NO_ORACLE_OPINION:
         assert (BROKEN / name).is_file(), name
+
+
+def test_model_uri_include_without_model_config_is_refused_like_libsdformat(
+    tmp_path: Path, sdf_oracle: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """MK535 (issue 18 item 3): a model:// folder on the resource path with model.sdf but no model.config
+    is refused by libsdformat (error code 13); with a model.config both accept it."""
+    models = tmp_path / "models"
+    for name in ("bare", "configured"):
+        (models / name).mkdir(parents=True)
+        (models / name / "model.sdf").write_text((BROKEN / "support" / "clean.sdf").read_text())
+    (models / "configured" / "model.config").write_text(
+        '<?xml version="1.0"?>\n<model><name>configured</name><sdf version="1.9">model.sdf</sdf></model>\n'
+    )
+    monkeypatch.setenv("SDF_PATH", str(models))
+    monkeypatch.setenv("GZ_SIM_RESOURCE_PATH", str(models))
+    for name, refused in (("bare", True), ("configured", False)):
+        world = tmp_path / f"{name}.world"
+        world.write_text(
+            f'<?xml version="1.0"?>\n<sdf version="1.9"><world name="w"><include><uri>model://{name}</uri>'
+            "</include></world></sdf>\n"
+        )
+        assert oracle_has_errors(sdf_oracle, world) is refused, name
+        errors = [d.code for d in validate(world).errors]
+        assert errors == (["MK535"] if refused else []), name
+
+
+_NESTED_STATIC = """
+    <model name="fixture">
+      <static>true</static>
+      <pose>1 0 0 0 0 0</pose>
+      <link name="post">
+        <collision name="post_collision"><geometry><box><size>0.1 0.1 0.5</size></box></geometry></collision>
+      </link>
+    </model>
+  </model>
+</sdf>"""
+
+
+def test_nested_static_model_is_accepted_like_libsdformat(tmp_path: Path, sdf_oracle: Path) -> None:
+    """MK155 (issue 18 item 3): a static model nested in a moving one is valid SDF; its links stay fixed in
+    the world. No error, and the message no longer claims the model is skipped or that its links float."""
+    clean = (BROKEN / "support" / "clean.sdf").read_text()
+    path = tmp_path / "nested_static.sdf"
+    path.write_text(clean.replace("  </model>\n</sdf>", _NESTED_STATIC))
+    assert not oracle_has_errors(sdf_oracle, path)
+    v = validate(path)
+    assert v.errors == []
+    (note,) = [d for d in v.diagnostics if d.code == "MK155"]
+    assert note.severity.value == "warning" and "libsdformat accepts it" in note.message
+    assert "skipped" not in note.message
+    (detached,) = [d for d in v.diagnostics if d.code == "MK201"]
+    assert detached.severity.value == "info" and 'nested model "fixture" is static' in detached.message
+    assert "floats freely" not in detached.message
+
+
+def test_include_placement_frame_with_pose_is_accepted(tmp_path: Path, sdf_oracle: Path) -> None:
+    """The counterpart of broken_sdf/include_placement_without_pose.world (MK157): with a <pose>,
+    libsdformat and modelkit accept it."""
+    (tmp_path / "clean.sdf").write_text((BROKEN / "support" / "clean.sdf").read_text())
+    world = tmp_path / "w.world"
+    world.write_text(
+        '<?xml version="1.0"?>\n<sdf version="1.9"><world name="w"><include><uri>clean.sdf</uri>'
+        "<pose>0 0 1 0 0 0</pose><placement_frame>upper</placement_frame></include></world></sdf>\n"
+    )
+    assert not oracle_has_errors(sdf_oracle, world)
+    assert validate(world).errors == []

@@ -102,17 +102,36 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
                     severity=Severity.WARNING,
                 )
                 continue
-            yield diag(
-                "MK313",
-                f'link "{link.name}" moves but its mass is zero, and so does everything below it: its joint '
-                "moves nothing with mass, which cannot be simulated (MuJoCo refuses it, PyBullet freezes the "
-                "joint)",
-                _mass_loc(link),
-            )
+            yield _massless_chain(robot, link)
 
 
 # A massless body that moves links with mass (MK313, a warning): who refuses it. An error under --target mjcf.
 MASSLESS_BODY_REFUSED = "MuJoCo refuses a moving body without mass"
+
+
+# Who loads a moving link whose mass is zero, like everything below it (MK313). Where the file's own loader
+# takes it (URDF: check_urdf) it is a warning, an error under --target mjcf; elsewhere an error.
+MASSLESS_CHAIN_CONSUMERS = (
+    "check_urdf accepts it (urdfdom keeps the zero mass), PyBullet loads it and freezes the joint (a "
+    "velocity motor leaves it at 0), MuJoCo refuses it"
+)
+
+
+def _massless_chain(robot: Robot, link: Link) -> Diagnostic:
+    """MK313 for a moving link whose joint moves nothing with mass."""
+    what = (
+        f'link "{link.name}" moves but its mass is zero, and so does everything below it: its joint moves '
+        "nothing with mass"
+    )
+    if robot.source_format == "urdf":
+        return diag(
+            "MK313",
+            f"{what}; {MASSLESS_CHAIN_CONSUMERS}",
+            _mass_loc(link),
+            hint="give the link its mass and inertia, or make its joint fixed",
+            severity=Severity.WARNING,
+        )
+    return diag("MK313", f"{what}, which cannot be simulated (MuJoCo refuses it)", _mass_loc(link))
 
 
 # MK313 for a moving link without <inertial> in a format whose loader accepts it (URDF: check_urdf
@@ -140,6 +159,10 @@ def _no_mass_information(robot: Robot, link: Link) -> Diagnostic:
 # MK301: an inertia matrix is asymmetric when an off-diagonal pair differs by more than this fraction of
 # the largest diagonal moment (smaller differences are rounding in the source and are ignored).
 ASYMMETRY_TOLERANCE = 1e-4
+# What a loader does with an asymmetric 9-element inertia (MK301, a warning: Choreonoid loads the file).
+ASYMMETRIC_INERTIA_CONSUMERS = (
+    "Choreonoid uses the matrix as given, which no rigid body has; convert writes its upper triangle"
+)
 # Larger masses or inertia components are refused: the parallel-axis sums, the principal moments and
 # an engine's mass matrix square and add them, which overflows double precision near 1e154 (a 1e308
 # inertia made the eigenvalue solver fail, and its moments came out as zero). No real body is near.
@@ -218,9 +241,9 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
             yield diag(
                 "MK301",
                 f'link "{link.name}": the inertia matrix is not symmetric (off-diagonal pairs differ by up '
-                f"to {skew:.6g}){static}",
+                f"to {skew:.6g}); {ASYMMETRIC_INERTIA_CONSUMERS}{static}",
                 where,
-                severity=severity,
+                hint="give the same value to each off-diagonal pair (row-major: xy = yx, xz = zx, yz = zy)",
             )
             continue
         head = merged_into.get(link.name)

@@ -100,8 +100,26 @@ def read_body(path: Path, options: BodyOptions | None = None, display: str | Non
     """Read a `.body` file into a :class:`Robot`; the robot is None when nothing usable was read."""
     options = options or BodyOptions()
     sink = DiagnosticSink()
-    robot = _BodyReader(path, options, sink, display or str(path), stack=()).read()
+    with v.trailing_text_noted() as noted:
+        robot = _BodyReader(path, options, sink, display or str(path), stack=()).read()
+    for node in noted:  # the sink keeps one record per place: a value read twice is reported once
+        sink.emit("MK181", trailing_text_message(node.value), node.loc, hint=TRAILING_TEXT_HINT)
     return ReadResult(robot, sorted_diagnostics(sink.items))
+
+
+# MK181: what Choreonoid does with a number followed by text ("0.001f", "0.5m") where it reads the value
+# with a "to" accessor (list elements, mass): C strtod reads the leading number and the rest is dropped.
+TRAILING_TEXT_HINT = "write the number alone (no C-style suffix such as f, no unit)"
+
+
+def trailing_text_message(text: str) -> str:
+    number = v.leading_number_text(text) or text
+    value = v.parse_float(number)
+    shown = number if value is None else f"{value:g}"
+    rest = text.strip()[len(number):]
+    what = f'"{text}" is a number followed by text'
+    return f'{what}: Choreonoid reads {shown} and ignores "{rest}" (so does modelkit)'
+
 
 
 # What Choreonoid does with a SubBody it cannot load (MK216): the robot loses that whole subtree.

@@ -353,6 +353,15 @@ class _Reporter:
             got = _show(error.instance)
             self.emit(("type",), "MK017", f"the top-level node must be a mapping, got {got}", node)
             return
+        if name == "number" and isinstance(error.instance, str):
+            leading = _leading_number(error.instance)
+            if leading is not None:  # "0.5f" where Choreonoid reads with a "read" accessor: it is ignored
+                self.emit(("type",), "MK181",
+                          f'{label}: "{error.instance}" is a number followed by text: Choreonoid ignores the '
+                          "value (it reads this key only when the whole text is a number) and keeps the "
+                          "default (so does modelkit)", node,
+                          f"write {leading} alone (no C-style suffix such as f, no unit)")
+                return
         code = _TYPE_CODES.get(name or "", "MK100")
         expected = description or _generic_description(error.schema)
         self.emit(("type",), code, f"{label}: expected {expected}, got {_show(error.instance)}", node)
@@ -393,6 +402,12 @@ class _Reporter:
         shown = " or ".join(f'"{key}"' for key in spellings)
         self.emit(("required", spellings[0]), "MK101",
                   f"{label}: missing required key {shown}{_in_node(error.schema)}", node)
+
+
+def _leading_number(text: str) -> str | None:
+    from modelkit.formats.body.values import leading_number_text
+
+    return leading_number_text(text)
 
 
 def _undefined_type_hint(type_name: str, known: Iterable[str]) -> str:

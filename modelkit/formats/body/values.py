@@ -13,6 +13,9 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 
 from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink
@@ -81,9 +84,43 @@ def number(node: YNode | None) -> float | None:
     return None if text is None else parse_float(text)
 
 
+# Scalars read by their leading number while text follows it ("0.001f"), gathered while a file is read so
+# that the reader reports each once (MK181): Choreonoid reads the number and drops the rest, silently.
+_TRAILING_TEXT: ContextVar[list[YScalar] | None] = ContextVar("body_trailing_text", default=None)
+
+
+@contextmanager
+def trailing_text_noted() -> Iterator[list[YScalar]]:
+    """Gather the scalars :func:`number_prefix` reads by their leading number only, within the block."""
+    noted: list[YScalar] = []
+    token = _TRAILING_TEXT.set(noted)
+    try:
+        yield noted
+    finally:
+        _TRAILING_TEXT.reset(token)
+
+
 def number_prefix(node: YNode | None) -> float | None:
+    """A number as Choreonoid's "to" accessors read it: its leading number (trailing text is noted)."""
     text = scalar_text(node)
-    return None if text is None else parse_float_prefix(text)
+    if text is None:
+        return None
+    whole = parse_float(text)
+    if whole is not None:
+        return whole
+    value = parse_float_prefix(text)
+    noted = _TRAILING_TEXT.get()
+    if value is not None and noted is not None and isinstance(node, YScalar):
+        noted.append(node)
+    return value
+
+
+def leading_number_text(text: str) -> str | None:
+    """The leading number of a text that is not a number as a whole (``"0.001f"`` → ``"0.001"``), or None."""
+    if parse_float(text) is not None:
+        return None
+    match = _FLOAT_PREFIX_RE.match(text)
+    return None if match is None else match.group(0).strip()
 
 
 def integer(node: YNode | None) -> int | None:

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, Severity
-from modelkit.formats.sdf.collect import ModelTree
+from modelkit.formats.sdf.collect import ModelTree, Scope
 from modelkit.formats.sdf.joints import AxisSpec, JointData
 from modelkit.formats.sdf.links import LinkData
 from modelkit.formats.sdf.poses import FrameGraph
@@ -331,17 +331,30 @@ class Assembler:
         for name in free:
             link_data = self.by_name[name]
             floating[name] = placement.model_pose @ self.frames.get(name, link_data.pose)
-            state = (
-                "in a static model it is fixed in the world"
-                if placement.static
-                else "in SDF it floats freely as a separate body"
-            )
+            nested_static = _static_scope(link_data.item.scope)
+            if placement.static:
+                state = "in a static model it is fixed in the world"
+            elif nested_static is not None:
+                state = f'its nested model "{nested_static.path}" is static, so it is fixed in the world'
+            else:
+                state = "in SDF it floats freely as a separate body"
+            fixed = placement.static or nested_static is not None
             self.sink.emit(
                 "MK201",
                 f'link "{link_data.item.local}" is not connected by any joint to the root link '
                 f'"{robot.root}"; {state}',
                 link_data.link.loc("name"),
-                severity=Severity.INFO if placement.static else Severity.WARNING,
+                severity=Severity.INFO if fixed else Severity.WARNING,
             )
         if floating:
             robot.extras["sdf_free_links"] = floating
+
+
+def _static_scope(scope: Scope) -> Scope | None:
+    """The innermost static model enclosing ``scope`` (itself included), or None."""
+    current: Scope | None = scope
+    while current is not None:
+        if current.static:
+            return current
+        current = current.parent
+    return None

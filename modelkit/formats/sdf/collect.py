@@ -187,6 +187,15 @@ class Collector:
                 "MK122", "<include> has no <uri>", values.loc(inc if uri_el is None else uri_el)
             )
             return None
+        placement_el = child(inc, "placement_frame")
+        if placement_el is not None and values.text(placement_el) and child(inc, "pose") is None:
+            self.ctx.sink.emit(
+                "MK157",
+                f'<include> of "{uri.strip()}" has a <placement_frame> but no <pose>: libsdformat refuses it '
+                '("<pose> is required when specifying the placement_frame element")',
+                values.loc(placement_el),
+                hint="add the <pose> at which the placement frame goes, e.g. <pose>0 0 0 0 0 0</pose>",
+            )
         loc = values.text_loc(uri_el)
         path = self.ctx.include_file(uri, src, loc)
         if path is None:

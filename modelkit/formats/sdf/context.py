@@ -175,9 +175,20 @@ class Context:
 
     def _model_folder(self, uri: str, folder: Path, loc: SourceLocation) -> Path | None:
         config = folder / "model.config"
+        if not config.is_file() and (folder / "manifest.xml").is_file():
+            config = folder / "manifest.xml"  # the older name, which libsdformat still reads
         if not config.is_file():
             fallback = folder / "model.sdf"
             if fallback.is_file():
+                # libsdformat 12 refuses the include ("Unable to resolve uri[...] to model path [...] since
+                # it does not contain a model.config file"); the model is still read to check it
+                self.sink.emit(
+                    "MK535",
+                    f'included model "{uri.strip()}": {folder} has no model.config, so libsdformat cannot '
+                    "resolve the include and refuses the file; modelkit reads its model.sdf to check it",
+                    loc,
+                    hint="add a model.config naming it: <model><sdf version=...>model.sdf</sdf></model>",
+                )
                 return fallback
             self.sink.emit(
                 "MK530",

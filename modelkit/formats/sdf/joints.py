@@ -20,7 +20,7 @@ from lxml.etree import _Element as Element
 
 from modelkit import rot3
 from modelkit.diagnostics import Severity, SourceLocation, did_you_mean
-from modelkit.formats.sdf.collect import Item
+from modelkit.formats.sdf.collect import MODEL_FRAME, Item
 from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import sensor_device
@@ -146,6 +146,17 @@ def _ends(ctx: Context, graph: FrameGraph, data: JointData, what: str) -> None:
             data.parent_link = WORLD_LINK
             joint.parent = WORLD_LINK
             continue
+        if text == MODEL_FRAME:  # current libsdformat resolves it to the canonical link, 12 refuses it
+            canonical = graph.link_of(graph.lookup(item.scope, text) or "")
+            resolved = f' "{canonical}"' if canonical else ""
+            ctx.sink.emit(
+                "MK156",
+                f'the {end} of {what} is the model frame "{MODEL_FRAME}": libsdformat 13 and later resolve '
+                f"it to the canonical link{resolved} (as modelkit does), libsdformat 12 (Gazebo Fortress) "
+                f'refuses it ("{end} frame with name[{MODEL_FRAME}] ... not found in model")',
+                loc,
+                hint="name the link the joint is meant to join, which every libsdformat reads",
+            )
         vertex = graph.lookup(item.scope, text)
         link = graph.link_of(vertex) if vertex is not None else None
         if vertex is None:

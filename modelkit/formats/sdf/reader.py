@@ -179,11 +179,12 @@ class _Reader:
             self._not_modelled(src, el, f'<{el.tag}> of model "{scope.path}" is not part of the robot model')
         for scope in _scopes(tree):
             if scope.static and not model.static and scope is not tree.scope:
-                self._not_modelled(
-                    scope.src,
-                    scope.element,
-                    f'nested model "{scope.path}" is static (fixed in the world) inside a model that moves; '
-                    "the robot model cannot weld part of a floating model to the world",
+                self.sink.emit(
+                    "MK155",
+                    f'nested model "{scope.path}" is static inside a model that moves: valid SDF '
+                    "(libsdformat accepts it) whose links stay fixed in the world; the robot model keeps "
+                    "them apart from the moving tree, and convert writes them as separate bodies (MK813)",
+                    scope.src.values.loc(scope.element),
                 )
         if model.world is not None:
             robot.extras["sdf_world"] = model.world
@@ -242,6 +243,7 @@ class _Reader:
                 frames.add(model.entry)
             models.append(model)
         self._world_names(world)
+        self._world_shared_names(world, names)
         for entry in world_frame_entries(src, world):
             attached = entry.default
             if attached != WORLD_LINK and not frames.exists(attached):
@@ -272,6 +274,37 @@ class _Reader:
                 )
             else:
                 seen[key] = values.loc(el).line or 0
+
+
+    def _world_shared_names(self, world: Element, models: dict[str, int]) -> None:
+        """MK158: a light or actor named like a model or like another light or actor of the world.
+
+        libsdformat loads such a world and only warns ("Non-unique name[a] detected 2 times in XML children
+        of world"); names must be unique among a world's children for Gazebo's entities and for `gz sdf`.
+        """
+        values = self.src.values
+        first: dict[str, tuple[str, int]] = {name: ("model", line) for name, line in models.items()}
+        for el in world:
+            tag, name = el.tag, el.get("name")
+            if not isinstance(tag, str) or tag not in SHARED_NAME_TAGS or not name:
+                continue
+            earlier = first.get(name)
+            if earlier is None:
+                first[name] = (tag, values.loc(el).line or 0)
+            elif earlier[0] != tag:  # the same type twice is MK237's
+                self.sink.emit(
+                    "MK158",
+                    f'<{tag}> "{name}" of world "{world.get("name") or ""}" has the name of the '
+                    f"<{earlier[0]}> at line {earlier[1]}; libsdformat loads the world but warns that the "
+                    "names of a world's children are not unique",
+                    values.loc(el, "name"),
+                    hint="give every model, light and actor of the world its own name",
+                )
+
+
+# World children that libsdformat only warns about when one shares a name with a model or with another of
+# them (MK158); frames and joints share the frame graph's namespace and are judged there.
+SHARED_NAME_TAGS = ("light", "actor")
 
 
 def _scopes(tree: ModelTree) -> list[Scope]:

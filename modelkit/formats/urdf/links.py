@@ -103,8 +103,8 @@ class Materials:
         if name is None:
             ctx.emit(
                 "MK136",
-                f'a <material> in a visual of link "{link}" has no `name`; urdfdom then drops the '
-                "visual and PyBullet refuses the file",
+                f'a <material> in a visual of link "{link}" has no `name`: check_urdf loads the file but '
+                "urdfdom drops this visual, PyBullet refuses the file",
                 ctx.loc(element),
                 hint='give it a name, e.g. <material name="red">',
             )
