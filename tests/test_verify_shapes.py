@@ -1,4 +1,4 @@
-"""Layer 1's collision-shape checks (``modelkit.verify.shapes``), against the real engines.
+"""Layer 1's collision-shape checks (``modelkit.verify.layers.shapes``), against the real engines.
 
 MuJoCo reads the written MJCF, PyBullet (in its child process) the written URDF. Each engine's
 shapes are read back in the link frame and compared with the source model's collision shapes:
@@ -22,10 +22,11 @@ import modelkit
 from modelkit.convert import write
 from modelkit.model import JointType
 from modelkit.spatial import Pose, matrix_from_rpy
-from modelkit.verify import layers, shapes
-from modelkit.verify.engine_mujoco import load as load_mujoco
-from modelkit.verify.facts import ShapeFacts, StaticFacts
-from modelkit.verify.reference import source_static
+from modelkit.verify.engines.mujoco import load as load_mujoco
+from modelkit.verify.engines.protocol import ShapeFacts, StaticFacts
+from modelkit.verify.engines.reference import source_static
+from modelkit.verify.layers import rigid as layers
+from modelkit.verify.layers import shapes
 from tests.conftest import CORPUS, TUTORIAL
 
 PANTILT = TUTORIAL / "mobile_robot_pantilt.body"
@@ -37,7 +38,7 @@ def _load(engine: str, path: Path, maps: Renames, root: str) -> Any:
     if engine == "mujoco":
         return load_mujoco(path, maps, root=root)
     pytest.importorskip("pybullet")
-    from modelkit.verify.engine_pybullet import load as load_pybullet
+    from modelkit.verify.engines.pybullet import load as load_pybullet
 
     return load_pybullet(path, maps, root=root)
 
@@ -255,7 +256,7 @@ def test_primitives_the_format_lacks_are_expected_as_meshes(real: Any) -> None:
 
 
 def test_engines_without_shapes_are_skipped_with_a_reason() -> None:
-    from modelkit.verify.engine_pinocchio import load as load_pinocchio
+    from modelkit.verify.engines.pinocchio import load as load_pinocchio
 
     robot = modelkit.load(PANTILT)
     eng = layers.Loaded("pinocchio", load_pinocchio(robot, {}, root="Chassis"))

@@ -23,8 +23,8 @@ import numpy as np
 from modelkit.convert.compare import random_configuration
 from modelkit.model import WORLD_LINK, Robot
 from modelkit.spatial import Pose
-from modelkit.verify import shapes
-from modelkit.verify.facts import Array, Check, EngineModel, Skip, StaticFacts
+from modelkit.verify.engines.protocol import Array, Check, EngineModel, Skip, StaticFacts
+from modelkit.verify.layers import shapes
 
 TOLERANCE = 1e-9
 Renames = dict[str, dict[str, str]]
@@ -153,7 +153,7 @@ def layer1(source: StaticFacts, eng: Loaded) -> list[Check]:
     checks.append(mass.check(1, label, "mass", eng.tolerance("mass")))
     checks.append(com.check(1, label, "com", eng.tolerance("com")))
     checks.append(inertia.check(1, label, "inertia", eng.tolerance("inertia")))
-    checks.extend(shapes.compare(source, facts, eng))  # collision shapes (modelkit.verify.shapes)
+    checks.extend(shapes.compare(source, facts, eng))  # collision shapes (modelkit.verify.layers.shapes)
     return checks
 
 

@@ -2,17 +2,17 @@
 the seed's controllers; the trajectories compared with each other and with engine-independent
 references (verification.md §1, §2, §6).
 
-What is graded (a :class:`~modelkit.verify.facts.Check`, layer 4), per graded profile:
+What is graded (a :class:`~modelkit.verify.engines.protocol.Check`, layer 4), per graded profile:
 
 * ``mujoco~pybullet``: ``path-position`` (the largest planar distance between the two root-frame
   paths over the run), ``path-yaw`` (the largest wrapped heading difference), ``wheel-angle`` (the
   largest wheel joint angle difference), ``pan-tilt-angle`` (the largest pan/tilt joint angle
   difference, at the wheel-angle tolerance); tolerances 1 cm, 10 mrad, 0.02 rad.
 * each engine against the rigid **no-slip** reference built from the source model's own mass
-  properties and driven by the same controllers (:mod:`modelkit.verify.reference_drive`):
+  properties and driven by the same controllers (:mod:`modelkit.verify.drive.reference`):
   ``noslip-position``, ``noslip-yaw``; tolerances 1.5 cm, 15 mrad.
 
-What is reported only (an :class:`~modelkit.verify.facts.Observation`): each engine's ``slip``
+What is reported only (an :class:`~modelkit.verify.engines.protocol.Observation`): each engine's ``slip``
 (distance between its path and its own wheel odometry) and ``effective-radius`` (the rolling radius
 its own path implies for each wheel), the distance from the ideal ``unicycle`` (it differs from any
 physical robot under this controller by v·τ plus the COM-offset yaw bias, §2.1), every comparison on
@@ -47,13 +47,13 @@ import numpy as np
 
 from modelkit.model import JointType, Robot
 from modelkit.verify.drive import Array, Drive, Profile, Scenario, Trajectory, WheelProxy
-from modelkit.verify.facts import Check, Observation, Skip
-from modelkit.verify.reference_drive import PlanarModel, noslip, odometry, planar_model, unicycle
+from modelkit.verify.drive.reference import PlanarModel, noslip, odometry, planar_model, unicycle
+from modelkit.verify.engines.protocol import Check, Observation, Skip
 
 LAYER = 4
 DRIVERS = {
-    "mujoco": "modelkit.verify.engine_mujoco:driver",
-    "pybullet": "modelkit.verify.engine_pybullet:driver",
+    "mujoco": "modelkit.verify.engines.mujoco:driver",
+    "pybullet": "modelkit.verify.engines.pybullet:driver",
 }
 PAIR = "mujoco~pybullet"
 NATIVE_WARNING = (
@@ -68,7 +68,7 @@ TRACK_SKIP = (
     "tracks: turning profiles (spin, arc) are NOT graded: they compare MuJoCo with PyBullet report-only; "
     "the no-slip reference is compared on straight profiles (w = 0) only, since a turning tracked robot "
     "must skid sideways, which no rigid no-slip model describes (grading turning against the skid-steer "
-    "reference, modelkit.verify.reference_skid, is not done yet). Continuous tracks themselves are not "
+    "reference, modelkit.verify.drive.reference_skid, is not done yet). Continuous tracks themselves are not "
     "simulated by either engine: both drive the cylinder rollers convert writes (MK809), each track's "
     "rollers coupled like its belt (MuJoCo: the file's mimic equality; PyBullet: a gear constraint), "
     "velocity-servoed with a torque bound of half what friction can pass (variant.SERVO_FRICTION_SHARE); "
@@ -119,7 +119,7 @@ def run(
 
     ``source``: the model as read (its root free, not welded); ``prepared``: the model with its track
     approximation (``convert``'s prepare), needed for tracked robots (computed when None).
-    ``inject``: fault specs (:mod:`modelkit.verify.inject`) applied to the verification variant's
+    ``inject``: fault specs (:mod:`modelkit.verify.layers.inject`) applied to the verification variant's
     files, as ``verify --inject`` applies them to the converted files. Never raises for a model
     problem: an engine failing is a failed check."""
     result = Layer4Result()
@@ -130,7 +130,7 @@ def run(
         result.skips.append(Skip(LAYER, "all", f"layer 4 not run: {exc}"))
         return result
     if drive.kind == "tracks" and prepared is None:
-        from modelkit.verify.vehicle import prepare_tracks
+        from modelkit.verify.drive.vehicle import prepare_tracks
 
         prepared = prepare_tracks(robot)
     model = planar_model(
@@ -261,7 +261,7 @@ def _setup(
 ) -> None:
     """Write the variant, apply the injected faults, load every engine and start the engines that run
     in a child process (PyBullet) on the job's profiles."""
-    from modelkit.verify.variant import write_variant
+    from modelkit.verify.drive.variant import write_variant
 
     proxy = job.proxy
     try:
@@ -284,7 +284,7 @@ def _setup(
     if proxy == "sphere":  # the graded run: the files convert writes by default, as they are
         result.settings["files"] = {k: p.name for k, p in sorted(files.items())}
     for spec in inject:
-        apply = _resolve("modelkit.verify.inject:apply")
+        apply = _resolve("modelkit.verify.layers.inject:apply")
         try:
             result.injected.append(f"layer 4 {proxy} variant: {apply(spec, files, maps)}")
         except ValueError as exc:  # e.g. cylinder-y on a variant whose wheels are sphere proxies
@@ -342,7 +342,7 @@ def _warnings(engine: str, proxy: str, messages: list[str], result: Layer4Result
     result.settings.setdefault("engines", {}).setdefault(engine, {})[f"{proxy}_warnings"] = unique
     if engine != "mujoco":
         return
-    from modelkit.verify.engine_mujoco import unstable
+    from modelkit.verify.engines.mujoco import unstable
 
     bad = unstable(unique)
     if bad:
