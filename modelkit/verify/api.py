@@ -33,7 +33,7 @@ A module that can integrate the model (layer 3b, the replay) also exposes::
 
 whose ``replay(law, seconds, dt)`` maps ``law.joints`` (source names) through its own ``renames``
 and returns q with one column per ``law.joints`` entry, in that order (MuJoCo's is in
-``engine_mujoco.py``). The replay tests inertial data: a simulator leaves the joints' passive terms
+``engines/mujoco.py``). The replay tests inertial data: a simulator leaves the joints' passive terms
 out (PyBullet zeroes all damping; MuJoCo zeroes damping, friction loss and stiffness and lists them in
 ``left_out``, said in a Skip). An engine that collects warnings while running (MuJoCo's
 ``runtime_warnings``, never ``MUJOCO_LOG.TXT``) has them in its settings in the report; those saying
