@@ -104,7 +104,7 @@ def verified(tmp_path_factory: pytest.TempPathFactory) -> tuple[VerifyReport, Pa
 
 
 def _pictures(report: VerifyReport, out: Path):  # type: ignore[no-untyped-def]
-    from modelkit.verify.layers.rigid import configurations
+    from modelkit.verify.layers.kinematics import configurations
     from modelkit.verify.report.pictures import render_pictures
     from modelkit.verify.source import read_robot, welded_copy
 

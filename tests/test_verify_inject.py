@@ -325,17 +325,17 @@ LAYER_FAULTS = [
 
 
 def _layer_checks(w: Written, out: Path, fmt_name: str, label: str) -> list[Any]:
-    layers = pytest.importorskip("modelkit.verify.layers.rigid")
     from modelkit.verify.engines.pinocchio import load as load_pinocchio
     from modelkit.verify.engines.reference import SourceModel, source_static
+    from modelkit.verify.layers import common, dynamics, kinematics, static
 
     model = _engine(fmt_name, out / FORMATS[fmt_name])
-    eng = layers.Loaded(label, model, w.renames[fmt_name])
+    eng = common.Loaded(label, model, w.renames[fmt_name])
     source = SourceModel(w.robot)
     pin = load_pinocchio(w.robot, {}, root="Chassis")
-    checks = list(layers.layer1(source_static(w.robot), eng))
-    checks += layers.layer2(source, eng, layers.configurations(w.robot, 20, 0))
-    checks += layers.layer3a(pin, eng, layers.states(w.robot, pin.dof_names(), 10, 0))
+    checks = list(static.layer1(source_static(w.robot), eng))
+    checks += kinematics.layer2(source, eng, kinematics.configurations(w.robot, 20, 0))
+    checks += dynamics.layer3a(pin, eng, dynamics.states(w.robot, pin.dof_names(), 10, 0))
     return checks
 
 

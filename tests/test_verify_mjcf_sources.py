@@ -87,7 +87,7 @@ def test_link_poses_follow_the_reader_at_random_configurations(tmp_path: Path) -
     """Intermediate links move with their own joint only: their poses come out of MuJoCo's body
     frames by undoing the later joints, and match the source model's forward kinematics."""
     from modelkit.verify.engines.reference import SourceModel
-    from modelkit.verify.layers.rigid import configurations
+    from modelkit.verify.layers.kinematics import configurations
 
     robot, mj, _ = _static(SUITE / "swimmer.xml", tmp_path)
     ref = SourceModel(robot)

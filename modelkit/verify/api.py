@@ -159,7 +159,7 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
 
 def _load_engines(names: Sequence[str], reference: Robot, files: dict[str, Path], maps: dict[str, Renames],
                   report: VerifyReport) -> list[Any]:
-    from modelkit.verify.layers.rigid import Loaded
+    from modelkit.verify.layers.common import Loaded
 
     loaded: list[Loaded] = []
     for name in names:
@@ -344,8 +344,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                    reading: Mapping[str, Any] | None = None) -> Robot | None:
     """Layers 1–3 on the welded model; returns the source model as read (None when nothing ran)."""
     from modelkit.verify.engines.reference import SourceModel, dof_joints, source_static
-    from modelkit.verify.layers import approximations, shapes
-    from modelkit.verify.layers import rigid as layers
+    from modelkit.verify.layers import approximations, dynamics, kinematics, shapes, static
 
     t0 = time.perf_counter()
     try:
@@ -393,18 +392,18 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         limits_entry = approximations.limits_skip(eng.label, stand_ins)
         if limits_entry is not None:
             report.skips.append(limits_entry)
-        report.checks.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: layers.layer1(st, eng)))
-        report.skips.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: layers.massless_skips(st, eng),
+        report.checks.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: static.layer1(st, eng)))
+        report.skips.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: static.massless_skips(st, eng),
                                      report.checks))
         report.skips.extend(shapes.skips(src_static, eng))
     report.checks[:] = _explain_invalid_inertia(reference, loaded, report.checks)
     t3 = time.perf_counter()
-    configs = layers.configurations(reference, configurations, seed)
+    configs = kinematics.configurations(reference, configurations, seed)
     for eng in loaded:
-        report.checks.extend(_guarded(2, eng, lambda eng=eng: layers.layer2(src, eng, configs)))
+        report.checks.extend(_guarded(2, eng, lambda eng=eng: kinematics.layer2(src, eng, configs)))
     t4 = time.perf_counter()
     pin_ref = next((e.model for e in loaded if e.label == "pinocchio"), None)
-    if layers.kinematic_only(reference):
+    if dynamics.kinematic_only(reference):
         report.skips.append(Skip(3, "all", "no link moved by a joint has mass in the source (a kinematic "
                                            "model): no dynamics to verify"))
         replay = False
@@ -416,7 +415,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         report.skips.append(Skip(3, "all", "layer 3a needs Pinocchio (the dynamics reference built from the "
                                            "source model), which is not among the loaded engines"))
     else:
-        state = layers.states(reference, pin_ref.dof_names(), samples, seed)
+        state = dynamics.states(reference, pin_ref.dof_names(), samples, seed)
         with_armature = [j.name for j in reference.joints if j.armature != 0.0]
         for eng in loaded:
             if eng.label == "pinocchio":
@@ -427,14 +426,14 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                    else pin_ref if model is reference else _pinocchio(model))
             try:
                 report.checks.extend(_guarded(3, eng,
-                                              lambda eng=eng, ref=ref: layers.layer3a(ref, eng, state)))
+                                              lambda eng=eng, ref=ref: dynamics.layer3a(ref, eng, state)))
                 if dropped:
                     report.skips.append(Skip(3, eng.label, (
                         f"joint armature (rotor inertia) of {', '.join(with_armature)} cannot be written in "
                         "URDF/SDF (MK820): the mass matrix is compared with the Pinocchio reference "
                         "without it")))
             except NotImplementedError:
-                report.skips.append(layers.no_dynamics(eng))
+                report.skips.append(dynamics.no_dynamics(eng))
     t5 = time.perf_counter()
     if replay:
         _replay(reference, files, maps, loaded, report, approx)

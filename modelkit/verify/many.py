@@ -277,7 +277,8 @@ def warm_up(jobs: Sequence[Job]) -> None:
 
     modules = {info.reader.partition(":")[0] for info in FORMATS}
     modules |= {f"modelkit.formats.{fmt}.writer" for fmt in ("mjcf", "urdf", "sdf")}
-    modules |= {"modelkit.convert.api", "modelkit.verify.layers.rigid", "modelkit.verify.engines.reference",
+    modules |= {"modelkit.convert.api", "modelkit.verify.layers.static", "modelkit.verify.layers.kinematics",
+                "modelkit.verify.layers.dynamics", "modelkit.verify.engines.reference",
                 "modelkit.verify.layers.approximations", "modelkit.verify.layers.shapes",
                 "modelkit.verify.layers.inject",
                 api.REPLAY.partition(":")[0], "yourdfpy", "trimesh"}

@@ -32,7 +32,7 @@ import numpy as np
 from modelkit.verify.engines.protocol import Array, Check, ShapeFacts, Skip, StaticFacts
 
 if TYPE_CHECKING:
-    from modelkit.verify.layers.rigid import Loaded
+    from modelkit.verify.layers.common import Loaded
 
 # Source primitives each engine's input format cannot hold: the writers mesh them.
 MESHED: dict[str, tuple[str, ...]] = {

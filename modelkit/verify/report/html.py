@@ -79,7 +79,7 @@ def _robot_and_files(report: VerifyReport, out_dir: Path, robot: Any, files: dic
 
 def _picture_job(report: VerifyReport, out_dir: Path, robot: Any, files: dict[str, Path] | None) -> Any:
     """The pictures' child process (:class:`~modelkit.verify.report.pictures.PictureJob`), started."""
-    from modelkit.verify.layers.rigid import configurations
+    from modelkit.verify.layers.kinematics import configurations
     from modelkit.verify.report.pictures import PictureJob
 
     model, paths = _robot_and_files(report, out_dir, robot, files)
