@@ -27,10 +27,10 @@ sys.path.insert(0, str(REPO))
 import numpy as np  # noqa: E402
 
 import modelkit  # noqa: E402
-from modelkit.verify import layer4, vehicle  # noqa: E402
-from modelkit.verify.drive import Command, Profile  # noqa: E402
-from modelkit.verify.reference_skid import skid_model, skid_reference, skid_tolerance  # noqa: E402
-from modelkit.verify.scenario import default_scenario  # noqa: E402
+from modelkit.verify.drive import Command, Profile, vehicle  # noqa: E402
+from modelkit.verify.drive.reference_skid import skid_model, skid_reference, skid_tolerance  # noqa: E402
+from modelkit.verify.drive.scenario import default_scenario  # noqa: E402
+from modelkit.verify.layers import layer4  # noqa: E402
 from tests import tracks_support as support  # noqa: E402
 
 

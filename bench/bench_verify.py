@@ -10,7 +10,7 @@ at once, each engine's load, the replay's overhead.
     each phase as the command prints it ("wall time: convert …, load …, layer 1 …, layer 4 …").
     The issue's target: the full verify of the tutorial pan-tilt robot under 5 s on a 2-core machine
     (part 1's: layers 1-3 under 3 s). The machine's load average is printed with the figures.
-(b) Layer 4's harness overhead (`modelkit.verify.variant.bench`) per profile of the default scenario:
+(b) Layer 4's harness overhead (`modelkit.verify.bench.bench`) per profile of the default scenario:
     simulated seconds per wall second of each engine's driver inside verify (controllers, samples)
     against a bare stepping loop of the same engine on the same floating-base variant (target ≥ 0.8),
     and a minimal hand-written closed loop (read, control, step) with the same controllers.
@@ -19,7 +19,7 @@ at once, each engine's load, the replay's overhead.
 (d) Each engine's share of "load": a fresh process per engine that imports the adapter and loads
     the written file (N runs): import and load seconds, medians. "load" includes what an adapter
     imports lazily (yourdfpy and trimesh) and PyBullet's child process (started, pybullet imported).
-(e) The replay's overhead (`modelkit.verify.replay.overhead`): simulated seconds per wall second
+(e) The replay's overhead (`modelkit.verify.layers.replay.overhead`): simulated seconds per wall second
     of each engine's replay against a bare stepping loop of the same engine on the same model
     (target ≥ 0.8), and for PyBullet the minimal closed loop (read the states, send torques, step)
     that any replay needs.
@@ -148,9 +148,9 @@ def bench_replay(source: Path, repeat: int) -> dict[str, Any]:
     from modelkit.convert import write
     from modelkit.convert.notes import renames
     from modelkit.verify.api import REPLAY_DT, REPLAY_SECONDS, welded_copy
-    from modelkit.verify.engine_mujoco import simulator as mujoco_simulator
-    from modelkit.verify.engine_pybullet import simulator as pybullet_simulator
-    from modelkit.verify.replay import default_law, overhead
+    from modelkit.verify.engines.mujoco import simulator as mujoco_simulator
+    from modelkit.verify.engines.pybullet import simulator as pybullet_simulator
+    from modelkit.verify.layers.replay import default_law, overhead
 
     robot, _ = welded_copy(load(source))
     with tempfile.TemporaryDirectory() as tmp:
@@ -169,12 +169,13 @@ def bench_replay(source: Path, repeat: int) -> dict[str, Any]:
 
 
 def bench_layer4(source: Path, repeat: int) -> dict[str, Any]:
-    """(b): ``variant.bench`` on every profile of the default scenario, ``repeat`` times; medians."""
+    """(b): ``modelkit.verify.bench.bench`` on every profile of the default scenario, ``repeat`` times;
+    medians."""
     from modelkit import load
-    from modelkit.verify import scenario as scenarios
-    from modelkit.verify import vehicle
-    from modelkit.verify.layer4 import floating
-    from modelkit.verify.variant import bench
+    from modelkit.verify.bench import bench
+    from modelkit.verify.drive import scenario as scenarios
+    from modelkit.verify.drive import vehicle
+    from modelkit.verify.layers.layer4 import floating
 
     robot = floating(load(source))
     drive = vehicle.find_drive(robot, scenarios.default_scenario())

@@ -34,7 +34,7 @@ from modelkit.diagnostics import (
     render_text,
 )
 from modelkit.format_names import FORMAT_NAMES
-from modelkit.verify.engines import DEFAULT_ENGINES  # data only: no numpy, no engine
+from modelkit.verify.engines.registry import DEFAULT_ENGINES  # data only: no numpy, no engine
 
 F = TypeVar("F", bound=Callable[..., Any])
 UNREADABLE_CODES = frozenset({"MK001", "MK002"})
@@ -676,7 +676,7 @@ def _verify(sources: tuple[Path, ...], output: Path | None, names: tuple[str, ..
 
 
 def _reading(kwargs: dict[str, Any], xacro_args: dict[str, str]) -> dict[str, Any]:
-    """verify's reading options as plain data (``modelkit.verify.api.read_options`` builds the
+    """verify's reading options as plain data (``modelkit.verify.source.read_options`` builds the
     ``ReadOptions`` from it, in this process or in a worker), only those that differ from the
     defaults, so that report.json and summary.json name what the user chose."""
     defaults = {"max_bytes": 64 * 1024 * 1024, "max_links": 10_000, "max_list_items": 250_000}
@@ -696,7 +696,7 @@ def _reading(kwargs: dict[str, Any], xacro_args: dict[str, str]) -> dict[str, An
 
 def _require_engines(names: tuple[str, ...], report: bool) -> None:
     """Exit 2 with the pip line when the engines (or the report's plots) are not installed."""
-    from modelkit.verify.engines import install_line, missing_packages
+    from modelkit.verify.engines.registry import install_line, missing_packages
 
     source = click.get_current_context().get_parameter_source("engines")
     named = source is not None and source is not click.core.ParameterSource.DEFAULT

@@ -10,8 +10,8 @@ from typing import Any
 
 import numpy as np
 
-from modelkit.verify.controllers import make_controllers
 from modelkit.verify.drive import Command, Drive, Profile, Trajectory
+from modelkit.verify.drive.controllers import make_controllers
 
 MODELS = Path(__file__).resolve().parent.parent / "samples/choreonoid_ros2_mobile_robot_tutorial/model"
 PANTILT = MODELS / "mobile_robot_pantilt.body"
@@ -53,8 +53,9 @@ def assert_same_layer4(robot: Any, engine: str, per_step: str, tmp_path: Path, m
     """Layer 4 on ``robot`` (its default scenario) with ``engine``'s fast driver, then with the per-step
     one (``per_step``: "module:function" building it), every check and observation the same to
     round-off and the same pass/fail; returns the engine's pairs of runs (each equal to round-off)."""
-    from modelkit.verify import layer4, vehicle
-    from modelkit.verify.scenario import default_scenario
+    from modelkit.verify.drive import vehicle
+    from modelkit.verify.drive.scenario import default_scenario
+    from modelkit.verify.layers import layer4
 
     scenario = default_scenario("wheels", True)
     drive = vehicle.find_drive(robot, scenario)

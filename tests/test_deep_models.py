@@ -17,7 +17,7 @@ from modelkit.convert.api import write
 from modelkit.formats.mjcf.write_xml import indent
 from modelkit.formats.mjcf.writer import MUJOCO_MAX_BODY_DEPTH
 from modelkit.tree import tree_json, tree_report
-from modelkit.verify.reference import dof_joints
+from modelkit.verify.engines.reference import dof_joints
 from tests import chain_support
 
 LINKS = 10_000

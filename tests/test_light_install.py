@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from modelkit.verify.engines import install_line, missing_packages
+from modelkit.verify.engines.registry import install_line, missing_packages
 
 pytestmark = pytest.mark.slow
 

@@ -10,7 +10,7 @@ from click.testing import CliRunner
 
 from modelkit.api import validate
 from modelkit.cli import main
-from modelkit.verify.scenario import MAX_STEPS, load
+from modelkit.verify.drive.scenario import MAX_STEPS, load
 
 HUGE = """<robot name="r">
 <link name="a"><inertial><mass value="1"/>
@@ -138,9 +138,9 @@ SAMPLES = Path(__file__).resolve().parents[1] / "samples" / "choreonoid_ros2_mob
 
 
 def test_a_300_character_robot_name_gives_layer_4_files_it_can_write(tmp_path: Path) -> None:
-    from modelkit.verify.scenario import default_scenario
-    from modelkit.verify.variant import write_variant
-    from modelkit.verify.vehicle import find_drive
+    from modelkit.verify.drive.scenario import default_scenario
+    from modelkit.verify.drive.variant import write_variant
+    from modelkit.verify.drive.vehicle import find_drive
 
     model = tmp_path / "long.body"
     text = (SAMPLES / "mobile_robot.body").read_text()

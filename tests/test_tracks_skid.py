@@ -1,4 +1,4 @@
-"""The skid-steer reference (modelkit.verify.reference_skid) and the converted tracked robot driven
+"""The skid-steer reference (modelkit.verify.drive.reference_skid) and the converted tracked robot driven
 on a plain floor in real MuJoCo and PyBullet (tests/tracks_support.py: the files `convert` writes).
 
 What is checked: the reference's physics (the steady spin rate of point contacts is the geometric
@@ -20,9 +20,8 @@ import numpy as np
 import pytest
 
 import modelkit
-from modelkit.verify import layer4, vehicle
-from modelkit.verify.drive import Command, Drive, Profile
-from modelkit.verify.reference_skid import (
+from modelkit.verify.drive import Command, Drive, Profile, vehicle
+from modelkit.verify.drive.reference_skid import (
     FLOOR_POSITION,
     FLOOR_YAW,
     SkidModel,
@@ -32,7 +31,8 @@ from modelkit.verify.reference_skid import (
     skid_tolerance,
     static_loads,
 )
-from modelkit.verify.scenario import default_scenario
+from modelkit.verify.drive.scenario import default_scenario
+from modelkit.verify.layers import layer4
 from tests import tracks_support as support
 
 SCENARIO = default_scenario("tracks", True)

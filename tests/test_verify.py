@@ -165,7 +165,7 @@ def _emitted_quantities() -> set[str]:
     import ast
 
     found: set[str] = set()
-    for path in sorted((REPO / "modelkit" / "verify").glob("*.py")):
+    for path in sorted((REPO / "modelkit" / "verify").rglob("*.py")):  # the subpackages too
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             if not isinstance(node, ast.Call) or len(node.args) < 2:
                 continue

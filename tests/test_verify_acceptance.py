@@ -18,7 +18,7 @@ import pytest
 from modelkit.api import validate
 from modelkit.model import JointType, Robot
 from modelkit.verify.api import DEFAULT_ENGINES, verify
-from modelkit.verify.facts import Skip
+from modelkit.verify.engines.protocol import Skip
 from modelkit.verify.report import VerifyReport
 from tests.conftest import CORPUS, SAMPLES, TUTORIAL
 
@@ -147,10 +147,10 @@ def test_documented_tiny_masses_are_listed_and_checked(tmp_path: Path) -> None:
     from modelkit.api import validate
     from modelkit.convert.api import write
     from modelkit.convert.notes import renames
-    from modelkit.verify import approximations, layers
     from modelkit.verify.api import welded_copy
-    from modelkit.verify.engine_drake import load as load_drake
-    from modelkit.verify.reference import source_static
+    from modelkit.verify.engines.drake import load as load_drake
+    from modelkit.verify.engines.reference import source_static
+    from modelkit.verify.layers import approximations, common, static
 
     report = verify(SENSORS_URDF, None, ("pinocchio", "drake"), replay=False)
     assert report.failed == []
@@ -170,7 +170,7 @@ def test_documented_tiny_masses_are_listed_and_checked(tmp_path: Path) -> None:
     assert edited != text
     sdf.write_text(edited)
     drake = load_drake(sdf, maps, root=str(robot.root))
-    checks = layers.layer1(expected, layers.Loaded("drake", drake, maps))
+    checks = static.layer1(expected, common.Loaded("drake", drake, maps))
     mass = next(c for c in checks if c.quantity == "mass")
     assert not mass.passed and mass.where == "LiDAR", mass
 
@@ -179,7 +179,7 @@ def test_an_engine_exception_becomes_a_failed_check() -> None:
     """An engine raising inside a layer (PyBullet once returned None from calculateInverseDynamics on
     a model without degrees of freedom) is a failed check carrying the message, not a crash."""
     from modelkit.verify.api import _guarded
-    from modelkit.verify.layers import Loaded
+    from modelkit.verify.layers.common import Loaded
 
     class Refusing:
         engine = "refusing"

@@ -25,8 +25,8 @@ from modelkit.convert import write
 from modelkit.convert.compare import random_configuration
 from modelkit.convert.notes import renames
 from modelkit.model import JointType, Robot
-from modelkit.verify import engine_drake
-from modelkit.verify.engine_mujoco import load as load_mujoco
+from modelkit.verify.engines import drake as engine_drake
+from modelkit.verify.engines.mujoco import load as load_mujoco
 from tests.conftest import CORPUS, TUTORIAL
 
 TOL = 1e-9

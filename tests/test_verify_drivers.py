@@ -13,8 +13,10 @@ import numpy as np
 import pytest
 
 import modelkit
-from modelkit.verify import engine_mujoco, engine_pybullet, variant
-from modelkit.verify.drive import Command, Drive, Profile, Scenario, Trajectory
+from modelkit.verify import bench as verify_bench
+from modelkit.verify.drive import Command, Drive, Profile, Scenario, Trajectory, variant
+from modelkit.verify.engines import mujoco as engine_mujoco
+from modelkit.verify.engines import pybullet as engine_pybullet
 from tests.drivers_support import DRIVE, PANTILT, TRACKS, profile
 
 # The seed's drive built by hand (LeftWheel/RightWheel, r 0.076, b 0.145: these tests do not depend on
@@ -187,7 +189,7 @@ def test_engines_keep_the_files_friction(pantilt: Any, tmp_path: Path) -> None:
 def test_bench_reports_harness_overhead(pantilt: Any, tmp_path: Path) -> None:
     profile = Profile("straight", 3.0, (Command(0.0, 0.5),), settle=0.5)
     scenario = Scenario(profiles=(profile,), controller="drive")
-    figures = variant.bench(pantilt, DRIVE, scenario, tmp_path)
+    figures = verify_bench.bench(pantilt, DRIVE, scenario, tmp_path)
     print({k: round(v, 3) for k, v in figures.items()})
     for engine in ("mujoco", "pybullet"):
         assert figures[f"{engine}_harness_s"] > 0 and figures[f"{engine}_bare_s"] > 0

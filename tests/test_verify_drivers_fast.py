@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import modelkit
-from modelkit.verify import engine_mujoco, variant
-from modelkit.verify.drive import Drive, Scenario
+from modelkit.verify.drive import Drive, Scenario, variant
+from modelkit.verify.engines import mujoco as engine_mujoco
 from tests.drivers_support import (
     DRIVE,
     PANTILT,
@@ -115,8 +115,8 @@ def test_track_controller_servo_targets_set_at_command_changes(tmp_path: Path) -
     numbers, and -kd·q̇ lands in the same sum). With them moving, straight (the tracked robot's graded
     profile) is within round-off; the turning ones skid (layer 4 reports them, no pass/fail) and grow
     the pan/tilt rounding to 1e-11..4e-9 over 10 s depending on the servo settings: printed only."""
-    from modelkit.verify import vehicle
-    from modelkit.verify.scenario import default_scenario
+    from modelkit.verify.drive import vehicle
+    from modelkit.verify.drive.scenario import default_scenario
 
     robot = modelkit.load(TRACKS)
     drive = vehicle.find_drive(robot, default_scenario("tracks", True))

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import modelkit
-from modelkit.verify import controllers, engine_pybullet, variant
-from modelkit.verify.drive import Command, Drive, Scenario
+from modelkit.verify.drive import Command, Drive, Scenario, controllers, variant
+from modelkit.verify.engines import pybullet as engine_pybullet
 from tests.drivers_support import (
     DRIVE,
     PANTILT,
@@ -125,8 +125,8 @@ def test_tracks_velocity_targets_at_command_changes(tmp_path: Path) -> None:
     constraints): with pan and tilt still the velocity motor is set once per command and nothing is
     sent per step: bit-identical to re-sending the same target every step. With them moving, straight
     (the tracked robot's graded profile) within round-off."""
-    from modelkit.verify import vehicle
-    from modelkit.verify.scenario import default_scenario
+    from modelkit.verify.drive import vehicle
+    from modelkit.verify.drive.scenario import default_scenario
 
     robot = modelkit.load(TRACKS)
     drive = vehicle.find_drive(robot, default_scenario("tracks", True))
@@ -222,7 +222,7 @@ def test_layer4_results_unchanged(pantilt: Any, tmp_path: Path, monkeypatch: pyt
     """Layer 4 (PyBullet, default scenario of the pan-tilt robot, sphere and native variants): every
     check and observation the same to round-off, the same pass/fail, with the fast driver as with the
     per-step one."""
-    from modelkit.verify import layer4
+    from modelkit.verify.layers import layer4
 
     monkeypatch.setitem(layer4.DRIVERS, "pybullet", f"{__name__}:fast_driver")
     runs = assert_same_layer4(pantilt, "pybullet", f"{__name__}:per_step_driver", tmp_path, monkeypatch)

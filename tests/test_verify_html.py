@@ -104,11 +104,11 @@ def verified(tmp_path_factory: pytest.TempPathFactory) -> tuple[VerifyReport, Pa
 
 
 def _pictures(report: VerifyReport, out: Path):  # type: ignore[no-untyped-def]
-    from modelkit.verify.api import _read, welded_copy
-    from modelkit.verify.layers import configurations
-    from modelkit.verify.pictures import render_pictures
+    from modelkit.verify.layers.kinematics import configurations
+    from modelkit.verify.report.pictures import render_pictures
+    from modelkit.verify.source import read_robot, welded_copy
 
-    robot, _ = welded_copy(_read(PANTILT))
+    robot, _ = welded_copy(read_robot(PANTILT))
     files = {fmt: out / name for fmt, name in report.files.items()}
     return render_pictures(robot, files, report.renames, configurations(robot, 1, report.seed))
 
@@ -126,7 +126,7 @@ def _require(pictures, engine: str) -> None:  # type: ignore[no-untyped-def]
 
 
 def test_plots_are_deterministic_and_drawn(tmp_path: Path) -> None:
-    from modelkit.verify.plots import profile_figure, write_plots
+    from modelkit.verify.report.plots import profile_figure, write_plots
 
     runs = synthetic_trajectories()
     arc = [t for t in runs if t.profile == "arc"]
@@ -147,7 +147,7 @@ def test_plots_are_deterministic_and_drawn(tmp_path: Path) -> None:
 
 
 def test_errors_on_log_axis_are_the_differences() -> None:
-    from modelkit.verify.plots import pose_errors
+    from modelkit.verify.report.plots import pose_errors
 
     runs = synthetic_trajectories()
     a = next(t for t in runs if (t.source, t.profile, t.variant) == ("mujoco", "arc", "sphere"))
@@ -173,7 +173,7 @@ def test_verify_validate_do_not_import_matplotlib() -> None:
 
 
 def test_pictures_agree_across_engines(verified: tuple[VerifyReport, Path]) -> None:
-    from modelkit.verify.pictures import difference
+    from modelkit.verify.report.pictures import difference
 
     report, out = verified
     pictures = _pictures(report, out)
@@ -207,7 +207,7 @@ def test_a_flipped_wheel_is_visible(verified: tuple[VerifyReport, Path], tmp_pat
     """The flipped wheel is judged against the same engine's picture of the correct conversion, so
     the margin is the wheel's, not the renderer's edge noise (PyBullet's TinyRenderer differs from
     the source by ~2 % on a correct file)."""
-    from modelkit.verify.pictures import difference
+    from modelkit.verify.report.pictures import difference
 
     def measured(pictures, engine: str) -> tuple[float, int]:  # type: ignore[no-untyped-def]
         source = pictures.get("source", "collision", 0)
@@ -238,7 +238,7 @@ def test_report_html_is_self_contained_and_deterministic(verified: tuple[VerifyR
                                                           tmp_path: Path) -> None:
     import copy
 
-    from modelkit.verify.html import write_artefacts
+    from modelkit.verify.report.html import write_artefacts
 
     report, out = verified
     files = {fmt: out / name for fmt, name in report.files.items()}
@@ -261,7 +261,7 @@ def test_report_html_is_self_contained_and_deterministic(verified: tuple[VerifyR
 def test_report_renders_in_headless_chromium(verified: tuple[VerifyReport, Path], tmp_path: Path) -> None:
     import copy
 
-    from modelkit.verify.html import write_artefacts
+    from modelkit.verify.report.html import write_artefacts
 
     chromium = _chromium()
     report, out = verified

@@ -24,9 +24,9 @@ from modelkit.convert import write
 from modelkit.convert.notes import renames
 from modelkit.model import JointType, Robot
 from modelkit.spatial import matrix_from_quat_wxyz
-from modelkit.verify.engine_mujoco import load as load_mujoco
-from modelkit.verify.facts import StaticFacts
-from modelkit.verify.inject import InjectError, apply, inject, parse
+from modelkit.verify.engines.mujoco import load as load_mujoco
+from modelkit.verify.engines.protocol import StaticFacts
+from modelkit.verify.layers.inject import InjectError, apply, inject, parse
 from tests.conftest import TUTORIAL
 
 PANTILT = TUTORIAL / "mobile_robot_pantilt.body"
@@ -64,7 +64,7 @@ def _engine(fmt_name: str, path: Path) -> Any:
     if fmt_name == "mjcf":
         return load_mujoco(path, {}, root="Chassis")
     pytest.importorskip("pydrake", reason="Drake is an optional extra: pip install modelkit[drake]")
-    from modelkit.verify.engine_drake import load as load_drake
+    from modelkit.verify.engines.drake import load as load_drake
 
     return load_drake(path, {}, root="Chassis")
 
@@ -325,17 +325,17 @@ LAYER_FAULTS = [
 
 
 def _layer_checks(w: Written, out: Path, fmt_name: str, label: str) -> list[Any]:
-    layers = pytest.importorskip("modelkit.verify.layers")
-    from modelkit.verify.engine_pinocchio import load as load_pinocchio
-    from modelkit.verify.reference import SourceModel, source_static
+    from modelkit.verify.engines.pinocchio import load as load_pinocchio
+    from modelkit.verify.engines.reference import SourceModel, source_static
+    from modelkit.verify.layers import common, dynamics, kinematics, static
 
     model = _engine(fmt_name, out / FORMATS[fmt_name])
-    eng = layers.Loaded(label, model, w.renames[fmt_name])
+    eng = common.Loaded(label, model, w.renames[fmt_name])
     source = SourceModel(w.robot)
     pin = load_pinocchio(w.robot, {}, root="Chassis")
-    checks = list(layers.layer1(source_static(w.robot), eng))
-    checks += layers.layer2(source, eng, layers.configurations(w.robot, 20, 0))
-    checks += layers.layer3a(pin, eng, layers.states(w.robot, pin.dof_names(), 10, 0))
+    checks = list(static.layer1(source_static(w.robot), eng))
+    checks += kinematics.layer2(source, eng, kinematics.configurations(w.robot, 20, 0))
+    checks += dynamics.layer3a(pin, eng, dynamics.states(w.robot, pin.dof_names(), 10, 0))
     return checks
 
 
@@ -379,7 +379,7 @@ GEOMETRY_FAULTS = [("cylinder-y:LeftWheel", "shape-pose", "LeftWheel"),
 @pytest.mark.parametrize(("spec", "quantity", "link"), GEOMETRY_FAULTS)
 def test_geometry_faults_fail_layer1_shapes_only(written: Written, tmp_path: Path, spec: str, quantity: str,
                                                  link: str) -> None:
-    """Collision geometry is a layer-1 fact (``StaticFacts.shapes``, ``modelkit.verify.shapes``):
+    """Collision geometry is a layer-1 fact (``StaticFacts.shapes``, ``modelkit.verify.layers.shapes``):
     a turned or resized wheel fails exactly one shape check, naming the link; it changes no mass
     property, so layers 2 and 3 stay green. (PyBullet: ``tests/test_verify_shapes.py``.)"""
     out = _copy(written, tmp_path)

@@ -13,18 +13,18 @@ import pytest
 
 import modelkit
 from modelkit.model import Robot
-from modelkit.verify import layer4
-from modelkit.verify.controllers import (
+from modelkit.verify.drive import Command, Drive, Profile, Scenario
+from modelkit.verify.drive.controllers import (
     DriveController,
     DriveTester,
     PanTiltController,
     TrackController,
     make_controllers,
 )
-from modelkit.verify.drive import Command, Drive, Profile, Scenario
-from modelkit.verify.reference_drive import noslip, odometry, planar_model, unicycle
-from modelkit.verify.scenario import builtin_profile, default_scenario, scenario_dict
-from modelkit.verify.vehicle import find_drive
+from modelkit.verify.drive.reference import noslip, odometry, planar_model, unicycle
+from modelkit.verify.drive.scenario import builtin_profile, default_scenario, scenario_dict
+from modelkit.verify.drive.vehicle import find_drive
+from modelkit.verify.layers import layer4
 
 from .conftest import PENDULUM_BODY, SAMPLES, TUTORIAL
 

@@ -22,7 +22,7 @@ pytest.importorskip("pinocchio")
 def test_yourdfpy_poses_are_its_own_path_products(tmp_path: Path) -> None:
     """The per-joint composition gives what ``get_transform(link, root)`` gives (to rounding), also
     for a root below the URDF's base link, and does not grow with the square of the chain."""
-    from modelkit.verify.reference import YourdfpyModel
+    from modelkit.verify.engines.reference import YourdfpyModel
 
     path = chain_support.write(tmp_path, "urdf", 60, branches=3)
     for root in ("link0", "link5"):
@@ -39,7 +39,7 @@ def test_yourdfpy_poses_are_its_own_path_products(tmp_path: Path) -> None:
 
 
 def test_pinocchio_refuses_a_data_of_cubic_size_before_allocating_it(tmp_path: Path) -> None:
-    from modelkit.verify.engine_pinocchio import PinocchioModel, TooManyDofs, max_dofs
+    from modelkit.verify.engines.pinocchio import PinocchioModel, TooManyDofs, max_dofs
 
     assert max_dofs() == 161
     PinocchioModel(load(chain_support.write(tmp_path, "urdf", max_dofs() + 1)))  # 161 joints: built
@@ -49,7 +49,7 @@ def test_pinocchio_refuses_a_data_of_cubic_size_before_allocating_it(tmp_path: P
 
 def test_the_replay_law_of_a_long_chain_is_refused_not_a_traceback(tmp_path: Path) -> None:
     """A 30-link chain's slowest modes contract by less than 1e-6 per step whatever the gains."""
-    from modelkit.verify.replay import UnstableLaw, default_law
+    from modelkit.verify.layers.replay import UnstableLaw, default_law
 
     with pytest.raises(UnstableLaw, match="slowest modes of a long chain"):
         default_law(load(chain_support.write(tmp_path, "urdf", 30)))
@@ -73,7 +73,7 @@ def test_verify_of_a_200_link_chain_skips_what_the_engines_cannot_hold(tmp_path:
 def test_pybullets_joint_limit_is_its_own(tmp_path: Path) -> None:
     """The skip above is PyBullet's limit, not ours: 127 moving joints answer, 128 do not."""
     pytest.importorskip("pybullet")
-    from modelkit.verify.engine_pybullet import (
+    from modelkit.verify.engines.pybullet import (
         MAX_MOVING_JOINTS,
         PyBulletError,
         PyBulletModel,

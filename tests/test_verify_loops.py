@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from modelkit.verify import approximations
 from modelkit.verify.api import verify
+from modelkit.verify.layers import approximations
 from tests.conftest import CORPUS
 
 pytest.importorskip("mujoco")

@@ -17,8 +17,8 @@ import pytest
 
 from modelkit.model import Robot
 from modelkit.verify.api import verify
-from modelkit.verify.engine_mujoco import MujocoModel
-from modelkit.verify.facts import Check, StaticFacts
+from modelkit.verify.engines.mujoco import MujocoModel
+from modelkit.verify.engines.protocol import Check, StaticFacts
 from tests.conftest import CORPUS
 
 SUITE = CORPUS / "dm_control_suite" / "dm_control" / "suite"
@@ -51,7 +51,7 @@ def _static(source: Path, tmp_path: Path) -> tuple[Robot, MujocoModel, StaticFac
     from modelkit.api import validate
     from modelkit.convert.api import write
     from modelkit.verify.api import welded_copy
-    from modelkit.verify.reference import source_static
+    from modelkit.verify.engines.reference import source_static
 
     robot = welded_copy(validate(source).robots[0])[0]
     path = tmp_path / "x.xml"
@@ -86,8 +86,8 @@ def test_a_multi_joint_body_is_the_readers_chain(tmp_path: Path) -> None:
 def test_link_poses_follow_the_reader_at_random_configurations(tmp_path: Path) -> None:
     """Intermediate links move with their own joint only: their poses come out of MuJoCo's body
     frames by undoing the later joints, and match the source model's forward kinematics."""
-    from modelkit.verify.layers import configurations
-    from modelkit.verify.reference import SourceModel
+    from modelkit.verify.engines.reference import SourceModel
+    from modelkit.verify.layers.kinematics import configurations
 
     robot, mj, _ = _static(SUITE / "swimmer.xml", tmp_path)
     ref = SourceModel(robot)
@@ -186,9 +186,9 @@ def test_drake_uses_its_world_body_for_a_world_root(tmp_path: Path) -> None:
     pytest.importorskip("pydrake")
     from modelkit.api import validate
     from modelkit.convert.api import write
-    from modelkit.verify import engine_drake
     from modelkit.verify.api import welded_copy
-    from modelkit.verify.reference import SourceModel
+    from modelkit.verify.engines import drake as engine_drake
+    from modelkit.verify.engines.reference import SourceModel
 
     robot = welded_copy(validate(SUITE / "pendulum.xml").robots[0])[0]
     assert robot.root == "world"
@@ -236,7 +236,7 @@ def test_unlimited_slides_are_compared_with_the_urdf_stand_in(tmp_path: Path) ->
 def test_replay_leaves_the_passive_terms_out_and_says_so(tmp_path: Path) -> None:
     """MuJoCo's damping, friction loss, stiffness (and armature when asked) are zeroed on the replay's
     compiled model, and ``left_out`` names the joints that had them; the report says so."""
-    from modelkit.verify.engine_mujoco import MujocoSimulator
+    from modelkit.verify.engines.mujoco import MujocoSimulator
 
     robot, _, _ = _static(HUMANOID, tmp_path)
     none: dict[str, dict[str, str]] = {"link": {}, "joint": {}}
@@ -257,7 +257,7 @@ def test_the_replays_1_kg_sits_at_the_link_origin(tmp_path: Path) -> None:
     """PyBullet's 1 kg for an intermediate link is at the link origin, its joint's anchor: MuJoCo's
     replay body for waist_lower__abdomen_z carries it at jnt_pos (0 0 .065), not at the body frame
     (the cause of humanoid's 0.19 rad replay difference)."""
-    from modelkit.verify.engine_mujoco import MujocoSimulator
+    from modelkit.verify.engines.mujoco import MujocoSimulator
 
     robot, _, _ = _static(HUMANOID, tmp_path)
     sim = MujocoSimulator(tmp_path / "x.xml", {"link": {}, "joint": {}}, str(robot.root), 1e-3,
@@ -273,8 +273,8 @@ def test_mujoco_warnings_are_collected_and_instability_fails(tmp_path: Path,
     """A replay that blows up (absurd gains) makes MuJoCo warn; the warning is collected on the
     simulator, no MUJOCO_LOG.TXT appears in the working directory, and it is a failed check."""
     from modelkit.verify.api import engine_warnings
-    from modelkit.verify.engine_mujoco import MujocoSimulator
-    from modelkit.verify.facts import TorqueLaw
+    from modelkit.verify.engines.mujoco import MujocoSimulator
+    from modelkit.verify.engines.protocol import TorqueLaw
     from modelkit.verify.report import VerifyReport
 
     robot, _, _ = _static(SUITE / "pendulum.xml", tmp_path)

@@ -26,9 +26,9 @@ from modelkit.convert.compare import random_configuration  # noqa: E402
 from modelkit.convert.notes import renames  # noqa: E402
 from modelkit.convert.options import WriteOptions  # noqa: E402
 from modelkit.model import JointType, Robot  # noqa: E402
-from modelkit.verify import engine_pybullet  # noqa: E402
-from modelkit.verify.engine_pybullet import PyBulletError, PyBulletModel  # noqa: E402
-from modelkit.verify.replay import TOLERANCE, default_law, layer3b  # noqa: E402
+from modelkit.verify.engines import pybullet as engine_pybullet  # noqa: E402
+from modelkit.verify.engines.pybullet import PyBulletError, PyBulletModel  # noqa: E402
+from modelkit.verify.layers.replay import TOLERANCE, default_law, layer3b  # noqa: E402
 
 from .conftest import TUTORIAL  # noqa: E402
 
@@ -218,7 +218,7 @@ def test_mass_matrix_and_bias_match_mujoco(pantilt: Converted, pb: Any) -> None:
 
 
 def _replay(pantilt: Converted, urdf: Path) -> Any:
-    from modelkit.verify import engine_mujoco
+    from modelkit.verify.engines import mujoco as engine_mujoco
 
     root = str(pantilt.robot.root)
     mj = engine_mujoco.simulator(pantilt.mjcf, pantilt.mjcf_renames, root=root, dt=1e-3)

@@ -19,11 +19,12 @@ from modelkit.convert import write
 from modelkit.convert.notes import renames
 from modelkit.convert.options import WriteOptions
 from modelkit.model import JointType
-from modelkit.verify import engine_mujoco, engine_pybullet
-from modelkit.verify.facts import TorqueLaw
-from modelkit.verify.html import render_html
-from modelkit.verify.replay import PERTURBATION, TOLERANCE, replay_layer
+from modelkit.verify.engines import mujoco as engine_mujoco
+from modelkit.verify.engines import pybullet as engine_pybullet
+from modelkit.verify.engines.protocol import TorqueLaw
+from modelkit.verify.layers.replay import PERTURBATION, TOLERANCE, replay_layer
 from modelkit.verify.report import VerifyReport, report_json
+from modelkit.verify.report.html import render_html
 
 PENDULUM = Path(__file__).parent / "replay" / "double_pendulum.urdf"
 SECONDS, DT = 10.0, 1e-3

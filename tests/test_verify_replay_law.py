@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import modelkit
-from modelkit.verify.replay import (
+from modelkit.verify.layers.replay import (
     MAX_BANDWIDTH,
     _axis_inertia_and_gravity,
     default_law,
@@ -65,7 +65,7 @@ def test_hopper_law_uses_the_effective_inertia_and_is_stable() -> None:
     """hopper (planar root joints in the tree, armature zeroed as the replay does): the subtree
     inertia overstates what the torso joints drive ~100×; the law's loop contracts at 1 ms."""
     pytest.importorskip("pinocchio")
-    from modelkit.verify.engine_pinocchio import PinocchioModel
+    from modelkit.verify.engines.pinocchio import PinocchioModel
 
     robot = modelkit.load(HOPPER)
     law = default_law(robot, DT)
@@ -103,7 +103,7 @@ def test_hopper_law_uses_the_effective_inertia_and_is_stable() -> None:
 def test_without_pinocchio_the_law_falls_back_to_the_subtree_inertia(monkeypatch: pytest.MonkeyPatch) -> None:
     """Pinocchio absent (its adapter cannot be imported): the gains come from the subtree inertia."""
     robot = modelkit.load(HOPPER)
-    monkeypatch.setitem(sys.modules, "modelkit.verify.engine_pinocchio", None)
+    monkeypatch.setitem(sys.modules, "modelkit.verify.engines.pinocchio", None)
     law = default_law(robot, DT)
     children: dict[str, list[str]] = {}
     for j in robot.joints:

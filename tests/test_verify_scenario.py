@@ -12,7 +12,7 @@ import pytest
 from modelkit.codes import CODES
 from modelkit.diagnostics import render_text
 from modelkit.verify.drive import Command
-from modelkit.verify.scenario import (
+from modelkit.verify.drive.scenario import (
     BUILTIN_PROFILES,
     default_scenario,
     load,

@@ -1,4 +1,4 @@
-"""Layer 1's collision-shape checks (``modelkit.verify.shapes``), against the real engines.
+"""Layer 1's collision-shape checks (``modelkit.verify.layers.shapes``), against the real engines.
 
 MuJoCo reads the written MJCF, PyBullet (in its child process) the written URDF. Each engine's
 shapes are read back in the link frame and compared with the source model's collision shapes:
@@ -22,10 +22,10 @@ import modelkit
 from modelkit.convert import write
 from modelkit.model import JointType
 from modelkit.spatial import Pose, matrix_from_rpy
-from modelkit.verify import layers, shapes
-from modelkit.verify.engine_mujoco import load as load_mujoco
-from modelkit.verify.facts import ShapeFacts, StaticFacts
-from modelkit.verify.reference import source_static
+from modelkit.verify.engines.mujoco import load as load_mujoco
+from modelkit.verify.engines.protocol import ShapeFacts, StaticFacts
+from modelkit.verify.engines.reference import source_static
+from modelkit.verify.layers import common, shapes, static
 from tests.conftest import CORPUS, TUTORIAL
 
 PANTILT = TUTORIAL / "mobile_robot_pantilt.body"
@@ -37,7 +37,7 @@ def _load(engine: str, path: Path, maps: Renames, root: str) -> Any:
     if engine == "mujoco":
         return load_mujoco(path, maps, root=root)
     pytest.importorskip("pybullet")
-    from modelkit.verify.engine_pybullet import load as load_pybullet
+    from modelkit.verify.engines.pybullet import load as load_pybullet
 
     return load_pybullet(path, maps, root=root)
 
@@ -109,7 +109,7 @@ def test_a_missing_mesh_is_a_skip_not_a_silent_pass(tmp_path: Path) -> None:
     assert "MK805" in {n.code for n in notes}
     source = source_static(robot)
     assert [s.type for s in source.shapes["Chassis"]] == [shapes.MISSING]
-    eng = layers.Loaded("mujoco", load_mujoco(tmp_path / "x.xml", {}, root="Chassis"))
+    eng = common.Loaded("mujoco", load_mujoco(tmp_path / "x.xml", {}, root="Chassis"))
     (skip,) = shapes.skips(source, eng)
     assert skip.layer == 1 and "file is missing" in skip.reason and "Chassis" in skip.reason
 
@@ -190,7 +190,7 @@ def test_engines_report_shapes_in_the_link_frame(frames: Path, engine: str, tmp_
     finally:
         model.close()
     assert set(got) == set(EXPECTED)
-    checks = shapes.compare(_expected_facts(), StaticFacts(shapes=got), layers.Loaded(engine, model))
+    checks = shapes.compare(_expected_facts(), StaticFacts(shapes=got), common.Loaded(engine, model))
     by = {c.quantity: c for c in checks}
     assert by["shape-set"].error == 0.0, by["shape-set"].detail
     assert by["shape-size"].error <= 1e-15, by["shape-size"].detail  # sizes are exact
@@ -213,7 +213,7 @@ def real(frames: Path) -> Any:
 
 
 def _compare(real: Any, a: StaticFacts, b: StaticFacts, label: str = "mujoco") -> dict[str, Any]:
-    return {c.quantity: c for c in shapes.compare(a, b, layers.Loaded(label, real))}
+    return {c.quantity: c for c in shapes.compare(a, b, common.Loaded(label, real))}
 
 
 def _pose_error(real: Any, kind: str, size: list[float], rotation: np.ndarray) -> float:
@@ -255,12 +255,12 @@ def test_primitives_the_format_lacks_are_expected_as_meshes(real: Any) -> None:
 
 
 def test_engines_without_shapes_are_skipped_with_a_reason() -> None:
-    from modelkit.verify.engine_pinocchio import load as load_pinocchio
+    from modelkit.verify.engines.pinocchio import load as load_pinocchio
 
     robot = modelkit.load(PANTILT)
-    eng = layers.Loaded("pinocchio", load_pinocchio(robot, {}, root="Chassis"))
+    eng = common.Loaded("pinocchio", load_pinocchio(robot, {}, root="Chassis"))
     source = source_static(robot)
     assert eng.model.static().shapes == {}
-    assert [c for c in layers.layer1(source, eng) if c.quantity.startswith("shape")] == []
+    assert [c for c in static.layer1(source, eng) if c.quantity.startswith("shape")] == []
     (skip,) = shapes.skips(source, eng)
     assert skip.layer == 1 and skip.engine == "pinocchio" and "reports no collision shapes" in skip.reason

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 
 import modelkit
-from modelkit.verify import approximations
 from modelkit.verify.api import verify
+from modelkit.verify.layers import approximations
 
 GO1_LIKE = """<?xml version="1.0"?>
 <robot name="go1_like">

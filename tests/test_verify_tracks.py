@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 import modelkit
-from modelkit.verify import layer4, variant, vehicle
-from modelkit.verify.drive import Command, Profile
-from modelkit.verify.reference_drive import noslip, planar_model
-from modelkit.verify.scenario import default_scenario
+from modelkit.verify.drive import Command, Profile, variant, vehicle
+from modelkit.verify.drive.reference import noslip, planar_model
+from modelkit.verify.drive.scenario import default_scenario
+from modelkit.verify.layers import layer4
 
 pytest.importorskip("mujoco")
 pytest.importorskip("pybullet")
@@ -71,8 +71,8 @@ def test_servo_gain_below_the_clamped_stability_limit() -> None:
 
 
 def _engines(robot, tmp_path: Path, profile: Profile, kv: float | None = None):  # type: ignore[no-untyped-def]
-    from modelkit.verify.engine_mujoco import driver as mujoco_driver
-    from modelkit.verify.engine_pybullet import driver as pybullet_driver
+    from modelkit.verify.engines.mujoco import driver as mujoco_driver
+    from modelkit.verify.engines.pybullet import driver as pybullet_driver
 
     source, _, scenario, drive = robot
     files, maps = variant.write_variant(source, drive, scenario, tmp_path, "sphere")

@@ -43,8 +43,8 @@ def test_the_g1_replay_really_passes_the_clamp(g1: Path, tmp_path: Path) -> None
     from modelkit.convert.api import write
     from modelkit.convert.options import WriteOptions
     from modelkit.verify.api import welded_copy
-    from modelkit.verify.engine_mujoco import simulator
-    from modelkit.verify.replay import default_law
+    from modelkit.verify.engines.mujoco import simulator
+    from modelkit.verify.layers.replay import default_law
 
     welded, _ = welded_copy(modelkit.load(g1))
     path = tmp_path / "g1.xml"

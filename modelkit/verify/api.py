@@ -6,7 +6,7 @@ The engine plug-in contract (what ``engine_<name>.py`` modules provide)
 
 Engines are found by name in :data:`ENGINES` (``"name": "module:function"``) and imported lazily,
 only when ``verify`` runs; an ``ImportError`` while importing the module (the engine's Python
-package is not installed) becomes a :class:`~modelkit.verify.facts.Skip` "not installed", never a
+package is not installed) becomes a :class:`~modelkit.verify.engines.protocol.Skip` "not installed", never a
 failure. Every module exposes::
 
     def load(model: Path | Robot, renames: Renames, *, root: str) -> EngineModel
@@ -23,7 +23,7 @@ failure. Every module exposes::
 * gravity is always (0, 0, −9.81) m/s² in the world frame; no joint damping, armature or friction
   is added by the adapter (only what the model itself has), and the adapter records every setting
   that matters in ``EngineModel.settings``.
-* it raises ``modelkit.verify.api.EngineError`` (or any ``Exception``) when the file cannot be
+* it raises ``modelkit.verify.engines.protocol.EngineError`` (or any ``Exception``) when the file cannot be
   loaded: that becomes a failed layer-1 ``load`` check for the engine, with the message (an engine
   refusing our file is a conversion defect, not a skip).
 
@@ -33,12 +33,12 @@ A module that can integrate the model (layer 3b, the replay) also exposes::
 
 whose ``replay(law, seconds, dt)`` maps ``law.joints`` (source names) through its own ``renames``
 and returns q with one column per ``law.joints`` entry, in that order (MuJoCo's is in
-``engine_mujoco.py``). The replay tests inertial data: a simulator leaves the joints' passive terms
+``engines/mujoco.py``). The replay tests inertial data: a simulator leaves the joints' passive terms
 out (PyBullet zeroes all damping; MuJoCo zeroes damping, friction loss and stiffness and lists them in
 ``left_out``, said in a Skip). An engine that collects warnings while running (MuJoCo's
 ``runtime_warnings``, never ``MUJOCO_LOG.TXT``) has them in its settings in the report; those saying
 the simulation went unstable are a failed ``stability`` check. Layer 3b itself is
-``modelkit.verify.replay``, imported lazily like the engines (missing → Skip)::
+``modelkit.verify.layers.replay``, imported lazily like the engines (missing → Skip)::
 
     def default_law(source: Robot) -> TorqueLaw
     def replay_layer(source: Robot, sims: list[Simulator], law: TorqueLaw, seconds: float, dt: float
@@ -48,7 +48,7 @@ the simulation went unstable are a failed ``stability`` check. Layer 3b itself i
 ``replay``). A simulator that also has ``replay_from(law, seconds, dt, start_q)`` (MuJoCo's) is the
 reference whose perturbed replays calibrate the tolerance.
 
-Fault injection (``--inject``) is ``modelkit.verify.inject:apply(spec: str, files: dict[str, Path],
+Fault injection (``--inject``) is ``modelkit.verify.layers.inject:apply(spec: str, files: dict[str, Path],
 renames: dict[str, Renames]) -> str``: it perturbs the written files in place (``files`` maps "mjcf",
 "urdf", "sdf" to paths, ``renames`` maps the same keys to that file's renames) and returns a one-line
 description for the report; a bad spec raises ``ValueError`` (exit 2).
@@ -68,29 +68,21 @@ from typing import Any
 import numpy as np
 
 from modelkit.model import JointType, Robot
-from modelkit.spatial import Pose
-from modelkit.verify.engines import DEFAULT_ENGINES, ENGINES, INPUTS
-from modelkit.verify.facts import Check, Skip
+from modelkit.verify.engines.protocol import Check, Skip
+from modelkit.verify.engines.registry import DEFAULT_ENGINES, ENGINES, INPUTS
 from modelkit.verify.report import VerifyReport
+from modelkit.verify.source import VerifyError, read_robot, welded_copy
 
 Renames = dict[str, dict[str, str]]
 
 SUFFIX = {"mjcf": ".xml", "urdf": ".urdf", "sdf": ".sdf"}
-REPLAY = "modelkit.verify.replay:replay_layer"
-INJECT = "modelkit.verify.inject:apply"
+REPLAY = "modelkit.verify.layers.replay:replay_layer"
+INJECT = "modelkit.verify.layers.inject:apply"
 
 CONFIGURATIONS = 50  # layer 2: q = 0 and this many random configurations
 SAMPLES = 20  # layer 3a: random (q, dq)
 REPLAY_SECONDS = 10.0
 REPLAY_DT = 1e-3
-
-
-class EngineError(RuntimeError):
-    """An engine could not load a model file."""
-
-
-class VerifyError(Exception):
-    """The run could not happen: unreadable input, no robot, a bad option (exit 2)."""
 
 
 def _resolve(target: str) -> Any:
@@ -99,63 +91,6 @@ def _resolve(target: str) -> Any:
     module, _, name = target.partition(":")
     with signals_held():  # Drake's initialisation would swallow a Ctrl-C; glfw's probe child would print it
         return getattr(importlib.import_module(module), name)
-
-
-def read_options(reading: Mapping[str, Any] | None) -> tuple[Any, str | None]:
-    """The ``ReadOptions`` and input format of verify's reading options given as plain data (the
-    keys of ``modelkit verify``'s options: input_format, package_paths {NAME: DIR}, path_variables,
-    resource_paths, xacro_args {KEY: VALUE}, legacy_xacro, materials, vrml_extrusion, max_bytes,
-    max_links, max_list_items; absent = the default, as in ``validate`` and ``convert``)."""
-    from modelkit.formats.common import ReadOptions
-    from modelkit.resources import Resolver
-
-    r = dict(reading or {})
-    resolver = Resolver(package_paths={k: Path(v) for k, v in r.get("package_paths", {}).items()},
-                        path_variables={k: Path(v) for k, v in r.get("path_variables", {}).items()},
-                        resource_paths=[Path(p) for p in r.get("resource_paths", [])])
-    options = ReadOptions(resolver=resolver, xacro_args=dict(r.get("xacro_args", {})),
-                          legacy_xacro=r.get("legacy_xacro"),
-                          materials_path=Path(r["materials"]) if r.get("materials") else None,
-                          faithful_extrusion=not r.get("vrml_extrusion", False))
-    for limit in ("max_bytes", "max_links", "max_list_items"):
-        if limit in r:
-            setattr(options, limit, int(r[limit]))
-    return options, r.get("input_format")
-
-
-def _read(source: Path, reading: Mapping[str, Any] | None = None) -> Robot:
-    from modelkit.api import validate
-    from modelkit.convert.api import CONVERTIBLE_ERRORS, UNREADABLE
-
-    if not source.exists():
-        raise VerifyError(f"{source}: no such file")
-    options, fmt = read_options(reading)
-    checked = validate(source, options, fmt)
-    if any(d.code in UNREADABLE for d in checked.diagnostics):
-        raise VerifyError(f"{source}: cannot be read: "
-                          + "; ".join(d.message for d in checked.diagnostics if d.code in UNREADABLE))
-    blocking = [d for d in checked.errors if d.code not in CONVERTIBLE_ERRORS]
-    robots = [r for r in checked.robots if r.root is not None]
-    if blocking or not robots:
-        why = "; ".join(f"{d.code} {d.message}" for d in blocking[:3]) or "no robot with a root link"
-        raise VerifyError(f"{source}: cannot be converted: {why}")
-    return robots[0]
-
-
-def welded_copy(robot: Robot) -> tuple[Robot, str]:
-    """The robot with its root welded to the world at the identity, and the sentence that says so.
-
-    A URDF's empty ``world`` link welded to the robot is absorbed first, as ``convert`` does (the
-    written files' root is the robot's first link, so the reference's must be too)."""
-    from modelkit.convert.base import absorb_world_weld
-
-    out = copy.deepcopy(robot)
-    absorb_world_weld(out)
-    was = out.root_joint.value if out.root_joint is not None else "left open by the format"
-    out.root_joint = JointType.FIXED
-    out.root_pose = Pose()
-    return out, (f"root link {out.root!r} ({was} in the source) welded to the world at the identity "
-                 "for layers 1-3")
 
 
 def _reference(welded: Robot, report: VerifyReport) -> Robot:
@@ -226,7 +161,7 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
 
 def _load_engines(names: Sequence[str], reference: Robot, files: dict[str, Path], maps: dict[str, Renames],
                   report: VerifyReport) -> list[Any]:
-    from modelkit.verify.layers import Loaded
+    from modelkit.verify.layers.common import Loaded
 
     loaded: list[Loaded] = []
     for name in names:
@@ -311,8 +246,9 @@ def verify(
     ``artefacts`` True (the caller will write the report with ``many.save``, which needs ``out_dir``):
     the report's plotting processes and pictures start while the layers run (``report.prepared``).
 
-    ``reading``: the reading options of ``validate`` and ``convert`` as plain data (:func:`read_options`;
-    package paths, xacro arguments, ...), written into ``report.parameters["reading"]`` when given.
+    ``reading``: the reading options of ``validate`` and ``convert`` as plain data
+    (:func:`modelkit.verify.source.read_options`; package paths, xacro arguments, ...), written into
+    ``report.parameters["reading"]`` when given.
     """
     report = VerifyReport(str(source), seed=seed)
     report.parameters = {"configurations": configurations, "dynamics_samples": samples,
@@ -328,7 +264,7 @@ def verify(
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if artefacts:
-        from modelkit.verify.html import Prepared
+        from modelkit.verify.report.html import Prepared
 
         report.prepared = Prepared()
     try:
@@ -352,7 +288,7 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
     chosen = None
     if scenario_path is not None and driven:  # a bad scenario file stops the run before any layer
         from modelkit.diagnostics import render_text
-        from modelkit.verify import scenario as scenarios
+        from modelkit.verify.drive import scenario as scenarios
 
         chosen, diagnostics = scenarios.load(scenario_path)
         if chosen is None:
@@ -380,8 +316,9 @@ def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence
             chosen: Any) -> None:
     """Layer 4: the source driven by the seed's controllers in MuJoCo and PyBullet, on a floor;
     ``chosen``: the scenario read from the user's file (None: the built-in one)."""
-    from modelkit.verify import layer4, vehicle
-    from modelkit.verify import scenario as scenarios
+    from modelkit.verify.drive import scenario as scenarios
+    from modelkit.verify.drive import vehicle
+    from modelkit.verify.layers import layer4
 
     try:
         drive = vehicle.find_drive(robot, chosen or scenarios.default_scenario())
@@ -408,12 +345,12 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                    inject: Sequence[str], seed: int, configurations: int, samples: int, replay: bool,
                    reading: Mapping[str, Any] | None = None) -> Robot | None:
     """Layers 1–3 on the welded model; returns the source model as read (None when nothing ran)."""
-    from modelkit.verify import approximations, layers, shapes
-    from modelkit.verify.reference import SourceModel, dof_joints, source_static
+    from modelkit.verify.engines.reference import SourceModel, dof_joints, source_static
+    from modelkit.verify.layers import approximations, dynamics, kinematics, shapes, static
 
     t0 = time.perf_counter()
     try:
-        robot = _read(source, reading)
+        robot = read_robot(source, reading)
         report.robot = robot.name
         welded, report.base = welded_copy(robot)
         reference = _reference(welded, report)
@@ -457,18 +394,18 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         limits_entry = approximations.limits_skip(eng.label, stand_ins)
         if limits_entry is not None:
             report.skips.append(limits_entry)
-        report.checks.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: layers.layer1(st, eng)))
-        report.skips.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: layers.massless_skips(st, eng),
+        report.checks.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: static.layer1(st, eng)))
+        report.skips.extend(_guarded(1, eng, lambda eng=eng, st=eng_static: static.massless_skips(st, eng),
                                      report.checks))
         report.skips.extend(shapes.skips(src_static, eng))
     report.checks[:] = _explain_invalid_inertia(reference, loaded, report.checks)
     t3 = time.perf_counter()
-    configs = layers.configurations(reference, configurations, seed)
+    configs = kinematics.configurations(reference, configurations, seed)
     for eng in loaded:
-        report.checks.extend(_guarded(2, eng, lambda eng=eng: layers.layer2(src, eng, configs)))
+        report.checks.extend(_guarded(2, eng, lambda eng=eng: kinematics.layer2(src, eng, configs)))
     t4 = time.perf_counter()
     pin_ref = next((e.model for e in loaded if e.label == "pinocchio"), None)
-    if layers.kinematic_only(reference):
+    if dynamics.kinematic_only(reference):
         report.skips.append(Skip(3, "all", "no link moved by a joint has mass in the source (a kinematic "
                                            "model): no dynamics to verify"))
         replay = False
@@ -480,7 +417,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         report.skips.append(Skip(3, "all", "layer 3a needs Pinocchio (the dynamics reference built from the "
                                            "source model), which is not among the loaded engines"))
     else:
-        state = layers.states(reference, pin_ref.dof_names(), samples, seed)
+        state = dynamics.states(reference, pin_ref.dof_names(), samples, seed)
         with_armature = [j.name for j in reference.joints if j.armature != 0.0]
         for eng in loaded:
             if eng.label == "pinocchio":
@@ -491,14 +428,14 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                    else pin_ref if model is reference else _pinocchio(model))
             try:
                 report.checks.extend(_guarded(3, eng,
-                                              lambda eng=eng, ref=ref: layers.layer3a(ref, eng, state)))
+                                              lambda eng=eng, ref=ref: dynamics.layer3a(ref, eng, state)))
                 if dropped:
                     report.skips.append(Skip(3, eng.label, (
                         f"joint armature (rotor inertia) of {', '.join(with_armature)} cannot be written in "
                         "URDF/SDF (MK820): the mass matrix is compared with the Pinocchio reference "
                         "without it")))
             except NotImplementedError:
-                report.skips.append(layers.no_dynamics(eng))
+                report.skips.append(dynamics.no_dynamics(eng))
     t5 = time.perf_counter()
     if replay:
         _replay(reference, files, maps, loaded, report, approx)
@@ -515,7 +452,7 @@ def _explain_invalid_inertia(reference: Robot, loaded: list[Any], checks: list[C
     """A failed layer-1 ``inertia`` check of PyBullet or drake-urdf at a link whose source inertia
     violates the triangle inequality (MK303) stays failed (the consumer refuses the source's data;
     the URDF keeps that data as it is), but its message says what the engine made of it and why."""
-    from modelkit.verify.approximations import triangle_moments
+    from modelkit.verify.layers.approximations import triangle_moments
 
     labels = {e.label for e in loaded}
     links = {link.name: link for link in reference.links}
@@ -528,10 +465,10 @@ def _explain_invalid_inertia(reference: Robot, loaded: list[Any], checks: list[C
             moments = triangle_moments(np.asarray(link.inertial.inertia, dtype=float))
             if moments is not None:
                 if check.engine == "pybullet":
-                    note = _resolve("modelkit.verify.engine_pybullet:invalid_inertia_note")
+                    note = _resolve("modelkit.verify.engines.pybullet:invalid_inertia_note")
                     why = str(note(link.name, moments))
                 else:
-                    why = str(_resolve("modelkit.verify.engine_drake:invalid_inertia_note")(
+                    why = str(_resolve("modelkit.verify.engines.drake:invalid_inertia_note")(
                         link.name, moments, link.inertial.mass))
                 check = dataclasses.replace(check, detail=f"{check.detail}: {why}")
         out.append(check)
@@ -559,7 +496,7 @@ def _approximations(reference: Robot, loaded: list[Any], files: dict[str, Path],
                     written: dict[str, list[Any]], report: VerifyReport) -> dict[str, Any]:
     """Per loaded engine, the documented mass approximations it holds (see ``approximations``), each
     listed in the report."""
-    from modelkit.verify import approximations
+    from modelkit.verify.layers import approximations
 
     out: dict[str, Any] = {}
     for eng in loaded:
@@ -593,13 +530,13 @@ def _left_out(sims: list[Any], maps: dict[str, Renames]) -> list[str]:
 
 
 def _pinocchio(robot: Robot) -> Any:
-    from modelkit.verify.engine_pinocchio import PinocchioModel
+    from modelkit.verify.engines.pinocchio import PinocchioModel
 
     return PinocchioModel(robot)
 
 
 def _without_armature(robot: Robot) -> Any:
-    from modelkit.verify.engine_pinocchio import PinocchioModel
+    from modelkit.verify.engines.pinocchio import PinocchioModel
 
     model = PinocchioModel(robot)
     model.model.armature[:] = 0.0
@@ -617,7 +554,7 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
         return
     try:
         layer3b = _resolve(REPLAY)
-        default_law = _resolve("modelkit.verify.replay:default_law")
+        default_law = _resolve("modelkit.verify.layers.replay:default_law")
     except ImportError as exc:
         report.skips.append(Skip(3, "mujoco+pybullet", f"layer 3b (replay) is not available: {exc}"))
         return
@@ -732,7 +669,7 @@ def engine_warnings(report: VerifyReport, label: str, messages: list[str], key: 
     ``stability`` check (the numbers of that run are not to be trusted)."""
     if not messages:
         return []
-    from modelkit.verify.engine_mujoco import unstable
+    from modelkit.verify.engines.mujoco import unstable
 
     unique = list(dict.fromkeys(messages))
     report.engines.setdefault(label, {})[key] = unique

@@ -150,14 +150,14 @@ def make_jobs(paths: Sequence[Path], options: Mapping[str, Any], absolute: bool 
 
 def check_options(options: Mapping[str, Any]) -> None:
     """Raise ``ValueError`` for an option that would make every model fail the same way."""
-    from modelkit.verify.engines import ENGINES
+    from modelkit.verify.engines.registry import ENGINES
 
     unknown = [e for e in options.get("engines", ()) if e not in ENGINES]
     if unknown:
         raise ValueError(f"unknown engine {unknown[0]!r}; known: {', '.join(sorted(ENGINES))}")
     if options.get("scenario"):
         from modelkit.diagnostics import render_text
-        from modelkit.verify.scenario import load
+        from modelkit.verify.drive.scenario import load
 
         scenario, diagnostics = load(options["scenario"])
         if scenario is None:
@@ -168,7 +168,7 @@ def check_options(options: Mapping[str, Any]) -> None:
 
 def save(report: Any, out_dir: Path, read_from: str | None = None) -> list[str]:
     """Write a report's files into ``out_dir``: ``report.html`` and its plots when the HTML writer
-    (:mod:`modelkit.verify.html`) is there and the run happened, then ``report.json``. ``read_from``:
+    (:mod:`modelkit.verify.report.html`) is there and the run happened, then ``report.json``. ``read_from``:
     where the model file is for this process when ``report.source`` (the path shown) is not it (a
     remote worker reads an absolute path). Returns the report files written (sorted, relative)."""
     from modelkit.verify.report import report_json
@@ -176,10 +176,10 @@ def save(report: Any, out_dir: Path, read_from: str | None = None) -> list[str]:
     safewrite.make_folder(out_dir, out_dir)
     write_artefacts: Callable[..., Any] | None = None
     try:
-        from modelkit.verify.html import write_artefacts as html_writer
+        from modelkit.verify.report.html import write_artefacts as html_writer
         write_artefacts = html_writer
     except ModuleNotFoundError as exc:
-        if exc.name != "modelkit.verify.html":
+        if exc.name != "modelkit.verify.report.html":
             raise
     if write_artefacts is not None and not report.errors:
         shown = report.source
@@ -277,8 +277,10 @@ def warm_up(jobs: Sequence[Job]) -> None:
 
     modules = {info.reader.partition(":")[0] for info in FORMATS}
     modules |= {f"modelkit.formats.{fmt}.writer" for fmt in ("mjcf", "urdf", "sdf")}
-    modules |= {"modelkit.convert.api", "modelkit.verify.layers", "modelkit.verify.reference",
-                "modelkit.verify.approximations", "modelkit.verify.shapes", "modelkit.verify.inject",
+    modules |= {"modelkit.convert.api", "modelkit.verify.layers.static", "modelkit.verify.layers.kinematics",
+                "modelkit.verify.layers.dynamics", "modelkit.verify.engines.reference",
+                "modelkit.verify.layers.approximations", "modelkit.verify.layers.shapes",
+                "modelkit.verify.layers.inject",
                 api.REPLAY.partition(":")[0], "yourdfpy", "trimesh"}
     for job in jobs:
         engines = job.options.get("engines", api.DEFAULT_ENGINES)

@@ -45,7 +45,7 @@ from lxml import etree
 
 from modelkit.convert.notes import ConversionNote
 from modelkit.model import Inertial, JointType, Robot
-from modelkit.verify.facts import Skip, StaticFacts
+from modelkit.verify.engines.protocol import Skip, StaticFacts
 
 Renames = dict[str, dict[str, str]]
 
@@ -186,7 +186,7 @@ def refused_inertias(engine: str, fmt: str, source: Robot) -> dict[str, Approxim
             fixed = np.zeros((3, 3))
             by = "PyBullet, refusing it (\"Bad inertia tensor properties\"), holds zero"
         else:
-            from modelkit.verify.engine_drake import substitute_moment
+            from modelkit.verify.engines.drake import substitute_moment
 
             moment = substitute_moment(float(link.inertial.mass))
             fixed = moment * np.eye(3)

@@ -6,12 +6,12 @@ artefact. The same PNGs are also written next to it (``plots/*.png``, ``pictures
 listed in ``report.artefacts``.
 
 Deterministic: the same report gives the same bytes (no time stamps, no wall times; the PNGs are
-deterministic too: :mod:`modelkit.verify.plots` and :func:`png`).
+deterministic too: :mod:`modelkit.verify.report.plots` and :func:`png`).
 
 :func:`write_artefacts` is the entry point ``verify`` calls: plots (layer 4 trajectories),
-pictures (every engine's view of the robot, :mod:`modelkit.verify.pictures`) and the HTML. The
-plots are drawn (in child processes, :class:`~modelkit.verify.plots.Plotters`) while the pictures' child
-process renders; ``verify(..., artefacts=True)`` starts both early (:class:`Prepared`).
+pictures (every engine's view of the robot, :mod:`modelkit.verify.report.pictures`) and the HTML.
+The plots are drawn (in child processes, :class:`~modelkit.verify.report.plots.Plotters`) while
+the pictures' child process renders; ``verify(..., artefacts=True)`` starts both early (:class:`Prepared`).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from modelkit import safewrite
-from modelkit.verify.report import LAYER_NAMES, VerifyReport, _plain, scope
+from modelkit.verify.report import LAYER_NAMES, VerifyReport, plain, scope
 
 PICTURE_ENGINES = ("mujoco", "pybullet")
 
@@ -66,9 +66,9 @@ class Artefacts:
 def _robot_and_files(report: VerifyReport, out_dir: Path, robot: Any, files: dict[str, Path] | None
                      ) -> tuple[Any, dict[str, Path]]:
     if robot is None:
-        from modelkit.verify.api import _read, welded_copy
+        from modelkit.verify.source import read_robot, welded_copy
 
-        robot, _ = welded_copy(_read(Path(report.source)))
+        robot, _ = welded_copy(read_robot(Path(report.source)))
     if files is None:
         files = {}
         for fmt, name in report.files.items():
@@ -78,9 +78,9 @@ def _robot_and_files(report: VerifyReport, out_dir: Path, robot: Any, files: dic
 
 
 def _picture_job(report: VerifyReport, out_dir: Path, robot: Any, files: dict[str, Path] | None) -> Any:
-    """The pictures' child process (:class:`~modelkit.verify.pictures.PictureJob`), started."""
-    from modelkit.verify.layers import configurations
-    from modelkit.verify.pictures import PictureJob
+    """The pictures' child process (:class:`~modelkit.verify.report.pictures.PictureJob`), started."""
+    from modelkit.verify.layers.kinematics import configurations
+    from modelkit.verify.report.pictures import PictureJob
 
     model, paths = _robot_and_files(report, out_dir, robot, files)
     engines = tuple(e for e in PICTURE_ENGINES if e in report.parameters.get("engines", PICTURE_ENGINES))
@@ -97,9 +97,9 @@ class Prepared:
     pictures: Any = None  # pictures.PictureJob | None
 
     def start_plotters(self) -> None:
-        from modelkit.verify.plots import PLOTTERS, Plotters, _cores
+        from modelkit.verify.report.plots import PLOTTERS, Plotters, usable_cores
 
-        if _cores() > 1:
+        if usable_cores() > 1:
             self.plotters = Plotters(PLOTTERS)
 
     def start_pictures(self, report: VerifyReport, out_dir: Path, robot: Any, files: dict[str, Path]) -> None:
@@ -122,7 +122,7 @@ def write_artefacts(report: VerifyReport, out_dir: Path, robot: Any = None,
     file in ``report.artefacts`` (relative to ``out_dir``). ``robot``: the model verified, root welded
     (read again from ``report.source`` when None); ``files``: the written MJCF/URDF ("mjcf", "urdf" →
     path; from ``report.files`` relative to ``out_dir`` when None)."""
-    from modelkit.verify.pictures import difference
+    from modelkit.verify.report.pictures import difference
 
     out_dir = Path(out_dir)
     safewrite.make_folder(out_dir, out_dir)
@@ -140,7 +140,7 @@ def write_artefacts(report: VerifyReport, out_dir: Path, robot: Any = None,
             except Exception as exc:  # pictures are an aid: never the reason a verify run fails
                 art.notes.append(f"pictures could not be made: {type(exc).__name__}: {exc}")
         if report.trajectories:
-            from modelkit.verify.plots import write_plots
+            from modelkit.verify.report.plots import write_plots
 
             tolerances = report.scenario.get("tolerances") if isinstance(report.scenario, dict) else None
             try:
@@ -278,11 +278,11 @@ def _observations_table(observations: list[Any]) -> str:
 
 
 def _json_block(value: Any) -> str:
-    return f"<pre>{_e(json.dumps(_plain(value), indent=2, sort_keys=True, ensure_ascii=False))}</pre>"
+    return f"<pre>{_e(json.dumps(plain(value), indent=2, sort_keys=True, ensure_ascii=False))}</pre>"
 
 
 def _pictures_section(art: Artefacts) -> list[str]:
-    from modelkit.verify.pictures import ENGINES, KINDS
+    from modelkit.verify.report.pictures import ENGINES, KINDS
 
     ps = art.pictures
     out = ["<h2>The robot as each engine sees it</h2>"]

@@ -2,17 +2,17 @@
 the seed's controllers; the trajectories compared with each other and with engine-independent
 references (verification.md §1, §2, §6).
 
-What is graded (a :class:`~modelkit.verify.facts.Check`, layer 4), per graded profile:
+What is graded (a :class:`~modelkit.verify.engines.protocol.Check`, layer 4), per graded profile:
 
 * ``mujoco~pybullet``: ``path-position`` (the largest planar distance between the two root-frame
   paths over the run), ``path-yaw`` (the largest wrapped heading difference), ``wheel-angle`` (the
   largest wheel joint angle difference), ``pan-tilt-angle`` (the largest pan/tilt joint angle
   difference, at the wheel-angle tolerance); tolerances 1 cm, 10 mrad, 0.02 rad.
 * each engine against the rigid **no-slip** reference built from the source model's own mass
-  properties and driven by the same controllers (:mod:`modelkit.verify.reference_drive`):
+  properties and driven by the same controllers (:mod:`modelkit.verify.drive.reference`):
   ``noslip-position``, ``noslip-yaw``; tolerances 1.5 cm, 15 mrad.
 
-What is reported only (an :class:`~modelkit.verify.facts.Observation`): each engine's ``slip``
+What is reported only (an :class:`~modelkit.verify.engines.protocol.Observation`): each engine's ``slip``
 (distance between its path and its own wheel odometry) and ``effective-radius`` (the rolling radius
 its own path implies for each wheel), the distance from the ideal ``unicycle`` (it differs from any
 physical robot under this controller by v·τ plus the COM-offset yaw bias, §2.1), every comparison on
@@ -29,7 +29,7 @@ PyBullet loads pybullet_data's ``plane.urdf`` as shipped (see the drivers for th
 Tracked robots are driven through the rollers ``convert`` writes, their velocity servos bounded
 high enough to impose the belt speed (as Choreonoid does; ``variant.SERVO_FRICTION_SHARE``). A tracked
 robot skids to turn, which no rigid no-slip model describes, so every profile of a tracked robot is
-graded against the **skid-steer** reference instead (:mod:`modelkit.verify.reference_skid`):
+graded against the **skid-steer** reference instead (:mod:`modelkit.verify.drive.reference_skid`):
 ``skid-position``, ``skid-yaw`` for each engine, at the tolerance ``skid_tolerance`` derives per profile
 (the spread of the skid path over the pressure distribution under the belt and μ × 0.5 … 2), and the
 pair ``mujoco~pybullet`` at the same derived tolerance (docs/verify.md, "Tracked robots": the two
@@ -52,20 +52,20 @@ import numpy as np
 
 from modelkit.model import JointType, Robot
 from modelkit.verify.drive import Array, Drive, Profile, Scenario, Trajectory, WheelProxy
-from modelkit.verify.facts import Check, Observation, Skip
-from modelkit.verify.reference_drive import PlanarModel, noslip, odometry, planar_model, unicycle
-from modelkit.verify.reference_skid import (
+from modelkit.verify.drive.reference import PlanarModel, noslip, odometry, planar_model, unicycle
+from modelkit.verify.drive.reference_skid import (
     SkidModel,
     SkidTolerance,
     skid_model,
     skid_reference,
     skid_tolerance,
 )
+from modelkit.verify.engines.protocol import Check, Observation, Skip
 
 LAYER = 4
 DRIVERS = {
-    "mujoco": "modelkit.verify.engine_mujoco:driver",
-    "pybullet": "modelkit.verify.engine_pybullet:driver",
+    "mujoco": "modelkit.verify.engines.mujoco:driver",
+    "pybullet": "modelkit.verify.engines.pybullet:driver",
 }
 PAIR = "mujoco~pybullet"
 NATIVE_WARNING = (
@@ -77,7 +77,7 @@ NATIVE_WARNING = (
     "the graded runs read convert's default files (sphere wheels, MK826)."
 )
 TRACK_SKIP = (
-    "tracks: graded against the skid-steer reference (modelkit.verify.reference_skid: the planar rigid "
+    "tracks: graded against the skid-steer reference (modelkit.verify.drive.reference_skid: the planar rigid "
     "body on Coulomb friction under the rollers with the belt speeds imposed), not the no-slip one, at "
     "the tolerance derived per profile from the pressure distribution under the belt and μ (docs/verify.md, "
     "\"Tracked robots\"); the continuous tracks themselves are not simulated by either engine: both drive "
@@ -131,7 +131,7 @@ def run(
 
     ``source``: the model as read (its root free, not welded); ``prepared``: the model with its track
     approximation (``convert``'s prepare), needed for tracked robots (computed when None).
-    ``inject``: fault specs (:mod:`modelkit.verify.inject`) applied to the verification variant's
+    ``inject``: fault specs (:mod:`modelkit.verify.layers.inject`) applied to the verification variant's
     files, as ``verify --inject`` applies them to the converted files. Never raises for a model
     problem: an engine failing is a failed check."""
     result = Layer4Result()
@@ -142,7 +142,7 @@ def run(
         result.skips.append(Skip(LAYER, "all", f"layer 4 not run: {exc}"))
         return result
     if drive.kind == "tracks" and prepared is None:
-        from modelkit.verify.vehicle import prepare_tracks
+        from modelkit.verify.drive.vehicle import prepare_tracks
 
         prepared = prepare_tracks(robot)
     model = planar_model(
@@ -281,7 +281,7 @@ def _setup(
 ) -> None:
     """Write the variant, apply the injected faults, load every engine and start the engines that run
     in a child process (PyBullet) on the job's profiles."""
-    from modelkit.verify.variant import write_variant
+    from modelkit.verify.drive.variant import write_variant
 
     proxy = job.proxy
     try:
@@ -304,7 +304,7 @@ def _setup(
     if proxy == "sphere":  # the graded run: the files convert writes by default, as they are
         result.settings["files"] = {k: p.name for k, p in sorted(files.items())}
     for spec in inject:
-        apply = _resolve("modelkit.verify.inject:apply")
+        apply = _resolve("modelkit.verify.layers.inject:apply")
         try:
             result.injected.append(f"layer 4 {proxy} variant: {apply(spec, files, maps)}")
         except ValueError as exc:  # e.g. cylinder-y on a variant whose wheels are sphere proxies
@@ -362,7 +362,7 @@ def _warnings(engine: str, proxy: str, messages: list[str], result: Layer4Result
     result.settings.setdefault("engines", {}).setdefault(engine, {})[f"{proxy}_warnings"] = unique
     if engine != "mujoco":
         return
-    from modelkit.verify.engine_mujoco import unstable
+    from modelkit.verify.engines.mujoco import unstable
 
     bad = unstable(unique)
     if bad:

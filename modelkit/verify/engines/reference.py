@@ -15,7 +15,7 @@ import numpy as np
 
 from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, JointType, Mesh, Robot, Sphere
 from modelkit.spatial import Pose
-from modelkit.verify.facts import Array, JointFacts, LinkFacts, ShapeFacts, StaticFacts
+from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, ShapeFacts, StaticFacts
 
 Renames = dict[str, dict[str, str]]
 DOF_TYPES = (JointType.REVOLUTE, JointType.PRISMATIC)
@@ -90,7 +90,8 @@ def dof_joints(robot: Robot) -> list[str]:
 
 
 class SourceModel:
-    """The in-memory source model as an :class:`~modelkit.verify.facts.EngineModel` (no dynamics)."""
+    """The in-memory source model as an :class:`~modelkit.verify.engines.protocol.EngineModel`
+    (no dynamics)."""
 
     engine = "source"
 

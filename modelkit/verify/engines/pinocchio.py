@@ -22,8 +22,8 @@ import pinocchio as pin
 
 from modelkit.model import Joint, JointType, Robot
 from modelkit.spatial import Pose
-from modelkit.verify.facts import Array, JointFacts, LinkFacts, StaticFacts
-from modelkit.verify.reference import unit
+from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, StaticFacts
+from modelkit.verify.engines.reference import unit
 
 Renames = dict[str, dict[str, str]]
 GRAVITY = (0.0, 0.0, -9.81)

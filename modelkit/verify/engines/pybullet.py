@@ -1,8 +1,8 @@
 """PyBullet adapter: a written URDF loaded into PyBullet **in a child process**.
 
 PyBullet keeps global state and can crash on bad input, so it runs in
-:mod:`modelkit.verify.pybullet_worker`, started by path with this interpreter; every request has a
-timeout, and a crash, a refusal or a timeout becomes an :class:`~modelkit.verify.api.EngineError`
+:mod:`modelkit.verify.engines.pybullet_worker`, started by path with this interpreter; every request has a
+timeout, and a crash, a refusal or a timeout becomes an :class:`~modelkit.verify.engines.protocol.EngineError`
 carrying PyBullet's message (never a hang).
 
 Settings (verification.md §2.8, §6): ``URDF_USE_INERTIA_FROM_FILE | URDF_USE_IMPLICIT_CYLINDER``,
@@ -42,12 +42,21 @@ import numpy as np
 from modelkit.convert.tracks import PYBULLET_SOLVER_ITERATIONS
 from modelkit.lifeline import preexec
 from modelkit.spatial import Pose
-from modelkit.verify.api import EngineError
-from modelkit.verify.facts import Array, JointFacts, LinkFacts, ShapeFacts, StaticFacts, TorqueLaw
+from modelkit.verify.engines.protocol import (
+    Array,
+    EngineError,
+    JointFacts,
+    LinkFacts,
+    ShapeFacts,
+    StaticFacts,
+    TorqueLaw,
+)
 
 Renames = dict[str, dict[str, str]]
 
 WORKER = Path(__file__).with_name("pybullet_worker.py")
+# -P: the worker's folder must not go first on sys.path, or this module (engines/pybullet.py) would
+# shadow the real ``pybullet`` package (and engines/mujoco.py ``mujoco``) in the child.
 GRAVITY = -9.81
 DEFAULT_TIMEOUT = 60.0  # seconds for one request (load, a batch of poses, a 10 s replay takes ~0.1 s)
 SETTINGS: dict[str, Any] = {
@@ -61,7 +70,7 @@ SETTINGS: dict[str, Any] = {
     "control": "TORQUE_CONTROL re-sent before every stepSimulation",
     "replay_joint_limits": "made inert for the replay (changeDynamics bounds ±1e30, jointLimitForce 0)",
     "integrator": "PyBullet btMultiBody semi-implicit Euler",
-    "process": "child process (modelkit/verify/pybullet_worker.py)",
+    "process": "child process (modelkit/verify/engines/pybullet_worker.py)",
     "base_mass_properties": "getDynamicsInfo(-1) of a second, floating-base load (a fixed base reads 0)",
 }
 
@@ -103,7 +112,7 @@ class Worker:
         self._stderr: IO[bytes] = tempfile.TemporaryFile()  # noqa: SIM115 (closed in close())
         env = dict(os.environ, PYTHONUNBUFFERED="1")
         self.proc = subprocess.Popen(
-            [sys.executable, str(WORKER)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+            [sys.executable, "-P", str(WORKER)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
             stderr=self._stderr, env=env, close_fds=True, preexec_fn=preexec(),
         )
 
@@ -188,8 +197,8 @@ class Worker:
 
 
 class PyBulletModel:
-    """A written URDF in PyBullet, base welded: the :class:`~modelkit.verify.facts.EngineModel`
-    and the :class:`~modelkit.verify.facts.Simulator` of layer 3b. Names are the URDF's."""
+    """A written URDF in PyBullet, base welded: the :class:`~modelkit.verify.engines.protocol.EngineModel`
+    and the :class:`~modelkit.verify.engines.protocol.Simulator` of layer 3b. Names are the URDF's."""
 
     engine = "pybullet"
 
@@ -394,7 +403,7 @@ def load(model: Path, renames: Renames, *, root: str, pose_path: str = "com-fram
 
 def render(urdfs: dict[str, Path], configurations: list[dict[str, float]], camera: dict[str, Any],
            timeout: float = DEFAULT_TIMEOUT) -> dict[tuple[str, int], tuple[Any, Any]]:
-    """TinyRenderer pictures for the report (``modelkit.verify.pictures``), in a child worker of its
+    """TinyRenderer pictures for the report (``modelkit.verify.report.pictures``), in a child worker of its
     own: (view, configuration index) → (RGB (H, W, 3) uint8, robot mask (H, W) bool). Joint names
     are the URDF's."""
     worker = Worker()
@@ -464,7 +473,7 @@ class PyBulletDriver:
     def __init__(self, model: Path, renames: Renames, drive: Any, scenario: Any, factory: str | None = None,
                  sys_path: list[str] | None = None, timeout: float = DEFAULT_TIMEOUT,
                  fast: bool = True, floor: str = FLOOR) -> None:
-        from modelkit.verify import variant as v
+        from modelkit.verify.drive import variant as v
 
         self.fast = fast
         self.path = Path(model)
@@ -540,7 +549,8 @@ class PyBulletDriver:
             "per_run": "resetSimulation and a fresh load (every run starts from the same state)",
             "controllers": [f"{name} ({mode}: {', '.join(joints)})"
                             for name, mode, joints in self.controllers],
-            "process": "child process (modelkit/verify/pybullet_worker.py); controllers built in the child",
+            "process": ("child process (modelkit/verify/engines/pybullet_worker.py); "
+                        "controllers built in the child"),
         }
         self.last_wall: list[float] = []
 
@@ -553,7 +563,7 @@ class PyBulletDriver:
 
     def start(self, profiles: list[Any], scenario: Any, drive: Any) -> None:
         """Send the profiles to the child and return at once; :meth:`result` collects them."""
-        from modelkit.verify import variant as v
+        from modelkit.verify.drive import variant as v
 
         if self._pending is not None:
             raise RuntimeError("a batch is still running; collect it with result() first")
@@ -580,7 +590,7 @@ class PyBulletDriver:
         return self.result()[0]
 
     def _trajectory(self, profile: Any, raw: dict[str, Any], every: int) -> Any:
-        from modelkit.verify import variant as v
+        from modelkit.verify.drive import variant as v
 
         base = np.frombuffer(raw["base"], dtype=np.float64).reshape(-1, 7)
         q = np.frombuffer(raw["q"], dtype=np.float64).reshape(len(base), len(self.recorded))

@@ -29,10 +29,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from modelkit.verify.facts import Array, Check, ShapeFacts, Skip, StaticFacts
+from modelkit.verify.engines.protocol import Array, Check, ShapeFacts, Skip, StaticFacts
 
 if TYPE_CHECKING:
-    from modelkit.verify.layers import Loaded
+    from modelkit.verify.layers.common import Loaded
 
 # Source primitives each engine's input format cannot hold: the writers mesh them.
 MESHED: dict[str, tuple[str, ...]] = {

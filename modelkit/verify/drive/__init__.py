@@ -3,20 +3,20 @@ controller contract and the trajectories every engine and reference produces.
 
 Data only (plus small helpers): the modules that do the work import these types.
 
-* :mod:`modelkit.verify.scenario` reads scenario YAML files (schema
+* :mod:`modelkit.verify.drive.scenario` reads scenario YAML files (schema
   ``schemas/verify-scenario.schema.json``) into :class:`Scenario` and holds the default profiles;
-* :mod:`modelkit.verify.vehicle` derives a :class:`Drive` from a model (wheel or track joints,
+* :mod:`modelkit.verify.drive.vehicle` derives a :class:`Drive` from a model (wheel or track joints,
   radius, half axle width, pan/tilt joints);
-* :mod:`modelkit.verify.controllers` holds the seed tutorial's controllers (:class:`Controller`),
+* :mod:`modelkit.verify.drive.controllers` holds the seed tutorial's controllers (:class:`Controller`),
   built from plain data by ``make_controllers(drive, scenario)`` so that an engine's child process
   can build the same ones;
-* :mod:`modelkit.verify.reference_drive` integrates the rigid no-slip model and the ideal unicycle
+* :mod:`modelkit.verify.drive.reference` integrates the rigid no-slip model and the ideal unicycle
   and computes wheel odometry;
 * ``engine_mujoco.driver`` / ``engine_pybullet.driver`` run a profile with contact on a floor and
   return a :class:`Trajectory`;
-* :mod:`modelkit.verify.variant` writes the verification variant (sphere wheel proxies) of the
+* :mod:`modelkit.verify.drive.variant` writes the verification variant (sphere wheel proxies) of the
   converted model;
-* :mod:`modelkit.verify.layer4` runs every profile in every engine, compares, and returns
+* :mod:`modelkit.verify.layers.layer4` runs every profile in every engine, compares, and returns
   ``Check`` (pass/fail) and ``Observation`` (reported only) records plus the trajectories for the
   report's plots.
 

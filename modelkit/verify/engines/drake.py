@@ -68,7 +68,7 @@ from pydrake.multibody.tree import (
 
 from modelkit.model import Robot
 from modelkit.spatial import Pose
-from modelkit.verify.facts import Array, JointFacts, LinkFacts, StaticFacts
+from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, StaticFacts
 
 Renames = dict[str, dict[str, str]]
 GRAVITY = (0.0, 0.0, -9.81)

@@ -21,6 +21,10 @@ from modelkit.spatial import Pose
 Array = NDArray[np.float64]
 
 
+class EngineError(RuntimeError):
+    """An engine could not load a model file."""
+
+
 @dataclass(frozen=True)
 class LinkFacts:
     mass: float

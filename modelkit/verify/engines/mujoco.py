@@ -29,7 +29,7 @@ import numpy as np
 from modelkit.formats.mjcf.quiet import collected_warnings
 from modelkit.model import Robot
 from modelkit.spatial import Pose, axis_angle, matrix_from_quat_wxyz
-from modelkit.verify.facts import Array, JointFacts, LinkFacts, ShapeFacts, StaticFacts, TorqueLaw
+from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, ShapeFacts, StaticFacts, TorqueLaw
 
 Renames = dict[str, dict[str, str]]
 GRAVITY = (0.0, 0.0, -9.81)
@@ -618,8 +618,8 @@ class MujocoDriver:
 
     def __init__(self, model: Path, renames: Renames, drive: Any, scenario: Any,
                  factory: str | None = None, fast: bool = True) -> None:
-        from modelkit.verify import variant as v
         from modelkit.verify.drive import Command
+        from modelkit.verify.drive import variant as v
 
         self.path = Path(model)
         self.renames = renames
@@ -823,8 +823,8 @@ class MujocoDriver:
         return np.array(d.qpos)
 
     def run(self, profile: Any, scenario: Any, drive: Any) -> Any:
-        from modelkit.verify import variant as v
         from modelkit.verify.drive import command_steps
+        from modelkit.verify.drive import variant as v
 
         m, d = self.model, self.data
         wall = time.perf_counter()

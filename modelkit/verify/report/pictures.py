@@ -476,7 +476,8 @@ class _MujocoJob:
 
     def _start(self) -> None:
         gl = self.backends.pop(0)
-        code = "import sys; from modelkit.verify.pictures import mujoco_child; sys.exit(mujoco_child())"
+        code = ("import sys; from modelkit.verify.report.pictures import mujoco_child; "
+                "sys.exit(mujoco_child())")
         self.gl = gl
         # cwd: a temporary folder, so that nothing MuJoCo might write lands in the user's folder.
         self.child = Child(code, env=dict(os.environ, MUJOCO_GL=gl, PYOPENGL_PLATFORM=gl), cwd=self._tmp.name)
@@ -529,7 +530,7 @@ def collision_urdf(urdf: Path, out: Path) -> Path:
 
 def _pybullet_pictures(urdf: Path, joints: list[dict[str, float]], camera: Camera,
                        pictures: PictureSet) -> None:
-    from modelkit.verify import engine_pybullet
+    from modelkit.verify.engines import pybullet as engine_pybullet
 
     with tempfile.TemporaryDirectory(prefix="modelkit-pbrender-") as tmp:
         collision = collision_urdf(urdf, Path(tmp) / "collision.urdf")
@@ -618,7 +619,7 @@ def render_pictures(robot: Robot, files: dict[str, Path], renames: dict[str, Ren
 # and the report only collects them. Any failure of the child falls back to rendering here.
 
 PICTURES_TIMEOUT = 180.0
-_PICTURES_CHILD = ("import sys; from modelkit.verify.pictures import pictures_child; "
+_PICTURES_CHILD = ("import sys; from modelkit.verify.report.pictures import pictures_child; "
                    "sys.exit(pictures_child())")
 
 

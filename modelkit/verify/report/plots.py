@@ -314,7 +314,7 @@ def write_plots(trajectories: Sequence[Any], out_dir: Path, tolerances: dict[str
     safewrite.make_folder(root, out_dir)
     names = profiles(trajectories)
     jobs = [(p, [t for t in trajectories if t.profile == p], tolerances, tuple(wheels)) for p in names]
-    own = plotters is None and len(jobs) > 1 and _cores() > 1
+    own = plotters is None and len(jobs) > 1 and usable_cores() > 1
     if own:
         plotters = Plotters()
     try:
@@ -340,10 +340,10 @@ def write_plots(trajectories: Sequence[Any], out_dir: Path, tolerances: dict[str
 
 PLOTTERS = 2
 PLOTTER_TIMEOUT = 120.0
-_CHILD = "import sys; from modelkit.verify.plots import serve; sys.exit(serve())"
+_CHILD = "import sys; from modelkit.verify.report.plots import serve; sys.exit(serve())"
 
 
-def _cores() -> int:
+def usable_cores() -> int:
     try:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # not Linux

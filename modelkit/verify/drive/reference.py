@@ -33,7 +33,7 @@
   ``n·τ_max / (r·M_eff)`` (the start-up transient, about 0.1 s and 2.6 cm on the tutorial robot's
   0.5 m/s straight), then the target held exactly. For a straight run this is meaningful (a track
   rolling without slip); a turning tracked robot must skid sideways (skid steering), which no rigid
-  no-slip model describes: layer 4 grades only what is meaningful (see :mod:`modelkit.verify.layer4`).
+  no-slip model describes: layer 4 grades only what is meaningful (see :mod:`modelkit.verify.layers.layer4`).
 
 * :func:`unicycle` — the ideal unicycle ``x' = v cos θ, y' = v sin θ, θ' = w`` integrated exactly
   from the commanded (v, w) (piecewise constant: arcs and straight segments in closed form).
@@ -56,9 +56,9 @@ import numpy as np
 
 from modelkit.model import Robot
 from modelkit.spatial import combine_mass_properties, rotate_inertia
-from modelkit.verify.controllers import make_controllers
 from modelkit.verify.drive import Array, Command, Drive, Profile, Scenario, Trajectory, command_steps
-from modelkit.verify.scenario import scenario_dict
+from modelkit.verify.drive.controllers import make_controllers
+from modelkit.verify.drive.scenario import scenario_dict
 
 RK4_SUBSTEPS = 1  # RK4 steps per control period (1 ms); 10 (0.1 ms, as §1) agrees to 1e-11 m, 5x slower
 
@@ -128,7 +128,7 @@ def planar_model(robot: Robot, drive: Drive, friction: float | None = None) -> P
     model with its track approximation), every link's inertial at q = 0 in the root frame.
     ``friction``: the roller–floor friction the engines use (``Scenario.friction``); None: the
     contact materials' (``convert.friction.floor_friction``), for the tracks' servo bound."""
-    from modelkit.verify.vehicle import wheel_shape
+    from modelkit.verify.drive.vehicle import wheel_shape
 
     poses = robot.world_poses()
     inv = poses[str(robot.root)].inverse()
@@ -222,7 +222,7 @@ def _servo_bound(
     from the whole robot's mass, the rollers' friction against the floor and the roller radius) and
     the number of rollers on each side."""
     from modelkit.convert.friction import floor_friction
-    from modelkit.verify.variant import servo_torque_limit
+    from modelkit.verify.drive.variant import servo_torque_limit
 
     joints = {j.name: j for j in robot.joints}
     sides = [

@@ -1,6 +1,6 @@
 """Layer 3b: the contact-free torque replay.
 
-The same :class:`~modelkit.verify.facts.TorqueLaw` (a PD law tracking sinusoids) drives the
+The same :class:`~modelkit.verify.engines.protocol.TorqueLaw` (a PD law tracking sinusoids) drives the
 fixed-base model in MuJoCo (``integrator="Euler"``) and in PyBullet at the same time step (1 ms)
 for 10 s, both from q = dq = 0. Both engines integrate semi-implicit Euler (v ← v + h·a(q, v),
 q ← q + h·v), so for a contact-free tree they compute the same ODE step up to round-off: the
@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from modelkit.model import JointType, Robot
-from modelkit.verify.facts import Array, Check, Simulator, Skip, TorqueLaw
+from modelkit.verify.engines.protocol import Array, Check, Simulator, Skip, TorqueLaw
 
 TOLERANCE = 1e-8  # rad (m for prismatic joints): two engines, same ODE step, round-off apart
 PERTURBATION = 1e-12  # rad (m): the start moved by this to measure the model's own amplification
@@ -142,7 +142,7 @@ def _effective_inverse(source: Robot, names: list[str]) -> Array | None:
     """(M⁻¹) restricted to ``names`` at q = 0, root welded, armature zeroed (the replay zeroes it),
     the other joints free; None when Pinocchio is not installed or cannot hold the model."""
     try:
-        from modelkit.verify.engine_pinocchio import PinocchioModel
+        from modelkit.verify.engines.pinocchio import PinocchioModel
     except ImportError:
         return None
     try:

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from modelkit.verify.facts import Check, Observation, Skip
+from modelkit.verify.engines.protocol import Check, Observation, Skip
 
 SCHEMA_ID = "modelkit-verify-report/1"
 LAYER_NAMES = {0: "all", 1: "1 static", 2: "2 kinematics", 3: "3 dynamics", 4: "4 driven"}
@@ -62,15 +62,15 @@ def _number(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
-def _plain(value: Any) -> Any:
+def plain(value: Any) -> Any:
     if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
+        return {str(k): plain(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
-        return [_plain(v) for v in value]
+        return [plain(v) for v in value]
     if isinstance(value, np.ndarray):
-        return _plain(value.tolist())
+        return plain(value.tolist())
     if isinstance(value, np.generic):
-        return _plain(value.item())
+        return plain(value.item())
     if isinstance(value, float):
         return _number(value)
     return value
@@ -91,20 +91,20 @@ def report_json(report: VerifyReport) -> str:
         "seed": report.seed,
         "base": report.base,
         "reference": report.reference,
-        "parameters": _plain(report.parameters),
+        "parameters": plain(report.parameters),
         "files": dict(sorted(report.files.items())),
-        "renames": _plain(report.renames),
-        "notes": _plain(report.notes),
+        "renames": plain(report.renames),
+        "notes": plain(report.notes),
         "injected": list(report.injected),
-        "engines": _plain(report.engines),
+        "engines": plain(report.engines),
         "checks": [check_json(c) for c in report.checks],
         "skips": [{"layer": s.layer, "engine": s.engine, "reason": s.reason} for s in report.skips],
         "observations": [{"layer": o.layer, "engine": o.engine, "quantity": o.quantity, "where": o.where,
                           "value": _number(o.value), "unit": o.unit, "detail": o.detail}
                          for o in report.observations],
-        "replay": _plain(report.replay),
-        "scenario": _plain(report.scenario),
-        "drive": _plain(report.drive),
+        "replay": plain(report.replay),
+        "scenario": plain(report.scenario),
+        "drive": plain(report.drive),
         "errors": list(report.errors),
     }
     return json.dumps(data, indent=2, ensure_ascii=False, allow_nan=False) + "\n"

@@ -7,13 +7,13 @@ adapters are imported by :mod:`modelkit.verify.api` when a verification runs.
 from __future__ import annotations
 
 ENGINES: dict[str, str] = {
-    "source": "modelkit.verify.reference:load",
-    "pinocchio": "modelkit.verify.engine_pinocchio:load",
-    "mujoco": "modelkit.verify.engine_mujoco:load",
-    "pybullet": "modelkit.verify.engine_pybullet:load",
-    "drake": "modelkit.verify.engine_drake:load",
-    "drake-urdf": "modelkit.verify.engine_drake:load_urdf",
-    "yourdfpy": "modelkit.verify.reference:load_yourdfpy",
+    "source": "modelkit.verify.engines.reference:load",
+    "pinocchio": "modelkit.verify.engines.pinocchio:load",
+    "mujoco": "modelkit.verify.engines.mujoco:load",
+    "pybullet": "modelkit.verify.engines.pybullet:load",
+    "drake": "modelkit.verify.engines.drake:load",
+    "drake-urdf": "modelkit.verify.engines.drake:load_urdf",
+    "yourdfpy": "modelkit.verify.engines.reference:load_yourdfpy",
 }
 DEFAULT_ENGINES = ("mujoco", "pybullet", "pinocchio", "drake", "drake-urdf", "yourdfpy")
 

@@ -1,7 +1,8 @@
-"""The PyBullet child process behind :mod:`modelkit.verify.engine_pybullet`.
+"""The PyBullet child process behind :mod:`modelkit.verify.engines.pybullet`.
 
 PyBullet keeps global state and can crash (segfault, abort) on bad input, so it never runs in the
-verifying process. This script is started by path (``python pybullet_worker.py``), imports only the
+verifying process. This script is started by path (``python -P pybullet_worker.py``: ``-P`` keeps its folder,
+whose ``pybullet.py`` is the parent's adapter, off ``sys.path``), imports only the
 standard library and ``pybullet``, and answers requests on stdin. Framing, both ways: a 4-byte
 big-endian length, then a pickle. A request is ``(command, kwargs)``; a reply is ``("ok", result)``
 or ``("error", message)``. PyBullet's C code prints to file descriptor 1, so the replies go to a
@@ -12,7 +13,7 @@ algebra lives in the parent, where it can be tested and typed.
 
 Layer 4's requests (``drive_setup``, ``drive_run``, ``drive_batch``, ``drive_bench``) are the
 exception to "standard library only": they import numpy, :mod:`modelkit.verify.drive` and the
-controller factory (``modelkit.verify.controllers:make_controllers``) on first use, so that the seed's
+controller factory (``modelkit.verify.drive.controllers:make_controllers``) on first use, so that the seed's
 controllers run here, every physics step, without crossing the pipe.
 """
 
@@ -237,7 +238,7 @@ class Engine:
 
     def render(self, paths: dict[str, str], configurations: list[dict[str, float]], camera: dict[str, Any]
                ) -> list[dict[str, Any]]:
-        """Pictures for the report (``modelkit.verify.pictures``): each URDF in ``paths`` (view name →
+        """Pictures for the report (``modelkit.verify.report.pictures``): each URDF in ``paths`` (view name →
         file) loaded fixed-base at the identity in a client of its own, at every configuration (joint
         name → q), through ``camera`` (eye, target, up, fovy, width, height, near, far) with
         TinyRenderer (software: no GPU, no display). Raw RGBA bytes and the segmentation buffer
@@ -371,7 +372,7 @@ class Engine:
         mass = sum(p.getDynamicsInfo(body, link, physicsClientId=c)[0] for link in range(-1, n))
         mu = max((friction[name] for name in contact), default=0.0)
         count = sum(len(g) for g in self.drive_rollers.values())
-        from modelkit.verify.variant import servo_torque_limit
+        from modelkit.verify.drive.variant import servo_torque_limit
 
         self.servo_limit = servo_torque_limit(mass, mu, cfg["roller_radius"], count, abs(cfg["gravity"]))
         return {"links": sorted(link_index), "friction": friction, "start_height": -gap,

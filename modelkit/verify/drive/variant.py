@@ -90,7 +90,7 @@ def _safe(name: str) -> str:
 
 # ---- shared by the two drivers (engine_mujoco.driver, engine_pybullet.driver) --------------------
 
-CONTROLLERS = "modelkit.verify.controllers:make_controllers"
+CONTROLLERS = "modelkit.verify.drive.controllers:make_controllers"
 """The controller factory (``make_controllers(drive: dict, scenario: dict) -> list[Controller]``),
 as ``module:function`` so that PyBullet's child process imports the very same one."""
 
@@ -99,7 +99,7 @@ def scenario_data(scenario: Scenario) -> dict[str, Any]:
     """The scenario as plain data for ``make_controllers`` (``scenario.scenario_dict`` when the
     scenario module has it, else the dataclass fields)."""
     try:
-        from modelkit.verify.scenario import scenario_dict
+        from modelkit.verify.drive.scenario import scenario_dict
     except ImportError:
         return dataclasses.asdict(scenario)
     return dict(scenario_dict(scenario))
@@ -172,43 +172,6 @@ def rotations_wxyz(q: Array) -> Array:
         np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=1),
         np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=1),
     ], axis=1)
-
-
-def bench(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path, profile: Profile | None = None,
-          factory: str | None = None) -> dict[str, float]:
-    """Layer 4's harness overhead on one model: wall seconds of one profile (settle + duration) run by
-    each driver (controllers every step, samples) and of a bare stepping loop of the same engine on the
-    same world over the same simulated time; ``*_ratio`` = bare / harness (1 = no overhead),
-    ``*_realtime`` = simulated seconds per wall second inside the harness; ``*_closed_ratio`` =
-    a minimal hand-written closed loop with the same controllers (read, control, step: verification.md
-    §4's "closed loop") / harness, i.e. the harness's own overhead. PyBullet's figures are the
-    child's own loop times (no pipe)."""
-    from modelkit.verify import engine_mujoco, engine_pybullet
-
-    profile = profile or scenario.profiles[0]
-    files, maps = write_variant(robot, drive, scenario, out_dir, "sphere")
-    simulated = profile.settle + profile.duration
-    out: dict[str, float] = {"simulated_s": simulated}
-    mj = engine_mujoco.driver(files["mjcf"], maps["mjcf"], drive=drive, scenario=scenario, factory=factory)
-    mj.run(profile, scenario, drive)  # warm-up
-    mj.run(profile, scenario, drive)
-    harness, loops = mj.last_wall, mj.bench(simulated)
-    bare, closed = loops["bare"], loops["closed_loop"]
-    out.update(mujoco_harness_s=harness, mujoco_bare_s=bare, mujoco_ratio=bare / harness,
-               mujoco_closed_loop_s=closed, mujoco_closed_ratio=closed / harness,
-               mujoco_realtime=simulated / harness, mujoco_bare_realtime=simulated / bare)
-    pb = engine_pybullet.driver(files["urdf"], maps["urdf"], drive=drive, scenario=scenario, factory=factory)
-    try:
-        pb.start([profile, profile], scenario, drive)
-        pb.result()
-        harness, loops = pb.last_wall[-1], pb.bench(simulated, (profile.commands or (None,))[0])
-        bare, closed = loops["bare"], loops["closed_loop"]
-    finally:
-        pb.close()
-    out.update(pybullet_harness_s=harness, pybullet_bare_s=bare, pybullet_ratio=bare / harness,
-               pybullet_closed_loop_s=closed, pybullet_closed_ratio=closed / harness,
-               pybullet_realtime=simulated / harness, pybullet_bare_realtime=simulated / bare)
-    return out
 
 
 SERVO_FRICTION_SHARE = 3.0

@@ -1,0 +1,7 @@
+"""The engines: one adapter module per engine behind one protocol (:mod:`.protocol`).
+
+:mod:`.registry` names them (data only, for the CLI); :mod:`.reference` is the source model itself
+(and yourdfpy); :mod:`.mujoco`, :mod:`.pybullet` (with its child process :mod:`.pybullet_worker`),
+:mod:`.pinocchio` and :mod:`.drake` load the written files. Nothing here is imported by
+``validate``, ``tree`` or ``convert``.
+"""

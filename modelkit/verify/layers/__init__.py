@@ -1,0 +1,1 @@
+"""The layers: each compares one property of the written robot across the engines."""

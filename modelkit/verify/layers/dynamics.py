@@ -1,0 +1,83 @@
+"""Layer 3a, dynamics without contact: the joint-space mass matrix and bias forces of each engine at
+random (q, dq) against the reference (Pinocchio built from the source), in the reference's dof order
+(errors relative to the largest entry; bias relative to max(1e-6, largest entry)).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from modelkit.convert.compare import random_configuration
+from modelkit.model import Robot
+from modelkit.verify.engines.protocol import Check, EngineModel, Skip
+from modelkit.verify.layers.common import Loaded, Worst, engine_q
+
+State = tuple[dict[str, float], dict[str, float]]
+
+
+def states(robot: Robot, dofs: list[str], count: int, seed: int) -> list[State]:
+    """Random (q, dq): q inside the limits, dq uniform in ±2 rad/s (±0.5 m/s on prismatic joints)."""
+    rng = np.random.default_rng(seed + 1)
+    out = []
+    for _ in range(count):
+        q = random_configuration(robot, rng)
+        dq = {name: float(rng.uniform(-2.0, 2.0)) for name in dofs}
+        out.append((q, dq))
+    return out
+
+
+def layer3a(reference: EngineModel, eng: Loaded,
+            samples: list[State]) -> list[Check]:
+    """Mass matrix and bias forces of the engine against the reference, in the reference's dof order."""
+    eng.model.mass_matrix({})  # NotImplementedError: an engine without dynamics (the caller skips it)
+    ref_dofs = reference.dof_names()
+    eng_dofs = eng.model.dof_names()
+    where = {name: i for i, name in enumerate(eng_dofs)}
+    order = [where.get(eng.joint(name), -1) for name in ref_dofs]
+    label = eng.label
+    if -1 in order or len(eng_dofs) != len(ref_dofs):
+        lost = [name for name, i in zip(ref_dofs, order, strict=True) if i < 0]
+        detail = f"degrees of freedom differ: source {ref_dofs}, engine {eng_dofs}; not found {lost}"
+        first = [*lost, ""][0]
+        return [Check(3, label, "mass-matrix", first, math.inf, eng.tolerance("mass-matrix"), detail),
+                Check(3, label, "bias", first, math.inf, eng.tolerance("bias"), detail)]
+    idx = np.asarray(order, dtype=int)
+    mm, bias = Worst(), Worst()
+    for k, (q, dq) in enumerate(samples):
+        ma = reference.mass_matrix(q)
+        mb = eng.model.mass_matrix(engine_q(q, eng))[np.ix_(idx, idx)]
+        diff = np.abs(ma - mb)
+        scale = max(float(np.max(np.abs(ma))) if ma.size else 0.0, 1e-300)
+        if diff.size:
+            i, j = (int(x) for x in np.unravel_index(int(np.argmax(diff)), diff.shape))
+            err = float(diff[i, j]) / scale
+            if mm.beats(err):
+                mm.see(err, ref_dofs[i] if i == j else f"{ref_dofs[i]}/{ref_dofs[j]}",
+                       f"sample {k}: M[{i},{j}] {ma[i, j]:.12g}, engine {mb[i, j]:.12g} "
+                       f"(relative to max |M| = {scale:.6g})")
+        ba = reference.bias(q, dq)
+        bb = eng.model.bias(engine_q(q, eng), engine_q(dq, eng))[idx]
+        bdiff = np.abs(ba - bb)
+        if bdiff.size:
+            n = int(np.argmax(bdiff))
+            bscale = max(1e-6, float(np.max(np.abs(ba))))
+            err = float(bdiff[n]) / bscale
+            if bias.beats(err):
+                bias.see(err, ref_dofs[n], f"sample {k}: bias {ba[n]:.12g}, engine {bb[n]:.12g} "
+                                           f"(relative to max(1e-6, max |b|) = {bscale:.6g})")
+    what = f"{len(samples)} random (q, dq), {len(ref_dofs)} dofs"
+    return [mm.check(3, label, "mass-matrix", eng.tolerance("mass-matrix"), what),
+            bias.check(3, label, "bias", eng.tolerance("bias"), what)]
+
+
+def no_dynamics(eng: Loaded) -> Skip:
+    return Skip(3, eng.label, f"{eng.label} computes kinematics only: no mass matrix or bias forces")
+
+
+def kinematic_only(robot: Robot) -> bool:
+    """True when no link the joints move has mass: a kinematic model, no dynamics to verify."""
+    moved = {j.child for j in robot.joints}
+    return not any(link.inertial is not None and link.inertial.mass > 0 for link in robot.links
+                   if link.name in moved)
