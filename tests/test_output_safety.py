@@ -196,8 +196,11 @@ def _commit_under_signal(tmp_path: Path, sig: int, model: str = "robot.xml") -> 
 def _model_has_its_meshes(out: Path, model: str) -> None:
     path = out / model
     if path.exists():
-        for name in re.findall(r'file="([^"]+)"', path.read_text()):
-            assert (out / name).is_file(), f"{model} is there without {name}"
+        text = path.read_text()
+        meshdir = re.search(r'meshdir="([^"]+)"', text)  # the MJCF's mesh files are relative to it
+        folder = out / meshdir.group(1) if meshdir else out
+        for name in re.findall(r'file="([^"]+)"', text):
+            assert (folder / name).is_file(), f"{model} is there without {name}"
 
 
 def test_kill_9_mid_commit_leaves_no_model_without_meshes_and_the_next_run_cleans_up(tmp_path: Path) -> None:
