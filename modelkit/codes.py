@@ -1309,8 +1309,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK847",
         "sensor-links",
         "info",
-        "URDF: cameras, LiDARs and IMUs are written as massless links on fixed joints (their TF frames; "
-        "cameras with a REP-103 optical frame), the `<gazebo reference>` naming them; the note lists them.",
+        "URDF: cameras, LiDARs and IMUs are written as links on fixed joints (their TF frames; cameras with "
+        "a REP-103 optical frame), each with a tiny inertial (1e-6 kg: PyBullet would read a link without "
+        "one as 1 kg), the `<gazebo reference>` naming them; the note lists them.",
     ),
     CodeInfo(
         "MK848",

@@ -212,3 +212,33 @@ def test_an_obj_of_one_object_is_copied_as_is(tmp_path: Path) -> None:
     status, output = _convert(source, out)
     assert status == 0 and "MK804" not in output, output
     assert (out.parent / "meshes" / "one.obj").read_text() == one
+
+
+PYBULLET_SHAPES = """
+import sys, pybullet as p
+p.connect(p.DIRECT)
+body = p.loadURDF(sys.argv[1])
+print("SHAPES", [s[2] for s in p.getCollisionShapeData(body, -1)])
+"""
+
+
+@pytest.mark.parametrize("suffix", [".urdf", ".sdf", ".body"])
+def test_an_ascii_stl_is_binary_in_every_target(suffix: str, tmp_path: Path) -> None:
+    """PyBullet reads only binary STL: an ASCII one crashed it (segmentation fault, measured), and
+    MuJoCo refuses it. Every writer converts it (MK804), keeping the file name."""
+    (tmp_path / "box.stl").write_bytes(_ascii_stl())
+    source = tmp_path / "robot.urdf"
+    source.write_text(_urdf("box.stl", collision=True))
+    out = tmp_path / "out" / f"robot{suffix}"
+    status, output = _convert(source, out)
+    assert status == 0 and "MK804" in output, output
+    written = (out.parent / "meshes" / "box.stl").read_bytes()
+    assert len(written) == 84 + 50 * int.from_bytes(written[80:84], "little") == 84 + 50 * 12
+    if suffix == ".urdf":
+        import subprocess
+        import sys
+
+        run = subprocess.run([sys.executable, "-c", PYBULLET_SHAPES, str(out)], capture_output=True,
+                             text=True, timeout=120, check=False)
+        assert run.returncode == 0, run.stderr
+        assert "SHAPES [5]" in run.stdout  # GEOM_MESH

@@ -33,6 +33,7 @@ from modelkit.convert.compare import Difference, compare_robots
 from modelkit.convert.notes import ConversionNote, renames
 from modelkit.convert.options import WriteOptions
 from modelkit.convert.registry import target_info
+from modelkit.formats.urdf.write_frames import FRAME_MASS
 from modelkit.model import Cylinder, Joint, JointType, Link, Robot
 from modelkit.spatial import Pose
 
@@ -195,7 +196,7 @@ def test_tutorial_robot_loads_in_pybullet_and_mujoco(name: str, tmp_path: Path) 
     wheels = _wheel_cylinders(source)
     assert len(wheels) == 2
     # PyBullet reads a link without <inertial> as 1 kg (MK816): the sensors' TF-frame links (MK847, 3 for
-    # the sensor robot) are left out for PyBullet with urdf_sensor_links=False, and counted in the default
+    # the sensor robot) carry a tiny inertial instead, counted in the default (none: urdf_sensor_links=False)
     sensor_links = 3 if name == "mobile_robot_sensors" else 0
     default = convert([TUTORIAL / f"{name}.body"], tmp_path / "default" / f"{name}.urdf")
     run = subprocess.run([sys.executable, "-c", PYBULLET_CHILD, str(tmp_path / "default" / f"{name}.urdf")],
@@ -203,7 +204,7 @@ def test_tutorial_robot_loads_in_pybullet_and_mujoco(name: str, tmp_path: Path) 
     assert default.status == 0 and run.returncode == 0, run.stderr
     # (PyBullet prints its "No inertial data for link" warnings on stdout, unterminated, before the result)
     loaded = json.loads(run.stdout[run.stdout.rindex('{"mass"'):].splitlines()[0])
-    assert math.isclose(loaded["mass"], _total_mass(source) + sensor_links * 1.0, rel_tol=1e-9)
+    assert math.isclose(loaded["mass"], _total_mass(source) + sensor_links * FRAME_MASS, rel_tol=1e-12)
     result = convert([TUTORIAL / f"{name}.body"], tmp_path / f"{name}.urdf",
                      options=WriteOptions(urdf_sensor_links=False))
     assert result.status == 0
@@ -266,7 +267,9 @@ def test_tracks_become_meshes_of_the_readers_volume(tmp_path: Path) -> None:
     assert len(track_meshes) >= 1, (written, volumes)
     tracks = _read(tmp_path / "tracks.urdf")
     assert not any(j.type is JointType.PSEUDO_CONTINUOUS_TRACK for j in tracks.joints)
-    assert math.isclose(_total_mass(tracks), _total_mass(source), rel_tol=1e-12)
+    frames = [lk for lk in tracks.links if lk.inertial is not None and lk.inertial.mass == FRAME_MASS]
+    assert len(frames) == 3  # the sensors' TF frames (MK847): LiDAR, RealSense and its optical frame
+    assert math.isclose(_total_mass(tracks) - len(frames) * FRAME_MASS, _total_mass(source), rel_tol=1e-12)
 
 
 @pytest.mark.parametrize("target", ["urdf", "sdf", "mjcf", "body"])

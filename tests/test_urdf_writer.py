@@ -161,8 +161,12 @@ def expected_after_urdf(robot: Robot) -> Robot:
     """The model with the writer's documented substitutions: URDF needs both position bounds of a
     prismatic joint (and of a revolute joint limited on one side only), ±1e16 where there is none;
     a welded root hangs from a `world` link by a fixed joint at the robot's placement; a camera, LiDAR
-    or IMU is a massless link on a fixed joint at its pose, a camera's optical frame one more (MK847)."""
-    from modelkit.formats.urdf.write_frames import FRAMED_KINDS
+    or IMU is a link of a tiny inertial on a fixed joint at its pose, a camera's optical frame one more
+    (MK847)."""
+    from modelkit.formats.urdf.write_frames import FRAME_INERTIA, FRAME_MASS, FRAMED_KINDS
+
+    def frame_link(name: str) -> Link:
+        return Link(name, inertial=Inertial(FRAME_MASS, (0.0, 0.0, 0.0), np.eye(3) * FRAME_INERTIA))
 
     out = copy.deepcopy(robot)
     taken = {lk.name for lk in out.links} | {j.name for j in out.joints}
@@ -171,13 +175,13 @@ def expected_after_urdf(robot: Robot) -> Robot:
             if device.canonical not in FRAMED_KINDS or device.name == link.name or "xml" in device.params:
                 continue
             frame = unique_name(device.name, taken)
-            out.links.append(Link(frame))
+            out.links.append(frame_link(frame))
             out.joints.append(Joint(unique_name(f"{frame}_joint", taken), JointType.FIXED, link.name, frame,
                                     origin=device.pose))
             if device.canonical in CAMERA_KINDS:  # REP-103: z forward, x right, y down
                 optical = unique_name(f"{frame}_optical", taken)
                 rep103 = Pose(matrix_from_rpy(-math.pi / 2, 0.0, -math.pi / 2), np.zeros(3))
-                out.links.append(Link(optical))
+                out.links.append(frame_link(optical))
                 out.joints.append(Joint(unique_name(f"{optical}_joint", taken), JointType.FIXED, frame,
                                         optical, origin=rep103))
     if out.root_joint is JointType.FIXED and out.root not in (None, "world"):
@@ -282,8 +286,9 @@ def test_tutorial_body_matches_the_hand_written_urdf(tmp_path: Path) -> None:
     assert {j.name for j in ours.joints} >= {"LeftWheel", "RightWheel", "PanJoint", "TiltJoint"}
     for link in ours.links:
         other_link = hand.link(link.name)
-        if link.name in ("LiDAR", "RealSense", "RealSense_optical"):
-            assert link.inertial is None and not link.visuals and not link.collisions
+        if link.name in ("LiDAR", "RealSense", "RealSense_optical"):  # TF frames of a tiny inertial
+            assert link.inertial is not None and link.inertial.mass == 1e-6
+            assert not link.visuals and not link.collisions
             continue
         assert other_link is not None and link.inertial is not None and other_link.inertial is not None
         assert link.inertial.mass == other_link.inertial.mass

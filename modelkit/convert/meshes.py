@@ -85,6 +85,20 @@ def for_mujoco(data: bytes, ext: str, scale: Vec3 | None = None) -> Prepared:
     return Prepared(triangles_to_bytes(mesh, "stl"), kind, _hollow(corners, scale), _flat(corners))
 
 
+def as_binary_stl(data: bytes) -> Prepared | None:
+    """A ``.stl`` file that is text (an ASCII STL, or OBJ text named ``.stl``) as a binary STL, for
+    every target; ``None`` for a binary STL or anything that is no mesh (then copied as is, and judged
+    by the target's own checks)."""
+    count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
+    if count >= 0 and len(data) == 84 + 50 * count:
+        return None
+    try:
+        ready = for_mujoco(data, "stl")
+    except Unusable:
+        return None
+    return ready if ready.converted is not None else None
+
+
 def _obj_for_mujoco(data: bytes, scale: Vec3 | None) -> Prepared:
     """An OBJ file kept as is, unless MuJoCo's own OBJ reader reads fewer triangles than it holds
     (measured on files of several objects: example-robot-data's ``nub.obj`` gives 29 of 1,404, its
@@ -297,6 +311,12 @@ class MeshExporter:
             except OSError as exc:
                 return None, f"mesh {uri} cannot be read ({exc.strerror})"
             if not mujoco:
+                binary = as_binary_stl(data) if ext == "stl" else None
+                if binary is not None:
+                    data = binary.data
+                    why = "PyBullet reads only binary STL (an ASCII one crashed it, measured)"
+                    self.notes.note("MK804", f"mesh {path.name} ({binary.converted}) converted to binary "
+                                    f"STL: {why}, and every consumer reads it", source, target)
                 return MeshRef(self._stage(data, safe_file_name(path.name, "mesh")), scale, ext), ""
             try:
                 ready = for_mujoco(data, ext, scale)

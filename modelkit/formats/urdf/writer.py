@@ -27,7 +27,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.notes import ConversionNote, renames
 from modelkit.convert.simulator import pybullet_settings
-from modelkit.formats.urdf.write_frames import sensor_frames
+from modelkit.formats.urdf.write_frames import frame_link, sensor_frames
 from modelkit.formats.urdf.write_gazebo import write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
 from modelkit.formats.urdf.write_links import MaterialTable, link_element, origin_element
@@ -128,8 +128,10 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
     joints.extend(_free_links(robot, names, ctx))
     frames = sensor_frames(robot, names, ctx)
     joints.extend(frames.joints)
-    for name in extra_links + frames.links:
+    for name in extra_links:
         etree.SubElement(links, "link", name=name)
+    for name in frames.links:
+        links.append(frame_link(name, ctx))
 
     out = etree.Element("robot", name=robot.name or "robot")
     materials.write(out)
@@ -147,7 +149,7 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
     for el in joints:
         out.append(el)
     write_extensions(out, robot, names, frames, ctx)
-    _massless(robot, names, ctx, frames.links)
+    _massless(robot, names, ctx)
     _notes(robot, ctx)
     settings = pybullet_settings(robot)
     if settings:
@@ -235,13 +237,14 @@ def _free_links(robot: Robot, names: NameTable, ctx: WriteContext) -> list[Eleme
     return out
 
 
-def _massless(robot: Robot, names: NameTable, ctx: WriteContext, added: list[str]) -> None:
-    """One note for the links written without ``<inertial>`` (frames), with what peers do to them."""
+def _massless(robot: Robot, names: NameTable, ctx: WriteContext) -> None:
+    """One note for the source's links written without ``<inertial>`` (frames), with what peers do to
+    them (the sensor frames the writer adds carry a tiny inertial: ``write_frames.FRAME_MASS``)."""
     massless = [
         names.links[i]
         for i, link in enumerate(robot.links)
         if (link.inertial is None or link.inertial.mass <= 0.0) and link.name != WORLD_LINK
-    ] + added
+    ]
     if not massless:
         return
     shown = ", ".join(f'"{n}"' for n in massless[:8]) + (

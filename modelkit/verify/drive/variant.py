@@ -54,9 +54,7 @@ def write_variant(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path,
     """Write the floating-base ``robot`` (the source model, root not welded) as MJCF and URDF into
     ``out_dir`` exactly as ``convert`` writes it (``<name>.xml`` / ``.urdf``; the native run's
     ``<name>_cylinder.*``; meshes in ``meshes/``): no edit of the written files, the engines load
-    them as they are. One option differs from ``convert``'s defaults: the URDF keeps its sensors on
-    their links (``urdf_sensor_links=False``), since PyBullet reads a massless sensor link as 1 kg
-    (MK816, MK847) and the dynamics compared are the source's.
+    them as they are, with ``convert``'s default options but the wheels' collision (``proxy``).
 
     Returns the files (``"mjcf"``, ``"urdf"``) and each file's renames (``{"link": {source:
     written}, "joint": {...}}``, from the writers' MK800 notes), as ``verify``'s conversion does."""
@@ -67,7 +65,7 @@ def write_variant(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path,
     del scenario, drive
     if proxy not in WRITE_CHOICE:
         raise ValueError(f"wheel proxy must be 'sphere' or 'native', not {proxy!r}")
-    options = WriteOptions(wheel_collision=WRITE_CHOICE[proxy], urdf_sensor_links=False)
+    options = WriteOptions(wheel_collision=WRITE_CHOICE[proxy])
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     stem = _safe(robot.name or "robot") + ("" if proxy == "sphere" else "_cylinder")
