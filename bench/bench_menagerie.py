@@ -1,7 +1,7 @@
 """Our MJCF next to MuJoCo's own URDF import and MuJoCo Menagerie's hand-written model of the same robot.
 
 For each robot: the source URDF (example-robot-data, a test dependency) converted by ``modelkit
-convert`` (defaults), the same URDF imported by MuJoCo itself, and
+convert`` (defaults, and ``--merge-fixed``), the same URDF imported by MuJoCo itself, and
 Menagerie's model (give the folder of a Menagerie checkout with ``--menagerie DIR``). Printed per
 model: bodies, joints, degrees of freedom, actuators (and their kind), total mass, whether the base
 floats, the largest distance of the four calves from Menagerie's at its ``home`` pose (each model
@@ -75,13 +75,14 @@ def mujoco_import(urdf: Path, folder: Path) -> mujoco.MjSpec:
     return mujoco.MjSpec.from_file(str(copy))
 
 
-def ours(urdf: Path, folder: Path) -> mujoco.MjSpec:
+def ours(urdf: Path, folder: Path, merge_fixed: bool) -> mujoco.MjSpec:
     """``modelkit convert`` with its defaults (the source's actuators: Go1's transmissions are effort
     interfaces, so motors; ``--actuators`` applies only to a source without any)."""
     from modelkit.convert.api import convert
+    from modelkit.convert.options import WriteOptions
 
-    out = folder / "modelkit" / f"{urdf.stem}.xml"
-    result = convert([urdf], out, force=True)
+    out = folder / f"modelkit{'_merged' if merge_fixed else ''}" / f"{urdf.stem}.xml"
+    result = convert([urdf], out, options=WriteOptions(merge_fixed=merge_fixed), force=True)
     if result.status != 0:
         sys.exit(f"convert failed: {[d.message for d in result.diagnostics][:3]}")
     return mujoco.MjSpec.from_file(str(out))
@@ -180,9 +181,10 @@ def main() -> None:
             _pose(menagerie[0], ref_data, home, height)
             reference = _calves(menagerie[0], ref_data)
             rows = {"menagerie": measure(menagerie, home, height, reference)}
-            for label in ("modelkit", "mujoco import"):
+            for label in ("modelkit", "modelkit --merge-fixed", "mujoco import"):
                 try:
-                    spec = ours(urdf, folder) if label == "modelkit" else mujoco_import(urdf, folder)
+                    spec = (mujoco_import(urdf, folder) if label == "mujoco import"
+                            else ours(urdf, folder, merge_fixed=label.endswith("--merge-fixed")))
                     model = with_floor(without_visual_meshes(spec))
                 except ValueError as exc:  # MuJoCo refuses the model: that is the row
                     rows[label] = {"refused": str(exc).splitlines()[0]}
