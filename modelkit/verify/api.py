@@ -583,13 +583,15 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
             mine = mj_approx.get(link)
             if mine is None or (mine.mass, mine.inertia) != (a.mass, a.inertia):
                 inertials[maps["mjcf"].get("link", {}).get(link, link)] = (a.mass, a.inertia)
+    principal = _diagonalised(loaded, maps) if "mjcf" in maps else {}
     for name in names:
         kind = INPUTS[name]
         root = maps[kind].get("link", {}).get(str(reference.root), str(reference.root))
         extra: dict[str, Any] = {}
         if kind == "mjcf":
             extra = {**({"armature": False} if with_armature else {}),
-                     **({"inertials": inertials} if inertials else {})}
+                     **({"inertials": inertials} if inertials else {}),
+                     **({"principal": principal} if principal else {})}
         try:
             make = _resolve(ENGINES[name].replace(":load", ":simulator"))
             sims.append(make(files[kind], maps[kind], root=root, dt=REPLAY_DT, **extra))
@@ -611,6 +613,12 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
             + (f"(mimic joints {', '.join(mimics)} follow their leaders there) " if mimics else "")
             + "because PyBullet does not read URDF <mimic> and a URDF holds no closed loop; the couplings "
             "themselves are not verified by the replay")))
+    if principal:
+        report.skips.append(Skip(3, "mujoco+pybullet", (
+            f"replay with PyBullet's diagonalised inertia given to MuJoCo too: {len(principal)} link(s) with "
+            "products of inertia hold the principal moments and axes PyBullet's URDF importer computed "
+            "(btMatrix3x3::diagonalize, threshold 1e-6) in both engines, so the replay compares the "
+            "integration of the same numbers; layer 3a compares each engine's tensor with the source")))
     if inertials:
         report.skips.append(Skip(3, "mujoco+pybullet", (
             f"replay with PyBullet's documented approximation given to MuJoCo too: {len(inertials)} link(s) "
@@ -647,6 +655,22 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
         messages = list(getattr(sim, "runtime_warnings", []))
         report.checks.extend(engine_warnings(report, sim.engine, messages, "replay_warnings",
                                              "the replay (layer 3b)"))
+
+
+def _diagonalised(loaded: list[Any], maps: dict[str, Renames]) -> dict[str, Any]:
+    """PyBullet's diagonalised link inertias (``PyBulletModel.diagonalised_inertials``), by the MJCF's
+    body names; empty when PyBullet is not loaded."""
+    engine = next((e.model for e in loaded if e.label == "pybullet"), None)
+    held = getattr(engine, "diagonalised_inertials", None)
+    if held is None:
+        return {}
+    source_of = {written: source for source, written in maps.get("urdf", {}).get("link", {}).items()}
+    mjcf = maps["mjcf"].get("link", {})
+    out = {}
+    for written, value in held().items():
+        source = source_of.get(written, written)
+        out[mjcf.get(source, source)] = value
+    return out
 
 
 def _welded_to_root(robot: Robot) -> set[str]:

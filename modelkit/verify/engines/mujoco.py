@@ -398,7 +398,8 @@ class MujocoSimulator:
     engine = "mujoco"
 
     def __init__(self, path: Path, renames: Renames, root: str, dt: float, armature: bool = True,
-                 inertials: dict[str, tuple[float, float]] | None = None) -> None:
+                 inertials: dict[str, tuple[float, float]] | None = None,
+                 principal: dict[str, tuple[float, Array, Array, Array]] | None = None) -> None:
         # Another engine's documented approximation: a mass on links that are no MuJoCo body of their
         # own (the intermediates of a multi-joint body) needs the body split (same kinematics).
         self.inner = MujocoModel(path, root, actuated=True, split={n for n in inertials or {} if "__" in n})
@@ -415,6 +416,17 @@ class MujocoSimulator:
             # is not the body frame when the joint has a pos (humanoid's abdomen joints: 0 0 .065).
             m.body_mass[b], m.body_inertia[b] = mass, (moment, moment, moment)
             m.body_ipos[b], m.body_iquat[b] = offsets[b], (1.0, 0.0, 0.0, 0.0)
+        # Another engine's diagonalised tensors (``principal``: mass, COM in the link frame, principal
+        # moments, axes as a quaternion xyzw), for bodies that are one link each: both engines then
+        # integrate the same numbers, and the replay tests the dynamics, not PyBullet's importer.
+        single = {body.index for body in self.inner._bodies if len(body.links) == 1}
+        for body, (mass, com, moments, quat_xyzw) in (principal or {}).items():
+            b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, body)
+            if b <= 0 or body == root or b not in single:
+                continue
+            m.body_mass[b], m.body_inertia[b] = mass, moments
+            m.body_ipos[b] = offsets[b] + com
+            m.body_iquat[b] = (quat_xyzw[3], quat_xyzw[0], quat_xyzw[1], quat_xyzw[2])
         m.opt.timestep = dt
         m.opt.integrator = int(mujoco.mjtIntegrator.mjINT_EULER)
         m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
@@ -527,8 +539,9 @@ class MujocoSimulator:
 
 
 def simulator(model: Path, renames: Renames, *, root: str, dt: float, armature: bool = True,
-              inertials: dict[str, tuple[float, float]] | None = None) -> MujocoSimulator:
-    return MujocoSimulator(Path(model), renames, root, dt, armature, inertials)
+              inertials: dict[str, tuple[float, float]] | None = None,
+              principal: dict[str, tuple[float, Array, Array, Array]] | None = None) -> MujocoSimulator:
+    return MujocoSimulator(Path(model), renames, root, dt, armature, inertials, principal)
 
 
 # ---- layer 4: the floating-base robot driven on a floor ----------------------------------------

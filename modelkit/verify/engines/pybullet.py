@@ -253,6 +253,22 @@ class PyBulletModel:
         if tolerances:
             self.settings["tolerances"] = tolerances
 
+    def diagonalised_inertials(self) -> dict[str, tuple[float, Array, Array, Array]]:
+        """The links whose URDF inertia PyBullet's importer diagonalised (products of inertia: its
+        inertial frame is rotated), as PyBullet holds them: mass, COM in the link frame, principal
+        moments, and the rotation of the principal axes (quaternion xyzw). The diagonalisation stops
+        at a threshold of 1e-6 (see the tolerances above), so this is PyBullet's own approximation of
+        the file's tensor."""
+        out = {}
+        identity = (0.0, 0.0, 0.0, 1.0)
+        for name, d in self._dynamics.items():
+            if name == self.base or np.allclose(d["inertial_orn"], identity, rtol=0.0, atol=1e-15):
+                continue
+            out[name] = (float(d["mass"]), np.asarray(d["inertial_pos"], dtype=float),
+                         np.asarray(d["inertia_diagonal"], dtype=float),
+                         np.asarray(d["inertial_orn"], dtype=float))
+        return out
+
     # ---- EngineModel --------------------------------------------------------------------------
 
     def dof_names(self) -> list[str]:
