@@ -58,6 +58,18 @@ def example_robot_data() -> Path | None:
     return None
 
 
+def example_robot(relative: str) -> Path:
+    """A file of example-robot-data's ``robots`` folder; the test is skipped when the wheel is missing
+    (a test dependency, so CI fails on that skip)."""
+    import pytest
+
+    robots = example_robot_data()
+    path = robots / relative if robots is not None else None
+    if path is None or not path.is_file():
+        pytest.skip(f"example-robot-data is not installed (a test dependency): {relative}")
+    return path
+
+
 # Skips that are answers, not missing tools: a corpus file that is not text for a test that reads
 # text. In CI (MODELKIT_REQUIRE_ORACLES) every other skip fails the run (see pytest_sessionfinish).
 SKIPS_ALLOWED_IN_CI = (r"^not UTF-8 text$",)

@@ -15,17 +15,12 @@ import pytest
 
 from modelkit.verify.api import verify
 
-from .conftest import example_robot_data
-
-ROBOTS = example_robot_data()
-ROMEO = ROBOTS / "romeo_description" / "urdf" / "romeo.urdf" if ROBOTS else None
+from .conftest import example_robot
 
 
 @pytest.fixture(scope="module")
 def romeo() -> Path:
-    if ROMEO is None or not ROMEO.is_file():
-        pytest.skip("example-robot-data is not installed (a test dependency)")
-    return ROMEO
+    return example_robot("romeo_description/urdf/romeo.urdf")
 
 
 def test_pybullet_s_diagonalised_inertias_replay_alike_in_both_engines(romeo: Path, tmp_path: Path) -> None:

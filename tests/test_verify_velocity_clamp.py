@@ -15,17 +15,12 @@ import pytest
 
 from modelkit.verify.api import verify
 
-from .conftest import example_robot_data
-
-ROBOTS = example_robot_data()
-G1 = ROBOTS / "g1_description" / "urdf" / "g1_29dof_rev_1_0.urdf" if ROBOTS else None
+from .conftest import example_robot
 
 
 @pytest.fixture(scope="module")
 def g1() -> Path:
-    if G1 is None or not G1.is_file():
-        pytest.skip("example-robot-data is not installed (a test dependency)")
-    return G1
+    return example_robot("g1_description/urdf/g1_29dof_rev_1_0.urdf")
 
 
 def test_a_wrist_past_100_rad_per_s_replays_alike_in_both_engines(g1: Path, tmp_path: Path) -> None:
