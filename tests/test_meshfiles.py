@@ -756,3 +756,24 @@ def test_binary_stl_does_not_import_trimesh(tmp_path: Path) -> None:
     done = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True, check=True,
                           timeout=120)
     assert done.stdout.split() == ["1", "False"]
+
+
+def test_a_changed_mesh_file_is_loaded_again_by_the_next_write(tmp_path: Path) -> None:
+    """convert remembers loaded mesh files within a process (verify writes a robot up to seven
+    times); a file changed between two writes must be read again, not served from memory."""
+    import trimesh
+
+    from modelkit.convert.api import convert
+
+    wrl = tmp_path / "part.wrl"
+    source = tmp_path / "robot.urdf"
+    source.write_text('<robot name="r"><link name="base"><visual><geometry><mesh filename="part.wrl"/>'
+                      "</geometry></visual></link></robot>")
+    sizes = []
+    for size in ("0.2 0.4 0.6", "1 2 3"):
+        wrl.write_text(f"#VRML V2.0 utf8\nShape {{ geometry Box {{ size {size} }} }}\n")
+        out = tmp_path / size.replace(" ", "_") / "robot.urdf"
+        assert convert([source], out).status == 0
+        (mesh,) = (out.parent / "meshes").iterdir()
+        sizes.append(float(np.ptp(trimesh.load(mesh, force="mesh").vertices[:, 2])))
+    assert sizes == pytest.approx([0.6, 3.0])
