@@ -60,6 +60,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "expanded document passes `--max-bytes` of text: an include diamond; refused where the next "
         "include stands.",
     ),
+    CodeInfo(
+        "MK009",
+        "body-subbody-work",
+        "error",
+        "SubBodies loaded for one `.body` file (each inclusion of the same file counted) pass 2,000: a "
+        "SubBody diamond, which Choreonoid would expand exponentially; refused where the next SubBody "
+        "stands. Real models load a handful.",
+    ),
     CodeInfo("MK010", "yaml-syntax", "error", "The YAML is malformed."),
     CodeInfo(
         "MK011",

@@ -324,3 +324,31 @@ def test_a_urdf_over_max_bytes_is_mk002_and_exit_2(tmp_path: Path) -> None:
     status, found = validate_json(model, seconds=10)
     assert status == 2 and [d["code"] for d in found] == ["MK002"], found
     assert run("tree", str(model), seconds=10).exit_code == 2
+
+
+def _subbody_file(folder: Path, name: str, children: list[tuple[str, str]]) -> None:
+    text = (f"format: ChoreonoidBody\nformat_version: 2.0\nname: {name}\nroot_link: {name}_root\nlinks:\n"
+            f"  - name: {name}_root\n    joint_type: fixed\n    mass: 1.0\n"
+            "    inertia: [ 0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01 ]\n"
+            "    elements:\n      - { type: Shape, geometry: { type: Box, size: [ 0.1, 0.1, 0.1 ] } }\n")
+    for uri, prefix in children:
+        text += f"  - {{ type: SubBody, uri: {uri}, parent: {name}_root, prefix: {prefix} }}\n"
+    (folder / f"{name}.body").write_text(text)
+
+
+def test_a_subbody_diamond_stops_at_the_load_bound(tmp_path: Path) -> None:
+    """Each of 20 nested bodies includes the next twice: 2^20 loads ran for minutes; now MK009 at the
+    SubBody where 2,000 loads are passed. A 300-deep chain (300 loads) is not bounded."""
+    from modelkit.api import validate
+
+    for i in range(20):
+        _subbody_file(tmp_path, f"d{i}", [(f"d{i + 1}.body", f"a{i}_"), (f"d{i + 1}.body", f"b{i}_")]
+                      if i < 19 else [])
+    result = validate(tmp_path / "d0.body")
+    codes = {d.code for d in result.errors}
+    assert codes == {"MK009"}, codes
+    assert any(d.location and d.location.line == 13 for d in result.errors if d.code == "MK009")
+    for i in range(300):
+        _subbody_file(tmp_path, f"c{i}", [(f"c{i + 1}.body", f"p{i}_")] if i < 299 else [])
+    chain = validate(tmp_path / "c0.body")  # (under pytest's deeper stack its last level may get MK104)
+    assert "MK009" not in {d.code for d in chain.diagnostics} and chain.robot is not None

@@ -122,6 +122,10 @@ def trailing_text_message(text: str) -> str:
 
 
 
+# SubBody loads one read may make, each inclusion counted (MK009): a body included twice by each of 20
+# nested bodies is 2^20 loads (it ran for minutes); real models load a handful. ~3 ms a load.
+MAX_SUBBODY_LOADS = 2_000
+
 # What Choreonoid does with a SubBody it cannot load (MK216): the robot loses that whole subtree.
 SUBBODY_DROPPED = (
     "Choreonoid prints \"cannot be loaded\" and loads the robot without that subtree (its links, masses and "
@@ -130,8 +134,10 @@ SUBBODY_DROPPED = (
 
 class _BodyReader:
     def __init__(
-        self, path: Path, options: BodyOptions, sink: DiagnosticSink, display: str, stack: tuple[str, ...]
+        self, path: Path, options: BodyOptions, sink: DiagnosticSink, display: str, stack: tuple[str, ...],
+        loads: list[int] | None = None,
     ) -> None:
+        self.loads = loads if loads is not None else [0]  # SubBody loads of this whole read (MK009)
         self.path = path
         self.options = options
         self.sink = sink
@@ -555,8 +561,17 @@ class _BodyReader:
                 uri_node.loc,
             )
             return []
+        self.loads[0] += 1
+        if self.loads[0] > MAX_SUBBODY_LOADS:
+            self.sink.emit(
+                "MK009",
+                f'SubBody "{uri}" is not read: this file has loaded {MAX_SUBBODY_LOADS:,} SubBodies (each '
+                "inclusion counted), as a body included twice by each of many nested bodies does",
+                uri_node.loc,
+            )
+            return []
         sub_sink = DiagnosticSink()
-        sub_reader = _BodyReader(path, self.options, sub_sink, str(path), self.stack)
+        sub_reader = _BodyReader(path, self.options, sub_sink, str(path), self.stack, self.loads)
         sub = sub_reader.read()
         for d in sub_sink.items:
             self.sink.add(d)
