@@ -66,8 +66,8 @@ def for_mujoco(data: bytes, ext: str, scale: Vec3 | None = None) -> Prepared:
         raise Unusable("the file is empty")
     if ext == "obj":
         return _obj_for_mujoco(data, scale)
-    count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
-    if count >= 0 and len(data) == 84 + 50 * count:
+    count = _binary_stl_faces(data)
+    if count is not None:
         corners = _checked(_binary_stl_corners(data, count))
         return Prepared(data, None, _hollow(corners, scale), _flat(corners))
     text = _text(data)
@@ -113,8 +113,7 @@ def as_binary_stl(data: bytes) -> Prepared | None:
     """A ``.stl`` file that is text (an ASCII STL, or OBJ text named ``.stl``) as a binary STL, for
     every target; ``None`` for a binary STL or anything that is no mesh (then copied as is, and judged
     by the target's own checks)."""
-    count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
-    if count >= 0 and len(data) == 84 + 50 * count:
+    if _binary_stl_faces(data) is not None:
         return None
     try:
         ready = for_mujoco(data, "stl")
@@ -156,6 +155,12 @@ def _obj_counts(data: bytes) -> tuple[int, int]:
         elif line.startswith((b"o ", b"g ")):
             groups += 1
     return triangles, groups
+
+
+def _binary_stl_faces(data: bytes) -> int | None:
+    """The face count of a binary STL (its size is 84 + 50 × the count it declares), else None."""
+    count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
+    return count if count >= 0 and len(data) == 84 + 50 * count else None
 
 
 def _binary_stl_corners(data: bytes, count: int) -> np.ndarray:
