@@ -280,6 +280,19 @@ def compare_fk(robot: Robot, models: dict[str, mujoco.MjModel], home_m: dict[str
             rows[label]["fk_vs_mujoco_import"] = fk_gap(positions["mujoco import"], positions[label], same)
 
 
+def solver_iterations(model: mujoco.MjModel, home: dict[str, float], height: float) -> float:
+    """Mean constraint-solver iterations per step over the same run as ``timed_run`` (not timed): a
+    model whose joints move under friction loss or limits needs more than one held still."""
+    data = mujoco.MjData(model)
+    pose(model, data, home, height)
+    steps = round(SECONDS / model.opt.timestep)
+    total = 0
+    for _ in range(steps):
+        mujoco.mj_step(model, data)
+        total += int(data.solver_niter[0])
+    return total / steps
+
+
 def compare_speed(models: dict[str, mujoco.MjModel], collisions: bool, home_m: dict[str, float],
                   home_u: dict[str, float], height: float, rounds: int, rows: dict[str, dict[str, Any]]
                   ) -> None:
@@ -302,6 +315,9 @@ def compare_speed(models: dict[str, mujoco.MjModel], collisions: bool, home_m: d
     for _ in range(rounds):  # the models take turns, so that other load on the machine hits them alike
         for key, model in timed.items():
             runs[key].append(timed_run(model, home_m if key[0] == "menagerie" else home_u, height))
+    for label, model in models.items():  # contact-free by now (contact_free changed them in place)
+        iterations = solver_iterations(model, home_m if label == "menagerie" else home_u, height)
+        rows[label]["contact_free_solver_iterations_per_step"] = round(iterations, 2)
     for (label, setup), values in runs.items():
         reference = runs["menagerie", setup.replace("_with_menagerie_integrator", "")]
         for stat, summary in (("median", statistics.median), ("best", max)):
