@@ -103,9 +103,9 @@ def without_meshes(spec: mujoco.MjSpec) -> tuple[mujoco.MjSpec, dict[str, int]]:
 def mujoco_import(urdf: Path, folder: Path) -> mujoco.MjSpec:
     """MuJoCo's own URDF import of the file without its <visual> elements (DAE meshes it cannot read).
     Its collision meshes are deleted from the spec before it is compiled, so their files are never read."""
-    copy = folder / urdf.name
-    copy.write_text(re.sub(r"<visual>.*?</visual>", "", urdf.read_text(), flags=re.S))
-    return mujoco.MjSpec.from_file(str(copy))
+    stripped = folder / urdf.name
+    stripped.write_text(re.sub(r"<visual>.*?</visual>", "", urdf.read_text(), flags=re.S))
+    return mujoco.MjSpec.from_file(str(stripped))
 
 
 def ours(urdf: Path, folder: Path, label: str) -> mujoco.MjSpec:
@@ -141,8 +141,9 @@ def home_pose(model: mujoco.MjModel) -> tuple[dict[str, float], float]:
 
 
 def pose(model: mujoco.MjModel, data: mujoco.MjData, home: dict[str, float], height: float) -> None:
-    """Reset, then the home pose by joint name; position servos (gain and bias) hold it. A model with
-    its own ``home`` keyframe (Menagerie's) uses its controls, which also drive tendon actuators."""
+    """Reset, then the home pose by joint name; position servos (gain and bias) hold it. A model whose
+    own ``home`` keyframe is this pose (Menagerie's) takes the keyframe's controls, which also drive
+    tendon actuators (Panda's fingers)."""
     mujoco.mj_resetData(model, data)
     for j in range(model.njnt):
         adr = model.jnt_qposadr[j]
@@ -151,7 +152,7 @@ def pose(model: mujoco.MjModel, data: mujoco.MjData, home: dict[str, float], hei
         else:
             data.qpos[adr] = home.get(_name(model, mujoco.mjtObj.mjOBJ_JOINT, j), 0.0)
     key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "home")
-    if key >= 0 and model.nu and np.any(model.key_ctrl[key]):
+    if key >= 0 and model.nu and np.allclose(model.key_qpos[key], data.qpos):
         data.ctrl[:] = model.key_ctrl[key]
         return
     for a in range(model.nu):
