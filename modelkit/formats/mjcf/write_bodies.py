@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.numbers import fmt, fmt_direction, fmt_vec
 from modelkit.convert.servo_gains import home_position
 from modelkit.formats.mjcf.write_chains import Chain, ChainFinder, shifted
 from modelkit.formats.mjcf.write_devices import DeviceWriter
@@ -333,7 +333,7 @@ class BodyTree:
             return True
         el = sub(body, "joint", name=name, type="hinge" if kind is JointType.REVOLUTE else "slide")
         self._anchor(el, anchor)
-        el.set("axis", fmt_vec(joint.axis))
+        el.set("axis", fmt_direction(joint.axis))
         self.scalar_joints.append(name)
         limits = joint.limits
         if math.isfinite(limits.lower) and math.isfinite(limits.upper) and limits.lower < limits.upper:
@@ -402,7 +402,7 @@ class BodyTree:
         for suffix, kind, axis in (("_tx", "slide", u), ("_ty", "slide", v), ("_rz", "hinge", normal)):
             target = f"body[{body_name}]/joint[{joint.name}{suffix}]"
             name = self.names.claim("joint", joint.name + suffix, joint.loc("name"), target, note=False)
-            el = sub(body, "joint", name=name, type=kind, axis=fmt_vec(axis))
+            el = sub(body, "joint", name=name, type=kind, axis=fmt_direction(axis))
             self._dynamics(el, joint, target)
             written.append(name)
         self.joint_names[joint.name] = written
