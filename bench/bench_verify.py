@@ -43,8 +43,9 @@ from typing import Any
 from modelkit.convert.options import WriteOptions
 
 # The engines' files as verify writes them for layers 1-3: the root is the base (no URDF world link,
-# the engines weld it), the sensors on their links (their link sets are compared with the source's).
-ENGINE_FILES = WriteOptions(urdf_world_link=False, urdf_sensor_links=False)
+# the engines weld it), the sensors on their links (their link sets are compared with the source's),
+# motors on joints the source does not actuate (the passive robot).
+ENGINE_FILES = WriteOptions(urdf_world_link=False, urdf_sensor_links=False, actuators="motor")
 
 REPO = Path(__file__).resolve().parents[1]
 PANTILT = REPO / "samples" / "choreonoid_ros2_mobile_robot_tutorial" / "model" / "mobile_robot_pantilt.body"

@@ -1307,6 +1307,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "out.",
     ),
     CodeInfo(
+        "MK845",
+        "home-outside-range",
+        "info",
+        "MJCF: a joint's home position (its initial position; 0 where the source gives none) lies outside "
+        "its range, so the `home` keyframe puts it at the nearest limit, where the joint's own limit would "
+        "push it and a position servo can hold it (Panda's joint 4: 0 against [-3.07, -0.07]).",
+    ),
+    CodeInfo(
         "MK846",
         "joint-keeps-link-name",
         "info",

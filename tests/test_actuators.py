@@ -18,7 +18,7 @@ from modelkit.convert.api import write
 from modelkit.convert.options import WriteOptions
 from modelkit.formats.common import ReadOptions
 from modelkit.model import ActuatorKind, Robot
-from tests.conftest import CORPUS, PENDULUM_BODY, example_robot_data
+from tests.conftest import CORPUS, PENDULUM_BODY, example_robot, example_robot_data
 
 mujoco = pytest.importorskip("mujoco")
 np = pytest.importorskip("numpy")
@@ -43,9 +43,11 @@ def hold_error(path: Path) -> tuple[int, float]:
     return int(m.nu), worst
 
 
-def convert(robot: Robot, folder: Path, actuators: str = "motor") -> tuple[Path, list]:
+def convert(robot: Robot, folder: Path, actuators: str | None = None) -> tuple[Path, list]:
+    """``robot`` written to MJCF in ``folder``, with ``--actuators`` default unless ``actuators``."""
     out = folder / f"{robot.name or 'model'}.xml"
-    notes = write(robot, out, options=WriteOptions(actuators=actuators), force=True)
+    options = WriteOptions() if actuators is None else WriteOptions(actuators=actuators)
+    notes = write(robot, out, options=options, force=True)
     return out, notes
 
 
@@ -188,7 +190,8 @@ def test_body_actuation_mode_becomes_an_actuator(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(("choice", "tags"), [("motor", ["motor"]), ("velocity", ["velocity"]),
-                                              ("position", ["position"]), ("none", [])])
+                                              ("position", ["position"]), ("none", []),
+                                              ("auto", ["motor"])])  # the pendulum's joint has no range
 def test_actuators_option_decides_for_a_source_without_any(tmp_path: Path, choice: str,
                                                            tags: list[str]) -> None:
     path = tmp_path / "pendulum.body"
@@ -201,6 +204,45 @@ def test_actuators_option_decides_for_a_source_without_any(tmp_path: Path, choic
     assert len([n for n in notes if n.code == "MK840"]) == (1 if choice in ("position", "velocity") else 0)
     m = mujoco.MjModel.from_xml_path(str(out))
     assert m.nu == len(tags)
+
+
+ARM_ON_WHEELS = """<robot name="arm_on_wheels">
+  <link name="base"><inertial><mass value="5"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="wheel"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><origin xyz="0 0 0.25"/><mass value="1"/>
+    <inertia ixx="0.02" iyy="0.02" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="slider"><inertial><mass value="0.5"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="wheel_joint" type="continuous"><parent link="base"/><child link="wheel"/><axis xyz="0 1 0"/>
+  </joint>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="arm"/><origin xyz="0 0 0.1"/>
+    <axis xyz="0 1 0"/><limit lower="-1.5" upper="1.5" effort="50" velocity="2"/></joint>
+  <joint name="lift" type="prismatic"><parent link="arm"/><child link="slider"/><origin xyz="0 0 0.5"/>
+    <axis xyz="0 0 1"/><limit lower="0" upper="0.2" effort="100" velocity="0.5"/></joint>
+</robot>
+"""
+
+
+def test_auto_servos_ranged_joints_and_leaves_endless_ones_free(tmp_path: Path) -> None:
+    """The default ``--actuators auto`` on a source without actuators: a position servo (with made-up
+    gains, MK840) on each joint with a range, a motor on the endless wheel joint; MK841 says so."""
+    path = tmp_path / "arm_on_wheels.urdf"
+    path.write_text(ARM_ON_WHEELS)
+    robot = load(path)
+    assert robot.actuators == []
+    out, notes = convert(robot, tmp_path / "out")
+    tags = {el.get("joint"): el.tag for el in actuator_elements(out)}
+    assert tags == {"wheel_joint": "motor", "shoulder": "position", "lift": "position"}
+    (said,) = [n for n in notes if n.code == "MK841"]
+    assert "2 <position> actuator(s) and 1 <motor> actuator(s)" in said.message
+    assert "--actuators auto" in said.message
+    assert len([n for n in notes if n.code == "MK840"]) == 2
+    m = mujoco.MjModel.from_xml_path(str(out))
+    assert m.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # servos: MK825
+    lift = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "lift")
+    assert tuple(m.actuator_ctrlrange[lift]) == (0.0, 0.2)  # the joint's range
 
 
 def test_made_up_gains_follow_the_rule(tmp_path: Path) -> None:
@@ -240,8 +282,9 @@ def test_ur5_holds_home_under_its_own_position_actuators(tmp_path: Path) -> None
 
 
 def test_panda_holds_its_reference_pose(tmp_path: Path) -> None:
-    """Panda (example-robot-data) has no transmissions: ``--actuators position`` gives one servo per
-    actuated joint (7 arm joints and finger 1; finger 2 mimics it); home = the SRDF's ``default`` state."""
+    """Panda (example-robot-data) has no transmissions: the default ``--actuators auto`` gives one position
+    servo per joint with a range (7 arm joints and finger 1; finger 2 mimics it); home = the SRDF's
+    ``default`` state."""
     robots = robots_dir()
     robot = load(robots / "panda_description" / "urdf" / "panda.urdf")
     pose = srdf_pose(robots / "panda_description" / "srdf" / "panda.srdf", "default")
@@ -252,10 +295,11 @@ def test_panda_holds_its_reference_pose(tmp_path: Path) -> None:
         if joint.mimic is not None:
             leader = by_name[joint.mimic.joint].initial_position
             joint.initial_position = joint.mimic.multiplier * leader + joint.mimic.offset
-    out, _ = convert(robot, tmp_path, "position")
+    out, _ = convert(robot, tmp_path)
     count, error = hold_error(out)
     actuated = [j for j in robot.joints if j.type.moves and j.mimic is None]
     assert count == len(actuated) == 8
+    assert [el.tag for el in actuator_elements(out)] == ["position"] * 8
     assert error < HOLD_TOLERANCE, f"Panda moved {error * 1e3:.3f} mm"
 
 
@@ -278,7 +322,8 @@ def test_fr3_holds_the_pose_its_ros2_control_starts_in(tmp_path: Path) -> None:
 
 
 def test_pa10_holds_home(tmp_path: Path) -> None:
-    """Choreonoid's PA10 (corpus): no actuation mode, so ``--actuators position``; rotor inertias are in
+    """Choreonoid's PA10 (corpus): no actuation mode, so the default ``--actuators auto`` servos every
+    joint (each has a range); rotor inertias are in
     the joints' armature, which the gain rule adds to the reflected inertia. Its zero pose stands
     upright (no gravity torque, nothing to hold), so home is bent: J2 30°, J4 60°, J6 30°."""
     path = CORPUS / "choreonoid" / "share" / "model" / "PA10" / "PA10.body"
@@ -288,11 +333,43 @@ def test_pa10_holds_home(tmp_path: Path) -> None:
     bent = {"J2": np.pi / 6, "J4": np.pi / 3, "J6": np.pi / 6}
     for joint in robot.joints:
         joint.initial_position = bent.get(joint.name, joint.initial_position)
-    out, _ = convert(robot, tmp_path, "position")
+    out, _ = convert(robot, tmp_path)
     count, error = hold_error(out)
     moving = [j for j in robot.joints if j.type.moves and j.mimic is None]
     assert count == len(moving)
+    assert {el.tag for el in actuator_elements(out)} == {"position"}
     assert error < HOLD_TOLERANCE, f"PA10 moved {error * 1e3:.3f} mm"
+
+
+# Every fixed-base arm of example-robot-data whose URDF names no actuators or position ones, with the
+# joints the default writes a servo for (the PR2 and Tiago carry continuous joints or wheels; Baxter,
+# Kinova and Z1 name effort interfaces: their motors are the source's answer).
+EXAMPLE_ARMS = {
+    "ur_description/urdf/ur3_robot.urdf": 6,
+    "ur_description/urdf/ur10_robot.urdf": 6,
+    "so_arm_description/urdf/so100.urdf": 6,
+    "so_arm_description/urdf/so101.urdf": 6,
+    "xarm_description/urdf/xarm7.urdf": 7,
+    "panda_description/urdf/panda.urdf": 8,
+    "talos_data/robots/talos_left_arm.urdf": 7,
+    "finger_edu_description/robots/finger_edu.urdf": 3,
+}
+
+
+@pytest.mark.parametrize("relative", sorted(EXAMPLE_ARMS))
+def test_every_example_arm_holds_home(tmp_path: Path, relative: str) -> None:
+    """The user's next step on an arm nobody here modelled: ``convert`` with the default options, load
+    the MJCF, reset to ``home`` (q = 0, put into range where it is not: MK845) and let it be. Position
+    servos on every ranged joint (``--actuators auto``), welded base (``--base auto``): within 1 mm."""
+    robot = load(example_robot(relative))
+    out, notes = convert(robot, tmp_path)
+    count, error = hold_error(out)
+    assert count == EXAMPLE_ARMS[relative]
+    assert {el.tag for el in actuator_elements(out)} == {"position"}
+    assert error < HOLD_TOLERANCE, f"{relative} moved {error * 1e3:.3f} mm"
+    if relative.endswith("panda.urdf"):  # joint 4's range [-3.07, -0.07] excludes q = 0
+        (moved,) = [n for n in notes if n.code == "MK845"]
+        assert moved.message.startswith("joint panda_joint4: home position 0 is outside its range")
 
 
 # -- other targets -----------------------------------------------------------------------------

@@ -97,3 +97,34 @@ def test_real_robots_are_written_clean_and_read_back_equal(source: str, tmp_path
         back_masses = {link.name: link.inertial.mass for link in back.links if link.inertial is not None}
         for name, mass in masses.items():
             assert back_masses.get(names.get(name, name)) == pytest.approx(mass, rel=1e-9), (target, name)
+
+
+def test_axis_dust_is_written_as_zero(tmp_path: Path) -> None:
+    """iCub's URDF (example-robot-data) writes hip axes as ``0 -1 6.12323e-17`` (a cosine of π/2): every
+    target writes ``0 -1 0``, and a real small component relative to the axis stays."""
+    from modelkit.convert.numbers import fmt_direction
+
+    assert fmt_direction([0.0, -1.0, 6.123233995736766e-17]) == "0 -1 0"
+    assert fmt_direction([0.0, -2.0, 1e-9]) == "0 -2 1e-9"  # 5e-10 of the length: not dust
+    source = tmp_path / "axis.urdf"
+    source.write_text("""<robot name="axis">
+  <link name="a"><inertial><mass value="1"/>
+    <inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="b"><inertial><mass value="1"/>
+    <inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 -1 6.12323e-17"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+""")
+    robot = validate(source).robot
+    assert robot is not None
+    where = ((".xml", "worldbody//joint"), (".urdf", "joint/axis"), (".sdf", "model/joint/axis/xyz"))
+    for suffix, path in where:
+        out = tmp_path / f"out{suffix}"
+        write(robot, out)
+        text = out.read_text()
+        assert "e-17" not in text, suffix
+        node = etree.parse(str(out)).getroot().find(path)
+        assert node is not None
+        value = node.get("axis") if suffix == ".xml" else node.get("xyz") if suffix == ".urdf" else node.text
+        assert value == "0 -1 0", suffix

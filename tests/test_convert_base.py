@@ -17,7 +17,7 @@ from modelkit.convert.api import convert
 from modelkit.convert.base import decide
 from modelkit.convert.options import WriteOptions
 from modelkit.model import JointType
-from tests.conftest import require_tool
+from tests.conftest import example_robot, require_tool
 from tests.test_sdf_reader import oracle_has_errors, sdf_oracle  # noqa: F401 (the fixture)
 
 DATA = Path(pybullet_data.getDataPath())
@@ -81,6 +81,19 @@ def test_robots_that_move_themselves_float(source: Path, why: str, tmp_path: Pat
     notes = _convert(source, fixed, "fixed")
     assert b"freejoint" not in fixed.read_bytes()
     assert any(c == "MK830" and "as asked" in m for c, m in notes)
+
+
+@pytest.mark.parametrize("side", ["left", "right"])
+def test_a_hand_on_its_palm_is_welded(side: str, tmp_path: Path) -> None:
+    """Allegro's hand (example-robot-data) has four limbs of four joints, which the legs rule would float;
+    three of them (the fingers) point up from the palm at q = 0, so they are not legs."""
+    source = example_robot(f"allegro_hand_description/urdf/allegro_{side}_hand.urdf")
+    out = tmp_path / "hand.xml"
+    notes = _convert(source, out)
+    assert b"freejoint" not in out.read_bytes()
+    decided = [m for c, m in notes if c == "MK830"]
+    assert len(decided) == 1 and "welded" in decided[0] and "3 limb(s) point up" in decided[0]
+    assert abs(_drop(out)) < 1e-9
 
 
 def test_decide_reports_feet_and_wheels() -> None:

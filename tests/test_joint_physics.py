@@ -13,6 +13,7 @@ import pytest
 
 from modelkit.api import validate
 from modelkit.convert.api import write
+from modelkit.convert.options import WriteOptions
 from modelkit.model import Box, Geom, Inertial, Joint, JointLimits, JointType, Link, Robot
 from modelkit.spatial import Pose
 
@@ -81,10 +82,11 @@ def test_home_keyframe_puts_the_arm_at_its_initial_position(tmp_path: Path) -> N
 
 
 def test_no_keyframe_without_initial_positions(tmp_path: Path) -> None:
+    """Motors and q = 0: nothing for a key to hold (position servos get one for their controls)."""
     robot = _robot()
     _joint(robot, "hinge").initial_position = 0.0
     out = tmp_path / "m.xml"
-    write(robot, out)
+    write(robot, out, options=WriteOptions(actuators="motor"))
     assert b"keyframe" not in out.read_bytes()
 
 

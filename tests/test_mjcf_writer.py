@@ -661,7 +661,7 @@ def test_mimic_becomes_joint_equality(tmp_path: Path) -> None:
     follower = _hinge("f", "base", "b")
     follower.mimic = Mimic("a", multiplier=-2.0, offset=0.25)
     robot = _chain(_hinge("a", "base", "a_link"), follower)
-    written = render(robot, tmp_path)
+    written = render(robot, tmp_path, options=WriteOptions(actuators="motor"))  # the leader's motor alone
     tree = etree.fromstring(written.data)
     (eq,) = tree.findall("equality/joint")
     assert (eq.get("joint1"), eq.get("joint2"), eq.get("polycoef")) == ("f", "a", "0.25 -2 0 0 0")

@@ -19,7 +19,9 @@ with a fixed joint, or no ``world`` link; .body: ``jointType: fixed|free``).
     touch the lowest level through two or more moving joints: floating;
   - legs that do not reach the ground at q = 0 (folded or sideways, as some quadrupeds are modelled):
     four or more limbs of two or more moving joints in a row hanging from the root's rigid body (four
-    legs, or two legs and two arms; an arm has one, a dual-arm torso two or three): floating;
+    legs, or two legs and two arms; an arm has one, a dual-arm torso two or three): floating. A limb
+    that points up at q = 0 (its links rise above its first joint by more than half its reach, as a
+    hand's fingers do) is not a leg: a hand on its palm is welded, not floated;
   - a robot without moving joints (an object: a cube, a mug) floats, as URDF's convention has it;
   - a robot without mass is welded (it cannot float in a simulator); one without any shape floats
     (nothing to judge by: URDF's own convention, so a URDF round trip keeps a floating root).
@@ -148,8 +150,10 @@ def decide(robot: Robot) -> BaseDecision:
     if not any(joint.type.moves for joint in robot.joints):
         return BaseDecision(JointType.FLOATING, "it has no moving joint (an object), so URDF's own "
                             "convention (a root that does not hang from `world` floats)")
-    limbs = _limbs(robot)
     poses = robot.world_poses()
+    every_limb = _limbs(robot)
+    limbs = [name for name in every_limb if not _points_up(robot, poses, name)]
+    raised = len(every_limb) - len(limbs)
     use_collisions = any(link.collisions for link in robot.links)
     lows: dict[str, tuple[float, float]] = {}
     for link in robot.links:
@@ -171,7 +175,8 @@ def decide(robot: Robot) -> BaseDecision:
     parent_joint = {joint.child: joint for joint in robot.joints}
     above = {name: _moving_above(parent_joint, name) for name in sorted(touching)}
     if any(not moving for moving in above.values()):
-        return _by_limbs(limbs, "the root's own body rests on the ground (an arm or a fixture)")
+        return _by_limbs(limbs, "the root's own body rests on the ground (an arm or a fixture"
+                         + (f"; {raised} limb(s) point up, as a hand's fingers do" if raised else "") + ")")
     wheels = _wheels(robot, poses, touching, use_collisions)
     if len(wheels) >= 2:
         shown = ", ".join(f'"{j.name}"' for j in wheels[:4]) + (" ..." if len(wheels) > 4 else "")
@@ -206,6 +211,29 @@ def _limbs(robot: Robot) -> list[str]:
             else:
                 body.append(joint.child)
     return sorted(joint.name for joint in starts if _depth(children, joint.child) >= 1)
+
+
+def _points_up(robot: Robot, poses: dict[str, Pose], first_joint: str) -> bool:
+    """Whether the limb below ``first_joint`` rises at q = 0: the highest of its link frames is above the
+    joint's frame by more than half the farthest one's distance from it (a hand's raised finger)."""
+    children = robot.children_of()
+    joint = next(j for j in robot.joints if j.name == first_joint)
+    start = poses.get(joint.child)
+    if start is None:
+        return False
+    origin = np.asarray(start.translation, dtype=float)
+    rise = reach = 0.0
+    stack, seen = [joint.child], set()
+    while stack:
+        name = stack.pop()
+        if name in seen or name not in poses:
+            continue
+        seen.add(name)
+        stack.extend(j.child for j in children.get(name, []))
+        offset = np.asarray(poses[name].translation, dtype=float) - origin
+        rise = max(rise, float(offset @ _UP))
+        reach = max(reach, float(np.linalg.norm(offset)))
+    return reach > 0.0 and rise > 0.5 * reach
 
 
 def _depth(children: dict[str, list[Joint]], link: str) -> int:

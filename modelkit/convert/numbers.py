@@ -78,6 +78,17 @@ def fmt_vec(values: Iterable[float] | np.ndarray) -> str:
                                               dtype=float).ravel())
 
 
+def fmt_direction(values: Iterable[float] | np.ndarray) -> str:
+    """A direction (a joint axis): each component within 1e-12 of the vector's length written as 0, as
+    a dimensionless rotation value would be (``0 -1 6.12323e-17`` → ``0 -1 0``: a cosine of π/2 that a
+    source's generator left in); the rest as :func:`fmt_vec`. The direction moves by at most 1e-12 rad."""
+    vector = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel()
+    length = float(np.linalg.norm(vector))
+    if length > 0.0 and math.isfinite(length):
+        vector = np.where(np.abs(vector) <= SNAP * length, 0.0, vector)
+    return fmt_vec(vector)
+
+
 def clean(value: float, tol: float = 1e-15) -> float:
     """``value`` with arithmetic dust below ``tol`` (absolute) set to exactly 0 (rotation matrices)."""
     return 0.0 if abs(value) < tol else float(value)

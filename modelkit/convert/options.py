@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 SDF_VERSIONS = ("1.6", "1.7", "1.8", "1.9", "1.10", "1.11")
 MESH_FORMATS = ("stl", "obj")
-ACTUATOR_CHOICES = ("motor", "position", "velocity", "none")  # where the source has no actuators
+ACTUATOR_CHOICES = ("auto", "motor", "position", "velocity", "none")  # where the source has no actuators
 GAZEBO_CHOICES = ("auto", "classic", "sim")  # convert.gazebo says what each means
 WHEEL_COLLISIONS = ("auto", "cylinder", "sphere", "ellipsoid")  # convert.wheels says what each means
 
@@ -32,6 +32,7 @@ class WriteOptions:
     gazebo: str = "auto"
     wheel_collision: str = "auto"  # auto|cylinder|sphere|ellipsoid: the wheels' collision (convert.wheels)
     base: str = "auto"  # fixed | floating | auto: how the root meets the world (modelkit/convert/base.py)
-    # actuators for a source without any (MJCF): motor (default) | position | velocity | none; the
-    # source's own actuators are always written as they are (docs/convert.md, "Actuators")
-    actuators: str = "motor"
+    # actuators for a source without any (MJCF): auto (default: a position servo on each joint with a
+    # range, a motor on each without) | motor | position | velocity | none; the source's own actuators
+    # are always written as they are (docs/convert.md, "Actuators")
+    actuators: str = "auto"

@@ -60,7 +60,9 @@ def _touching(mujoco: Any, xml: bytes, assets: dict[str, bytes]) -> Checked:
     data = mujoco.MjData(model)
     found: dict[tuple[int, int], tuple[float, set[str]]] = {}
     home = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "home")
-    states: list[tuple[str, Any]] = [("home", home)] if home >= 0 else [("q = 0", None)]
+    # a home key that is q = 0 (servo controls only) is named so: the user's "at rest" is q = 0 there
+    zero = home < 0 or bool((model.key_qpos[home] == model.qpos0).all())
+    states: list[tuple[str, Any]] = [("q = 0" if zero else "home", home if home >= 0 else None)]
     for label, key in states:
         if key is None:
             mujoco.mj_resetData(model, data)

@@ -129,6 +129,8 @@ default 50 iterations a motor under a skid turn's load stays unconverged (measur
 spin, 1 rad/s for 10 s: a roller 0.31 rad behind its target; at 400 within 0.004 rad). A URDF cannot
 carry it: MK809 says so."""
 
+TRACK_ROLLER = "track roller"  # the source_kind of the roller servos added here (not the source's)
+
 
 @dataclass(frozen=True)
 class TrackShape:
@@ -366,7 +368,7 @@ def _approximate(robot: Robot, joint: Joint, link: Link, notes: NoteSink) -> Non
             roller_joint.joint_id = joint.joint_id
             roller_joint.actuation_mode = joint.actuation_mode or "velocity"
             if robot.actuators:  # a source with actuators: the driven roller keeps its motor
-                robot.actuators.append(Actuator(joint_name, ActuatorKind.EFFORT, source_kind="track roller",
+                robot.actuators.append(Actuator(joint_name, ActuatorKind.EFFORT, source_kind=TRACK_ROLLER,
                                                 source=joint.source))
         else:
             roller_joint.mimic = Mimic(joint_names[0], 1.0, 0.0, joint.source)

@@ -67,6 +67,7 @@ from typing import Any
 
 import numpy as np
 
+from modelkit.convert.options import WriteOptions
 from modelkit.model import JointType, Robot
 from modelkit.verify.engines.protocol import Check, Skip
 from modelkit.verify.engines.registry import DEFAULT_ENGINES, ENGINES, INPUTS
@@ -77,6 +78,10 @@ Renames = dict[str, dict[str, str]]
 
 SUFFIX = {"mjcf": ".xml", "urdf": ".urdf", "sdf": ".sdf"}
 REPLAY = "modelkit.verify.layers.replay:replay_layer"
+# The options of the files layers 1-3 read (layer 4 reads convert's defaults): the engines weld the root
+# themselves (no URDF `world` link), sensors stay on their links (PyBullet reads a massless link as
+# 1 kg), and joints the source does not actuate get motors (zero control: the passive robot).
+ENGINE_FILES = WriteOptions(urdf_world_link=False, urdf_sensor_links=False, actuators="motor")
 INJECT = "modelkit.verify.layers.inject:apply"
 
 CONFIGURATIONS = 50  # layer 2: q = 0 and this many random configurations
@@ -97,7 +102,6 @@ def _reference(welded: Robot, report: VerifyReport) -> Robot:
     """The model the layers compare with: the source, or its track approximation (said in a Skip)."""
     from modelkit.convert.api import prepare
     from modelkit.convert.notes import NoteSink
-    from modelkit.convert.options import WriteOptions
     from modelkit.convert.registry import target_info
 
     notes = NoteSink()
@@ -120,7 +124,6 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
     """Write the files the engines read; ``written`` receives each written file's notes."""
     from modelkit.convert.api import output_stem, write
     from modelkit.convert.notes import renames
-    from modelkit.convert.options import WriteOptions
 
     files: dict[str, Path] = {}
     maps: dict[str, Renames] = {}
@@ -144,9 +147,10 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
         path = out_dir / f"{stem}{SUFFIX[fmt]}"
         # The engines weld the root themselves (fixed base): no URDF `world` link, the root is the base.
         # Sensors stay on their links: PyBullet reads a massless sensor link as 1 kg (MK816, MK847).
+        # Layers 1-3 compare the passive robot: motors (zero control, no force) where the source names
+        # no actuators, not the default's position servos, which pull every joint to its home pose.
         try:
-            notes = write(welded, path, fmt, WriteOptions(urdf_world_link=False, urdf_sensor_links=False),
-                          force=True)
+            notes = write(welded, path, fmt, ENGINE_FILES, force=True)
         except (FileExistsError, PermissionError) as exc:  # a symlink or an input where the file goes
             raise VerifyError(f"cannot write {path}: {exc}") from exc
         if written is not None:

@@ -9,8 +9,11 @@
   follower or a locked joint) is left out (MK842); a transmission reduction is folded into the joint
   (MK843).
 * A source without actuators: every hinge and slide that is not a mimic follower or locked gets the
-  ``--actuators`` kind (``motor`` by default: gear 1, the control is the joint force, ``ctrlrange`` =
-  ±effort; zero control applies no force, so the passive model is unchanged), or none (MK841).
+  ``--actuators`` kind, or none (MK841). ``auto`` (the default): a position servo on each joint with a
+  range (the model holds its ``home`` pose, as MuJoCo Menagerie's arms and legs do), a motor on each
+  joint without one (wheels: gear 1, the control is the joint force, ``ctrlrange`` = ±effort; zero
+  control leaves the joint free). The track approximation's roller servos do not count as the
+  source's: a tracked robot's other joints get the choice too.
 
 Position actuators make the ``home`` keyframe carry ``ctrl`` = the home positions (others 0), so that
 a model reset to ``home`` holds it.
@@ -22,7 +25,16 @@ import math
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.numbers import fmt, fmt_vec
-from modelkit.convert.servo_gains import SERVO_BANDWIDTH_HZ, position_gains, reflected_inertias, velocity_gain
+from modelkit.convert.servo_gains import (
+    SERVO_BANDWIDTH_HZ,
+    JointLoad,
+    joint_loads,
+    natural_frequency,
+    natural_frequency_for,
+    position_gains,
+    velocity_gain,
+)
+from modelkit.convert.tracks import TRACK_ROLLER
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, sub
 from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Robot
@@ -30,6 +42,7 @@ from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Robot
 ELEMENTS = {ActuatorKind.EFFORT: "motor", ActuatorKind.POSITION: "position",
             ActuatorKind.VELOCITY: "velocity"}
 CHOICES = {"motor": ActuatorKind.EFFORT, "position": ActuatorKind.POSITION, "velocity": ActuatorKind.VELOCITY}
+ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # MK841 lists kinds in this order
 
 
 class ActuatorWriter:
@@ -43,51 +56,82 @@ class ActuatorWriter:
         self.ctrl: list[float] = []  # the home keyframe's ctrl, one per written actuator
         self.any_position = False
         self.servos = 0  # position and velocity actuators written
-        self._inertias: dict[str, float] | None = None
+        self._loads: dict[str, JointLoad] | None = None
 
     def write(self, home: dict[str, float]) -> None:
         by_name: dict[str, Joint] = {}
         for each in self.robot.joints:
             by_name.setdefault(each.name, each)
-        if self.robot.actuators:
-            planned: list[tuple[Actuator, Joint | None]] = [
-                (a, by_name.get(a.joint)) for a in self.robot.actuators
-            ]
-            made_up = False
-        else:
-            kind = CHOICES.get(self.ctx.options.actuators)
-            planned = [] if kind is None else [
-                (Actuator(joint=j.name, kind=kind, source_kind="--actuators", source=j.source), j)
-                for j in self.robot.joints if j.type in (JointType.REVOLUTE, JointType.PRISMATIC)
-            ]
-            made_up = True
+        planned: list[tuple[Actuator, Joint | None]] = [
+            (a, by_name.get(a.joint)) for a in self.robot.actuators
+        ]
+        # The track approximation's roller servos are the writer's, not the source's: the rest of a
+        # tracked robot is as silent as any other source (convert.tracks).
+        made_up = not any(a.source_kind != TRACK_ROLLER for a in self.robot.actuators)
+        chosen: list[Actuator] = []
+        if made_up:
+            taken = {a.joint for a in self.robot.actuators}
+            for free in self.robot.joints:
+                kind = self._chosen_kind(free)
+                if kind is not None and free.name not in taken:
+                    chosen.append(Actuator(joint=free.name, kind=kind, source_kind="--actuators",
+                                           source=free.source))
+            planned += [(a, by_name.get(a.joint)) for a in chosen]
         skipped = self._constrained()
-        written = 0
+        written: dict[ActuatorKind, int] = {}
         for actuator, joint in planned:
             target = self.joint_names.get(actuator.joint)
             reason = self._unwritable(joint, target, skipped)
             if reason is not None:
-                if not made_up:
+                if actuator.source_kind != "--actuators":
                     self.ctx.note("MK842", f"actuator on joint {actuator.joint} left out: {reason}",
                                   actuator.source, "actuator")
                 continue
             assert joint is not None and target is not None
             self._one(actuator, joint, target[0], home.get(target[0], 0.0))
-            written += 1
+            if actuator.source_kind == "--actuators":
+                written[actuator.kind] = written.get(actuator.kind, 0) + 1
         self._uncanonical()
         movable = any(j.type in (JointType.REVOLUTE, JointType.PRISMATIC) for j in self.robot.joints)
         if made_up and movable:
-            choice = self.ctx.options.actuators
-            element = ELEMENTS.get(CHOICES.get(choice, ActuatorKind.EFFORT))
-            what = "no actuators" if choice == "none" else f"{written} <{element}> actuator(s)"
-            self.ctx.note("MK841", f"the source names no actuators: {what} written (--actuators {choice})",
-                          self.robot.source, "actuator")
+            self._said_choice(written)
+
+    def _chosen_kind(self, joint: Joint) -> ActuatorKind | None:
+        """The ``--actuators`` kind of a joint the source does not actuate (None: no actuator).
+
+        ``auto``: a position servo on a joint with a finite range, so the written model holds its home
+        pose as MuJoCo Menagerie's arms and legs do; a motor on a joint without one (wheels, casters,
+        endless spindles), whose zero control leaves it free as the source has it."""
+        if joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
+            return None
+        choice = self.ctx.options.actuators
+        if choice == "auto":
+            lower, upper = joint.limits.lower, joint.limits.upper
+            ranged = math.isfinite(lower) and math.isfinite(upper) and lower < upper
+            return ActuatorKind.POSITION if ranged else ActuatorKind.EFFORT
+        return CHOICES.get(choice)
+
+    def _said_choice(self, written: dict[ActuatorKind, int]) -> None:
+        """MK841: the source names no actuators, what ``--actuators`` wrote instead."""
+        choice = self.ctx.options.actuators
+        if choice == "none":
+            what = "no actuators"
+        elif not written:
+            what = "no actuators (no hinge or slide that is free to drive)"
+        else:
+            what = " and ".join(f"{count} <{ELEMENTS[kind]}> actuator(s)" for kind, count in
+                                sorted(written.items(), key=lambda item: ORDER.index(item[0])))
+            if choice == "auto":
+                what += (": a position servo on each joint with a range (the home keyframe holds), a motor "
+                         "on each joint without one (zero control leaves it free)")
+        self.ctx.note("MK841", f"the source names no actuators: {what} written (--actuators {choice})",
+                      self.robot.source, "actuator")
 
     def _uncanonical(self) -> None:
         """MK842 for an MJCF source's actuators that the model could not hold (activation dynamics,
         tendon or site transmissions, other gain and bias laws): they are not written."""
         kept = self.robot.extras.get("mjcf_actuators") or []
-        canonical = sum(1 for a in self.robot.actuators if a.source_kind != "track roller")
+        canonical = sum(1 for a in self.robot.actuators if a.source_kind != TRACK_ROLLER)
         left = len(kept) - canonical
         if left > 0:
             self.ctx.note(
@@ -112,10 +156,10 @@ class ActuatorWriter:
             return "the joint follows another (mimic) or is locked"
         return None
 
-    def inertia(self, joint: Joint) -> float:
-        if self._inertias is None:
-            self._inertias = reflected_inertias(self.robot)
-        return self._inertias.get(joint.name, 0.0)
+    def load(self, joint: Joint) -> JointLoad:
+        if self._loads is None:
+            self._loads = joint_loads(self.robot)
+        return self._loads.get(joint.name, JointLoad(0.0))
 
     def _one(self, actuator: Actuator, joint: Joint, target: str, home_q: float) -> None:
         kind = actuator.kind
@@ -165,26 +209,34 @@ class ActuatorWriter:
         kp, kv = actuator.kp, actuator.kv
         if actuator.kind is ActuatorKind.POSITION:
             if kp is None:
-                inertia = self.inertia(joint)
-                kp, rule_kv = position_gains(inertia)
+                load = self.load(joint)
+                kp, rule_kv = position_gains(load)
                 kv = rule_kv if kv is None else kv
-                self._made_up(actuator, joint, target, inertia, f"kp {fmt(kp)}, kv {fmt(kv)}")
+                self._made_up(actuator, joint, target, load, f"kp {fmt(kp)}, kv {fmt(kv)}",
+                              natural_frequency_for(load))
             el.set("kp", fmt(kp))
             if kv:
                 el.set("kv", fmt(kv))
         else:
             if kv is None:
-                inertia = self.inertia(joint)
-                kv = velocity_gain(inertia)
-                self._made_up(actuator, joint, target, inertia, f"kv {fmt(kv)}")
+                load = self.load(joint)
+                kv = velocity_gain(load)
+                self._made_up(actuator, joint, target, load, f"kv {fmt(kv)}", natural_frequency())
             el.set("kv", fmt(kv))
 
-    def _made_up(self, actuator: Actuator, joint: Joint, target: str, inertia: float, gains: str) -> None:
+    def _made_up(self, actuator: Actuator, joint: Joint, target: str, load: JointLoad, gains: str,
+                 wn: float) -> None:
         unit = "kg" if joint.type is JointType.PRISMATIC else "kg·m²"
+        hz = wn / (2.0 * math.pi)
+        why = f"a {fmt(SERVO_BANDWIDTH_HZ)} Hz critically damped servo"
+        if hz > SERVO_BANDWIDTH_HZ * (1.0 + 1e-9):
+            force = "N" if joint.type is JointType.PRISMATIC else "N·m"
+            why = (f"a critically damped servo raised to {hz:.1f} Hz against the gravity load "
+                   f"{load.gravity:.3g} {force} at home (docs/convert.md)")
         self.ctx.note(
             "MK840",
             f"{actuator.kind.value} actuator on joint {joint.name}: {gains} from its reflected inertia "
-            f"{fmt(inertia)} {unit} at home and a {fmt(SERVO_BANDWIDTH_HZ)} Hz critically damped servo "
+            f"{fmt(load.inertia)} {unit} at home and {why} "
             f"(the source{' ' + actuator.source_kind if actuator.source_kind else ''} gives no gains)",
             actuator.source or joint.source,
             f"actuator[{target}]",

@@ -32,7 +32,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.numbers import fmt, fmt_direction, fmt_vec
+from modelkit.convert.servo_gains import home_position
 from modelkit.formats.mjcf.write_chains import Chain, ChainFinder, shifted
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_geoms import GeomWriter
@@ -332,7 +333,7 @@ class BodyTree:
             return True
         el = sub(body, "joint", name=name, type="hinge" if kind is JointType.REVOLUTE else "slide")
         self._anchor(el, anchor)
-        el.set("axis", fmt_vec(joint.axis))
+        el.set("axis", fmt_direction(joint.axis))
         self.scalar_joints.append(name)
         limits = joint.limits
         if math.isfinite(limits.lower) and math.isfinite(limits.upper) and limits.lower < limits.upper:
@@ -364,9 +365,26 @@ class BodyTree:
                 target,
             )
         self._dynamics(el, joint, target)
-        if joint.initial_position:
-            self.home[name] = joint.initial_position  # the `home` keyframe (writer.py)
+        home = self._home_in_range(joint, target)
+        if home:
+            self.home[name] = home  # the `home` keyframe (writer.py)
         return True
+
+    def _home_in_range(self, joint: Joint, target: str) -> float:
+        """The joint's home position, at the nearest limit when it lies outside the written range (MK845):
+        there the joint's own limit would push it, and a position servo (whose control range is the
+        joint's) can hold it."""
+        nearest = home_position(joint)
+        if nearest != joint.initial_position:
+            limits = joint.limits
+            self.ctx.note(
+                "MK845",
+                f"joint {joint.name}: home position {fmt(joint.initial_position)} is outside its range "
+                f"[{fmt(limits.lower)}, {fmt(limits.upper)}]; the home keyframe puts it at {fmt(nearest)}",
+                joint.loc("limits"),
+                target,
+            )
+        return nearest
 
     @staticmethod
     def _anchor(el: Element, anchor: np.ndarray | None) -> None:
@@ -384,7 +402,7 @@ class BodyTree:
         for suffix, kind, axis in (("_tx", "slide", u), ("_ty", "slide", v), ("_rz", "hinge", normal)):
             target = f"body[{body_name}]/joint[{joint.name}{suffix}]"
             name = self.names.claim("joint", joint.name + suffix, joint.loc("name"), target, note=False)
-            el = sub(body, "joint", name=name, type=kind, axis=fmt_vec(axis))
+            el = sub(body, "joint", name=name, type=kind, axis=fmt_direction(axis))
             self._dynamics(el, joint, target)
             written.append(name)
         self.joint_names[joint.name] = written

@@ -38,7 +38,7 @@ from lxml.etree import _Element as Element
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.gazebo import gazebo_family
-from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.numbers import fmt, fmt_direction, fmt_vec
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
 from modelkit.formats.sdf.write_geometry import GeomWriter
 from modelkit.formats.sdf.write_names import Names
@@ -417,7 +417,7 @@ class _ModelWriter:
         axis = sub(el, "axis")
         vec = np.asarray(joint.axis, dtype=float)
         norm = float(np.linalg.norm(vec))
-        sub(axis, "xyz", fmt_vec(vec / norm if norm > 0 else vec))
+        sub(axis, "xyz", fmt_direction(vec / norm if norm > 0 else vec))
         lim = joint.limits
         limited = joint.type is JointType.PRISMATIC or lim.position_limited
         finite_rates = math.isfinite(lim.effort) or math.isfinite(lim.velocity)
@@ -494,7 +494,7 @@ class _ModelWriter:
         if kind in ("revolute", "prismatic"):
             axis = sub(el, "axis")
             vec = np.asarray(loop.axis, dtype=float)
-            sub(axis, "xyz", fmt_vec(vec / float(np.linalg.norm(vec))))
+            sub(axis, "xyz", fmt_direction(vec / float(np.linalg.norm(vec))))
             limit = sub(axis, "limit")
             num(limit, "lower", -UNLIMITED)
             num(limit, "upper", UNLIMITED)

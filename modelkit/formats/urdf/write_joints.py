@@ -22,7 +22,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.numbers import fmt, fmt_direction
 from modelkit.formats.urdf.write_links import origin_element
 from modelkit.formats.urdf.write_names import NameTable
 from modelkit.model import Joint, JointLimits, JointType
@@ -129,7 +129,7 @@ def _extras(parent: Element, joint: Joint) -> None:
 def _axis(joint: Joint) -> str:
     axis = np.asarray(joint.axis, dtype=float)
     norm = float(np.linalg.norm(axis))
-    return fmt_vec(axis / norm if norm > 0.0 else axis)
+    return fmt_direction(axis / norm if norm > 0.0 else axis)
 
 
 def joint_elements(
@@ -219,7 +219,7 @@ def _ball(
         origin_element(el, joint.origin if i == 0 else Pose())
         etree.SubElement(el, "parent", link=links[i])
         etree.SubElement(el, "child", link=links[i + 1])
-        etree.SubElement(el, "axis", xyz=fmt_vec(axis))
+        etree.SubElement(el, "axis", xyz=fmt_direction(axis))
         _dynamics(el, joint)
         out.append(el)
     extra_links.extend(links[1:3])
