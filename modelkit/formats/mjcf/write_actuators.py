@@ -121,10 +121,11 @@ class ActuatorWriter:
         else:
             what = " and ".join(f"{count} <{ELEMENTS[kind]}> actuator(s)" for kind, count in
                                 sorted(written.items(), key=lambda item: ORDER.index(item[0])))
-            if choice == "auto":
-                what += (": a position servo on each joint with a range (the home keyframe holds), a motor "
-                         "on each joint without one (zero control leaves it free)")
-        self.ctx.note("MK841", f"the source names no actuators: {what} written (--actuators {choice})",
+        why = ""
+        if choice == "auto":
+            why = ("; auto puts a position servo on each joint with a range (the home keyframe holds) and a "
+                   "motor on each joint without one (zero control leaves it free)")
+        self.ctx.note("MK841", f"the source names no actuators: {what} written (--actuators {choice}{why})",
                       self.robot.source, "actuator")
 
     def _uncanonical(self) -> None:
