@@ -338,3 +338,61 @@ def test_hung_child_times_out_and_is_killed(pantilt: Converted) -> None:
         assert model._worker.proc.poll() is not None
     finally:
         model.close()
+
+
+# ---- children started ahead of need (verify's prestart) ------------------------------------------
+
+
+def test_a_prestarted_child_is_taken_and_answers_as_a_fresh_one(pantilt: Converted) -> None:
+    engine_pybullet.discard_spares()
+    engine_pybullet.prestart(1)
+    started = engine_pybullet._SPARES[0].proc.pid
+    root = str(pantilt.robot.root)
+    taken = engine_pybullet.load(pantilt.urdf, pantilt.urdf_renames, root=root)
+    fresh = engine_pybullet.load(pantilt.urdf, pantilt.urdf_renames, root=root)
+    try:
+        assert taken._worker.proc.pid == started  # the adapter did not start a child of its own
+        assert fresh._worker.proc.pid != started
+        q = random_configuration(pantilt.robot, np.random.default_rng(3))
+        assert np.array_equal(taken.mass_matrix(q), fresh.mass_matrix(q))
+        assert np.array_equal(taken.bias(q, q), fresh.bias(q, q))
+        for link, pose in taken.link_poses(q).items():
+            other = fresh.link_poses(q)[link]
+            assert np.array_equal(pose.rotation, other.rotation)
+            assert np.array_equal(pose.translation, other.translation)
+    finally:
+        taken.close()
+        fresh.close()
+
+
+def test_spares_nobody_took_are_ended() -> None:
+    engine_pybullet.discard_spares()
+    engine_pybullet.prestart(2)
+    procs = [w.proc for w in engine_pybullet._SPARES]
+    assert engine_pybullet.discard_spares() == 2
+    assert engine_pybullet._SPARES == []
+    assert all(proc.poll() is not None for proc in procs)
+
+
+def test_verify_ends_the_started_children_nobody_took(tmp_path: Path,
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """verify starts PyBullet's children ahead of need (here: layers 1-3's and the replay's; none for
+    layer 4, which does not run) and ends, when it returns, any that no adapter took: here one
+    more, started before the run."""
+    from modelkit.verify.api import verify
+
+    started: list[Any] = []
+    real = engine_pybullet.Worker.__init__
+
+    def recording(self: Any) -> None:
+        real(self)
+        started.append(self.proc)
+
+    monkeypatch.setattr(engine_pybullet.Worker, "__init__", recording)
+    engine_pybullet.discard_spares()
+    engine_pybullet.prestart(1)  # one child too many: verify's adapters leave one of three untaken
+    report = verify(PANTILT, tmp_path / "out", engines=("mujoco", "pybullet"), driven=False)
+    assert not report.errors
+    assert len(started) == 3
+    assert engine_pybullet._SPARES == []
+    assert all(proc.poll() is not None for proc in started)
