@@ -258,11 +258,8 @@ def verify(
         report.parameters["reading"] = dict(reading)
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="modelkit-verify-") as tmp:
-            try:
-                _run(report, Path(source), Path(tmp), engines, mjcf, urdf, sdf, inject, seed,
-                     configurations, samples, replay, scenario, driven, progress or _silent, reading)
-            finally:
-                _discard_spares()
+            _run(report, Path(source), Path(tmp), engines, mjcf, urdf, sdf, inject, seed,
+                 configurations, samples, replay, scenario, driven, progress or _silent, reading)
             return report
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -274,7 +271,6 @@ def verify(
         _run(report, Path(source), out, engines, mjcf, urdf, sdf, inject, seed, configurations, samples,
              replay, scenario, driven, progress or _silent, reading)
     finally:
-        _discard_spares()
         if report.prepared is not None and report.errors:  # no report to write (many.save)
             report.prepared.close()
             report.prepared = None
@@ -283,58 +279,6 @@ def verify(
 
 def _silent(_: str) -> None:
     return None
-
-
-PYBULLET_ADAPTER = "modelkit.verify.engines.pybullet"
-
-
-def _prestart_pybullet(count: int) -> None:
-    """Start ``count`` PyBullet child processes now (they import PyBullet while this process reads,
-    converts or replays), for the adapters that come next; nothing when PyBullet is not installed."""
-    from modelkit.verify.engines.registry import MODULES, _installed
-
-    if count > 0 and _installed(MODULES["pybullet"]):
-        _resolve(f"{PYBULLET_ADAPTER}:prestart")(count)
-
-
-def _discard_spares() -> None:
-    """End the PyBullet children started ahead of need that no adapter took."""
-    import sys
-
-    adapter = sys.modules.get(PYBULLET_ADAPTER)
-    if adapter is not None:
-        adapter.discard_spares()
-
-
-def _has_dynamics(reference: Robot) -> bool:
-    """Whether layer 3 has dynamics to verify (see the skips in :func:`_layers_1_to_3`)."""
-    from modelkit.verify.engines.reference import dof_joints
-    from modelkit.verify.layers import dynamics
-
-    return not dynamics.kinematic_only(reference) and bool(dof_joints(reference))
-
-
-def _find_drive(robot: Robot, chosen: Any) -> Any:
-    """Layer 4's drive of ``robot`` (:func:`modelkit.verify.drive.vehicle.find_drive`), or the
-    ``ValueError`` saying why the robot has none."""
-    from modelkit.verify.drive import scenario as scenarios
-    from modelkit.verify.drive import vehicle
-
-    try:
-        return vehicle.find_drive(robot, chosen or scenarios.default_scenario())
-    except ValueError as exc:
-        return exc
-
-
-def _layer4_children(drive: Any, engines: Sequence[str], chosen: Any) -> int:
-    """How many PyBullet children layer 4 will start for this drive: one per verification variant
-    (the graded one, and the report-only native-wheel one when the scenario asks for it)."""
-    from modelkit.verify.drive import scenario as scenarios
-
-    if isinstance(drive, ValueError) or "pybullet" not in engines:
-        return 0
-    scenario = chosen or scenarios.default_scenario(drive.kind, bool(drive.pan or drive.tilt))
-    return 1 + int(bool(scenario.native_report) and scenario.wheel_proxy == "sphere")
 
 
 def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str], mjcf: str | Path | None,
@@ -351,16 +295,9 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
             report.errors.extend(f"--scenario: {render_text(d)}" for d in diagnostics)
             return
     progress(f"reading and converting {source.name}; layers 1-3 (static, kinematics, dynamics)")
-    found: list[Any] = []  # layer 4's drive (or why there is none), found before the replay
-
-    def before_replay(robot: Robot) -> None:
-        if driven and not found:
-            found.append(_find_drive(robot, chosen))
-            _prestart_pybullet(_layer4_children(found[0], engines, chosen))  # they start during the replay
-
     try:
         robot = _layers_1_to_3(report, source, out_dir, engines, mjcf, urdf, sdf, inject, seed,
-                               configurations, samples, replay, reading, before_replay)
+                               configurations, samples, replay, reading)
     except VerifyError as exc:
         report.errors.append(str(exc))
         return
@@ -372,20 +309,21 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
     progress("layer 4: driving the robot in MuJoCo and PyBullet")
     if report.prepared is not None:  # the plotting processes import matplotlib while layer 4 runs
         report.prepared.start_plotters()
-    drive = found[0] if found else _find_drive(robot, chosen)
-    _layer4(report, robot, out_dir, engines, inject, chosen, drive)
+    _layer4(report, robot, out_dir, engines, inject, chosen)
 
 
 def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence[str], inject: Sequence[str],
-            chosen: Any, drive: Any) -> None:
+            chosen: Any) -> None:
     """Layer 4: the source driven by the seed's controllers in MuJoCo and PyBullet, on a floor;
-    ``chosen``: the scenario read from the user's file (None: the built-in one); ``drive``: what
-    :func:`_find_drive` found."""
+    ``chosen``: the scenario read from the user's file (None: the built-in one)."""
     from modelkit.verify.drive import scenario as scenarios
+    from modelkit.verify.drive import vehicle
     from modelkit.verify.layers import layer4
 
-    if isinstance(drive, ValueError):
-        report.skips.append(Skip(4, "all", f"layer 4 (driven scenarios) not run: {drive}"))
+    try:
+        drive = vehicle.find_drive(robot, chosen or scenarios.default_scenario())
+    except ValueError as exc:
+        report.skips.append(Skip(4, "all", f"layer 4 (driven scenarios) not run: {exc}"))
         return
     chosen = chosen or scenarios.default_scenario(drive.kind, bool(drive.pan or drive.tilt))
     t0 = time.perf_counter()
@@ -405,23 +343,17 @@ def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence
 def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str],
                    mjcf: str | Path | None, urdf: str | Path | None, sdf: str | Path | None,
                    inject: Sequence[str], seed: int, configurations: int, samples: int, replay: bool,
-                   reading: Mapping[str, Any] | None = None,
-                   before_replay: Callable[[Robot], None] | None = None) -> Robot | None:
-    """Layers 1–3 on the welded model; returns the source model as read (None when nothing ran).
-    ``before_replay(robot)`` runs after layer 3a, whether or not the replay runs."""
+                   reading: Mapping[str, Any] | None = None) -> Robot | None:
+    """Layers 1–3 on the welded model; returns the source model as read (None when nothing ran)."""
     from modelkit.verify.engines.reference import SourceModel, dof_joints, source_static
     from modelkit.verify.layers import approximations, dynamics, kinematics, shapes, static
 
     t0 = time.perf_counter()
-    if "pybullet" in engines:  # its child for layers 1-3 imports PyBullet while this process reads
-        _prestart_pybullet(1)
     try:
         robot = read_robot(source, reading)
         report.robot = robot.name
         welded, report.base = welded_copy(robot)
         reference = _reference(welded, report)
-        if replay and {"mujoco", "pybullet"} <= set(engines) and _has_dynamics(reference):
-            _prestart_pybullet(1)  # the replay's, started while this process converts and loads
         given = {"mjcf": Path(mjcf) if mjcf else None, "urdf": Path(urdf) if urdf else None,
                  "sdf": Path(sdf) if sdf else None}
         needed = {INPUTS[e] for e in engines if e in INPUTS} - {"robot"}
@@ -505,8 +437,6 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
             except NotImplementedError:
                 report.skips.append(dynamics.no_dynamics(eng))
     t5 = time.perf_counter()
-    if before_replay is not None:
-        before_replay(robot)
     if replay:
         _replay(reference, files, maps, loaded, report, approx)
     t6 = time.perf_counter()

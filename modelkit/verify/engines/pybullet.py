@@ -25,7 +25,6 @@ the child link frame with the child's inertial orientation.
 
 from __future__ import annotations
 
-import atexit
 import math
 import os
 import pickle
@@ -34,7 +33,6 @@ import struct
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 from typing import IO, Any
@@ -185,14 +183,6 @@ class Worker:
             self.proc.kill()
             self.proc.wait(timeout=5)
 
-    def discard(self) -> None:
-        """End a child that was never asked anything (a spare): no reply to wait for."""
-        self.kill()
-        for stream in (self.proc.stdin, self.proc.stdout):
-            if stream is not None:
-                stream.close()
-        self._stderr.close()
-
     def close(self) -> None:
         if self.proc.poll() is None:
             try:
@@ -204,54 +194,6 @@ class Worker:
             if stream is not None:
                 stream.close()
         self._stderr.close()
-
-
-# ---- child processes started ahead of need -------------------------------------------------------
-# A child costs a process start and PyBullet's import before it answers (a third of a second of CPU,
-# on the critical path when the adapter waits for its first reply). ``verify`` knows which adapters
-# come (layers 1-3, the replay, layer 4's variants) and calls :func:`prestart` while its own process
-# works on something else (reading, converting, the replay); the next adapter takes a started child
-# instead of starting one. A started child is the same as a fresh one (it has imported PyBullet and
-# nothing else; every adapter connects its own client), so the numbers do not change.
-
-_SPARES: list[Worker] = []
-_SPARES_LOCK = threading.Lock()
-
-
-def prestart(count: int = 1) -> None:
-    """Start ``count`` more child processes now, for the next adapters to take (:func:`discard_spares`
-    ends those left over)."""
-    for _ in range(count):
-        try:
-            worker = Worker()
-        except OSError:  # the adapter will start its own (and say why it cannot)
-            return
-        with _SPARES_LOCK:
-            _SPARES.append(worker)
-
-
-def take_worker() -> Worker:
-    """A child started by :func:`prestart` that is still alive, else a new one."""
-    while True:
-        with _SPARES_LOCK:
-            worker = _SPARES.pop(0) if _SPARES else None
-        if worker is None:
-            return Worker()
-        if worker.proc.poll() is None:
-            return worker
-        worker.discard()
-
-
-def discard_spares() -> int:
-    """End the started children nobody took; returns how many."""
-    with _SPARES_LOCK:
-        left, _SPARES[:] = list(_SPARES), []
-    for worker in left:
-        worker.discard()
-    return len(left)
-
-
-atexit.register(discard_spares)
 
 
 class PyBulletModel:
@@ -269,7 +211,7 @@ class PyBulletModel:
         self.timeout = timeout
         self.dt = dt
         self.last_replay_wall = math.nan
-        self._worker = take_worker()
+        self._worker = Worker()
         try:
             info = self._worker.request("load", timeout=timeout, path=str(Path(urdf).resolve()),
                                         gravity=GRAVITY, dt=dt)
@@ -567,7 +509,7 @@ class PyBulletDriver:
         for rollers in drive.rollers.values():
             for j in rollers:
                 joint_names.setdefault(j, j)
-        self._worker = take_worker()
+        self._worker = Worker()
         self._pending: tuple[int, list[Any], Any, Any] | None = None
         try:
             info = self._worker.request(
