@@ -2,12 +2,15 @@
 at once, each engine's load, the replay's overhead.
 
     python bench/bench_verify.py [--repeat N] [--many-repeat M] [--no-many] [--json FILE] [--source MODEL]
+                                 [--as-is] [--only-command]
 
 (a) `modelkit verify MODEL -o DIR` in a fresh process (N runs after a warm-up, taking turns): all four
     layers and the report (report.json, report.html with its plots and pictures), with every engine
     (the default) and with the default install's engines (MuJoCo, PyBullet, Pinocchio), and both
-    without the replay (`--no-replay`: layers 1-3a + 4). Median/min/max wall time, and the median of
-    each phase as the command prints it ("wall time: convert …, load …, layer 1 …, layer 4 …").
+    without the replay (`--no-replay`: layers 1-3a + 4). Median/min/max wall time, the median CPU
+    time (user + system of the command and every child it waited for), and the median of each phase
+    as the command prints it ("wall time: convert …, load …, layer 1 …, layer 4 …"). With Python's
+    bytecode cache on in a temporary PYTHONPYCACHEPREFIX (as after a pip install), unless --as-is.
     The issue's target: the full verify of the tutorial pan-tilt robot under 5 s on a 2-core machine
     (part 1's: layers 1-3 under 3 s). The machine's load average is printed with the figures.
 (b) Layer 4's harness overhead (`modelkit.verify.bench.bench`) per profile of the default scenario:
@@ -32,6 +35,7 @@ import argparse
 import json
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -75,10 +79,27 @@ print(json.dumps({{"import": t2 - t1, "load": t4 - t3}}))
 """
 
 
-def fresh(cmd: list[str]) -> tuple[float, str]:
+def cached_bytecode_env(prefix: Path) -> dict[str, str]:
+    """The environment with Python's bytecode cache on, kept under ``prefix`` (PYTHONPYCACHEPREFIX,
+    nothing written into the source tree): what a user's ``pip install`` gives. This development
+    environment sets PYTHONDONTWRITEBYTECODE and modelkit is an editable install without
+    ``__pycache__``, so as is every process of a verify run (the command, PyBullet's children, the
+    plotting and picture processes) compiles modelkit's sources again."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    env["PYTHONPYCACHEPREFIX"] = str(prefix)
+    return env
+
+
+def fresh(cmd: list[str], env: dict[str, str] | None = None) -> tuple[float, str, float]:
+    """Wall seconds, stdout, and CPU seconds (user + system) of the command and every child process
+    it waited for (PyBullet's, the plotting and picture processes)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    return time.perf_counter() - start, done.stdout
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, done.stdout, cpu
 
 
 def phases(stdout: str) -> dict[str, float]:
@@ -92,7 +113,7 @@ def summary(values: list[float]) -> dict[str, float]:
     return {"median_s": statistics.median(values), "min_s": min(values), "max_s": max(values)}
 
 
-def bench_command(source: Path, repeat: int) -> dict[str, Any]:
+def bench_command(source: Path, repeat: int, env: dict[str, str] | None = None) -> dict[str, Any]:
     jobs = {
         "every engine": [],
         "every engine, --no-replay": ["--no-replay"],
@@ -100,17 +121,19 @@ def bench_command(source: Path, repeat: int) -> dict[str, Any]:
         f"{DEFAULT_INSTALL}, --no-replay": ["--engines", DEFAULT_INSTALL, "--no-replay"],
     }
     walls: dict[str, list[float]] = {k: [] for k in jobs}
+    cpus: dict[str, list[float]] = {k: [] for k in jobs}
     split: dict[str, list[dict[str, float]]] = {k: [] for k in jobs}
     codes: dict[str, str] = {}
     with tempfile.TemporaryDirectory() as tmp:
         cmds = {name: [str(MODELKIT), "verify", str(source), "-o", str(Path(tmp) / f"r{i}"), *extra]
                 for i, (name, extra) in enumerate(jobs.items())}
         for cmd in cmds.values():
-            fresh(cmd)  # warm-up
+            fresh(cmd, env)  # warm-up (and the bytecode cache)
         for _ in range(repeat):
             for name, cmd in cmds.items():
-                wall, out = fresh(cmd)
+                wall, out, cpu = fresh(cmd, env)
                 walls[name].append(wall)
+                cpus[name].append(cpu)
                 split[name].append(phases(out))
                 codes[name] = next((ln for ln in out.splitlines() if ln.startswith(("PASS", "FAIL"))), "?")
     result: dict[str, Any] = {}
@@ -118,6 +141,7 @@ def bench_command(source: Path, repeat: int) -> dict[str, Any]:
         keys = sorted({k for s in split[name] for k in s}, key=lambda k: list(split[name][0]).index(k)
                       if split[name] and k in split[name][0] else 99)
         result[name] = {**summary(walls[name]), "verdict": codes[name],
+                        "cpu_median_s": statistics.median(cpus[name]),
                         "phases_median_s": {k: statistics.median(s.get(k, 0.0) for s in split[name])
                                             for k in keys}}
     return result
@@ -222,18 +246,31 @@ def main() -> int:
     parser.add_argument("--source", type=Path, default=PANTILT)
     parser.add_argument("--many-repeat", type=int, default=3, help="runs of each -j for (c)")
     parser.add_argument("--no-many", action="store_true", help="leave (c) out")
+    parser.add_argument("--as-is", action="store_true",
+                        help="(a) in the environment as it is (no bytecode cache when it sets "
+                             "PYTHONDONTWRITEBYTECODE), not with a bytecode cache as after a pip install")
+    parser.add_argument("--only-command", action="store_true", help="(a) only")
     args = parser.parse_args()
     source = args.source.resolve()
     figures: dict[str, Any] = {"source": source.name, "repeat": args.repeat,
-                               "cores": len(os.sched_getaffinity(0)), "load_average_before": load_average()}
-    figures["command"] = bench_command(source, args.repeat)
+                               "cores": len(os.sched_getaffinity(0)), "load_average_before": load_average(),
+                               "bytecode": "as is" if args.as_is else "cached (PYTHONPYCACHEPREFIX)"}
+    with tempfile.TemporaryDirectory(prefix="modelkit-bench-pycache-") as prefix:
+        figures["command"] = bench_command(source, args.repeat,
+                                           None if args.as_is else cached_bytecode_env(Path(prefix)))
+    figures["load_average_after_command"] = load_average()
     print(f"(a) modelkit verify {source.name} -o DIR (all four layers and the report), fresh process, "
-          f"{args.repeat} runs after a warm-up; {figures['cores']} cores, load average "
-          f"{figures['load_average_before']} before; target: under 5 s")
+          f"{args.repeat} runs after a warm-up, bytecode {figures['bytecode']}; {figures['cores']} cores, "
+          f"load average {figures['load_average_before']} before, {figures['load_average_after_command']} "
+          "after; target: under 5 s")
     for name, row in figures["command"].items():
         split = ", ".join(f"{k} {v:.2f}" for k, v in row["phases_median_s"].items())
         print(f"  {name:38s} median {row['median_s']:.2f} s  (min {row['min_s']:.2f}, max {row['max_s']:.2f})"
-              f"  {row['verdict'][:40]}\n      phases (median s): {split}")
+              f"  CPU {row['cpu_median_s']:.2f} s  {row['verdict'][:40]}\n      phases (median s): {split}")
+    if args.only_command:
+        if args.json is not None:
+            args.json.write_text(json.dumps(figures, indent=2, sort_keys=True) + "\n")
+        return 0
     figures["layer4"] = bench_layer4(source, args.repeat)
     print("(b) layer 4 harness overhead: simulated s per wall s inside verify's drivers vs a bare stepping "
           "loop of the same engine on the same model (target ratio >= 0.8; medians)")
