@@ -777,3 +777,20 @@ def test_a_changed_mesh_file_is_loaded_again_by_the_next_write(tmp_path: Path) -
         (mesh,) = (out.parent / "meshes").iterdir()
         sizes.append(float(np.ptp(trimesh.load(mesh, force="mesh").vertices[:, 2])))
     assert sizes == pytest.approx([0.6, 3.0])
+
+
+def test_compact_mesh_drops_unused_vertices_keeping_the_order_of_the_rest() -> None:
+    # compact_mesh marks used vertices in one pass; the result must be the one of the sorted
+    # np.unique of the face indices (used vertices in file order, faces renumbered).
+    from modelkit.geometry.meshfiles import compact_mesh
+
+    rng = np.random.default_rng(7)
+    vertices = rng.normal(size=(500, 3))
+    faces = rng.integers(0, 500, size=(300, 3)) // 2 * 2  # only even vertices are used
+    kept, renumbered = compact_mesh(vertices, faces)
+    used = np.unique(faces)
+    assert np.array_equal(kept, vertices[used])
+    assert np.array_equal(kept[renumbered], vertices[faces])
+    assert len(kept) == len(used) < 500
+    whole, same = compact_mesh(vertices[:3], np.array([[0, 1, 2]]))
+    assert np.array_equal(whole, vertices[:3]) and np.array_equal(same, [[0, 1, 2]])

@@ -556,7 +556,12 @@ def compact_mesh(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> Mes
     """Drop vertices no face refers to (keeps the order of the others)."""
     if len(faces) == 0:
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
-    used = np.unique(faces)
+    if faces.min() >= 0 and faces.max() < len(vertices):
+        mark = np.zeros(len(vertices), dtype=bool)
+        mark[faces.ravel()] = True  # one pass, where np.unique sorts every index: the same sorted result
+        used = np.flatnonzero(mark)
+    else:  # out-of-range indices fail (or wrap) exactly as they always did
+        used = np.unique(faces)
     if len(used) == len(vertices):
         return np.asarray(vertices, dtype=np.float64), faces.astype(np.int64)
     remap = np.full(len(vertices), -1, dtype=np.int64)
