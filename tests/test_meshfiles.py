@@ -794,3 +794,32 @@ def test_compact_mesh_drops_unused_vertices_keeping_the_order_of_the_rest() -> N
     assert len(kept) == len(used) < 500
     whole, same = compact_mesh(vertices[:3], np.array([[0, 1, 2]]))
     assert np.array_equal(whole, vertices[:3]) and np.array_equal(same, [[0, 1, 2]])
+
+
+def _merged_by_unique(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The former merge of identical STL vertices, by ``np.unique(axis=0)``: the reference."""
+    _, first, inverse = np.unique(vertices, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return vertices[np.sort(first)], rank[inverse.reshape(-1)][faces]
+
+
+def test_identical_vertices_merge_as_np_unique_merges_them() -> None:
+    # Small integer grids so that rows repeat; -0.0 against 0.0 and NaN rows included.
+    from modelkit.geometry.meshfiles import _merge_identical_vertices
+
+    rng = np.random.default_rng(11)
+    merges = 0
+    for trial in range(300):
+        vertices = rng.integers(-2, 3, size=(int(rng.integers(1, 80)), 3)).astype(float)
+        vertices[rng.random(vertices.shape) < 0.1] = -0.0
+        if trial % 3 == 0:
+            vertices[rng.random(vertices.shape) < 0.05] = np.nan
+        faces = rng.integers(0, len(vertices), size=(30, 3))
+        merged, renumbered = _merge_identical_vertices(vertices, faces)
+        expected, expected_faces = _merged_by_unique(vertices, faces)
+        assert np.array_equal(merged, expected, equal_nan=True), trial
+        assert np.array_equal(renumbered, expected_faces), trial
+        merges += len(merged) < len(vertices)
+    assert merges > 200  # the grids do repeat rows: the comparison is not of untouched inputs
