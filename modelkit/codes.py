@@ -56,9 +56,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK008",
         "xacro-include-work",
         "error",
-        "xacro includes processed for one file (each inclusion of the same file counted) pass 2,000, or the "
-        "expanded document passes `--max-bytes` of text: an include diamond; refused where the next "
-        "include stands.",
+        "xacro includes and `load_yaml` files processed for one file (each inclusion or load of the same "
+        "file counted) pass 2,000, or the text they add passes `--max-bytes`: an include diamond, a load "
+        "in a loop; refused where the next include or load stands.",
     ),
     CodeInfo(
         "MK009",

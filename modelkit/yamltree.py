@@ -24,7 +24,7 @@ from typing import Any
 
 import yaml
 
-from modelkit.diagnostics import DiagnosticSink, SourceLocation
+from modelkit.diagnostics import Diagnostic, DiagnosticSink, SourceLocation, diag
 from modelkit.textio import (  # re-exported: the file checks are shared with the XML readers
     DEFAULT_EXPANSION_LIMIT,
     DEFAULT_MAX_BYTES,
@@ -421,6 +421,87 @@ def _scan_events_with(
     return names, None, aliases, None
 
 
+def _list_too_long(exc: ListTooLong, path: str) -> Diagnostic:
+    if exc.key:
+        return diag(
+            "MK005",
+            f'"{exc.key}" has more than {exc.limit} items, over the limit; refusing the document',
+            _loc(path, exc.mark),
+            hint="raise the limit with --max-links if the model is genuine",
+        )
+    return diag(
+        "MK006",
+        f"a list has more than {exc.limit} items; refusing the document",
+        _loc(path, exc.mark),
+        hint="raise the limit with --max-list-items if the file is genuine",
+    )
+
+
+def _too_deep(mark: Any, path: str) -> Diagnostic:
+    message = f"YAML nesting deeper than {MAX_NESTING} levels; refusing the document"
+    return diag("MK010", message, _loc(path, mark))
+
+
+@dataclass(frozen=True)
+class StructureScan:
+    """What the event scan found: a refusal (MK006, MK010) or None, and how many aliases there are."""
+
+    problem: Diagnostic | None
+    aliases: int
+
+
+def scan_structure(text: str, path: str, max_list_items: int = DEFAULT_MAX_LIST_ITEMS) -> StructureScan:
+    """What the event scan refuses before anything is composed: a list over ``max_list_items``
+    (MK006) or nesting deeper than :data:`MAX_NESTING` (MK010). One pass over the events, never
+    recursive, so it is safe on any text; without aliases nothing can expand past the text's size."""
+    try:
+        _, too_deep, aliases = _scan_events(text, max_list_items)
+    except ListTooLong as exc:
+        return StructureScan(_list_too_long(exc, path), 0)
+    return StructureScan(_too_deep(too_deep, path) if too_deep is not None else None, len(aliases))
+
+
+def measure_composed(root: yaml.Node, limit: int) -> tuple[str, yaml.Node] | None:
+    """:func:`measure_expansion` on PyYAML's composed node graph (an alias is the anchored node
+    object itself): ``("recursive", node)``, ``("limit", node)`` or None, in time linear in the
+    number of distinct nodes."""
+    sizes: dict[int, int] = {}
+    on_stack: set[int] = set()
+    stack: list[tuple[yaml.Node, bool]] = [(root, False)]
+    while stack:
+        node, children_done = stack.pop()
+        key = id(node)
+        if children_done:
+            on_stack.discard(key)
+            total = 1
+            for child in _composed_children(node):
+                total += sizes.get(id(child), 1)  # a scalar is not in sizes
+                if total > limit:
+                    return ("limit", node)
+            sizes[key] = total
+            continue
+        if key in sizes:
+            continue
+        on_stack.add(key)
+        stack.append((node, True))
+        for child in _composed_children(node):
+            if isinstance(child, yaml.ScalarNode):
+                continue
+            if id(child) in on_stack:
+                return ("recursive", child)
+            if id(child) not in sizes:
+                stack.append((child, False))
+    return None
+
+
+def _composed_children(node: yaml.Node) -> list[yaml.Node]:
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    if isinstance(node, yaml.MappingNode):
+        return [item for pair in node.value for item in pair]
+    return []
+
+
 def measure_expansion(root: YNode, limit: int) -> tuple[str, YNode] | None:
     """Check the size the document would have with every alias copied out.
 
@@ -534,27 +615,10 @@ def _parse_yaml(
             if check is not None and blanked and not check.trusted(blanked):
                 raise _FastPathMissed
     except ListTooLong as exc:
-        if exc.key:
-            sink.emit(
-                "MK005",
-                f'"{exc.key}" has more than {exc.limit} items, over the limit; refusing the document',
-                _loc(path, exc.mark),
-                hint="raise the limit with --max-links if the model is genuine",
-            )
-            return YamlDocument(None, path, {})
-        sink.emit(
-            "MK006",
-            f"a list has more than {exc.limit} items; refusing the document",
-            _loc(path, exc.mark),
-            hint="raise the limit with --max-list-items if the file is genuine",
-        )
+        sink.add(_list_too_long(exc, path))
         return YamlDocument(None, path, {})
     if too_deep is not None:
-        sink.emit(
-            "MK010",
-            f"YAML nesting deeper than {MAX_NESTING} levels; refusing the document",
-            _loc(path, too_deep),
-        )
+        sink.add(_too_deep(too_deep, path))
         return YamlDocument(None, path, {})
     stand_ins: dict[tuple[int, int], YNode] = {}
     if imported_anchors:

@@ -511,3 +511,37 @@ def test_a_number_with_a_c_suffix_is_read_as_choreonoid_reads_it(tmp_path: Path)
     assert ignored.location.line == 15 and "2.0" not in ignored.message
     (read,) = [d for d in v.warnings if d.code == "MK181" and '"2.0f"' in d.message]
     assert 'Choreonoid reads 2 and ignores "f"' in read.message
+
+
+_TWO_LINKS = (
+    "links:\n"
+    "  - name: {root}\n    joint_type: free\n    mass: 1.0\n    inertia: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
+    "  - name: arm\n    parent: {parent}\n    joint_type: fixed\n    mass: 1.0\n"
+    "    inertia: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
+)
+
+
+@pytest.mark.parametrize(
+    ("root", "parent"),
+    [("&n", "*n"), ("base", ""), ("base", '""'), ("&n", "*n  # the alias of an anchored empty value")],
+)
+def test_an_empty_parent_is_no_parent_as_in_choreonoid(tmp_path: Path, root: str, parent: str) -> None:
+    # Choreonoid's YAML reader keeps `name: &n` (an anchored empty value) as the scalar "" and the
+    # alias as the same node; its body loader treats an empty parent string as none: "The parent
+    # of arm is not specified" for a link other than the root. An empty name and an empty parent
+    # used to match each other here and the file loaded.
+    path = write(tmp_path, _HEADER + _TWO_LINKS.format(root=root, parent=parent))
+    errors = [d for d in validate(path).diagnostics if d.severity.value == "error"]
+    assert [d.code for d in errors] == ["MK218"]
+    assert '"arm"' in errors[0].message and "empty" in errors[0].message
+    assert errors[0].location is not None and errors[0].location.line == 9  # the link "arm"
+
+
+def test_an_anchored_empty_value_is_the_empty_scalar_for_every_alias(tmp_path: Path) -> None:
+    # `note: &e` holds "" (Choreonoid's reader makes an empty ScalarNode and registers the anchor);
+    # its alias as a contact material is that same "" (a warning, as for `material: ""`).
+    text = _HEADER.replace("name:", "HOLD: &e\nname:", 1) + _TWO_LINKS.format(root="base", parent="base")
+    path = write(tmp_path, text.replace("    parent: base\n", "    parent: base\n    material: *e\n"))
+    found = [d for d in validate(path).diagnostics if d.severity.value != "info"]  # MK119: the holder key
+    assert [d.code for d in found] == ["MK508"]
+    assert '""' in found[0].message

@@ -777,3 +777,49 @@ def test_a_changed_mesh_file_is_loaded_again_by_the_next_write(tmp_path: Path) -
         (mesh,) = (out.parent / "meshes").iterdir()
         sizes.append(float(np.ptp(trimesh.load(mesh, force="mesh").vertices[:, 2])))
     assert sizes == pytest.approx([0.6, 3.0])
+
+
+def test_compact_mesh_drops_unused_vertices_keeping_the_order_of_the_rest() -> None:
+    # compact_mesh marks used vertices in one pass; the result must be the one of the sorted
+    # np.unique of the face indices (used vertices in file order, faces renumbered).
+    from modelkit.geometry.meshfiles import compact_mesh
+
+    rng = np.random.default_rng(7)
+    vertices = rng.normal(size=(500, 3))
+    faces = rng.integers(0, 500, size=(300, 3)) // 2 * 2  # only even vertices are used
+    kept, renumbered = compact_mesh(vertices, faces)
+    used = np.unique(faces)
+    assert np.array_equal(kept, vertices[used])
+    assert np.array_equal(kept[renumbered], vertices[faces])
+    assert len(kept) == len(used) < 500
+    whole, same = compact_mesh(vertices[:3], np.array([[0, 1, 2]]))
+    assert np.array_equal(whole, vertices[:3]) and np.array_equal(same, [[0, 1, 2]])
+
+
+def _merged_by_unique(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The former merge of identical STL vertices, by ``np.unique(axis=0)``: the reference."""
+    _, first, inverse = np.unique(vertices, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return vertices[np.sort(first)], rank[inverse.reshape(-1)][faces]
+
+
+def test_identical_vertices_merge_as_np_unique_merges_them() -> None:
+    # Small integer grids so that rows repeat; -0.0 against 0.0 and NaN rows included.
+    from modelkit.geometry.meshfiles import _merge_identical_vertices
+
+    rng = np.random.default_rng(11)
+    merges = 0
+    for trial in range(300):
+        vertices = rng.integers(-2, 3, size=(int(rng.integers(1, 80)), 3)).astype(float)
+        vertices[rng.random(vertices.shape) < 0.1] = -0.0
+        if trial % 3 == 0:
+            vertices[rng.random(vertices.shape) < 0.05] = np.nan
+        faces = rng.integers(0, len(vertices), size=(30, 3))
+        merged, renumbered = _merge_identical_vertices(vertices, faces)
+        expected, expected_faces = _merged_by_unique(vertices, faces)
+        assert np.array_equal(merged, expected, equal_nan=True), trial
+        assert np.array_equal(renumbered, expected_faces), trial
+        merges += len(merged) < len(vertices)
+    assert merges > 200  # the grids do repeat rows: the comparison is not of untouched inputs

@@ -556,7 +556,12 @@ def compact_mesh(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> Mes
     """Drop vertices no face refers to (keeps the order of the others)."""
     if len(faces) == 0:
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
-    used = np.unique(faces)
+    if faces.min() >= 0 and faces.max() < len(vertices):
+        mark = np.zeros(len(vertices), dtype=bool)
+        mark[faces.ravel()] = True  # one pass, where np.unique sorts every index: the same sorted result
+        used = np.flatnonzero(mark)
+    else:  # out-of-range indices fail (or wrap) exactly as they always did
+        used = np.unique(faces)
     if len(used) == len(vertices):
         return np.asarray(vertices, dtype=np.float64), faces.astype(np.int64)
     remap = np.full(len(vertices), -1, dtype=np.int64)
@@ -565,15 +570,29 @@ def compact_mesh(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> Mes
 
 
 def _merge_identical_vertices(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> Mesh:
-    """Merge exactly equal vertices (STL is a triangle soup), keeping first-occurrence order."""
-    if len(vertices) == 0:
+    """Merge exactly equal vertices (STL is a triangle soup), keeping first-occurrence order.
+
+    Rows are grouped by a stable ``lexsort`` of the three coordinates (equal as floats: -0.0 is 0.0,
+    a NaN equals nothing), which gives the groups and first occurrences of ``np.unique(axis=0)``
+    at a tenth of its cost: that sorts the rows as structured items, compared field by field through
+    a generic function (2.5 s of so101.urdf's 13 STL files)."""
+    count = len(vertices)
+    if count == 0:
         return vertices, faces
-    _, first, inverse = np.unique(vertices, axis=0, return_index=True, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    order = np.argsort(first, kind="stable")  # unique rows in order of first occurrence
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    return np.asarray(vertices[np.sort(first)], dtype=np.float64), rank[inverse][faces]
+    rows = np.asarray(vertices, dtype=np.float64).reshape(count, -1)
+    order = np.lexsort(rows.T[::-1])  # by x, then y, then z; stable, so a group's first is its first
+    ranked = rows[order]
+    starts = np.empty(count, dtype=bool)
+    starts[0] = True
+    np.any(ranked[1:] != ranked[:-1], axis=1, out=starts[1:])
+    group = np.cumsum(starts) - 1  # the group of each sorted row
+    first = order[starts]  # each group's first occurrence in the file
+    by_first = np.argsort(first, kind="stable")
+    rank = np.empty_like(by_first)
+    rank[by_first] = np.arange(len(by_first))  # groups numbered in order of first occurrence
+    inverse = np.empty(count, dtype=np.int64)
+    inverse[order] = rank[group]
+    return np.asarray(vertices[np.sort(first)], dtype=np.float64), inverse[faces]
 
 
 # ---- STL / OBJ (trimesh) ----------------------------------------------------------------------

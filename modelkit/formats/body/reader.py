@@ -690,7 +690,7 @@ class _BodyReader:
             if not link.name and record.link.source is not None:
                 self.sink.emit("MK210", "a link without a name cannot be referenced as a parent", link.source)
             if link.name == root_name and robot.root_joint is None:
-                if record.parent is not None and record.parent_loc is not None:
+                if record.parent and record.parent_loc is not None:
                     self.sink.emit(
                         "MK209",
                         f'the root link "{link.name}" has a parent "{record.parent}", which is ignored',
@@ -700,10 +700,11 @@ class _BodyReader:
                 robot.root_pose = record.pose
                 robot.extras["root_joint_source"] = joint.loc("type")
                 continue
-            if record.parent is None:
+            if not record.parent:  # Choreonoid: an empty parent (`parent:`, an alias of one) is none
                 self.sink.emit(
                     "MK218",
-                    f'the parent of "{link.name}" is not specified',
+                    f'the parent of "{link.name}" is not specified'
+                    + (" (its `parent` value is empty)" if record.parent == "" else ""),
                     link.source,
                     hint=f"add `parent:` or make it the root with `root_link: {link.name}`",
                 )

@@ -29,6 +29,14 @@ class PackageNotFound(Exception):
         self.package = package
 
 
+class YamlFileMissing(Exception):
+    """``load_yaml`` of a file that does not exist."""
+
+    def __init__(self, path: str) -> None:
+        super().__init__(path)
+        self.path = path
+
+
 class ValueTooLarge(Exception):
     """An evaluated value grew past the size limit (a property that doubles itself)."""
 
@@ -182,6 +190,10 @@ def diagnose(exc: BaseException, ctx: FailureContext) -> Diagnostic | None:
             locate(ctx, None, node),
             hint="give the folder that holds it with --package-path NAME=DIR (or ROS_PACKAGE_PATH)",
         )
+    missing_yaml = _first(exc, YamlFileMissing)
+    if isinstance(missing_yaml, YamlFileMissing):
+        message = f"load_yaml: {missing_yaml.path} does not exist" + _in_macro(ctx)
+        return diag("MK705", message, locate(ctx, None, node))
     unreadable = _first(exc, UnreadableFile)
     if isinstance(unreadable, UnreadableFile):
         return diag(unreadable.code, f"{unreadable.path}: {unreadable.message}", locate(ctx, None, node))

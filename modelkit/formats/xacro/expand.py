@@ -39,6 +39,7 @@ from modelkit.formats.xacro.errors import (
     PackageNotFound,
     Reported,
     ValueTooLarge,
+    YamlFileMissing,
     diagnose,
 )
 from modelkit.formats.xacro.guard import ExpressionGuard, Sandbox, model_root
@@ -53,7 +54,7 @@ from modelkit.formats.xacro.legacy import (
 )
 from modelkit.formats.xacro.origins import OriginMap, dom_elements
 from modelkit.formats.xacro.pretty import pretty_xml
-from modelkit.textio import UnreadableFile, read_regular, real_path
+from modelkit.textio import UnreadableFile, decode_text, read_regular, real_path
 from modelkit.xmlsource import XmlDocument, read_xml
 
 # Elements that macro and block expansion may create (a macro bomb stops here); a lower
@@ -300,25 +301,37 @@ class _Run:
         return {"find": find, "env": env, "optenv": optenv}
 
     def load_yaml(self, filename: str) -> Any:
-        """xacro's ``load_yaml``, reading only inside the sandbox and only regular files."""
-        import yaml
+        """xacro's ``load_yaml``, reading only regular files inside the sandbox, counted with the
+        includes (MK008) and refused when the YAML is too large or an alias bomb (:mod:`.yamlload`)."""
+        from modelkit.formats.xacro.yamlload import YamlRefused, load_bounded  # imports PyYAML
 
         xacro = self.xacro
-        for unit in xacro.ConstructUnits:
-            yaml.SafeLoader.add_constructor(unit.value.tag, unit.constructor)
         filename = xacro.abs_filename_spec(filename)
         self.sandbox.check(filename)
+        if not os.path.lexists(filename):
+            raise YamlFileMissing(filename)
         try:
             data = read_regular(filename, self.options.max_bytes)
         except UnreadableFile as exc:
             exc.path = filename
             raise
+        display = self.display_for(Path(filename))
+        text = decode_text(data, display, self.sink)
+        if text is None:
+            raise Reported()
+        self._count_parse(filename, len(text))
         xacro.filestack.append(filename)
         try:
-            return xacro.YamlListWrapper.wrap(yaml.safe_load(data))
+            value = load_bounded(
+                text, display, xacro.ConstructUnits, self.options.max_list_items, self.options.expansion_limit
+            )
+        except YamlRefused as refused:
+            self.sink.add(refused.diagnostic)
+            raise Reported() from refused
         finally:
             xacro.filestack.pop()
             xacro.all_includes.append(filename)
+        return xacro.YamlListWrapper.wrap(value)
 
     # -- running -------------------------------------------------------------------------------
 

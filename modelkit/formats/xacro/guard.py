@@ -44,6 +44,7 @@ _GROWING_OPS: dict[type[ast.operator], str] = {
     ast.Mult: "__mk_mul",
     ast.LShift: "__mk_lshift",
     ast.Mod: "__mk_mod",
+    ast.Add: "__mk_add",
 }
 
 
@@ -84,6 +85,10 @@ class _Rewriter(ast.NodeTransformer):
         call = ast.Call(ast.Name("__mk_call", ast.Load()), [node.func, *node.args], node.keywords)
         return ast.copy_location(call, node)
 
+    def visit_JoinedStr(self, node: ast.JoinedStr) -> ast.AST:
+        self.generic_visit(node)
+        return ast.copy_location(ast.Call(ast.Name("__mk_sized", ast.Load()), [node], []), node)
+
     def visit_comprehension(self, node: ast.comprehension) -> ast.AST:
         self.generic_visit(node)
         node.iter = ast.copy_location(ast.Call(ast.Name("__mk_iter", ast.Load()), [node.iter], []), node.iter)
@@ -104,6 +109,8 @@ class ExpressionGuard:
             "__mk_mul": self.mul,
             "__mk_lshift": self.lshift,
             "__mk_mod": self.mod,
+            "__mk_add": self.add,
+            "__mk_sized": self.sized,
             "__mk_call": self.call,
             "__mk_iter": self.iterate,
         }
@@ -157,7 +164,21 @@ class ExpressionGuard:
     def mod(self, left: Any, right: Any) -> Any:
         if isinstance(left, str):
             _check_widths(left)
-        return left % right
+        return self.sized(left % right)
+
+    def add(self, left: Any, right: Any) -> Any:
+        sizes = (_length(left), _length(right))
+        if sizes[0] is not None and sizes[1] is not None:
+            self._items_ok(sizes[0] + sizes[1])
+        return left + right
+
+    def sized(self, value: Any) -> Any:
+        """A value just built (a call's result, a formatted string): its items count as work, so
+        turning a large shared value (a YAML file's anchors) into text again and again stops."""
+        size = _length(value)
+        if size is not None:
+            self._spend(size)
+        return value
 
     def call(self, function: Any, *args: Any, **kwargs: Any) -> Any:
         if function is range:
@@ -178,7 +199,7 @@ class ExpressionGuard:
         result = function(*args, **kwargs)
         if _is_int(result):
             self._int_ok(result)
-        return result
+        return self.sized(result)
 
     def iterate(self, iterable: Iterable[Any]) -> Iterator[Any]:
         for item in iterable:
@@ -203,7 +224,10 @@ def _checked_code(expr: str) -> CodeType | tuple[str, ...]:
     )
     if invalid:
         return tuple(invalid)
-    return compile(ast.fix_missing_locations(_Rewriter().visit(tree)), "<expression>", "eval")
+    try:
+        return compile(ast.fix_missing_locations(_Rewriter().visit(tree)), "<expression>", "eval")
+    except RecursionError as exc:  # thousands of chained operators
+        raise ExpressionTooLarge("an expression nested too deeply to evaluate") from exc
 
 
 def _name_of(node: ast.AST) -> str | None:
