@@ -1,13 +1,15 @@
-"""SDF actuators (issue 17 item 2).
+"""SDF actuators and self-collision (issue 17 items 2 and 4).
 
 Actuators: gz-sim's joint-controller systems (JointPositionController, JointController, ApplyJointForce)
 are read as canonical actuators and written back as those systems; every other format's actuators reach
-SDF as them and come back as the same kinds. Oracles: libsdformat (the compiled checker of
-``tests/test_sdf_reader.py``) accepts every written file, Drake parses it.
+SDF as them and come back as the same kinds. Self-collision: the SDF writer's ``<self_collide>`` flags
+follow the MJCF writer's touching pairs. Oracles: libsdformat (the compiled checker of
+``tests/test_sdf_reader.py``) accepts every written file, Drake parses it, MuJoCo finds the pairs.
 """
 
 from __future__ import annotations
 
+import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -18,7 +20,7 @@ from modelkit.convert.api import write
 from modelkit.convert.notes import ConversionNote, renames
 from modelkit.convert.options import WriteOptions
 from modelkit.model import ActuatorKind, Robot
-from tests.conftest import PENDULUM_BODY
+from tests.conftest import PENDULUM_BODY, example_robot
 from tests.test_actuators import MJCF, URDF
 from tests.test_sdf_reader import oracle_has_errors, sdf_oracle  # noqa: F401 (the fixture)
 
@@ -148,6 +150,7 @@ def test_gz_sim_joint_controllers_are_read_as_actuators(tmp_path: Path) -> None:
     # force mode: a PID on the velocity error, kv = p_gain
     assert (slide.kind, slide.kv, slide.force_range) == (ActuatorKind.VELOCITY, 5.0, (-10.0, 10.0))
     assert push.kind is ActuatorKind.EFFORT
+    assert robot.extras["sdf_self_collide"] is True
 
 
 def test_sdf_to_sdf_keeps_each_controller_whole(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
@@ -244,3 +247,184 @@ def test_gazebo_classic_leaves_the_systems_out(tmp_path: Path) -> None:
     notes = write(source, out, options=WriteOptions(gazebo="classic"))
     assert _plugins(out) == []
     assert any("3 actuator(s)" in m and "Gazebo classic" in m for m in _codes(notes, "MK808"))
+
+
+# -- self-collision --------------------------------------------------------------------------------
+
+
+def _flags(path: Path) -> tuple[str | None, dict[str, str]]:
+    model = ET.parse(path).getroot().find("model")
+    assert model is not None
+    links = {link.get("name", ""): link.findtext("self_collide", "") for link in model.findall("link")}
+    return model.findtext("self_collide"), {k: v for k, v in links.items() if v}
+
+
+def test_panda_self_collision_follows_the_mjcf_excludes(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+    """Panda touches itself at rest in 3 pairs (MuJoCo, MK832). SDF cannot exclude a pair: the links of
+    those pairs are left unflagged, every other link with collision shapes gets <self_collide>, and the
+    model flag stays off. libsdformat accepts it, Drake loads it."""
+    panda = load(example_robot("panda_description/urdf/panda.urdf"))
+    mjcf = tmp_path / "mjcf" / "panda.xml"
+    write(panda, mjcf)
+    contact = ET.parse(mjcf).getroot().find("contact")
+    assert contact is not None
+    excluded = {(e.get("body1"), e.get("body2")) for e in contact.iter("exclude")}
+    assert len(excluded) == 3
+    out = tmp_path / "sdf" / "panda.sdf"
+    notes = write(panda, out)
+    assert not oracle_has_errors(sdf_oracle, out)
+    model_flag, links = _flags(out)
+    assert model_flag is None
+    touching = {name for pair in excluded for name in pair}
+    shaped = {link.name for link in panda.links if link.collisions}
+    assert links == dict.fromkeys(shaped - touching, "true")
+    assert len(links) == 6
+    (note,) = _codes(notes, "MK834")
+    assert note.startswith("3 link pair(s) touch at rest") and "gz-sim reads only the model's flag" in note
+    assert _drake_loads(out) > 0
+
+
+def test_arm_that_touches_nothing_gets_the_model_flag(tmp_path: Path) -> None:
+    """UR5 flags its links itself (``<gazebo><selfCollide>``): kept. Without them, nothing touches at
+    rest and the model flag says it all."""
+    ur5 = load(example_robot("ur_description/urdf/ur5_robot.urdf"))
+    out = tmp_path / "own" / "ur5.sdf"
+    notes = write(ur5, out)
+    own = {"shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link", "wrist_3_link",
+           "ee_link"}
+    assert _flags(out) == (None, dict.fromkeys(own, "true"))
+    assert _codes(notes, "MK834") == []
+    assert not [m for m in _codes(notes, "MK808") if "extension of link" in m]  # selfCollide is all they say
+    for link in ur5.links:
+        link.extras.pop("gazebo", None)
+    out = tmp_path / "policy" / "ur5.sdf"
+    notes = write(ur5, out)
+    assert _flags(out) == ("true", {})
+    assert any("no two links touch at rest" in m for m in _codes(notes, "MK834"))
+
+
+def test_an_sdf_sources_own_flags_are_kept(tmp_path: Path) -> None:
+    source = load(_write_text(tmp_path, "arm.sdf", ARM))
+    out = tmp_path / "out" / "arm.sdf"
+    notes = write(source, out)
+    assert _flags(out) == ("true", {"base": "false"})
+    assert _codes(notes, "MK834") == []
+
+
+# -- self-collision in URDF: what libsdformat's URDF import (Gazebo's reader) makes of it ----------
+
+FLAGS_SOURCE = r"""
+#include <iostream>
+#include <sdf/sdf.hh>
+// Prints the self_collide flags libsdformat gives the model and each link of a file (a URDF is
+// converted as Gazebo converts it).
+int main(int argc, char **argv) {
+  sdf::Root root;
+  sdf::Errors errors = root.Load(argv[1]);
+  if (!errors.empty() || root.Model() == nullptr) { std::cout << "error\n"; return 1; }
+  const sdf::Model *model = root.Model();
+  std::cout << "model " << model->SelfCollide() << "\n";
+  for (uint64_t i = 0; i < model->LinkCount(); ++i) {
+    const sdf::Link *link = model->LinkByIndex(i);
+    std::cout << link->Name() << " " << link->Element()->Get<bool>("self_collide") << "\n";
+  }
+  return 0;
+}
+"""
+
+
+@pytest.fixture(scope="module")
+def sdf_flags(sdf_oracle: Path) -> Path:  # noqa: F811 (libsdformat present: the oracle compiled)
+    import hashlib
+    import subprocess
+
+    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "sdformat12"], capture_output=True,
+                           text=True, check=True).stdout.split()
+    digest = hashlib.sha256((FLAGS_SOURCE + " ".join(flags)).encode()).hexdigest()[:16]
+    binary = sdf_oracle.parent / f"sdf_flags-{digest}"
+    if not binary.exists():
+        source = binary.with_suffix(".cc")
+        source.write_text(FLAGS_SOURCE)
+        partial = binary.with_name(f"{binary.name}.{os.getpid()}")
+        subprocess.run(["g++", "-O0", "-o", str(partial), str(source), *flags], check=True)
+        partial.replace(binary)
+    return binary
+
+
+def _libsdformat_flags(binary: Path, path: Path) -> tuple[bool, set[str]]:
+    """(the model's flag, the links flagged) as libsdformat converts the file."""
+    import subprocess
+
+    run = subprocess.run([str(binary), path.name], cwd=path.parent, capture_output=True, text=True,
+                         timeout=60)
+    assert run.returncode == 0, run.stdout + run.stderr
+    lines = [line.rsplit(" ", 1) for line in run.stdout.splitlines()]
+    model = dict(lines)["model"] == "1"
+    return model, {name for name, value in lines if name != "model" and value == "1"}
+
+
+def test_urdf_self_collision_reaches_gazebo_through_libsdformat(tmp_path: Path, sdf_flags: Path) -> None:
+    """Panda → URDF: libsdformat's URDF import (Gazebo's) flags the 6 links that touch nothing and not
+    the model; UR5 → URDF: the model flag. The MK834 note tells PyBullet users the flag and the pairs."""
+    panda = load(example_robot("panda_description/urdf/panda.urdf"))
+    panda.source_format = "mjcf"  # a URDF source keeps its own <gazebo> blocks: judge the policy itself
+    out = tmp_path / "panda" / "panda.urdf"
+    notes = write(panda, out)
+    model, links = _libsdformat_flags(sdf_flags, out)
+    touching = {"panda_link5", "panda_link7", "panda_hand", "panda_leftfinger", "panda_rightfinger"}
+    assert not model
+    assert links == {link.name for link in panda.links if link.collisions} - touching
+    (note,) = _codes(notes, "MK834")
+    assert "URDF_USE_SELF_COLLISION" in note and "panda_leftfinger/panda_rightfinger" in note
+    ur5 = load(example_robot("ur_description/urdf/ur5_robot.urdf"))
+    out = tmp_path / "ur5" / "ur5.urdf"
+    write(ur5, out)  # ur_description flags its 7 links itself: kept as they are
+    own = {"shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link", "wrist_3_link",
+           "ee_link"}
+    assert _libsdformat_flags(sdf_flags, out) == (False, own - {"ee_link"})  # lumped into wrist_3_link
+    ur5.source_format = "mjcf"
+    for link in ur5.links:
+        link.extras.pop("gazebo", None)
+    out = tmp_path / "ur5_policy" / "ur5.urdf"
+    write(ur5, out)  # the policy: nothing touches at rest, so the model's flag
+    assert _libsdformat_flags(sdf_flags, out) == (True, set())
+
+
+def test_sdf_flags_reach_urdf_and_come_back(tmp_path: Path, sdf_flags: Path) -> None:
+    source = load(_write_text(tmp_path, "arm.sdf", ARM))
+    out = tmp_path / "out" / "arm.urdf"
+    notes = write(source, out)
+    assert _libsdformat_flags(sdf_flags, out) == (True, set())  # base's explicit false is the default
+    assert not [m for m in _codes(notes, "MK808") if "self_collide" in m]
+    back = tmp_path / "back" / "arm.urdf"
+    again = write(load(out), back)
+    assert _libsdformat_flags(sdf_flags, back) == (True, set())  # a URDF's own blocks are kept as such
+    assert _codes(again, "MK834") == []
+
+
+def test_pybullet_with_its_flag_excludes_parent_and_child(tmp_path: Path) -> None:
+    """What the MK834 note tells PyBullet users, measured: loaded with URDF_USE_SELF_COLLISION, a link
+    overlapping its parent makes no contact, one overlapping its grandparent does (MuJoCo's rule)."""
+    pybullet = pytest.importorskip("pybullet")
+    box = '<box size="0.2 0.2 0.2"/>'
+    inertial = ('<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" '
+                'iyz="0"/></inertial>')
+    links = "".join(f'<link name="{n}">{inertial}<collision><origin xyz="0 0 {z}"/><geometry>{box}</geometry>'
+                    "</collision></link>" for n, z in (("a", 0), ("b", 0), ("c", -0.1)))
+    joints = "".join(f'<joint name="{j}" type="revolute"><parent link="{p}"/><child link="{c}"/>'
+                     f'<origin xyz="0 0 {z}"/><axis xyz="0 0 1"/>'
+                     '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+                     for j, p, c, z in (("j", "a", "b", 0.1), ("k", "b", "c", 0.0)))
+    path = _write_text(tmp_path, "chain.urdf", f'<robot name="chain">{links}{joints}</robot>')
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        found = {}
+        for label, flags in (("off", 0), ("on", pybullet.URDF_USE_SELF_COLLISION)):
+            body = pybullet.loadURDF(str(path), useFixedBase=1, flags=flags, physicsClientId=client)
+            pybullet.performCollisionDetection(physicsClientId=client)
+            contacts = pybullet.getContactPoints(body, body, physicsClientId=client)
+            found[label] = {(c[3], c[4]) for c in contacts}
+            pybullet.removeBody(body, physicsClientId=client)
+    finally:
+        pybullet.disconnect(client)
+    assert found == {"off": set(), "on": {(1, -1)}}  # c (link 1) with a (the base), never b with a or c

@@ -25,7 +25,7 @@ libsdformat's URDF import drops massless links, so neither is truthful. The rule
 
 Names are made unique and legal by :mod:`write_names`; geometry by :mod:`write_geometry`;
 sensors, lights and plugins by :mod:`write_devices`; the actuators as gz-sim joint controllers by
-:mod:`write_actuators`.
+:mod:`write_actuators`; ``<self_collide>`` by :mod:`write_self_collide`.
 """
 
 from __future__ import annotations
@@ -44,6 +44,7 @@ from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
 from modelkit.formats.sdf.write_geometry import GeomWriter
 from modelkit.formats.sdf.write_names import Names
+from modelkit.formats.sdf.write_self_collide import only_self_collide, self_collide_policy
 from modelkit.formats.sdf.write_xml import add_pose, num, sub
 from modelkit.model import SYNTHESISED, WORLD_LINK, DeviceKind, Joint, JointType, Link, LoopConstraint, Robot
 from modelkit.spatial import Mat3, Pose, Vec3
@@ -117,6 +118,7 @@ class _ModelWriter:
         self.model_poses: dict[str, Pose] = {}  # link → pose in the model frame at q = 0 (SDF 1.6)
         self.ft_to_joint: dict[str, list[tuple[object, Pose]]] = {}
         self.axis_joints: dict[str, str] = {}  # source joint → written revolute/prismatic joint
+        self.self_collide: dict[str, bool] = {}  # link → its <self_collide> (write_self_collide)
 
     # -- plan --------------------------------------------------------------------------------
 
@@ -165,6 +167,7 @@ class _ModelWriter:
         if self.frames_ok and not self.world_root and robot.root in self.links:
             model.set("canonical_link", self.names.links[robot.root or ""])
         self._root(model)
+        self.self_collide = self_collide_policy(robot, ctx, model, {lk.name for lk in written_links})
         for link in written_links:
             self._link(model, link)
         for link in self._ordered_links():
@@ -244,6 +247,8 @@ class _ModelWriter:
         name = self.names.links[link.name]
         el = sub(model, "link", name=name)
         self._link_pose(el, link.name)
+        if link.name in self.self_collide:
+            sub(el, "self_collide", "true" if self.self_collide[link.name] else "false")
         self._inertial(el, link, name)
         friction = floor_friction(self.robot).get(link.name) if link.contact_material else None
         self.geoms.link_geoms(el, link, name, Pose(), None, friction)
@@ -267,10 +272,11 @@ class _ModelWriter:
                 link.source,
                 f"link[{name}]",
             )
-        if link.extras.get("gazebo"):
+        if link.extras.get("gazebo") and not only_self_collide(link.extras["gazebo"]):
             ctx.note(
                 "MK808",
-                f'<gazebo> extension of link "{link.name}" is not carried over',
+                f'<gazebo> extension of link "{link.name}" is not carried over'
+                + (" (its selfCollide is, as <self_collide>)" if link.name in self.self_collide else ""),
                 link.source,
                 f"link[{name}]",
             )
