@@ -172,6 +172,26 @@ def test_sdf_to_sdf_keeps_each_controller_whole(tmp_path: Path, sdf_oracle: Path
     assert _drake_loads(out) == 6  # the world weld and five joints
 
 
+def test_a_plugin_for_several_joints_is_one_actuator_each(tmp_path: Path) -> None:
+    """gz-sim's JointPositionController takes several <joint_name>s ("identical joints"): one actuator
+    each, written back as one plugin each with the plugin's other parameters."""
+    text = ARM.replace("<joint_name>elbow</joint_name>",
+                       "<joint_name>elbow</joint_name><joint_name>nowhere</joint_name>"
+                       "<joint_name>spin</joint_name><topic>/both</topic>")
+    robot = load(_write_text(tmp_path, "arm.sdf", text))
+    got = {a.joint: a for a in robot.actuators}
+    assert (got["elbow"].kind, got["spin"].kind) == (ActuatorKind.POSITION, ActuatorKind.POSITION)
+    assert got["spin"].kp == 100.0  # the first plugin naming a joint wins (the JointController comes later)
+    out = tmp_path / "out" / "arm.sdf"
+    write(robot, out)
+    spin = [p for p in _plugins(out) if p.findtext("joint_name") == "spin"]
+    # the source's own JointController on spin is copied as it was (both act in gz-sim, as in the source)
+    assert [p.get("filename") for p in spin] == ["ignition-gazebo-joint-position-controller-system",
+                                                 "gz-sim-joint-controller-system"]
+    kept = [(c.tag, c.text) for c in spin[0]]
+    assert kept == [("joint_name", "spin"), ("topic", "/both"), ("p_gain", "100")]  # the source's order
+
+
 # -- other formats to SDF and back ---------------------------------------------------------------
 
 
