@@ -1269,6 +1269,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "the compiler refused it), so touching body pairs were not looked for and none is excluded.",
     ),
     CodeInfo(
+        "MK834",
+        "self-collision-policy",
+        "info",
+        "SDF (and URDF for Gazebo) cannot exclude a pair of links from colliding, only flag links or the "
+        "whole model (`<self_collide>`): the written flags follow the MJCF output's policy as far as they "
+        "can (docs/convert.md, \"Self-collision\"), and the note says what each simulator then does.",
+    ),
+    CodeInfo(
         "MK840",
         "actuator-gains-made-up",
         "info",

@@ -150,6 +150,15 @@ def test_x_to_y_to_x_keeps_the_robot(family: str, path: Path, through: str, tmp_
         assert differences, f"expected a loss ({why}) but the round trip was exact: update EXPECTED_LOSSES"
         differences = [d for d in differences if not allowed(d)]
     assert differences == [], "\n".join(str(d) for d in differences[:20])
+    if through == "sdf":  # SDF holds actuators as gz-sim systems (docs/convert.md, "Actuators")
+        assert _actuator_kinds(final, renames(notes, "link")) == _actuator_kinds(source, {})
+
+
+def _actuator_kinds(robot: Robot, links: dict[str, str]) -> dict[str, str]:
+    """Each actuator's kind by the (source-named) child link of its joint: joints may be renamed."""
+    back = {new: old for old, new in links.items()}
+    child = {j.name: j.child for j in robot.joints}
+    return {back.get(child.get(a.joint, ""), child.get(a.joint, "")): a.kind.value for a in robot.actuators}
 
 
 # ---- the issue's acceptance checks on the tutorial robots ------------------------------------

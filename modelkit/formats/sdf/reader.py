@@ -19,6 +19,7 @@ from lxml.etree import _Element as Element
 
 from modelkit.diagnostics import DiagnosticSink, sorted_diagnostics
 from modelkit.formats.common import ReadOptions, ReadResult
+from modelkit.formats.sdf.actuators import read_actuators
 from modelkit.formats.sdf.assemble import Assembler, Placement
 from modelkit.formats.sdf.collect import Collector, ModelTree, Scope
 from modelkit.formats.sdf.context import Context
@@ -175,6 +176,11 @@ class _Reader:
         plugins = [plugin_data(ctx, src, el, f'model "{scope.path}"') for scope, src, el in tree.plugins]
         if plugins:
             robot.extras["sdf_plugins"] = plugins
+            pairs = zip(tree.plugins, plugins, strict=True)
+            read_actuators(robot, [(src, el, data) for (_, src, el), data in pairs])
+        self_collide = child(tree.scope.element, "self_collide")
+        if self_collide is not None:
+            robot.extras["sdf_self_collide"] = tree.scope.src.values.boolean(self_collide)
         for scope, src, el in tree.other:
             self._not_modelled(src, el, f'<{el.tag}> of model "{scope.path}" is not part of the robot model')
         for scope in _scopes(tree):

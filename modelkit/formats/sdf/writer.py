@@ -24,7 +24,8 @@ libsdformat's URDF import drops massless links, so neither is truthful. The rule
   (valid for every SDF consumer, negligible against any real part), and noted as such.
 
 Names are made unique and legal by :mod:`write_names`; geometry by :mod:`write_geometry`;
-sensors, lights and plugins by :mod:`write_devices`.
+sensors, lights and plugins by :mod:`write_devices`; the actuators as gz-sim joint controllers by
+:mod:`write_actuators`; ``<self_collide>`` by :mod:`write_self_collide`.
 """
 
 from __future__ import annotations
@@ -39,9 +40,11 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.numbers import fmt, fmt_direction, fmt_vec
+from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
 from modelkit.formats.sdf.write_geometry import GeomWriter
 from modelkit.formats.sdf.write_names import Names
+from modelkit.formats.sdf.write_self_collide import only_self_collide, self_collide_policy
 from modelkit.formats.sdf.write_xml import add_pose, num, sub
 from modelkit.model import SYNTHESISED, WORLD_LINK, DeviceKind, Joint, JointType, Link, LoopConstraint, Robot
 from modelkit.spatial import Mat3, Pose, Vec3
@@ -114,6 +117,8 @@ class _ModelWriter:
         self.unjointed: set[str] = set()  # links whose joint SDF cannot hold: they float
         self.model_poses: dict[str, Pose] = {}  # link → pose in the model frame at q = 0 (SDF 1.6)
         self.ft_to_joint: dict[str, list[tuple[object, Pose]]] = {}
+        self.axis_joints: dict[str, str] = {}  # source joint → written revolute/prismatic joint
+        self.self_collide: dict[str, bool] = {}  # link → its <self_collide> (write_self_collide)
 
     # -- plan --------------------------------------------------------------------------------
 
@@ -162,6 +167,7 @@ class _ModelWriter:
         if self.frames_ok and not self.world_root and robot.root in self.links:
             model.set("canonical_link", self.names.links[robot.root or ""])
         self._root(model)
+        self.self_collide = self_collide_policy(robot, ctx, model, {lk.name for lk in written_links})
         for link in written_links:
             self._link(model, link)
         for link in self._ordered_links():
@@ -241,6 +247,8 @@ class _ModelWriter:
         name = self.names.links[link.name]
         el = sub(model, "link", name=name)
         self._link_pose(el, link.name)
+        if link.name in self.self_collide:
+            sub(el, "self_collide", "true" if self.self_collide[link.name] else "false")
         self._inertial(el, link, name)
         friction = floor_friction(self.robot).get(link.name) if link.contact_material else None
         self.geoms.link_geoms(el, link, name, Pose(), None, friction)
@@ -264,10 +272,11 @@ class _ModelWriter:
                 link.source,
                 f"link[{name}]",
             )
-        if link.extras.get("gazebo"):
+        if link.extras.get("gazebo") and not only_self_collide(link.extras["gazebo"]):
             ctx.note(
                 "MK808",
-                f'<gazebo> extension of link "{link.name}" is not carried over',
+                f'<gazebo> extension of link "{link.name}" is not carried over'
+                + (" (its selfCollide is, as <self_collide>)" if link.name in self.self_collide else ""),
                 link.source,
                 f"link[{name}]",
             )
@@ -381,6 +390,8 @@ class _ModelWriter:
         sub(el, "child", child)
         if kind in ("revolute", "continuous", "prismatic"):
             self._axis(el, joint, name)
+            if joint.mimic is None:
+                self.axis_joints[joint.name] = name
         if joint.armature:
             ctx.note(
                 "MK820",
@@ -512,7 +523,10 @@ class _ModelWriter:
 
     def _model_extras(self, model: Element) -> None:
         robot, ctx = self.robot, self.ctx
+        ActuatorWriter(robot, ctx, self.devices.gazebo, self.axis_joints).write(model)
         for plugin in robot.extras.get("sdf_plugins", []):
+            if plugin.get("actuates"):
+                continue  # written from the canonical actuators (write_actuators)
             if robot.source_format == "sdf":
                 self.devices.plugin(model, plugin, "model")
             else:
@@ -521,20 +535,15 @@ class _ModelWriter:
                 )
         for key, what in (("gazebo", "<gazebo> extensions"), ("transmissions", "<transmission> elements")):
             if robot.extras.get(key):
+                carried = (" (the actuators they name are written as gz-sim joint controllers)"
+                           if key == "transmissions" and robot.actuators else "")
                 ctx.note(
                     "MK808",
-                    f"{what} of the source are simulator or controller data; they are not carried over",
+                    f"{what} of the source are simulator or controller data; they are not carried over"
+                    + carried,
                     robot.source,
                     "model",
                 )
-        if robot.actuators and not robot.extras.get("transmissions"):
-            ctx.note(
-                "MK808",
-                f"{len(robot.actuators)} actuator(s) of the source: SDF has no actuator element (Gazebo "
-                "drives joints through plugins); not carried over",
-                robot.source,
-                "model",
-            )
         world = robot.extras.get("sdf_world")
         if isinstance(world, dict) and (world.get("lights") or world.get("plugins")):
             ctx.note(

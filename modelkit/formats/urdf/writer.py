@@ -5,8 +5,8 @@ Element order: robot-level materials, links (model order, then links the writer 
 extensions. Pretty-printed with two-space indentation, numbers through
 :func:`modelkit.convert.numbers.fmt`. The parts live in ``write_names`` (unique names, MK800),
 ``write_links`` (inertials, geometry, materials), ``write_joints`` (joint types, synthesised limits),
-``write_frames`` (sensor links and optical frames, MK847) and ``write_gazebo`` (sensors, friction,
-kept extension blocks).
+``write_frames`` (sensor links and optical frames, MK847), ``write_gazebo`` (sensors, friction,
+kept extension blocks) and ``write_self_collide`` (Gazebo's self-collision flags, MK834).
 
 How the root meets the world: URDF has no root pose and its consumers float the root unless it
 hangs from a link named ``world``. A welded root (``--base``, settled in ``modelkit/convert/base.py``)
@@ -32,6 +32,7 @@ from modelkit.formats.urdf.write_gazebo import write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
 from modelkit.formats.urdf.write_links import MaterialTable, link_element, origin_element
 from modelkit.formats.urdf.write_names import NameTable
+from modelkit.formats.urdf.write_self_collide import write_self_collision
 from modelkit.model import WORLD_LINK, JointType, Robot
 from modelkit.spatial import Pose
 
@@ -59,6 +60,7 @@ SILENT_EXTRAS = frozenset(
         "mujoco",
         "sensor",
         "sdf_plugins",  # written as <gazebo> blocks (write_gazebo)
+        "sdf_self_collide",  # written as a robot-level <gazebo> block (write_self_collide)
     }
 )
 # Robot extras that do: the note that says they are left out.
@@ -149,6 +151,7 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
     for el in joints:
         out.append(el)
     write_extensions(out, robot, names, frames, ctx)
+    write_self_collision(out, robot, names.link_map, ctx)
     _massless(robot, names, ctx)
     _notes(robot, ctx)
     settings = pybullet_settings(robot)
@@ -263,7 +266,9 @@ def _massless(robot: Robot, names: NameTable, ctx: WriteContext) -> None:
 def _link_extras(extras: dict[str, object], source_name: str, name: str, ctx: WriteContext) -> None:
     for key, value in sorted(extras.items()):
         if key == "sdf_link" and isinstance(value, dict):
-            value = {k: v for k, v in value.items() if SDF_LINK_DEFAULTS.get(k, not v) != v}
+            # self_collide is written as <gazebo><selfCollide> (write_self_collide)
+            value = {k: v for k, v in value.items()
+                     if k != "self_collide" and SDF_LINK_DEFAULTS.get(k, not v) != v}
         if key in SILENT_LINK_EXTRAS or not value:
             continue
         ctx.note(

@@ -1,0 +1,201 @@
+"""SDF writer, actuators: the model's canonical actuators as gz-sim joint-controller systems.
+
+SDF has no actuator element; Gazebo Sim drives a joint through a model ``<plugin>`` (the systems and
+their parameters: :mod:`modelkit.formats.sdf.actuators`). One plugin per actuator on a written
+revolute or prismatic joint:
+
+* position → ``JointPositionController``: ``p_gain`` = kp, ``d_gain`` = kv, ``i_gain`` 0 (gz-sim's
+  default integral gain is 0.1), ``cmd_max``/``cmd_min`` = the force range, else ±the joint's effort
+  limit (gz-sim's own default clamp is ±1000);
+* velocity → ``JointController`` with ``use_force_commands`` (a PID on the velocity error, the canonical
+  velocity servo): ``p_gain`` = kv, ``i_gain``/``d_gain`` 0, the force range as for position; an
+  actuator read from a JointController in velocity mode is written back in velocity mode;
+* effort → ``ApplyJointForce``: the command is the joint force (gear, control and force ranges have no
+  parameter there: MK844).
+
+Gains the source did not give come from :mod:`modelkit.convert.servo_gains` (MK840), as for MJCF,
+except for an actuator read from an SDF plugin: a gain it left out stays out (gz-sim's default). An
+actuator read from an SDF plugin gets that plugin's other parameters back (``topic``, ``i_gain``,
+``initial_position``...) and its ``filename``/``name`` (``ignition-gazebo-...`` stays). Written for
+Gazebo classic (``--gazebo classic``), which has no such systems, actuators are left out (MK808).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from lxml.etree import _Element as Element
+
+from modelkit.convert.context import WriteContext
+from modelkit.convert.numbers import fmt
+from modelkit.convert.servo_gains import (
+    SERVO_BANDWIDTH_HZ,
+    JointLoad,
+    joint_loads,
+    position_gains,
+    velocity_gain,
+)
+from modelkit.formats.sdf.actuators import system_of
+from modelkit.formats.sdf.write_xml import num, parse_fragment, sub
+from modelkit.model import Actuator, ActuatorKind, Joint, Robot
+
+SYSTEM_FILES = {
+    "JointPositionController": "gz-sim-joint-position-controller-system",
+    "JointController": "gz-sim-joint-controller-system",
+    "ApplyJointForce": "gz-sim-apply-joint-force-system",
+}
+SYSTEM_FOR = {
+    ActuatorKind.POSITION: "JointPositionController",
+    ActuatorKind.VELOCITY: "JointController",
+    ActuatorKind.EFFORT: "ApplyJointForce",
+}
+NOT_COPIED = frozenset({"joint_name"})  # the source plugin's children the writer always writes itself
+
+
+def from_sdf_plugin(actuator: Actuator) -> bool:
+    return actuator.source_kind.startswith("gz-sim ")
+
+
+def source_plugins(robot: Robot) -> dict[str, dict[str, Any]]:
+    """Joint name → the source's plugin dict that became its actuator (SDF sources)."""
+    out: dict[str, dict[str, Any]] = {}
+    for plugin in robot.extras.get("sdf_plugins") or []:
+        if isinstance(plugin, dict):
+            for joint in plugin.get("actuates") or []:
+                out.setdefault(str(joint), plugin)
+    return out
+
+
+def _system(plugin: Element) -> str | None:
+    return system_of(plugin.get("filename") or "", plugin.get("name") or "")
+
+
+class ActuatorWriter:
+    """Writes the plugins into ``model``; ``joints`` maps source joint names to written revolute or
+    prismatic joints (anything else cannot carry one of these systems)."""
+
+    def __init__(self, robot: Robot, ctx: WriteContext, family: str, joints: dict[str, str]) -> None:
+        self.robot = robot
+        self.ctx = ctx
+        self.family = family
+        self.joints = joints
+        self.sources = source_plugins(robot)
+        self._loads: dict[str, JointLoad] | None = None
+
+    def write(self, model: Element) -> int:
+        robot = self.robot
+        if not robot.actuators:
+            return 0
+        if self.family == "classic":
+            self.ctx.note(
+                "MK808",
+                f"{len(robot.actuators)} actuator(s) of the source are left out: Gazebo classic has no "
+                "per-joint controller plugin (its robots are driven by gazebo_ros_control from URDF "
+                "transmissions); --gazebo sim writes them as gz-sim joint controllers",
+                robot.source,
+                "model",
+            )
+            return 0
+        by_name: dict[str, Joint] = {}
+        for each in robot.joints:
+            by_name.setdefault(each.name, each)
+        written = 0
+        made_up: list[str] = []
+        lost: list[str] = []
+        for actuator in robot.actuators:
+            target = self.joints.get(actuator.joint)
+            joint = by_name.get(actuator.joint)
+            if target is None or joint is None:
+                self.ctx.note("MK842", f"actuator on joint {actuator.joint} left out: the joint is not "
+                              "written as a revolute or prismatic joint", actuator.source, "model/plugin")
+                continue
+            self._one(model, actuator, joint, target, made_up, lost)
+            written += 1
+        if made_up:
+            self.ctx.note(
+                "MK840",
+                f"{len(made_up)} servo(s) without gains in the source get gains for a "
+                f"{fmt(SERVO_BANDWIDTH_HZ)} Hz critically damped loop on each joint's reflected inertia at "
+                "home, raised where gravity at home would make it sag (docs/convert.md): " + "; ".join(made_up),
+                robot.source,
+                "model/plugin",
+            )
+        if lost:
+            self.ctx.note(
+                "MK844",
+                f"{len(lost)} actuator(s) written as gz-sim systems without what those systems cannot hold: "
+                + "; ".join(lost),
+                robot.source,
+                "model/plugin",
+            )
+        return written
+
+    # -- one actuator -------------------------------------------------------------------------------
+
+    def _one(self, model: Element, actuator: Actuator, joint: Joint, target: str, made_up: list[str],
+             lost: list[str]) -> None:
+        source = self.sources.get(actuator.joint) if from_sdf_plugin(actuator) else None
+        verbatim = parse_fragment(str(source.get("xml", ""))) if source is not None else None
+        system = SYSTEM_FOR[actuator.kind]
+        if verbatim is not None and _system(verbatim) != system:
+            verbatim = None  # the actuator's kind changed since it was read: written from the model
+        filename = verbatim.get("filename") if verbatim is not None else None
+        cls = verbatim.get("name") if verbatim is not None else None
+        el = sub(model, "plugin", filename=filename or SYSTEM_FILES[system],
+                 name=cls or f"gz::sim::systems::{system}")
+        sub(el, "joint_name", target)
+        written: set[str] = {"joint_name"}
+        if verbatim is None:
+            written |= self._parameters(el, actuator, joint, target, made_up)
+            self._losses(actuator, target, lost)
+        for extra in verbatim if verbatim is not None else []:
+            if isinstance(extra.tag, str) and extra.tag not in written:
+                extra.tail = None
+                el.append(extra)
+
+    def _parameters(self, el: Element, actuator: Actuator, joint: Joint, target: str,
+                    made_up: list[str]) -> set[str]:
+        kind = actuator.kind
+        if kind is ActuatorKind.EFFORT:
+            return set()
+        if kind is ActuatorKind.VELOCITY:
+            sub(el, "use_force_commands", "true")
+        kp, kv = actuator.kp, actuator.kv
+        load = self._load(joint.name)
+        inertia = load.inertia
+        if kind is ActuatorKind.POSITION and (kp is None or kv is None):
+            rule_kp, rule_kv = position_gains(load)
+            kp = rule_kp if kp is None else kp
+            kv = rule_kv if kv is None else kv
+            made_up.append(f"{target} kp {fmt(kp)} kv {fmt(kv)} (inertia {fmt(inertia)})")
+        elif kind is ActuatorKind.VELOCITY and kv is None:
+            kv = velocity_gain(load)
+            made_up.append(f"{target} kv {fmt(kv)} (inertia {fmt(inertia)})")
+        gains = (kp, 0.0, kv) if kind is ActuatorKind.POSITION else (kv, 0.0, 0.0)
+        for tag, value in zip(("p_gain", "i_gain", "d_gain"), gains, strict=True):
+            num(el, tag, float(value or 0.0))
+        force = actuator.force_range
+        effort = joint.limits.effort
+        if force is None and math.isfinite(effort) and effort > 0.0:
+            force = (-effort, effort)
+        if force is not None:
+            num(el, "cmd_max", force[1])
+            num(el, "cmd_min", force[0])
+        return {"use_force_commands", "p_gain", "i_gain", "d_gain", "cmd_max", "cmd_min"}
+
+    def _losses(self, actuator: Actuator, target: str, lost: list[str]) -> None:
+        dropped: list[str] = []
+        if actuator.gear != 1.0:
+            dropped.append(f"gear {fmt(actuator.gear)}")
+        if actuator.ctrl_range is not None:
+            dropped.append(f"ctrlrange {fmt(actuator.ctrl_range[0])} {fmt(actuator.ctrl_range[1])}")
+        if actuator.kind is ActuatorKind.EFFORT and actuator.force_range is not None:
+            dropped.append(f"forcerange {fmt(actuator.force_range[0])} {fmt(actuator.force_range[1])}")
+        if dropped:
+            lost.append(f"{target} ({', '.join(dropped)})")
+
+    def _load(self, joint: str) -> JointLoad:
+        if self._loads is None:
+            self._loads = joint_loads(self.robot)
+        return self._loads.get(joint, JointLoad(0.0))

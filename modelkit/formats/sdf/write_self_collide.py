@@ -1,0 +1,87 @@
+"""SDF writer, self-collision: ``<self_collide>`` on the model or on links, and a note (MK834).
+
+* A source's own flags (SDF's model and link flags, a URDF's ``<gazebo>`` ``selfCollide``) are written
+  as it gave them.
+* Any other source gets the policy of :mod:`modelkit.convert.self_collision`, the MJCF writer's as far as
+  SDF can say it: when no two links touch at rest, ``<model><self_collide>true`` (every pair of links not
+  joined by a joint collides, as in MuJoCo); otherwise each link with collision shapes that touches
+  nothing gets ``<link><self_collide>true`` and the links of the touching pairs none. Gazebo classic
+  applies the link flags (two links collide when either has it), so every pair collides but pairs of two
+  touching-pair links; gz-sim's physics reads the model flag only, so there the robot does not collide
+  with itself. When MuJoCo could not check, nothing is written (Gazebo's default: no self-collision).
+"""
+
+from __future__ import annotations
+
+from lxml import etree
+from lxml.etree import _Element as Element
+
+from modelkit.convert.context import WriteContext
+from modelkit.convert.self_collision import plan, source_flags
+from modelkit.model import Robot
+
+
+def only_self_collide(entries: object) -> bool:
+    """URDF ``<gazebo reference>`` blocks that say nothing but ``selfCollide`` (written as link flags)."""
+    if not isinstance(entries, list) or not entries:
+        return False
+    for entry in entries:
+        try:
+            block = etree.fromstring(str(entry.get("xml", ""))) if isinstance(entry, dict) else None
+        except etree.XMLSyntaxError:
+            return False
+        if block is None or {c.tag for c in block if isinstance(c.tag, str)} != {"selfCollide"}:
+            return False
+    return True
+
+
+def _model_flag(model: Element, value: bool = True) -> None:
+    el = etree.Element("self_collide")
+    el.text = "true" if value else "false"
+    model.insert(0, el)
+
+
+def self_collide_policy(
+    robot: Robot, ctx: WriteContext, model: Element, written: set[str]
+) -> dict[str, bool]:
+    """Write the model flag into ``model``; return the link flags (source link name → value)."""
+    model_flag, link_flags = source_flags(robot)
+    if model_flag is not None or link_flags:
+        if model_flag is not None:
+            _model_flag(model, model_flag)
+        return {name: value for name, value in link_flags.items() if name in written}
+    policy = plan(robot, ctx)
+    if not policy.decided:
+        return {}
+    if policy.failure is not None:
+        ctx.note(
+            "MK834",
+            f"self-collision left off (Gazebo's default): whether links touch at rest was not checked "
+            f"({policy.failure})",
+            robot.source,
+            "model/self_collide",
+        )
+        return {}
+    if policy.model:
+        _model_flag(model)
+        ctx.note(
+            "MK834",
+            "<self_collide> on the model: every pair of links not joined by a joint collides, as in the MJCF "
+            "output (no two links touch at rest)",
+            robot.source,
+            "model/self_collide",
+        )
+        return {}
+    flagged = [name for name in policy.links if name in written]
+    shown = ", ".join(f"{a}/{b}" for a, b in policy.pairs)
+    ctx.note(
+        "MK834",
+        f"{len(policy.pairs)} link pair(s) touch at rest ({shown}); SDF cannot exclude a pair, so "
+        f"<self_collide> is on the {len(flagged)} link(s) that touch nothing and off on the others: "
+        "Gazebo classic collides every pair with a flagged link (pairs of two unflagged links do not "
+        "collide); gz-sim reads only the model's flag, which stays off, so there the robot does not "
+        "collide with itself",
+        robot.source,
+        "model/self_collide",
+    )
+    return dict.fromkeys(flagged, True)
