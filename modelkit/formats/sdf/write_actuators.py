@@ -117,7 +117,8 @@ class ActuatorWriter:
                 "MK840",
                 f"{len(made_up)} servo(s) without gains in the source get gains for a "
                 f"{fmt(SERVO_BANDWIDTH_HZ)} Hz critically damped loop on each joint's reflected inertia at "
-                "home, raised where gravity at home would make it sag (docs/convert.md): " + "; ".join(made_up),
+                "home, raised where gravity at home would make it sag (docs/convert.md): "
+                + "; ".join(made_up),
                 robot.source,
                 "model/plugin",
             )
