@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import re
 from array import array
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import yaml
 
@@ -461,37 +461,14 @@ def scan_structure(text: str, path: str, max_list_items: int = DEFAULT_MAX_LIST_
     return StructureScan(_too_deep(too_deep, path) if too_deep is not None else None, len(aliases))
 
 
+_Node = TypeVar("_Node")
+
+
 def measure_composed(root: yaml.Node, limit: int) -> tuple[str, yaml.Node] | None:
     """:func:`measure_expansion` on PyYAML's composed node graph (an alias is the anchored node
     object itself): ``("recursive", node)``, ``("limit", node)`` or None, in time linear in the
     number of distinct nodes."""
-    sizes: dict[int, int] = {}
-    on_stack: set[int] = set()
-    stack: list[tuple[yaml.Node, bool]] = [(root, False)]
-    while stack:
-        node, children_done = stack.pop()
-        key = id(node)
-        if children_done:
-            on_stack.discard(key)
-            total = 1
-            for child in _composed_children(node):
-                total += sizes.get(id(child), 1)  # a scalar is not in sizes
-                if total > limit:
-                    return ("limit", node)
-            sizes[key] = total
-            continue
-        if key in sizes:
-            continue
-        on_stack.add(key)
-        stack.append((node, True))
-        for child in _composed_children(node):
-            if isinstance(child, yaml.ScalarNode):
-                continue
-            if id(child) in on_stack:
-                return ("recursive", child)
-            if id(child) not in sizes:
-                stack.append((child, False))
-    return None
+    return _measure(root, limit, _composed_children, lambda node: 1)
 
 
 def _composed_children(node: yaml.Node) -> list[yaml.Node]:
@@ -509,18 +486,26 @@ def measure_expansion(root: YNode, limit: int) -> tuple[str, YNode] | None:
     node where the expanded count passes ``limit``, or None when the document is fine. Shared nodes
     are measured once, so the check is linear in the size of the file.
     """
+    return _measure(root, limit, _children,
+                    lambda node: 1 + (len(node.values) if isinstance(node, YNumbers) else 0))
+
+
+def _measure(root: _Node, limit: int, children: Callable[[_Node], list[_Node]],
+             own: Callable[[_Node], int]) -> tuple[str, _Node] | None:
+    """The expanded size of a node graph whose shared nodes stand for copies: each node counts
+    ``own(node)`` plus its children's sizes. Iterative post-order walk (a malicious file must not hit
+    Python's recursion limit either), each distinct node measured once."""
     sizes: dict[int, int] = {}
     on_stack: set[int] = set()
-    # Iterative post-order walk: a malicious file must not hit Python's recursion limit either.
-    stack: list[tuple[YNode, bool]] = [(root, False)]
+    stack: list[tuple[_Node, bool]] = [(root, False)]
     while stack:
         node, children_done = stack.pop()
         key = id(node)
         if children_done:
             on_stack.discard(key)
-            total = 1 + (len(node.values) if isinstance(node, YNumbers) else 0)
-            for child in _children(node):
-                total += sizes[id(child)]
+            total = own(node)
+            for child in children(node):
+                total += sizes.get(id(child), 1)
                 if total > limit:
                     return ("limit", node)
             sizes[key] = total
@@ -531,7 +516,7 @@ def measure_expansion(root: YNode, limit: int) -> tuple[str, YNode] | None:
             return ("recursive", node)
         on_stack.add(key)
         stack.append((node, True))
-        for child in _children(node):
+        for child in children(node):
             if id(child) in on_stack:
                 return ("recursive", child)
             if id(child) not in sizes:

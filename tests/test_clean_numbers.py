@@ -128,3 +128,36 @@ def test_axis_dust_is_written_as_zero(tmp_path: Path) -> None:
         assert node is not None
         value = node.get("axis") if suffix == ".xml" else node.get("xyz") if suffix == ".urdf" else node.text
         assert value == "0 -1 0", suffix
+
+
+def test_inertia_dust_is_written_as_zero(tmp_path: Path) -> None:
+    """iCub's ankle links (example-robot-data) are ``ixx=iyy=izz=0, ixz=1.35525e-20``: float dust of a
+    zero tensor, with a negative eigenvalue MuJoCo refuses. Entries below 1e-12 of mass × size² are 0
+    in every target, so the MJCF loads (the foot welded below carries the inertia)."""
+    from modelkit.convert.numbers import clean_inertia, length_scale
+
+    with length_scale(1.0):
+        dusty = np.array([[0.0, 0.0, 1.35525e-20], [0.0, 0.0, 0.0], [1.35525e-20, 0.0, 0.0]])
+        assert not clean_inertia(dusty, 0.2675).any()
+        real = np.array([[1e-9, 0.0, 2e-12], [0.0, 1e-9, 0.0], [2e-12, 0.0, 1e-9]])
+        assert (clean_inertia(real, 0.001) == real).all()  # 2e-12 > 1e-12 × 0.001 kg × 1 m²: kept
+    source = tmp_path / "ankle.urdf"
+    source.write_text("""<robot name="ankle">
+  <link name="shin"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="ankle"><inertial><mass value="0.2675"/>
+    <inertia ixx="0" ixy="0" ixz="1.35525e-20" iyy="0" iyz="0" izz="0"/></inertial></link>
+  <link name="foot"><inertial><mass value="0.5"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="roll" type="revolute"><parent link="shin"/><child link="ankle"/><axis xyz="1 0 0"/>
+    <limit lower="-0.4" upper="0.4" effort="11" velocity="1"/></joint>
+  <joint name="sole" type="fixed"><parent link="ankle"/><child link="foot"/><origin xyz="0 0 -0.05"/></joint>
+</robot>
+""")
+    robot = validate(source).robot
+    assert robot is not None
+    for suffix in (".xml", ".urdf", ".sdf"):
+        out = tmp_path / f"out{suffix}"
+        write(robot, out)
+        assert "e-20" not in out.read_text(), suffix
+    mujoco.MjModel.from_xml_path(str(tmp_path / "out.xml"))  # refused before: a negative eigenvalue

@@ -11,7 +11,8 @@ they know the quantity: :func:`clean_rotation` for quaternion components, Euler 
 entries (dimensionless: below 1e-12 is 0, and within 1e-12 of ±1, ±0.5 or ±√½ is that value),
 :func:`clean_angle` for angles (within 1e-12 of a multiple of π/4 is that multiple), and
 :func:`clean_length` for positions (below 1e-12 of the model's length scale is 0; the scale is set
-with :func:`length_scale` around a write, 1 m by default).
+with :func:`length_scale` around a write, 1 m by default), and :func:`clean_inertia` for inertia
+tensors (below 1e-12 of the link's mass × the length scale² is 0).
 """
 
 from __future__ import annotations
@@ -117,6 +118,18 @@ def clean_length(value: float) -> float:
     """A position coordinate with dust below 1e-12 of the model's length scale set to 0."""
     x = float(value)
     return 0.0 if abs(x) <= SNAP * _LENGTH_SCALE.get() else x
+
+
+def clean_inertia(tensor: np.ndarray, mass: float) -> np.ndarray:
+    """An inertia tensor (kg·m²) with entries below 1e-12 of ``mass`` × the model's length scale²
+    set to 0: iCub's ``ixz="1.35525e-20"`` on a link whose other five entries are 0 is float dust of
+    a zero tensor, and written as it is, MuJoCo refuses it (a negative eigenvalue)."""
+    t = np.asarray(tensor, dtype=float)
+    scale = SNAP * abs(float(mass)) * _LENGTH_SCALE.get() ** 2
+    if not math.isfinite(scale) or scale <= 0.0:
+        return t
+    cleaned: np.ndarray = np.where(np.abs(t) <= scale, 0.0, t)
+    return cleaned
 
 
 @contextmanager

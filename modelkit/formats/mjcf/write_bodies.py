@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.numbers import fmt, fmt_direction, fmt_vec
+from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_vec
 from modelkit.convert.servo_gains import home_position
 from modelkit.formats.mjcf.write_chains import Chain, ChainFinder, shifted
 from modelkit.formats.mjcf.write_devices import DeviceWriter
@@ -460,7 +460,7 @@ class BodyTree:
             )
         mass = inertial.mass if inertial is not None else 0.0
         com = np.asarray(inertial.com, dtype=float) if inertial is not None else np.zeros(3)
-        tensor = np.asarray(inertial.inertia, dtype=float) if inertial is not None else np.zeros((3, 3))
+        tensor = clean_inertia(inertial.inertia, inertial.mass) if inertial is not None else np.zeros((3, 3))
         if moving:
             group_mass, moments = self._weld_group(link)
             if group_mass < SINGULAR:

@@ -39,7 +39,7 @@ from lxml.etree import _Element as Element
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.gazebo import gazebo_family
-from modelkit.convert.numbers import fmt, fmt_direction, fmt_vec
+from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_vec
 from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
 from modelkit.formats.sdf.write_geometry import GeomWriter
@@ -320,7 +320,7 @@ class _ModelWriter:
         add_pose(inertial_el, Pose(np.eye(3), np.asarray(inertial.com, dtype=float)))
         num(inertial_el, "mass", inertial.mass)
         tensor = sub(inertial_el, "inertia")
-        m = self._valid_inertia(link, name, np.asarray(inertial.inertia, dtype=float))
+        m = self._valid_inertia(link, name, clean_inertia(inertial.inertia, inertial.mass))
         for key, (i, j) in (
             ("ixx", (0, 0)),
             ("ixy", (0, 1)),
