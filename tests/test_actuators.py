@@ -391,3 +391,23 @@ def test_mjcf_actuators_reach_urdf_and_body_as_their_kinds(tmp_path: Path) -> No
     body = tmp_path / "body" / "four.body"
     write(robot, body, force=True)
     assert {a.joint: a.kind for a in load(body).actuators} == kinds
+
+
+def test_reflected_inertias_equal_mujocos_mass_matrix(tmp_path: Path) -> None:
+    """The gain rule's inertia of every Panda joint (summed once per subtree, bottom up, with a
+    parallel-axis shift) is the diagonal of MuJoCo's own joint-space mass matrix at home."""
+    from modelkit.convert.servo_gains import joint_loads
+
+    robot = load(example_robot("panda_description/urdf/panda.urdf"))
+    loads = joint_loads(robot)
+    out, _ = convert(robot, tmp_path, "motor")
+    m = mujoco.MjModel.from_xml_path(str(out))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home"))
+    mujoco.mj_forward(m, d)
+    full = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, full)
+    for j in range(m.njnt):
+        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
+        dof = m.jnt_dofadr[j]
+        assert loads[name].inertia == pytest.approx(full[dof, dof], rel=1e-9), name

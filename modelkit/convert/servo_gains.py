@@ -23,7 +23,7 @@ A subtree without mass gets ``MIN_INERTIA`` so that every gain is positive.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -61,63 +61,110 @@ def natural_frequency() -> float:
 
 
 def joint_loads(robot: Robot) -> dict[str, JointLoad]:
-    """Joint name → :class:`JointLoad` at home, hinges and slides (armature in the inertia)."""
+    """Joint name → :class:`JointLoad` at home, hinges and slides (armature in the inertia).
+
+    Linear in the number of links (a 10,000-link chain is written in seconds): each link's subtree is
+    summed once, bottom up, as its mass ``M``, first moment ``S = Σ m c`` and second moment about the
+    world origin ``J = Σ R I Rᵀ + m (|c|² 1 − c cᵀ)``; a joint at ``a`` then reads its subtree's
+    inertia about ``a`` by the parallel-axis shift ``J − (2 a·S − M |a|²) 1 + S aᵀ + a Sᵀ − M a aᵀ``.
+    The reach is the farthest corner of the box around the subtree's centres of mass (at most √3
+    times the farthest centre itself)."""
     home = {j.name: home_position(j) for j in robot.joints}
     poses = robot.world_poses(home)
-    children = robot.children_of()
-    links: dict[str, Link] = {}
-    for link in robot.links:
-        links.setdefault(link.name, link)
+    sums = _subtree_sums(robot, poses)
     out: dict[str, JointLoad] = {}
     for joint in robot.joints:
         if joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC) or joint.child not in poses:
             continue
-        load = _subtree_load(links, joint, poses, children)
+        total = sums.get(joint.child)
+        load = JointLoad(0.0) if total is None else _load_about(joint, poses[joint.child], total)
         out[joint.name] = JointLoad(load.inertia + joint.armature, load.gravity, load.reach)
     return out
 
 
-def _subtree_load(
-    links: dict[str, Link], joint: Joint, poses: dict[str, Pose], children: dict[str, list[Joint]]
-) -> JointLoad:
-    frame = poses[joint.child]
-    rotation = np.asarray(frame.rotation, dtype=float)
-    axis = rotation @ np.asarray(joint.axis, dtype=float)
+@dataclass
+class _Sums:
+    """A subtree's mass, first moment and second moment about the world origin, and the box around
+    its centres of mass (empty: ``low`` > ``high``)."""
+
+    mass: float = 0.0
+    first: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    second: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    low: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
+    high: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))
+
+    def add(self, other: _Sums) -> None:
+        self.mass += other.mass
+        self.first += other.first
+        self.second += other.second
+        self.low = np.minimum(self.low, other.low)
+        self.high = np.maximum(self.high, other.high)
+
+
+def _own_sums(link: Link | None, pose: Pose | None) -> _Sums:
+    sums = _Sums()
+    if link is None or link.inertial is None or pose is None:
+        return sums
+    mass = float(link.inertial.mass)
+    r = np.asarray(pose.rotation, dtype=float)
+    com = r @ np.asarray(link.inertial.com, dtype=float) + np.asarray(pose.translation, dtype=float)
+    inertia = r @ np.asarray(link.inertial.inertia, dtype=float) @ r.T
+    sums.mass = mass
+    sums.first = mass * com
+    sums.second = inertia + mass * (float(com @ com) * np.eye(3) - np.outer(com, com))
+    if mass > 0.0:
+        sums.low, sums.high = com.copy(), com.copy()
+    return sums
+
+
+def _subtree_sums(robot: Robot, poses: dict[str, Pose]) -> dict[str, _Sums]:
+    """Every link's :class:`_Sums` over its subtree, by one iterative post-order walk of the tree."""
+    children = robot.children_of()
+    links: dict[str, Link] = {}
+    for link in robot.links:
+        links.setdefault(link.name, link)
+    sums: dict[str, _Sums] = {}
+    for start in links:
+        if start in sums:
+            continue
+        stack: list[tuple[str, bool]] = [(start, False)]
+        while stack:
+            name, done = stack.pop()
+            if done:
+                total = _own_sums(links.get(name), poses.get(name))
+                for joint in children.get(name, []):
+                    below = sums.get(joint.child)
+                    if below is not None and joint.child != name:
+                        total.add(below)
+                sums[name] = total
+                continue
+            if name in sums:
+                continue
+            sums[name] = _Sums()  # a placeholder: a cycle back to here adds nothing
+            stack.append((name, True))
+            stack.extend((j.child, False) for j in children.get(name, []) if j.child not in sums)
+    return sums
+
+
+def _load_about(joint: Joint, frame: Pose, sums: _Sums) -> JointLoad:
+    axis = np.asarray(frame.rotation, dtype=float) @ np.asarray(joint.axis, dtype=float)
     norm = float(np.linalg.norm(axis))
     if norm == 0.0:
         return JointLoad(0.0)
     axis /= norm
     anchor = np.asarray(frame.translation, dtype=float)
-    inertia_sum, weight, reach = 0.0, np.zeros(3), 0.0
-    stack, seen = [joint.child], set()
-    while stack:
-        name = stack.pop()
-        if name in seen:
-            continue
-        seen.add(name)
-        stack.extend(j.child for j in children.get(name, []))
-        link = links.get(name)
-        if link is None or link.inertial is None or name not in poses:
-            continue
-        mass = float(link.inertial.mass)
-        pose = poses[name]
-        r = np.asarray(pose.rotation, dtype=float)
-        com = r @ np.asarray(link.inertial.com, dtype=float) + np.asarray(pose.translation, dtype=float)
-        offset = com - anchor
-        if joint.type is JointType.PRISMATIC:
-            inertia_sum += mass
-            weight += mass * GRAVITY
-            continue
-        if mass > 0.0:
-            reach = max(reach, float(np.linalg.norm(offset)))
-            weight += np.cross(offset, mass * GRAVITY)
-        inertia = r @ np.asarray(link.inertial.inertia, dtype=float) @ r.T
-        perpendicular = offset - float(offset @ axis) * axis
-        inertia_sum += float(axis @ inertia @ axis) + mass * float(perpendicular @ perpendicular)
-    gravity = abs(float(weight @ axis))
-    if joint.type is JointType.PRISMATIC:
-        reach = 1.0  # a slide's sag is its own displacement
-    return JointLoad(inertia_sum, gravity, reach)
+    if joint.type is JointType.PRISMATIC:  # a slide's sag is its own displacement
+        return JointLoad(sums.mass, abs(float(axis @ (sums.mass * GRAVITY))), 1.0)
+    shift = ((2.0 * float(anchor @ sums.first) - sums.mass * float(anchor @ anchor)) * np.eye(3)
+             - np.outer(sums.first, anchor) - np.outer(anchor, sums.first)
+             + sums.mass * np.outer(anchor, anchor))
+    inertia = float(axis @ (sums.second - shift) @ axis)
+    gravity = abs(float(axis @ np.cross(sums.first - sums.mass * anchor, GRAVITY)))
+    reach = 0.0
+    if np.all(sums.low <= sums.high):
+        corners = np.maximum(np.abs(sums.low - anchor), np.abs(sums.high - anchor))
+        reach = float(np.linalg.norm(corners))
+    return JointLoad(max(inertia, 0.0), gravity, reach)
 
 
 def natural_frequency_for(load: JointLoad) -> float:
