@@ -1281,9 +1281,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "actuator-gains-made-up",
         "info",
         "A position or velocity actuator the source gave no gains for (URDF transmissions and ros2_control, "
-        "Choreonoid actuation modes, `--actuators position|velocity`) gets gains from the documented rule "
-        "(docs/convert.md: a stated bandwidth on each joint's reflected inertia at home); the note gives "
-        "them.",
+        "Choreonoid actuation modes, SDF controllers, `--actuators auto|position|velocity`) gets gains from "
+        "the documented rule (docs/convert.md: a stated bandwidth on each joint's reflected inertia at home, "
+        "raised where gravity at home would make the servo sag); the note gives them.",
     ),
     CodeInfo(
         "MK841",
