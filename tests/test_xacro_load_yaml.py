@@ -2,7 +2,7 @@
 
 Issue 18 §2: an alias bomb loaded by ``load_yaml`` and printed by an expression ran for minutes past
 2 GB. Each case here is a real file in ``tmp_path``; the memory cases run ``modelkit validate`` in a
-child process and read its peak resident size (``ru_maxrss``), under an address-space cap so that a
+child process and read its peak resident size (``VmHWM``), under an address-space cap so that a
 regression fails the test instead of swapping the machine. Values of a sound file are compared with
 the xacro package's own ``process_file``, run in its own process.
 """
@@ -24,17 +24,18 @@ GIB = 1 << 30
 
 # Runs the CLI in a child process with 2 GiB of address space at most and prints, after the CLI's
 # own output, one JSON line with the exit code and the peak resident size in bytes.
-_CHILD = """
+_CHILD = f"""
 import json, resource, sys
+sys.path.insert(0, {str(Path(__file__).resolve().parents[1])!r})
 resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
 from modelkit.cli import main
+from tests.hostile.runner import own_peak_kib
 try:
     main(sys.argv[1:], standalone_mode=False)
     code = 0
 except SystemExit as exc:
     code = exc.code
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-print(json.dumps({"exit": code, "peak": peak}))
+print(json.dumps({{"exit": code, "peak": own_peak_kib() * 1024}}))
 """
 
 

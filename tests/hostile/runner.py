@@ -22,7 +22,7 @@ def _expire(signum: int, frame: FrameType | None) -> None:
     raise TimeoutError("case timed out")
 
 
-def _own_peak_kib() -> int:
+def own_peak_kib() -> int:
     """This process's own peak resident set, in KiB.
 
     Not ``getrusage(RUSAGE_SELF).ru_maxrss``: Linux carries the forking parent's peak across
@@ -68,7 +68,7 @@ def main() -> None:
             record["stray"] = sorted(os.listdir(cwd))
             os.chdir("/")
         print(json.dumps(record), flush=True)
-    print(json.dumps({"peak_kib": _own_peak_kib()}), flush=True)
+    print(json.dumps({"peak_kib": own_peak_kib()}), flush=True)
 
 
 if __name__ == "__main__":
