@@ -66,6 +66,31 @@ def source_flags(robot: Robot) -> tuple[bool | None, dict[str, bool]]:
     return found, links
 
 
+@dataclass
+class Flags:
+    """What a per-link target writes: the model flag (None: none), the link flags (source link name →
+    value), and ``policy`` when they come from :func:`plan` rather than from the source."""
+
+    model: bool | None = None
+    links: dict[str, bool] = field(default_factory=dict)
+    policy: SelfCollision | None = None
+
+
+def flags(robot: Robot, ctx: WriteContext) -> Flags:
+    """The source's own flags when it has any, else :func:`plan`'s: the model flag when nothing touches
+    at rest, else the flag on every link with collision shapes outside the touching pairs; none when
+    MuJoCo could not check or there are too few links to say anything."""
+    model, links = source_flags(robot)
+    if model is not None or links:
+        return Flags(model, links)
+    policy = plan(robot, ctx)
+    if not policy.decided or policy.failure is not None:
+        return Flags(policy=policy)
+    if policy.model:
+        return Flags(True, {}, policy)
+    return Flags(None, dict.fromkeys(policy.links, True), policy)
+
+
 def colliding_links(robot: Robot) -> list[str]:
     return [link.name for link in robot.links if link.collisions]
 

@@ -17,7 +17,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.self_collision import plan, source_flags
+from modelkit.convert.self_collision import flags
 from modelkit.model import Robot
 
 
@@ -45,43 +45,27 @@ def self_collide_policy(
     robot: Robot, ctx: WriteContext, model: Element, written: set[str]
 ) -> dict[str, bool]:
     """Write the model flag into ``model``; return the link flags (source link name → value)."""
-    model_flag, link_flags = source_flags(robot)
-    if model_flag is not None or link_flags:
-        if model_flag is not None:
-            _model_flag(model, model_flag)
-        return {name: value for name, value in link_flags.items() if name in written}
-    policy = plan(robot, ctx)
-    if not policy.decided:
-        return {}
+    chosen = flags(robot, ctx)
+    if chosen.model is not None:
+        _model_flag(model, chosen.model)
+    link_flags = {name: value for name, value in chosen.links.items() if name in written}
+    policy = chosen.policy
+    if policy is None or not policy.decided:
+        return link_flags
     if policy.failure is not None:
-        ctx.note(
-            "MK834",
-            f"self-collision left off (Gazebo's default): whether links touch at rest was not checked "
-            f"({policy.failure})",
-            robot.source,
-            "model/self_collide",
+        message = ("self-collision left off (Gazebo's default): whether links touch at rest was not checked "
+                   f"({policy.failure})")
+    elif policy.model:
+        message = ("<self_collide> on the model: every pair of links not joined by a joint collides, as in "
+                   "the MJCF output (no two links touch at rest)")
+    else:
+        shown = ", ".join(f"{a}/{b}" for a, b in policy.pairs)
+        message = (
+            f"{len(policy.pairs)} link pair(s) touch at rest ({shown}); SDF cannot exclude a pair, so "
+            f"<self_collide> is on the {len(link_flags)} link(s) that touch nothing and off on the others: "
+            "Gazebo classic collides every pair with a flagged link (pairs of two unflagged links do not "
+            "collide); gz-sim reads only the model's flag, which stays off, so there the robot does not "
+            "collide with itself"
         )
-        return {}
-    if policy.model:
-        _model_flag(model)
-        ctx.note(
-            "MK834",
-            "<self_collide> on the model: every pair of links not joined by a joint collides, as in the MJCF "
-            "output (no two links touch at rest)",
-            robot.source,
-            "model/self_collide",
-        )
-        return {}
-    flagged = [name for name in policy.links if name in written]
-    shown = ", ".join(f"{a}/{b}" for a, b in policy.pairs)
-    ctx.note(
-        "MK834",
-        f"{len(policy.pairs)} link pair(s) touch at rest ({shown}); SDF cannot exclude a pair, so "
-        f"<self_collide> is on the {len(flagged)} link(s) that touch nothing and off on the others: "
-        "Gazebo classic collides every pair with a flagged link (pairs of two unflagged links do not "
-        "collide); gz-sim reads only the model's flag, which stays off, so there the robot does not "
-        "collide with itself",
-        robot.source,
-        "model/self_collide",
-    )
-    return dict.fromkeys(flagged, True)
+    ctx.note("MK834", message, robot.source, "model/self_collide")
+    return link_flags

@@ -23,7 +23,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.self_collision import plan, source_flags
+from modelkit.convert.self_collision import flags
 from modelkit.model import Robot
 
 PYBULLET = ("PyBullet ignores self-collision unless the URDF is loaded with URDF_USE_SELF_COLLISION "
@@ -41,39 +41,31 @@ def write_self_collision(
     robot_el: Element, robot: Robot, link_names: dict[str, str], ctx: WriteContext
 ) -> None:
     """``link_names``: source link name → written name."""
-    model, links = source_flags(robot)
     if robot.source_format == "urdf":
         return  # its own <gazebo> blocks (or their absence) are written back as they were
-    if model is not None or links:
-        if model is not None:
-            _block(robot_el, None, "self_collide", model)
-        for name, value in links.items():
-            if name in link_names:
-                _block(robot_el, link_names[name], "selfCollide", value)
-        return
-    policy = plan(robot, ctx)
-    if not policy.decided:
+    chosen = flags(robot, ctx)
+    if chosen.model is not None:
+        _block(robot_el, None, "self_collide", chosen.model)
+    flagged = [link_names[name] for name in chosen.links if name in link_names]
+    for name, value in chosen.links.items():
+        if name in link_names:
+            _block(robot_el, link_names[name], "selfCollide", value)
+    policy = chosen.policy
+    if policy is None or not policy.decided:
         return
     if policy.failure is not None:
-        ctx.note("MK834", "no self-collision flags written (Gazebo's default: off): whether links touch at "
-                 f"rest was not checked ({policy.failure})", robot.source, "gazebo")
-        return
-    if policy.model:
-        _block(robot_el, None, "self_collide", True)
-        ctx.note("MK834", "a robot-level <gazebo><self_collide> (libsdformat copies it into the model): in "
-                 "Gazebo every pair of links not joined by a joint collides, as in the MJCF output (no two "
-                 f"links touch at rest); {PYBULLET}", robot.source, "gazebo")
-        return
-    flagged = [link_names[n] for n in policy.links if n in link_names]
-    for name in flagged:
-        _block(robot_el, name, "selfCollide", True)
-    shown = ", ".join(f"{link_names.get(a, a)}/{link_names.get(b, b)}" for a, b in policy.pairs)
-    ctx.note(
-        "MK834",
-        f"{len(policy.pairs)} link pair(s) touch at rest ({shown}); URDF cannot exclude a pair, so "
-        f"<gazebo><selfCollide> is on the {len(flagged)} link(s) that touch nothing: Gazebo classic collides "
-        "every pair with a flagged link, gz-sim reads only the model's flag (off: no self-collision); "
-        f"{PYBULLET}, then setCollisionFilterPair(..., enableCollision=0) on those pairs",
-        robot.source,
-        "gazebo",
-    )
+        message = ("no self-collision flags written (Gazebo's default: off): whether links touch at rest was "
+                   f"not checked ({policy.failure})")
+    elif policy.model:
+        message = ("a robot-level <gazebo><self_collide> (libsdformat copies it into the model): in Gazebo "
+                   "every pair of links not joined by a joint collides, as in the MJCF output (no two links "
+                   f"touch at rest); {PYBULLET}")
+    else:
+        shown = ", ".join(f"{link_names.get(a, a)}/{link_names.get(b, b)}" for a, b in policy.pairs)
+        message = (
+            f"{len(policy.pairs)} link pair(s) touch at rest ({shown}); URDF cannot exclude a pair, so "
+            f"<gazebo><selfCollide> is on the {len(flagged)} link(s) that touch nothing: Gazebo classic "
+            "collides every pair with a flagged link, gz-sim reads only the model's flag (off: no "
+            f"self-collision); {PYBULLET}, then setCollisionFilterPair(..., enableCollision=0) on those pairs"
+        )
+    ctx.note("MK834", message, robot.source, "gazebo")
