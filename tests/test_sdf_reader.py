@@ -883,3 +883,46 @@ def test_include_placement_frame_with_pose_is_accepted(tmp_path: Path, sdf_oracl
     )
     assert not oracle_has_errors(sdf_oracle, world)
     assert validate(world).errors == []
+
+
+@pytest.mark.parametrize("layout", ["model-root", "sdf-subfolder"])
+def test_mesh_uri_relative_to_an_included_model_is_found_in_its_folder(
+    tmp_path: Path, sdf_oracle: Path, layout: str
+) -> None:
+    """Issue 18 item 3: a mesh URI written relative to an included model's own file is resolved from that
+    file's folder (as Gazebo does), not from the including file's: both layouts validate without a
+    finding, libsdformat accepts them, and convert copies the mesh, which MuJoCo then loads."""
+    kr16 = CORPUS / "kuka_experimental" / "kuka_kr16_support" / "meshes" / "kr16_2" / "collision"
+    kr16 = kr16 / "link_1.stl"
+    folder = tmp_path / "models" / "part"
+    model_file, uri = ("model.sdf", "meshes/part.stl") if layout == "model-root" else (
+        "sdf/model.sdf", "../meshes/part.stl")
+    (folder / "meshes").mkdir(parents=True)
+    (folder / "meshes" / "part.stl").write_bytes(kr16.read_bytes())
+    (folder / model_file).parent.mkdir(parents=True, exist_ok=True)
+    (folder / "model.config").write_text(
+        f'<?xml version="1.0"?>\n<model><name>part</name><sdf version="1.9">{model_file}</sdf></model>\n')
+    geometry = f"<geometry><mesh><uri>{uri}</uri></mesh></geometry>"
+    (folder / model_file).write_text(model("1.9", (
+        '<link name="base"><inertial><mass>1</mass><inertia><ixx>0.1</ixx><iyy>0.1</iyy><izz>0.1</izz>'
+        f'</inertia></inertial><collision name="c">{geometry}</collision><visual name="v">{geometry}</visual>'
+        "</link>"), name="part"))
+    top = tmp_path / "scene" / "top.sdf"
+    top.parent.mkdir()
+    top.write_text(model("1.9", (
+        '<link name="root"><inertial><mass>1</mass></inertial></link>'
+        "<include><uri>model://part</uri><name>p</name></include>"
+        '<joint name="j" type="fixed"><parent>root</parent><child>p::base</child></joint>'), name="top"))
+    env = {"GZ_SIM_RESOURCE_PATH": str(tmp_path / "models")}
+    result = CliRunner().invoke(main, ["validate", str(top)], env=env)
+    assert result.exit_code == 0 and "0 error(s), 0 warning(s)" in result.output, result.output
+    run = subprocess.run([str(sdf_oracle), top.name], cwd=top.parent, capture_output=True, text=True,
+                         timeout=60, env={**os.environ, **env, "SDF_PATH": env["GZ_SIM_RESOURCE_PATH"]})
+    assert run.returncode == 0 and "Error" not in run.stdout + run.stderr, run.stdout + run.stderr
+    out = tmp_path / "out" / "top.xml"
+    result = CliRunner().invoke(main, ["convert", str(top), "-o", str(out)], env=env)
+    assert result.exit_code == 0, result.output
+    import mujoco
+
+    written = mujoco.MjModel.from_xml_path(str(out))
+    assert written.nmesh == 1 and written.mesh_vertnum[0] > 0
