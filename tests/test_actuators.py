@@ -8,6 +8,7 @@ The hold test is the acceptance check: an arm converted to MJCF with position ac
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -411,3 +412,50 @@ def test_reflected_inertias_equal_mujocos_mass_matrix(tmp_path: Path) -> None:
         name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
         dof = m.jnt_dofadr[j]
         assert loads[name].inertia == pytest.approx(full[dof, dof], rel=1e-9), name
+
+
+# Legged robots of example-robot-data whose URDF names no actuators: each gets a free base and a position
+# servo per joint, and its home keyframe (q = 0, put into range: MK845) is a standing pose. Left out: A1
+# (home puts all four feet 0.16 m behind their hips and it tips over nose first: a pose, not a gain), and
+# Go1, B1 and HyQ, whose URDFs name effort interfaces (motors at zero control: the source's answer).
+EXAMPLE_LEGGED = (
+    "anymal_b_simple_description/robots/anymal.urdf",
+    "anymal_c_simple_description/urdf/anymal.urdf",
+    "go2_description/urdf/go2.urdf",
+    "laikago_description/urdf/laikago.urdf",
+    "solo_description/robots/solo12.urdf",
+)
+STAND_SECONDS, STAND_SAG, STAND_TILT = 3.0, 0.015, 0.05  # s, m, rad
+
+
+def stand_on_a_plain_floor(path: Path) -> tuple[float, float]:
+    """The written MJCF with only a default-contact plane added, reset to ``home``, lowered onto the
+    floor and left alone: (how far the base sank in m, how far it tilted in rad)."""
+    spec = mujoco.MjSpec.from_file(str(path))
+    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0])
+    m = spec.compile()
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home"))
+    assert m.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE, "a legged robot is free"
+    for _ in range(100):  # lift it out of the floor: no contact deeper than 0.1 mm
+        mujoco.mj_forward(m, d)
+        depth = min([c.dist for c in d.contact[:d.ncon]] or [0.0])
+        if depth >= -1e-4:
+            break
+        d.qpos[2] -= depth
+    start = float(d.qpos[2])
+    for _ in range(round(STAND_SECONDS / m.opt.timestep)):
+        mujoco.mj_step(m, d)
+    w = min(1.0, abs(float(d.qpos[3])))
+    return start - float(d.qpos[2]), 2.0 * math.acos(w)
+
+
+@pytest.mark.parametrize("relative", EXAMPLE_LEGGED)
+def test_example_legged_robots_stand_at_home(tmp_path: Path, relative: str) -> None:
+    """The user's next step on a legged robot: ``convert`` with the default options, a floor added, reset
+    to ``home``: it floats and stands on its own servos (base within 15 mm and 0.05 rad after 3 s)."""
+    robot = load(example_robot(relative))
+    out, _ = convert(robot, tmp_path)
+    assert {el.tag for el in actuator_elements(out)} == {"position"}
+    sag, tilt = stand_on_a_plain_floor(out)
+    assert sag < STAND_SAG and tilt < STAND_TILT, f"{relative}: sank {sag * 1e3:.1f} mm, tilted {tilt:.3f}"
