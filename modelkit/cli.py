@@ -450,6 +450,9 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
               help="URDF <gazebo> blocks and SDF sensors for Gazebo classic (ray, depth, gazebo_ros plugins) "
                    "or Gazebo Sim (gpu_lidar, rgbd_camera, gz-sim systems); auto: what the source used, "
                    "Sim when it says nothing (MK848).")
+@click.option("--ros-plugins/--no-ros-plugins", default=True, show_default=True,
+              help="Gazebo classic: a sensor the source gave no plugin gets the gazebo_ros plugin that "
+                   "publishes it to ROS 2 (LaserScan/PointCloud2, camera and depth images, Imu; MK850).")
 @click.option("--wheel-collision", type=click.Choice(WHEEL_COLLISIONS), default="auto", show_default=True,
               help="Collision shape of wheels (auto: a sphere for MJCF and URDF, the cylinder for SDF and "
                    ".body; MK826).")
@@ -480,6 +483,7 @@ def convert(
     urdf_distinct_names: bool,
     urdf_sensor_links: bool,
     gazebo: str,
+    ros_plugins: bool,
     wheel_collision: str,
     base: str,
     actuators: str,
@@ -507,6 +511,7 @@ def convert(
         urdf_distinct_names=urdf_distinct_names,
         urdf_sensor_links=urdf_sensor_links,
         gazebo=gazebo,
+        ros_plugins=ros_plugins,
         wheel_collision=wheel_collision,
         base=base,
         actuators=actuators,

@@ -1352,6 +1352,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "camera's range...) is left out; the note names each with its value.",
     ),
     CodeInfo(
+        "MK850",
+        "gazebo-ros-plugin-added",
+        "info",
+        "Gazebo classic: a sensor the source gave no plugin gets the `gazebo_ros` plugin that publishes it "
+        "to ROS 2 (ray sensor, camera or IMU plugin, stamped with its TF frame); the note gives the topics. "
+        "`--no-ros-plugins` leaves them out.",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",

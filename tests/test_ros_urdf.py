@@ -241,3 +241,109 @@ def test_unmapped_sensor_parameters_are_notes_and_classic_sdf_loads(
     lidar = next(s for s in sdf.iter("sensor") if s.get("name") == "LiDAR")
     assert lidar.get("type") == "ray" and lidar.find("ray") is not None and lidar.find("lidar") is None
     assert not oracle_has_errors(sdf_oracle, tmp_path / "sdf" / "robot.sdf")
+
+
+SDF_PRINT_SOURCE = r"""
+#include <iostream>
+#include <sdf/sdf.hh>
+// Prints the SDF libsdformat makes of a file (a URDF: its URDF to SDF conversion, what Gazebo spawns).
+int main(int argc, char **argv) {
+  if (argc != 2) { std::cerr << "usage: sdf_print FILE\n"; return 2; }
+  sdf::Root root;
+  sdf::Errors errors = root.Load(argv[1]);
+  for (const auto &e : errors)
+    std::cerr << "Error Code " << static_cast<int>(e.Code()) << ": " << e.Message() << "\n";
+  if (!errors.empty()) return 1;
+  std::cout << root.Element()->ToString("");
+  return 0;
+}
+"""
+
+
+@pytest.fixture(scope="module")
+def sdf_print(tmp_path_factory: pytest.TempPathFactory, sdf_oracle: Path) -> Path:  # noqa: F811
+    """libsdformat 12's reading of a file, printed as SDF (compiled like the SDF oracle, which it needs)."""
+    import shlex
+    import shutil
+
+    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "sdformat12"], capture_output=True, text=True,
+                           check=True).stdout
+    folder = tmp_path_factory.mktemp("sdf_print")
+    (folder / "sdf_print.cc").write_text(SDF_PRINT_SOURCE)
+    compiler = shutil.which("g++")
+    assert compiler is not None
+    subprocess.run([compiler, "-O0", "-o", str(folder / "sdf_print"), str(folder / "sdf_print.cc"),
+                    *shlex.split(flags)], check=True)
+    return folder / "sdf_print"
+
+
+def _plugins_by_sensor(root: etree._Element) -> dict[str, dict[str, str]]:
+    """Sensor name → its plugin's file name and each leaf element's text by its path in the plugin
+    (``ros/remapping`` for a ``<remapping>`` in ``<ros>``)."""
+    out: dict[str, dict[str, str]] = {}
+    for sensor in root.iter("sensor"):
+        for plugin in sensor.iter("plugin"):
+            fields = {"filename": plugin.get("filename", "")}
+            stack = [(child, child.tag) for child in plugin]
+            while stack:
+                element, path = stack.pop()
+                stack.extend((child, f"{path}/{child.tag}") for child in element)
+                if len(element) == 0:
+                    fields[path] = (element.text or "").strip()
+            out[sensor.get("name", "")] = fields
+    return out
+
+
+EXPECTED_PLUGINS = {
+    "LiDAR": {"filename": "libgazebo_ros_ray_sensor.so", "ros/remapping": "~/out:=LiDAR/scan",
+              "output_type": "sensor_msgs/LaserScan", "frame_name": "LiDAR"},
+    "RealSense": {"filename": "libgazebo_ros_camera.so", "camera_name": "RealSense",
+                  "frame_name": "RealSense_optical", "min_depth": "0.1", "max_depth": "10"},
+}
+
+
+def test_classic_sensors_publish_to_ros(tmp_path: Path, sdf_print: Path) -> None:
+    """A .body robot for Gazebo classic: the LiDAR gets gazebo_ros's ray-sensor plugin (LaserScan, stamped
+    with its TF frame) and the RealSense the camera plugin (stamped with its REP-103 optical frame, its
+    detection range as min/max depth, no longer an MK849 loss); MK850 names the topics. check_urdf takes
+    the file, and libsdformat's URDF conversion (what Gazebo spawns) keeps both plugins in the sensors."""
+    robot = _read(SENSORS)
+    options = WriteOptions(gazebo="classic", urdf_distinct_names=True)
+    path, notes = _write(robot, tmp_path / "classic", options)
+    assert _plugins_by_sensor(etree.parse(str(path)).getroot()) == EXPECTED_PLUGINS
+    added = {n.message.split('"')[1]: n.message for n in notes if n.code == "MK850"}
+    assert set(added) == {"LiDAR", "RealSense"}
+    assert "sensor_msgs/LaserScan on LiDAR/scan" in added["LiDAR"]
+    assert "RealSense/depth/image_raw, RealSense/points" in added["RealSense"]
+    (unmapped,) = [n.message for n in notes if n.code == "MK849" and '"RealSense"' in n.message]
+    assert "detection_rate 0.9" in unmapped and "range_" not in unmapped
+    _check_urdf(path)
+    run = subprocess.run([str(sdf_print), path.name], cwd=path.parent, capture_output=True, text=True,
+                         timeout=60)
+    assert run.returncode == 0, run.stderr
+    converted = _plugins_by_sensor(etree.fromstring(run.stdout.encode()))
+    assert {name: fields["filename"] for name, fields in converted.items()} == {
+        name: fields["filename"] for name, fields in EXPECTED_PLUGINS.items()}
+    assert converted["RealSense"]["frame_name"] == "RealSense_optical"
+
+
+def test_ros_plugins_only_where_the_source_has_none_and_for_classic(tmp_path: Path) -> None:
+    """No plugin for Gazebo Sim (its sensors reach ROS through ros_gz_bridge), none with --no-ros-plugins,
+    and a source's own plugins stay the only ones (the lecture's unicycle); the SDF target gets them too,
+    stamped with the sensor's link (no frame_name: the SDF has no TF frames of its own)."""
+    robot = _read(SENSORS)
+    for folder, options in (("sim", WriteOptions(gazebo="sim")),
+                            ("off", WriteOptions(gazebo="classic", ros_plugins=False))):
+        path, notes = _write(robot, tmp_path / folder, options)
+        assert _plugins_by_sensor(etree.parse(str(path)).getroot()) == {}
+        assert "MK850" not in {n.code for n in notes}
+    path, notes = _write(_read(UNICYCLE), tmp_path / "unicycle", WriteOptions(gazebo="classic"))
+    assert "MK850" not in {n.code for n in notes}
+    assert {f["filename"] for f in _plugins_by_sensor(etree.parse(str(path)).getroot()).values()} == {
+        "libgazebo_ros_velodyne_laser.so", "libgazebo_ros_camera.so"}
+    plan = OutputPlan(tmp_path / "sdf")
+    render_model(robot, "sdf", plan, "robot.sdf", WriteOptions(gazebo="classic"))
+    plan.commit()
+    in_sdf = _plugins_by_sensor(etree.parse(str(tmp_path / "sdf" / "robot.sdf")).getroot())
+    assert in_sdf == {name: {k: v for k, v in fields.items() if k != "frame_name"}
+                      for name, fields in EXPECTED_PLUGINS.items()}

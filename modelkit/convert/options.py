@@ -30,6 +30,9 @@ class WriteOptions:
     # URDF <gazebo> blocks and SDF sensors: auto|classic|sim, the Gazebo whose sensor types and plugins
     # are written (auto: the source's; modelkit/convert/gazebo.py)
     gazebo: str = "auto"
+    # Gazebo classic: a sensor the source gave no plugin gets the gazebo_ros plugin that publishes it to
+    # ROS 2 (MK850; modelkit/formats/sdf/ros_plugins.py)
+    ros_plugins: bool = True
     wheel_collision: str = "auto"  # auto|cylinder|sphere|ellipsoid: the wheels' collision (convert.wheels)
     base: str = "auto"  # fixed | floating | auto: how the root meets the world (modelkit/convert/base.py)
     # actuators for a source without any (MJCF): auto (default: a position servo on each joint with a

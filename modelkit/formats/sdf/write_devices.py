@@ -16,6 +16,7 @@ from lxml.etree import _Element as Element
 from modelkit.convert.context import WriteContext
 from modelkit.convert.names import unique_name
 from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.formats.sdf.ros_plugins import RosPlugin, ros_plugin
 from modelkit.formats.sdf.sensors import CONFIG_ELEMENT
 from modelkit.formats.sdf.write_xml import add_pose, data_to_element, num, parse_fragment, rgba, sub
 from modelkit.model import CAMERA_KINDS, LIGHT_KINDS, Device, DeviceKind
@@ -93,9 +94,11 @@ class DeviceWriter:
         self.gazebo = gazebo  # "classic" | "sim": sensor types and plugins (modelkit/convert/gazebo.py)
 
     def device(
-        self, parent: Element, device: Device, pose: Pose, relative_to: str | None, owner: str, used: set[str]
+        self, parent: Element, device: Device, pose: Pose, relative_to: str | None, owner: str,
+        used: set[str], frame: str | None = None,
     ) -> None:
-        """Write one device under ``parent`` (a link or a joint), or note why it is left out."""
+        """Write one device under ``parent`` (a link or a joint), or note why it is left out. ``frame``:
+        the TF frame its data is stamped with, where the writer made one (URDF sensor frames)."""
         name = unique_name(device.name or device.kind, used)
         if is_sdf_native(device, self.source_format):
             if device.kind.startswith("light:"):
@@ -159,15 +162,20 @@ class DeviceWriter:
                 device.source,
                 target,
             )
-        self._unmapped(device, kind, params, target)
+        generated = self._ros_plugin(device, kind, name, frame)
+        self._unmapped(device, kind, params, target, generated.consumed if generated else frozenset())
         self._plugins(sensor, device, target)
+        if generated is not None:
+            self._write_ros_plugin(sensor, generated, device, target)
 
-    def _unmapped(self, device: Device, kind: DeviceKind, params: dict[str, Any], target: str) -> None:
-        """One MK849 note naming the canonical parameters the sensor has no element for."""
+    def _unmapped(self, device: Device, kind: DeviceKind, params: dict[str, Any], target: str,
+                  carried: frozenset[str] = frozenset()) -> None:
+        """One MK849 note naming the canonical parameters the sensor has no element for (``carried``: those a
+        generated plugin holds)."""
         group = "camera" if kind in CAMERA_KINDS else "lidar" if kind is DeviceKind.LIDAR else "other"
         if kind in (DeviceKind.IMU, DeviceKind.ACCELEROMETER, DeviceKind.GYRO):
             group = "imu"
-        written = WRITTEN_PARAMS[group] | NOTED_PARAMS | {"update_rate"}
+        written = WRITTEN_PARAMS[group] | NOTED_PARAMS | {"update_rate"} | carried
         left = {k: v for k, v in sorted(params.items()) if k not in written}
         for axis in ("horizontal", "vertical"):  # the scan's resolution is written as 1
             if group == "lidar" and left.get(f"{axis}_resolution") == 1.0:
@@ -201,6 +209,33 @@ class DeviceWriter:
                 device.source,
                 target,
             )
+
+    def _ros_plugin(self, device: Device, kind: DeviceKind, name: str, frame: str | None) -> RosPlugin | None:
+        """The ``gazebo_ros`` plugin a Gazebo classic sensor gets when its source gave it none (and the
+        ``ros_plugins`` option is on): :mod:`modelkit.formats.sdf.ros_plugins`."""
+        if self.gazebo != "classic" or not self.ctx.options.ros_plugins or device.params.get("plugins"):
+            return None
+        return ros_plugin(kind, name, frame, device.canonical_params, fmt)
+
+    def _write_ros_plugin(self, sensor: Element, plugin: RosPlugin, device: Device, target: str) -> None:
+        element = sub(sensor, "plugin", name=plugin.name, filename=plugin.filename)
+        for path, text in plugin.elements:
+            holder = element
+            *parents, leaf = path.split("/")
+            for tag in parents:
+                found = holder.find(tag)
+                holder = found if found is not None else sub(holder, tag)
+            sub(holder, leaf, text)
+        frame = dict(plugin.elements).get("frame_name")
+        carried = f"; it carries {', '.join(sorted(plugin.consumed))}" if plugin.consumed else ""
+        self.ctx.note(
+            "MK850",
+            f'sensor "{device.name}": a gazebo_ros plugin ({plugin.filename}) publishes {plugin.publishes} '
+            f"to ROS 2 in Gazebo classic, stamped {frame or 'with its link'}{carried} (the source has no "
+            "plugin; --no-ros-plugins leaves it out)",
+            device.source,
+            target,
+        )
 
     # -- canonical sensors ---------------------------------------------------------------------
 

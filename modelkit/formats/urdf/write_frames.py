@@ -47,9 +47,11 @@ FRAME_INERTIA = 1e-12  # kg·m², each principal moment
 @dataclass
 class SensorFrames:
     """Where each device's sensor is written: the link its ``<gazebo reference>`` names and the
-    sensor's pose in it, by (link index, device index); and the links and joints to add."""
+    sensor's pose in it, by (link index, device index); the TF frame its data is stamped with (the
+    sensor link, a camera's optical frame); and the links and joints to add."""
 
     where: dict[tuple[int, int], tuple[str, Pose]] = field(default_factory=dict)
+    data_frames: dict[tuple[int, int], str] = field(default_factory=dict)
     links: list[str] = field(default_factory=list)
     joints: list[Element] = field(default_factory=list)
 
@@ -77,6 +79,7 @@ def sensor_frames(robot: Robot, names: NameTable, ctx: WriteContext) -> SensorFr
             out.links.append(frame)
             out.joints.append(_fixed(names.fresh(f"{frame}_joint"), parent, frame, device.pose))
             out.where[(link_index, device_index)] = (frame, Pose())
+            out.data_frames[(link_index, device_index)] = frame
             text = f'"{frame}" on "{parent}"'
             if frame != wanted:
                 text += f' (the name "{wanted}" is taken)'
@@ -84,6 +87,7 @@ def sensor_frames(robot: Robot, names: NameTable, ctx: WriteContext) -> SensorFr
                 optical = names.fresh(f"{frame}_optical")
                 out.links.append(optical)
                 out.joints.append(_fixed(names.fresh(f"{optical}_joint"), frame, optical, OPTICAL_POSE))
+                out.data_frames[(link_index, device_index)] = optical
                 text += f' with its optical frame "{optical}"'
             listed.append(text)
     if listed:

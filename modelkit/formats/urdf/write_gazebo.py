@@ -50,18 +50,20 @@ def parse_block(xml: str) -> Element | None:
 
 
 def sensor_element(
-    device: Device, ctx: WriteContext, owner: str, pose: Pose | None = None, gazebo: str = "sim"
+    device: Device, ctx: WriteContext, owner: str, pose: Pose | None = None, gazebo: str = "sim",
+    frame: str | None = None,
 ) -> Element | None:
     """An SDF ``<sensor>`` for a device of the shared vocabulary at ``pose`` in the referenced link
     (default: the device pose) for Gazebo ``gazebo`` (classic or sim), written by the SDF writer's own
-    device code (None: no sensor)."""
+    device code (None: no sensor); ``frame``: the TF frame its data is stamped with."""
     from modelkit.formats.sdf.write_devices import CANONICAL_SENSOR, DeviceWriter
 
     if device.canonical not in CANONICAL_SENSOR:
         return None
     holder = etree.Element("gazebo")
     where = device.pose if pose is None else pose
-    DeviceWriter(ctx, GAZEBO_SDF_VERSION, "urdf", gazebo).device(holder, device, where, None, owner, set())
+    DeviceWriter(ctx, GAZEBO_SDF_VERSION, "urdf", gazebo).device(holder, device, where, None, owner, set(),
+                                                                 frame)
     return holder[0] if len(holder) else None
 
 
@@ -107,8 +109,10 @@ def _device(
     ctx: WriteContext,
     place: tuple[str, Pose],
     gazebo: str,
+    frame: str | None,
 ) -> None:
-    """One device: its kept block on its link, or a sensor on ``place`` (its frame link and pose)."""
+    """One device: its kept block on its link, or a sensor on ``place`` (its frame link and pose), its
+    data stamped with ``frame``."""
     xml = device.params.get("xml")
     if isinstance(xml, str):
         block = parse_block(xml)
@@ -116,7 +120,7 @@ def _device(
             _gazebo(robot_el, name).append(block)
             return
     reference, pose = place
-    sensor = sensor_element(device, ctx, f"gazebo[{reference}]", pose, gazebo)
+    sensor = sensor_element(device, ctx, f"gazebo[{reference}]", pose, gazebo, frame)
     if sensor is None:
         what = device.canonical.value if device.canonical is not DeviceKind.OTHER else device.kind
         ctx.note(
@@ -136,7 +140,7 @@ def write_extensions(
     """Every ``<gazebo>`` block (per link, per joint, robot level), then the other kept extensions."""
     friction = floor_friction(robot)
     gazebo = gazebo_family(robot, ctx.options.gazebo)
-    framed: list[tuple[Link, str, Device, tuple[str, Pose]]] = []
+    framed: list[tuple[Link, str, Device, tuple[str, Pose], str | None]] = []
     for index, link in enumerate(robot.links):
         name = names.links[index]
         written = _kept_blocks(robot_el, link.extras.get("gazebo"), name, ctx, f'link "{link.name}"')
@@ -161,12 +165,13 @@ def write_extensions(
             if device.name in written and isinstance(device.params.get("xml"), str):
                 continue
             place = frames.place(index, device_index, name, device)
+            frame = frames.data_frames.get((index, device_index))
             if place[0] != name:  # on its sensor link, which comes after the model's links
-                framed.append((link, name, device, place))
+                framed.append((link, name, device, place, frame))
                 continue
-            _device(robot_el, link, name, device, ctx, place, gazebo)
-    for link, name, device, place in framed:
-        _device(robot_el, link, name, device, ctx, place, gazebo)
+            _device(robot_el, link, name, device, ctx, place, gazebo, frame)
+    for link, name, device, place, frame in framed:
+        _device(robot_el, link, name, device, ctx, place, gazebo, frame)
     for index, joint in enumerate(robot.joints):
         _kept_blocks(robot_el, joint.extras.get("gazebo"), names.joints[index], ctx, f'joint "{joint.name}"')
     for entry in robot.extras.get("gazebo", []) or []:
