@@ -16,7 +16,7 @@ from typing import Any, NoReturn, TypeVar
 
 import click
 
-from modelkit.convert.options import (
+from modelkit.convert.choices import (
     ACTUATOR_CHOICES,
     GAZEBO_CHOICES,
     MESH_FORMATS,

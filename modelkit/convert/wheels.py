@@ -30,8 +30,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from modelkit.convert.choices import WHEEL_COLLISIONS
 from modelkit.convert.notes import NoteSink
-from modelkit.convert.options import WHEEL_COLLISIONS
 from modelkit.model import Cylinder, Ellipsoid, Geom, JointType, Robot, Sphere
 from modelkit.spatial import Pose
 
