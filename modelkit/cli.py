@@ -16,14 +16,13 @@ from typing import Any, NoReturn, TypeVar
 
 import click
 
-from modelkit.convert.options import (
+from modelkit.convert.choices import (
     ACTUATOR_CHOICES,
     GAZEBO_CHOICES,
     MESH_FORMATS,
     SDF_VERSIONS,
     WHEEL_COLLISIONS,
 )
-from modelkit.convert.registry import TARGET_NAMES
 from modelkit.diagnostics import (
     Diagnostic,
     Severity,
@@ -33,7 +32,7 @@ from modelkit.diagnostics import (
     render_json,
     render_text,
 )
-from modelkit.format_names import FORMAT_NAMES
+from modelkit.formats.registry import FORMAT_NAMES, TARGET_NAMES
 from modelkit.verify.engines.registry import DEFAULT_ENGINES  # data only: no numpy, no engine
 
 F = TypeVar("F", bound=Callable[..., Any])

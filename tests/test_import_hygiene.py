@@ -25,6 +25,8 @@ from typing import Any
 
 import pytest
 
+from modelkit.formats.registry import FORMAT_NAMES
+
 from .conftest import PENDULUM_BODY
 
 PROJECT_ROOT = Path(__file__).resolve().parents[1]
@@ -99,7 +101,7 @@ def test_no_simulator_or_mesh_stack_for_a_model_without_meshes(command: list[str
     assert report["exit_code"] == 0, report["output"]
     # The check itself works: modelkit ran in this interpreter.
     assert "modelkit.cli" in report["modules"]
-    assert any(m.startswith("modelkit.formats.body") for m in report["modules"])
+    assert "modelkit.formats.body.reader" in report["modules"]
     loaded = [m for m in report["modules"] if m.partition(".")[0] in watched]
     assert loaded == [], f"`modelkit {' '.join(command)}` imported {loaded}"
     assert report["attempted"] == [], f"`modelkit {' '.join(command)}` tried to import {report['attempted']}"
@@ -145,7 +147,8 @@ def test_other_xml_input_does_not_import_mujoco(tmp_path: Path) -> None:
     path.write_text(URDF_AS_XML)
     report = _run(["tree", str(path)], SIMULATORS)
     assert "modelkit.cli" in report["modules"]
-    assert not any(m.startswith("modelkit.formats.mjcf") for m in report["modules"])
+    mjcf = [m for m in report["modules"] if m.startswith("modelkit.formats.mjcf")]
+    assert mjcf == ["modelkit.formats.mjcf", "modelkit.formats.mjcf.declare"], mjcf  # the declaration only
     loaded = [m for m in report["modules"] if m.partition(".")[0] in SIMULATORS]
     assert loaded == [] and report["attempted"] == []
 
@@ -173,7 +176,12 @@ def test_cli_import_and_help_load_no_numpy_and_no_reader() -> None:
     assert report["exit_code"] == 0, report["output"]
     loaded = sorted({m.partition(".")[0] for m in report["modules"]} & set(heavy))
     assert loaded == [], f"`modelkit --help` imported {loaded}"
-    assert not any(m.startswith("modelkit.formats") or m == "modelkit.api" for m in report["modules"])
+    # Of the formats, only their declarations (data): each format's package (its __init__ imports nothing)
+    # and its declare.py, the declaration class and the registry; no reader, writer or shared module.
+    declarations = {"modelkit.formats", "modelkit.formats.declaration", "modelkit.formats.registry"}
+    declarations |= {f"modelkit.formats.{name}{tail}" for name in FORMAT_NAMES for tail in ("", ".declare")}
+    beyond = [m for m in report["modules"] if m.startswith("modelkit.formats") and m not in declarations]
+    assert beyond == [] and "modelkit.api" not in report["modules"], beyond
 
 
 SMALL_URDF = """\

@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from modelkit.convert.options import GAZEBO_CHOICES
+from modelkit.convert.choices import GAZEBO_CHOICES
 from modelkit.model import Robot
 
 __all__ = ["GAZEBO_CHOICES", "gazebo_family", "plugin_family", "source_family"]

@@ -1,14 +1,9 @@
-"""What a writer can be asked to do differently (every option has the safe default)."""
+"""What a writer can be asked to do differently (every option has the safe default); the values the
+string options take are in :mod:`modelkit.convert.choices`."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-
-SDF_VERSIONS = ("1.6", "1.7", "1.8", "1.9", "1.10", "1.11")
-MESH_FORMATS = ("stl", "obj")
-ACTUATOR_CHOICES = ("auto", "motor", "position", "velocity", "none")  # where the source has no actuators
-GAZEBO_CHOICES = ("auto", "classic", "sim")  # convert.gazebo says what each means
-WHEEL_COLLISIONS = ("auto", "cylinder", "sphere", "ellipsoid")  # convert.wheels says what each means
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,5 @@
-"""Which writer writes which target format, and the file suffix each target gets.
+"""Which writer writes which target format, and the file suffix each target gets: derived from the
+formats' declarations (:mod:`modelkit.formats.registry`, each format's ``declare.py``).
 
 Writers are imported lazily (mujoco only for MJCF output). A writer is a function
 ``write(robot, ctx) -> bytes``: the model file's content; meshes go through ``ctx.meshes``.
@@ -12,29 +13,38 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from modelkit.formats.declaration import FormatDeclaration
+from modelkit.formats.registry import TARGET_NAMES, WRITTEN
+
 if TYPE_CHECKING:
     from modelkit.convert.context import WriteContext
     from modelkit.model import Robot
 
 Writer = Callable[["Robot", "WriteContext"], bytes]
+__all__ = ["TARGETS", "TARGET_NAMES", "TargetInfo", "Writer", "load_writer", "target_for_path", "target_info"]
 
 
 @dataclass(frozen=True)
 class TargetInfo:
+    """A format modelkit writes: its name and its declared output."""
+
     name: str
     suffix: str  # what `convert -o DIR --to NAME` names the files
     suffixes: tuple[str, ...]  # output suffixes that select this target
     writer: str  # "module:function"
     tracks_native: bool = False  # the target holds pseudo continuous tracks itself
+    auto_wheel: str = "cylinder"  # the wheel collision `--wheel-collision auto` writes
 
 
-TARGETS: tuple[TargetInfo, ...] = (
-    TargetInfo("urdf", ".urdf", (".urdf",), "modelkit.formats.urdf.writer:write_urdf"),
-    TargetInfo("sdf", ".sdf", (".sdf",), "modelkit.formats.sdf.writer:write_sdf"),
-    TargetInfo("mjcf", ".xml", (".xml", ".mjcf"), "modelkit.formats.mjcf.writer:write_mjcf"),
-    TargetInfo("body", ".body", (".body",), "modelkit.formats.body.writer:write_body", tracks_native=True),
-)
-TARGET_NAMES = tuple(t.name for t in TARGETS)
+def _target(declaration: FormatDeclaration) -> TargetInfo:
+    out = declaration.output
+    if out is None:
+        raise ValueError(f"format {declaration.name} declares no output")
+    return TargetInfo(declaration.name, out.suffix, out.suffixes, out.writer, out.tracks_native,
+                      out.auto_wheel)
+
+
+TARGETS: tuple[TargetInfo, ...] = tuple(_target(d) for d in WRITTEN)
 
 
 def target_info(name: str) -> TargetInfo:

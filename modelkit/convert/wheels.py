@@ -30,8 +30,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from modelkit.convert.choices import WHEEL_COLLISIONS
 from modelkit.convert.notes import NoteSink
-from modelkit.convert.options import WHEEL_COLLISIONS
+from modelkit.convert.registry import TARGETS
 from modelkit.model import Cylinder, Ellipsoid, Geom, JointType, Robot, Sphere
 from modelkit.spatial import Pose
 
@@ -42,8 +43,9 @@ GROUND_LEVEL = 1e-3
 HORIZONTAL = 1e-6
 """|axis · z| below this: a joint axis is horizontal."""
 PARALLEL = 1e-6
-SPHERE_TARGETS = frozenset({"mjcf", "urdf"})
-"""Targets whose ``auto`` wheel collision is a sphere (the formats MuJoCo and PyBullet load)."""
+SPHERE_TARGETS = frozenset(t.name for t in TARGETS if t.auto_wheel == "sphere")
+"""Targets whose ``auto`` wheel collision is a sphere (the formats MuJoCo and PyBullet load), as each
+format declares it (``auto_wheel`` in its ``declare.py``)."""
 
 
 def resolve(choice: str, target: str) -> str:

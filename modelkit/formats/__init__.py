@@ -1,129 +1,29 @@
-"""The format registry: which reader handles which file.
+"""The formats: one package per format (``body``, ``urdf``, ``xacro``, ``sdf``, ``mjcf``), each declaring
+itself in its ``declare.py`` (collected by :mod:`modelkit.formats.registry`), with its reader and writer.
 
-Readers are imported lazily so that `validate` and `tree` load only what the input needs (mujoco
-only for MJCF input, which it reads).
+Importing this package (or a declaration) imports no reader: ``read_model``, ``detect_format`` and
+``FORMATS`` come from :mod:`modelkit.formats.reading` on first use, so that the CLI can read the
+declarations without loading numpy.
 """
 
 from __future__ import annotations
 
-import gc
-import importlib
-from dataclasses import dataclass
-from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from modelkit.diagnostics import DiagnosticSink, SourceLocation
-from modelkit.format_names import FORMAT_NAMES
-from modelkit.formats.common import ReadOptions, ReadResult
-from modelkit.textio import OpenedFile, UnreadableFile, check_regular, recording
+if TYPE_CHECKING:
+    from modelkit.formats.reading import FORMATS, detect_format, read_model
 
-
-@dataclass(frozen=True)
-class FormatInfo:
-    name: str
-    suffixes: tuple[str, ...]
-    description: str
-    reader: str  # "module:function", imported on first use
-    root_tags: tuple[str, ...] = ()  # the top XML element that identifies the format
+_HOMES = {
+    "FORMATS": "modelkit.formats.reading",
+    "detect_format": "modelkit.formats.reading",
+    "read_model": "modelkit.formats.reading",
+}
+__all__ = ["FORMATS", "detect_format", "read_model"]
 
 
-FORMATS: tuple[FormatInfo, ...] = (
-    FormatInfo(
-        "body",
-        (".body",),
-        "Choreonoid body file (YAML), format 1.0 and 2.0",
-        "modelkit.formats.body.reader:read_body",
-    ),
-    FormatInfo(
-        "xacro",
-        (".xacro",),
-        "xacro macro file, expanded to URDF (legacy xacro detected)",
-        "modelkit.formats.xacro.reader:read_xacro",
-    ),
-    FormatInfo(
-        "urdf", (".urdf",), "URDF 1.0-1.2", "modelkit.formats.urdf.reader:read_urdf", root_tags=("robot",)
-    ),
-    FormatInfo(
-        "sdf",
-        (".sdf", ".world"),
-        "SDFormat 1.2-1.12 (models and worlds)",
-        "modelkit.formats.sdf.reader:read_sdf",
-        root_tags=("sdf",),
-    ),
-    FormatInfo(
-        "mjcf",
-        (".mjcf",),
-        "MuJoCo MJCF (read through mujoco)",
-        "modelkit.formats.mjcf.reader:read_mjcf",
-        root_tags=("mujoco",),
-    ),
-)
-assert sorted(FORMAT_NAMES) == sorted(info.name for info in FORMATS), "modelkit.format_names is stale"
+def __getattr__(name: str) -> Any:
+    if name in _HOMES:
+        import importlib
 
-
-def detect_format(path: Path, explicit: str | None = None) -> str | None:
-    """The format of ``path``: by extension, else by its top XML element (``.xml`` files)."""
-    if explicit:
-        return explicit
-    name = path.name.lower()
-    for info in FORMATS:
-        if any(name.endswith(s) for s in info.suffixes):
-            return info.name
-    from modelkit.xmlsource import sniff_root_tag
-
-    tag = sniff_root_tag(path)
-    for info in FORMATS:
-        if tag is not None and tag in info.root_tags:
-            return info.name
-    return None
-
-
-def read_model(
-    path: Path, options: ReadOptions | None = None, fmt: str | None = None, display: str | None = None
-) -> ReadResult:
-    """Read any supported model file; an unknown format is a diagnostic, not an exception.
-
-    ``ReadResult.opened`` lists every regular file the read opened (see :func:`modelkit.textio.recording`)."""
-    with recording() as opened:
-        result = _read_model(path, options, fmt, display)
-    result.opened = _unique(opened)
-    return result
-
-
-def _unique(opened: list[OpenedFile]) -> list[OpenedFile]:
-    seen: set[tuple[int, int]] = set()
-    out = []
-    for item in opened:
-        if item.identity not in seen:
-            seen.add(item.identity)
-            out.append(item)
-    return out
-
-
-def _read_model(path: Path, options: ReadOptions | None, fmt: str | None, display: str | None) -> ReadResult:
-    shown = display or str(path)
-    sink = DiagnosticSink()
-    try:  # before any reader (or MuJoCo) opens it: only a regular file within the size limit
-        check_regular(path, (options or ReadOptions()).max_bytes)
-    except UnreadableFile as exc:
-        sink.emit(exc.code, exc.message, SourceLocation(shown), hint=exc.hint)
-        return ReadResult(None, sink.items)
-    kind = detect_format(path, fmt)
-    for info in FORMATS:
-        if info.name == kind:
-            module_name, _, function = info.reader.partition(":")
-            reader = getattr(importlib.import_module(module_name), function)
-            # Reading builds a large, acyclic object graph (parser nodes, then the model): the cyclic
-            # garbage collector's passes over it free nothing and cost a third of the time of a big file.
-            collecting = gc.isenabled()
-            gc.disable()
-            try:
-                result: ReadResult = reader(path, options or ReadOptions(), shown)
-            finally:
-                if collecting:
-                    gc.enable()
-            return result
-    known = ", ".join(s for info in FORMATS for s in info.suffixes)
-    message = f"cannot tell the format of this file (supported: {known}, or .xml with a <robot>, "
-    message += "<sdf> or <mujoco> top element); use --input-format"
-    sink.emit("MK001", message, SourceLocation(shown))
-    return ReadResult(None, sink.items)
+        return getattr(importlib.import_module(_HOMES[name]), name)
+    raise AttributeError(f"module 'modelkit.formats' has no attribute {name!r}")

@@ -5,10 +5,24 @@
 * :mod:`.origins` maps each expanded element back to the source line that wrote it;
 * :mod:`.errors` turns xacro's exceptions into located diagnostics;
 * :mod:`.reader` hands the result to the URDF reader.
+
+``expand_xacro`` and ``read_xacro`` are imported on first use, so that importing the format's
+declaration (``declare``) does not import the reader.
 """
 
 from __future__ import annotations
 
-from modelkit.formats.xacro.reader import expand_xacro, read_xacro
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from modelkit.formats.xacro.reader import expand_xacro, read_xacro
 
 __all__ = ["expand_xacro", "read_xacro"]
+
+
+def __getattr__(name: str) -> Any:
+    if name in __all__:
+        from modelkit.formats.xacro import reader
+
+        return getattr(reader, name)
+    raise AttributeError(f"module 'modelkit.formats.xacro' has no attribute {name!r}")

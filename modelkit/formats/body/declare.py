@@ -1,0 +1,16 @@
+"""The Choreonoid body format, as modelkit reads and writes it (see :mod:`modelkit.formats.declaration`)."""
+
+from modelkit.formats.declaration import FormatDeclaration, OutputDeclaration
+
+FORMAT = FormatDeclaration(
+    name="body",
+    description="Choreonoid body file (YAML), format 1.0 and 2.0",
+    suffixes=(".body",),
+    reader="modelkit.formats.body.reader:read_body",
+    output=OutputDeclaration(
+        writer="modelkit.formats.body.writer:write_body",
+        suffix=".body",
+        suffixes=(".body",),
+        tracks_native=True,  # Choreonoid simulates pseudo continuous tracks (AISTSimulator)
+    ),
+)

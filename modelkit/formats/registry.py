@@ -1,0 +1,34 @@
+"""Every format modelkit knows: the declarations of ``modelkit/formats/<name>/declare.py``, collected.
+
+Data only, importable without any reader or writer (nor numpy): the CLI's ``--input-format`` and
+``--to`` choices come from here at startup. :mod:`modelkit.formats.reading` picks the reader,
+:mod:`modelkit.convert.registry` the writer. A new format adds its package with a ``declare.py`` and
+one entry below (``tests/test_format_registry.py`` fails until it does).
+"""
+
+from __future__ import annotations
+
+from modelkit.formats.body import declare as body
+from modelkit.formats.declaration import FormatDeclaration
+from modelkit.formats.mjcf import declare as mjcf
+from modelkit.formats.sdf import declare as sdf
+from modelkit.formats.urdf import declare as urdf
+from modelkit.formats.xacro import declare as xacro
+
+DECLARED: tuple[FormatDeclaration, ...] = (body.FORMAT, urdf.FORMAT, xacro.FORMAT, sdf.FORMAT, mjcf.FORMAT)
+"""Every format, in the order of ``--input-format``'s choices. Detection tries them in this order
+(their suffixes and root tags are disjoint, so the order decides nothing there)."""
+
+WRITTEN: tuple[FormatDeclaration, ...] = (urdf.FORMAT, sdf.FORMAT, mjcf.FORMAT, body.FORMAT)
+"""The formats that declare an output, in the order of ``convert --to``'s choices."""
+
+FORMAT_NAMES: tuple[str, ...] = tuple(d.name for d in DECLARED)
+TARGET_NAMES: tuple[str, ...] = tuple(d.name for d in WRITTEN)
+
+
+def declared(name: str) -> FormatDeclaration:
+    """The declaration of format ``name`` (KeyError: no such format)."""
+    for d in DECLARED:
+        if d.name == name:
+            return d
+    raise KeyError(name)

@@ -1,0 +1,16 @@
+"""SDFormat, as modelkit reads and writes it (see :mod:`modelkit.formats.declaration`)."""
+
+from modelkit.formats.declaration import FormatDeclaration, OutputDeclaration
+
+FORMAT = FormatDeclaration(
+    name="sdf",
+    description="SDFormat 1.2-1.12 (models and worlds)",
+    suffixes=(".sdf", ".world"),
+    reader="modelkit.formats.sdf.reader:read_sdf",
+    root_tags=("sdf",),
+    output=OutputDeclaration(
+        writer="modelkit.formats.sdf.writer:write_sdf",
+        suffix=".sdf",
+        suffixes=(".sdf",),
+    ),
+)
