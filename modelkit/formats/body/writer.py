@@ -67,6 +67,7 @@ class _Names:
     by_name: dict[str, str] = field(default_factory=dict)
     joints: dict[int, str] = field(default_factory=dict)
     joint_used: set[str] = field(default_factory=set)
+    subtree_mass: dict[str, float] = field(default_factory=dict)  # by source link name, through every joint
 
 
 def _names(robot: Robot) -> _Names:
@@ -118,7 +119,10 @@ def _tree_order(robot: Robot) -> tuple[list[Link], dict[str, Joint]]:
 
 
 def write_body(robot: Robot, ctx: WriteContext) -> bytes:
+    from modelkit.checks.masses import lumped_masses
+
     names = _names(robot)
+    names.subtree_mass = lumped_masses(robot, every_joint=True)
     for link in robot.links:
         if names.links[id(link)] != link.name:
             ctx.rename("link", link.name, names.links[id(link)], "link names must be unique and not empty",
@@ -194,6 +198,10 @@ def _link_node(robot: Robot, link: Link, joint: Joint | None, names: _Names, ctx
         if "actuation_mode" not in node:
             _actuation_from_actuators(robot, joint, node)
     _inertial(link.inertial, node)
+    own = max(link.inertial.mass, 0.0) if link.inertial is not None else 0.0
+    # a link not reachable from the root (an SDF free link, written as a free child) carries only itself
+    if joint is not None and joint.type.moves and names.subtree_mass.get(link.name, own) <= 0.0:
+        _massless_chain(link, node, ctx, target)
     if link.contact_material:
         node["material"] = link.contact_material
     elements = link_elements(link, ctx, from_body)
@@ -298,6 +306,27 @@ def _limits(joint: Joint, node: dict[str, Any]) -> None:
         node["joint_velocity_range"] = Flow([_bound(joint, vlo), _bound(joint, vhi)])
     if math.isfinite(limits.effort):
         node["max_joint_effort"] = num(limits.effort)
+
+
+# What a moving link gets when neither it nor anything below it has mass (a URDF's massless finger chain):
+# Choreonoid's forward dynamics needs a positive mass and inertia on each moving body (validate: MK313).
+# The values of the MJCF writer's rule for MuJoCo, which refuses the same links.
+CHAIN_MASS = 1e-6  # kg
+CHAIN_INERTIA = 1e-9  # kg·m², on each axis
+
+
+def _massless_chain(link: Link, node: dict[str, Any], ctx: WriteContext, target: str) -> None:
+    node["mass"] = num(CHAIN_MASS)
+    node["center_of_mass"] = nums(np.zeros(3))
+    node["inertia"] = nums((np.eye(3) * CHAIN_INERTIA).ravel())
+    ctx.note(
+        "MK816",
+        f"link {link.name} moves but neither it nor anything below it has mass; Choreonoid cannot simulate "
+        f"such a joint (validate: MK313), so it gets {CHAIN_MASS:g} kg and {CHAIN_INERTIA:g} kg·m² on each "
+        "axis",
+        link.loc("mass"),
+        target,
+    )
 
 
 def _inertial(inertial: Inertial | None, node: dict[str, Any]) -> None:
