@@ -347,3 +347,34 @@ def test_ros_plugins_only_where_the_source_has_none_and_for_classic(tmp_path: Pa
     in_sdf = _plugins_by_sensor(etree.parse(str(tmp_path / "sdf" / "robot.sdf")).getroot())
     assert in_sdf == {name: {k: v for k, v in fields.items() if k != "frame_name"}
                       for name, fields in EXPECTED_PLUGINS.items()}
+
+
+def test_imu_colour_camera_and_3d_lidar_get_their_plugins(tmp_path: Path) -> None:
+    """The other kinds: a colour camera (no depth topics), a LiDAR with a vertical field (a point cloud),
+    and Choreonoid's acceleration and rate-gyro sensors (the IMU plugin, world-frame orientation)."""
+    text = SENSORS.read_text()
+    text = text.replace("format: COLOR_DEPTH", "format: COLOR")
+    vertical = "yaw_range: 270.0\n        pitch_range: 30.0\n        pitch_step: 2.0"
+    text = text.replace("yaw_range: 270.0", vertical)
+    imu = ("      -\n        type: AccelerationSensor\n        name: Accel\n      -\n"
+           "        type: RateGyroSensor\n        name: Gyro\n")
+    marker = "    elements:\n"
+    at = text.index(marker) + len(marker)  # the first link's elements (the chassis)
+    source = tmp_path / "model" / "robot.body"
+    source.parent.mkdir()
+    for item in TUTORIAL.iterdir():  # the robot's resources, beside it
+        if item.name != source.name and not (source.parent / item.name).exists():
+            (source.parent / item.name).symlink_to(item)
+    source.write_text(text[:at] + imu + text[at:])
+    path, notes = _write(_read(source), tmp_path / "out", WriteOptions(gazebo="classic"))
+    plugins = _plugins_by_sensor(etree.parse(str(path)).getroot())
+    assert plugins["LiDAR"]["output_type"] == "sensor_msgs/PointCloud2"
+    assert plugins["LiDAR"]["ros/remapping"] == "~/out:=LiDAR/points"
+    assert plugins["RealSense"] == {"filename": "libgazebo_ros_camera.so", "camera_name": "RealSense",
+                                    "frame_name": "RealSense_optical"}
+    for name in ("Accel", "Gyro"):
+        assert plugins[name] == {"filename": "libgazebo_ros_imu_sensor.so",
+                                 "ros/remapping": f"~/out:={name}/imu",
+                                 "initial_orientation_as_reference": "false", "frame_name": name}
+    assert len([n for n in notes if n.code == "MK850"]) == 4
+    _check_urdf(path)
