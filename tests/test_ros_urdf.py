@@ -243,40 +243,6 @@ def test_unmapped_sensor_parameters_are_notes_and_classic_sdf_loads(
     assert not oracle_has_errors(sdf_oracle, tmp_path / "sdf" / "robot.sdf")
 
 
-SDF_PRINT_SOURCE = r"""
-#include <iostream>
-#include <sdf/sdf.hh>
-// Prints the SDF libsdformat makes of a file (a URDF: its URDF to SDF conversion, what Gazebo spawns).
-int main(int argc, char **argv) {
-  if (argc != 2) { std::cerr << "usage: sdf_print FILE\n"; return 2; }
-  sdf::Root root;
-  sdf::Errors errors = root.Load(argv[1]);
-  for (const auto &e : errors)
-    std::cerr << "Error Code " << static_cast<int>(e.Code()) << ": " << e.Message() << "\n";
-  if (!errors.empty()) return 1;
-  std::cout << root.Element()->ToString("");
-  return 0;
-}
-"""
-
-
-@pytest.fixture(scope="module")
-def sdf_print(tmp_path_factory: pytest.TempPathFactory, sdf_oracle: Path) -> Path:  # noqa: F811
-    """libsdformat 12's reading of a file, printed as SDF (compiled like the SDF oracle, which it needs)."""
-    import shlex
-    import shutil
-
-    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "sdformat12"], capture_output=True, text=True,
-                           check=True).stdout
-    folder = tmp_path_factory.mktemp("sdf_print")
-    (folder / "sdf_print.cc").write_text(SDF_PRINT_SOURCE)
-    compiler = shutil.which("g++")
-    assert compiler is not None
-    subprocess.run([compiler, "-O0", "-o", str(folder / "sdf_print"), str(folder / "sdf_print.cc"),
-                    *shlex.split(flags)], check=True)
-    return folder / "sdf_print"
-
-
 def _plugins_by_sensor(root: etree._Element) -> dict[str, dict[str, str]]:
     """Sensor name → its plugin's file name and each leaf element's text by its path in the plugin
     (``ros/remapping`` for a ``<remapping>`` in ``<ros>``)."""
@@ -302,7 +268,7 @@ EXPECTED_PLUGINS = {
 }
 
 
-def test_classic_sensors_publish_to_ros(tmp_path: Path, sdf_print: Path) -> None:
+def test_classic_sensors_publish_to_ros(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
     """A .body robot for Gazebo classic: the LiDAR gets gazebo_ros's ray-sensor plugin (LaserScan, stamped
     with its TF frame) and the RealSense the camera plugin (stamped with its REP-103 optical frame, its
     detection range as min/max depth, no longer an MK849 loss); MK850 names the topics. check_urdf takes
@@ -318,8 +284,8 @@ def test_classic_sensors_publish_to_ros(tmp_path: Path, sdf_print: Path) -> None
     (unmapped,) = [n.message for n in notes if n.code == "MK849" and '"RealSense"' in n.message]
     assert "detection_rate 0.9" in unmapped and "range_" not in unmapped
     _check_urdf(path)
-    run = subprocess.run([str(sdf_print), path.name], cwd=path.parent, capture_output=True, text=True,
-                         timeout=60)
+    run = subprocess.run([str(sdf_oracle), "--print", path.name], cwd=path.parent, capture_output=True,
+                         text=True, timeout=60)
     assert run.returncode == 0, run.stderr
     converted = _plugins_by_sensor(etree.fromstring(run.stdout.encode()))
     assert {name: fields["filename"] for name, fields in converted.items()} == {

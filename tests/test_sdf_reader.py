@@ -732,13 +732,18 @@ static bool sameTypeUniqueNames(sdf::ElementPtr elem) {
     ok = sameTypeUniqueNames(c) && ok;
   return ok;
 }
+// With --print FILE it prints the SDF libsdformat made of the file instead (a URDF: its URDF to SDF
+// conversion, what Gazebo spawns), errors on stderr.
 int main(int argc, char **argv) {
-  if (argc != 2) { std::cerr << "usage: sdf_check FILE\n"; return 2; }
+  const bool print = argc == 3 && std::string(argv[1]) == "--print";
+  if (argc != 2 && !print) { std::cerr << "usage: sdf_check [--print] FILE\n"; return 2; }
   sdf::Root root;
-  sdf::Errors errors = root.Load(argv[1]);
+  sdf::Errors errors = root.Load(argv[argc - 1]);
   for (const auto &e : errors)
-    std::cout << "Error Code " << static_cast<int>(e.Code()) << ": " << e.Message() << "\n";
+    (print ? std::cerr : std::cout) << "Error Code " << static_cast<int>(e.Code()) << ": " << e.Message()
+                                    << "\n";
   if (!errors.empty()) return 1;
+  if (print) { std::cout << root.Element()->ToString(""); return 0; }
   if (!sdf::checkCanonicalLinkNames(&root)) { std::cout << "invalid canonical link name\n"; return 1; }
   if (!sdf::checkJointParentChildLinkNames(&root)) { std::cout << "invalid parent or child\n"; return 1; }
   if (!sdf::checkFrameAttachedToGraph(&root)) { std::cout << "invalid attached_to graph\n"; return 1; }
