@@ -344,3 +344,21 @@ def test_imu_colour_camera_and_3d_lidar_get_their_plugins(tmp_path: Path) -> Non
                                  "initial_orientation_as_reference": "false", "frame_name": name}
     assert len([n for n in notes if n.code == "MK850"]) == 4
     _check_urdf(path)
+
+
+def test_a_urdf_sensors_own_plugins_reach_sdf(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+    """A URDF sensor's plugins (the lecture's unicycle, written to URDF) are carried to SDF as an SDF
+    sensor's are: the three gazebo_ros plugins stay the only ones (no MK850), no MK808 claims the sensor
+    blocks are lost, and libsdformat accepts the file. Before, URDF → SDF dropped them."""
+    urdf, _ = _write(_read(UNICYCLE), tmp_path / "urdf")
+    plan = OutputPlan(tmp_path / "sdf")
+    notes = render_model(_read(urdf), "sdf", plan, "robot.sdf", WriteOptions())
+    plan.commit()
+    sdf = tmp_path / "sdf" / "robot.sdf"
+    sensors = etree.parse(str(sdf)).getroot().iter("sensor")
+    plugins = [p.get("filename") for s in sensors for p in s.iter("plugin")]
+    assert sorted(plugins) == [
+        "libgazebo_ros_camera.so", "libgazebo_ros_velodyne_laser.so", "libgazebo_ros_velodyne_laser.so"]
+    assert "MK850" not in {n.code for n in notes}
+    assert not [n for n in notes if n.code == "MK808" and "extension of link" in n.message]
+    assert not oracle_has_errors(sdf_oracle, sdf)

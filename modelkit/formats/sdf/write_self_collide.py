@@ -21,8 +21,9 @@ from modelkit.convert.self_collision import flags
 from modelkit.model import Robot
 
 
-def only_self_collide(entries: object) -> bool:
-    """URDF ``<gazebo reference>`` blocks that say nothing but ``selfCollide`` (written as link flags)."""
+def only_carried(entries: object) -> bool:
+    """URDF ``<gazebo reference>`` blocks that say nothing but what the SDF writer carries on its own:
+    ``selfCollide`` (written as link flags) and ``<sensor>``s (the link's devices, with their plugins)."""
     if not isinstance(entries, list) or not entries:
         return False
     for entry in entries:
@@ -30,8 +31,10 @@ def only_self_collide(entries: object) -> bool:
             block = etree.fromstring(str(entry.get("xml", ""))) if isinstance(entry, dict) else None
         except etree.XMLSyntaxError:
             return False
-        if block is None or {c.tag for c in block if isinstance(c.tag, str)} != {"selfCollide"}:
+        if block is None or not {c.tag for c in block if isinstance(c.tag, str)} <= {"selfCollide", "sensor"}:
             return False
+        if any(not (c.get("name") and c.get("type")) for c in block if c.tag == "sensor"):
+            return False  # a sensor the reader could not make a device of (MK620) is not carried
     return True
 
 

@@ -44,7 +44,7 @@ from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
 from modelkit.formats.sdf.write_geometry import GeomWriter
 from modelkit.formats.sdf.write_names import Names
-from modelkit.formats.sdf.write_self_collide import only_self_collide, self_collide_policy
+from modelkit.formats.sdf.write_self_collide import only_carried, self_collide_policy
 from modelkit.formats.sdf.write_xml import add_pose, num, sub
 from modelkit.model import SYNTHESISED, WORLD_LINK, DeviceKind, Joint, JointType, Link, LoopConstraint, Robot
 from modelkit.spatial import Mat3, Pose, Vec3
@@ -272,7 +272,7 @@ class _ModelWriter:
                 link.source,
                 f"link[{name}]",
             )
-        if link.extras.get("gazebo") and not only_self_collide(link.extras["gazebo"]):
+        if link.extras.get("gazebo") and not only_carried(link.extras["gazebo"]):
             ctx.note(
                 "MK808",
                 f'<gazebo> extension of link "{link.name}" is not carried over'

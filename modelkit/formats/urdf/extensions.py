@@ -227,6 +227,13 @@ def _sensor(ctx: Context, element: Element) -> Device | None:
         kind, name, source=ctx.loc(element), canonical=canonical, canonical_params=canonical_params
     )
     device.params["xml"] = canonical_xml(element)
+    plugins = [
+        {"name": child.get("name") or "", "filename": child.get("filename") or "",
+         "owner": f'sensor "{name}"', "xml": canonical_xml(child)}
+        for child in element if child.tag == "plugin"
+    ]
+    if plugins:  # as an SDF sensor's (modelkit/formats/sdf/sensors.py): other targets carry them
+        device.params["plugins"] = plugins
     for key in ("update_rate", "always_on", "visualize", "topic"):
         child = ctx.first(element, key)
         if child is not None:
