@@ -27,6 +27,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from modelkit.convert.numbers import fmt
 from modelkit.model import CAMERA_KINDS, DeviceKind
 
 RAY = "libgazebo_ros_ray_sensor.so"
@@ -49,10 +50,8 @@ class RosPlugin:
     publishes: str
 
 
-def ros_plugin(kind: DeviceKind, sensor: str, frame: str | None, params: dict[str, Any],
-               number: Any) -> RosPlugin | None:
-    """The plugin of a canonical sensor named ``sensor`` (None: none for this kind). ``number`` formats
-    a float as the writer does."""
+def ros_plugin(kind: DeviceKind, sensor: str, frame: str | None, params: dict[str, Any]) -> RosPlugin | None:
+    """The plugin of a canonical sensor named ``sensor`` (None: none for this kind)."""
     frame_element = (("frame_name", frame),) if frame else ()
     name = f"{sensor}_ros"
     if kind is DeviceKind.LIDAR:
@@ -70,7 +69,7 @@ def ros_plugin(kind: DeviceKind, sensor: str, frame: str | None, params: dict[st
             for key, element in (("range_min", "min_depth"), ("range_max", "max_depth")):
                 value = params.get(key)
                 if isinstance(value, int | float) and math.isfinite(value) and value > 0.0:
-                    elements += ((element, number(value)),)
+                    elements += ((element, fmt(value)),)
                     consumed.add(key)
             topics += [f"{sensor}/depth/image_raw", f"{sensor}/points"]
         return RosPlugin(CAMERA, name, elements, frozenset(consumed), ", ".join(topics))

@@ -215,7 +215,7 @@ class DeviceWriter:
         ``ros_plugins`` option is on): :mod:`modelkit.formats.sdf.ros_plugins`."""
         if self.gazebo != "classic" or not self.ctx.options.ros_plugins or device.params.get("plugins"):
             return None
-        return ros_plugin(kind, name, frame, device.canonical_params, fmt)
+        return ros_plugin(kind, name, frame, device.canonical_params)
 
     def _write_ros_plugin(self, sensor: Element, plugin: RosPlugin, device: Device, target: str) -> None:
         element = sub(sensor, "plugin", name=plugin.name, filename=plugin.filename)
