@@ -161,3 +161,23 @@ def test_inertia_dust_is_written_as_zero(tmp_path: Path) -> None:
         write(robot, out)
         assert "e-20" not in out.read_text(), suffix
     mujoco.MjModel.from_xml_path(str(tmp_path / "out.xml"))  # refused before: a negative eigenvalue
+
+
+def test_centre_of_mass_dust_is_written_as_zero(tmp_path: Path) -> None:
+    """pybullet_data's xArm 6 gripper has finger centres of mass at ``2.9948e-14 0.021559 0.015181`` (a CAD
+    export's dust, 6e-14 of the arm's size): every target writes the point with 0, a real small offset
+    (1e-9 m on a 0.5 m robot) stays, and the source's non-dust values are untouched."""
+    from modelkit.convert.numbers import fmt_position
+
+    with length_scale(0.5):
+        assert fmt_position([2.9948e-14, 0.021559, 0.015181]) == "0 0.021559 0.015181"
+        assert fmt_position([1e-9, 0.0, -0.25]) == "1e-9 0 -0.25"
+    source = DATA / "xarm" / "xarm6_with_gripper.urdf"
+    robot = validate(source).robot
+    assert robot is not None
+    for suffix in (".xml", ".urdf", ".sdf"):
+        out = tmp_path / f"out{suffix}"
+        write(robot, out)
+        text = out.read_text()
+        assert not re.search(r"[-\d.]+e-1[3-9]", text), (suffix, re.findall(r"\S*e-1[3-9]\S*", text)[:3])
+        assert "0.021559 0.015181" in text, suffix

@@ -11,8 +11,9 @@ they know the quantity: :func:`clean_rotation` for quaternion components, Euler 
 entries (dimensionless: below 1e-12 is 0, and within 1e-12 of ±1, ±0.5 or ±√½ is that value),
 :func:`clean_angle` for angles (within 1e-12 of a multiple of π/4 is that multiple), and
 :func:`clean_length` for positions (below 1e-12 of the model's length scale is 0; the scale is set
-with :func:`length_scale` around a write, 1 m by default), and :func:`clean_inertia` for inertia
-tensors (below 1e-12 of the link's mass × the length scale² is 0).
+with :func:`length_scale` around a write, 1 m by default; :func:`fmt_position` writes a point so),
+and :func:`clean_inertia` for inertia tensors (below 1e-12 of the link's mass × the length scale²
+is 0).
 """
 
 from __future__ import annotations
@@ -77,6 +78,13 @@ def fmt_vec(values: Iterable[float] | np.ndarray) -> str:
     """Numbers separated by single spaces (XML attribute lists)."""
     return " ".join(fmt(v) for v in np.asarray(list(values) if not isinstance(values, np.ndarray) else values,
                                               dtype=float).ravel())
+
+
+def fmt_position(values: Iterable[float] | np.ndarray) -> str:
+    """A point in metres (a centre of mass, a joint anchor, a light): each coordinate cleaned by
+    :func:`clean_length`, so a CAD export's ``2.9948e-14`` on a half-metre arm is written as 0."""
+    vector = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel()
+    return fmt_vec([clean_length(float(v)) for v in vector])
 
 
 def fmt_direction(values: Iterable[float] | np.ndarray) -> str:

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_vec
+from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_position, fmt_vec
 from modelkit.convert.servo_gains import home_position
 from modelkit.formats.mjcf.write_chains import Chain, ChainFinder, shifted
 from modelkit.formats.mjcf.write_devices import DeviceWriter
@@ -389,7 +389,7 @@ class BodyTree:
     @staticmethod
     def _anchor(el: Element, anchor: np.ndarray | None) -> None:
         if anchor is not None and np.any(anchor != 0.0):
-            el.set("pos", fmt_vec(anchor))
+            el.set("pos", fmt_position(anchor))
 
     def _planar(self, body: Element, joint: Joint, body_name: str) -> None:
         normal = np.asarray(joint.axis, dtype=float)
@@ -494,7 +494,7 @@ class BodyTree:
                     f"body[{name}]",
                 )
             return
-        el = sub(body, "inertial", pos=fmt_vec(com), mass=fmt(mass))
+        el = sub(body, "inertial", pos=fmt_position(com), mass=fmt(mass))
         off = (tensor[0, 1], tensor[0, 2], tensor[1, 2])
         if any(v != 0.0 for v in off):
             el.set("fullinertia", fmt_vec([tensor[0, 0], tensor[1, 1], tensor[2, 2], *off]))

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.numbers import fmt, fmt_position, fmt_vec
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, set_pose, sub
 from modelkit.model import CAMERA_KINDS, LIGHT_KINDS, Device, DeviceKind, Link
@@ -125,7 +125,7 @@ class DeviceWriter:
             DeviceKind.DIRECTIONAL_LIGHT: "directional",
         }[device.canonical]
         el = sub(body, "light", name=self.names.claim("light", device.name, device.source, target), type=kind)
-        el.set("pos", fmt_vec(device.pose.translation))
+        el.set("pos", fmt_position(device.pose.translation))
         direction = np.asarray(p.get("direction", (0.0, 0.0, -1.0)), dtype=float)
         el.set("dir", fmt_vec(device.pose.rotation @ direction))
         if p.get("color") is not None:

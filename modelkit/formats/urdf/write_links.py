@@ -18,7 +18,7 @@ from lxml.etree import _Element as Element
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import PairFriction
 from modelkit.convert.meshes import MeshRef
-from modelkit.convert.numbers import clean_angle, clean_inertia, clean_length, fmt, fmt_vec
+from modelkit.convert.numbers import clean_angle, clean_inertia, clean_length, fmt, fmt_position, fmt_vec
 from modelkit.convert.output import safe_file_name
 from modelkit.diagnostics import SourceLocation
 from modelkit.model import (
@@ -61,7 +61,7 @@ def inertial_element(parent: Element, link: Link, ctx: WriteContext, target: str
             f"{target}/inertial",
         )
     el = etree.SubElement(parent, "inertial")
-    etree.SubElement(el, "origin", xyz=fmt_vec(inertial.com), rpy="0 0 0")
+    etree.SubElement(el, "origin", xyz=fmt_position(inertial.com), rpy="0 0 0")
     etree.SubElement(el, "mass", value=fmt(inertial.mass))
     i = clean_inertia(inertial.inertia, inertial.mass)
     etree.SubElement(
