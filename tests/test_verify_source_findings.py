@@ -59,3 +59,77 @@ def test_pybullet_refusing_the_source_inertia_is_no_conversion_fail(tmp_path: Pa
     assert "not a conversion fault" in entry.reason
     # the base is welded: its tensor takes part in no dynamics, so the replay runs and passes
     assert [c for c in report.checks if c.quantity == "replay" and c.passed]
+
+
+# Drake's cart-pole (pydrake's examples/multibody/cart_pole/cart_pole.sdf), reduced: libsdformat refuses
+# exact zeros, so the cart and the point-mass pole carry 1e-20 on each axis, which validate calls zero
+# (MK302) and every writer prints as 0 (clean numbers); MuJoCo's moving bodies get 1e-9 more (MK870).
+CART_POLE = """<?xml version="1.0"?>
+<sdf version="1.7">
+  <model name="cart_pole">
+    <link name="cart">
+      <inertial><mass>10</mass><inertia><ixx>1e-20</ixx><iyy>1e-20</iyy><izz>1e-20</izz>
+        <ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>
+    </link>
+    <link name="pole">
+      <pose>0 0 -0.5 0 0 0</pose>
+      <inertial><mass>1</mass><inertia><ixx>1e-20</ixx><iyy>1e-20</iyy><izz>1e-20</izz>
+        <ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>
+    </link>
+    <joint name="slider" type="prismatic"><parent>world</parent><child>cart</child>
+      <axis><xyz>1 0 0</xyz><limit><lower>-2</lower><upper>2</upper></limit></axis></joint>
+    <joint name="pin" type="revolute"><parent>cart</parent><child>pole</child>
+      <pose>0 0 0.5 0 0 0</pose><axis><xyz>0 -1 0</xyz></axis></joint>
+  </model>
+</sdf>
+"""
+
+
+def test_a_zero_source_inertia_written_clean_is_a_source_finding(tmp_path: Path) -> None:
+    """Every engine holds what the writer printed (0, and MuJoCo 1e-9 per axis), which layer 1 checks,
+    naming the source's MK302; the replay still runs (the two repairs differ by 1e-9 kg·m²)."""
+    path = tmp_path / "cart_pole.sdf"
+    path.write_text(CART_POLE)
+    robot = modelkit.load(path)
+    zero = approximations.zero_inertias("urdf", [], {}, robot)
+    assert set(zero) == {"cart", "pole"} and zero["cart"].code == "MK302"
+    assert np.array_equal(np.asarray(zero["cart"].tensor), np.zeros(9))
+    report = verify(path, engines=("mujoco", "pybullet", "pinocchio"), configurations=3, samples=3,
+                    driven=False)
+    assert not report.errors
+    assert [c for c in report.checks if not c.passed] == [], [c for c in report.checks if not c.passed]
+    for engine in ("mujoco", "pybullet"):
+        (entry,) = [s for s in report.skips if s.engine == engine and "source finding MK302" in s.reason]
+        assert "cart" in entry.reason and "pole" in entry.reason
+    (mujoco,) = [s for s in report.skips if s.engine == "mujoco" and "MK302" in s.reason]
+    assert "1e-9" in mujoco.reason
+    assert [c for c in report.checks if c.quantity == "replay" and c.passed]
+
+
+# Drake's planar gripper (examples/planar_gripper/planar_gripper.sdf), reduced: three fingers, of which
+# only the first is joined to the model's first link; the others are free bodies (validate's MK201).
+# verify stopped with a KeyError in the replay's law before.
+FINGER = """    <link name="{f}_base"><pose>{x} 0 0 0 0 0</pose>
+      <inertial><mass>0.5</mass><inertia><ixx>0.001</ixx><iyy>0.001</iyy><izz>0.001</izz>
+        <ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial></link>
+    <link name="{f}_link"><pose>{x} 0 -0.1 0 0 0</pose>
+      <inertial><mass>0.1</mass><inertia><ixx>0.0002</ixx><iyy>0.0002</iyy><izz>0.0001</izz>
+        <ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial></link>
+    <joint name="{f}_joint" type="revolute"><parent>{f}_base</parent><child>{f}_link</child>
+      <axis><xyz>1 0 0</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis></joint>
+"""
+
+
+def test_links_apart_from_the_root_tree_are_said_not_graded(tmp_path: Path) -> None:
+    fingers = "".join(FINGER.format(f=f"finger{i}", x=0.2 * i) for i in (1, 2, 3))
+    path = tmp_path / "gripper.sdf"
+    path.write_text(f'<?xml version="1.0"?>\n<sdf version="1.7"><model name="gripper">\n{fingers}'
+                    "  </model>\n</sdf>\n")
+    report = verify(path, engines=("mujoco", "pybullet", "pinocchio"), configurations=3, samples=3,
+                    driven=False)
+    assert not report.errors
+    assert [c for c in report.checks if not c.passed] == [], [c for c in report.checks if not c.passed]
+    (entry,) = [s for s in report.skips if "not connected to the root link" in s.reason]
+    assert "finger2_base, finger2_link, finger3_base, finger3_link" in entry.reason
+    assert "not graded" in entry.reason
+    assert [c for c in report.checks if c.quantity == "replay" and c.passed]

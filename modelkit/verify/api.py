@@ -72,7 +72,7 @@ from modelkit.model import JointType, Robot
 from modelkit.verify.engines.protocol import Check, Skip
 from modelkit.verify.engines.registry import DEFAULT_ENGINES, ENGINES, INPUTS
 from modelkit.verify.report import VerifyReport
-from modelkit.verify.source import VerifyError, read_robot, welded_copy
+from modelkit.verify.source import VerifyError, read_robot, root_tree_only, welded_copy
 
 Renames = dict[str, dict[str, str]]
 
@@ -357,6 +357,12 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         robot = read_robot(source, reading)
         report.robot = robot.name
         welded, report.base = welded_copy(robot)
+        apart = root_tree_only(welded)
+        if apart:
+            report.skips.append(Skip(1, "all", (
+                f"{len(apart)} link(s) not connected to the root link {welded.root!r} (free bodies of "
+                f"the source, MK201: {', '.join(apart)}) not graded by layers 1-3, which compare the "
+                "root's tree")))
         reference = _reference(welded, report)
         given = {"mjcf": Path(mjcf) if mjcf else None, "urdf": Path(urdf) if urdf else None,
                  "sdf": Path(sdf) if sdf else None}
@@ -570,7 +576,7 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
     # are given to MuJoCo for the replay, so that both integrate the same robot (listed in the report).
     pb_approx = (approx or {}).get("pybullet", {})
     mj_approx = (approx or {}).get("mujoco", {})
-    refused = sorted(link for link, a in pb_approx.items() if a.code in ("MK302", "MK303"))
+    refused = sorted(link for link, a in pb_approx.items() if a.refused_by_engine)
     moving = [link for link in refused if link not in _welded_to_root(reference)]
     if moving:
         report.skips.append(Skip(3, "mujoco+pybullet", (

@@ -77,3 +77,29 @@ def welded_copy(robot: Robot) -> tuple[Robot, str]:
     out.root_pose = Pose()
     return out, (f"root link {out.root!r} ({was} in the source) welded to the world at the identity "
                  "for layers 1-3")
+
+
+def root_tree_only(robot: Robot) -> list[str]:
+    """Remove from ``robot`` (in place) every link the root's tree does not reach, with the joints,
+    loops and actuators that touch them; return the removed links' names, in document order.
+
+    An SDF model may hold links no joint connects to the root (MK201): each is a free body of its
+    own. Layers 1-3 compare one tree welded at its root, which those bodies are not part of, so they
+    are taken out before the files are written and the report says they were not graded."""
+    reached = set(robot.world_poses({})) if robot.root is not None else set()
+    removed = [link.name for link in robot.links if link.name not in reached]
+    if not removed:
+        return []
+    gone = set(removed)
+    robot.links = [link for link in robot.links if link.name not in gone]
+    dropped = {j.name for j in robot.joints if j.parent in gone or j.child in gone}
+    robot.joints = [j for j in robot.joints if j.name not in dropped]
+    for joint in robot.joints:
+        if joint.mimic is not None and joint.mimic.joint in dropped:
+            joint.mimic = None
+    robot.loops = [loop for loop in robot.loops if loop.link1 not in gone and loop.link2 not in gone]
+    robot.actuators = [a for a in robot.actuators if a.joint not in dropped]
+    free = robot.extras.get("sdf_free_links")
+    if isinstance(free, dict):
+        robot.extras["sdf_free_links"] = {k: v for k, v in free.items() if k not in gone}
+    return removed

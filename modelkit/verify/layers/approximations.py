@@ -63,6 +63,9 @@ class Approximated:
     code: str
     by: str  # who approximates: "the SDF writer", "the MJCF writer", "PyBullet reading the URDF"
     tensor: tuple[float, ...] | None = None  # a lifted inertia (row-major 3×3): mass and COM kept
+    # the engine itself refused the source's tensor and holds its own repair (refused_inertias), as
+    # opposed to holding what the writer wrote
+    refused_by_engine: bool = False
 
 
 def _source_names(renames: Renames) -> dict[str, str]:
@@ -136,6 +139,48 @@ def lifted_inertias(fmt: str, notes: Iterable[ConversionNote], renames: Renames,
     return out
 
 
+def zero_inertias(fmt: str, notes: Iterable[ConversionNote], renames: Renames, source: Robot
+                  ) -> dict[str, Approximated]:
+    """Links whose source tensor ``validate`` calls zero (MK302: every principal moment within its
+    tolerance of 0; Drake's cart-pole writes 1e-20 on each axis because libsdformat refuses exact
+    zeros) on a link with mass. Every writer prints such a tensor as the clean numbers rule says
+    (entries below 1e-12 of the link's mass × the robot's size² are 0:
+    :func:`modelkit.convert.numbers.clean_inertia`), and the MJCF writer adds 1e-9 kg·m² on each axis
+    where MuJoCo would refuse a moving body's singular inertia (MK870 "singular"). The engine is
+    compared with that tensor (mass and COM kept): the source's MK302 is a source finding, not a
+    conversion FAIL."""
+    from modelkit.convert.api import length_scale_of
+    from modelkit.convert.numbers import clean_inertia, length_scale
+
+    back = _source_names(renames)
+    lifted: set[str] = set()
+    for note in notes:
+        match = re.fullmatch(r"body\[(.+)\]/inertial", note.target or "")
+        if fmt == "mjcf" and note.code == "MK870" and "singular" in note.message and match:
+            lifted.add(back.get(match[1], match[1]))
+    out: dict[str, Approximated] = {}
+    with length_scale(length_scale_of(source)):
+        for link in source.links:
+            if link.inertial is None or link.inertial.mass <= 0.0:
+                continue
+            tensor = np.asarray(link.inertial.inertia, dtype=float)
+            low, mid, high = (float(v) for v in np.linalg.eigvalsh(0.5 * (tensor + tensor.T)))
+            if refusal_code((low, mid, high)) != "MK302":
+                continue
+            held = clean_inertia(tensor, float(link.inertial.mass))
+            if link.name in lifted:
+                from modelkit.formats.mjcf.write_bodies import MIN_INERTIA
+
+                held = held + MIN_INERTIA * np.eye(3)
+            if np.array_equal(held, tensor):
+                continue
+            by = ("the MJCF writer, writing the dust as 0 and adding 1e-9 kg·m² per axis (MK870)"
+                  if link.name in lifted else "the writer, printing the dust as 0 (clean numbers)")
+            out[link.name] = Approximated(link.name, float(link.inertial.mass), 0.0, "MK302", by,
+                                          tuple(float(v) for v in held.ravel()))
+    return out
+
+
 def pybullet_defaults(urdf: Path, source: Robot, renames: Renames) -> dict[str, Approximated]:
     """Links of the written URDF without ``<inertial>`` that are massless in the source: PyBullet
     reads each as 1 kg with a unit inertia (URDF itself says massless)."""
@@ -193,7 +238,7 @@ def refused_inertias(engine: str, fmt: str, source: Robot) -> dict[str, Approxim
             by = ("Drake's URDF parser, refusing it, holds its plausible-guess solid sphere at water "
                   f"density ({moment:.9g} kg·m² per axis)")
         out[link.name] = Approximated(link.name, float(link.inertial.mass), 0.0, refusal_code(moments), by,
-                                      tuple(float(v) for v in fixed.ravel()))
+                                      tuple(float(v) for v in fixed.ravel()), refused_by_engine=True)
     return out
 
 
@@ -204,6 +249,7 @@ def for_engine(engine: str, fmt: str, notes: Iterable[ConversionNote], file: Pat
     notes = list(notes)
     out = from_notes(fmt, notes, renames)
     out.update(lifted_inertias(fmt, notes, renames, source))
+    out.update(zero_inertias(fmt, notes, renames, source))
     if engine == "pybullet" and fmt == "urdf":
         out.update(pybullet_defaults(file, source, renames))
     out.update(refused_inertias(engine, fmt, source))

@@ -51,8 +51,12 @@ MAX_HALVINGS = 60
 def _axis_inertia_and_gravity(robot: Robot, joint_name: str,
                               poses: dict[str, Any], children: dict[str, list[str]]) -> tuple[float, float]:
     """The subtree's inertia about (revolute) or mass along (prismatic) the joint axis at q = 0,
-    and an upper bound of the gravity load on the joint, root welded at the identity."""
+    and an upper bound of the gravity load on the joint, root welded at the identity. A joint outside
+    the root's tree (in the subtree of a free body of an SDF model, MK201) has no pose there: (0, 0),
+    so it gets no torque and no excitation (its free body falls as a whole, the joint at rest)."""
     joint = next(j for j in robot.joints if j.name == joint_name)
+    if joint.child not in poses:
+        return 0.0, 0.0
     frame = poses[joint.child]
     axis = frame.rotation @ np.asarray(joint.axis, dtype=float)
     axis = axis / float(np.linalg.norm(axis))
