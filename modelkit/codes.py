@@ -594,6 +594,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "child; the extra joints are kept as loop constraints. Reference: libsdformat loads closed chains "
         "(its own `four_bar.sdf`).",
     ),
+    CodeInfo(
+        "MK242",
+        "duplicate-actuator-name",
+        "warning",
+        "Two URDF transmissions name the same `<actuator>` for different joints. Reference: check_urdf, "
+        "PyBullet and MuJoCo load the file; Drake refuses it (joint actuator names must be unique within "
+        "a model). `convert` writes the later one as `<actuator>_<joint>` (MK800).",
+    ),
     # -- MK3xx: mass properties, joints, transforms ---------------------------------------------
     CodeInfo("MK300", "mass-not-positive", "error", "A link's mass is zero or negative."),
     CodeInfo(

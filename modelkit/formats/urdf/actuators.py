@@ -42,8 +42,10 @@ def read_actuators(ctx: Context, root: Element, robot: Robot) -> None:
     """Fill ``robot.actuators`` from the transmissions, then ros2_control, in document order."""
     joints = {j.name for j in robot.joints}
     found: dict[str, Actuator] = {}
+    motors: dict[str, str] = {}  # actuator name → the joint of the first transmission naming it
     for element in ctx.children(root, "transmission"):
         _transmission(ctx, element, joints, found)
+        _same_motor(ctx, element, motors)
     for element in ctx.children(root, "ros2_control"):
         _ros2_control(ctx, element, joints, found)
         _initial_values(ctx, element, robot)
@@ -75,6 +77,21 @@ def _transmission(ctx: Context, element: Element, joints: set[str], found: dict[
             source_kind=(written or "").strip(),
             source=ctx.loc(joint_el),
         )
+
+
+def _same_motor(ctx: Context, element: Element, motors: dict[str, str]) -> None:
+    """MK242 when this transmission's actuator is already another transmission's (for another joint)."""
+    joint_names = [str(j.get("name")) for j in ctx.children(element, "joint") if j.get("name")]
+    for actuator in ctx.children(element, "actuator"):
+        name = actuator.get("name")
+        if not name or not joint_names:
+            continue
+        first = motors.setdefault(name, joint_names[0])
+        if first not in joint_names:
+            ctx.emit("MK242", f'actuator "{name}" of the transmission of joint "{joint_names[0]}" is also '
+                     f'the actuator of joint "{first}": Drake refuses the file (joint actuator names must '
+                     "be unique within a model); check_urdf, PyBullet and MuJoCo load it",
+                     ctx.loc(actuator, "name"))
 
 
 def _initial_values(ctx: Context, element: Element, robot: Robot) -> None:

@@ -27,11 +27,28 @@ INTERFACES = {
 }
 
 
+def unique_motor(name: str, joint: str, taken: set[str]) -> str:
+    """``name``, or ``<name>_<joint>`` (then with ``_`` appended) when another transmission already
+    has an actuator of that name (MK242: Drake refuses two), recorded in ``taken``."""
+    out = name if name not in taken else f"{name}_{joint}"
+    while out in taken:
+        out += "_"
+    taken.add(out)
+    return out
+
+
+def rename_motor(ctx: WriteContext, old: str, new: str, joint: str) -> None:
+    """The MK800 note of :func:`unique_motor`'s renaming."""
+    ctx.rename("actuator", old, new, f'another transmission already names actuator "{old}" (joint "{joint}" '
+               "is driven by its own; Drake refuses two joint actuators of one name)", None, "transmission")
+
+
 def write_transmissions(robot_el: Element, robot: Robot, joint_map: dict[str, str], ctx: WriteContext) -> int:
     """Write the transmissions; return how many. Nothing when the source kept its own blocks."""
     if robot.extras.get("transmissions") or robot.extras.get("ros2_control"):
         return 0
     taken: set[str] = set()
+    motors: set[str] = set()
     written = 0
     lost: list[str] = []
     for actuator in robot.actuators:
@@ -46,7 +63,11 @@ def write_transmissions(robot_el: Element, robot: Robot, joint_map: dict[str, st
         etree.SubElement(el, "type").text = "transmission_interface/SimpleTransmission"
         joint_el = etree.SubElement(el, "joint", name=joint)
         etree.SubElement(joint_el, "hardwareInterface").text = INTERFACES[actuator.kind]
-        motor = etree.SubElement(el, "actuator", name=actuator.name or f"{joint}_motor")
+        wanted = actuator.name or f"{joint}_motor"
+        motor_name = unique_motor(wanted, joint, motors)
+        if motor_name != wanted:
+            rename_motor(ctx, wanted, motor_name, joint)
+        motor = etree.SubElement(el, "actuator", name=motor_name)
         etree.SubElement(motor, "mechanicalReduction").text = fmt(actuator.reduction)
         written += 1
         dropped = [f"{k} {fmt(v)}" for k, v in (("kp", actuator.kp), ("kv", actuator.kv)) if v]

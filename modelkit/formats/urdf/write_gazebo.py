@@ -22,7 +22,7 @@ from modelkit.convert.friction import floor_friction
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.numbers import fmt
 from modelkit.diagnostics import SourceLocation
-from modelkit.formats.urdf.write_actuators import write_transmissions
+from modelkit.formats.urdf.write_actuators import rename_motor, unique_motor, write_transmissions
 from modelkit.formats.urdf.write_frames import SensorFrames
 from modelkit.formats.urdf.write_names import NameTable
 from modelkit.model import Device, DeviceKind, Link, Robot
@@ -218,6 +218,7 @@ def _model_plugins(robot_el: Element, robot: Robot, gazebo: str, ctx: WriteConte
 
 
 def _transmissions(robot_el: Element, robot: Robot, names: NameTable, ctx: WriteContext) -> None:
+    motors: set[str] = set()
     for entry in robot.extras.get("transmissions", []) or []:
         block = parse_block(entry.get("xml", "")) if isinstance(entry, dict) else None
         if block is None:
@@ -229,7 +230,16 @@ def _transmissions(robot_el: Element, robot: Robot, names: NameTable, ctx: Write
                 "transmission",
             )
             continue
+        joints = []
         for joint_el in block.iter("joint"):
             if joint_el.get("name") in names.joint_map:
                 joint_el.set("name", names.joint(joint_el.get("name", "")))
+            joints.append(joint_el.get("name", ""))
+        for motor in block.iter("actuator"):
+            wanted = motor.get("name")
+            if wanted and joints:
+                written = unique_motor(wanted, joints[0], motors)
+                if written != wanted:
+                    motor.set("name", written)
+                    rename_motor(ctx, wanted, written, joints[0])
         robot_el.append(block)
