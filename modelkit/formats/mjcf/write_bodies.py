@@ -45,8 +45,19 @@ from modelkit.spatial import Pose, combine_mass_properties, principal_moments, r
 MIN_MASS = 1e-6  # kg, given to a moving body whose weld group has no mass
 MIN_INERTIA = 1e-9  # kg·m², added on each axis when the weld group's inertia is singular
 PLATE_MARGIN = 1e-10  # relative: how far above a + b = c a full tensor is raised (mujoco_valid_inertia)
-SINGULAR = 1e-12  # below this a mass or principal moment counts as zero (MuJoCo's mjMINVAL is 1e-15)
+SINGULAR = 1e-12  # below this a mass counts as zero (MuJoCo's mjMINVAL is 1e-15)
+# Below these a moving body's smallest principal moment counts as zero: MuJoCo refuses a diagonal
+# inertia under mjMINVAL (1e-15) and a fullinertia whose smallest eigenvalue is under mjEPS (1e-14;
+# measured: 6.7e-15 refused, 1.3e-14 taken); each with a 10× margin. pybullet_data's thrower.xml has
+# a wrist of 7.96e-14 kg·m² that MuJoCo itself compiled: it is written as it is.
+SINGULAR_DIAGONAL = 1e-14
+SINGULAR_FULL = 1e-13
 MOVING = (JointType.REVOLUTE, JointType.PRISMATIC, JointType.BALL, JointType.PLANAR, JointType.FLOATING)
+
+def _diagonal(tensor: np.ndarray) -> bool:
+    """Whether the tensor is written as ``diaginertia`` (no product of inertia)."""
+    return not any(float(tensor[i, j]) != 0.0 for i, j in ((0, 1), (0, 2), (1, 2)))
+
 
 # A body still to write: (parent element, link, pose in the parent body, incoming joint, free_top,
 # detached); or a floating joint whose child is split off as a top-level body when its turn comes.
@@ -474,7 +485,7 @@ class BodyTree:
                 )
                 mass, com = mass + MIN_MASS, com if mass > 0.0 else np.zeros(3)
                 tensor = tensor + MIN_INERTIA * np.eye(3)
-            elif float(np.min(moments)) < SINGULAR:
+            elif float(np.min(moments)) < (SINGULAR_DIAGONAL if _diagonal(tensor) else SINGULAR_FULL):
                 self.ctx.note(
                     "MK870",
                     f"link {link.name} moves but its inertia (with what is welded to it) is "

@@ -64,6 +64,9 @@ class StaticFacts:
     joints: dict[str, JointFacts] = field(default_factory=dict)
     # Collision shapes per link (every link a key, [] for none); empty when the engine reports none.
     shapes: dict[str, list[ShapeFacts]] = field(default_factory=dict)
+    # The source's named frames that are not links (SDF <frame>s, MJCF sites): an engine that lists a
+    # file's frames with its bodies (Drake on SDF) reports them; they are no extra link.
+    frames: frozenset[str] = frozenset()
 
 
 class EngineModel(Protocol):

@@ -50,7 +50,19 @@ def source_static(robot: Robot) -> StaticFacts:
             joint.limits.lower if moving else -math.inf, joint.limits.upper if moving else math.inf)
     facts.shapes = {link.name: [s for s in map(shape_facts, link.collisions) if s is not None]
                     for link in robot.links}
+    facts.frames = frozenset(named_frames(robot))
     return facts
+
+
+def named_frames(robot: Robot) -> list[str]:
+    """The names of the source's frames that are not links: SDF ``<frame>``s and MJCF sites, which
+    the readers keep with the link they hang on (``extras``)."""
+    out: list[str] = []
+    for link in robot.links:
+        out.extend(str(name) for name in (link.extras.get("sdf_frames") or {}))
+        out.extend(str(site.get("name")) for site in (link.extras.get("mjcf_sites") or [])
+                   if isinstance(site, dict) and site.get("name"))
+    return out
 
 
 def shape_facts(geom: Geom) -> ShapeFacts | None:

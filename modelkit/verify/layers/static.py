@@ -45,7 +45,7 @@ def layer1(source: StaticFacts, eng: Loaded) -> list[Check]:
     # base report it (compared), Drake's world body and SDF's world frame are no link of the model.
     missing = [name for name in source.links if eng.link(name) not in facts.links and name != world]
     written = {eng.link(name) for name in source.links}
-    extra = sorted(name for name in facts.links if name not in written)
+    extra = sorted(name for name in facts.links if name not in written and name not in source.frames)
     detail = f"missing {missing}, extra {extra}" if missing or extra else f"{len(source.links)} links"
     count = float(len(missing) + len(extra))
     checks.append(Check(1, label, "link-set", [*missing, *extra, ""][0], count, 0.0, detail))
