@@ -1412,6 +1412,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "are written explicitly, so nothing changes in the dynamics.",
     ),
     CodeInfo(
+        "MK877",
+        "mjcf-refused-by-mujoco",
+        "error",
+        "MuJoCo's compiler refuses the written MJCF (compiled while converting) for a reason no other note "
+        "explains; the file is written, the note quotes MuJoCo, and convert exits 1.",
+    ),
+    CodeInfo(
         "MK880",
         "body-shape-size-not-positive",
         "warning",

@@ -242,3 +242,45 @@ def test_an_ascii_stl_is_binary_in_every_target(suffix: str, tmp_path: Path) -> 
                              text=True, timeout=120, check=False)
         assert run.returncode == 0, run.stderr
         assert "SHAPES [5]" in run.stdout  # GEOM_MESH
+
+
+# robosuite's Sawyer head_1.obj, reduced: one flat object 2.75 mm above its origin (a disc). MuJoCo
+# finds no volume ("mesh volume is too small"); from the origin the surface and the origin make a cone
+# of 3.9e-6 m³, so the writer thought it solid and copied it without inertia="shell" (Sawyer refused).
+FLAT_DISC_OBJ = "".join(f"v {0.037 * np.cos(a):.6f} {0.037 * np.sin(a):.6f} 0.00275\n"
+                        for a in np.linspace(0.0, 2.0 * np.pi, 12, endpoint=False)) + \
+    "".join(f"f 1 {i} {i + 1}\n" for i in range(2, 12))
+
+
+@pytest.mark.parametrize(("collision", "status", "code", "geoms"),
+                         [(False, 0, "MK876", 1), (True, 1, "MK805", 1)])
+def test_a_flat_obj_of_one_object_loads_or_exits_1(collision: bool, status: int, code: str, geoms: int,
+                                                   tmp_path: Path) -> None:
+    (tmp_path / "disc.obj").write_text(FLAT_DISC_OBJ)
+    source = tmp_path / "robot.urdf"
+    source.write_text(_urdf("disc.obj", collision))
+    out = tmp_path / "out" / "robot.xml"
+    got, output = _convert(source, out)
+    assert got == status and code in output, output
+    model = mujoco.MjModel.from_xml_path(str(out))  # refused before: "mesh volume is too small: disc"
+    assert int(model.ngeom) == geoms
+    assert (out.parent / "meshes" / "disc.obj").read_text() == FLAT_DISC_OBJ  # still the file as it was
+
+
+def test_a_written_file_mujoco_refuses_is_an_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The safety net under every MJCF rule: when MuJoCo's compiler refuses the written file for a reason
+    no note explains (here the writer's hollow-mesh rule is switched off, as it was wrong for the Sawyer
+    head before), MK877 quotes MuJoCo and convert exits 1; before, only an info note (MK833) said so."""
+    import modelkit.convert.meshes as meshes
+
+    monkeypatch.setattr(meshes, "_hollow", lambda corners, scale=None: False)
+    (tmp_path / "disc.obj").write_text(FLAT_DISC_OBJ)
+    source = tmp_path / "robot.urdf"
+    source.write_text(_urdf("disc.obj", collision=False).replace(
+        "</link>", '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>'))
+    out = tmp_path / "out" / "robot.xml"
+    status, output = _convert(source, out)
+    assert status == 1, output
+    assert "error MK877" in output and "mesh volume is too small" in output, output
+    with pytest.raises(ValueError, match="mesh volume is too small"):
+        mujoco.MjModel.from_xml_path(str(out))

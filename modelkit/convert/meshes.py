@@ -123,15 +123,19 @@ def as_binary_stl(data: bytes) -> Prepared | None:
 
 
 def _obj_for_mujoco(data: bytes, scale: Vec3 | None) -> Prepared:
-    """An OBJ file kept as is, unless MuJoCo's own OBJ reader reads fewer triangles than it holds
-    (measured on files of several objects: example-robot-data's ``nub.obj`` gives 29 of 1,404, its
-    laikago ``trunk.obj`` 5,368 of 22,246); then its triangles become a binary STL, read whole. Only
+    """An OBJ file kept as is (with whether it is hollow or flat), unless MuJoCo's own OBJ reader reads
+    fewer triangles than it holds (measured on files of several objects: example-robot-data's
+    ``nub.obj`` gives 29 of 1,404, its laikago ``trunk.obj`` 5,368 of 22,246); then its triangles
+    become a binary STL, read whole. Only
     files of two or more ``o``/``g`` groups are put to MuJoCo (:mod:`modelkit.formats.mjcf.meshprobe`,
     ~0.1 s for a 10,000-face file): every OBJ measured that MuJoCo reads short has them, and none of
     the single-group ones (84 files of example-robot-data and the corpus)."""
     triangles, groups = _obj_counts(data)
     if groups < 2:
-        return Prepared(data, None, False, False)
+        corners = _obj_corners(data)
+        if corners is None or len(corners) == 0 or not np.all(np.isfinite(corners)):
+            return Prepared(data, None, False, False)  # MuJoCo's own verdict comes with the model
+        return Prepared(data, None, _hollow(corners, scale), _flat(corners))
     from modelkit.formats.mjcf.meshprobe import faces_mujoco_reads
 
     read = faces_mujoco_reads(data, "obj")
@@ -143,6 +147,34 @@ def _obj_for_mujoco(data: bytes, scale: Vec3 | None) -> Prepared:
     why = (f"an OBJ file of {groups} objects of which MuJoCo's OBJ reader keeps {read:,} of its "
            f"{triangles:,} triangles")
     return Prepared(triangles_to_bytes(mesh, "stl"), why, _hollow(corners, scale), _flat(corners))
+
+
+def _obj_corners(data: bytes) -> np.ndarray | None:
+    """The triangles (n × 3 × 3) of an OBJ file's faces, polygons fanned from their first corner, indices
+    as OBJ counts them (from 1; negative from the last vertex so far); None when a line does not parse.
+    Read without trimesh (0.5-0.8 s to import): only whether MuJoCo will find the mesh hollow or flat
+    is asked (robosuite's Sawyer ``head_1.obj``, one flat group, was copied and MuJoCo refused the model:
+    "mesh volume is too small")."""
+    vertices: list[list[float]] = []
+    triangles: list[tuple[int, int, int]] = []
+    try:
+        for line in data.splitlines():
+            if line.startswith(b"v "):
+                vertices.append([float(w) for w in line.split()[1:4]])
+            elif line.startswith(b"f "):
+                ids = [int(w.split(b"/", 1)[0]) for w in line.split()[1:]]
+                ids = [i - 1 if i > 0 else len(vertices) + i for i in ids]
+                triangles.extend((ids[0], ids[k], ids[k + 1]) for k in range(1, len(ids) - 1))
+        if not triangles:
+            return np.zeros((0, 3, 3))
+        points = np.array(vertices, dtype=np.float64).reshape(-1, 3)
+        index = np.array(triangles, dtype=np.int64)
+    except ValueError:
+        return None
+    if index.min() < 0 or index.max() >= len(points):
+        return None
+    corners: np.ndarray = points[index]
+    return corners
 
 
 def _obj_counts(data: bytes) -> tuple[int, int]:
@@ -204,8 +236,12 @@ def _checked(corners: np.ndarray, stl: bool = True) -> np.ndarray:
 
 def _hollow(corners: np.ndarray, scale: Vec3 | None = None) -> bool:
     """Whether the triangles, scaled, enclose (almost) no volume: |V| below 1e-6 of their box's
-    volume scale, or below 1e-12 m³ (MuJoCo refuses below 1e-15: "mesh volume is too small")."""
+    volume scale, or below 1e-12 m³ (MuJoCo refuses below 1e-15: "mesh volume is too small"). V is
+    summed over tetrahedra from the vertices' centroid, as MuJoCo does: from the origin, an open
+    surface has the volume of the cone it makes with the origin (robosuite's flat Sawyer ``head_1.obj``,
+    2.75 mm off its origin: 3.9e-6 m³, while MuJoCo finds none)."""
     corners = corners * (np.ones(3) if scale is None else np.asarray(scale, dtype=float))
+    corners = corners - corners.reshape(-1, 3).mean(axis=0)
     triple = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2]))
     volume = abs(float(triple.sum())) / 6.0
     extent = float(np.max(corners.reshape(-1, 3).max(axis=0) - corners.reshape(-1, 3).min(axis=0)))

@@ -35,6 +35,7 @@ class Touching:
 class Checked:
     pairs: list[Touching]
     failure: str | None = None  # why nothing was checked
+    refused: bool = False  # the failure is MuJoCo's compiler refusing the file
 
 
 def touching_pairs(xml: bytes, assets: dict[str, bytes]) -> Checked:
@@ -56,7 +57,7 @@ def _touching(mujoco: Any, xml: bytes, assets: dict[str, bytes]) -> Checked:
     try:
         model = mujoco.MjModel.from_xml_string(xml.decode("utf-8"), assets)
     except Exception as exc:  # MuJoCo raises ValueError with its compiler's message
-        return Checked([], f"MuJoCo did not compile the written file ({' '.join(str(exc).split())})")
+        return Checked([], f"MuJoCo did not compile the written file ({' '.join(str(exc).split())})", True)
     data = mujoco.MjData(model)
     found: dict[tuple[int, int], tuple[float, set[str]]] = {}
     home = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "home")

@@ -76,6 +76,7 @@ class MjcfWriter:
         self.robot = robot
         self.ctx = ctx
         self.names = NameTable(ctx)
+        self._refusal_explained = False  # a note already says why MuJoCo refuses the file (MK872)
         self.root = etree.Element("mujoco", model=robot.name)
         self.sections = {tag: sub(self.root, tag) for tag in SECTIONS}
         compiler = self.sections["compiler"]
@@ -145,6 +146,9 @@ class MjcfWriter:
         if checked.failure is not None:
             self.ctx.note("MK833", f"self-contact at rest not checked: {checked.failure}", self.robot.source,
                           "contact")
+            if checked.refused and not self._refusal_explained:
+                self.ctx.note("MK877", f"{checked.failure.replace('did not compile', 'refuses')}: the file "
+                              "is written, but it does not load in MuJoCo", self.robot.source, "mujoco")
             return
         links = {el.get("name"): link for link, el in self.tree.bodies.items()}
         for pair in checked.pairs:
@@ -204,6 +208,7 @@ class MjcfWriter:
         link = next((lk for lk, el in self.tree.bodies.items() if el is body), None)
         found = self.robot.link(link) if link is not None else None
         source = found.source if found is not None else self.robot.source
+        self._refusal_explained = True
         self.ctx.note(
             "MK872",
             f"the bodies nest {depth} deep (body {name}); MuJoCo's XML parser reads at most "
