@@ -84,7 +84,7 @@ def _names(robot: Robot) -> _Names:
         out.by_name.setdefault(link.name, name)
     for joint in robot.joints:
         child = out.by_name.get(joint.child, joint.child)
-        wanted = child if joint.extras.get("implicit_name") else (joint.name or child)
+        wanted = child if joint.implicit_name else (joint.name or child)
         out.joints[id(joint)] = unique_name(wanted, out.joint_used)
     return out
 
@@ -130,7 +130,7 @@ def write_body(robot: Robot, ctx: WriteContext) -> bytes:
     for joint in robot.joints:
         wanted = joint.name or joint.child
         written = names.joints[id(joint)]
-        if not joint.extras.get("implicit_name") and written != wanted:
+        if not joint.implicit_name and written != wanted:
             ctx.rename("joint", wanted, written, "joint names must be unique", joint.source)
     order, parent_joint = _tree_order(robot)
     from_body = robot.source_format == "body"
@@ -177,7 +177,7 @@ def _unconnected(robot: Robot, order: list[Link], ctx: WriteContext) -> list[tup
         kind = JointType.FIXED if static else JointType.FLOATING
         joint = Joint(f"{link.name}", kind, robot.root, link.name, robot.root_pose.inverse() @ world,
                       source=link.source)
-        joint.extras["implicit_name"] = True
+        joint.implicit_name = True
         ctx.note("MK814", f'link "{link.name}" is not connected to the root by a joint; it is written as a '
                  f"`{JOINT_WORDS[kind]}` child of the root at its initial pose "
                  f"({'fixed in a static model' if static else 'Choreonoid floats it as a separate body'})",

@@ -43,11 +43,7 @@ SILENT_EXTRAS = frozenset(
     {
         "materials",
         "urdf_version",
-        "world_link",
-        "root_joint_source",
-        "root_joint_name",
         "materials_path",
-        "masses_unknown",
         "sdf_canonical_link",
         "sdf_version",
         "sdf_model_pose",
@@ -80,7 +76,6 @@ DROPPED_EXTRAS = {
 SILENT_LINK_EXTRAS = frozenset(
     {
         "gazebo",
-        "synthesised",
         "is_continuous_track",
         "track",
         "mjcf_body_id",
@@ -175,10 +170,10 @@ def _root(robot: Robot, names: NameTable, ctx: WriteContext, add_world: bool) ->
         return []
     root = names.link(robot.root)
     out: list[Element] = []
-    where = robot.extras.get("root_joint_source") or robot.source
+    where = robot.root_joint_source or robot.source
     if add_world:
         word = "fixed" if robot.root_joint is JointType.FIXED else "floating"
-        wanted = robot.extras.get("root_joint_name") or f"{WORLD_LINK}_to_{root}"
+        wanted = robot.root_joint_name or f"{WORLD_LINK}_to_{root}"
         el = etree.Element("joint", name=names.fresh(str(wanted)), type=word)
         origin_element(el, robot.root_pose)
         etree.SubElement(el, "parent", link=WORLD_LINK)
