@@ -365,6 +365,8 @@ class Robot:
     ``root_joint_name`` and ``root_joint_source`` are the name and place of the source's element that
     set ``root_joint`` (a ``.body`` root's joint type; a URDF's fixed joint from ``world``, absorbed
     into ``root_pose``), for the targets that write the weld as a named joint and for notes.
+    ``free_link_poses`` holds the world pose of each link no joint connects to the tree where the
+    source gives one (SDF floats such a link as a separate body, or fixes it in a static model).
     """
 
     name: str
@@ -380,6 +382,7 @@ class Robot:
     masses_unknown: bool = False
     root_joint_name: str | None = None
     root_joint_source: SourceLocation | None = None
+    free_link_poses: dict[str, Pose] = field(default_factory=dict)
     extras: dict[str, Any] = field(default_factory=dict)  # one format's own data, kept as is
 
     def link(self, name: str) -> Link | None:

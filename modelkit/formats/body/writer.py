@@ -40,7 +40,6 @@ from modelkit.formats.body.write_devices import device_node
 from modelkit.formats.body.write_shapes import link_elements
 from modelkit.formats.body.write_yaml import Flow, Num, deg, dump, num, nums, put_pose, rotation_value
 from modelkit.model import WORLD_LINK, Inertial, Joint, JointType, Link, Robot
-from modelkit.spatial import Pose
 
 JOINT_WORDS = {
     JointType.FIXED: "fixed",
@@ -162,7 +161,7 @@ def _unconnected(robot: Robot, order: list[Link], ctx: WriteContext) -> list[tup
     that, so they are written as `free` (or `fixed`) children of the root at that pose. Any other
     unconnected link has no pose to write and is left out (MK822)."""
     written = {id(lk) for lk in order}
-    free_poses = robot.extras.get("sdf_free_links") or {}
+    free_poses = robot.free_link_poses
     static = (robot.root_joint is JointType.FIXED and "sdf_world_joint" not in robot.extras
               and robot.root != WORLD_LINK)
     out = []
@@ -170,7 +169,7 @@ def _unconnected(robot: Robot, order: list[Link], ctx: WriteContext) -> list[tup
         if id(link) in written or robot.root is None:
             continue
         world = free_poses.get(link.name)
-        if not isinstance(world, Pose):
+        if world is None:
             ctx.note("MK822", f'link "{link.name}" is not connected to the root "{robot.root}" and has no '
                      "pose of its own; it is not written", link.source, None)
             continue

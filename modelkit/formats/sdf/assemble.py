@@ -347,7 +347,7 @@ class Assembler:
                 severity=Severity.INFO if fixed else Severity.WARNING,
             )
         if floating:
-            robot.extras["sdf_free_links"] = floating
+            robot.free_link_poses = floating
 
 
 def _static_scope(scope: Scope) -> Scope | None:

@@ -231,7 +231,7 @@ class _ModelWriter:
         """The link's frame: relative to its parent link (≥ 1.7) or in the model frame (1.6)."""
         joint = self.joint_of.get(name)
         if name == self.robot.root or joint is None:
-            free = self.robot.extras.get("sdf_free_links", {})
+            free = self.robot.free_link_poses
             if name in free:
                 add_pose(el, self.robot.root_pose.inverse() @ free[name])
             return

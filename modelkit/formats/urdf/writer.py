@@ -47,7 +47,6 @@ SILENT_EXTRAS = frozenset(
         "sdf_canonical_link",
         "sdf_version",
         "sdf_model_pose",
-        "sdf_free_links",
         "sdf_world_joint",
         "mjcf_compiled",
         "gazebo",
@@ -212,14 +211,14 @@ def _free_links(robot: Robot, names: NameTable, ctx: WriteContext) -> list[Eleme
         return []
     children = {j.child for j in robot.joints}
     reached = set(robot.world_poses())
-    free_poses = robot.extras.get("sdf_free_links") or {}
+    free_poses = robot.free_link_poses
     out: list[Element] = []
     for index, link in enumerate(robot.links):
         if link.name in reached or link.name in children or link.name == robot.root:
             continue
         name = names.links[index]
-        placed = free_poses.get(link.name) if isinstance(free_poses, dict) else None
-        origin = robot.root_pose.inverse() @ placed if isinstance(placed, Pose) else Pose()
+        placed = free_poses.get(link.name)
+        origin = robot.root_pose.inverse() @ placed if placed is not None else Pose()
         el = etree.Element("joint", name=names.fresh(f"{name}_free"), type="floating")
         origin_element(el, origin)
         etree.SubElement(el, "parent", link=names.link(robot.root))
