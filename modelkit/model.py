@@ -233,6 +233,9 @@ class Link:
     collisions: list[Geom] = field(default_factory=list)
     devices: list[Device] = field(default_factory=list)
     contact_material: str | None = None
+    self_collide: bool | None = None
+    """The source's own word on whether this link collides with the robot's other links (SDF
+    ``<self_collide>``, a URDF ``<gazebo>`` block's ``selfCollide``); None: it says nothing."""
     synthesised: bool = False
     """Made up by a reader or a pass, not written in the source (an MJCF multi-joint body's
     intermediate frames, the world link a reader adds to hang joints from, a track's rollers)."""
@@ -383,6 +386,7 @@ class Robot:
     root_joint_name: str | None = None
     root_joint_source: SourceLocation | None = None
     free_link_poses: dict[str, Pose] = field(default_factory=dict)
+    self_collide: bool | None = None  # the model-wide flag (SDF <model><self_collide>), see Link's
     extras: dict[str, Any] = field(default_factory=dict)  # one format's own data, kept as is
 
     def link(self, name: str) -> Link | None:

@@ -150,7 +150,7 @@ def test_gz_sim_joint_controllers_are_read_as_actuators(tmp_path: Path) -> None:
     # force mode: a PID on the velocity error, kv = p_gain
     assert (slide.kind, slide.kv, slide.force_range) == (ActuatorKind.VELOCITY, 5.0, (-10.0, 10.0))
     assert push.kind is ActuatorKind.EFFORT
-    assert robot.extras["sdf_self_collide"] is True
+    assert robot.self_collide is True
 
 
 def test_sdf_to_sdf_keeps_each_controller_whole(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811

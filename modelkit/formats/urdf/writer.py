@@ -55,7 +55,6 @@ SILENT_EXTRAS = frozenset(
         "mujoco",
         "sensor",
         "sdf_plugins",  # written as <gazebo> blocks (write_gazebo)
-        "sdf_self_collide",  # written as a robot-level <gazebo> block (write_self_collide)
     }
 )
 # Robot extras that do: the note that says they are left out.
