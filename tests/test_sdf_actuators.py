@@ -317,6 +317,7 @@ def test_arm_that_touches_nothing_gets_the_model_flag(tmp_path: Path) -> None:
     assert not [m for m in _codes(notes, "MK808") if "extension of link" in m]  # selfCollide is all they say
     for link in ur5.links:
         link.extras.pop("gazebo", None)
+        link.self_collide = None  # the flag the reader took from the block
     out = tmp_path / "policy" / "ur5.sdf"
     notes = write(ur5, out)
     assert _flags(out) == ("true", {})
@@ -405,6 +406,7 @@ def test_urdf_self_collision_reaches_gazebo_through_libsdformat(tmp_path: Path, 
     ur5.source_format = "mjcf"
     for link in ur5.links:
         link.extras.pop("gazebo", None)
+        link.self_collide = None  # the flag the reader took from the block
     out = tmp_path / "ur5_policy" / "ur5.urdf"
     write(ur5, out)  # the policy: nothing touches at rest, so the model's flag
     assert _libsdformat_flags(sdf_flags, out) == (True, set())
