@@ -239,6 +239,7 @@ class Link:
     synthesised: bool = False
     """Made up by a reader or a pass, not written in the source (an MJCF multi-joint body's
     intermediate frames, the world link a reader adds to hang joints from, a track's rollers)."""
+    track: str | None = None  # a roller (synthesised) standing for this source track link
     extras: dict[str, Any] = field(default_factory=dict)  # one format's own data, kept as is
     source: SourceLocation | None = None
     sources: dict[str, SourceLocation] = field(default_factory=dict)  # per attribute: "name", "mass"...
@@ -290,6 +291,7 @@ class Joint:
     joint_id: int | None = None
     actuation_mode: str | None = None
     synthesised: bool = False  # made up, not written in the source (see Link.synthesised)
+    track: str | None = None  # a roller's joint (synthesised): the source track link it stands for
     implicit_name: bool = False
     """The source gives the joint no name of its own: it is named after its child link (``.body``,
     where a link is its joint), so a writer that can names it after the link as written."""

@@ -46,8 +46,8 @@ WRITTEN_EXTRAS = frozenset(
      "sdf_plugins"}
 )
 SILENT_EXTRAS = WRITTEN_EXTRAS | EXTRAS_QUIET
-# Link extras written elsewhere (URDF's <gazebo> blocks) or carrying nothing: a track pass's roller mark.
-SILENT_LINK_EXTRAS = frozenset({"gazebo", "track"}) | EXTRAS_QUIET_LINK
+# Link extras written elsewhere: URDF's <gazebo> blocks.
+SILENT_LINK_EXTRAS = frozenset({"gazebo"}) | EXTRAS_QUIET_LINK
 SDF_LINK_DEFAULTS = {
     "gravity": True,
     "kinematic": False,
