@@ -14,7 +14,6 @@ FORMAT = FormatDeclaration(
         tracks_native=True,  # Choreonoid simulates pseudo continuous tracks (AISTSimulator)
     ),
     extras=ExtrasDeclaration(
-        quiet=frozenset({"materials_path"}),  # the converters read the material table themselves
         quiet_link=frozenset({"is_continuous_track"}),
     ),
 )
