@@ -32,10 +32,6 @@ if TYPE_CHECKING:
 WORLD_LINK = "world"
 """The name of the link that stands for the world itself (every format's convention)."""
 
-SYNTHESISED = "synthesised"
-"""The ``extras`` key (value True) of a link or joint the reader made up: not written in the source
-(an MJCF multi-joint body's intermediate frames, the world link a reader adds to hang joints from)."""
-
 AXIS_UNIT_TOLERANCE = 1e-3
 """A written joint axis whose length is off 1 by more than this is not a rounded unit vector
 ("0.7071 0 0.7071" has length 0.99999): URDF and SDF readers warn (MK306). The ``.body`` reader warns
@@ -237,7 +233,14 @@ class Link:
     collisions: list[Geom] = field(default_factory=list)
     devices: list[Device] = field(default_factory=list)
     contact_material: str | None = None
-    extras: dict[str, Any] = field(default_factory=dict)  # format-specific data kept as is
+    self_collide: bool | None = None
+    """The source's own word on whether this link collides with the robot's other links (SDF
+    ``<self_collide>``, a URDF ``<gazebo>`` block's ``selfCollide``); None: it says nothing."""
+    synthesised: bool = False
+    """Made up by a reader or a pass, not written in the source (an MJCF multi-joint body's
+    intermediate frames, the world link a reader adds to hang joints from, a track's rollers)."""
+    track: str | None = None  # a roller (synthesised) standing for this source track link
+    extras: dict[str, Any] = field(default_factory=dict)  # one format's own data, kept as is
     source: SourceLocation | None = None
     sources: dict[str, SourceLocation] = field(default_factory=dict)  # per attribute: "name", "mass"...
 
@@ -287,7 +290,12 @@ class Joint:
     initial_position: float = 0.0
     joint_id: int | None = None
     actuation_mode: str | None = None
-    extras: dict[str, Any] = field(default_factory=dict)
+    synthesised: bool = False  # made up, not written in the source (see Link.synthesised)
+    track: str | None = None  # a roller's joint (synthesised): the source track link it stands for
+    implicit_name: bool = False
+    """The source gives the joint no name of its own: it is named after its child link (``.body``,
+    where a link is its joint), so a writer that can names it after the link as written."""
+    extras: dict[str, Any] = field(default_factory=dict)  # one format's own data, kept as is
     source: SourceLocation | None = None
     sources: dict[str, SourceLocation] = field(default_factory=dict)  # per attribute: "parent", "axis"...
 
@@ -357,8 +365,13 @@ class Robot:
 
     ``actuators`` are the source's own actuators (none: the source says nothing about actuation).
 
-    ``extras["masses_unknown"]`` is True when the reader could not tell the masses (an MJCF file
-    MuJoCo could not compile: the masses it would infer from geoms); mass rules then say nothing.
+    ``masses_unknown`` is True when the reader could not tell the masses (an MJCF file MuJoCo could
+    not compile: the masses it would infer from geoms); mass rules then say nothing.
+    ``root_joint_name`` and ``root_joint_source`` are the name and place of the source's element that
+    set ``root_joint`` (a ``.body`` root's joint type; a URDF's fixed joint from ``world``, absorbed
+    into ``root_pose``), for the targets that write the weld as a named joint and for notes.
+    ``free_link_poses`` holds the world pose of each link no joint connects to the tree where the
+    source gives one (SDF floats such a link as a separate body, or fixes it in a static model).
     """
 
     name: str
@@ -371,7 +384,12 @@ class Robot:
     actuators: list[Actuator] = field(default_factory=list)
     source_format: str = ""
     source: SourceLocation | None = None
-    extras: dict[str, Any] = field(default_factory=dict)
+    masses_unknown: bool = False
+    root_joint_name: str | None = None
+    root_joint_source: SourceLocation | None = None
+    free_link_poses: dict[str, Pose] = field(default_factory=dict)
+    self_collide: bool | None = None  # the model-wide flag (SDF <model><self_collide>), see Link's
+    extras: dict[str, Any] = field(default_factory=dict)  # one format's own data, kept as is
 
     def link(self, name: str) -> Link | None:
         for link in self.links:

@@ -21,7 +21,6 @@ from modelkit.convert.notes import ConversionNote
 from modelkit.diagnostics import Diagnostic
 from modelkit.formats.body.writer import body_renames
 from modelkit.model import (
-    SYNTHESISED,
     Box,
     Capsule,
     Cone,
@@ -98,7 +97,7 @@ def _inherited(item: Converted, d: Diagnostic) -> bool:
     writes the model it is given, and these are the model's own problems."""
     if d.code in {s.code for s in item.source_diagnostics}:
         return True
-    synthesised = {lk.name for lk in item.robot.links if lk.extras.get(SYNTHESISED)}
+    synthesised = {lk.name for lk in item.robot.links if lk.synthesised}
     return d.code == "MK313" and any(f'"{name}"' in d.message for name in synthesised)
 
 

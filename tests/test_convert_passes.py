@@ -124,7 +124,7 @@ def test_tracks_become_rows_of_rollers(tracks_robot: Robot) -> None:
         for i, (jname, lname) in enumerate(zip(rollers, links, strict=True)):
             joint = joints[jname]
             roller = tracks_robot.link(lname)
-            assert roller is not None and roller.extras == {"synthesised": True, "track": name}
+            assert roller is not None and roller.synthesised and roller.track == name and roller.extras == {}
             assert joint.type is JointType.REVOLUTE and joint.parent == name and joint.child == lname
             assert not joint.limits.position_limited
             assert np.allclose(joint.axis, [0, 1, 0])

@@ -486,7 +486,7 @@ def test_a_body_with_several_joints_becomes_a_chain() -> None:
     assert (by_name["hip_x"].parent, by_name["hip_x"].child) == ("torso", "hip__hip_x")
     assert (by_name["hip_y"].parent, by_name["hip_y"].child) == ("hip__hip_x", "hip")
     middle = robot.link("hip__hip_x")
-    assert middle is not None and middle.inertial is None and middle.extras["synthesised"] is True
+    assert middle is not None and middle.inertial is None and middle.synthesised is True
     # hip_y's anchor is 6 cm above hip_x's: the second joint's origin moves by that much.
     assert np.allclose(by_name["hip_y"].origin.translation, [0, 0, 0.06])
     assert np.allclose(by_name["hip_y"].axis, np.array([0, 1, 0.5]) / math.sqrt(1.25))
@@ -518,7 +518,7 @@ def test_top_level_body_with_hinges_hangs_from_a_world_link() -> None:
     robot = read(path).robot
     assert robot is not None and robot.root == "world" and robot.root_joint is JointType.FIXED
     world = robot.link("world")
-    assert world is not None and world.extras == {"synthesised": True}
+    assert world is not None and world.synthesised and world.extras == {}
     slider = next(j for j in robot.joints if j.name == "slider")
     assert slider.type is JointType.PRISMATIC and slider.parent == "world"
 

@@ -150,7 +150,7 @@ def test_gz_sim_joint_controllers_are_read_as_actuators(tmp_path: Path) -> None:
     # force mode: a PID on the velocity error, kv = p_gain
     assert (slide.kind, slide.kv, slide.force_range) == (ActuatorKind.VELOCITY, 5.0, (-10.0, 10.0))
     assert push.kind is ActuatorKind.EFFORT
-    assert robot.extras["sdf_self_collide"] is True
+    assert robot.self_collide is True
 
 
 def test_sdf_to_sdf_keeps_each_controller_whole(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
@@ -317,6 +317,7 @@ def test_arm_that_touches_nothing_gets_the_model_flag(tmp_path: Path) -> None:
     assert not [m for m in _codes(notes, "MK808") if "extension of link" in m]  # selfCollide is all they say
     for link in ur5.links:
         link.extras.pop("gazebo", None)
+        link.self_collide = None  # the flag the reader took from the block
     out = tmp_path / "policy" / "ur5.sdf"
     notes = write(ur5, out)
     assert _flags(out) == ("true", {})
@@ -405,6 +406,7 @@ def test_urdf_self_collision_reaches_gazebo_through_libsdformat(tmp_path: Path, 
     ur5.source_format = "mjcf"
     for link in ur5.links:
         link.extras.pop("gazebo", None)
+        link.self_collide = None  # the flag the reader took from the block
     out = tmp_path / "ur5_policy" / "ur5.urdf"
     write(ur5, out)  # the policy: nothing touches at rest, so the model's flag
     assert _libsdformat_flags(sdf_flags, out) == (True, set())

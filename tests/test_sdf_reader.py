@@ -464,7 +464,7 @@ def test_free_links_and_loops_are_reported(tmp_path: Path) -> None:
     ]
     assert [loop.name for loop in robot.loops] == ["j3"] and robot.loops[0].type == "hinge"
     assert [j.name for j in robot.joints] == ["j1", "j2"]
-    assert "d" in robot.extras["sdf_free_links"]
+    assert "d" in robot.free_link_poses
 
 
 def test_joint_details(tmp_path: Path) -> None:

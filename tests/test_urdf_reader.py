@@ -440,7 +440,7 @@ def test_world_root_is_fixed_to_the_world(tmp_path: Path) -> None:
   <joint name="weld" type="fixed"><parent link="world"/><child link="base"/></joint>""")
     robot, _ = read(tmp_path, text)
     assert robot is not None and robot.root == "world" and robot.root_joint is JointType.FIXED
-    assert robot.extras["world_link"] == "world"
+    assert "world_link" not in robot.extras  # the root says it: no copy of it in extras
 
 
 def test_two_parents_keep_both_joints(tmp_path: Path) -> None:

@@ -187,7 +187,7 @@ def expected_after_urdf(robot: Robot) -> Robot:
     if out.root_joint is JointType.FIXED and out.root not in (None, "world"):
         root = str(out.root)
         out.links.insert(0, Link("world"))
-        name = str(out.extras.get("root_joint_name") or f"world_to_{root}")
+        name = str(out.root_joint_name or f"world_to_{root}")
         out.joints.append(Joint(name, JointType.FIXED, "world", root, origin=out.root_pose))
         out.root, out.root_pose = "world", Pose()
     for joint in out.joints:

@@ -9,7 +9,7 @@ from modelkit import rot3
 from modelkit.checks.masses import body_mass_properties, lumped_masses, welded_bodies
 from modelkit.checks.registry import rule
 from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
-from modelkit.model import SYNTHESISED, JointType, Link, Robot
+from modelkit.model import JointType, Link, Robot
 from modelkit.spatial import Pose
 
 # Who fills in missing mass properties, per source format (the wording of MK304).
@@ -61,14 +61,14 @@ def _mass_loc(link: Link) -> SourceLocation | None:
 @rule("mass", "MK300", "MK304", "MK313")
 def mass(robot: Robot) -> Iterator[Diagnostic]:
     """Masses are positive where it matters; default mass properties are flagged."""
-    if robot.extras.get("masses_unknown"):
+    if robot.masses_unknown:
         return  # e.g. MuJoCo could not compile the file: masses it would infer from geoms are unknown
     moving = _moving_links(robot)
     merged = _merged_masses(robot)
     carried: dict[str, float] | None = None  # subtree masses, computed when first needed
     for link in robot.links:
         inertial = link.inertial
-        if link.extras.get(SYNTHESISED):
+        if link.synthesised:
             continue  # a link the reader made up (MJCF intermediate frames, a world link to hang from)
         if inertial is None:
             # A link without mass information (URDF/SDF) hung on a fixed joint is part of its

@@ -17,7 +17,7 @@ from modelkit.checks.bounds import Aabb, geom_box, shapes_box, union
 from modelkit.checks.masses import body_mass_properties, welded_bodies
 from modelkit.checks.registry import rule
 from modelkit.diagnostics import Diagnostic, SourceLocation, diag
-from modelkit.model import SYNTHESISED, Capsule, Cone, Cylinder, Geom, Joint, Link, Mesh, Robot
+from modelkit.model import Capsule, Cone, Cylinder, Geom, Joint, Link, Mesh, Robot
 from modelkit.spatial import Pose
 
 # MK418: a collision is "far" from the visuals when the gap between their boxes exceeds this fraction of the
@@ -57,7 +57,7 @@ def _parent_joints(robot: Robot) -> dict[str, Joint]:
 
 
 def _judged(link: Link) -> bool:
-    return not link.extras.get(SYNTHESISED)
+    return not link.synthesised
 
 
 def _repeats_joint_origin(offset: rot3.V3, joint: Joint | None, size: float) -> str:
@@ -165,7 +165,7 @@ def inertia_implausible(robot: Robot) -> Iterator[Diagnostic]:
     joined by fixed joints are judged as the one body engines merge them into: a placeholder inertia on a
     1 g sensor frame welded to a 10 kg trunk changes nothing.
     """
-    if robot.extras.get("masses_unknown"):
+    if robot.masses_unknown:
         return
     links = {link.name: link for link in robot.links}
     for head, members in welded_bodies(robot).items():
@@ -196,7 +196,7 @@ def _implausible_body(
     judged: list[Link] = []
     for name, pose in members:
         link = links.get(name)
-        if link is None or link.extras.get(SYNTHESISED):
+        if link is None or link.synthesised:
             continue
         inertial = link.inertial
         if inertial is not None and (inertial.defaulted or not math.isfinite(inertial.mass)):

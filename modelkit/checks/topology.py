@@ -24,7 +24,7 @@ def unique_names(robot: Robot) -> Iterator[Diagnostic]:
             first_link[link.name] = index
     first_joint: dict[str, int] = {}
     for i, joint in enumerate(robot.joints):
-        if joint.extras.get("implicit_name"):
+        if joint.implicit_name:
             continue  # named after its link: a duplicate is already a duplicate link name
         if joint.name in first_joint:
             where = robot.joints[first_joint[joint.name]].loc("name")
@@ -41,7 +41,7 @@ def parents_exist(robot: Robot) -> Iterator[Diagnostic]:
     for joint in robot.joints:
         if joint.parent in names:
             continue
-        if joint.extras.get("implicit_name"):  # .body: the joint is its link
+        if joint.implicit_name:  # .body: the joint is its link
             yield diag(
                 "MK202",
                 f'parent link "{joint.parent}" of "{joint.child}" is not defined',
@@ -179,7 +179,7 @@ def link_joint_collision(robot: Robot) -> Iterator[Diagnostic]:
         links.setdefault(link.name, link)
     severity, consumers = _name_collision_verdict(robot)
     for joint in robot.joints:
-        if joint.extras.get("implicit_name"):
+        if joint.implicit_name:
             continue
         same = links.get(joint.name)
         if same is not None:

@@ -62,7 +62,7 @@ def settle_base(robot: Robot, choice: str, notes: NoteSink) -> None:
         return
     if robot.root == WORLD_LINK:
         absorb_world_weld(robot)
-    where = robot.extras.get("root_joint_source") or robot.source
+    where = robot.root_joint_source or robot.source
     if robot.root == WORLD_LINK:
         _settle_world_root(robot, choice, notes)
         return
@@ -88,7 +88,7 @@ def settle_base(robot: Robot, choice: str, notes: NoteSink) -> None:
 
 def absorb_world_weld(robot: Robot) -> None:
     """An empty ``world`` link with one fixed joint to the robot (a URDF's way of welding it) is the
-    root welded at that joint's origin; the joint's name is kept (``extras["root_joint_name"]``) for the
+    root welded at that joint's origin; the joint's name is kept (``root_joint_name``) for the
     targets that write the weld as a joint (URDF, SDF)."""
     world = robot.link(WORLD_LINK)
     hanging = [joint for joint in robot.joints if joint.parent == WORLD_LINK]
@@ -107,10 +107,9 @@ def absorb_world_weld(robot: Robot) -> None:
     robot.joints.remove(weld)
     robot.root, robot.root_joint = weld.child, JointType.FIXED
     robot.root_pose = robot.root_pose @ weld.origin
-    robot.extras["root_joint_name"] = weld.name
+    robot.root_joint_name = weld.name
     if weld.source is not None:
-        robot.extras["root_joint_source"] = weld.source
-    robot.extras.pop("world_link", None)
+        robot.root_joint_source = weld.source
 
 
 def _asked(choice: str) -> JointType | None:

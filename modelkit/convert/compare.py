@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from modelkit.model import SYNTHESISED, Joint, JointType, Robot
+from modelkit.model import Joint, JointType, Robot
 from modelkit.spatial import Pose
 
 
@@ -67,7 +67,7 @@ def compare_robots(
 ) -> list[Difference]:
     """Differences between source ``a`` and converted ``b`` (an empty list: the same robot).
 
-    Links of ``b`` marked synthesised (``extras["synthesised"]``) are not required in ``a``.
+    Links of ``b`` marked ``synthesised`` are not required in ``a``.
     """
     mapping = renames or {}
 
@@ -80,7 +80,7 @@ def compare_robots(
     for missing in sorted(set(a_links) - set(b_links)):
         out.append(Difference("link-set", missing, "link missing in the converted model"))
     for extra in sorted(set(b_links) - set(a_links)):
-        if not b_links[extra].extras.get(SYNTHESISED):
+        if not b_links[extra].synthesised:
             out.append(Difference("link-set", extra, "link only in the converted model"))
     b_joint_by_child = {j.child: j for j in b.joints}
     for ja in a.joints:

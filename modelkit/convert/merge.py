@@ -9,7 +9,7 @@ remains, except:
 * ``pseudo_continuous_track`` joints are not fixed joints: their links keep their moving contact
   surface (``.body`` target) and are never merged. After :mod:`modelkit.convert.tracks` has run
   (other targets), a track link is an ordinary fixed visual link and is merged like any other;
-  its rollers then hang from the parent and keep ``extras["track"]`` naming the source track.
+  its rollers then hang from the parent and keep ``track`` naming the source track.
 
 What fusing a child C on fixed joint J (origin X, C's frame in the parent P's frame) does:
 

@@ -43,27 +43,8 @@ def source_flags(robot: Robot) -> tuple[bool | None, dict[str, bool]]:
 
     SDF: ``<model><self_collide>`` and ``<link><self_collide>``; URDF: ``<gazebo reference="L">
     <selfCollide>`` and a robot-level ``<gazebo><self_collide>`` (what libsdformat's import reads)."""
-    model = robot.extras.get("sdf_self_collide")
-    found: bool | None = model if isinstance(model, bool) else None
-    links: dict[str, bool] = {}
-    for link in robot.links:
-        flags = link.extras.get("sdf_link")
-        if isinstance(flags, dict) and isinstance(flags.get("self_collide"), bool):
-            links[link.name] = bool(flags["self_collide"])
-        for entry in link.extras.get("gazebo") or []:
-            if isinstance(entry, dict) and isinstance(entry.get("selfCollide"), bool):
-                links[link.name] = bool(entry["selfCollide"])
-    for entry in robot.extras.get("gazebo") or []:
-        if not isinstance(entry, dict) or "self_collide" not in str(entry.get("xml", "")):
-            continue
-        try:
-            block = etree.fromstring(str(entry["xml"]))
-        except etree.XMLSyntaxError:
-            continue
-        flag = block.find("self_collide")
-        if flag is not None:
-            found = (flag.text or "").strip().lower() in ("1", "true")
-    return found, links
+    links = {link.name: link.self_collide for link in robot.links if link.self_collide is not None}
+    return robot.self_collide, links
 
 
 @dataclass

@@ -64,7 +64,6 @@ import numpy as np
 from modelkit.convert.names import unique_name
 from modelkit.convert.notes import NoteSink
 from modelkit.model import (
-    SYNTHESISED,
     Actuator,
     ActuatorKind,
     Box,
@@ -355,7 +354,7 @@ def _approximate(robot: Robot, joint: Joint, link: Link, notes: NoteSink) -> Non
         along_axis = Pose(_rotation_z_to(shape.axis, shape.forward), np.zeros(3))
         cylinder = Geom(Cylinder(r, shape.width), along_axis, name=f"{name}_collision", source=geom_source)
         roller = Link(name, inertial, collisions=[cylinder], contact_material=material,
-                      extras={SYNTHESISED: True, "track": link.name}, source=link.source)
+                      synthesised=True, track=link.name, source=link.source)
         limits = JointLimits()
         for attribute in ("velocity", "velocity_lower", "velocity_upper"):
             value = getattr(joint.limits, attribute)
@@ -363,7 +362,7 @@ def _approximate(robot: Robot, joint: Joint, link: Link, notes: NoteSink) -> Non
                 setattr(limits, attribute, value / r)
         roller_joint = Joint(joint_name, JointType.REVOLUTE, link.name, name, Pose(np.eye(3), centre),
                              shape.axis.copy(), limits, source=joint.source,
-                             extras={SYNTHESISED: True, "track": link.name})
+                             synthesised=True, track=link.name)
         if i == 0:
             roller_joint.joint_id = joint.joint_id
             roller_joint.actuation_mode = joint.actuation_mode or "velocity"
@@ -448,7 +447,7 @@ def assembly_mass_properties(robot: Robot, track_link: str) -> tuple[float, Vec3
         child = robot.link(joint.child)
         if joint.parent != track_link or child is None or child.inertial is None:
             continue
-        if child.extras.get("track") != track_link:
+        if child.track != track_link:
             continue
         rot, offset = joint.origin.rotation, joint.origin.translation
         parts.append((child.inertial.mass, rot @ child.inertial.com + offset,

@@ -21,6 +21,21 @@ class OutputDeclaration(NamedTuple):
     auto_wheel: str = "cylinder"  # the wheel collision `--wheel-collision auto` writes: cylinder or sphere
 
 
+class ExtrasDeclaration(NamedTuple):
+    """The keys a format's reader keeps in ``extras`` (data only the format itself reads and writes) that
+    another target's writer meets when it walks ``extras`` to say what it leaves out.
+
+    ``quiet`` (robot) and ``quiet_link`` (link) keys carry nothing that target misses: bookkeeping, or
+    data the model's own fields already hold. ``dropped`` gives each other robot key the note's code
+    and its words ("MJCF tendons"). The owning format says this once, so no writer lists another
+    format's keys.
+    """
+
+    quiet: frozenset[str] = frozenset()
+    quiet_link: frozenset[str] = frozenset()
+    dropped: tuple[tuple[str, str, str], ...] = ()  # (key, code, what)
+
+
 class FormatDeclaration(NamedTuple):
     """A model format: how modelkit recognises and reads it, and (``output``) whether and how it writes it."""
 
@@ -30,3 +45,4 @@ class FormatDeclaration(NamedTuple):
     reader: str  # "module:function", imported on first use: read(path, options, display) -> ReadResult
     root_tags: tuple[str, ...] = ()  # top XML elements that identify it (an .xml file)
     output: OutputDeclaration | None = None  # None: modelkit reads it but does not write it
+    extras: ExtrasDeclaration = ExtrasDeclaration()  # its own extras keys, as other targets see them

@@ -26,6 +26,16 @@ FORMAT_NAMES: tuple[str, ...] = tuple(d.name for d in DECLARED)
 TARGET_NAMES: tuple[str, ...] = tuple(d.name for d in WRITTEN)
 
 
+EXTRAS_QUIET: frozenset[str] = frozenset().union(*(d.extras.quiet for d in DECLARED))
+"""Robot ``extras`` keys a target that drops them has nothing to say about (each format's own, declared)."""
+EXTRAS_QUIET_LINK: frozenset[str] = frozenset().union(*(d.extras.quiet_link for d in DECLARED))
+"""The same for link ``extras`` keys."""
+EXTRAS_DROPPED: dict[str, tuple[str, str]] = {
+    key: (code, what) for d in DECLARED for key, code, what in d.extras.dropped
+}
+"""Robot ``extras`` key → (code, words) of the note a target that drops it gives (each format's own)."""
+
+
 def declared(name: str) -> FormatDeclaration:
     """The declaration of format ``name`` (KeyError: no such format)."""
     for d in DECLARED:

@@ -1,6 +1,6 @@
 """The Choreonoid body format, as modelkit reads and writes it (see :mod:`modelkit.formats.declaration`)."""
 
-from modelkit.formats.declaration import FormatDeclaration, OutputDeclaration
+from modelkit.formats.declaration import ExtrasDeclaration, FormatDeclaration, OutputDeclaration
 
 FORMAT = FormatDeclaration(
     name="body",
@@ -12,5 +12,8 @@ FORMAT = FormatDeclaration(
         suffix=".body",
         suffixes=(".body",),
         tracks_native=True,  # Choreonoid simulates pseudo continuous tracks (AISTSimulator)
+    ),
+    extras=ExtrasDeclaration(
+        quiet_link=frozenset({"is_continuous_track"}),
     ),
 )

@@ -357,7 +357,7 @@ class _BodyReader:
         )
         joint.sources["name"] = (joint_name_node or name_node or node).loc
         if joint_name_node is None:
-            joint.extras["implicit_name"] = True
+            joint.implicit_name = True
         if joint_type_node is not None:
             joint.sources["type"] = joint_type_node.loc
         joint.actuation_mode = ACTUATION_MODES.get(mode_word or "")
@@ -698,7 +698,7 @@ class _BodyReader:
                     )
                 robot.root_joint = JointType.FLOATING if joint.type is JointType.FLOATING else JointType.FIXED
                 robot.root_pose = record.pose
-                robot.extras["root_joint_source"] = joint.loc("type")
+                robot.root_joint_source = joint.loc("type")
                 continue
             if not record.parent:  # Choreonoid: an empty parent (`parent:`, an alias of one) is none
                 self.sink.emit(

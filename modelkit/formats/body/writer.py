@@ -40,7 +40,6 @@ from modelkit.formats.body.write_devices import device_node
 from modelkit.formats.body.write_shapes import link_elements
 from modelkit.formats.body.write_yaml import Flow, Num, deg, dump, num, nums, put_pose, rotation_value
 from modelkit.model import WORLD_LINK, Inertial, Joint, JointType, Link, Robot
-from modelkit.spatial import Pose
 
 JOINT_WORDS = {
     JointType.FIXED: "fixed",
@@ -84,7 +83,7 @@ def _names(robot: Robot) -> _Names:
         out.by_name.setdefault(link.name, name)
     for joint in robot.joints:
         child = out.by_name.get(joint.child, joint.child)
-        wanted = child if joint.extras.get("implicit_name") else (joint.name or child)
+        wanted = child if joint.implicit_name else (joint.name or child)
         out.joints[id(joint)] = unique_name(wanted, out.joint_used)
     return out
 
@@ -130,7 +129,7 @@ def write_body(robot: Robot, ctx: WriteContext) -> bytes:
     for joint in robot.joints:
         wanted = joint.name or joint.child
         written = names.joints[id(joint)]
-        if not joint.extras.get("implicit_name") and written != wanted:
+        if not joint.implicit_name and written != wanted:
             ctx.rename("joint", wanted, written, "joint names must be unique", joint.source)
     order, parent_joint = _tree_order(robot)
     from_body = robot.source_format == "body"
@@ -162,7 +161,7 @@ def _unconnected(robot: Robot, order: list[Link], ctx: WriteContext) -> list[tup
     that, so they are written as `free` (or `fixed`) children of the root at that pose. Any other
     unconnected link has no pose to write and is left out (MK822)."""
     written = {id(lk) for lk in order}
-    free_poses = robot.extras.get("sdf_free_links") or {}
+    free_poses = robot.free_link_poses
     static = (robot.root_joint is JointType.FIXED and "sdf_world_joint" not in robot.extras
               and robot.root != WORLD_LINK)
     out = []
@@ -170,14 +169,14 @@ def _unconnected(robot: Robot, order: list[Link], ctx: WriteContext) -> list[tup
         if id(link) in written or robot.root is None:
             continue
         world = free_poses.get(link.name)
-        if not isinstance(world, Pose):
+        if world is None:
             ctx.note("MK822", f'link "{link.name}" is not connected to the root "{robot.root}" and has no '
                      "pose of its own; it is not written", link.source, None)
             continue
         kind = JointType.FIXED if static else JointType.FLOATING
         joint = Joint(f"{link.name}", kind, robot.root, link.name, robot.root_pose.inverse() @ world,
                       source=link.source)
-        joint.extras["implicit_name"] = True
+        joint.implicit_name = True
         ctx.note("MK814", f'link "{link.name}" is not connected to the root by a joint; it is written as a '
                  f"`{JOINT_WORDS[kind]}` child of the root at its initial pose "
                  f"({'fixed in a static model' if static else 'Choreonoid floats it as a separate body'})",

@@ -28,7 +28,6 @@ from modelkit.diagnostics import DiagnosticSink, SourceLocation
 from modelkit.formats.mjcf.bodies import MjBody, MjGeom, MjJoint, MjSite, translation
 from modelkit.formats.mjcf.source import Locator
 from modelkit.model import (
-    SYNTHESISED,
     WORLD_LINK,
     Box,
     Capsule,
@@ -204,7 +203,7 @@ class RobotBuilder:
             robot.root = name
             robot.links.append(self._intermediate(name, body, free))
             return name, Pose()
-        world = Link(WORLD_LINK, source=self.loc.body(body.index), extras={SYNTHESISED: True})
+        world = Link(WORLD_LINK, source=self.loc.body(body.index), synthesised=True)
         world.sources["name"] = self.loc.body(body.index)
         if robot.link(WORLD_LINK) is None:
             robot.links.append(world)
@@ -222,7 +221,7 @@ class RobotBuilder:
             joint = Joint(
                 name, JointType.FIXED, start, link.name, origin=pose, source=self.loc.body(body.index)
             )
-            joint.extras[SYNTHESISED] = True
+            joint.synthesised = True
             joint.sources["name"] = joint.sources["parent"] = self.loc.body(body.index)
             robot.joints.append(joint)
             return
@@ -273,7 +272,8 @@ class RobotBuilder:
     def _intermediate(self, name: str, body: MjBody, mj: MjJoint) -> Link:
         link = Link(name, source=self.loc.joint(mj.index))
         link.sources["name"] = self.loc.joint(mj.index, "name")
-        link.extras.update({SYNTHESISED: True, "mjcf_intermediate_of": self.link_name[body.index]})
+        link.synthesised = True
+        link.extras["mjcf_intermediate_of"] = self.link_name[body.index]
         return link
 
     # -- joints --------------------------------------------------------------------------------

@@ -1,6 +1,6 @@
 """MJCF, as modelkit reads (through mujoco) and writes it; see :mod:`modelkit.formats.declaration`."""
 
-from modelkit.formats.declaration import FormatDeclaration, OutputDeclaration
+from modelkit.formats.declaration import ExtrasDeclaration, FormatDeclaration, OutputDeclaration
 
 FORMAT = FormatDeclaration(
     name="mjcf",
@@ -13,5 +13,21 @@ FORMAT = FormatDeclaration(
         suffix=".xml",
         suffixes=(".xml", ".mjcf"),
         auto_wheel="sphere",  # MuJoCo: a cylinder rolling on a plane gets odd contacts
+    ),
+    extras=ExtrasDeclaration(
+        quiet=frozenset({"mjcf_compiled"}),
+        quiet_link=frozenset({"mjcf_body_id", "mjcf_body_offset", "mjcf_intermediate_of"}),
+        dropped=(
+            ("mjcf_actuators", "MK808", "MJCF actuators"),
+            ("mjcf_tendons", "MK808", "MJCF tendons"),
+            ("mjcf_equalities", "MK808", "MJCF equality constraints"),
+            ("mjcf_sensors", "MK806", "MJCF sensors"),
+            ("mjcf_cameras", "MK806", "MJCF cameras"),
+            ("mjcf_lights", "MK806", "MJCF lights"),
+            ("mjcf_sites", "MK808", "MJCF sites (named frames)"),
+            ("mjcf_keyframes", "MK820", "MJCF keyframes (stored joint positions)"),
+            ("mjcf_world_geoms", "MK822", "MJCF world geoms"),
+            ("mjcf_world_sites", "MK822", "MJCF world sites"),
+        ),
     ),
 )

@@ -329,7 +329,7 @@ class _MjcfReader:
         built = RobotBuilder(bodies, locator, self.sink, name).build()
         for robot in built.robots:
             robot.extras["mjcf_compiled"] = False
-            robot.extras["masses_unknown"] = True
+            robot.masses_unknown = True
         self.sink.emit(
             "MK174",
             "the kinematic tree was read from the uncompiled model: links have no geometry and only "

@@ -148,7 +148,7 @@ class BodyTree:
                 or (incoming is not None and incoming.parent in self.links)
             ):
                 continue
-            free = self.robot.extras.get("sdf_free_links") or {}
+            free = self.robot.free_link_poses
             pose = free.get(link.name, robot.root_pose)
             static = robot.root_joint is JointType.FIXED
             how = "welded to the world, as the root is" if static else "with <freejoint/>"

@@ -30,7 +30,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from modelkit.model import SYNTHESISED, Joint, JointType, Link, Robot
+from modelkit.model import Joint, JointType, Link, Robot
 from modelkit.spatial import Pose, rotate_inertia
 
 BODY_JOINTS = (JointType.REVOLUTE, JointType.PRISMATIC, JointType.BALL)
@@ -117,7 +117,7 @@ class ChainFinder:
     def _absorbable(self, link: Link, end: str, incoming: str) -> bool:
         inertial = link.inertial
         return bool(
-            link.extras.get(SYNTHESISED)
+            link.synthesised
             and link.name == f"{end}__{incoming}"
             and (inertial is None or (inertial.mass == 0.0 and not np.any(inertial.inertia)))
             and not (link.visuals or link.collisions or link.devices)

@@ -25,7 +25,7 @@ from modelkit.formats.sdf.collect import ModelTree, Scope
 from modelkit.formats.sdf.joints import AxisSpec, JointData
 from modelkit.formats.sdf.links import LinkData
 from modelkit.formats.sdf.poses import FrameGraph
-from modelkit.model import SYNTHESISED, WORLD_LINK, Inertial, Joint, JointType, Link, LoopConstraint, Robot
+from modelkit.model import WORLD_LINK, Inertial, Joint, JointType, Link, LoopConstraint, Robot
 from modelkit.rot3 import peek
 from modelkit.spatial import Pose
 
@@ -88,7 +88,7 @@ class Assembler:
             if tree_joints.get(jd.child_link or "") is jd:
                 robot.joints.append(self._joint(jd))
         if synthetic:
-            robot.links.insert(0, Link(WORLD_LINK, extras={"sdf_synthetic_world": True, SYNTHESISED: True}))
+            robot.links.insert(0, Link(WORLD_LINK, synthesised=True, extras={"sdf_synthetic_world": True}))
             for jd in world_joints:
                 robot.joints.append(self._world_joint(jd))
         for jd in loops:
@@ -347,7 +347,7 @@ class Assembler:
                 severity=Severity.INFO if fixed else Severity.WARNING,
             )
         if floating:
-            robot.extras["sdf_free_links"] = floating
+            robot.free_link_poses = floating
 
 
 def _static_scope(scope: Scope) -> Scope | None:

@@ -1,6 +1,6 @@
 """SDFormat, as modelkit reads and writes it (see :mod:`modelkit.formats.declaration`)."""
 
-from modelkit.formats.declaration import FormatDeclaration, OutputDeclaration
+from modelkit.formats.declaration import ExtrasDeclaration, FormatDeclaration, OutputDeclaration
 
 FORMAT = FormatDeclaration(
     name="sdf",
@@ -12,5 +12,10 @@ FORMAT = FormatDeclaration(
         writer="modelkit.formats.sdf.writer:write_sdf",
         suffix=".sdf",
         suffixes=(".sdf",),
+    ),
+    extras=ExtrasDeclaration(
+        quiet=frozenset({"sdf_canonical_link", "sdf_version", "sdf_model_pose", "sdf_world_joint"}),
+        quiet_link=frozenset({"sdf_link_pose"}),
+        dropped=(("sdf_world", "MK822", "the SDF world around the model"),),
     ),
 )

@@ -115,6 +115,8 @@ def read_link(ctx: Context, graph: FrameGraph, item: Item) -> LinkData:
     decay = child(el, "velocity_decay")
     if decay is not None:
         flags["velocity_decay"] = element_data(decay)
+    if "self_collide" in flags:
+        link.self_collide = flags.pop("self_collide")
     if flags:
         link.extras["sdf_link"] = flags
     for key in NOT_MODELLED:

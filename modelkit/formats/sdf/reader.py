@@ -180,7 +180,7 @@ class _Reader:
             read_actuators(robot, [(src, el, data) for (_, src, el), data in pairs])
         self_collide = child(tree.scope.element, "self_collide")
         if self_collide is not None:
-            robot.extras["sdf_self_collide"] = tree.scope.src.values.boolean(self_collide)
+            robot.self_collide = tree.scope.src.values.boolean(self_collide)
         for scope, src, el in tree.other:
             self._not_modelled(src, el, f'<{el.tag}> of model "{scope.path}" is not part of the robot model')
         for scope in _scopes(tree):

@@ -46,7 +46,7 @@ from modelkit.formats.sdf.write_geometry import GeomWriter
 from modelkit.formats.sdf.write_names import Names
 from modelkit.formats.sdf.write_self_collide import only_carried, self_collide_policy
 from modelkit.formats.sdf.write_xml import add_pose, num, sub
-from modelkit.model import SYNTHESISED, WORLD_LINK, DeviceKind, Joint, JointType, Link, LoopConstraint, Robot
+from modelkit.model import WORLD_LINK, DeviceKind, Joint, JointType, Link, LoopConstraint, Robot
 from modelkit.spatial import Mat3, Pose, Vec3
 
 TINY_MASS = 1e-6
@@ -191,7 +191,7 @@ class _ModelWriter:
         add_pose(model, robot.root_pose)
         if self.world_root:
             world = self.links.get(WORLD_LINK)
-            if world is not None and not world.extras.get(SYNTHESISED):
+            if world is not None and not world.synthesised:
                 ctx.note(
                     "MK814",
                     'the link "world" is SDF\'s world itself: it is not written as a link; the joints '
@@ -211,8 +211,8 @@ class _ModelWriter:
         if robot.root_joint is JointType.FIXED:
             info = robot.extras.get("sdf_world_joint")
             wanted = (info.get("name") if isinstance(info, dict) and info.get("name")
-                      else robot.extras.get("root_joint_name") or "world_joint")
-            name = self.names.claim("joint", str(wanted), robot.extras.get("root_joint_source"))
+                      else robot.root_joint_name or "world_joint")
+            name = self.names.claim("joint", str(wanted), robot.root_joint_source)
             joint = sub(model, "joint", name=name, type="fixed")
             sub(joint, "parent", WORLD_LINK)
             sub(joint, "child", self.names.links[robot.root or ""])
@@ -231,7 +231,7 @@ class _ModelWriter:
         """The link's frame: relative to its parent link (≥ 1.7) or in the model frame (1.6)."""
         joint = self.joint_of.get(name)
         if name == self.robot.root or joint is None:
-            free = self.robot.extras.get("sdf_free_links", {})
+            free = self.robot.free_link_poses
             if name in free:
                 add_pose(el, self.robot.root_pose.inverse() @ free[name])
             return

@@ -189,8 +189,11 @@ def read_gazebo(
     else:
         link = links.get(reference) if reference else None
         joint = joints.get(reference) if reference else None
+    collide = dict.get(entry, "selfCollide")  # not entry.get: that would make the block's XML now
     if link is not None:
         link.extras.setdefault("gazebo", []).append(entry)
+        if isinstance(collide, bool):
+            link.self_collide = collide
         for sensor in ctx.children(element, "sensor"):
             device = _sensor(ctx, sensor)
             if device is not None:
@@ -199,6 +202,9 @@ def read_gazebo(
         joint.extras.setdefault("gazebo", []).append(entry)
     else:
         robot.extras.setdefault("gazebo", []).append(entry)
+        flag = element.find("self_collide")  # libsdformat's import reads a robot-level one
+        if flag is not None:
+            robot.self_collide = (flag.text or "").strip().lower() in ("1", "true")
         if reference:
             names = {lk.name for lk in robot.links} | {j.name for j in robot.joints}
             ctx.emit(

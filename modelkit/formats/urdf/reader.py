@@ -182,7 +182,6 @@ def _root(robot: Robot) -> None:
         # A root named "world" is the world itself (ROS, Gazebo, MuJoCo): the robot is welded to it
         # through the joints below it.
         robot.root_joint = JointType.FIXED
-        robot.extras["world_link"] = WORLD_LINK
 
 
 def _extensions(ctx: Context, root: Element, robot: Robot) -> None:

@@ -27,6 +27,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.notes import ConversionNote, renames
 from modelkit.convert.simulator import pybullet_settings
+from modelkit.formats.registry import EXTRAS_DROPPED, EXTRAS_QUIET, EXTRAS_QUIET_LINK
 from modelkit.formats.urdf.write_frames import frame_link, sensor_frames
 from modelkit.formats.urdf.write_gazebo import write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
@@ -38,57 +39,15 @@ from modelkit.spatial import Pose
 
 __all__ = ["urdf_renames", "write_urdf"]
 
-# Robot extras that carry no model information (or that this writer writes elsewhere).
-SILENT_EXTRAS = frozenset(
-    {
-        "materials",
-        "urdf_version",
-        "world_link",
-        "root_joint_source",
-        "root_joint_name",
-        "materials_path",
-        "masses_unknown",
-        "sdf_canonical_link",
-        "sdf_version",
-        "sdf_model_pose",
-        "sdf_free_links",
-        "sdf_world_joint",
-        "mjcf_compiled",
-        "gazebo",
-        "transmissions",
-        "ros2_control",
-        "mujoco",
-        "sensor",
-        "sdf_plugins",  # written as <gazebo> blocks (write_gazebo)
-        "sdf_self_collide",  # written as a robot-level <gazebo> block (write_self_collide)
-    }
+# Robot extras this writer writes itself: URDF's own blocks, and SDF's plugins as <gazebo> blocks
+# (write_gazebo). Other formats' keys are described by their own declarations (EXTRAS_QUIET...).
+WRITTEN_EXTRAS = frozenset(
+    {"materials", "urdf_version", "gazebo", "transmissions", "ros2_control", "mujoco", "sensor",
+     "sdf_plugins"}
 )
-# Robot extras that do: the note that says they are left out.
-DROPPED_EXTRAS = {
-    "mjcf_actuators": ("MK808", "MJCF actuators"),
-    "mjcf_tendons": ("MK808", "MJCF tendons"),
-    "mjcf_equalities": ("MK808", "MJCF equality constraints"),
-    "mjcf_sensors": ("MK806", "MJCF sensors"),
-    "mjcf_cameras": ("MK806", "MJCF cameras"),
-    "mjcf_lights": ("MK806", "MJCF lights"),
-    "mjcf_sites": ("MK808", "MJCF sites (named frames)"),
-    "mjcf_keyframes": ("MK820", "MJCF keyframes (stored joint positions)"),
-    "mjcf_world_geoms": ("MK822", "MJCF world geoms"),
-    "mjcf_world_sites": ("MK822", "MJCF world sites"),
-    "sdf_world": ("MK822", "the SDF world around the model"),
-}
-SILENT_LINK_EXTRAS = frozenset(
-    {
-        "gazebo",
-        "synthesised",
-        "is_continuous_track",
-        "track",
-        "mjcf_body_id",
-        "mjcf_body_offset",
-        "mjcf_intermediate_of",
-        "sdf_link_pose",
-    }
-)
+SILENT_EXTRAS = WRITTEN_EXTRAS | EXTRAS_QUIET
+# Link extras written elsewhere: URDF's <gazebo> blocks.
+SILENT_LINK_EXTRAS = frozenset({"gazebo"}) | EXTRAS_QUIET_LINK
 SDF_LINK_DEFAULTS = {
     "gravity": True,
     "kinematic": False,
@@ -175,10 +134,10 @@ def _root(robot: Robot, names: NameTable, ctx: WriteContext, add_world: bool) ->
         return []
     root = names.link(robot.root)
     out: list[Element] = []
-    where = robot.extras.get("root_joint_source") or robot.source
+    where = robot.root_joint_source or robot.source
     if add_world:
         word = "fixed" if robot.root_joint is JointType.FIXED else "floating"
-        wanted = robot.extras.get("root_joint_name") or f"{WORLD_LINK}_to_{root}"
+        wanted = robot.root_joint_name or f"{WORLD_LINK}_to_{root}"
         el = etree.Element("joint", name=names.fresh(str(wanted)), type=word)
         origin_element(el, robot.root_pose)
         etree.SubElement(el, "parent", link=WORLD_LINK)
@@ -217,14 +176,14 @@ def _free_links(robot: Robot, names: NameTable, ctx: WriteContext) -> list[Eleme
         return []
     children = {j.child for j in robot.joints}
     reached = set(robot.world_poses())
-    free_poses = robot.extras.get("sdf_free_links") or {}
+    free_poses = robot.free_link_poses
     out: list[Element] = []
     for index, link in enumerate(robot.links):
         if link.name in reached or link.name in children or link.name == robot.root:
             continue
         name = names.links[index]
-        placed = free_poses.get(link.name) if isinstance(free_poses, dict) else None
-        origin = robot.root_pose.inverse() @ placed if isinstance(placed, Pose) else Pose()
+        placed = free_poses.get(link.name)
+        origin = robot.root_pose.inverse() @ placed if placed is not None else Pose()
         el = etree.Element("joint", name=names.fresh(f"{name}_free"), type="floating")
         origin_element(el, origin)
         etree.SubElement(el, "parent", link=names.link(robot.root))
@@ -306,6 +265,6 @@ def _notes(robot: Robot, ctx: WriteContext) -> None:
             value = value[len(robot.actuators):] if len(value) > len(robot.actuators) else []
             if not value:
                 continue
-        code, what = DROPPED_EXTRAS.get(key, ("MK808", f"extension data {key}"))
+        code, what = EXTRAS_DROPPED.get(key, ("MK808", f"extension data {key}"))
         count = f"{len(value)} " if isinstance(value, list) else ""
         ctx.note(code, f"{count}{what}: URDF has no equivalent; left out", robot.source, "robot")

@@ -1,0 +1,109 @@
+"""``extras`` hold one format's own data: only that format's reader and writer name its keys.
+
+A format's keys are ``<format>_...`` (``mjcf_sites``, ``sdf_world``...) and, for URDF, its extension
+blocks (``gazebo``, ``transmissions``, ``ros2_control``, ``mujoco``). Anything outside
+``modelkit/formats/<format>/`` that names one (a string constant of a prefixed key anywhere; an
+unprefixed URDF key read from ``.extras``) must be listed in :data:`EXCEPTIONS` with its reason.
+The test fails on a new use and on a stale entry, so the list can only shrink.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parent.parent / "modelkit"
+PREFIXED = re.compile(r"^(mjcf|sdf|urdf|body)_[a-z0-9_]+$")
+URDF_BLOCKS = frozenset({"gazebo", "transmissions", "ros2_control", "mujoco"})
+
+EXCEPTIONS: dict[tuple[str, str], str] = {
+    ("checks/topology.py", "sdf_version"):
+        "MK211's verdict on a joint named like a link depends on the SDF file's version",
+    ("convert/gazebo.py", "sdf_plugins"):
+        "Gazebo plugins are the same XML in SDF and in URDF <gazebo> blocks: which Gazebo they are for",
+    ("formats/urdf/write_gazebo.py", "sdf_plugins"): "an SDF model's plugins are written as <gazebo> blocks",
+    ("formats/urdf/writer.py", "sdf_plugins"): "the same: written, so no MK808 note",
+    ("formats/urdf/write_joints.py", "mjcf_stiffness"):
+        "an MJCF ball joint's spring is noted as dropped; as Joint.spring_stiffness the .body writer "
+        "would note it too (an output change, left for its own commit)",
+    ("formats/urdf/writer.py", "mjcf_actuators"):
+        "the MJCF reader keeps every actuator, also those Robot.actuators holds: the note counts only "
+        "the others (keeping only those would change the reader's MK175 counts)",
+    ("formats/urdf/writer.py", "mjcf_cameras"):
+        "the MJCF reader keeps every camera, also those on links (devices): only the others are noted",
+    ("formats/urdf/writer.py", "mjcf_lights"): "the same, for lights",
+    ("formats/urdf/writer.py", "sdf_link"):
+        "an SDF link's flags are noted only where they differ from SDF's defaults",
+    ("formats/body/writer.py", "sdf_world_joint"):
+        "a model fixed without a world joint is a static SDF model: its free links are written fixed",
+    ("formats/body/writer.py", "gazebo"): "URDF extension blocks are noted as not carried over",
+    ("formats/body/writer.py", "transmissions"): "the same",
+    ("formats/body/writer.py", "ros2_control"): "the same",
+    ("formats/body/writer.py", "mujoco"): "the same",
+    ("formats/sdf/writer.py", "gazebo"):
+        "URDF <gazebo> blocks are noted as not carried over, except a link's that only says what the "
+        "model holds (selfCollide, sensors)",
+    ("formats/sdf/writer.py", "transmissions"): "URDF transmissions are noted as not carried over",
+}
+
+
+def _owner(key: str) -> str:
+    return "urdf" if key in URDF_BLOCKS else key.split("_", 1)[0]
+
+
+def _extras_keys(tree: ast.AST) -> set[str]:
+    """Unprefixed URDF keys read from an ``extras`` dict: ``x.extras.get("k")``, ``x.extras["k"]``,
+    ``"k" in x.extras``, and the strings of a module-level ``..._EXTRAS`` tuple or set."""
+    found: set[str] = set()
+
+    def is_extras(node: ast.AST) -> bool:
+        return isinstance(node, ast.Attribute) and node.attr == "extras"
+
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and is_extras(node.func.value):
+            args = node.args[:1]
+        elif isinstance(node, ast.Subscript) and is_extras(node.value):
+            args = [node.slice]
+        elif isinstance(node, ast.Compare) and any(is_extras(c) for c in node.comparators):
+            args = [node.left]
+        elif isinstance(node, ast.Assign) and any(
+                isinstance(t, ast.Name) and t.id.endswith("EXTRAS") for t in node.targets):
+            args = [e for e in ast.walk(node.value) if isinstance(e, ast.Constant)]
+        elif isinstance(node, ast.For) and isinstance(node.iter, ast.Tuple):
+            args = [e for e in ast.walk(node.iter) if isinstance(e, ast.Constant)]
+        else:
+            continue
+        found |= {a.value for a in args if isinstance(a, ast.Constant) and a.value in URDF_BLOCKS}
+    return found
+
+
+def uses() -> set[tuple[str, str]]:
+    """(module path under modelkit/, key) for every use of a format's key outside its own package."""
+    out: set[tuple[str, str]] = set()
+    for path in sorted(PACKAGE.rglob("*.py")):
+        rel = path.relative_to(PACKAGE).as_posix()
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        keys = {n.value for n in ast.walk(tree)
+                if isinstance(n, ast.Constant) and isinstance(n.value, str) and PREFIXED.match(n.value)}
+        keys |= _extras_keys(tree)
+        for key in keys:
+            if not rel.startswith(f"formats/{_owner(key)}/"):
+                out.add((rel, key))
+    return out
+
+
+def test_no_module_names_another_formats_extras_keys() -> None:
+    found = uses()
+    new = sorted(found - EXCEPTIONS.keys())
+    stale = sorted(EXCEPTIONS.keys() - found)
+    assert not new, f"another format's extras keys used (own them, or list them with a reason): {new}"
+    assert not stale, f"exceptions no longer used (remove them from EXCEPTIONS): {stale}"
+
+
+def test_the_scan_sees_what_it_must() -> None:
+    """The scan finds a prefixed key anywhere and an unprefixed URDF key read from extras."""
+    tree = ast.parse('x = robot.extras.get("gazebo")\ny = "mjcf_sites"\nz = options.gazebo\n')
+    assert _extras_keys(tree) == {"gazebo"}
+    assert [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and PREFIXED.match(str(n.value))] \
+        == ["mjcf_sites"]
