@@ -99,7 +99,5 @@ def root_tree_only(robot: Robot) -> list[str]:
             joint.mimic = None
     robot.loops = [loop for loop in robot.loops if loop.link1 not in gone and loop.link2 not in gone]
     robot.actuators = [a for a in robot.actuators if a.joint not in dropped]
-    free = robot.extras.get("sdf_free_links")
-    if isinstance(free, dict):
-        robot.extras["sdf_free_links"] = {k: v for k, v in free.items() if k not in gone}
+    robot.free_link_poses = {k: v for k, v in robot.free_link_poses.items() if k not in gone}
     return removed
