@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from enum import StrEnum
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from modelkit.diagnostics import SourceLocation
@@ -372,6 +373,9 @@ class Robot:
     into ``root_pose``), for the targets that write the weld as a named joint and for notes.
     ``free_link_poses`` holds the world pose of each link no joint connects to the tree where the
     source gives one (SDF floats such a link as a separate body, or fixes it in a static model).
+    ``materials_file`` is the contact-material table the links' ``contact_material`` names refer to
+    when the user gave one (Choreonoid's ``materials.yaml``, the reading option ``--materials``); None:
+    Choreonoid's own table.
     """
 
     name: str
@@ -389,6 +393,7 @@ class Robot:
     root_joint_source: SourceLocation | None = None
     free_link_poses: dict[str, Pose] = field(default_factory=dict)
     self_collide: bool | None = None  # the model-wide flag (SDF <model><self_collide>), see Link's
+    materials_file: Path | None = None
     extras: dict[str, Any] = field(default_factory=dict)  # one format's own data, kept as is
 
     def link(self, name: str) -> Link | None:

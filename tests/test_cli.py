@@ -167,3 +167,22 @@ def test_validate_leaves_the_callers_environment_as_it_was(monkeypatch: pytest.M
     result = CliRunner().invoke(main, ["validate", str(pendulum)])
     assert result.exit_code == 0, result.output
     assert "MUJOCO_GL" not in os.environ
+
+
+def test_materials_table_reaches_the_written_friction(tmp_path: Path) -> None:
+    """`convert --materials TABLE` gives the links the friction of the user's table against Choreonoid's
+    floor material (Ground), as validate reads the table; before, the converted friction always came from
+    Choreonoid's own table (the reader never handed the path on), so the Rubber link got the Default rule."""
+    table = tmp_path / "materials.yaml"
+    table.write_text("materials:\n  - name: Default\n    roughness: 0.5\n    viscosity: 0.0\n"
+                     "  - name: Ground\n    roughness: 0.5\n    viscosity: 0.0\n"
+                     "  - name: Rubber\n    roughness: 1.0\n    viscosity: 0.5\n"
+                     "contact_materials:\n  - materials: [ Rubber, Ground ]\n    friction: 0.37\n")
+    body = tmp_path / "m.body"
+    body.write_text(CLEAN.replace("    joint_axis: Y\n", "    joint_axis: Y\n    material: Rubber\n")
+                    + "    elements:\n      - type: Shape\n"
+                    "        geometry: { type: Box, size: [ 0.1, 0.1, 0.1 ] }\n")
+    out = tmp_path / "out" / "m.xml"
+    code, stdout, _ = run("convert", "--materials", str(table), str(body), "-o", str(out))
+    assert code == 0, stdout
+    assert 'friction="0.37 0.005 0.0001"' in out.read_text()

@@ -51,10 +51,8 @@ def pair_friction(a: str, b: str, materials_path: Path | None = None) -> PairFri
 
 def floor_friction(robot: Robot, floor: str = FLOOR_MATERIAL) -> dict[str, PairFriction]:
     """Link name → its friction against the floor material, for links that name a material."""
-    path = robot.extras.get("materials_path")
-    materials_path = Path(path) if isinstance(path, str) else None
     out: dict[str, PairFriction] = {}
     for link in robot.links:
         if link.contact_material:
-            out[link.name] = pair_friction(link.contact_material, floor, materials_path)
+            out[link.name] = pair_friction(link.contact_material, floor, robot.materials_file)
     return out

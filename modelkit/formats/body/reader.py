@@ -179,7 +179,8 @@ class _BodyReader:
             self.sink.emit("MK114", 'there is no "links" value defining the links of the body', root.loc)
             return None
         name = v.get_text(root, "name") or self.path.stem
-        robot = Robot(name=name, source_format="body", source=root.loc)
+        robot = Robot(name=name, source_format="body", source=root.loc,
+                      materials_file=self.options.materials_path)
         ctx = WalkContext(
             self.path,
             self.display,
