@@ -604,3 +604,19 @@ def test_mjcf_cameras_on_links_are_written_not_reported_as_dropped(tmp_path: Pat
     dropped = [n.message for n in notes if "MJCF cameras" in n.message or "MJCF lights" in n.message]
     assert dropped == ["1 MJCF lights: URDF has no equivalent; left out"]  # the world's sun only
     assert any(n.code == "MK806" and '"lamp"' in n.message for n in notes)  # the link's lamp, once
+
+
+@pytest.mark.parametrize("robot", ["mobile_robot_pantilt", "mobile_robot_tracks"])
+def test_the_tutorial_robots_wheels_and_tracks_are_not_noted_as_lost(robot: str, tmp_path: Path) -> None:
+    """convert's wheel and track passes record what they made in the model for the writers; the URDF
+    writer took those records for another format's data and warned "extension data wheels: URDF has no
+    equivalent; left out" (MK808) on the tutorial's robots, whose wheels and tracks it does write."""
+    from modelkit.convert.api import write
+
+    samples = Path(__file__).resolve().parents[1] / "samples"
+    source = samples / "choreonoid_ros2_mobile_robot_tutorial" / "model"
+    loaded = validate(source / f"{robot}.body").robot
+    assert loaded is not None
+    notes = write(loaded, tmp_path / f"{robot}.urdf")
+    lost = [n.message for n in notes if n.code == "MK808" and "extension data" in n.message]
+    assert lost == []
