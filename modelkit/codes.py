@@ -1389,6 +1389,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "links): the file is written, but MuJoCo refuses it.",
     ),
     CodeInfo(
+        "MK873",
+        "mjcf-frames-as-sites",
+        "info",
+        "Massless links on fixed joints that carry nothing (a tool flange, a TCP, a camera's optical frame) "
+        "are written as `<site>`s in the body they hang on, at the same pose, as MuJoCo Menagerie writes "
+        "them, instead of empty bodies; the note lists them. `--frame-bodies` keeps them as bodies.",
+    ),
+    CodeInfo(
         "MK875",
         "mjcf-camera-fovy-clamped",
         "warning",

@@ -13,5 +13,6 @@ FORMAT = FormatDeclaration(
         suffix=".xml",
         suffixes=(".xml", ".mjcf"),
         auto_wheel="sphere",  # MuJoCo: a cylinder rolling on a plane gets odd contacts
+        sites_native=True,
     ),
 )
