@@ -212,3 +212,19 @@ def test_urdf_to_mjcf_to_urdf_gives_the_links_back(relative: str, tmp_path: Path
     sdf = (tmp_path / "sdf" / "m.sdf").read_text()
     for name in FRAMES[relative]:
         assert f'<frame name="{name}" attached_to=' in sdf
+
+
+def test_verify_finds_the_frames_among_the_sites_of_a_default_mjcf(tmp_path: Path) -> None:
+    """``verify robot.urdf --mjcf robot.xml`` on convert's default file: the frame links are sites
+    there, found as the source's links (link and joint sets complete) at their poses (layer 2)."""
+    pytest.importorskip("pinocchio")
+    from modelkit.verify.api import verify
+
+    write(_robot(UR5), tmp_path / "ur5.xml")
+    report = verify(example_robot(UR5), mjcf=tmp_path / "ur5.xml", engines=("mujoco", "pinocchio"),
+                    replay=False, driven=False, configurations=5, samples=2)
+    assert not report.errors
+    checks = {(c.engine, c.quantity): c for c in report.checks}
+    assert checks[("mujoco", "link-set")].error == 0.0, checks[("mujoco", "link-set")].detail
+    assert checks[("mujoco", "joint-set")].error == 0.0
+    assert report.failed == [], [c.detail for c in report.failed]

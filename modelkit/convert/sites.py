@@ -2,7 +2,8 @@
 
 The MJCF reader keeps every site of a body in ``robot.extras["mjcf_sites"]`` (its name, the link it is
 on, its pose in that link's frame, its type and size). A site is a **named frame** when it has a name
-and nothing else uses it: no sensor, equality, actuator transmission or tendon of the source names it,
+and nothing else uses it: no sensor, equality, actuator transmission or tendon of the source names it
+(the reader marks such sites ``used``: the file's sensors and equalities are on its main robot only),
 and no device was made of it. The MJCF writer writes named frames back as sites; the frame links of a
 model (:mod:`modelkit.convert.frames`) go the other way, MJCF → URDF → MJCF keeps them as sites.
 
@@ -44,6 +45,7 @@ def used_sites(robot: Robot) -> set[str]:
         used.update(str(w.get("object")) for w in tendon.get("wraps", []) if w.get("type") == "site")
     for link in robot.links:
         used.update(str(d.params["site"]) for d in link.devices if "site" in d.params)
+    used.update(str(s.get("name")) for s in extras.get(SITES) or [] if s.get("used"))  # the reader's mark
     return used
 
 

@@ -64,6 +64,9 @@ class StaticFacts:
     joints: dict[str, JointFacts] = field(default_factory=dict)
     # Collision shapes per link (every link a key, [] for none); empty when the engine reports none.
     shapes: dict[str, list[ShapeFacts]] = field(default_factory=dict)
+    # Named frames that are no link of the engine (MJCF sites), each as a fixed joint from its body's
+    # link: a source link found only here was written as a frame (MK873), neither missing nor extra.
+    frames: dict[str, JointFacts] = field(default_factory=dict)
 
 
 class EngineModel(Protocol):
