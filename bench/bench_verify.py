@@ -48,8 +48,9 @@ from modelkit.convert.options import WriteOptions
 
 # The engines' files as verify writes them for layers 1-3: the root is the base (no URDF world link,
 # the engines weld it), the sensors on their links (their link sets are compared with the source's),
-# motors on joints the source does not actuate (the passive robot).
-ENGINE_FILES = WriteOptions(urdf_world_link=False, urdf_sensor_links=False, actuators="motor")
+# motors on joints the source does not actuate (the passive robot), frames as bodies (link sets compared).
+ENGINE_FILES = WriteOptions(urdf_world_link=False, urdf_sensor_links=False, actuators="motor",
+                            frame_sites=False)
 
 REPO = Path(__file__).resolve().parents[1]
 PANTILT = REPO / "samples" / "choreonoid_ros2_mobile_robot_tutorial" / "model" / "mobile_robot_pantilt.body"

@@ -436,6 +436,10 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
 @click.option("--keep-package-uris", is_flag=True,
               help="Keep package:// and model:// mesh references instead of copying the meshes.")
 @click.option("--merge-fixed", is_flag=True, help="Fuse links on fixed joints into their parents.")
+@click.option("--frame-sites/--frame-bodies", default=True, show_default=True,
+              help="MJCF: massless links on fixed joints that carry nothing (a tool flange, a TCP, an "
+                   "optical frame) as <site>s in the body they hang on, as MuJoCo Menagerie writes them "
+                   "(MK873); --frame-bodies writes them as empty bodies.")
 @click.option("--urdf-world-link", is_flag=True,
               help="URDF: hang a floating root from a `world` link too (a welded root always does).")
 @click.option("--urdf-distinct-names", is_flag=True,
@@ -478,6 +482,7 @@ def convert(
     keep_collada: bool,
     keep_package_uris: bool,
     merge_fixed: bool,
+    frame_sites: bool,
     urdf_world_link: bool,
     urdf_distinct_names: bool,
     urdf_sensor_links: bool,
@@ -506,6 +511,7 @@ def convert(
         keep_collada=keep_collada,
         keep_package_uris=keep_package_uris,
         merge_fixed=merge_fixed,
+        frame_sites=frame_sites,
         urdf_world_link=True if urdf_world_link else None,
         urdf_distinct_names=urdf_distinct_names,
         urdf_sensor_links=urdf_sensor_links,

@@ -1397,6 +1397,16 @@ _TABLE: tuple[CodeInfo, ...] = (
         "links): the file is written, but MuJoCo refuses it.",
     ),
     CodeInfo(
+        "MK873",
+        "mjcf-frames-as-sites",
+        "info",
+        "Massless links on fixed joints that carry nothing (a tool flange, a TCP, a camera's optical frame) "
+        "are written as `<site>`s in the body they hang on, at the same pose, as MuJoCo Menagerie writes "
+        "them, instead of empty bodies; the note lists them. The other way, an MJCF source's sites that "
+        "name frames (used by no sensor, equality, actuator or tendon) become massless links on fixed "
+        "joints in URDF, SDF and `.body`. `--frame-bodies` keeps frames as bodies and leaves sites out.",
+    ),
+    CodeInfo(
         "MK875",
         "mjcf-camera-fovy-clamped",
         "warning",

@@ -64,11 +64,13 @@ def input_files(robot: Robot, model_path: Path) -> set[Path]:
 def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: NoteSink) -> Robot:
     """A copy of ``robot`` shaped for the target: tracks approximated where the target has none,
     wheel collisions as ``options.wheel_collision`` says (MK826), fixed joints merged on request, the
-    base settled (welded or free). The source model is never changed."""
+    base settled (welded or free), an MJCF source's named-frame sites made frame links where the target
+    has no sites (MK873). The source model is never changed."""
     from modelkit.convert.base import settle_base
     from modelkit.convert.merge import merge_fixed_joints
     from modelkit.convert.tracks import approximate_tracks
     from modelkit.convert.wheels import approximate_wheels
+    from modelkit.formats.mjcf.site_frames import sites_as_links
 
     _check_mass_properties(robot)
     out = copy.deepcopy(robot)
@@ -76,6 +78,8 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     if not target.tracks_native:
         approximate_tracks(out, notes)
     approximate_wheels(out, options.wheel_collision, target.name, notes)
+    if options.frame_sites and not target.sites_native:
+        sites_as_links(out, notes)
     if options.merge_fixed:
         merge_fixed_joints(out, notes)
     return out

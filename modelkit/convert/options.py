@@ -34,3 +34,6 @@ class WriteOptions:
     # range, a motor on each without) | motor | position | velocity | none; the source's own actuators
     # are always written as they are (docs/convert.md, "Actuators")
     actuators: str = "auto"
+    # MJCF: massless frame links (modelkit/convert/frames.py) as <site>s in the body they hang on, as
+    # MuJoCo Menagerie writes them (MK873); False writes them as empty bodies
+    frame_sites: bool = True

@@ -34,6 +34,7 @@ class TargetInfo:
     writer: str  # "module:function"
     tracks_native: bool = False  # the target holds pseudo continuous tracks itself
     auto_wheel: str = "cylinder"  # the wheel collision `--wheel-collision auto` writes
+    sites_native: bool = False  # the target holds MJCF sites itself (else they become frame links)
 
 
 def _target(declaration: FormatDeclaration) -> TargetInfo:
@@ -41,7 +42,7 @@ def _target(declaration: FormatDeclaration) -> TargetInfo:
     if out is None:
         raise ValueError(f"format {declaration.name} declares no output")
     return TargetInfo(declaration.name, out.suffix, out.suffixes, out.writer, out.tracks_native,
-                      out.auto_wheel)
+                      out.auto_wheel, out.sites_native)
 
 
 TARGETS: tuple[TargetInfo, ...] = tuple(_target(d) for d in WRITTEN)

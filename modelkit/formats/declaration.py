@@ -19,6 +19,7 @@ class OutputDeclaration(NamedTuple):
     suffixes: tuple[str, ...]  # output file suffixes that select this format
     tracks_native: bool = False  # the format holds pseudo continuous tracks itself
     auto_wheel: str = "cylinder"  # the wheel collision `--wheel-collision auto` writes: cylinder or sphere
+    sites_native: bool = False  # the format holds MJCF sites (named frames on a body) itself
 
 
 class ExtrasDeclaration(NamedTuple):

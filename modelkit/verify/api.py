@@ -80,8 +80,10 @@ SUFFIX = {"mjcf": ".xml", "urdf": ".urdf", "sdf": ".sdf"}
 REPLAY = "modelkit.verify.layers.replay:replay_layer"
 # The options of the files layers 1-3 read (layer 4 reads convert's defaults): the engines weld the root
 # themselves (no URDF `world` link), sensors stay on their links (PyBullet reads a massless link as
-# 1 kg), and joints the source does not actuate get motors (zero control: the passive robot).
-ENGINE_FILES = WriteOptions(urdf_world_link=False, urdf_sensor_links=False, actuators="motor")
+# 1 kg), joints the source does not actuate get motors (zero control: the passive robot), and massless
+# frames stay bodies in MJCF and an MJCF source's sites stay out of URDF and SDF (link sets are compared).
+ENGINE_FILES = WriteOptions(urdf_world_link=False, urdf_sensor_links=False, actuators="motor",
+                            frame_sites=False)
 INJECT = "modelkit.verify.layers.inject:apply"
 
 CONFIGURATIONS = 50  # layer 2: q = 0 and this many random configurations

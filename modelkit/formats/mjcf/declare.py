@@ -13,6 +13,7 @@ FORMAT = FormatDeclaration(
         suffix=".xml",
         suffixes=(".xml", ".mjcf"),
         auto_wheel="sphere",  # MuJoCo: a cylinder rolling on a plane gets odd contacts
+        sites_native=True,
     ),
     extras=ExtrasDeclaration(
         quiet=frozenset({"mjcf_compiled"}),

@@ -284,10 +284,13 @@ class _MjcfReader:
                 robot.extras.update(
                     {"mjcf_compiled": True, "mjcf_sites": [], "mjcf_cameras": [], "mjcf_lights": []}
                 )
+            used = _used_sites(data)
             for body in bodies:
-                built.robot_of_body[body.index].extras["mjcf_sites"].extend(
-                    builder.sites(body.sites, body.index)
-                )
+                sites = builder.sites(body.sites, body.index)
+                for site in sites:
+                    if site["name"] in used:
+                        site["used"] = True  # by a sensor, equality, actuator or tendon of the file
+                built.robot_of_body[body.index].extras["mjcf_sites"].extend(sites)
             for body_id, kind, name, pose, params in reader.cameras_and_lights():
                 robot = built.robot_of_body.get(body_id, main)
                 robot.extras[f"mjcf_{kind}s"].append(builder.attached(body_id, name, pose, **params))
@@ -385,3 +388,21 @@ def _home_positions(keyframes: list[dict[str, Any]], bodies: list[MjBody], joint
             if joint is None or address is None or mj.kind not in ("hinge", "slide") or address >= len(qpos):
                 continue
             joint.initial_position = float(qpos[address])
+
+
+def _used_sites(data: dict[str, list[dict[str, Any]]]) -> set[str]:
+    """Names of the sites a sensor, equality, actuator transmission or tendon of the file names."""
+    used: set[str] = set()
+    for sensor in data.get("mjcf_sensors", []):
+        if sensor.get("objtype") == "site" and sensor.get("object"):
+            used.add(str(sensor["object"]))
+    for eq in data.get("mjcf_equalities", []):
+        if eq.get("objtype") == "site":
+            used.update(str(eq[key]) for key in ("obj1", "obj2") if eq.get(key))
+    for actuator in data.get("mjcf_actuators", []):
+        if actuator.get("transmission") in ("site", "slidercrank") and actuator.get("target"):
+            used.add(str(actuator["target"]))
+    for tendon in data.get("mjcf_tendons", []):
+        wraps = tendon.get("wraps", [])
+        used.update(str(w["object"]) for w in wraps if w.get("type") == "site" and w.get("object"))
+    return used

@@ -22,18 +22,25 @@
   MK819, the note says the value).
 * A chain the MJCF reader made from a multi-joint MuJoCo body is written back as that one body with
   its joints (:mod:`.write_chains`): no massless moving bodies, so no made-up mass.
+* Frame links (:func:`modelkit.convert.frames.frame_links`: massless, on fixed joints, carrying
+  nothing) are ``<site name pos quat>``s in the nearest body above them, their poses composed up to it,
+  written after that body's own contents in tree order (``WriteOptions.frame_sites``; one MK873 note
+  lists them). With ``frame_sites`` off they are bodies without ``<inertial>`` (MK816).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.frames import frame_links
 from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_position, fmt_vec
 from modelkit.convert.servo_gains import home_position
+from modelkit.formats.mjcf.site_frames import named_frames, site_pose
 from modelkit.formats.mjcf.write_chains import Chain, ChainFinder, shifted
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_geoms import GeomWriter
@@ -45,6 +52,7 @@ from modelkit.spatial import Pose, combine_mass_properties, principal_moments, r
 MIN_MASS = 1e-6  # kg, given to a moving body whose weld group has no mass
 MIN_INERTIA = 1e-9  # kg·m², added on each axis when the weld group's inertia is singular
 PLATE_MARGIN = 1e-10  # relative: how far above a + b = c a full tensor is raised (mujoco_valid_inertia)
+DEFAULT_SITE_SIZE = 0.005  # m: MuJoCo's default site size (a sphere of this radius)
 SINGULAR = 1e-12  # below this a mass counts as zero (MuJoCo's mjMINVAL is 1e-15)
 # Below these a moving body's smallest principal moment counts as zero: MuJoCo refuses a diagonal
 # inertia under mjMINVAL (1e-15) and a fullinertia whose smallest eigenvalue is under mjEPS (1e-14;
@@ -99,6 +107,7 @@ class BodyTree:
     frames: dict[str, Pose] = field(default_factory=dict)  # link frame in its body's frame, when not equal
     home: dict[str, float] = field(default_factory=dict)  # written hinge/slide → initial position
     body_pose: dict[Element, Pose] = field(default_factory=dict)  # body → its pose in its parent
+    sites: dict[str, tuple[str, str]] = field(default_factory=dict)  # frame link → (site, link of its body)
 
     def __post_init__(self) -> None:
         self.children = self.robot.children_of()
@@ -106,6 +115,10 @@ class BodyTree:
         self.parent_joint = {j.child: j for j in self.robot.joints}
         self.chains = ChainFinder(self.robot, self.children)
         self.absorbed: set[str] = set()  # intermediate links written as joints of their chain's body
+        self.frame_links = set(frame_links(self.robot)) if self.ctx.options.frame_sites else set()
+        self.kept_sites: dict[str, list[dict[str, Any]]] = {}  # an MJCF source's named frames, by link
+        for site in named_frames(self.robot):
+            self.kept_sites.setdefault(str(site["link"]), []).append(site)
         for joint in self.robot.joints:
             chain = self.chains.below(joint)
             if chain is not None:
@@ -177,7 +190,7 @@ class BodyTree:
 
     def _claim_subtree(self, start: str) -> None:
         for name in self._subtree(start):
-            if name not in self.body_name and name not in self.absorbed:
+            if name not in self.body_name and name not in self.absorbed and name not in self.frame_links:
                 link = self.links[name]
                 self.body_name[name] = self.names.claim("body", name, link.loc("name"), f"body[{name}]")
 
@@ -197,6 +210,8 @@ class BodyTree:
         """Body names in tree order, so that renames are deterministic."""
         for name in self._subtree(self.robot.root) if self.robot.root else []:
             if (name == WORLD_LINK and name == self.robot.root) or name in self.absorbed:
+                continue
+            if name in self.frame_links:
                 continue
             link = self.links[name]
             self.body_name[name] = self.names.claim("body", name, link.loc("name"), f"body[{name}]")
@@ -289,13 +304,48 @@ class BodyTree:
         self._inertial(el, link, name, moving)
         self._contents(el, link, name, static=False)
         pending: list[_Pending] = []
+        frames: list[tuple[str, Pose]] = []
         for child in self.children.get(link.name, []):
             if child.type is JointType.FLOATING:
                 pending.append(child)
                 continue
             origin = child.origin if frame is None else frame @ child.origin
+            if child.child in self.frame_links:
+                frames.append((child.child, origin))
+                continue
             pending.append((el, child.child, origin, child, False, False))
+        self._kept_sites(el, link.name, frame or Pose())
+        self._frame_sites(el, link.name, frames)
         return pending
+
+    def _kept_sites(self, el: Element, link: str, frame: Pose) -> None:
+        """An MJCF source's sites that name frames (:mod:`.site_frames`), written back."""
+        for site in self.kept_sites.get(link, []):
+            wanted = str(site["name"])
+            name = self.names.claim("site", wanted, None, f"site[{wanted}]")
+            written = sub(el, "site", name=name)
+            set_pose(written, frame @ site_pose(site))
+            kind = str(site.get("type") or "sphere")
+            if kind != "sphere":
+                written.set("type", kind)
+            size = [float(v) for v in site.get("size") or []]
+            used = {"sphere": 1, "capsule": 2, "cylinder": 2}.get(kind, 3)
+            if size and size[:used] != [DEFAULT_SITE_SIZE] * used:
+                written.set("size", fmt_vec(size[:used]))
+
+    def _frame_sites(self, el: Element, body_link: str, frames: list[tuple[str, Pose]]) -> None:
+        """The frame links below a body as its ``<site>``s, each frame's chain in pre-order."""
+        stack = list(reversed(frames))
+        while stack:
+            name, pose = stack.pop()
+            link = self.links[name]
+            site = self.names.claim("site", name, link.loc("name"), f"site[{name}]", note=False)
+            if site != name:
+                self.ctx.rename("link", name, site, "the site name is taken", link.loc("name"),
+                                f"site[{site}]")
+            set_pose(sub(el, "site", name=site), pose)
+            self.sites[name] = (site, body_link)
+            stack.extend((j.child, pose @ j.origin) for j in reversed(self.children.get(name, [])))
 
     def _contents(self, el: Element, link: Link, name: str, static: bool) -> None:
         self.geoms.link_geoms(el, link, name)

@@ -30,6 +30,8 @@ body pairs touching at rest. The style is MuJoCo Menagerie's (docs/convert.md, "
   or velocity servos set ``<option integrator="implicitfast">`` (MK825) unless an integrator is set.
 * A multi-joint MuJoCo body that the MJCF reader made a chain of links is written back as one body
   with its joints (:mod:`.write_chains`).
+* Massless frame links (a tool flange, a TCP, an optical frame) are ``<site>``s in the body they hang
+  on (:mod:`.write_bodies`, MK873), unless ``WriteOptions.frame_sites`` is off.
 * Self-collision follows MuJoCo's defaults (parent–child and welded pairs never collide), and any
   other body pair whose collision shapes MuJoCo finds touching at the ``home`` keyframe (q = 0 without one)
   gets ``<contact><exclude>`` (MK832; :mod:`modelkit.convert.self_contact` compiles the file; MK833
@@ -105,6 +107,7 @@ class MjcfWriter:
 
     def write(self) -> bytes:
         self.tree.write(self.sections["worldbody"])
+        self._frame_note()
         self._depth()
         self._joint_ids()
         self._mimics()
@@ -190,6 +193,25 @@ class MjcfWriter:
         self.sections["compiler"].set("meshdir", MESH_FOLDER)
         for el, name in zip(meshes, files, strict=True):
             el.set("file", name[len(prefix):])
+
+    def _frame_note(self) -> None:
+        """One MK873 note naming the frame links written as sites (write_bodies)."""
+        sites = self.tree.sites
+        if not sites:
+            return
+        listed = ", ".join(
+            f"{link} (in {self.tree.body_name.get(body, body)})" if site == link
+            else f"{link} as site {site} (in {self.tree.body_name.get(body, body)})"
+            for link, (site, body) in sites.items()
+        )
+        self.ctx.note(
+            "MK873",
+            f"{len(sites)} massless frame link(s) on fixed joints written as <site>s in the body they hang "
+            f"on, at the same pose (MuJoCo Menagerie's way: no empty bodies): {listed}; --frame-bodies "
+            "(WriteOptions.frame_sites=False) writes them as bodies",
+            self.robot.source,
+            "site",
+        )
 
     def _depth(self) -> None:
         """MK872 when the bodies nest deeper than MuJoCo reads: the file is written all the same."""

@@ -188,6 +188,7 @@ class MujocoModel:
                 self._vadr.append(int(m.jnt_dofadr[j]))
         self._bodies = [self._body(b) for b in range(1, m.nbody)]
         self._link_of = {link: body for body in self._bodies for link in body.links}
+        self._sites = self._frame_sites()
         self.settings: dict[str, Any] = {
             "version": mujoco.__version__,
             "file": path.name,
@@ -222,6 +223,29 @@ class MujocoModel:
         offset = np.array(m.jnt_pos[chain[-1]], dtype=float) if chain else np.zeros(3)
         parent = int(m.body_parentid[b])
         return _Body(b, name, self._bname(parent) if parent > 0 else "world", chain, links, offset)
+
+    def _frame_sites(self) -> dict[str, int]:
+        """Named sites on a body whose name no link has and that nothing uses (a sensor, an equality, an
+        actuator, a tendon): frames a writer made of massless links (MK873)."""
+        m = self.model
+        site = int(mujoco.mjtObj.mjOBJ_SITE)
+        used = {int(m.sensor_objid[i]) for i in range(m.nsensor) if int(m.sensor_objtype[i]) == site}
+        for e in range(m.neq):
+            if int(m.eq_objtype[e]) == site:
+                used.update((int(m.eq_obj1id[e]), int(m.eq_obj2id[e])))
+        by_site = (int(mujoco.mjtTrn.mjTRN_SITE), int(mujoco.mjtTrn.mjTRN_SLIDERCRANK))
+        for a in range(m.nu):
+            if int(m.actuator_trntype[a]) in by_site:
+                used.update(int(i) for i in m.actuator_trnid[a])
+        used.update(int(m.wrap_objid[w]) for w in range(m.nwrap)
+                    if int(m.wrap_type[w]) == int(mujoco.mjtWrap.mjWRAP_SITE))
+        links = {link for body in self._bodies for link in body.links} | {"world"}
+        out: dict[str, int] = {}
+        for s in range(m.nsite):
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_SITE, s)
+            if name and name not in links and s not in used and int(m.site_bodyid[s]) > 0:
+                out.setdefault(name, s)
+        return out
 
     @property
     def _world_is_root(self) -> bool:
@@ -274,6 +298,9 @@ class MujocoModel:
                 axis = np.array(m.jnt_axis[j], dtype=float) if moving else np.zeros(3)
                 facts.joints[self._jname(j)] = JointFacts(jtype, parent, child, axis, lower, upper)
                 parent = child
+        for name, s in self._sites.items():
+            body = self._bodies[int(m.site_bodyid[s]) - 1]
+            facts.frames[name] = JointFacts("fixed", body.name, name, np.zeros(3))
         facts.shapes = self.shapes()
         return facts
 
@@ -361,6 +388,8 @@ class MujocoModel:
                 step = np.asarray(m.jnt_pos[body.joints[k]], dtype=float) - m.jnt_pos[later]
                 frame = frame @ self._motion(later).inverse() @ Pose(np.eye(3), step)
                 world[body.links[k]] = frame
+        for name, s in self._sites.items():
+            world[name] = Pose(d.site_xmat[s].reshape(3, 3).copy(), d.site_xpos[s].copy())
         base = world.get(self.root, Pose()).inverse()
         return {name: base @ pose for name, pose in world.items()}
 

@@ -66,7 +66,10 @@ class StaticFacts:
     shapes: dict[str, list[ShapeFacts]] = field(default_factory=dict)
     # The source's named frames that are not links (SDF <frame>s, MJCF sites): an engine that lists a
     # file's frames with its bodies (Drake on SDF) reports them; they are no extra link.
-    frames: frozenset[str] = frozenset()
+    named_frames: frozenset[str] = frozenset()
+    # Named frames that are no link of the engine (MJCF sites), each as a fixed joint from its body's
+    # link: a source link found only here was written as a frame (MK873), neither missing nor extra.
+    frames: dict[str, JointFacts] = field(default_factory=dict)
 
 
 class EngineModel(Protocol):

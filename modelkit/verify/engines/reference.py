@@ -50,7 +50,7 @@ def source_static(robot: Robot) -> StaticFacts:
             joint.limits.lower if moving else -math.inf, joint.limits.upper if moving else math.inf)
     facts.shapes = {link.name: [s for s in map(shape_facts, link.collisions) if s is not None]
                     for link in robot.links}
-    facts.frames = frozenset(named_frames(robot))
+    facts.named_frames = frozenset(named_frames(robot))
     return facts
 
 

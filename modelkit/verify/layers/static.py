@@ -43,14 +43,15 @@ def layer1(source: StaticFacts, eng: Loaded) -> list[Check]:
     world = world_root(source)
     # The source's root "world" link is the engine's world: MuJoCo's world body and PyBullet's fixed
     # base report it (compared), Drake's world body and SDF's world frame are no link of the model.
-    missing = [name for name in source.links if eng.link(name) not in facts.links and name != world]
+    missing = [name for name in source.links
+               if eng.link(name) not in facts.links and eng.link(name) not in facts.frames and name != world]
     written = {eng.link(name) for name in source.links}
-    extra = sorted(name for name in facts.links if name not in written and name not in source.frames)
+    extra = sorted(name for name in facts.links if name not in written and name not in source.named_frames)
     detail = f"missing {missing}, extra {extra}" if missing or extra else f"{len(source.links)} links"
     count = float(len(missing) + len(extra))
     checks.append(Check(1, label, "link-set", [*missing, *extra, ""][0], count, 0.0, detail))
 
-    by_child = {jf.child: (name, jf) for name, jf in facts.joints.items()}
+    by_child = {jf.child: (name, jf) for name, jf in [*facts.frames.items(), *facts.joints.items()]}
     jmissing = [name for name, jf in source.joints.items() if eng.link(jf.child) not in by_child]
     checks.append(Check(1, label, "joint-set", [*jmissing, ""][0], float(len(jmissing)), 0.0,
                         f"no joint moves the links of {jmissing}" if jmissing
