@@ -69,6 +69,10 @@ def test_mjcf_rotations_take_the_shortest_exact_text() -> None:
     assert written(matrix_from_rpy(math.pi, 0.0, 0.0)) == {"zaxis": "0 0 -1"}
     assert written(matrix_from_rpy(1.57079, 0.0, 1.57079)) == {"euler": "1.57079 0 1.57079"}
     assert written(matrix_from_rpy(0.0, 0.0, math.pi)) == {"quat": "0 0 0 1"}
+    # pybullet_data's Spirit40 writes its leg cylinders at rpy="0 1.5707963268 0", 5e-12 past π/2: the
+    # matrix's own triple is (−π, 1.57079632678979, −π) and its zaxis "1 0 -5.10341196725696e-12" was
+    # written; the source's triple is the other one of the two, and the shortest
+    assert written(matrix_from_rpy(0.0, 1.5707963268, 0.0)) == {"euler": "0 1.5707963268 0"}
     for rotation in (matrix_from_rpy(0.3, -1.2, 2.9), matrix_from_rpy(math.pi, 0.0, 0.0)):
         assert np.allclose(z_turn([0.0, 0.0, -1.0]) @ np.eye(3), matrix_from_rpy(math.pi, 0.0, 0.0))
         assert written(rotation)  # never the identity for a turn
