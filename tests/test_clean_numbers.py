@@ -185,3 +185,29 @@ def test_centre_of_mass_dust_is_written_as_zero(tmp_path: Path) -> None:
         text = out.read_text()
         assert not re.search(r"[-\d.]+e-1[3-9]", text), (suffix, re.findall(r"\S*e-1[3-9]\S*", text)[:3])
         assert "0.021559 0.015181" in text, suffix
+
+
+def test_a_pitch_past_a_right_angle_keeps_its_source_text(tmp_path: Path) -> None:
+    """pybullet_data's Spirit40 turns its leg cylinders by rpy="0 1.5707963268 0", 5e-12 past π/2. The
+    matrix's own roll-pitch-yaw is (−π, 1.57079632678979, −π): URDF and SDF wrote that, MJCF a zaxis
+    with 5.1e-12 in it. Of the two triples of every rotation, the shorter is written, here the source's."""
+    source = tmp_path / "leg.urdf"
+    source.write_text("""<robot name="leg">
+  <link name="a"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><origin xyz="0.103 0 0" rpy="0 1.5707963268 0"/>
+      <geometry><cylinder radius="0.013" length="0.206"/></geometry></visual></link>
+</robot>
+""")
+    robot = validate(source).robot
+    assert robot is not None
+    for suffix, text in ((".urdf", 'rpy="0 1.5707963268 0"'), (".sdf", "0.103 0 0 0 1.5707963268 0"),
+                         (".xml", 'euler="0 1.5707963268 0"')):
+        out = tmp_path / f"out{suffix}"
+        write(robot, out)
+        assert text in out.read_text(), (suffix, out.read_text())
+    for rpy in ((0.3, 2.9, -1.0), (3.0, -1.6, 0.2), (0.0, -1.5707963268, 0.0)):  # either triple: same matrix
+        from modelkit.convert.numbers import fmt_rpy
+
+        again = matrix_from_rpy(*(float(v) for v in fmt_rpy(matrix_from_rpy(*rpy)).split()))
+        assert np.allclose(again, matrix_from_rpy(*rpy), atol=1e-12)

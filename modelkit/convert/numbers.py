@@ -87,6 +87,31 @@ def fmt_position(values: Iterable[float] | np.ndarray) -> str:
     return fmt_vec([clean_length(float(v)) for v in vector])
 
 
+def fmt_rpy(rotation: np.ndarray) -> str:
+    """A rotation as URDF/SDF roll-pitch-yaw text (MJCF ``euler`` with ``eulerseq="XYZ"``), angles
+    cleaned by :func:`clean_angle`. Every rotation has two triples, (r, p, y) and (r + π, π − p, y + π);
+    the shorter text that gives the matrix back to 1e-12 is written, the matrix's own on a tie. A
+    source's ``rpy="0 1.5707963268 0"`` (a pitch 5e-12 past π/2; pybullet_data's Spirit40) comes back
+    from the matrix as (−π, 1.57079632678979, −π): its own text is the other triple."""
+    from modelkit.spatial import matrix_from_rpy, rpy_from_matrix
+
+    r = np.asarray(rotation, dtype=float)
+    roll, pitch, yaw = (float(a) for a in rpy_from_matrix(r))
+    own = fmt_vec([clean_angle(a) for a in (roll, pitch, yaw)])
+    other = fmt_vec([clean_angle(_wrap(a)) for a in (roll + math.pi, math.pi - pitch, yaw + math.pi)])
+    if len(other) < len(own):
+        back = matrix_from_rpy(*(float(v) for v in other.split()))
+        if float(np.max(np.abs(back - r))) <= SNAP:
+            return other
+    return own
+
+
+def _wrap(angle: float) -> float:
+    """``angle`` in (−π, π]."""
+    wrapped = math.remainder(angle, 2.0 * math.pi)
+    return math.pi if wrapped == -math.pi else wrapped
+
+
 def fmt_direction(values: Iterable[float] | np.ndarray) -> str:
     """A direction (a joint axis): each component within 1e-12 of the vector's length written as 0, as
     a dimensionless rotation value would be (``0 -1 6.12323e-17`` → ``0 -1 0``: a cosine of π/2 that a

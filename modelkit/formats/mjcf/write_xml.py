@@ -7,8 +7,8 @@ import math
 import numpy as np
 from lxml import etree
 
-from modelkit.convert.numbers import SNAP, clean_angle, clean_length, clean_rotation, fmt, fmt_vec
-from modelkit.spatial import Mat3, Pose, axis_angle, matrix_from_rpy, rpy_from_matrix
+from modelkit.convert.numbers import SNAP, clean_length, clean_rotation, fmt, fmt_rpy, fmt_vec
+from modelkit.spatial import Mat3, Pose, axis_angle, matrix_from_rpy
 
 Element = etree._Element
 
@@ -83,26 +83,13 @@ def z_turn(z: list[float]) -> np.ndarray:
 
 
 def euler_text(rotation: Mat3) -> str | None:
-    """The rotation as fixed-axis x-y-z angles (``eulerseq="XYZ"``), or None when the printed angles
-    do not give back the matrix to 1e-12.
-
-    Every rotation has two such triples, (r, p, y) and (r + π, π − p, y + π); the shorter text is
-    written. A source's ``rpy="0 1.5707963268 0"`` (a pitch 5e-12 past π/2) comes back from the matrix
-    as ``-3.14159265358979 1.57079632678979 -3.14159265358979``: its own text is the other triple."""
-    roll, pitch, yaw = (float(a) for a in rpy_from_matrix(rotation))
-    texts = []
-    for angles in ((roll, pitch, yaw), (_wrap(roll + math.pi), _wrap(math.pi - pitch), _wrap(yaw + math.pi))):
-        text = fmt_vec([clean_angle(a) for a in angles])
-        back = matrix_from_rpy(*(float(v) for v in text.split()))
-        if float(np.max(np.abs(back - np.asarray(rotation, dtype=float)))) <= SNAP:
-            texts.append(text)
-    return min(texts, key=len) if texts else None  # the first (the matrix's own triple) on a tie
-
-
-def _wrap(angle: float) -> float:
-    """``angle`` in (−π, π]."""
-    wrapped = math.remainder(angle, 2.0 * math.pi)
-    return math.pi if wrapped == -math.pi else wrapped
+    """The rotation as fixed-axis x-y-z angles (``eulerseq="XYZ"``, :func:`fmt_rpy`: the shorter of its
+    two triples), or None when the printed angles do not give back the matrix to 1e-12."""
+    text = fmt_rpy(np.asarray(rotation, dtype=float))
+    back = matrix_from_rpy(*(float(v) for v in text.split()))
+    if float(np.max(np.abs(back - np.asarray(rotation, dtype=float)))) > SNAP:
+        return None
+    return text
 
 
 def sub(parent: Element, tag: str, **attributes: str) -> Element:

@@ -5,12 +5,11 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
 from lxml import etree
 from lxml.etree import _Element as Element
 
-from modelkit.convert.numbers import clean_angle, clean_length, fmt, fmt_vec
-from modelkit.spatial import Mat3, Pose
+from modelkit.convert.numbers import clean_length, fmt, fmt_rpy, fmt_vec
+from modelkit.spatial import Pose
 
 
 def sub(parent: Element, tag: str, text: str | None = None, **attrib: str) -> Element:
@@ -27,22 +26,9 @@ def num(parent: Element, tag: str, value: float) -> Element:
     return sub(parent, tag, fmt(value))
 
 
-def rpy(rotation: Mat3) -> tuple[float, float, float]:
-    """Fixed-axis roll, pitch, yaw of R = Rz·Ry·Rx, accurate near pitch = ±90° (atan2, not asin)."""
-    r = np.asarray(rotation, dtype=float)
-    pitch = math.atan2(-float(r[2, 0]), math.hypot(float(r[0, 0]), float(r[1, 0])))
-    if math.hypot(float(r[0, 0]), float(r[1, 0])) > 1e-12:
-        roll = math.atan2(float(r[2, 1]), float(r[2, 2]))
-        yaw = math.atan2(float(r[1, 0]), float(r[0, 0]))
-    else:  # gimbal lock: everything into yaw
-        roll = 0.0
-        yaw = math.atan2(-float(r[0, 1]), float(r[1, 1]))
-    return clean_angle(roll), clean_angle(pitch), clean_angle(yaw)
-
-
 def pose_text(pose: Pose) -> str:
     t = [clean_length(float(v)) for v in pose.translation]
-    return fmt_vec([*t, *rpy(pose.rotation)])
+    return f"{fmt_vec(t)} {fmt_rpy(pose.rotation)}"
 
 
 def add_pose(parent: Element, pose: Pose, relative_to: str | None = None, always: bool = False) -> None:
