@@ -7,7 +7,7 @@ import math
 import numpy as np
 from lxml import etree
 
-from modelkit.convert.numbers import SNAP, clean_length, clean_rotation, fmt, fmt_rpy, fmt_vec
+from modelkit.convert.numbers import SNAP, clean_rotation, fmt, fmt_position, fmt_rpy, fmt_vec
 from modelkit.spatial import Mat3, Pose, axis_angle, matrix_from_rpy
 
 Element = etree._Element
@@ -47,9 +47,9 @@ def set_pose(el: Element, pose: Pose) -> None:
     ``euler``, URDF's roll-pitch-yaw (with ``<compiler eulerseq="XYZ">``, which the writer adds):
     ``rpy="1.57079 0 1.57079"`` stays ``euler="1.57079 0 1.57079"`` instead of a quaternion of
     four 15-digit numbers."""
-    t = np.array([clean_length(v) for v in np.asarray(pose.translation, dtype=float)])
-    if np.any(t != 0.0):
-        el.set("pos", fmt_vec(t))
+    position = fmt_position(pose.translation)
+    if position != "0 0 0":
+        el.set("pos", position)
     if not np.array_equal(np.asarray(pose.rotation, dtype=float), np.eye(3)):
         q = quat_wxyz(pose.rotation)
         if not (q[0] == 1.0 and not np.any(q[1:])):

@@ -8,7 +8,7 @@ from typing import Any
 from lxml import etree
 from lxml.etree import _Element as Element
 
-from modelkit.convert.numbers import clean_length, fmt, fmt_rpy, fmt_vec
+from modelkit.convert.numbers import fmt, fmt_position, fmt_rpy, fmt_vec
 from modelkit.spatial import Pose
 
 
@@ -27,8 +27,7 @@ def num(parent: Element, tag: str, value: float) -> Element:
 
 
 def pose_text(pose: Pose) -> str:
-    t = [clean_length(float(v)) for v in pose.translation]
-    return f"{fmt_vec(t)} {fmt_rpy(pose.rotation)}"
+    return f"{fmt_position(pose.translation)} {fmt_rpy(pose.rotation)}"
 
 
 def add_pose(parent: Element, pose: Pose, relative_to: str | None = None, always: bool = False) -> None:

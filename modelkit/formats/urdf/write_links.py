@@ -18,7 +18,7 @@ from lxml.etree import _Element as Element
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import PairFriction
 from modelkit.convert.meshes import MeshRef
-from modelkit.convert.numbers import clean_inertia, clean_length, fmt, fmt_position, fmt_rpy, fmt_vec
+from modelkit.convert.numbers import clean_inertia, fmt, fmt_position, fmt_rpy, fmt_vec
 from modelkit.convert.output import safe_file_name
 from modelkit.diagnostics import SourceLocation
 from modelkit.model import (
@@ -41,7 +41,7 @@ TEXTURE_FOLDER = "textures"
 
 def origin_element(parent: Element, pose: Pose, always: bool = False) -> None:
     """``<origin xyz rpy>`` for ``pose`` (left out when it is the identity, unless ``always``)."""
-    xyz = fmt_vec([clean_length(v) for v in pose.translation])
+    xyz = fmt_position(pose.translation)
     rpy = fmt_rpy(pose.rotation)
     if always or xyz != "0 0 0" or rpy != "0 0 0":
         etree.SubElement(parent, "origin", xyz=xyz, rpy=rpy)
