@@ -1368,6 +1368,24 @@ _TABLE: tuple[CodeInfo, ...] = (
         "`--no-ros-plugins` leaves them out.",
     ),
     CodeInfo(
+        "MK851",
+        "surface-friction-not-held",
+        "warning",
+        "A collision shape's own friction (MJCF geom friction and condim, a URDF link's PyBullet "
+        "`<contact>`, SDF `<surface><friction>`) has a part the target cannot hold: a second sliding "
+        "direction, torsional or rolling friction, different values on shapes of one URDF link, or any "
+        "friction in `.body` (whose friction is a pair of named contact materials); also PyBullet "
+        "`<contact>` parameters other than friction (stiffness, damping, restitution...) outside URDF. "
+        "The note gives the value left out.",
+    ),
+    CodeInfo(
+        "MK852",
+        "surface-friction-written",
+        "info",
+        "A collision shape's own friction from another format is written as the target's per-shape or "
+        "per-link value; the note says how the target combines it with the shape it touches.",
+    ),
+    CodeInfo(
         "MK860",
         "sdf-inertia-adjusted",
         "warning",

@@ -138,6 +138,26 @@ class VisualMaterial:
         return (r, g, b, 1.0 - self.transparency)
 
 
+@dataclass(frozen=True)
+class SurfaceFriction:
+    """A collision shape's own friction against whatever it touches, as the source set it.
+
+    ``sliding`` is the Coulomb coefficient (dimensionless). ``torsional`` (about the contact normal)
+    and ``rolling`` are in metres (torque = coefficient × normal force), as MuJoCo and PyBullet define
+    them; 0 where the source's engine does not apply them (an MJCF geom of condim 3 has no torsional
+    friction, whatever its ``friction`` attribute says), None where the source does not say. Readers
+    set it only when the source gives a shape its own friction; a `.body` link's friction is a pair
+    of contact materials instead (``Link.contact_material``). ``sliding2`` is the coefficient along
+    the second friction direction when the source gives one that differs (SDF ``<mu2>``, a Gazebo
+    ``<mu2>``); None: isotropic.
+    """
+
+    sliding: float
+    torsional: float | None = None
+    rolling: float | None = None
+    sliding2: float | None = None  # the second direction's where it differs (SDF ``mu2``): anisotropic
+
+
 @dataclass(eq=False)
 class Geom:
     """One visual or collision shape, placed in its link frame."""
@@ -147,6 +167,7 @@ class Geom:
     name: str | None = None
     material: VisualMaterial | None = None
     source: SourceLocation | None = None
+    friction: SurfaceFriction | None = None  # collision shapes: the source's own friction, if any
 
 
 @dataclass(eq=False)

@@ -73,6 +73,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     from modelkit.formats.mjcf.site_frames import sites_as_links
 
     _check_mass_properties(robot)
+    _foreign_link_extras(robot, target, notes)
     out = copy.deepcopy(robot)
     settle_base(out, options.base, notes)
     if not target.tracks_native:
@@ -83,6 +84,23 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     if options.merge_fixed:
         merge_fixed_joints(out, notes)
     return out
+
+
+def _foreign_link_extras(robot: Robot, target: TargetInfo, notes: NoteSink) -> None:
+    """A note for each link's extras that its format declares dropped by the other targets."""
+    from modelkit.formats.registry import EXTRAS_DROPPED_LINK
+
+    for link in robot.links:
+        for key in sorted(link.extras):
+            owner = EXTRAS_DROPPED_LINK.get(key)
+            if owner is None or owner[0] == target.name or not link.extras[key]:
+                continue
+            _, code, what = owner
+            value = link.extras[key]
+            shown = (", ".join(f"{k} {v}".rstrip() for k, v in sorted(value.items()))
+                     if isinstance(value, dict) else str(value))
+            notes.note(code, f"link {link.name}: {what} ({shown}) cannot be written in {target.name}; "
+                       "left out", link.source, f"link[{link.name}]")
 
 
 def _check_mass_properties(robot: Robot) -> None:

@@ -5,6 +5,10 @@ of materials (``materials.yaml``), or, for a pair the table lacks, Choreonoid's 
 clamp(√(roughness₁·roughness₂), 0, 100). Targets hold friction per shape and combine two shapes'
 values by their own rule (MuJoCo: max; PyBullet and Gazebo/ODE: product or min), so a writer asks
 here for each link's friction against the floor material and writes it with a note (MK817).
+
+A shape of a URDF, SDF or MJCF source carries its own friction instead (``Geom.friction``): the
+writers put it on the same shape where the target holds friction per shape (MJCF, SDF), on the link
+where it holds one per link (URDF), and note what the target cannot hold (MK851).
 """
 
 from __future__ import annotations
@@ -14,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from modelkit.diagnostics import DiagnosticSink
-from modelkit.model import Robot
+from modelkit.model import Link, Robot, SurfaceFriction
 
 FLOOR_MATERIAL = "Ground"  # what Choreonoid's floors and terrains use
 
@@ -56,3 +60,29 @@ def floor_friction(robot: Robot, floor: str = FLOOR_MATERIAL) -> dict[str, PairF
         if link.contact_material:
             out[link.name] = pair_friction(link.contact_material, floor, robot.materials_file)
     return out
+
+
+def link_surface(link: Link) -> tuple[SurfaceFriction | None, list[SurfaceFriction]]:
+    """For a target that holds one friction per link (URDF's ``<contact>`` and ``<gazebo>``): the
+    friction of the link's first collision that has one, and the other, different ones the link's
+    collisions have (which such a target cannot hold)."""
+    found: list[SurfaceFriction] = []
+    for geom in link.collisions:
+        if geom.friction is not None and geom.friction not in found:
+            found.append(geom.friction)
+    if not found:
+        return None, []
+    return found[0], found[1:]
+
+
+def describe(friction: SurfaceFriction) -> str:
+    """``sliding 0.3, torsional 0.01`` — the coefficients a source gave, for notes."""
+    from modelkit.convert.numbers import fmt
+
+    parts = [f"sliding {fmt(friction.sliding)}"]
+    if friction.sliding2 is not None:
+        parts.append(f"second direction {fmt(friction.sliding2)}")
+    for name, value in (("torsional", friction.torsional), ("rolling", friction.rolling)):
+        if value:
+            parts.append(f"{name} {fmt(value)} m")
+    return ", ".join(parts)

@@ -28,13 +28,15 @@ class ExtrasDeclaration(NamedTuple):
 
     ``quiet`` (robot) and ``quiet_link`` (link) keys carry nothing that target misses: bookkeeping, or
     data the model's own fields already hold. ``dropped`` gives each other robot key the note's code
-    and its words ("MJCF tendons"). The owning format says this once, so no writer lists another
-    format's keys.
+    and its words ("MJCF tendons"); ``dropped_link`` does the same for link keys, and ``convert`` notes
+    them for every other target (:func:`modelkit.convert.api.prepare`). The owning format says this
+    once, so no writer lists another format's keys.
     """
 
     quiet: frozenset[str] = frozenset()
     quiet_link: frozenset[str] = frozenset()
     dropped: tuple[tuple[str, str, str], ...] = ()  # (key, code, what)
+    dropped_link: tuple[tuple[str, str, str], ...] = ()  # the same for link keys, noted by convert itself
 
 
 class FormatDeclaration(NamedTuple):

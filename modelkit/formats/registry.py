@@ -34,6 +34,10 @@ EXTRAS_DROPPED: dict[str, tuple[str, str]] = {
     key: (code, what) for d in DECLARED for key, code, what in d.extras.dropped
 }
 """Robot ``extras`` key → (code, words) of the note a target that drops it gives (each format's own)."""
+EXTRAS_DROPPED_LINK: dict[str, tuple[str, str, str]] = {
+    key: (d.name, code, what) for d in DECLARED for key, code, what in d.extras.dropped_link
+}
+"""Link ``extras`` key → (owning format, code, words) of the note every other target gives."""
 
 
 def declared(name: str) -> FormatDeclaration:

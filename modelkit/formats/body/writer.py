@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.friction import describe, link_surface
 from modelkit.convert.names import unique_name
 from modelkit.formats.body.write_devices import device_node
 from modelkit.formats.body.write_shapes import link_elements
@@ -203,6 +204,7 @@ def _link_node(robot: Robot, link: Link, joint: Joint | None, names: _Names, ctx
         _massless_chain(link, node, ctx, target)
     if link.contact_material:
         node["material"] = link.contact_material
+    _surface_loss(link, ctx, target)
     elements = link_elements(link, ctx, from_body)
     for i, device in enumerate(link.devices):
         written = device_node(device, from_body, ctx, f"{target}/device[{i}]")
@@ -211,6 +213,23 @@ def _link_node(robot: Robot, link: Link, joint: Joint | None, names: _Names, ctx
     if elements:
         node["elements"] = elements
     return node
+
+
+def _surface_loss(link: Link, ctx: WriteContext, target: str) -> None:
+    """MK851: a `.body` link's friction is a pair of named contact materials (a materials table), so
+    the friction a URDF, SDF or MJCF source gives its shapes has no place here."""
+    surface, others = link_surface(link)
+    if surface is None:
+        return
+    ctx.note(
+        "MK851",
+        f"the collisions of link {link.name} have their own friction ({describe(surface)}"
+        + "".join(f"; {describe(f)}" for f in others)
+        + "), which a .body file cannot hold: Choreonoid takes friction from the pair of the two bodies' "
+        "contact materials (a materials table); left out, so the link uses the Default material",
+        link.loc("collision"),
+        target,
+    )
 
 
 def _root(robot: Robot, node: dict[str, Any], link: Link, ctx: WriteContext, target: str) -> None:

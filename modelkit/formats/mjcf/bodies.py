@@ -69,6 +69,8 @@ class MjGeom:
     mesh_file: str | None = None
     mesh_path: str | None = None
     mesh_scale: V3 = (1.0, 1.0, 1.0)
+    friction: V3 = (1.0, 0.005, 0.0001)  # sliding, torsional, rolling (MuJoCo's defaults)
+    condim: int = 3
 
     @property
     def visual_only(self) -> bool:

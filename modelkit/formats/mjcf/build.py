@@ -44,6 +44,7 @@ from modelkit.model import (
     Mimic,
     Robot,
     Sphere,
+    SurfaceFriction,
     VisualMaterial,
 )
 from modelkit.spatial import Pose
@@ -389,7 +390,8 @@ class RobotBuilder:
             r, g, b, a = mg.rgba
             diffuse = (float(r), float(g), float(b))
             material = VisualMaterial(name=mg.material, diffuse=diffuse, transparency=1.0 - a)
-        return Geom(geometry, back @ mg.pose, mg.name, material, where)
+        friction = None if mg.visual_only else surface_friction(mg)
+        return Geom(geometry, back @ mg.pose, mg.name, material, where, friction)
 
     @staticmethod
     def geometry(mg: MjGeom) -> Geometry | None:
@@ -478,3 +480,20 @@ def apply_joint_equalities(
 def quoted(name: str | None) -> str:
     """`` "name"`` with a leading blank, or "" when there is no name (for messages)."""
     return f' "{name}"' if name else ""
+
+
+MUJOCO_DEFAULT_FRICTION = SurfaceFriction(1.0, 0.0, 0.0)
+"""What a geom of MuJoCo's default ``friction="1 0.005 0.0001"`` and ``condim="3"`` does."""
+
+
+def surface_friction(mg: MjGeom) -> SurfaceFriction | None:
+    """The friction a MuJoCo geom applies: ``condim`` says which of its three coefficients act (1: none,
+    the contact is frictionless; 3: sliding; 4: and torsional; 6: and rolling). None when that is
+    MuJoCo's default, which the source did not choose."""
+    sliding, torsional, rolling = (float(x) for x in mg.friction)
+    acting = SurfaceFriction(
+        sliding if mg.condim > 1 else 0.0,
+        torsional if mg.condim >= 4 else 0.0,
+        rolling if mg.condim >= 6 else 0.0,
+    )
+    return None if acting == MUJOCO_DEFAULT_FRICTION else acting

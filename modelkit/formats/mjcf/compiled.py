@@ -144,6 +144,8 @@ class CompiledModel:
             group=int(m.geom_group[g]),
             rgba=(rgba[0], rgba[1], rgba[2], rgba[3]),
             material=material,
+            friction=rot3.vec3(m.geom_friction[g]),
+            condim=int(m.geom_condim[g]),
         )
         mesh = int(m.geom_dataid[g])
         if kind == "mesh" and mesh >= 0:

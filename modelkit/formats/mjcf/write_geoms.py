@@ -45,7 +45,7 @@ from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.diagnostics import SourceLocation
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, set_pose, sub
-from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere
+from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere, SurfaceFriction
 
 MESH_READABLE = ("stl", "obj")
 COLLISION_GROUP = "3"
@@ -65,6 +65,7 @@ class GeomWriter:
     mesh_assets: dict[tuple[str, tuple[float, ...]], str] = field(default_factory=dict)
     shared_stems: set[str] = field(default_factory=set)  # stems of both a collision and a visual file
     used: set[str] = field(default_factory=set)  # the classes (VISUAL, COLLISION) a geom names
+    surface_links: set[str] = field(default_factory=set)  # links whose geoms got the source's friction
 
     def defaults(self, section: Element, robot_name: str) -> None:
         """``<default class=robot>`` with the ``visual`` and ``collision`` classes the geoms use."""
@@ -118,7 +119,9 @@ class GeomWriter:
         el.set("class", role)
         self.used.add(role)
         self.appearance(el, geom, target)
-        if collision and link.name in self.friction:
+        if collision and geom.friction is not None:
+            self.set_surface_friction(el, geom.friction, link, target)
+        elif collision and link.name in self.friction:
             self.set_friction(el, link, target)
 
     def shape(self, geom: Geom, target: str, file_stem: str,
@@ -198,6 +201,30 @@ class GeomWriter:
                 geom.source,
                 target,
             )
+
+    def set_surface_friction(self, el: Element, friction: SurfaceFriction, link: Link, target: str) -> None:
+        """A shape's own friction: ``condim`` says which coefficients act (1 none, 3 sliding, 4 and
+        torsional, 6 and rolling) and ``friction`` lists that many (MuJoCo fills the rest)."""
+        torsional, rolling = friction.torsional or 0.0, friction.rolling or 0.0
+        values = [friction.sliding]
+        condim = "3" if friction.sliding > 0.0 else "1"
+        if rolling > 0.0:
+            condim, values = "6", [friction.sliding, torsional, rolling]
+        elif torsional > 0.0:
+            condim, values = "4", [friction.sliding, torsional]
+        el.set("friction", fmt_vec(values))
+        if condim != "3":
+            el.set("condim", condim)
+        if friction.sliding2 is not None:
+            self.ctx.note(
+                "MK851",
+                f"a collision of link {link.name} has a sliding friction of {fmt(friction.sliding)} in its "
+                f"first direction and {fmt(friction.sliding2)} in its second; a MuJoCo geom holds one "
+                f"coefficient for both, and {fmt(friction.sliding)} is written",
+                link.loc("collision"),
+                target,
+            )
+        self.surface_links.add(link.name)
 
     def set_friction(self, el: Element, link: Link, target: str) -> None:
         pair = self.friction[link.name]

@@ -52,7 +52,7 @@ from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.formats.mjcf.write_actuators import ActuatorWriter
 from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_devices import DeviceWriter
-from modelkit.formats.mjcf.write_geoms import COLLISION, GeomWriter, shared_stems
+from modelkit.formats.mjcf.write_geoms import COLLISION, CONTACT_PRIORITY, GeomWriter, shared_stems
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, quat_wxyz, set_pose, sub
 from modelkit.model import WORLD_LINK, LoopConstraint, Robot
@@ -124,11 +124,30 @@ class MjcfWriter:
         self._actuators()
         self._home()
         self.geoms.defaults(self.sections["default"], self.robot.name)
+        self._surface_note()
         self._meshdir()
         if any(el.get("euler") is not None for el in self.root.iter()):
             self.sections["compiler"].set("eulerseq", EULER_SEQUENCE)  # set_pose's euler: URDF's rpy
         self._self_contact()
         return self._text()
+
+    def _surface_note(self) -> None:
+        """Once per file: how MuJoCo combines the source's shape frictions the geoms now hold."""
+        links = sorted(self.geoms.surface_links)
+        if not links or self.robot.source_format == "mjcf":
+            return
+        self.ctx.note(
+            "MK852",
+            f"the source's own friction of the collision shapes of {len(links)} link(s) "
+            f"({', '.join(links[:5])}{', ...' if len(links) > 5 else ''}) is written as geom friction "
+            f"and condim; the collision geoms have priority {CONTACT_PRIORITY}, so against a floor of "
+            "MuJoCo's default priority 0 the robot's values are used; the source's engine may combine "
+            "two shapes' values otherwise "
+            "(PyBullet multiplies them, so against pybullet_data's plane.urdf, friction 1, the numbers "
+            "agree; Gazebo/ODE takes the smaller)",
+            self.robot.source,
+            "default",
+        )
 
     def _text(self) -> bytes:
         for tag in SECTIONS:

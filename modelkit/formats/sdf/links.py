@@ -27,7 +27,18 @@ from modelkit.formats.sdf.geometry import element_data, read_geometry, read_mate
 from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import light_device, plugin_data, sensor_device
 from modelkit.formats.sdf.values import Values, child, children
-from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Inertial, Link, Sphere
+from modelkit.model import (
+    Box,
+    Capsule,
+    Cone,
+    Cylinder,
+    Ellipsoid,
+    Geom,
+    Inertial,
+    Link,
+    Sphere,
+    SurfaceFriction,
+)
 from modelkit.spatial import Mat3, Pose, Vec3
 
 DEFAULT_DENSITY = 1000.0
@@ -94,6 +105,7 @@ def read_link(ctx: Context, graph: FrameGraph, item: Item) -> LinkData:
                     link.extras.setdefault("sdf_materials", {})[name] = material.extras
                 link.visuals.append(geom)
             else:
+                geom.friction = surface_friction(values, child(geom_el, "surface"))
                 link.collisions.append(geom)
                 data.collision_densities.append(values.number(child(geom_el, "density")))
             for plugin in children(geom_el, "plugin"):
@@ -271,3 +283,25 @@ def _solid(geometry: object, density: float) -> tuple[float, Vec3, Mat3] | None:
         side = m * (3.0 * r * r / 20.0 + 3.0 * h * h / 80.0)
         return m, np.array([0.0, 0.0, -h / 4.0]), np.diag([side, side, 0.3 * m * r * r])
     return None
+
+
+def surface_friction(values: Values, surface: Element | None) -> SurfaceFriction | None:
+    """A collision's own friction: ``<surface><friction>``'s ODE ``<mu>``/``<mu2>`` (Gazebo's engines
+    read these), else Bullet's ``<friction>``/``<friction2>``; Bullet's ``<rolling_friction>``. None
+    when the collision gives no coefficient. ``<torsional>`` (Gazebo's ODE patch model, which has no
+    counterpart in the other formats) is not read."""
+    friction = None if surface is None else child(surface, "friction")
+    if friction is None:
+        return None
+    ode, bullet = child(friction, "ode"), child(friction, "bullet")
+    first = values.child_number(ode, "mu") if ode is not None else None
+    second = values.child_number(ode, "mu2") if ode is not None else None
+    if first is None and bullet is not None:
+        first = values.child_number(bullet, "friction")
+        second = values.child_number(bullet, "friction2")
+    rolling = None if bullet is None else values.child_number(bullet, "rolling_friction")
+    if first is None and second is None and rolling is None:
+        return None
+    sliding = 1.0 if first is None else first  # SDF's default mu
+    other = 1.0 if second is None else second
+    return SurfaceFriction(sliding, None, rolling, None if other == sliding else other)

@@ -9,20 +9,22 @@ from __future__ import annotations
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.friction import PairFriction
+from modelkit.convert.friction import PairFriction, describe
 from modelkit.convert.names import unique_name
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.formats.sdf.write_xml import add_pose, num, rgba, sub
-from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere
+from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere, SurfaceFriction
 from modelkit.spatial import Pose
 
 MESH_READABLE = ("stl", "obj", "dae")
 
 
 class GeomWriter:
-    def __init__(self, ctx: WriteContext, version: tuple[int, int]) -> None:
+    def __init__(self, ctx: WriteContext, version: tuple[int, int], source_format: str = "") -> None:
         self.ctx = ctx
         self.version = version
+        self.source_format = source_format
+        self.surface_noted: set[str] = set()  # links whose own friction has had its MK852 note
 
     def link_geoms(
         self,
@@ -47,6 +49,8 @@ class GeomWriter:
                     continue
                 if kind == "visual":
                     self._material(shape, geom, target)
+                elif geom.friction is not None:
+                    self._surface(shape, geom.friction, link, target)
                 elif friction is not None:
                     self._friction(shape, friction, link, target)
 
@@ -110,6 +114,39 @@ class GeomWriter:
                 "MK818",
                 f"texture {material.texture} is not carried over; the colours are",
                 geom.source,
+                target,
+            )
+
+    def _surface(self, collision: Element, friction: SurfaceFriction, link: Link, target: str) -> None:
+        """A shape's own friction: ODE's ``<mu>``/``<mu2>`` and Bullet's ``<friction>``/``<friction2>``
+        and ``<rolling_friction>``. Torsional friction is not written: SDF's ``<torsional>`` is Gazebo
+        ODE's contact-patch model, with no coefficient of MuJoCo's or PyBullet's meaning."""
+        second = friction.sliding if friction.sliding2 is None else friction.sliding2
+        friction_el = sub(sub(collision, "surface"), "friction")
+        ode = sub(friction_el, "ode")
+        num(ode, "mu", friction.sliding)
+        num(ode, "mu2", second)
+        bullet = sub(friction_el, "bullet")
+        num(bullet, "friction", friction.sliding)
+        num(bullet, "friction2", second)
+        if friction.rolling is not None:
+            num(bullet, "rolling_friction", friction.rolling)
+        if friction.torsional:
+            self.ctx.note(
+                "MK851",
+                f"a collision of link {link.name} has a torsional friction of {fmt(friction.torsional)} m, "
+                "which SDF cannot hold (its <torsional> is Gazebo ODE's contact-patch model); left out",
+                link.loc("collision"),
+                target,
+            )
+        if self.source_format != "sdf" and link.name not in self.surface_noted:
+            self.surface_noted.add(link.name)
+            self.ctx.note(
+                "MK852",
+                f"link {link.name}: the source's friction of its collisions ({describe(friction)}) is "
+                "written as each collision's <surface><friction> (ODE mu/mu2, Bullet friction); Gazebo/ODE "
+                "takes the smaller of two shapes' values, and other engines may multiply them",
+                link.loc("collision"),
                 target,
             )
 

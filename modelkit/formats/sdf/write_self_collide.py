@@ -20,10 +20,13 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.self_collision import flags
 from modelkit.model import Robot
 
+CARRIED = frozenset({"selfCollide", "sensor", "mu1", "mu2"})
+
 
 def only_carried(entries: object) -> bool:
     """URDF ``<gazebo reference>`` blocks that say nothing but what the SDF writer carries on its own:
-    ``selfCollide`` (written as link flags) and ``<sensor>``s (the link's devices, with their plugins)."""
+    ``selfCollide`` (written as link flags), ``<sensor>``s (the link's devices, with their plugins) and
+    ``mu1``/``mu2`` (the collisions' own friction, written as their ``<surface>``)."""
     if not isinstance(entries, list) or not entries:
         return False
     for entry in entries:
@@ -31,7 +34,7 @@ def only_carried(entries: object) -> bool:
             block = etree.fromstring(str(entry.get("xml", ""))) if isinstance(entry, dict) else None
         except etree.XMLSyntaxError:
             return False
-        if block is None or not {c.tag for c in block if isinstance(c.tag, str)} <= {"selfCollide", "sensor"}:
+        if block is None or not {c.tag for c in block if isinstance(c.tag, str)} <= CARRIED:
             return False
         if any(not (c.get("name") and c.get("type")) for c in block if c.tag == "sensor"):
             return False  # a sensor the reader could not make a device of (MK620) is not carried

@@ -105,7 +105,7 @@ class _ModelWriter:
         self.version = parse_version(ctx.options.sdf_version)
         self.frames_ok = self.version >= (1, 7)
         self.names = Names(ctx)
-        self.geoms = GeomWriter(ctx, self.version)
+        self.geoms = GeomWriter(ctx, self.version, robot.source_format)
         self.devices = DeviceWriter(
             ctx, self.version, robot.source_format, gazebo_family(robot, ctx.options.gazebo)
         )

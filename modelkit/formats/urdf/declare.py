@@ -1,6 +1,6 @@
 """URDF, as modelkit reads and writes it (see :mod:`modelkit.formats.declaration`)."""
 
-from modelkit.formats.declaration import FormatDeclaration, OutputDeclaration
+from modelkit.formats.declaration import ExtrasDeclaration, FormatDeclaration, OutputDeclaration
 
 FORMAT = FormatDeclaration(
     name="urdf",
@@ -13,5 +13,10 @@ FORMAT = FormatDeclaration(
         suffix=".urdf",
         suffixes=(".urdf",),
         auto_wheel="sphere",  # PyBullet loads URDF: a cylinder rolling on a plane gets odd contacts there
+    ),
+    extras=ExtrasDeclaration(
+        dropped_link=(
+            ("urdf_contact", "MK851", "PyBullet <contact> parameters other than friction"),
+        ),
     ),
 )

@@ -22,7 +22,7 @@ from modelkit import rot3
 from modelkit.diagnostics import did_you_mean
 from modelkit.formats.devices import sdf_sensor_canonical
 from modelkit.formats.urdf.values import Context
-from modelkit.model import Device, Joint, Link, Robot
+from modelkit.model import Device, Joint, Link, Robot, SurfaceFriction
 from modelkit.spatial import Pose
 from modelkit.xmlsource import parse_number, parse_numbers
 
@@ -168,6 +168,20 @@ def _value(text: str | None) -> Any:
     return stripped
 
 
+def _gazebo_friction(link: Link, mu1: Any, mu2: Any) -> None:
+    """A link block's ``mu1``/``mu2`` (what Gazebo puts on each of the link's collisions, SDF's
+    ``<mu>``/``<mu2>``) as the collisions' own friction, unless PyBullet's ``<contact>`` gave one."""
+    if not isinstance(mu1, float) and not isinstance(mu2, float):
+        return
+    if any(geom.friction is not None for geom in link.collisions):
+        return
+    first = mu1 if isinstance(mu1, float) and mu1 >= 0.0 else 1.0  # SDF's default
+    second = mu2 if isinstance(mu2, float) and mu2 >= 0.0 else 1.0
+    friction = SurfaceFriction(first, None, None, None if second == first else second)
+    for geom in link.collisions:
+        geom.friction = friction
+
+
 def read_gazebo(
     ctx: Context,
     element: Element,
@@ -194,6 +208,7 @@ def read_gazebo(
         link.extras.setdefault("gazebo", []).append(entry)
         if isinstance(collide, bool):
             link.self_collide = collide
+        _gazebo_friction(link, dict.get(entry, "mu1"), dict.get(entry, "mu2"))
         for sensor in ctx.children(element, "sensor"):
             device = _sensor(ctx, sensor)
             if device is not None:

@@ -16,7 +16,18 @@ from modelkit import rot3
 from modelkit.diagnostics import Severity, did_you_mean
 from modelkit.formats.meshref import MeshChecker
 from modelkit.formats.urdf.values import Context, number, origin, vector
-from modelkit.model import Box, Capsule, Cylinder, Geom, Geometry, Inertial, Link, Sphere, VisualMaterial
+from modelkit.model import (
+    Box,
+    Capsule,
+    Cylinder,
+    Geom,
+    Geometry,
+    Inertial,
+    Link,
+    Sphere,
+    SurfaceFriction,
+    VisualMaterial,
+)
 from modelkit.xmlsource import parse_numbers
 
 INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
@@ -164,11 +175,60 @@ def read_link(ctx: Context, element: Element, meshes: MeshChecker, materials: Ma
             if material is not None:
                 geom.material = materials.use(ctx, material, link.name)
             link.visuals.append(geom)
+    contact = ctx.first(element, "contact")
+    friction = None
+    if contact is not None:
+        friction = contact_friction(ctx, contact, link.name)
+        link.extras["urdf_contact"] = contact_parameters(contact)
     for collision in ctx.children(element, "collision"):
         geom = _read_geom(ctx, collision, link.name, meshes, visual_only=False)
         if geom is not None:
+            geom.friction = friction
             link.collisions.append(geom)
     return link
+
+
+FRICTIONS = ("lateral_friction", "spinning_friction", "rolling_friction")
+
+
+def contact_parameters(contact: Element) -> dict[str, str]:
+    """The children of PyBullet's ``<contact>`` other than its frictions, as written (``value``; ""
+    for ``<friction_anchor/>``): PyBullet's own contact model, which the URDF writer writes back."""
+    out: dict[str, str] = {}
+    for child in contact:
+        tag = child.tag
+        if isinstance(tag, str) and tag not in FRICTIONS and tag not in out:
+            out[tag] = child.get("value", "")
+    return out
+
+
+PYBULLET_LATERAL_DEFAULT = 0.5
+"""PyBullet's lateral friction of a link whose ``<contact>`` does not give one."""
+
+
+def contact_friction(ctx: Context, contact: Element, link: str) -> SurfaceFriction | None:
+    """PyBullet's ``<contact>`` of a link: its lateral, spinning and rolling friction hold for all the
+    link's collisions (None when it gives none of the three). The other children (stiffness,
+    restitution...) are PyBullet's own contact model and are not read."""
+    values: dict[str, float] = {}
+    for tag in FRICTIONS:
+        child = ctx.first(contact, tag)
+        if child is None:
+            continue
+        value = number(ctx, child, "value", f'{tag} of link "{link}"', required=True)
+        if value is not None and value < 0.0:
+            ctx.emit("MK121", f'{tag} of link "{link}": `value="{child.get("value")}"` is negative',
+                     ctx.loc(child, "value"))
+            value = None
+        if value is not None:
+            values[tag] = value
+    if not values:
+        return None
+    return SurfaceFriction(
+        values.get("lateral_friction", PYBULLET_LATERAL_DEFAULT),
+        values.get("spinning_friction", 0.0),
+        values.get("rolling_friction", 0.0),
+    )
 
 
 def read_inertial(ctx: Context, element: Element, link: str) -> Inertial | None:

@@ -23,10 +23,25 @@ XINCLUDE = "http://www.w3.org/2001/XInclude"
 XACRO = frozenset({"http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro", "http://wiki.ros.org/xacro"})
 SHAPES = ("box", "cylinder", "sphere", "mesh", "capsule")
 
+# PyBullet's extension: a link's <contact> (its importer reads these; urdfdom ignores the element).
+PYBULLET_CONTACT = (
+    "lateral_friction",
+    "rolling_friction",
+    "spinning_friction",
+    "restitution",
+    "contact_cfm",
+    "contact_erp",
+    "stiffness",
+    "damping",
+    "inertia_scaling",
+    "friction_anchor",
+)
+
 # Allowed children of each URDF element (by tag; a tag means the same wherever it appears).
 CHILDREN: dict[str, tuple[str, ...]] = {
     "robot": ("link", "joint", "material", *sorted(EXTENSIONS)),
-    "link": ("inertial", "visual", "collision"),
+    "link": ("inertial", "visual", "collision", "contact"),
+    "contact": PYBULLET_CONTACT,
     "inertial": ("origin", "mass", "inertia"),
     "visual": ("origin", "geometry", "material"),
     "collision": ("origin", "geometry"),
@@ -71,10 +86,14 @@ ATTRIBUTES: dict[str, tuple[str, ...]] = {
     "limit": ("lower", "upper", "effort", "velocity", "acceleration", "deceleration", "jerk"),
     "mimic": ("joint", "multiplier", "offset"),
     "safety_controller": ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity"),
+    "contact": (),
+    **{tag: ("value",) for tag in PYBULLET_CONTACT if tag != "friction_anchor"},
+    "friction_anchor": (),
 }
 # Children that may appear at most once (urdfdom reads the first). Visuals and collisions repeat.
 ONCE: dict[str, frozenset[str]] = {
-    "link": frozenset({"inertial"}),
+    "link": frozenset({"inertial", "contact"}),
+    "contact": frozenset(PYBULLET_CONTACT),
     "inertial": frozenset({"origin", "mass", "inertia"}),
     "visual": frozenset({"origin", "geometry", "material"}),
     "collision": frozenset({"origin", "geometry"}),

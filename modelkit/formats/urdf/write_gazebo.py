@@ -18,14 +18,14 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.friction import floor_friction
+from modelkit.convert.friction import describe, floor_friction, link_surface
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.numbers import fmt
 from modelkit.diagnostics import SourceLocation
 from modelkit.formats.urdf.write_actuators import rename_motor, unique_motor, write_transmissions
 from modelkit.formats.urdf.write_frames import SensorFrames
 from modelkit.formats.urdf.write_names import NameTable
-from modelkit.model import Device, DeviceKind, Link, Robot
+from modelkit.model import Device, DeviceKind, Link, Robot, SurfaceFriction
 from modelkit.spatial import Pose
 
 # Gazebo reads the SDF inside a URDF's <gazebo> blocks; sensors are written as SDF 1.6 describes them
@@ -144,8 +144,11 @@ def write_extensions(
     for index, link in enumerate(robot.links):
         name = names.links[index]
         written = _kept_blocks(robot_el, link.extras.get("gazebo"), name, ctx, f'link "{link.name}"')
+        surface, _ = link_surface(link)
         pair = friction.get(link.name)
-        if pair is not None:
+        if surface is not None and robot.source_format != "urdf" and not _has_mu(link):
+            _surface_block(_gazebo(robot_el, name), link, surface, name, robot, ctx)
+        elif surface is None and pair is not None:
             friction_block = _gazebo(robot_el, name)
             etree.SubElement(friction_block, "mu1").text = fmt(pair.dynamic)
             etree.SubElement(friction_block, "mu2").text = fmt(pair.dynamic)
@@ -243,3 +246,32 @@ def _transmissions(robot_el: Element, robot: Robot, names: NameTable, ctx: Write
                     motor.set("name", written)
                     rename_motor(ctx, wanted, written, joints[0])
         robot_el.append(block)
+
+
+def _has_mu(link: Link) -> bool:
+    """The link's kept ``<gazebo>`` blocks already set its friction."""
+    blocks = link.extras.get("gazebo")
+    return isinstance(blocks, list) and any(
+        isinstance(b, dict) and (dict.get(b, "mu1") is not None or dict.get(b, "mu2") is not None)
+        for b in blocks
+    )
+
+
+def _surface_block(block: Element, link: Link, surface: SurfaceFriction, name: str, robot: Robot,
+                   ctx: WriteContext) -> None:
+    """Gazebo's ``mu1``/``mu2`` of a link from its shapes' own friction (MJCF, SDF sources)."""
+    etree.SubElement(block, "mu1").text = fmt(surface.sliding)
+    etree.SubElement(block, "mu2").text = fmt(
+        surface.sliding if surface.sliding2 is None else surface.sliding2
+    )
+    lost = [f"{what} {fmt(value)} m" for what, value in (("torsional", surface.torsional),
+                                                          ("rolling", surface.rolling)) if value]
+    ctx.note(
+        "MK852",
+        f"link {link.name}: the source's friction of its collisions ({describe(surface)}) is written as "
+        "PyBullet's <contact> (lateral, spinning, rolling) and as Gazebo's mu1/mu2"
+        + (f" ({', '.join(lost)} only in <contact>: Gazebo's URDF block has no field for it)" if lost else "")
+        + "; PyBullet multiplies two shapes' values and Gazebo/ODE takes the smaller",
+        link.loc("collision"),
+        f"gazebo[{name}]",
+    )

@@ -16,7 +16,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.friction import PairFriction
+from modelkit.convert.friction import PairFriction, describe, link_surface
 from modelkit.convert.meshes import MeshRef
 from modelkit.convert.numbers import clean_inertia, fmt, fmt_position, fmt_rpy, fmt_vec
 from modelkit.convert.output import safe_file_name
@@ -32,6 +32,7 @@ from modelkit.model import (
     Mesh,
     Robot,
     Sphere,
+    SurfaceFriction,
     VisualMaterial,
 )
 from modelkit.spatial import Pose
@@ -208,16 +209,57 @@ def link_element(
                     if what not in materials.appearance_dropped:
                         materials.appearance_dropped.append(what)
             el.append(item)
-    if friction is not None and link.collisions:
-        contact_element(el, friction)
+    surface, others = link_surface(link)
+    kept = link.extras.get(CONTACT_EXTRAS)
+    # a URDF source's friction came from its <contact> when it had one (else from its kept <gazebo> mu1)
+    if surface is not None and (robot.source_format != "urdf" or kept is not None):
+        contact = contact_element(el, surface.sliding, surface.rolling or 0.0, surface.torsional or 0.0)
+        _surface_losses(link, surface, others, ctx, target)
+    elif friction is not None and link.collisions:
+        contact = contact_element(el, friction.dynamic, 0.0, 0.0)
+    elif kept:
+        contact = etree.SubElement(el, "contact")
+    else:
+        return el
+    for tag, value in sorted((kept or {}).items()):
+        etree.SubElement(contact, tag, **({"value": value} if value else {}))
     return el
 
 
-def contact_element(link_el: Element, friction: PairFriction) -> None:
-    """PyBullet's ``<contact>``: lateral friction = the pair's dynamic friction (Bullet multiplies the
-    two bodies' values, and pybullet_data's plane.urdf has 1, so the product is the pair's); rolling
-    and spinning friction 0, as MuJoCo with condim 3 and Choreonoid have none."""
+CONTACT_EXTRAS = "urdf_contact"  # PyBullet's <contact> children other than friction (URDF reader)
+
+
+def contact_element(link_el: Element, lateral: float, rolling: float, spinning: float) -> Element:
+    """PyBullet's ``<contact>``. For a `.body` material pair: lateral friction = the pair's dynamic
+    friction (Bullet multiplies the two bodies' values, and pybullet_data's plane.urdf has 1, so the
+    product is the pair's); rolling and spinning friction 0, as MuJoCo with condim 3 and Choreonoid
+    have none. For a shape's own friction: its sliding, rolling and torsional coefficients."""
     contact = etree.SubElement(link_el, "contact")
-    etree.SubElement(contact, "lateral_friction", value=fmt(friction.dynamic))
-    etree.SubElement(contact, "rolling_friction", value="0")
-    etree.SubElement(contact, "spinning_friction", value="0")
+    etree.SubElement(contact, "lateral_friction", value=fmt(lateral))
+    etree.SubElement(contact, "rolling_friction", value=fmt(rolling))
+    etree.SubElement(contact, "spinning_friction", value=fmt(spinning))
+    return contact
+
+
+def _surface_losses(
+    link: Link, kept: SurfaceFriction, others: list[SurfaceFriction], ctx: WriteContext, target: str
+) -> None:
+    """MK851 for what one ``<contact>`` per link cannot hold."""
+    if others:
+        ctx.note(
+            "MK851",
+            f"the collisions of link {link.name} have different frictions; a URDF link holds one "
+            f"(PyBullet's <contact>), and the first is written ({describe(kept)}); left out: "
+            + "; ".join(describe(f) for f in others),
+            link.loc("collision"),
+            target,
+        )
+    if kept.sliding2 is not None:
+        ctx.note(
+            "MK851",
+            f"a collision of link {link.name} has a sliding friction of {fmt(kept.sliding)} in its first "
+            f"direction and {fmt(kept.sliding2)} in its second; PyBullet's <contact> holds one "
+            f"coefficient, {fmt(kept.sliding)} (the Gazebo block keeps both)",
+            link.loc("collision"),
+            target,
+        )

@@ -31,7 +31,7 @@ from modelkit.formats.registry import EXTRAS_DROPPED, EXTRAS_QUIET, EXTRAS_QUIET
 from modelkit.formats.urdf.write_frames import frame_link, sensor_frames
 from modelkit.formats.urdf.write_gazebo import write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
-from modelkit.formats.urdf.write_links import MaterialTable, link_element, origin_element
+from modelkit.formats.urdf.write_links import CONTACT_EXTRAS, MaterialTable, link_element, origin_element
 from modelkit.formats.urdf.write_names import NameTable
 from modelkit.formats.urdf.write_self_collide import write_self_collision
 from modelkit.model import WORLD_LINK, JointType, Robot
@@ -51,7 +51,7 @@ WRITTEN_EXTRAS = frozenset(
 PASS_EXTRAS = frozenset({"wheels", "tracks"})
 SILENT_EXTRAS = WRITTEN_EXTRAS | EXTRAS_QUIET | PASS_EXTRAS
 # Link extras written elsewhere: URDF's <gazebo> blocks.
-SILENT_LINK_EXTRAS = frozenset({"gazebo"}) | EXTRAS_QUIET_LINK
+SILENT_LINK_EXTRAS = frozenset({"gazebo", CONTACT_EXTRAS}) | EXTRAS_QUIET_LINK
 SDF_LINK_DEFAULTS = {
     "gravity": True,
     "kinematic": False,
