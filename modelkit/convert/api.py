@@ -8,6 +8,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -73,7 +74,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     from modelkit.formats.mjcf.site_frames import sites_as_links
 
     _check_mass_properties(robot)
-    _foreign_link_extras(robot, target, notes)
+    _foreign_extras(robot, target, notes)
     out = copy.deepcopy(robot)
     settle_base(out, options.base, notes)
     if not target.tracks_native:
@@ -86,21 +87,32 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     return out
 
 
-def _foreign_link_extras(robot: Robot, target: TargetInfo, notes: NoteSink) -> None:
-    """A note for each link's extras that its format declares dropped by the other targets."""
-    from modelkit.formats.registry import EXTRAS_DROPPED_LINK
+def _foreign_extras(robot: Robot, target: TargetInfo, notes: NoteSink) -> None:
+    """A note for each link's and joint's extras that its format declares dropped by the other
+    targets (``dropped_link``, ``dropped_joint``), unless this target's writer handles the key."""
+    from modelkit.convert.extras_notes import shown_extras
+    from modelkit.formats.registry import EXTRAS_DROPPED_JOINT, EXTRAS_DROPPED_LINK, declared
 
-    for link in robot.links:
-        for key in sorted(link.extras):
-            owner = EXTRAS_DROPPED_LINK.get(key)
-            if owner is None or owner[0] == target.name or not link.extras[key]:
+    output = declared(target.name).output
+    handled = output.handles_link if output is not None else frozenset()
+    owners: list[tuple[str, Any, dict[str, tuple[str, str, str]], frozenset[str]]] = [
+        *((f"link {link.name}", link, EXTRAS_DROPPED_LINK, handled) for link in robot.links),
+        *((f"joint {joint.name}", joint, EXTRAS_DROPPED_JOINT, frozenset()) for joint in robot.joints),
+    ]
+    for label, element, table, skip in owners:
+        for key in sorted(element.extras):
+            entry = table.get(key)
+            value = element.extras[key]
+            if entry is None or entry[0] == target.name or key in skip or not value:
                 continue
-            _, code, what = owner
-            value = link.extras[key]
-            shown = (", ".join(f"{k} {v}".rstrip() for k, v in sorted(value.items()))
-                     if isinstance(value, dict) else str(value))
-            notes.note(code, f"link {link.name}: {what} ({shown}) cannot be written in {target.name}; "
-                       "left out", link.source, f"link[{link.name}]")
+            _, code, what = entry
+            shown = shown_extras(value)
+            if not shown:
+                continue
+            notes.note(code, f"{label}: {what} ({shown}) has no {target.name} equivalent; left out",
+                       element.source, f"{label.split(' ', 1)[0]}[{element.name}]")
+
+
 
 
 def _check_mass_properties(robot: Robot) -> None:

@@ -20,6 +20,7 @@ class OutputDeclaration(NamedTuple):
     tracks_native: bool = False  # the format holds pseudo continuous tracks itself
     auto_wheel: str = "cylinder"  # the wheel collision `--wheel-collision auto` writes: cylinder or sphere
     sites_native: bool = False  # the format holds MJCF sites (named frames on a body) itself
+    handles_link: frozenset[str] = frozenset()  # other formats' link extras keys its writer notes itself
 
 
 class ExtrasDeclaration(NamedTuple):
@@ -28,15 +29,17 @@ class ExtrasDeclaration(NamedTuple):
 
     ``quiet`` (robot) and ``quiet_link`` (link) keys carry nothing that target misses: bookkeeping, or
     data the model's own fields already hold. ``dropped`` gives each other robot key the note's code
-    and its words ("MJCF tendons"); ``dropped_link`` does the same for link keys, and ``convert`` notes
-    them for every other target (:func:`modelkit.convert.api.prepare`). The owning format says this
-    once, so no writer lists another format's keys.
+    and its words ("MJCF tendons"); ``dropped_link`` and ``dropped_joint`` do the same for link and joint
+    keys, and ``convert`` notes those for every other target (:func:`modelkit.convert.api.prepare`)
+    unless the target's writer handles the key itself (``OutputDeclaration.handles_link``). The owning format
+    says this once, so no writer lists another format's keys.
     """
 
     quiet: frozenset[str] = frozenset()
     quiet_link: frozenset[str] = frozenset()
     dropped: tuple[tuple[str, str, str], ...] = ()  # (key, code, what)
     dropped_link: tuple[tuple[str, str, str], ...] = ()  # the same for link keys, noted by convert itself
+    dropped_joint: tuple[tuple[str, str, str], ...] = ()  # and for joint keys
 
 
 class FormatDeclaration(NamedTuple):

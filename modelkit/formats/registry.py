@@ -38,6 +38,10 @@ EXTRAS_DROPPED_LINK: dict[str, tuple[str, str, str]] = {
     key: (d.name, code, what) for d in DECLARED for key, code, what in d.extras.dropped_link
 }
 """Link ``extras`` key → (owning format, code, words) of the note every other target gives."""
+EXTRAS_DROPPED_JOINT: dict[str, tuple[str, str, str]] = {
+    key: (d.name, code, what) for d in DECLARED for key, code, what in d.extras.dropped_joint
+}
+"""The same for joint ``extras`` keys."""
 
 
 def declared(name: str) -> FormatDeclaration:

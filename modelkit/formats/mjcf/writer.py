@@ -52,6 +52,7 @@ from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.formats.mjcf.write_actuators import ActuatorWriter
 from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_devices import DeviceWriter
+from modelkit.formats.mjcf.write_foreign import note_foreign_extras
 from modelkit.formats.mjcf.write_geoms import COLLISION, CONTACT_PRIORITY, GeomWriter, shared_stems
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, quat_wxyz, set_pose, sub
@@ -125,6 +126,7 @@ class MjcfWriter:
         self._home()
         self.geoms.defaults(self.sections["default"], self.robot.name)
         self._surface_note()
+        note_foreign_extras(self.robot, self.ctx)
         self._meshdir()
         if any(el.get("euler") is not None for el in self.root.iter()):
             self.sections["compiler"].set("eulerseq", EULER_SEQUENCE)  # set_pose's euler: URDF's rpy

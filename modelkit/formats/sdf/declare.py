@@ -12,10 +12,15 @@ FORMAT = FormatDeclaration(
         writer="modelkit.formats.sdf.writer:write_sdf",
         suffix=".sdf",
         suffixes=(".sdf",),
+        handles_link=frozenset({"gazebo"}),  # a URDF link block: written or noted (write_self_collide)
     ),
     extras=ExtrasDeclaration(
         quiet=frozenset({"sdf_canonical_link", "sdf_version", "sdf_model_pose", "sdf_world_joint"}),
         quiet_link=frozenset({"sdf_link_pose"}),
-        dropped=(("sdf_world", "MK822", "the SDF world around the model"),),
+        dropped=(
+            ("sdf_world", "MK822", "the SDF world around the model"),
+            ("sdf_plugins", "MK808", "SDF model plugins"),
+        ),
+        dropped_link=(("sdf_plugins", "MK808", "SDF plugins of a visual or collision"),),
     ),
 )

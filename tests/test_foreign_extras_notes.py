@@ -1,0 +1,82 @@
+"""What another format keeps for itself, and a target cannot hold, is said once: never dropped silently.
+
+Before, a URDF joint's ``<safety_controller>``, ``<calibration>`` and ``<gazebo>`` block vanished in
+every other target, and an MJCF output said nothing of the source's ``<gazebo>`` blocks or an SDF
+model's plugins. Each case converts a small file and reads the notes a user sees.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import pytest
+
+from modelkit.convert.api import convert
+from modelkit.convert.notes import ConversionNote
+
+INERTIA = '<inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/>'
+URDF = f"""<robot name="r">
+  <link name="a"><inertial><mass value="1"/>{INERTIA}</inertial>
+    <collision><geometry><box size="1 1 1"/></geometry></collision></link>
+  <link name="b"><inertial><mass value="1"/>{INERTIA}</inertial></link>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+    <safety_controller soft_lower_limit="-0.9" soft_upper_limit="0.9" k_position="10" k_velocity="1"/>
+    <calibration rising="0.1"/></joint>
+  <gazebo reference="a"><mu1>0.2</mu1><mu2>0.2</mu2><kp>1e6</kp></gazebo>
+  <gazebo reference="j"><provideFeedback>true</provideFeedback></gazebo>
+  <gazebo><plugin name="p" filename="libmy_plugin.so"/></gazebo>
+</robot>"""
+
+
+def _notes(tmp_path: Path, target: str) -> list[ConversionNote]:
+    source = tmp_path / "r.urdf"
+    source.write_text(URDF)
+    return convert([source], tmp_path / "out" / f"r.{target}").notes
+
+
+def _about(notes: list[ConversionNote], *words: str) -> list[ConversionNote]:
+    return [n for n in notes if all(w in n.message for w in words)]
+
+
+@pytest.mark.parametrize("target", ["xml", "sdf", "body"])
+def test_urdf_joint_data_is_said_once_in_every_other_target(tmp_path: Path, target: str) -> None:
+    notes = _notes(tmp_path, target)
+    safety = _about(notes, "joint j", "<safety_controller>")
+    assert len(safety) == 1 and "soft_lower_limit -0.9" in safety[0].message and safety[0].code == "MK820"
+    assert len(_about(notes, "joint j", "<calibration>", "rising 0.1")) == 1
+    assert len(_about(notes, "joint j", "<gazebo> block", "<provideFeedback>")) == 1
+
+
+def test_mjcf_says_what_of_the_gazebo_blocks_it_leaves_out_and_not_what_it_carries(tmp_path: Path) -> None:
+    notes = _notes(tmp_path, "xml")
+    link = _about(notes, "link a", "<gazebo> block")
+    assert len(link) == 1 and "<kp>" in link[0].message and "mu1" not in link[0].message  # mu1: geom friction
+    robot = _about(notes, "the robot's <gazebo> blocks")
+    assert len(robot) == 1 and robot[0].code == "MK808"
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / "out" / "r.xml"))
+    assert [float(model.geom_friction[g][0]) for g in range(model.ngeom) if model.geom_contype[g]] == [0.2]
+
+
+def test_sdf_keeps_its_own_link_block_note_without_a_second(tmp_path: Path) -> None:
+    notes = _notes(tmp_path, "sdf")
+    assert len(_about(notes, "<gazebo>", 'link "a"')) + len(_about(notes, "link a", "<gazebo>")) == 1
+
+
+def test_urdf_to_urdf_says_nothing_of_its_own_blocks(tmp_path: Path) -> None:
+    notes = _notes(tmp_path, "urdf")
+    assert _about(notes, "<safety_controller>") == [] and _about(notes, "<gazebo>") == []
+    written = (tmp_path / "out" / "r.urdf").read_text()
+    assert "<safety_controller" in written and "<calibration" in written and "provideFeedback" in written
+
+
+def test_sdf_model_plugin_is_named_by_its_library_in_mjcf(tmp_path: Path) -> None:
+    source = tmp_path / "p.sdf"
+    source.write_text(
+        '<sdf version="1.9"><model name="m"><link name="a"><inertial><mass>1</mass></inertial></link>'
+        '<plugin filename="gz-sim-wheel-slip-system" name="gz::sim::systems::WheelSlip"/></model></sdf>'
+    )
+    notes = convert([source], tmp_path / "out" / "p.xml").notes
+    said = _about(notes, "SDF model plugins", "gz-sim-wheel-slip-system")
+    assert len(said) == 1 and said[0].code == "MK808"
