@@ -98,6 +98,7 @@ ERD_FILES = [
     "romeo_description/urdf/romeo_small.urdf",
     "allegro_hand_description/urdf/allegro_right_hand.urdf",
     "tiago_description/robots/tiago.urdf",
+    "icub_description/robots/icub.urdf",
 ]
 
 

@@ -1084,8 +1084,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "and the package paths given; refused unread.",
     ),
     # -- MK8xx: conversion notes ------------------------------------------------------------
-    # MK800-MK849 shared by every writer; MK850-859 URDF, MK860-869 SDF, MK870-879 MJCF,
-    # MK880-889 .body; MK890-899 the convert command (outputs refused, targets that cannot hold).
+    # MK800-MK849 shared by every writer (full: MK854 is shared too); MK850-859 URDF, MK860-869 SDF,
+    # MK870-879 MJCF, MK880-889 .body; MK890-899 the convert command (outputs refused, targets that
+    # cannot hold).
     CodeInfo(
         "MK800", "renamed", "info", "A name the target forbids or reserves was changed; the note names both."
     ),
@@ -1384,6 +1385,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "info",
         "A collision shape's own friction from another format is written as the target's per-shape or "
         "per-link value; the note says how the target combines it with the shape it touches.",
+    ),
+    CodeInfo(
+        "MK854",
+        "joint-spring-dropped",
+        "warning",
+        "A joint spring (stiffness and rest position; a ball joint's, towards its zero orientation) the "
+        "target has no place for is left out: URDF (any joint), `.body` (any joint), SDF (a ball or fixed "
+        "joint, which has no axis to hold it); the note names the joint and the values. The joint no "
+        "longer holds its pose under load.",
     ),
     CodeInfo(
         "MK860",

@@ -307,7 +307,7 @@ class Joint:
     damping: float = 0.0  # viscous, N·m·s/rad or N·s/m
     friction: float = 0.0  # Coulomb (dry) friction, N·m or N
     spring_stiffness: float = 0.0  # N·m/rad or N/m, pulling q towards spring_reference
-    spring_reference: float = 0.0  # q at which the spring is at rest
+    spring_reference: float = 0.0  # q at which the spring is at rest (a ball joint: 0, its zero orientation)
     mimic: Mimic | None = None
     initial_position: float = 0.0
     joint_id: int | None = None

@@ -24,9 +24,6 @@ EXCEPTIONS: dict[tuple[str, str], str] = {
         "Gazebo plugins are the same XML in SDF and in URDF <gazebo> blocks: which Gazebo they are for",
     ("formats/urdf/write_gazebo.py", "sdf_plugins"): "an SDF model's plugins are written as <gazebo> blocks",
     ("formats/urdf/writer.py", "sdf_plugins"): "the same: written, so no MK808 note",
-    ("formats/urdf/write_joints.py", "mjcf_stiffness"):
-        "an MJCF ball joint's spring is noted as dropped; as Joint.spring_stiffness the .body writer "
-        "would note it too (an output change, left for its own commit)",
     ("formats/urdf/writer.py", "mjcf_actuators"):
         "the MJCF reader keeps every actuator, also those Robot.actuators holds: the note counts only "
         "the others (keeping only those would change the reader's MK175 counts)",

@@ -128,7 +128,9 @@ def test_body_keeps_armature_initial_position_and_limits(tmp_path: Path) -> None
     assert math.isclose(b.limits.effort, a.limits.effort)
     assert math.isclose(b.limits.velocity, a.limits.velocity)
     said = " ".join(n.message for n in notes if n.code == "MK820")
-    assert "damping" in said and "spring" in said  # Choreonoid's body format has neither
+    assert "damping" in said  # Choreonoid's body format has none
+    springs = " ".join(n.message for n in notes if n.code == "MK854")  # nor springs (a warning)
+    assert "stiffness 12, reference 0.25" in springs and "stiffness 100, reference 0.05" in springs
 
 
 def test_choreonoid_rotor_inertia_becomes_mjcf_armature(tmp_path: Path) -> None:

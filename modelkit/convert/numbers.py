@@ -89,21 +89,60 @@ def fmt_position(values: Iterable[float] | np.ndarray) -> str:
 
 def fmt_rpy(rotation: np.ndarray) -> str:
     """A rotation as URDF/SDF roll-pitch-yaw text (MJCF ``euler`` with ``eulerseq="XYZ"``), angles
-    cleaned by :func:`clean_angle`. Every rotation has two triples, (r, p, y) and (r + π, π − p, y + π);
-    the shorter text that gives the matrix back to 1e-12 is written, the matrix's own on a tie. A
-    source's ``rpy="0 1.5707963268 0"`` (a pitch 5e-12 past π/2; pybullet_data's Spirit40) comes back
-    from the matrix as (−π, 1.57079632678979, −π): its own text is the other triple."""
-    from modelkit.spatial import matrix_from_rpy, rpy_from_matrix
+    cleaned by :func:`clean_angle`. Every rotation has two triples, (r, p, y) and (r + π, π − p, y + π),
+    each angle in (−π, π]: the shorter text that gives the matrix back to 1e-12 is written, the
+    matrix's own on a tie. A source's ``rpy="0 1.5707963268 0"`` (a pitch 5e-12 past π/2; pybullet_data's
+    Spirit40) comes back from the matrix as (−π, 1.57079632678979, −π): its own text is the other triple.
+
+    An angle whose 2π-equivalent on the other side of ±π is a decimal a person wrote (``3.1416``; see
+    :func:`_as_written`) is written as that equivalent (a whole turn more about one axis is the same
+    matrix), if the triple's text still gives the matrix back. iCub's ``rpy="-1.5708 3.1416 -1.5708"``
+    (a pitch 7.3e-6 past π) comes back as the other triple with a pitch of −3.14158530717959: its
+    equivalent is the source's ``3.1416``."""
+    from modelkit.spatial import rpy_from_matrix
 
     r = np.asarray(rotation, dtype=float)
+
+    def text_of(angles: list[float]) -> str:
+        plain = fmt_vec(angles)
+        written = " ".join(_as_written(a) for a in angles)
+        return written if written != plain and _exact(written, r) else plain
+
     roll, pitch, yaw = (float(a) for a in rpy_from_matrix(r))
-    own = fmt_vec([clean_angle(a) for a in (roll, pitch, yaw)])
-    other = fmt_vec([clean_angle(_wrap(a)) for a in (roll + math.pi, math.pi - pitch, yaw + math.pi)])
-    if len(other) < len(own):
-        back = matrix_from_rpy(*(float(v) for v in other.split()))
-        if float(np.max(np.abs(back - r))) <= SNAP:
-            return other
+    own = text_of([clean_angle(a) for a in (roll, pitch, yaw)])
+    other = text_of([clean_angle(_wrap(a)) for a in (roll + math.pi, math.pi - pitch, yaw + math.pi)])
+    if len(other) < len(own) and _exact(other, r):
+        return other
     return own
+
+
+WRITTEN_DIGITS = 12  # at most: a longer decimal near a double is chance (one in ten has 14 digits)
+
+
+def _as_written(angle: float) -> str:
+    """``fmt(angle)``, or ``fmt`` of its equivalent on the other side of ±π (``angle ∓ 2π``) when that
+    one is a decimal a person wrote: found by :func:`_short` with at most :data:`WRITTEN_DIGITS`
+    significant digits, and fewer than ``angle``'s own text."""
+    text = fmt(angle)
+    if angle:
+        turned = angle - math.copysign(2.0 * math.pi, angle)
+        short = _short(turned)
+        if short is not None and _digits(short) <= WRITTEN_DIGITS and _digits(fmt(turned)) < _digits(text):
+            return fmt(turned)
+    return text
+
+
+def _digits(number: str) -> int:
+    """Significant digits of a number's text (``-0.05236`` → 4)."""
+    return len(number.split("e")[0].replace("-", "").replace(".", "").lstrip("0"))
+
+
+def _exact(text: str, rotation: np.ndarray) -> bool:
+    """Whether the roll-pitch-yaw ``text`` gives ``rotation`` back to :data:`SNAP`."""
+    from modelkit.spatial import matrix_from_rpy
+
+    back = matrix_from_rpy(*(float(v) for v in text.split()))
+    return float(np.max(np.abs(back - rotation))) <= SNAP
 
 
 def _wrap(angle: float) -> float:

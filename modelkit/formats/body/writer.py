@@ -13,6 +13,8 @@ What it writes, and the choices made (body-format.md is the specification):
   subtree off as a free body, which is what the model means), pseudo_continuous_track (kept: this
   target has tracks). Planar and ball joints → fixed (MK813). ``joint_name`` only when it differs
   from the link name; ``joint_range`` always for moving joints (``[ unlimited, unlimited ]`` where infinite).
+  No joint damping or friction (MK820), armature only on revolute and prismatic joints (MK820), no
+  springs (MK854, :mod:`modelkit.convert.joint_springs`).
 * Mass: explicit ``mass``/``center_of_mass``/``inertia`` (9 numbers) on every link, ``mass: 0`` for a
   link without an inertial, so no Choreonoid default (1 kg, identity inertia) applies by accident.
   An inertial the source left to those defaults (``Inertial.defaulted``) stays implicit: the keys
@@ -36,6 +38,7 @@ import numpy as np
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import describe, link_surface
+from modelkit.convert.joint_springs import note_spring_dropped
 from modelkit.convert.names import unique_name
 from modelkit.formats.body.write_devices import device_node
 from modelkit.formats.body.write_shapes import link_elements
@@ -290,12 +293,15 @@ def _joint(joint: Joint, node: dict[str, Any], names: _Names, ctx: WriteContext)
             node["joint_axis_inertia"] = num(joint.armature)
     if joint.actuation_mode in ACTUATION_WORDS:
         node["actuation_mode"] = ACTUATION_WORDS[joint.actuation_mode]
-    dropped = [f"{k} {v:g}" for k, v in (("damping", joint.damping), ("friction", joint.friction),
-                                         ("spring", joint.spring_stiffness)) if v]
+    dropped = [f"{k} {v:g}" for k, v in (("damping", joint.damping), ("friction", joint.friction)) if v]
     if dropped:
         ctx.note("MK820", f'joint "{joint.name}": Choreonoid\'s body format has no joint '
                  f"{' or '.join(k.split()[0] for k in dropped)} ({', '.join(dropped)}); left out",
                  joint.source, target)
+    if joint.armature and not moving:
+        ctx.note("MK820", f'joint "{joint.name}": armature {joint.armature:g} left out: it is written as a '
+                 f"{word} joint, which has no joint_axis_inertia", joint.source, target)
+    note_spring_dropped(ctx, joint, "Choreonoid's body format has no joint spring", target)
     if joint.mimic is not None:
         ctx.note("MK812", f'joint "{joint.name}" mimics "{joint.mimic.joint}" (×{joint.mimic.multiplier:g} '
                  f"{joint.mimic.offset:+g}); Choreonoid's body loader has no mimic joints",

@@ -307,8 +307,9 @@ class RobotBuilder:
         if mj.stiffness and mj.kind in ("hinge", "slide"):
             joint.spring_stiffness, joint.spring_reference = mj.stiffness, mj.springref
         elif mj.stiffness:
-            extras["mjcf_stiffness"] = mj.stiffness  # a ball joint's spring: MJCF's own
-            extras["mjcf_springref"] = mj.springref
+            # MuJoCo pulls a ball (free) joint towards its zero orientation (pose): qpos_spring = qpos0,
+            # springref is ignored; the model's reference 0 says so
+            joint.spring_stiffness, joint.spring_reference = mj.stiffness, 0.0
         joint.extras.update(extras)
         self.joints[mj.index] = joint
         return joint

@@ -12,7 +12,8 @@
   (MK813). MuJoCo allows a free joint on top-level bodies only, so a floating joint inside the tree
   makes its subtree a top-level body with ``<freejoint/>`` at its pose in the world at q = 0 (as
   Choreonoid's own MuJoCo plugin does; MK813).
-* ``damping``, ``frictionloss``, ``armature``, ``stiffness``/``springref`` as given; a finite effort limit →
+* ``damping``, ``frictionloss``, ``armature``, ``stiffness``/``springref`` as given (a ball joint:
+  ``stiffness`` only, pulling towards its zero orientation); a finite effort limit →
   ``actuatorfrcrange``; initial positions → the ``home`` keyframe (writer.py).
 * Inertials: ``<inertial pos mass diaginertia>`` when the tensor is diagonal, else ``fullinertia="Ixx
   Iyy Izz Ixy Ixz Iyz"``; MuJoCo never recomputes them (``inertiafromgeom="false"``). A massless
@@ -481,7 +482,10 @@ class BodyTree:
             el.set("frictionloss", fmt(joint.friction))
         if joint.armature:
             el.set("armature", fmt(joint.armature))
-        if (joint.spring_stiffness or joint.spring_reference) and joint.type is not JointType.BALL:
+        if joint.type is JointType.BALL:
+            if joint.spring_stiffness:  # towards the zero orientation: MuJoCo's, springref ignored
+                el.set("stiffness", fmt(joint.spring_stiffness))
+        elif joint.spring_stiffness or joint.spring_reference:
             el.set("stiffness", fmt(joint.spring_stiffness))
             el.set("springref", fmt(joint.spring_reference))
         effort = joint.limits.effort

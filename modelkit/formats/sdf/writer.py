@@ -39,6 +39,7 @@ from lxml.etree import _Element as Element
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.gazebo import gazebo_family
+from modelkit.convert.joint_springs import note_spring_dropped
 from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_vec
 from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
@@ -392,6 +393,8 @@ class _ModelWriter:
             self._axis(el, joint, name)
             if joint.mimic is None:
                 self.axis_joints[joint.name] = name
+        else:
+            self._axisless_dynamics(joint, kind, name)
         if joint.armature:
             ctx.note(
                 "MK820",
@@ -402,6 +405,16 @@ class _ModelWriter:
         used: set[str] = set()
         for device, pose in self.ft_to_joint.get(joint.child, []):
             self.devices.device(el, device, pose, None, f"joint[{name}]", used)  # type: ignore[arg-type]
+
+    def _axisless_dynamics(self, joint: Joint, kind: str, name: str) -> None:
+        """A ball or fixed joint has no ``<axis>``, where SDF keeps damping, friction and springs."""
+        why = f"a {kind} joint has no <axis><dynamics> in SDF"
+        lost = [f"{word} {fmt(value)}" for word, value in (("damping", joint.damping),
+                                                            ("friction", joint.friction)) if value]
+        if lost:
+            self.ctx.note("MK820", f'joint "{joint.name}": {", ".join(lost)} left out: {why}', joint.source,
+                          f"joint[{name}]")
+        note_spring_dropped(self.ctx, joint, why, f"joint[{name}]")
 
     def _joint_type(self, joint: Joint, name: str) -> str:
         t = joint.type

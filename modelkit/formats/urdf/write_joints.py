@@ -22,6 +22,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.joint_springs import note_spring_dropped
 from modelkit.convert.numbers import fmt, fmt_direction
 from modelkit.formats.urdf.write_links import origin_element
 from modelkit.formats.urdf.write_names import NameTable
@@ -112,8 +113,6 @@ def _dropped_values(joint: Joint, dropped: list[str]) -> None:
         dropped.append(f"actuation mode {joint.actuation_mode}")
     if "limit" in joint.extras:
         dropped.append("URDF 1.2 acceleration/deceleration/jerk limits")
-    if joint.spring_stiffness or joint.spring_reference or joint.extras.get("mjcf_stiffness"):
-        dropped.append("spring (stiffness, reference)")
 
 
 def _extras(parent: Element, joint: Joint) -> None:
@@ -198,6 +197,7 @@ def joint_elements(
             joint.source,
             f"joint[{name}]",
         )
+    note_spring_dropped(ctx, joint, "URDF has no joint spring", f"joint[{name}]")
     return [el]
 
 
@@ -231,4 +231,12 @@ def _ball(
         joint.source,
         f"joint[{out[0].get('name', '')}]",
     )
+    if joint.armature != 0.0:
+        ctx.note(
+            "MK820",
+            f'joint "{joint.name}": URDF has no field for armature {fmt(joint.armature)}, left out',
+            joint.source,
+            f"joint[{out[0].get('name', '')}]",
+        )
+    note_spring_dropped(ctx, joint, "URDF has no joint spring", f"joint[{out[0].get('name', '')}]")
     return out
