@@ -109,7 +109,7 @@ def _foreign_extras(robot: Robot, target: TargetInfo, notes: NoteSink) -> None:
             shown = shown_extras(value)
             if not shown:
                 continue
-            notes.note(code, f"{label}: {what} ({shown}) has no {target.name} equivalent; left out",
+            notes.note(code, f"{label}: {what} ({shown}): no {target.name} equivalent; left out",
                        element.source, f"{label.split(' ', 1)[0]}[{element.name}]")
 
 

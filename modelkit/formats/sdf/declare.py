@@ -21,6 +21,9 @@ FORMAT = FormatDeclaration(
             ("sdf_world", "MK822", "the SDF world around the model"),
             ("sdf_plugins", "MK808", "SDF model plugins"),
         ),
-        dropped_link=(("sdf_plugins", "MK808", "SDF plugins of a visual or collision"),),
+        dropped_link=(
+            ("sdf_plugins", "MK808", "SDF plugins of a visual or collision"),
+            ("sdf_surface", "MK851", "SDF surface parameters other than friction"),
+        ),
     ),
 )
