@@ -12,7 +12,7 @@ FORMAT = FormatDeclaration(
         writer="modelkit.formats.sdf.writer:write_sdf",
         suffix=".sdf",
         suffixes=(".sdf",),
-        handles_link=frozenset({"gazebo"}),  # a URDF link block: written or noted (write_self_collide)
+        handles=frozenset({"gazebo"}),  # a URDF's <gazebo> blocks: written or noted (write_self_collide)
     ),
     extras=ExtrasDeclaration(
         quiet=frozenset({"sdf_canonical_link", "sdf_version", "sdf_model_pose", "sdf_world_joint"}),
