@@ -1380,6 +1380,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "The note gives the value left out.",
     ),
     CodeInfo(
+        "MK853",
+        "simulator-options-dropped",
+        "warning",
+        "An MJCF file's own `<option>` settings (timestep, integrator, cone, gravity...) have no place in "
+        "the target (URDF, SDF model, `.body`); the note lists them so the user sets them in the "
+        "simulator.",
+    ),
+    CodeInfo(
         "MK852",
         "surface-friction-written",
         "info",

@@ -80,3 +80,33 @@ def test_sdf_model_plugin_is_named_by_its_library_in_mjcf(tmp_path: Path) -> Non
     notes = convert([source], tmp_path / "out" / "p.xml").notes
     said = _about(notes, "SDF model plugins", "gz-sim-wheel-slip-system")
     assert len(said) == 1 and said[0].code == "MK808"
+
+
+MJCF = """<mujoco model="o">
+  <option timestep="0.001" integrator="RK4"><flag warmstart="disable"/></option>
+  <worldbody>
+    <body name="b" pos="0 0 1"><freejoint/>
+      <geom type="box" size="0.1 0.1 0.1" mass="1" solref="0.01 1" solimp="0.8 0.9 0.01" margin="0.002"/>
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
+def test_mjcf_options_and_contact_parameters_survive_mjcf_and_are_said_elsewhere(tmp_path: Path) -> None:
+    source = tmp_path / "o.xml"
+    source.write_text(MJCF)
+    out = tmp_path / "m" / "o.xml"
+    notes = convert([source], out).notes
+    assert not [n for n in notes if n.code in ("MK851", "MK853")]
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert model.opt.timestep == 0.001 and model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
+    assert model.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_WARMSTART
+    g = next(g for g in range(model.ngeom) if model.geom_contype[g])
+    assert list(model.geom_solref[g]) == [0.01, 1.0] and model.geom_margin[g] == 0.002
+    assert list(model.geom_solimp[g][:3]) == pytest.approx([0.8, 0.9, 0.01])
+    for target in ("o.urdf", "o.sdf", "o.body"):
+        notes = convert([source], tmp_path / target.replace(".", "_") / target).notes
+        options = [n for n in notes if n.code == "MK853"]
+        assert len(options) == 1 and "<option>" in options[0].message, target
+        contact = [n for n in notes if n.code == "MK851" and "contact parameters" in n.message]
+        assert len(contact) == 1 and "solref 0.01 1" in contact[0].message, target

@@ -200,3 +200,34 @@ def test_gazebo_mu_of_a_urdf_link_reaches_mujoco_and_sdf(tmp_path: Path) -> None
     same = tmp_path / "u" / "r.urdf"  # URDF to URDF: the block as written, no <contact> made up
     convert([path], same)
     assert "<contact>" not in same.read_text() and same.read_text().count("<mu1>") == 1
+
+
+SURFACE = """<sdf version="1.9"><model name="r"><link name="a">
+  <inertial><mass>1</mass><inertia><ixx>0.1</ixx><iyy>0.1</iyy><izz>0.1</izz></inertia></inertial>
+  <collision name="c"><geometry><box><size>0.2 0.2 0.2</size></box></geometry>
+    <surface><bounce><restitution_coefficient>0.5</restitution_coefficient></bounce>
+      <friction><ode><mu>0.4</mu><mu2>0.4</mu2><fdir1>1 0 0</fdir1></ode>
+        <torsional><coefficient>0.02</coefficient></torsional></friction>
+      <contact><ode><kp>1e6</kp></ode></contact></surface></collision>
+</link></model></sdf>"""
+
+
+def test_sdf_surface_beyond_friction_is_kept_in_sdf_and_said_elsewhere(
+    tmp_path: Path, sdf_oracle: Path  # noqa: F811
+) -> None:
+    source = tmp_path / "s.sdf"
+    source.write_text(SURFACE)
+    out = tmp_path / "o" / "r.sdf"
+    result = convert([source], out)
+    assert not [n for n in result.notes if n.code in ("MK851", "MK808")]
+    assert not oracle_has_errors(sdf_oracle, out)
+    text = out.read_text()
+    kept_parts = (
+        "<restitution_coefficient>0.5<", "<fdir1>1 0 0<", "<coefficient>0.02<", "<kp>1e6<", "<mu>0.4<"
+    )
+    for kept in kept_parts:
+        assert kept in text, kept
+    for target in ("r.xml", "r.urdf", "r.body"):
+        notes = convert([source], tmp_path / target.replace(".", "_") / target).notes
+        said = [n for n in notes if n.code == "MK851" and "SDF surface parameters" in n.message]
+        assert len(said) == 1 and "<bounce>" in said[0].message and "<contact>" in said[0].message, target

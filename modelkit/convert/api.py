@@ -94,7 +94,9 @@ def _foreign_extras(robot: Robot, target: TargetInfo, notes: NoteSink) -> None:
     from modelkit.formats.registry import EXTRAS_DROPPED_JOINT, EXTRAS_DROPPED_LINK, declared
 
     output = declared(target.name).output
-    handled = output.handles_link if output is not None else frozenset()
+    handled = output.handles if output is not None else frozenset()
+    if output is not None and not output.walks_extras:
+        _foreign_robot_extras(robot, target.name, handled, notes)
     owners: list[tuple[str, Any, dict[str, tuple[str, str, str]], frozenset[str]]] = [
         *((f"link {link.name}", link, EXTRAS_DROPPED_LINK, handled) for link in robot.links),
         *((f"joint {joint.name}", joint, EXTRAS_DROPPED_JOINT, frozenset()) for joint in robot.joints),
@@ -109,10 +111,28 @@ def _foreign_extras(robot: Robot, target: TargetInfo, notes: NoteSink) -> None:
             shown = shown_extras(value)
             if not shown:
                 continue
-            notes.note(code, f"{label}: {what} ({shown}) has no {target.name} equivalent; left out",
+            notes.note(code, f"{label}: {what} ({shown}): no {target.name} equivalent; left out",
                        element.source, f"{label.split(' ', 1)[0]}[{element.name}]")
 
 
+
+
+def _foreign_robot_extras(robot: Robot, target: str, handled: frozenset[str], notes: NoteSink) -> None:
+    """For a target whose writer does not walk the robot's ``extras``: a note for each key another
+    format declares dropped (tendons, keyframes, simulator options...)."""
+    from modelkit.convert.extras_notes import shown_extras
+    from modelkit.formats.registry import EXTRAS_DROPPED, EXTRAS_OWNER, EXTRAS_PARTLY_CARRIED
+
+    for key in sorted(robot.extras):
+        value = robot.extras[key]
+        owner = EXTRAS_OWNER.get(key)
+        if owner is None or owner == target or key in handled or key in EXTRAS_PARTLY_CARRIED or not value:
+            continue
+        shown = shown_extras(value) if not isinstance(value, list) else f"{len(value)}"
+        if not shown:
+            continue
+        code, what = EXTRAS_DROPPED[key]
+        notes.note(code, f"{what} ({shown}): no {target} equivalent; left out", robot.source, "robot")
 
 
 def _check_mass_properties(robot: Robot) -> None:

@@ -9,6 +9,10 @@ CARRIED_BLOCK_TAGS = frozenset({"mu1", "mu2", "selfCollide", "sensor"})
 shapes' friction, the link's self-collision flag, the link's devices. They are written, not lost."""
 
 
+BOOKKEEPING = frozenset({"collision", "name", "source", "reference"})
+"""Keys of a kept entry that place it rather than hold data (a collision's index, a block's link)."""
+
+
 def shown_extras(value: Any) -> str:
     """An extras value in a note ("" when nothing of it is lost): a kept XML block by its children's
     tags (those the model carries left out), a plugin by its library, a dict's non-empty values as
@@ -28,7 +32,8 @@ def shown_extras(value: Any) -> str:
         text = ", ".join(f"<{t}>" for t in dict.fromkeys(tags))
     elif isinstance(value, dict):
         items = sorted(
-            ((k, v) for k, v in value.items() if v not in (None, "", [], {})), key=lambda kv: str(kv[0])
+            ((k, v) for k, v in value.items() if v not in (None, "", [], {}) and k not in BOOKKEEPING),
+            key=lambda kv: str(kv[0]),
         )
         text = ", ".join(f"{k} {v}".rstrip() for k, v in items)
     else:

@@ -20,7 +20,8 @@ class OutputDeclaration(NamedTuple):
     tracks_native: bool = False  # the format holds pseudo continuous tracks itself
     auto_wheel: str = "cylinder"  # the wheel collision `--wheel-collision auto` writes: cylinder or sphere
     sites_native: bool = False  # the format holds MJCF sites (named frames on a body) itself
-    handles_link: frozenset[str] = frozenset()  # other formats' link extras keys its writer notes itself
+    handles: frozenset[str] = frozenset()  # other formats' robot/link extras keys its writer notes itself
+    walks_extras: bool = False  # its writer notes every other format's robot extras key itself
 
 
 class ExtrasDeclaration(NamedTuple):
@@ -31,8 +32,11 @@ class ExtrasDeclaration(NamedTuple):
     data the model's own fields already hold. ``dropped`` gives each other robot key the note's code
     and its words ("MJCF tendons"); ``dropped_link`` and ``dropped_joint`` do the same for link and joint
     keys, and ``convert`` notes those for every other target (:func:`modelkit.convert.api.prepare`)
-    unless the target's writer handles the key itself (``OutputDeclaration.handles_link``). The owning format
-    says this once, so no writer lists another format's keys.
+    unless the target's writer handles the key itself (``OutputDeclaration.handles``). ``convert`` also
+    notes ``dropped`` robot keys for a target whose writer does not walk ``extras`` itself
+    (``OutputDeclaration.walks_extras``), except ``partly_carried`` ones (MJCF cameras: those on links
+    are the model's devices), which only a walking writer can count. The owning format says this once,
+    so no writer lists another format's keys.
     """
 
     quiet: frozenset[str] = frozenset()
@@ -40,6 +44,7 @@ class ExtrasDeclaration(NamedTuple):
     dropped: tuple[tuple[str, str, str], ...] = ()  # (key, code, what)
     dropped_link: tuple[tuple[str, str, str], ...] = ()  # the same for link keys, noted by convert itself
     dropped_joint: tuple[tuple[str, str, str], ...] = ()  # and for joint keys
+    partly_carried: frozenset[str] = frozenset()  # dropped robot keys the model's fields carry in part
 
 
 class FormatDeclaration(NamedTuple):

@@ -34,6 +34,10 @@ EXTRAS_DROPPED: dict[str, tuple[str, str]] = {
     key: (code, what) for d in DECLARED for key, code, what in d.extras.dropped
 }
 """Robot ``extras`` key → (code, words) of the note a target that drops it gives (each format's own)."""
+EXTRAS_PARTLY_CARRIED: frozenset[str] = frozenset().union(*(d.extras.partly_carried for d in DECLARED))
+"""Dropped robot keys whose content the model's fields carry in part (counted by walking writers)."""
+EXTRAS_OWNER: dict[str, str] = {key: d.name for d in DECLARED for key, _, _ in d.extras.dropped}
+"""Robot ``extras`` key declared dropped → the format that owns it."""
 EXTRAS_DROPPED_LINK: dict[str, tuple[str, str, str]] = {
     key: (d.name, code, what) for d in DECLARED for key, code, what in d.extras.dropped_link
 }

@@ -12,6 +12,7 @@ FORMAT = FormatDeclaration(
         suffix=".body",
         suffixes=(".body",),
         tracks_native=True,  # Choreonoid simulates pseudo continuous tracks (AISTSimulator)
+        handles=frozenset({"gazebo", "mujoco"}),  # noted with the URDF's other blocks (_plugin_notes)
     ),
     extras=ExtrasDeclaration(
         quiet_link=frozenset({"is_continuous_track"}),

@@ -50,6 +50,18 @@ class MjJoint:
     qpos_address: int | None = None  # where the joint's values start in qpos (compiled models)
 
 
+GEOM_CONTACT_DEFAULTS: dict[str, tuple[float, ...]] = {
+    "solref": (0.02, 1.0),
+    "solimp": (0.9, 0.95, 0.001, 0.5, 2.0),
+    "margin": (0.0,),
+    "gap": (0.0,),
+    "solmix": (1.0,),
+}
+"""A geom's contact parameters besides friction, with MuJoCo's defaults. Not ``priority``: a written
+MJCF's collision class sets its own (the robot's friction wins against a floor), and other targets
+combine shapes by their own rules."""
+
+
 @dataclass
 class MjGeom:
     """One geom, placed in its body frame. For a mesh the pose is that of the file's coordinates
@@ -71,6 +83,7 @@ class MjGeom:
     mesh_scale: V3 = (1.0, 1.0, 1.0)
     friction: V3 = (1.0, 0.005, 0.0001)  # sliding, torsional, rolling (MuJoCo's defaults)
     condim: int = 3
+    contact: dict[str, str] = field(default_factory=dict)  # solref, solimp... where not MuJoCo's default
 
     @property
     def visual_only(self) -> bool:

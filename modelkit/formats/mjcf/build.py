@@ -367,6 +367,9 @@ class RobotBuilder:
             geom = self.geom(mg, back)
             if geom is None:
                 continue
+            if not mg.visual_only and mg.contact:
+                entry = {"collision": len(collisions), "name": mg.name, **mg.contact}
+                link.extras.setdefault("mjcf_contact", []).append(entry)
             (visuals if mg.visual_only else collisions).append(geom)
         link.visuals = visuals if visuals else [self._copy(g) for g in collisions]
         link.collisions = collisions

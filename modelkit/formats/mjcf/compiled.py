@@ -15,6 +15,7 @@ from typing import Any
 
 from modelkit import rot3
 from modelkit.formats.mjcf.bodies import (
+    GEOM_CONTACT_DEFAULTS,
     MjBody,
     MjGeom,
     MjInertial,
@@ -146,6 +147,7 @@ class CompiledModel:
             material=material,
             friction=rot3.vec3(m.geom_friction[g]),
             condim=int(m.geom_condim[g]),
+            contact=contact_attributes(m, g),
         )
         mesh = int(m.geom_dataid[g])
         if kind == "mesh" and mesh >= 0:
@@ -308,3 +310,16 @@ def mesh_path(model_dir: Path, meshdir: str, written: str) -> Path:
     if not base.is_absolute():
         base = model_dir / base
     return (base / path).absolute()
+
+
+def contact_attributes(m: Any, g: int) -> dict[str, str]:
+    """Geom ``g``'s contact parameters that differ from MuJoCo's defaults, as MJCF attribute text."""
+    from modelkit.convert.numbers import fmt_vec
+
+    out: dict[str, str] = {}
+    for name, default in GEOM_CONTACT_DEFAULTS.items():
+        raw = getattr(m, f"geom_{name}")[g]
+        values = tuple(float(x) for x in (raw if hasattr(raw, "__len__") else (raw,)))
+        if any(abs(a - b) > 1e-12 * max(1.0, abs(b)) for a, b in zip(values, default, strict=True)):
+            out[name] = fmt_vec(values)
+    return out

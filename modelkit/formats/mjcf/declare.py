@@ -14,10 +14,14 @@ FORMAT = FormatDeclaration(
         suffixes=(".xml", ".mjcf"),
         auto_wheel="sphere",  # MuJoCo: a cylinder rolling on a plane gets odd contacts
         sites_native=True,
+        walks_extras=True,  # write_foreign
     ),
     extras=ExtrasDeclaration(
         quiet=frozenset({"mjcf_compiled"}),
         quiet_link=frozenset({"mjcf_body_id", "mjcf_body_offset", "mjcf_intermediate_of"}),
+        partly_carried=frozenset(
+            {"mjcf_actuators", "mjcf_sensors", "mjcf_cameras", "mjcf_lights", "mjcf_sites"}
+        ),
         dropped=(
             ("mjcf_actuators", "MK808", "MJCF actuators"),
             ("mjcf_tendons", "MK808", "MJCF tendons"),
@@ -29,6 +33,8 @@ FORMAT = FormatDeclaration(
             ("mjcf_keyframes", "MK820", "MJCF keyframes (stored joint positions)"),
             ("mjcf_world_geoms", "MK822", "MJCF world geoms"),
             ("mjcf_world_sites", "MK822", "MJCF world sites"),
+            ("mjcf_option", "MK853", "MJCF simulator options (<option>)"),
         ),
+        dropped_link=(("mjcf_contact", "MK851", "MJCF contact parameters other than friction"),),
     ),
 )

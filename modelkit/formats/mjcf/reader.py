@@ -33,6 +33,7 @@ from modelkit.formats.mjcf.compiled import CompiledModel, mesh_path
 from modelkit.formats.mjcf.devices import add_devices
 from modelkit.formats.mjcf.errors import error_location, error_text
 from modelkit.formats.mjcf.files import check_asset_files, check_sizes
+from modelkit.formats.mjcf.options import source_options
 from modelkit.formats.mjcf.quiet import collected_warnings
 from modelkit.formats.mjcf.source import SourceIndex, TreeShape, locate, pair
 from modelkit.formats.mjcf.uncompiled import SpecReader
@@ -296,6 +297,9 @@ class _MjcfReader:
                 robot.extras[f"mjcf_{kind}s"].append(builder.attached(body_id, name, pose, **params))
             add_devices(reader.mj, reader.m, builder, built)  # the same, as canonical devices on links
             main.extras.update(data)
+            options = source_options(builder.loc.index)
+            if options:
+                main.extras["mjcf_option"] = options
 
         def attached(key: str) -> int:
             return sum(len(r.extras.get(key, [])) for r in built.robots)

@@ -43,6 +43,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import FLOOR_MATERIAL, PairFriction
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.diagnostics import SourceLocation
+from modelkit.formats.mjcf.bodies import GEOM_CONTACT_DEFAULTS
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, set_pose, sub
 from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere, SurfaceFriction
@@ -83,12 +84,17 @@ class GeomWriter:
                 group=VISUAL_GROUP)
 
     def link_geoms(self, body: Element, link: Link, body_name: str) -> None:
+        contact = {e["collision"]: e for e in link.extras.get("mjcf_contact", [])}
         for i, geom in enumerate(link.collisions):
-            self.geom(body, geom, f"body[{body_name}]/collision[{i}]", link, collision=True)
+            el = self.geom(body, geom, f"body[{body_name}]/collision[{i}]", link, collision=True)
+            if el is not None and i in contact:  # an MJCF source's own solref, solimp, margin...
+                for key in GEOM_CONTACT_DEFAULTS:
+                    if key in contact[i]:
+                        el.set(key, str(contact[i][key]))
         for i, geom in enumerate(link.visuals):
             self.geom(body, geom, f"body[{body_name}]/visual[{i}]", link, collision=False)
 
-    def geom(self, body: Element, geom: Geom, target: str, link: Link, collision: bool) -> None:
+    def geom(self, body: Element, geom: Geom, target: str, link: Link, collision: bool) -> Element | None:
         if refused_by_mujoco(geom.geometry):
             role = (
                 "collision shape (a consumer that loads it, such as PyBullet, collides with a point there)"
@@ -103,12 +109,12 @@ class GeomWriter:
                 geom.source,
                 target,
             )
-            return
+            return None
         shape = self.shape(
             geom, target, f"{link.name}_{target.rsplit('/', 1)[1].replace('[', '').rstrip(']')}", collision
         )
         if shape is None:
-            return
+            return None
         el = sub(body, "geom")
         if geom.name:
             el.set("name", self.names.claim("geom", geom.name, geom.source, target))
@@ -123,6 +129,7 @@ class GeomWriter:
             self.set_surface_friction(el, geom.friction, link, target)
         elif collision and link.name in self.friction:
             self.set_friction(el, link, target)
+        return el
 
     def shape(self, geom: Geom, target: str, file_stem: str,
               collision: bool = False) -> dict[str, str] | None:

@@ -93,6 +93,12 @@ class MjcfWriter:
         options, why = mujoco_options(robot)  # wheels or tracks (convert.simulator says why)
         for key, value in options.items():
             self.sections["option"].set(key, value)
+        own = robot.extras.get("mjcf_option") or {}  # an MJCF source's own settings win
+        for key, value in sorted(own.items()):
+            if isinstance(value, dict):  # <flag>
+                sub(self.sections["option"], key, **{k: str(v) for k, v in sorted(value.items())})
+            else:
+                self.sections["option"].set(key, str(value))
         if options:
             stiff = (f"; the collision geoms have solref {CONTACT['solref']!r} and solimp "
                      f"{CONTACT['solimp']!r} (stiff contact: the wheels keep their rolling radius)"

@@ -12,7 +12,7 @@ FORMAT = FormatDeclaration(
         writer="modelkit.formats.sdf.writer:write_sdf",
         suffix=".sdf",
         suffixes=(".sdf",),
-        handles_link=frozenset({"gazebo"}),  # a URDF link block: written or noted (write_self_collide)
+        handles=frozenset({"gazebo"}),  # a URDF's <gazebo> blocks: written or noted (write_self_collide)
     ),
     extras=ExtrasDeclaration(
         quiet=frozenset({"sdf_canonical_link", "sdf_version", "sdf_model_pose", "sdf_world_joint"}),
@@ -21,6 +21,9 @@ FORMAT = FormatDeclaration(
             ("sdf_world", "MK822", "the SDF world around the model"),
             ("sdf_plugins", "MK808", "SDF model plugins"),
         ),
-        dropped_link=(("sdf_plugins", "MK808", "SDF plugins of a visual or collision"),),
+        dropped_link=(
+            ("sdf_plugins", "MK808", "SDF plugins of a visual or collision"),
+            ("sdf_surface", "MK851", "SDF surface parameters other than friction"),
+        ),
     ),
 )

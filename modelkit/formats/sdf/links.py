@@ -105,7 +105,11 @@ def read_link(ctx: Context, graph: FrameGraph, item: Item) -> LinkData:
                     link.extras.setdefault("sdf_materials", {})[name] = material.extras
                 link.visuals.append(geom)
             else:
-                geom.friction = surface_friction(values, child(geom_el, "surface"))
+                surface = child(geom_el, "surface")
+                geom.friction = surface_friction(values, surface)
+                rest = None if surface is None else surface_rest(surface)
+                if rest is not None:
+                    link.extras.setdefault("sdf_surface", []).append({"collision": name, "xml": rest})
                 link.collisions.append(geom)
                 data.collision_densities.append(values.number(child(geom_el, "density")))
             for plugin in children(geom_el, "plugin"):
@@ -305,3 +309,35 @@ def surface_friction(values: Values, surface: Element | None) -> SurfaceFriction
     sliding = 1.0 if first is None else first  # SDF's default mu
     other = 1.0 if second is None else second
     return SurfaceFriction(sliding, None, rolling, None if other == sliding else other)
+
+
+CARRIED_FRICTION = {"ode": ("mu", "mu2"), "bullet": ("friction", "friction2", "rolling_friction")}
+"""The ``<surface><friction>`` children ``Geom.friction`` holds (the rest is kept as XML)."""
+
+
+def surface_rest(surface: Element) -> str | None:
+    """A collision's ``<surface>`` without what ``Geom.friction`` holds, as XML for the SDF writer to
+    write back (bounce, contact stiffness, torsional friction, slip...); None when nothing is left."""
+    from lxml import etree
+
+    copy = etree.fromstring(etree.tostring(surface, with_tail=False))
+    for element in copy.iter():  # the writer indents it anew
+        if element.text is not None and not element.text.strip():
+            element.text = None
+        element.tail = None
+    friction = child(copy, "friction")
+    if friction is not None:
+        for engine, tags in CARRIED_FRICTION.items():
+            holder = child(friction, engine)
+            if holder is None:
+                continue
+            for tag in tags:
+                for element in children(holder, tag):
+                    holder.remove(element)
+            if not len(holder):
+                friction.remove(holder)
+        if not len(friction):
+            copy.remove(friction)
+    if not any(isinstance(c.tag, str) for c in copy):
+        return None
+    return etree.tostring(copy, encoding="unicode", with_tail=False)

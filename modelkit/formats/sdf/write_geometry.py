@@ -6,6 +6,7 @@ a cone (never native) and, before 1.8, a capsule or ellipsoid are written as mes
 
 from __future__ import annotations
 
+from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
@@ -37,6 +38,7 @@ class GeomWriter:
     ) -> None:
         """Write the link's visuals and collisions under ``el``; ``offset`` maps link-frame poses to
         the frame the pose is written in (identity when the link frame is the written frame)."""
+        kept = {str(e.get("collision")): str(e.get("xml")) for e in link.extras.get("sdf_surface", [])}
         for kind, geoms in (("visual", link.visuals), ("collision", link.collisions)):
             used: set[str] = set()
             for index, geom in enumerate(geoms):
@@ -47,6 +49,8 @@ class GeomWriter:
                 if not self._geometry(shape, geom, f"{written}_{kind}_{name}", target):
                     el.remove(shape)
                     continue
+                if kind == "collision" and geom.name in kept:
+                    shape.append(etree.fromstring(kept[geom.name]))  # the source's surface, friction aside
                 if kind == "visual":
                     self._material(shape, geom, target)
                 elif geom.friction is not None:
@@ -122,13 +126,13 @@ class GeomWriter:
         and ``<rolling_friction>``. Torsional friction is not written: SDF's ``<torsional>`` is Gazebo
         ODE's contact-patch model, with no coefficient of MuJoCo's or PyBullet's meaning."""
         second = friction.sliding if friction.sliding2 is None else friction.sliding2
-        friction_el = sub(sub(collision, "surface"), "friction")
-        ode = sub(friction_el, "ode")
-        num(ode, "mu", friction.sliding)
-        num(ode, "mu2", second)
-        bullet = sub(friction_el, "bullet")
-        num(bullet, "friction", friction.sliding)
-        num(bullet, "friction2", second)
+        friction_el = _child(_child(collision, "surface"), "friction")
+        ode = _child(friction_el, "ode")
+        _first(ode, "mu", friction.sliding)
+        _first(ode, "mu2", second, after="mu")
+        bullet = _child(friction_el, "bullet")
+        _first(bullet, "friction", friction.sliding)
+        _first(bullet, "friction2", second, after="friction")
         if friction.rolling is not None:
             num(bullet, "rolling_friction", friction.rolling)
         if friction.torsional:
@@ -179,3 +183,18 @@ class GeomWriter:
             link.loc("material"),
             target,
         )
+
+
+def _child(parent: Element, tag: str) -> Element:
+    """The first child ``tag`` of ``parent`` (a kept ``<surface>`` may hold it), made when absent."""
+    found = parent.find(tag)
+    return found if found is not None else sub(parent, tag)
+
+
+def _first(parent: Element, tag: str, value: float, after: str | None = None) -> None:
+    """``<tag>value</tag>`` as the first child of ``parent`` (after ``after``), where SDF lists it
+    before the kept children (``<fdir1>``, ``<slip1>``...)."""
+    element = etree.Element(tag)
+    element.text = fmt(value)
+    previous = parent.find(after) if after is not None else None
+    parent.insert(0 if previous is None else list(parent).index(previous) + 1, element)

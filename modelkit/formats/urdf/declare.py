@@ -13,6 +13,7 @@ FORMAT = FormatDeclaration(
         suffix=".urdf",
         suffixes=(".urdf",),
         auto_wheel="sphere",  # PyBullet loads URDF: a cylinder rolling on a plane gets odd contacts there
+        walks_extras=True,
     ),
     extras=ExtrasDeclaration(
         # the version is bookkeeping; the named materials, transmissions and <ros2_control> are kept for

@@ -27,7 +27,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.notes import ConversionNote, renames
 from modelkit.convert.simulator import pybullet_settings
-from modelkit.formats.registry import EXTRAS_DROPPED, EXTRAS_QUIET, EXTRAS_QUIET_LINK
+from modelkit.formats.registry import EXTRAS_DROPPED, EXTRAS_DROPPED_LINK, EXTRAS_QUIET, EXTRAS_QUIET_LINK
 from modelkit.formats.urdf.write_frames import frame_link, sensor_frames
 from modelkit.formats.urdf.write_gazebo import write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
@@ -51,7 +51,10 @@ WRITTEN_EXTRAS = frozenset(
 PASS_EXTRAS = frozenset({"wheels", "tracks"})
 SILENT_EXTRAS = WRITTEN_EXTRAS | EXTRAS_QUIET | PASS_EXTRAS
 # Link extras written elsewhere: URDF's <gazebo> blocks.
-SILENT_LINK_EXTRAS = frozenset({"gazebo", CONTACT_EXTRAS}) | EXTRAS_QUIET_LINK
+# Link extras other formats declare dropped are noted by convert itself (convert.api._foreign_extras).
+SILENT_LINK_EXTRAS = (
+    frozenset({"gazebo", CONTACT_EXTRAS}) | EXTRAS_QUIET_LINK | frozenset(EXTRAS_DROPPED_LINK)
+)
 SDF_LINK_DEFAULTS = {
     "gravity": True,
     "kinematic": False,
