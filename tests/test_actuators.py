@@ -18,7 +18,7 @@ from modelkit.api import load
 from modelkit.convert.api import write
 from modelkit.convert.options import WriteOptions
 from modelkit.formats.common import ReadOptions
-from modelkit.model import ActuatorKind, Robot
+from modelkit.model import ActuatorKind, JointType, Robot
 from tests.conftest import CORPUS, PENDULUM_BODY, example_robot, example_robot_data
 
 mujoco = pytest.importorskip("mujoco")
@@ -459,3 +459,59 @@ def test_example_legged_robots_stand_at_home(tmp_path: Path, relative: str) -> N
     assert {el.tag for el in actuator_elements(out)} == {"position"}
     sag, tilt = stand_on_a_plain_floor(out)
     assert sag < STAND_SAG and tilt < STAND_TILT, f"{relative}: sank {sag * 1e3:.1f} mm, tilted {tilt:.3f}"
+
+
+# pybullet_data's quadrupeds whose URDFs declare leg joints ``continuous`` (no range) and name no
+# actuators: Laikago (toes, Z up) all twelve, Aliengo its four thighs. ``--actuators auto`` used to give
+# each such joint a motor (as for a wheel), and at zero control the robot folded to the floor (Laikago
+# 396 mm, Aliengo 350 mm in 2 s); a joint in a leg now gets a position servo (convert.legs).
+PYBULLET_LEGGED_CONTINUOUS = ("laikago/laikago_toes_zup.urdf", "aliengo/aliengo.urdf")
+
+
+@pytest.mark.parametrize("relative", PYBULLET_LEGGED_CONTINUOUS)
+def test_continuous_leg_joints_are_servoed_so_the_robot_stands(tmp_path: Path, relative: str) -> None:
+    pybullet_data = pytest.importorskip("pybullet_data")
+    robot = load(Path(pybullet_data.getDataPath()) / relative)
+    assert any(not math.isfinite(j.limits.upper) for j in robot.joints if j.type.moves), "a continuous joint"
+    out, notes = convert(robot, tmp_path)
+    sag, tilt = stand_on_a_plain_floor(out)
+    assert sag < STAND_SAG and tilt < STAND_TILT, f"{relative}: sank {sag * 1e3:.1f} mm, tilted {tilt:.3f}"
+    assert [el.tag for el in actuator_elements(out)] == ["position"] * 12
+    (said,) = [n for n in notes if n.code == "MK841"]
+    assert "or in a leg" in said.message
+
+
+FOUR_CASTERS = """<robot name="cart">
+  <link name="base"><inertial><mass value="10"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.6 0.4 0.1"/></geometry></collision></link>
+""" + "".join(f"""
+  <link name="fork{i}"><inertial><mass value="0.2"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="-0.02 0 -0.03"/><geometry><box size="0.02 0.04 0.06"/></geometry>
+    </collision></link>
+  <link name="wheel{i}"><inertial><mass value="0.3"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin rpy="1.5707963 0 0"/><geometry><cylinder radius="0.05" length="0.03"/></geometry>
+    </collision></link>
+  <joint name="swivel{i}" type="continuous"><parent link="base"/><child link="fork{i}"/>
+    <origin xyz="{x} {y} -0.1"/><axis xyz="0 0 1"/></joint>
+  <joint name="spin{i}" type="continuous"><parent link="fork{i}"/><child link="wheel{i}"/>
+    <origin xyz="-0.04 0 -0.06"/><axis xyz="0 1 0"/></joint>""" for i, (x, y) in enumerate(
+    [(0.25, 0.15), (0.25, -0.15), (-0.25, 0.15), (-0.25, -0.15)])) + "\n</robot>\n"
+
+
+def test_casters_are_not_legs(tmp_path: Path) -> None:
+    """A cart on four casters has four limbs of two joints, as a quadruped has; its limbs carry wheels
+    (an endless hinge whose child is round about its axis), so swivels and wheels keep their motors."""
+    from modelkit.convert.base import decide
+    from modelkit.convert.legs import leg_joints
+
+    path = tmp_path / "cart.urdf"
+    path.write_text(FOUR_CASTERS)
+    robot = load(path)
+    robot.root_joint = decide(robot).kind  # as --base auto settles it: floating, on wheels
+    assert robot.root_joint is JointType.FLOATING
+    assert leg_joints(robot) == frozenset()
+    out, _ = convert(robot, tmp_path / "out")
+    assert [el.tag for el in actuator_elements(out)] == ["motor"] * 8

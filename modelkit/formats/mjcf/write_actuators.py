@@ -10,10 +10,10 @@
   (MK843).
 * A source without actuators: every hinge and slide that is not a mimic follower or locked gets the
   ``--actuators`` kind, or none (MK841). ``auto`` (the default): a position servo on each joint with a
-  range (the model holds its ``home`` pose, as MuJoCo Menagerie's arms and legs do), a motor on each
-  joint without one (wheels: gear 1, the control is the joint force, ``ctrlrange`` = ±effort; zero
-  control leaves the joint free). The track approximation's roller servos do not count as the
-  source's: a tracked robot's other joints get the choice too.
+  range or in a leg (the model holds its ``home`` pose, as MuJoCo Menagerie's arms and legs do), a
+  motor on each other joint without a range (wheels: gear 1, the control is the joint force,
+  ``ctrlrange`` = ±effort; zero control leaves the joint free). The track approximation's roller
+  servos do not count as the source's: a tracked robot's other joints get the choice too.
 
 Position actuators make the ``home`` keyframe carry ``ctrl`` = the home positions (others 0), so that
 a model reset to ``home`` holds it.
@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.legs import leg_joints
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.convert.servo_gains import (
     SERVO_BANDWIDTH_HZ,
@@ -57,6 +58,7 @@ class ActuatorWriter:
         self.any_position = False
         self.servos = 0  # position and velocity actuators written
         self._loads: dict[str, JointLoad] | None = None
+        self._legs: frozenset[str] | None = None  # the joints in a legged robot's legs, found once
 
     def write(self, home: dict[str, float]) -> None:
         by_name: dict[str, Joint] = {}
@@ -99,16 +101,19 @@ class ActuatorWriter:
     def _chosen_kind(self, joint: Joint) -> ActuatorKind | None:
         """The ``--actuators`` kind of a joint the source does not actuate (None: no actuator).
 
-        ``auto``: a position servo on a joint with a finite range, so the written model holds its home
-        pose as MuJoCo Menagerie's arms and legs do; a motor on a joint without one (wheels, casters,
-        endless spindles), whose zero control leaves it free as the source has it."""
+        ``auto``: a position servo on a joint with a finite range or in a leg (:mod:`modelkit.convert.legs`:
+        a URDF's ``continuous`` knee), so the written model holds its home pose as MuJoCo Menagerie's arms
+        and legs do; a motor on any other joint without one (wheels, casters, endless spindles), whose
+        zero control leaves it free as the source has it."""
         if joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
             return None
         choice = self.ctx.options.actuators
         if choice == "auto":
             lower, upper = joint.limits.lower, joint.limits.upper
             ranged = math.isfinite(lower) and math.isfinite(upper) and lower < upper
-            return ActuatorKind.POSITION if ranged else ActuatorKind.EFFORT
+            if self._legs is None:
+                self._legs = leg_joints(self.robot)
+            return ActuatorKind.POSITION if ranged or joint.name in self._legs else ActuatorKind.EFFORT
         return CHOICES.get(choice)
 
     def _said_choice(self, written: dict[ActuatorKind, int]) -> None:
@@ -123,8 +128,8 @@ class ActuatorWriter:
                                 sorted(written.items(), key=lambda item: ORDER.index(item[0])))
         why = ""
         if choice == "auto":
-            why = ("; auto puts a position servo on each joint with a range (the home keyframe holds) and a "
-                   "motor on each joint without one (zero control leaves it free)")
+            why = ("; auto puts a position servo on each joint with a range or in a leg (the home keyframe "
+                   "holds) and a motor on each other joint without a range (zero control leaves it free)")
         self.ctx.note("MK841", f"the source names no actuators: {what} written (--actuators {choice}{why})",
                       self.robot.source, "actuator")
 

@@ -1,0 +1,72 @@
+"""The joints of a legged robot's legs, for the writers that must not take a leg joint for a wheel.
+
+A URDF may declare a leg's joints ``continuous`` (pybullet_data's Laikago: all twelve; Aliengo: its
+four thighs). ``--actuators auto`` gives a joint without a range a motor, as wheels, casters and
+spindles want (zero control leaves them free); on a leg that motor lets the robot fold to the floor.
+
+A leg here is a limb as :mod:`modelkit.convert.base` counts them for ``--base auto`` (a first moving
+joint below the root's rigid body with two or more moving joints in a row below it, not pointing up at
+q = 0), in a robot with four or more such limbs whose root floats (as settled for the output: a welded
+test rig of 30 chains has no legs), that carries no wheel: no hinge in it without a range
+whose child's shapes are round about its axis (a wheeled leg's wheel, a caster's wheel; a cart with
+four casters has four limbs of two joints, and its swivels stay free).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from modelkit.convert.base import LIMBS, _limbs, _points_up, _round_about
+from modelkit.model import Joint, JointType, Robot
+
+
+def leg_joints(robot: Robot) -> frozenset[str]:
+    """The names of the hinges and slides in the legs of a legged robot (empty for any other robot)."""
+    if robot.root_joint is not JointType.FLOATING:
+        return frozenset()
+    poses = robot.world_poses()
+    legs = [name for name in _limbs(robot) if not _points_up(robot, poses, name)]
+    if len(legs) < LIMBS:
+        return frozenset()
+    children = robot.children_of()
+    by_name = {joint.name: joint for joint in robot.joints}
+    links = {link.name: link for link in robot.links}
+    out: set[str] = set()
+    for first in legs:
+        below = _below(children, by_name[first])
+        if any(_is_wheel(joint, links) for joint in below):
+            continue
+        out.update(j.name for j in below if j.type in (JointType.REVOLUTE, JointType.PRISMATIC))
+    return frozenset(out)
+
+
+def _below(children: dict[str, list[Joint]], first: Joint) -> list[Joint]:
+    """``first`` and every joint below it."""
+    out: list[Joint] = [first]
+    stack, seen = [first.child], {first.child}
+    while stack:
+        for joint in children.get(stack.pop(), []):
+            out.append(joint)
+            if joint.child not in seen:
+                seen.add(joint.child)
+                stack.append(joint.child)
+    return out
+
+
+def _is_wheel(joint: Joint, links: dict) -> bool:
+    """A hinge without a range whose child's collision shapes (its visuals without any) are round
+    about its axis."""
+    if joint.type is not JointType.REVOLUTE:
+        return False
+    lower, upper = joint.limits.lower, joint.limits.upper
+    if math.isfinite(lower) and math.isfinite(upper) and lower < upper:
+        return False
+    link = links.get(joint.child)
+    axis = np.asarray(joint.axis, dtype=float)
+    norm = float(np.linalg.norm(axis))
+    if link is None or norm == 0.0:
+        return False
+    geoms = link.collisions or link.visuals
+    return any(_round_about(geom, axis / norm) for geom in geoms)
