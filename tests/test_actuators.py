@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from modelkit.api import load
+from modelkit.api import load, validate
 from modelkit.convert.api import write
 from modelkit.convert.options import WriteOptions
 from modelkit.formats.common import ReadOptions
@@ -515,3 +515,62 @@ def test_casters_are_not_legs(tmp_path: Path) -> None:
     assert leg_joints(robot) == frozenset()
     out, _ = convert(robot, tmp_path / "out")
     assert [el.tag for el in actuator_elements(out)] == ["motor"] * 8
+
+
+# -- what a legged robot's source cannot give, said at conversion (MK856, MK857) --------------------
+
+STANDING_LEGGED = (*EXAMPLE_LEGGED, "a1_description/urdf/a1.urdf")  # A1: feet on the floor, then it tips
+
+
+def test_a_home_that_lies_on_the_body_is_said(tmp_path: Path) -> None:
+    """pybullet_data's Spirit40 at q = 0 (its home: the URDF gives no initial positions) has its legs
+    folded flat beside its body: MK856 says the home keyframe is not a stance, and MuJoCo agrees: on a
+    plain floor its hips, not its toes, carry it."""
+    pybullet_data = pytest.importorskip("pybullet_data")
+    robot = load(Path(pybullet_data.getDataPath()) / "quadruped" / "spirit40.urdf")
+    out, notes = convert(robot, tmp_path)
+    (said,) = [n for n in notes if n.code == "MK856"]
+    assert "hip0, hip1, hip2, hip3" in said.message and said.severity == "warning"
+    spec = mujoco.MjSpec.from_file(str(out))
+    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0])
+    m = spec.compile()
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home"))
+    for _ in range(round(1.0 / m.opt.timestep)):
+        mujoco.mj_step(m, d)
+    touching = {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g]))
+                for c in d.contact[:d.ncon] for g in (c.geom1, c.geom2)} - {"world"}
+    assert {"hip0", "hip1", "hip2", "hip3"} <= touching and not touching & {"toe0", "toe1", "toe2", "toe3"}
+
+
+def test_source_motors_on_legs_are_said(tmp_path: Path) -> None:
+    """HyQ's URDF names an EffortJointInterface on each of its 12 leg joints: written as motors (the
+    source's answer), so MK857 says the legs are limp at zero control."""
+    robot = load(example_robot("hyq_description/robots/hyq_no_sensors.urdf"))
+    out, notes = convert(robot, tmp_path)
+    assert {el.tag for el in actuator_elements(out)} == {"motor"}
+    (said,) = [n for n in notes if n.code == "MK857"]
+    assert said.message.startswith("12 of the 12 leg joints")
+    assert not [n for n in notes if n.code == "MK856"]
+
+
+@pytest.mark.parametrize("relative", STANDING_LEGGED)
+def test_no_leg_notes_on_robots_whose_home_stands(tmp_path: Path, relative: str) -> None:
+    """Legged robots whose home puts their feet on the floor and whose joints get servos: neither note."""
+    robot = load(example_robot(relative))
+    _, notes = convert(robot, tmp_path)
+    assert not [n for n in notes if n.code in ("MK856", "MK857")]
+
+
+def test_no_leg_notes_on_the_tutorial_robots(tmp_path: Path) -> None:
+    """The samples (the tutorial's wheeled, tracked and pan-tilt robots, the smartcar, the unicycle)."""
+    samples = Path(__file__).resolve().parents[1] / "samples"
+    paths = sorted(samples.glob("choreonoid_ros2_mobile_robot_tutorial/model/*.body"))
+    paths += [samples / "smartcar" / "urdf" / "myrobot.urdf.xacro",
+              samples / "gazebo_unicycle" / "unicycle.sdf"]
+    assert len(paths) >= 5
+    for path in paths:
+        robot = validate(path).robot  # mobile_robot_mesh.body has an error (its missing chassis mesh)
+        assert robot is not None
+        _, notes = convert(robot, tmp_path / path.stem)
+        assert not [n for n in notes if n.code in ("MK856", "MK857")], path.name

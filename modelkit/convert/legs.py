@@ -10,6 +10,12 @@ q = 0), in a robot with four or more such limbs whose root floats (as settled fo
 test rig of 30 chains has no legs), that carries no wheel: no hinge in it without a range
 whose child's shapes are round about its axis (a wheeled leg's wheel, a caster's wheel; a cart with
 four casters has four limbs of two joints, and its swivels stay free).
+
+:func:`resting_on` says what a legged robot rests on at its home pose: the links whose shapes reach
+the lowest level (within 2 % of the robot's height, at least 1 mm, as ``--base auto`` judges it) that
+hang from the root through fewer than two moving joints (the body, a hip): pybullet_data's Spirit40
+at q = 0 has its legs folded flat beside its body, Vision60 its legs sideways. The MJCF writer says so
+(MK856): its servos then hold a pose that lies on the floor.
 """
 
 from __future__ import annotations
@@ -18,8 +24,11 @@ import math
 
 import numpy as np
 
-from modelkit.convert.base import LIMBS, _limbs, _points_up, _round_about
+from modelkit.convert.base import LIMBS, _limbs, _moving_above, _points_up, _round_about
+from modelkit.convert.tracks import extent
 from modelkit.model import Joint, JointType, Robot
+
+_UP = np.array([0.0, 0.0, 1.0])
 
 
 def leg_joints(robot: Robot) -> frozenset[str]:
@@ -70,3 +79,30 @@ def _is_wheel(joint: Joint, links: dict) -> bool:
         return False
     geoms = link.collisions or link.visuals
     return any(_round_about(geom, axis / norm) for geom in geoms)
+
+
+def resting_on(robot: Robot, home: dict[str, float]) -> list[str]:
+    """The links a legged robot at ``home`` (joint name → position) rests on other than its feet: those
+    reaching the lowest level through fewer than two moving joints from the root (sorted; empty when
+    it stands on its feet, or has no legs)."""
+    if not leg_joints(robot):
+        return []
+    poses = robot.world_poses(home)
+    use_collisions = any(link.collisions for link in robot.links)
+    lows: dict[str, tuple[float, float]] = {}
+    for link in robot.links:
+        geoms = link.collisions if use_collisions else link.visuals
+        pose = poses.get(link.name)
+        if pose is None or not geoms:
+            continue
+        span = extent(geoms, pose.rotation.T @ _UP)
+        if span is not None:
+            z = float(pose.translation[2])
+            lows[link.name] = (z + span[0], z + span[1])
+    if not lows:
+        return []
+    ground = min(low for low, _ in lows.values())
+    tolerance = max(1e-3, 0.02 * (max(high for _, high in lows.values()) - ground))
+    parent_joint = {joint.child: joint for joint in robot.joints}
+    return sorted(name for name, (low, _) in lows.items()
+                  if low - ground <= tolerance and len(_moving_above(parent_joint, name)) < 2)

@@ -24,11 +24,12 @@ from __future__ import annotations
 import math
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.legs import leg_joints
+from modelkit.convert.legs import leg_joints, resting_on
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.convert.servo_gains import (
     SERVO_BANDWIDTH_HZ,
     JointLoad,
+    home_position,
     joint_loads,
     natural_frequency,
     natural_frequency_for,
@@ -81,6 +82,7 @@ class ActuatorWriter:
             planned += [(a, by_name.get(a.joint)) for a in chosen]
         skipped = self._constrained()
         written: dict[ActuatorKind, int] = {}
+        on_joint: dict[str, Actuator] = {}  # source joint name → the actuator written on it
         for actuator, joint in planned:
             target = self.joint_names.get(actuator.joint)
             reason = self._unwritable(joint, target, skipped)
@@ -91,12 +93,41 @@ class ActuatorWriter:
                 continue
             assert joint is not None and target is not None
             self._one(actuator, joint, target[0], home.get(target[0], 0.0))
+            on_joint.setdefault(joint.name, actuator)
             if actuator.source_kind == "--actuators":
                 written[actuator.kind] = written.get(actuator.kind, 0) + 1
         self._uncanonical()
         movable = any(j.type in (JointType.REVOLUTE, JointType.PRISMATIC) for j in self.robot.joints)
         if made_up and movable:
             self._said_choice(written)
+        self._said_legs(on_joint)
+
+    def _said_legs(self, on_joint: dict[str, Actuator]) -> None:
+        """MK857: the source's motors leave a legged robot's legs limp; MK856: its home pose, which the
+        servos hold, lies on the body, not the feet (convert.legs)."""
+        if self._legs is None:
+            self._legs = leg_joints(self.robot)
+        legs = sorted(self._legs)
+        if not legs:
+            return
+        limp = [name for name in legs if name in on_joint and on_joint[name].kind is ActuatorKind.EFFORT
+                and on_joint[name].source_kind != "--actuators"]
+        if limp:
+            shown = ", ".join(limp[:4]) + (" ..." if len(limp) > 4 else "")
+            self.ctx.note("MK857", f"{len(limp)} of the {len(legs)} leg joints ({shown}) have the source's "
+                          "effort actuators, written as <motor>: at zero control those legs are limp and the "
+                          "robot lies down on a floor until a controller drives them", self.robot.source,
+                          "actuator")
+        held = [name for name in legs if name in on_joint and on_joint[name].kind is ActuatorKind.POSITION]
+        if not held:
+            return
+        home = {j.name: home_position(j) for j in self.robot.joints}
+        resting = resting_on(self.robot, home)
+        if resting:
+            shown = ", ".join(resting[:4]) + (" ..." if len(resting) > 4 else "")
+            self.ctx.note("MK856", f"the home keyframe is not a standing pose: at home the robot rests on "
+                          f"{shown}, not on its feet (the source gives no initial positions of a stance), so "
+                          "on a floor its servos hold it lying down", self.robot.source, "keyframe")
 
     def _chosen_kind(self, joint: Joint) -> ActuatorKind | None:
         """The ``--actuators`` kind of a joint the source does not actuate (None: no actuator).
