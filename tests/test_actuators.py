@@ -415,10 +415,12 @@ def test_reflected_inertias_equal_mujocos_mass_matrix(tmp_path: Path) -> None:
 
 
 # Legged robots of example-robot-data whose URDF names no actuators: each gets a free base and a position
-# servo per joint, and its home keyframe (q = 0, put into range: MK845) is a standing pose. Left out: A1
-# (home puts all four feet 0.16 m behind their hips and it tips over nose first: a pose, not a gain), and
-# Go1, B1 and HyQ, whose URDFs name effort interfaces (motors at zero control: the source's answer).
+# servo per joint, and its home keyframe (q = 0, put into range: MK845) is a standing pose. The A1's home
+# puts all four feet 0.16 m behind their hips: with gains for its legs' own weight alone it sagged and
+# tipped over nose first; with each leg's share of the robot's weight in the rule it stands. Left out:
+# Go1, B1 and HyQ, whose URDFs name effort interfaces (motors at zero control: the source's answer, MK857).
 EXAMPLE_LEGGED = (
+    "a1_description/urdf/a1.urdf",
     "anymal_b_simple_description/robots/anymal.urdf",
     "anymal_c_simple_description/urdf/anymal.urdf",
     "go2_description/urdf/go2.urdf",
@@ -519,7 +521,7 @@ def test_casters_are_not_legs(tmp_path: Path) -> None:
 
 # -- what a legged robot's source cannot give, said at conversion (MK856, MK857) --------------------
 
-STANDING_LEGGED = (*EXAMPLE_LEGGED, "a1_description/urdf/a1.urdf")  # A1: feet on the floor, then it tips
+STANDING_LEGGED = EXAMPLE_LEGGED
 
 
 def test_a_home_that_lies_on_the_body_is_said(tmp_path: Path) -> None:

@@ -16,6 +16,11 @@ the lowest level (within 2 % of the robot's height, at least 1 mm, as ``--base a
 hang from the root through fewer than two moving joints (the body, a hip): pybullet_data's Spirit40
 at q = 0 has its legs folded flat beside its body, Vision60 its legs sideways. The MJCF writer says so
 (MK856): its servos then hold a pose that lies on the floor.
+
+:func:`carried_loads` is what each leg joint carries of the robot standing at home, for the servo gain
+rule (:mod:`modelkit.convert.servo_gains`): the robot's weight shared equally by its legs, standing on
+each leg's foot (the leg's lowest link frame at home), as a torque about the joint (a force along a
+slide) with the distance from the joint to that foot as its lever.
 """
 
 from __future__ import annotations
@@ -79,6 +84,42 @@ def _is_wheel(joint: Joint, links: dict) -> bool:
         return False
     geoms = link.collisions or link.visuals
     return any(_round_about(geom, axis / norm) for geom in geoms)
+
+
+def carried_loads(robot: Robot, home: dict[str, float]) -> dict[str, tuple[float, float]]:
+    """Leg joint name → (the torque, or force, that the robot's weight shared by its legs puts on it at
+    ``home`` through the leg's foot; the distance from the joint to the foot). Empty without legs."""
+    legs = leg_joints(robot)
+    if not legs:
+        return {}
+    poses = robot.world_poses(home)
+    children = robot.children_of()
+    by_name = {joint.name: joint for joint in robot.joints}
+    firsts = [name for name in _limbs(robot) if name in legs]
+    mass = sum(max(link.inertial.mass, 0.0) for link in robot.links if link.inertial is not None)
+    share = np.array([0.0, 0.0, mass * 9.81 / len(firsts)])  # the floor's push on each foot
+    out: dict[str, tuple[float, float]] = {}
+    for first in firsts:
+        below = [j for j in _below(children, by_name[first]) if j.child in poses]
+        if not below:
+            continue
+        lowest = min((poses[j.child] for j in below), key=lambda pose: float(pose.translation[2]))
+        foot = np.asarray(lowest.translation, dtype=float)
+        for joint in below:
+            if joint.name not in legs:
+                continue
+            frame = poses[joint.child]
+            axis = np.asarray(frame.rotation, dtype=float) @ np.asarray(joint.axis, dtype=float)
+            norm = float(np.linalg.norm(axis))
+            if norm == 0.0:
+                continue
+            axis /= norm
+            lever = foot - np.asarray(frame.translation, dtype=float)
+            if joint.type is JointType.PRISMATIC:
+                out[joint.name] = (abs(float(axis @ share)), 1.0)
+            else:
+                out[joint.name] = (abs(float(axis @ np.cross(lever, share))), float(np.linalg.norm(lever)))
+    return out
 
 
 def resting_on(robot: Robot, home: dict[str, float]) -> list[str]:

@@ -268,8 +268,11 @@ class ActuatorWriter:
         why = f"a {fmt(SERVO_BANDWIDTH_HZ)} Hz critically damped servo"
         if hz > SERVO_BANDWIDTH_HZ * (1.0 + 1e-9):
             force = "N" if joint.type is JointType.PRISMATIC else "N·m"
+            if self._legs is None:
+                self._legs = leg_joints(self.robot)
+            share = " (with its leg's share of the robot's weight)" if joint.name in self._legs else ""
             why = (f"a critically damped servo raised to {hz:.1f} Hz against the gravity load "
-                   f"{load.gravity:.3g} {force} at home (docs/convert.md)")
+                   f"{load.gravity:.3g} {force}{share} at home (docs/convert.md)")
         self.ctx.note(
             "MK840",
             f"{actuator.kind.value} actuator on joint {joint.name}: {gains} from its reflected inertia "
