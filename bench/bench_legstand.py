@@ -139,7 +139,7 @@ def stand(xml: Path, seconds: float) -> tuple[mujoco.MjModel, dict[str, float]]:
             worst = max(worst, float(np.abs(d.qpos[adr] - home[adr]).max()))
     w = min(1.0, abs(float(d.qpos[3])))
     share = at_limit / steps if m.nu else np.zeros(1)
-    a = int(np.argmax(share)) if m.nu else -1
+    a = int(np.argmax(share)) if m.nu and share.max() > 0.0 else -1  # the joint named only when it sat
     jname = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.actuator_trnid[a, 0])) if a >= 0 else ""
     return m, {"drop": start - float(d.qpos[2]), "tilt": 2.0 * math.acos(w), "joint_error": worst,
                "saturated": float(share.max()), "saturated_joint": jname or ""}
