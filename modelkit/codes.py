@@ -1376,7 +1376,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MJCF: a legged robot's `home` keyframe (its initial positions, 0 where the source gives none) is "
         "not a standing pose: at home its body or hips reach the floor before its feet (pybullet_data's "
         "Spirit40 at q = 0 has its legs folded flat, Vision60 its legs sideways), so on a floor the servos "
-        "hold it lying down. Give the joints initial positions of a stance (the source has none).",
+        "hold it lying down. Give the joints initial positions of a stance (the source has none; in a URDF, "
+        "a ros2_control position `state_interface`'s `initial_value`).",
     ),
     CodeInfo(
         "MK857",
@@ -1384,7 +1385,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "MJCF: the source names effort actuators on a legged robot's leg joints (URDF "
         "`EffortJointInterface` transmissions: Unitree's Go1 and A1, HyQ, B1), written as `<motor>`s: at "
-        "zero control the legs are limp and the robot lies down on a floor until a controller drives them.",
+        "zero control the legs are limp and the robot lies down on a floor until a controller drives them "
+        "(without the transmissions, `--actuators auto` gives them position servos).",
     ),
     CodeInfo(
         "MK860",

@@ -116,8 +116,9 @@ class ActuatorWriter:
             shown = ", ".join(limp[:4]) + (" ..." if len(limp) > 4 else "")
             self.ctx.note("MK857", f"{len(limp)} of the {len(legs)} leg joints ({shown}) have the source's "
                           "effort actuators, written as <motor>: at zero control those legs are limp and the "
-                          "robot lies down on a floor until a controller drives them", self.robot.source,
-                          "actuator")
+                          "robot lies down on a floor until a controller drives them (without its "
+                          "transmissions, --actuators auto would give them position servos)",
+                          self.robot.source, "actuator")
         held = [name for name in legs if name in on_joint and on_joint[name].kind is ActuatorKind.POSITION]
         if not held:
             return
@@ -126,8 +127,9 @@ class ActuatorWriter:
         if resting:
             shown = ", ".join(resting[:4]) + (" ..." if len(resting) > 4 else "")
             self.ctx.note("MK856", f"the home keyframe is not a standing pose: at home the robot rests on "
-                          f"{shown}, not on its feet (the source gives no initial positions of a stance), so "
-                          "on a floor its servos hold it lying down", self.robot.source, "keyframe")
+                          f"{shown}, not on its feet (the source gives no initial positions of a stance; a "
+                          "URDF can give them as ros2_control initial_value), so on a floor its servos hold "
+                          "it lying down", self.robot.source, "keyframe")
 
     def _chosen_kind(self, joint: Joint) -> ActuatorKind | None:
         """The ``--actuators`` kind of a joint the source does not actuate (None: no actuator).
