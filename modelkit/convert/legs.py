@@ -31,7 +31,7 @@ import numpy as np
 
 from modelkit.convert.base import LIMBS, _limbs, _moving_above, _points_up, _round_about
 from modelkit.convert.tracks import extent
-from modelkit.model import Joint, JointType, Robot
+from modelkit.model import Joint, JointType, Link, Robot
 
 _UP = np.array([0.0, 0.0, 1.0])
 
@@ -69,7 +69,7 @@ def _below(children: dict[str, list[Joint]], first: Joint) -> list[Joint]:
     return out
 
 
-def _is_wheel(joint: Joint, links: dict) -> bool:
+def _is_wheel(joint: Joint, links: dict[str, Link]) -> bool:
     """A hinge without a range whose child's collision shapes (its visuals without any) are round
     about its axis."""
     if joint.type is not JointType.REVOLUTE:
