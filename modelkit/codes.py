@@ -1368,6 +1368,27 @@ _TABLE: tuple[CodeInfo, ...] = (
         "to ROS 2 (ray sensor, camera or IMU plugin, stamped with its TF frame); the note gives the topics. "
         "`--no-ros-plugins` leaves them out.",
     ),
+    # MK856-MK857: MJCF, what a legged robot's home keyframe and actuators cannot do by the source's own
+    # data (numbered here, in the free part of the URDF block; docs/convert.md, "Legged robots on a floor").
+    CodeInfo(
+        "MK856",
+        "legged-home-rests-on-body",
+        "warning",
+        "MJCF: a legged robot's `home` keyframe (its initial positions, 0 where the source gives none) is "
+        "not a standing pose: at home its body or hips reach the floor before its feet (pybullet_data's "
+        "Spirit40 at q = 0 has its legs folded flat, Vision60 its legs sideways), so on a floor the servos "
+        "hold it lying down. Give the joints initial positions of a stance (the source has none; in a URDF, "
+        "a ros2_control position `state_interface`'s `initial_value`).",
+    ),
+    CodeInfo(
+        "MK857",
+        "legged-motors-limp",
+        "warning",
+        "MJCF: the source names effort actuators on a legged robot's leg joints (URDF "
+        "`EffortJointInterface` transmissions: Unitree's Go1 and A1, HyQ, B1), written as `<motor>`s: at "
+        "zero control the legs are limp and the robot lies down on a floor until a controller drives them "
+        "(without the transmissions, `--actuators auto` gives them position servos).",
+    ),
     CodeInfo(
         "MK851",
         "surface-friction-not-held",

@@ -14,11 +14,11 @@ from pathlib import Path
 
 import pytest
 
-from modelkit.api import load
+from modelkit.api import load, validate
 from modelkit.convert.api import write
 from modelkit.convert.options import WriteOptions
 from modelkit.formats.common import ReadOptions
-from modelkit.model import ActuatorKind, Robot
+from modelkit.model import ActuatorKind, JointType, Robot
 from tests.conftest import CORPUS, PENDULUM_BODY, example_robot, example_robot_data
 
 mujoco = pytest.importorskip("mujoco")
@@ -415,10 +415,12 @@ def test_reflected_inertias_equal_mujocos_mass_matrix(tmp_path: Path) -> None:
 
 
 # Legged robots of example-robot-data whose URDF names no actuators: each gets a free base and a position
-# servo per joint, and its home keyframe (q = 0, put into range: MK845) is a standing pose. Left out: A1
-# (home puts all four feet 0.16 m behind their hips and it tips over nose first: a pose, not a gain), and
-# Go1, B1 and HyQ, whose URDFs name effort interfaces (motors at zero control: the source's answer).
+# servo per joint, and its home keyframe (q = 0, put into range: MK845) is a standing pose. The A1's home
+# puts all four feet 0.16 m behind their hips: with gains for its legs' own weight alone it sagged and
+# tipped over nose first; with each leg's share of the robot's weight in the rule it stands. Left out:
+# Go1, B1 and HyQ, whose URDFs name effort interfaces (motors at zero control: the source's answer, MK857).
 EXAMPLE_LEGGED = (
+    "a1_description/urdf/a1.urdf",
     "anymal_b_simple_description/robots/anymal.urdf",
     "anymal_c_simple_description/urdf/anymal.urdf",
     "go2_description/urdf/go2.urdf",
@@ -459,3 +461,150 @@ def test_example_legged_robots_stand_at_home(tmp_path: Path, relative: str) -> N
     assert {el.tag for el in actuator_elements(out)} == {"position"}
     sag, tilt = stand_on_a_plain_floor(out)
     assert sag < STAND_SAG and tilt < STAND_TILT, f"{relative}: sank {sag * 1e3:.1f} mm, tilted {tilt:.3f}"
+
+
+# pybullet_data's quadrupeds whose URDFs declare leg joints ``continuous`` (no range) and name no
+# actuators: Laikago (toes, Z up) all twelve, Aliengo its four thighs. ``--actuators auto`` used to give
+# each such joint a motor (as for a wheel), and at zero control the robot folded to the floor (Laikago
+# 396 mm, Aliengo 350 mm in 2 s); a joint in a leg now gets a position servo (convert.legs).
+PYBULLET_LEGGED_CONTINUOUS = ("laikago/laikago_toes_zup.urdf", "aliengo/aliengo.urdf")
+
+
+@pytest.mark.parametrize("relative", PYBULLET_LEGGED_CONTINUOUS)
+def test_continuous_leg_joints_are_servoed_so_the_robot_stands(tmp_path: Path, relative: str) -> None:
+    pybullet_data = pytest.importorskip("pybullet_data")
+    robot = load(Path(pybullet_data.getDataPath()) / relative)
+    assert any(not math.isfinite(j.limits.upper) for j in robot.joints if j.type.moves), "a continuous joint"
+    out, notes = convert(robot, tmp_path)
+    sag, tilt = stand_on_a_plain_floor(out)
+    assert sag < STAND_SAG and tilt < STAND_TILT, f"{relative}: sank {sag * 1e3:.1f} mm, tilted {tilt:.3f}"
+    assert [el.tag for el in actuator_elements(out)] == ["position"] * 12
+    (said,) = [n for n in notes if n.code == "MK841"]
+    assert "or in a leg" in said.message
+
+
+FOUR_CASTERS = """<robot name="cart">
+  <link name="base"><inertial><mass value="10"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.6 0.4 0.1"/></geometry></collision></link>
+""" + "".join(f"""
+  <link name="fork{i}"><inertial><mass value="0.2"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="-0.02 0 -0.03"/><geometry><box size="0.02 0.04 0.06"/></geometry>
+    </collision></link>
+  <link name="wheel{i}"><inertial><mass value="0.3"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin rpy="1.5707963 0 0"/><geometry><cylinder radius="0.05" length="0.03"/></geometry>
+    </collision></link>
+  <joint name="swivel{i}" type="continuous"><parent link="base"/><child link="fork{i}"/>
+    <origin xyz="{x} {y} -0.1"/><axis xyz="0 0 1"/></joint>
+  <joint name="spin{i}" type="continuous"><parent link="fork{i}"/><child link="wheel{i}"/>
+    <origin xyz="-0.04 0 -0.06"/><axis xyz="0 1 0"/></joint>""" for i, (x, y) in enumerate(
+    [(0.25, 0.15), (0.25, -0.15), (-0.25, 0.15), (-0.25, -0.15)])) + "\n</robot>\n"
+
+
+def test_casters_are_not_legs(tmp_path: Path) -> None:
+    """A cart on four casters has four limbs of two joints, as a quadruped has; its limbs carry wheels
+    (an endless hinge whose child is round about its axis), so swivels and wheels keep their motors."""
+    from modelkit.convert.base import decide
+    from modelkit.convert.legs import leg_joints
+
+    path = tmp_path / "cart.urdf"
+    path.write_text(FOUR_CASTERS)
+    robot = load(path)
+    robot.root_joint = decide(robot).kind  # as --base auto settles it: floating, on wheels
+    assert robot.root_joint is JointType.FLOATING
+    assert leg_joints(robot) == frozenset()
+    out, _ = convert(robot, tmp_path / "out")
+    assert [el.tag for el in actuator_elements(out)] == ["motor"] * 8
+
+
+# -- what a legged robot's source cannot give, said at conversion (MK856, MK857) --------------------
+
+STANDING_LEGGED = EXAMPLE_LEGGED
+
+
+def test_a_home_that_lies_on_the_body_is_said(tmp_path: Path) -> None:
+    """pybullet_data's Spirit40 at q = 0 (its home: the URDF gives no initial positions) has its legs
+    folded flat beside its body: MK856 says the home keyframe is not a stance, and MuJoCo agrees: on a
+    plain floor its hips, not its toes, carry it."""
+    pybullet_data = pytest.importorskip("pybullet_data")
+    robot = load(Path(pybullet_data.getDataPath()) / "quadruped" / "spirit40.urdf")
+    out, notes = convert(robot, tmp_path)
+    (said,) = [n for n in notes if n.code == "MK856"]
+    assert "hip0, hip1, hip2, hip3" in said.message and said.severity == "warning"
+    spec = mujoco.MjSpec.from_file(str(out))
+    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0])
+    m = spec.compile()
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home"))
+    for _ in range(round(1.0 / m.opt.timestep)):
+        mujoco.mj_step(m, d)
+    touching = {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g]))
+                for c in d.contact[:d.ncon] for g in (c.geom1, c.geom2)} - {"world"}
+    assert {"hip0", "hip1", "hip2", "hip3"} <= touching and not touching & {"toe0", "toe1", "toe2", "toe3"}
+
+
+def test_source_motors_on_legs_are_said(tmp_path: Path) -> None:
+    """HyQ's URDF names an EffortJointInterface on each of its 12 leg joints: written as motors (the
+    source's answer), so MK857 says the legs are limp at zero control."""
+    robot = load(example_robot("hyq_description/robots/hyq_no_sensors.urdf"))
+    out, notes = convert(robot, tmp_path)
+    assert {el.tag for el in actuator_elements(out)} == {"motor"}
+    (said,) = [n for n in notes if n.code == "MK857"]
+    assert said.message.startswith("12 of the 12 leg joints")
+    assert not [n for n in notes if n.code == "MK856"]
+
+
+@pytest.mark.parametrize("relative", STANDING_LEGGED)
+def test_no_leg_notes_on_robots_whose_home_stands(tmp_path: Path, relative: str) -> None:
+    """Legged robots whose home puts their feet on the floor and whose joints get servos: neither note."""
+    robot = load(example_robot(relative))
+    _, notes = convert(robot, tmp_path)
+    assert not [n for n in notes if n.code in ("MK856", "MK857")]
+
+
+def test_no_leg_notes_on_the_tutorial_robots(tmp_path: Path) -> None:
+    """The samples (the tutorial's wheeled, tracked and pan-tilt robots, the smartcar, the unicycle)."""
+    samples = Path(__file__).resolve().parents[1] / "samples"
+    paths = sorted(samples.glob("choreonoid_ros2_mobile_robot_tutorial/model/*.body"))
+    paths += [samples / "smartcar" / "urdf" / "myrobot.urdf.xacro",
+              samples / "gazebo_unicycle" / "unicycle.sdf"]
+    assert len(paths) >= 5
+    for path in paths:
+        robot = validate(path).robot  # mobile_robot_mesh.body has an error (its missing chassis mesh)
+        assert robot is not None
+        _, notes = convert(robot, tmp_path / path.stem)
+        assert not [n for n in notes if n.code in ("MK856", "MK857")], path.name
+
+
+def test_spirit40_given_a_stance_holds_it_with_its_legs_share_of_the_weight(tmp_path: Path) -> None:
+    """pybullet_data's Spirit40 has 75 g lower legs: with gains for a leg's own weight alone its knees
+    got kp 44 N·m/rad and, given a stance (hips 0.8, knees 1.6 rad) on a plain floor, sagged 0.18 rad
+    (the base 26 mm) while carrying the 11.5 kg robot; with each leg's share of the weight in the rule,
+    every joint stays within 0.05 rad of the stance and the base within 15 mm."""
+    pybullet_data = pytest.importorskip("pybullet_data")
+    robot = load(Path(pybullet_data.getDataPath()) / "quadruped" / "spirit40.urdf")
+    for joint in robot.joints:
+        joint.initial_position = {"0": 0.8, "2": 0.8, "4": 0.8, "6": 0.8,
+                                  "1": 1.6, "3": 1.6, "5": 1.6, "7": 1.6}.get(joint.name, 0.0)
+    out, notes = convert(robot, tmp_path)
+    assert not [n for n in notes if n.code == "MK856"], "a stance: its toes carry it"
+    spec = mujoco.MjSpec.from_file(str(out))
+    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0])
+    m = spec.compile()
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home"))
+    for _ in range(100):  # lift it out of the floor: no contact deeper than 0.1 mm
+        mujoco.mj_forward(m, d)
+        depth = min([c.dist for c in d.contact[:d.ncon]] or [0.0])
+        if depth >= -1e-4:
+            break
+        d.qpos[2] -= depth
+    home, start = d.qpos[7:].copy(), float(d.qpos[2])
+    worst = 0.0
+    for _ in range(round(STAND_SECONDS / m.opt.timestep)):
+        mujoco.mj_step(m, d)
+        worst = max(worst, float(np.abs(d.qpos[7:] - home).max()))
+    sag = start - float(d.qpos[2])
+    assert worst < 0.05 and sag < STAND_SAG, f"joints {worst:.3f} rad off, base sank {sag * 1e3:.1f} mm"

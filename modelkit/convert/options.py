@@ -31,8 +31,8 @@ class WriteOptions:
     wheel_collision: str = "auto"  # auto|cylinder|sphere|ellipsoid: the wheels' collision (convert.wheels)
     base: str = "auto"  # fixed | floating | auto: how the root meets the world (modelkit/convert/base.py)
     # actuators for a source without any (MJCF): auto (default: a position servo on each joint with a
-    # range, a motor on each without) | motor | position | velocity | none; the source's own actuators
-    # are always written as they are (docs/convert.md, "Actuators")
+    # range or in a leg, a motor on each other) | motor | position | velocity | none; the source's own
+    # actuators are always written as they are (docs/convert.md, "Actuators")
     actuators: str = "auto"
     # MJCF: massless frame links (modelkit/convert/frames.py) as <site>s in the body they hang on, as
     # MuJoCo Menagerie writes them (MK873); False writes them as empty bodies

@@ -17,6 +17,9 @@ raised to ``τ_g · R / SAG_PER_JOINT``: small arms with long light links (the S
 after 2 s at 30 Hz alone) hold as well as big ones. The raised servo's frequency stays at most
 ``2π·MAX_BANDWIDTH_HZ`` (``ωn·dt`` ≤ 1 at MuJoCo's 2 ms step; the explicit limit is 2). ``τ_g`` is
 taken with gravity along the root's −Z (an arm standing upright on its base, as fixed bases are).
+A joint in a leg of a legged robot also carries its share of the robot's weight through its foot
+(:func:`modelkit.convert.legs.carried_loads`): that torque is added to ``τ_g``, and ``R`` is at least
+the distance to the foot, so a leg's servos hold the robot standing at home as an arm's hold the arm.
 A subtree without mass gets ``MIN_INERTIA`` so that every gain is positive.
 """
 
@@ -27,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from modelkit.convert.legs import carried_loads
 from modelkit.model import Joint, JointType, Link, Robot
 from modelkit.spatial import Pose
 
@@ -79,6 +83,10 @@ def joint_loads(robot: Robot) -> dict[str, JointLoad]:
         total = sums.get(joint.child)
         load = JointLoad(0.0) if total is None else _load_about(joint, poses[joint.child], total)
         out[joint.name] = JointLoad(load.inertia + joint.armature, load.gravity, load.reach)
+    for name, (torque, lever) in carried_loads(robot, home).items():
+        if name in out:
+            own = out[name]
+            out[name] = JointLoad(own.inertia, own.gravity + torque, max(own.reach, lever))
     return out
 
 

@@ -10,10 +10,10 @@
   (MK843).
 * A source without actuators: every hinge and slide that is not a mimic follower or locked gets the
   ``--actuators`` kind, or none (MK841). ``auto`` (the default): a position servo on each joint with a
-  range (the model holds its ``home`` pose, as MuJoCo Menagerie's arms and legs do), a motor on each
-  joint without one (wheels: gear 1, the control is the joint force, ``ctrlrange`` = ±effort; zero
-  control leaves the joint free). The track approximation's roller servos do not count as the
-  source's: a tracked robot's other joints get the choice too.
+  range or in a leg (the model holds its ``home`` pose, as MuJoCo Menagerie's arms and legs do), a
+  motor on each other joint without a range (wheels: gear 1, the control is the joint force,
+  ``ctrlrange`` = ±effort; zero control leaves the joint free). The track approximation's roller
+  servos do not count as the source's: a tracked robot's other joints get the choice too.
 
 Position actuators make the ``home`` keyframe carry ``ctrl`` = the home positions (others 0), so that
 a model reset to ``home`` holds it.
@@ -24,10 +24,12 @@ from __future__ import annotations
 import math
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.legs import leg_joints, resting_on
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.convert.servo_gains import (
     SERVO_BANDWIDTH_HZ,
     JointLoad,
+    home_position,
     joint_loads,
     natural_frequency,
     natural_frequency_for,
@@ -57,6 +59,7 @@ class ActuatorWriter:
         self.any_position = False
         self.servos = 0  # position and velocity actuators written
         self._loads: dict[str, JointLoad] | None = None
+        self._legs: frozenset[str] | None = None  # the joints in a legged robot's legs, found once
 
     def write(self, home: dict[str, float]) -> None:
         by_name: dict[str, Joint] = {}
@@ -79,6 +82,7 @@ class ActuatorWriter:
             planned += [(a, by_name.get(a.joint)) for a in chosen]
         skipped = self._constrained()
         written: dict[ActuatorKind, int] = {}
+        on_joint: dict[str, Actuator] = {}  # source joint name → the actuator written on it
         for actuator, joint in planned:
             target = self.joint_names.get(actuator.joint)
             reason = self._unwritable(joint, target, skipped)
@@ -89,26 +93,60 @@ class ActuatorWriter:
                 continue
             assert joint is not None and target is not None
             self._one(actuator, joint, target[0], home.get(target[0], 0.0))
+            on_joint.setdefault(joint.name, actuator)
             if actuator.source_kind == "--actuators":
                 written[actuator.kind] = written.get(actuator.kind, 0) + 1
         self._uncanonical()
         movable = any(j.type in (JointType.REVOLUTE, JointType.PRISMATIC) for j in self.robot.joints)
         if made_up and movable:
             self._said_choice(written)
+        self._said_legs(on_joint)
+
+    def _said_legs(self, on_joint: dict[str, Actuator]) -> None:
+        """MK857: the source's motors leave a legged robot's legs limp; MK856: its home pose, which the
+        servos hold, lies on the body, not the feet (convert.legs)."""
+        if self._legs is None:
+            self._legs = leg_joints(self.robot)
+        legs = sorted(self._legs)
+        if not legs:
+            return
+        limp = [name for name in legs if name in on_joint and on_joint[name].kind is ActuatorKind.EFFORT
+                and on_joint[name].source_kind != "--actuators"]
+        if limp:
+            shown = ", ".join(limp[:4]) + (" ..." if len(limp) > 4 else "")
+            self.ctx.note("MK857", f"{len(limp)} of the {len(legs)} leg joints ({shown}) have the source's "
+                          "effort actuators, written as <motor>: at zero control those legs are limp and the "
+                          "robot lies down on a floor until a controller drives them (without its "
+                          "transmissions, --actuators auto would give them position servos)",
+                          self.robot.source, "actuator")
+        held = [name for name in legs if name in on_joint and on_joint[name].kind is ActuatorKind.POSITION]
+        if not held:
+            return
+        home = {j.name: home_position(j) for j in self.robot.joints}
+        resting = resting_on(self.robot, home)
+        if resting:
+            shown = ", ".join(resting[:4]) + (" ..." if len(resting) > 4 else "")
+            self.ctx.note("MK856", f"the home keyframe is not a standing pose: at home the robot rests on "
+                          f"{shown}, not on its feet (the source gives no initial positions of a stance; a "
+                          "URDF can give them as ros2_control initial_value), so on a floor its servos hold "
+                          "it lying down", self.robot.source, "keyframe")
 
     def _chosen_kind(self, joint: Joint) -> ActuatorKind | None:
         """The ``--actuators`` kind of a joint the source does not actuate (None: no actuator).
 
-        ``auto``: a position servo on a joint with a finite range, so the written model holds its home
-        pose as MuJoCo Menagerie's arms and legs do; a motor on a joint without one (wheels, casters,
-        endless spindles), whose zero control leaves it free as the source has it."""
+        ``auto``: a position servo on a joint with a finite range or in a leg (:mod:`modelkit.convert.legs`:
+        a URDF's ``continuous`` knee), so the written model holds its home pose as MuJoCo Menagerie's arms
+        and legs do; a motor on any other joint without one (wheels, casters, endless spindles), whose
+        zero control leaves it free as the source has it."""
         if joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
             return None
         choice = self.ctx.options.actuators
         if choice == "auto":
             lower, upper = joint.limits.lower, joint.limits.upper
             ranged = math.isfinite(lower) and math.isfinite(upper) and lower < upper
-            return ActuatorKind.POSITION if ranged else ActuatorKind.EFFORT
+            if self._legs is None:
+                self._legs = leg_joints(self.robot)
+            return ActuatorKind.POSITION if ranged or joint.name in self._legs else ActuatorKind.EFFORT
         return CHOICES.get(choice)
 
     def _said_choice(self, written: dict[ActuatorKind, int]) -> None:
@@ -123,8 +161,8 @@ class ActuatorWriter:
                                 sorted(written.items(), key=lambda item: ORDER.index(item[0])))
         why = ""
         if choice == "auto":
-            why = ("; auto puts a position servo on each joint with a range (the home keyframe holds) and a "
-                   "motor on each joint without one (zero control leaves it free)")
+            why = ("; auto puts a position servo on each joint with a range or in a leg (the home keyframe "
+                   "holds) and a motor on each other joint without a range (zero control leaves it free)")
         self.ctx.note("MK841", f"the source names no actuators: {what} written (--actuators {choice}{why})",
                       self.robot.source, "actuator")
 
@@ -232,8 +270,11 @@ class ActuatorWriter:
         why = f"a {fmt(SERVO_BANDWIDTH_HZ)} Hz critically damped servo"
         if hz > SERVO_BANDWIDTH_HZ * (1.0 + 1e-9):
             force = "N" if joint.type is JointType.PRISMATIC else "N·m"
+            if self._legs is None:
+                self._legs = leg_joints(self.robot)
+            share = " (with its leg's share of the robot's weight)" if joint.name in self._legs else ""
             why = (f"a critically damped servo raised to {hz:.1f} Hz against the gravity load "
-                   f"{load.gravity:.3g} {force} at home (docs/convert.md)")
+                   f"{load.gravity:.3g} {force}{share} at home (docs/convert.md)")
         self.ctx.note(
             "MK840",
             f"{actuator.kind.value} actuator on joint {joint.name}: {gains} from its reflected inertia "

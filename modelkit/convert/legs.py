@@ -1,0 +1,149 @@
+"""The joints of a legged robot's legs, for the writers that must not take a leg joint for a wheel.
+
+A URDF may declare a leg's joints ``continuous`` (pybullet_data's Laikago: all twelve; Aliengo: its
+four thighs). ``--actuators auto`` gives a joint without a range a motor, as wheels, casters and
+spindles want (zero control leaves them free); on a leg that motor lets the robot fold to the floor.
+
+A leg here is a limb as :mod:`modelkit.convert.base` counts them for ``--base auto`` (a first moving
+joint below the root's rigid body with two or more moving joints in a row below it, not pointing up at
+q = 0), in a robot with four or more such limbs whose root floats (as settled for the output: a welded
+test rig of 30 chains has no legs), that carries no wheel: no hinge in it without a range
+whose child's shapes are round about its axis (a wheeled leg's wheel, a caster's wheel; a cart with
+four casters has four limbs of two joints, and its swivels stay free).
+
+:func:`resting_on` says what a legged robot rests on at its home pose: the links whose shapes reach
+the lowest level (within 2 % of the robot's height, at least 1 mm, as ``--base auto`` judges it) that
+hang from the root through fewer than two moving joints (the body, a hip): pybullet_data's Spirit40
+at q = 0 has its legs folded flat beside its body, Vision60 its legs sideways. The MJCF writer says so
+(MK856): its servos then hold a pose that lies on the floor.
+
+:func:`carried_loads` is what each leg joint carries of the robot standing at home, for the servo gain
+rule (:mod:`modelkit.convert.servo_gains`): the robot's weight shared equally by its legs, standing on
+each leg's foot (the leg's lowest link frame at home), as a torque about the joint (a force along a
+slide) with the distance from the joint to that foot as its lever.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from modelkit.convert.base import LIMBS, _limbs, _moving_above, _points_up, _round_about
+from modelkit.convert.tracks import extent
+from modelkit.model import Joint, JointType, Link, Robot
+
+_UP = np.array([0.0, 0.0, 1.0])
+
+
+def leg_joints(robot: Robot) -> frozenset[str]:
+    """The names of the hinges and slides in the legs of a legged robot (empty for any other robot)."""
+    if robot.root_joint is not JointType.FLOATING:
+        return frozenset()
+    poses = robot.world_poses()
+    legs = [name for name in _limbs(robot) if not _points_up(robot, poses, name)]
+    if len(legs) < LIMBS:
+        return frozenset()
+    children = robot.children_of()
+    by_name = {joint.name: joint for joint in robot.joints}
+    links = {link.name: link for link in robot.links}
+    out: set[str] = set()
+    for first in legs:
+        below = _below(children, by_name[first])
+        if any(_is_wheel(joint, links) for joint in below):
+            continue
+        out.update(j.name for j in below if j.type in (JointType.REVOLUTE, JointType.PRISMATIC))
+    return frozenset(out)
+
+
+def _below(children: dict[str, list[Joint]], first: Joint) -> list[Joint]:
+    """``first`` and every joint below it."""
+    out: list[Joint] = [first]
+    stack, seen = [first.child], {first.child}
+    while stack:
+        for joint in children.get(stack.pop(), []):
+            out.append(joint)
+            if joint.child not in seen:
+                seen.add(joint.child)
+                stack.append(joint.child)
+    return out
+
+
+def _is_wheel(joint: Joint, links: dict[str, Link]) -> bool:
+    """A hinge without a range whose child's collision shapes (its visuals without any) are round
+    about its axis."""
+    if joint.type is not JointType.REVOLUTE:
+        return False
+    lower, upper = joint.limits.lower, joint.limits.upper
+    if math.isfinite(lower) and math.isfinite(upper) and lower < upper:
+        return False
+    link = links.get(joint.child)
+    axis = np.asarray(joint.axis, dtype=float)
+    norm = float(np.linalg.norm(axis))
+    if link is None or norm == 0.0:
+        return False
+    geoms = link.collisions or link.visuals
+    return any(_round_about(geom, axis / norm) for geom in geoms)
+
+
+def carried_loads(robot: Robot, home: dict[str, float]) -> dict[str, tuple[float, float]]:
+    """Leg joint name → (the torque, or force, that the robot's weight shared by its legs puts on it at
+    ``home`` through the leg's foot; the distance from the joint to the foot). Empty without legs."""
+    legs = leg_joints(robot)
+    if not legs:
+        return {}
+    poses = robot.world_poses(home)
+    children = robot.children_of()
+    by_name = {joint.name: joint for joint in robot.joints}
+    firsts = [name for name in _limbs(robot) if name in legs]
+    mass = sum(max(link.inertial.mass, 0.0) for link in robot.links if link.inertial is not None)
+    share = np.array([0.0, 0.0, mass * 9.81 / len(firsts)])  # the floor's push on each foot
+    out: dict[str, tuple[float, float]] = {}
+    for first in firsts:
+        below = [j for j in _below(children, by_name[first]) if j.child in poses]
+        if not below:
+            continue
+        lowest = min((poses[j.child] for j in below), key=lambda pose: float(pose.translation[2]))
+        foot = np.asarray(lowest.translation, dtype=float)
+        for joint in below:
+            if joint.name not in legs:
+                continue
+            frame = poses[joint.child]
+            axis = np.asarray(frame.rotation, dtype=float) @ np.asarray(joint.axis, dtype=float)
+            norm = float(np.linalg.norm(axis))
+            if norm == 0.0:
+                continue
+            axis /= norm
+            lever = foot - np.asarray(frame.translation, dtype=float)
+            if joint.type is JointType.PRISMATIC:
+                out[joint.name] = (abs(float(axis @ share)), 1.0)
+            else:
+                out[joint.name] = (abs(float(axis @ np.cross(lever, share))), float(np.linalg.norm(lever)))
+    return out
+
+
+def resting_on(robot: Robot, home: dict[str, float]) -> list[str]:
+    """The links a legged robot at ``home`` (joint name → position) rests on other than its feet: those
+    reaching the lowest level through fewer than two moving joints from the root (sorted; empty when
+    it stands on its feet, or has no legs)."""
+    if not leg_joints(robot):
+        return []
+    poses = robot.world_poses(home)
+    use_collisions = any(link.collisions for link in robot.links)
+    lows: dict[str, tuple[float, float]] = {}
+    for link in robot.links:
+        geoms = link.collisions if use_collisions else link.visuals
+        pose = poses.get(link.name)
+        if pose is None or not geoms:
+            continue
+        span = extent(geoms, pose.rotation.T @ _UP)
+        if span is not None:
+            z = float(pose.translation[2])
+            lows[link.name] = (z + span[0], z + span[1])
+    if not lows:
+        return []
+    ground = min(low for low, _ in lows.values())
+    tolerance = max(1e-3, 0.02 * (max(high for _, high in lows.values()) - ground))
+    parent_joint = {joint.child: joint for joint in robot.joints}
+    return sorted(name for name, (low, _) in lows.items()
+                  if low - ground <= tolerance and len(_moving_above(parent_joint, name)) < 2)
