@@ -582,7 +582,12 @@ def test_spirit40_given_a_stance_holds_it_with_its_legs_share_of_the_weight(tmp_
     """pybullet_data's Spirit40 has 75 g lower legs: with gains for a leg's own weight alone its knees
     got kp 44 N·m/rad and, given a stance (hips 0.8, knees 1.6 rad) on a plain floor, sagged 0.18 rad
     (the base 26 mm) while carrying the 11.5 kg robot; with each leg's share of the weight in the rule,
-    every joint stays within 0.05 rad of the stance and the base within 15 mm."""
+    every joint is back within 0.05 rad of the stance after 3 s and the base within 15 mm.
+
+    Its toes carry the source's PyBullet friction (lateral 3, spinning 0.3: MJCF friction "3 0.3",
+    condim 4), so they stick where they land: the legs take the touchdown without sliding, a transient
+    of 0.09 rad at 0.1 s that the servos then work off (0.003 rad at 3 s). Measured with the rule
+    before (gains for a leg's own weight): 0.23 rad transient, 0.10 rad at 3 s, 26.6 mm sag."""
     pybullet_data = pytest.importorskip("pybullet_data")
     robot = load(Path(pybullet_data.getDataPath()) / "quadruped" / "spirit40.urdf")
     for joint in robot.joints:
@@ -601,10 +606,14 @@ def test_spirit40_given_a_stance_holds_it_with_its_legs_share_of_the_weight(tmp_
         if depth >= -1e-4:
             break
         d.qpos[2] -= depth
+    toes = [g for g in range(m.ngeom) if m.geom_condim[g] == 4]
+    assert len(toes) == 4 and all(float(m.geom_friction[g][0]) == 3.0 for g in toes)  # the source's
     home, start = d.qpos[7:].copy(), float(d.qpos[2])
     worst = 0.0
     for _ in range(round(STAND_SECONDS / m.opt.timestep)):
         mujoco.mj_step(m, d)
         worst = max(worst, float(np.abs(d.qpos[7:] - home).max()))
-    sag = start - float(d.qpos[2])
-    assert worst < 0.05 and sag < STAND_SAG, f"joints {worst:.3f} rad off, base sank {sag * 1e3:.1f} mm"
+    sag, held = start - float(d.qpos[2]), float(np.abs(d.qpos[7:] - home).max())
+    assert held < 0.05 and worst < 0.15 and sag < STAND_SAG, (
+        f"joints {held:.3f} rad off at the end ({worst:.3f} at worst), base sank {sag * 1e3:.1f} mm"
+    )

@@ -47,6 +47,16 @@ EXPECTED = {
 }
 
 
+def _base_dynamics(urdf: Path) -> tuple[float, ...]:
+    """PyBullet's ``getDynamicsInfo`` of the file's base link, loaded as PyBullet users load it."""
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        body = pybullet.loadURDF(str(urdf), physicsClientId=client)
+        return tuple(pybullet.getDynamicsInfo(body, -1, physicsClientId=client))
+    finally:
+        pybullet.disconnect(client)
+
+
 def _source(tmp_path: Path, kind: str) -> Path:
     path = tmp_path / f"source.{kind}"
     path.write_text(SOURCES[kind])
@@ -103,12 +113,7 @@ def test_mujoco_reads_the_written_friction(tmp_path: Path, kind: str) -> None:
 def test_pybullet_reads_the_written_friction(tmp_path: Path, kind: str) -> None:
     out = tmp_path / "out" / "r.urdf"
     convert([_source(tmp_path, kind)], out)
-    client = pybullet.connect(pybullet.DIRECT)
-    try:
-        body = pybullet.loadURDF(str(out), physicsClientId=client)
-        info = pybullet.getDynamicsInfo(body, -1, physicsClientId=client)
-    finally:
-        pybullet.disconnect(client)
+    info = _base_dynamics(out)
     expected = EXPECTED[kind]
     assert info[1] == pytest.approx(expected.sliding)  # lateral
     assert info[6] == pytest.approx(expected.rolling or 0.0)  # rolling
@@ -171,12 +176,7 @@ def test_pybullet_contact_model_is_kept_in_urdf_and_said_elsewhere(tmp_path: Pat
     source = _source(tmp_path, "urdf")
     back = tmp_path / "u" / "r.urdf"
     convert([source], back)
-    client = pybullet.connect(pybullet.DIRECT)
-    try:
-        body = pybullet.loadURDF(str(back), physicsClientId=client)
-        info = pybullet.getDynamicsInfo(body, -1, physicsClientId=client)
-    finally:
-        pybullet.disconnect(client)
+    info = _base_dynamics(back)
     assert (info[8], info[9]) == (pytest.approx(1000.0), pytest.approx(30000.0))  # damping, stiffness
     result = convert([source], tmp_path / "o" / target)
     said = [n for n in result.notes if n.code == "MK851" and "PyBullet <contact> parameters" in n.message]

@@ -54,6 +54,24 @@ class BaseDecision:
     reason: str
 
 
+
+def vertical_spans(robot: Robot, poses: dict[str, Pose]) -> dict[str, tuple[float, float]]:
+    """Link name → the lowest and highest world height of its collision shapes (its visuals when the
+    robot has no collision shape at all), at ``poses``; links without shapes or pose are absent."""
+    use_collisions = any(link.collisions for link in robot.links)
+    spans: dict[str, tuple[float, float]] = {}
+    for link in robot.links:
+        geoms = link.collisions if use_collisions else link.visuals
+        pose = poses.get(link.name)
+        if pose is None or not geoms:
+            continue
+        span = extent(geoms, pose.rotation.T @ _UP)
+        if span is not None:
+            z = float(pose.translation[2])
+            spans[link.name] = (z + span[0], z + span[1])
+    return spans
+
+
 def settle_base(robot: Robot, choice: str, notes: NoteSink) -> None:
     """Set ``robot.root_joint`` (and the joints from a ``world`` root) to the base the output gets."""
     if choice not in BASE_CHOICES:
@@ -154,16 +172,7 @@ def decide(robot: Robot) -> BaseDecision:
     limbs = [name for name in every_limb if not _points_up(robot, poses, name)]
     raised = len(every_limb) - len(limbs)
     use_collisions = any(link.collisions for link in robot.links)
-    lows: dict[str, tuple[float, float]] = {}
-    for link in robot.links:
-        geoms = link.collisions if use_collisions else link.visuals
-        pose = poses.get(link.name)
-        if pose is None or not geoms:
-            continue
-        span = extent(geoms, pose.rotation.T @ _UP)
-        if span is not None:
-            z = float(pose.translation[2])
-            lows[link.name] = (z + span[0], z + span[1])
+    lows = vertical_spans(robot, poses)
     if not lows:
         return BaseDecision(JointType.FLOATING, "it has no shape to judge by, so URDF's own convention "
                             "(a root that does not hang from `world` floats)")

@@ -29,11 +29,8 @@ import math
 
 import numpy as np
 
-from modelkit.convert.base import LIMBS, _limbs, _moving_above, _points_up, _round_about
-from modelkit.convert.tracks import extent
+from modelkit.convert.base import LIMBS, _limbs, _moving_above, _points_up, _round_about, vertical_spans
 from modelkit.model import Joint, JointType, Link, Robot
-
-_UP = np.array([0.0, 0.0, 1.0])
 
 
 def leg_joints(robot: Robot) -> frozenset[str]:
@@ -129,17 +126,7 @@ def resting_on(robot: Robot, home: dict[str, float]) -> list[str]:
     if not leg_joints(robot):
         return []
     poses = robot.world_poses(home)
-    use_collisions = any(link.collisions for link in robot.links)
-    lows: dict[str, tuple[float, float]] = {}
-    for link in robot.links:
-        geoms = link.collisions if use_collisions else link.visuals
-        pose = poses.get(link.name)
-        if pose is None or not geoms:
-            continue
-        span = extent(geoms, pose.rotation.T @ _UP)
-        if span is not None:
-            z = float(pose.translation[2])
-            lows[link.name] = (z + span[0], z + span[1])
+    lows = vertical_spans(robot, poses)
     if not lows:
         return []
     ground = min(low for low, _ in lows.values())
