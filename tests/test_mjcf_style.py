@@ -9,6 +9,12 @@ masses and inertias, every geom's body, type, size, pose, contype, conaffinity, 
 friction, solref and solimp, every mesh's vertex count and bounds. The same is compiled from today's
 output and compared to 1e-12.
 
+One deliberate change since: the MJCF humanoid's contact parameters and timestep. The writer before
+lost the source's own (condim 1, friction 0.7, solref ".015 1", solimp ".9 .99 .003", timestep 0.005)
+and gave every geom priority 1; the reference now holds the source's, which the output compiles to
+exactly (each of its 19 collision geoms and the option checked against MuJoCo's compile of the
+source itself).
+
 Regenerate the reference only from a writer known to be right:
 ``python -m tests.test_mjcf_style > tests/mjcf/style_before.json``.
 """

@@ -87,9 +87,28 @@ def test_mujoco_default_friction_is_not_a_source_choice(tmp_path: Path) -> None:
     path.write_text(MJCF.replace(' friction="0.3 0.02 0.01" condim="6"', ' friction="1 0.02 0.01"'))
     robot = read_model(path).robot
     assert robot is not None and robot.links[-1].collisions[0].friction is None
-    path.write_text(MJCF.replace(' condim="6"', ' condim="1"'))
+
+
+def test_mjcf_condim_1_mixes_by_mujocos_rule_in_mjcf_output(tmp_path: Path) -> None:
+    """A geom of condim 1 is frictionless only against other condim-1 geoms: MuJoCo mixes two geoms of
+    equal priority by the larger condim and friction, so on a default floor (condim 3, friction 1) it
+    slides with friction 1 (dm_control's humanoid: condim 1, friction 0.7). Its own sliding friction
+    is kept, and MJCF output keeps its condim and priority, so the same floor gives the same contact."""
+    path = tmp_path / "c.xml"
+    path.write_text(MJCF.replace(' friction="0.3 0.02 0.01" condim="6"', ' friction="0.7" condim="1"'))
     robot = read_model(path).robot
-    assert robot is not None and robot.links[-1].collisions[0].friction == SurfaceFriction(0.0, 0.0, 0.0)
+    assert robot is not None and robot.links[-1].collisions[0].friction == SurfaceFriction(0.7, 0.0, 0.0)
+    out = tmp_path / "o" / "c.xml"
+    convert([path], out)
+    spec = mujoco.MjSpec.from_file(str(out))
+    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0])
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    data.qpos[2] = 0.099  # resting on the floor
+    mujoco.mj_forward(model, data)
+    assert data.ncon > 0
+    contact = data.contact[0]
+    assert contact.dim == 3 and contact.friction[0] == pytest.approx(1.0)  # as the source on that floor
 
 
 @pytest.mark.parametrize("kind", sorted(SOURCES))
@@ -106,7 +125,8 @@ def test_mujoco_reads_the_written_friction(tmp_path: Path, kind: str) -> None:
     assert model.geom_friction[g][2] == pytest.approx(expected.rolling or 0.0, abs=1e-12)
     if expected.torsional:
         assert model.geom_friction[g][1] == pytest.approx(expected.torsional, abs=1e-12)
-    assert model.geom_priority[g] == 1  # wins against a default floor's friction
+    # another format's friction wins against a default floor's; an MJCF source keeps MuJoCo's own rule
+    assert model.geom_priority[g] == (0 if kind == "xml" else 1)
 
 
 @pytest.mark.parametrize("kind", sorted(SOURCES))

@@ -56,10 +56,14 @@ GEOM_CONTACT_DEFAULTS: dict[str, tuple[float, ...]] = {
     "margin": (0.0,),
     "gap": (0.0,),
     "solmix": (1.0,),
+    "condim": (3.0,),
+    "priority": (0.0,),
 }
-"""A geom's contact parameters besides friction, with MuJoCo's defaults. Not ``priority``: a written
-MJCF's collision class sets its own (the robot's friction wins against a floor), and other targets
-combine shapes by their own rules."""
+"""A geom's contact parameters besides its friction coefficients, with MuJoCo's defaults. ``condim``
+and ``priority`` decide, with MuJoCo's mixing rule, which geom's friction a contact uses: an MJCF
+source's own are written back as they were (MJCF output keeps MuJoCo's rules, see
+``formats.mjcf.write_geoms``)."""
+INTEGER_CONTACT = frozenset({"condim", "priority"})
 
 
 @dataclass

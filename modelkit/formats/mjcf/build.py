@@ -491,12 +491,15 @@ MUJOCO_DEFAULT_FRICTION = SurfaceFriction(1.0, 0.0, 0.0)
 
 
 def surface_friction(mg: MjGeom) -> SurfaceFriction | None:
-    """The friction a MuJoCo geom applies: ``condim`` says which of its three coefficients act (1: none,
-    the contact is frictionless; 3: sliding; 4: and torsional; 6: and rolling). None when that is
-    MuJoCo's default, which the source did not choose."""
+    """The friction a MuJoCo geom brings to a contact: its sliding coefficient, and its torsional and
+    rolling ones where its ``condim`` lets them act (4: torsional, 6: and rolling). MuJoCo mixes two
+    geoms of equal priority by the larger condim and the larger coefficients, so a geom's ``condim``
+    1 makes only its contacts with other condim-1 geoms frictionless (a humanoid's limbs), not with a
+    floor: it is kept with the geom's other contact parameters for MJCF output, not read as a
+    friction of 0. None when the coefficients are MuJoCo's default, which the source did not choose."""
     sliding, torsional, rolling = (float(x) for x in mg.friction)
     acting = SurfaceFriction(
-        sliding if mg.condim > 1 else 0.0,
+        sliding,
         torsional if mg.condim >= 4 else 0.0,
         rolling if mg.condim >= 6 else 0.0,
     )

@@ -16,6 +16,7 @@ from typing import Any
 from modelkit import rot3
 from modelkit.formats.mjcf.bodies import (
     GEOM_CONTACT_DEFAULTS,
+    INTEGER_CONTACT,
     MjBody,
     MjGeom,
     MjInertial,
@@ -321,5 +322,5 @@ def contact_attributes(m: Any, g: int) -> dict[str, str]:
         raw = getattr(m, f"geom_{name}")[g]
         values = tuple(float(x) for x in (raw if hasattr(raw, "__len__") else (raw,)))
         if any(abs(a - b) > 1e-12 * max(1.0, abs(b)) for a, b in zip(values, default, strict=True)):
-            out[name] = fmt_vec(values)
+            out[name] = str(int(values[0])) if name in INTEGER_CONTACT else fmt_vec(values)
     return out

@@ -67,6 +67,9 @@ class GeomWriter:
     shared_stems: set[str] = field(default_factory=set)  # stems of both a collision and a visual file
     used: set[str] = field(default_factory=set)  # the classes (VISUAL, COLLISION) a geom names
     surface_links: set[str] = field(default_factory=set)  # links whose geoms got the source's friction
+    mujoco_rules: bool = False
+    """An MJCF source: its geoms' friction, condim and priority are written as they were, and mix with
+    a floor's by MuJoCo's rules as in the source (no collision-class priority above a floor's)."""
 
     def defaults(self, section: Element, robot_name: str) -> None:
         """``<default class=robot>`` with the ``visual`` and ``collision`` classes the geoms use."""
@@ -75,8 +78,9 @@ class GeomWriter:
         top = sub(section, "default", **{"class": self.names.claim("default", robot_name or "robot",
                                                                     note=False)})
         if COLLISION in self.used:
-            geom = sub(sub(top, "default", **{"class": COLLISION}), "geom", group=COLLISION_GROUP,
-                       priority=CONTACT_PRIORITY)
+            geom = sub(sub(top, "default", **{"class": COLLISION}), "geom", group=COLLISION_GROUP)
+            if not self.mujoco_rules:
+                geom.set("priority", CONTACT_PRIORITY)
             for key, value in self.contact.items():
                 geom.set(key, value)
         if VISUAL in self.used:

@@ -87,7 +87,8 @@ class MjcfWriter:
         compiler.set("autolimits", "true")
         compiler.set("inertiafromgeom", "false")
         self.geoms = GeomWriter(ctx, self.names, self.sections["asset"], floor_friction(robot),
-                                mujoco_contact(robot), shared_stems=shared_stems(robot.links))
+                                mujoco_contact(robot), shared_stems=shared_stems(robot.links),
+                                mujoco_rules=robot.source_format == "mjcf")
         self.devices = DeviceWriter(ctx, self.names, self.sections["sensor"])
         self.tree = BodyTree(robot, ctx, self.names, self.geoms, self.devices)
         options, why = mujoco_options(robot)  # wheels or tracks (convert.simulator says why)
