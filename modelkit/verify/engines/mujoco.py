@@ -146,8 +146,21 @@ def _compile(path: Path, root: str, actuated: bool = False,
                 act.gaintype, act.biastype = mujoco.mjtGain.mjGAIN_FIXED, mujoco.mjtBias.mjBIAS_AFFINE
                 act.gainprm[0] = 0.0
     model = spec.compile()
-    model.opt.gravity[:] = GRAVITY
+    reference_world(model)
     return model, welded
+
+
+def reference_world(model: Any) -> None:
+    """The world layers 1–3 compare engines in, whatever the file's ``<option>`` says (an MJCF source's
+    own options are written back by ``convert``: dm_control's finger and swimmer disable gravity, the
+    swimmer swims in a fluid): gravity (0, 0, −9.81), no fluid or wind, every feature flag at
+    MuJoCo's default (the replay then disables contact, limits and equalities itself)."""
+    model.opt.gravity[:] = GRAVITY
+    model.opt.density = 0.0
+    model.opt.viscosity = 0.0
+    model.opt.wind[:] = 0.0
+    model.opt.disableflags = 0
+    model.opt.enableflags = 0
 
 
 @dataclass(frozen=True)
@@ -195,6 +208,7 @@ class MujocoModel:
             "base": ("root body's free joint deleted through MjSpec" if deleted
                      else "root body has no free joint"),
             "gravity": list(GRAVITY),
+            "world": "no fluid or wind, MuJoCo's default feature flags (the file's own <option> set aside)",
             "links": ("the model's links, as modelkit's MJCF reader makes them from MuJoCo's compiled "
                       "bodies: a body's link frame is the body frame moved to its last joint's anchor "
                       "(jnt_pos); a body with n joints is a chain of n links, the first n - 1 massless "
