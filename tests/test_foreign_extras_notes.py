@@ -110,3 +110,26 @@ def test_mjcf_options_and_contact_parameters_survive_mjcf_and_are_said_elsewhere
         assert len(options) == 1 and "<option>" in options[0].message, target
         contact = [n for n in notes if n.code == "MK851" and "contact parameters" in n.message]
         assert len(contact) == 1 and "solref 0.01 1" in contact[0].message, target
+
+
+PAIRS = """<mujoco model="cp"><worldbody>
+  <body name="a"><freejoint/><geom name="ga" type="sphere" size="0.1" mass="1"/>
+    <body name="b" pos="0 0 0.3"><joint name="j" type="hinge"/>
+      <geom name="gb" type="sphere" size="0.1" mass="1"/></body></body></worldbody>
+  <contact><pair geom1="ga" geom2="gb" friction="0.5 0.5 0.005 0.0001 0.0001"/><exclude body1="a" body2="b"/>
+  </contact>
+</mujoco>"""
+
+
+def test_mjcf_contact_pairs_and_excludes_are_written_back_or_said(tmp_path: Path) -> None:
+    source = tmp_path / "cp.xml"
+    source.write_text(PAIRS)
+    out = tmp_path / "m" / "cp.xml"
+    notes = convert([source], out).notes
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert (model.npair, model.nexclude) == (1, 1) and list(model.pair_friction[0][:2]) == [0.5, 0.5]
+    assert not [n for n in notes if n.code == "MK851"]
+    for target in ("cp.urdf", "cp.sdf", "cp.body"):
+        notes = convert([source], tmp_path / target.replace(".", "_") / target).notes
+        said = [n for n in notes if n.code == "MK851" and "contact pairs" in n.message]
+        assert len(said) == 1, target

@@ -34,6 +34,7 @@ FORMAT = FormatDeclaration(
             ("mjcf_world_geoms", "MK822", "MJCF world geoms"),
             ("mjcf_world_sites", "MK822", "MJCF world sites"),
             ("mjcf_option", "MK853", "MJCF simulator options (<option>)"),
+            ("mjcf_contact_pairs", "MK851", "MJCF contact pairs and exclusions (<contact>)"),
         ),
         dropped_link=(("mjcf_contact", "MK851", "MJCF contact parameters other than friction"),),
     ),

@@ -300,6 +300,10 @@ class _MjcfReader:
             options = source_options(builder.loc.index)
             if options:
                 main.extras["mjcf_option"] = options
+            pairs = [{"tag": p.tag, "attributes": {str(k): str(v) for k, v in p.el.attrib.items()}}
+                     for p in builder.loc.index.section_items("contact") if p.tag in ("pair", "exclude")]
+            if pairs:
+                main.extras["mjcf_contact_pairs"] = pairs
 
         def attached(key: str) -> int:
             return sum(len(r.extras.get(key, [])) for r in built.robots)

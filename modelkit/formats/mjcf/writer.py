@@ -51,6 +51,7 @@ from modelkit.convert.self_contact import touching_pairs
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.formats.mjcf.write_actuators import ActuatorWriter
 from modelkit.formats.mjcf.write_bodies import BodyTree
+from modelkit.formats.mjcf.write_contact_pairs import write_source_pairs
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_foreign import note_foreign_extras
 from modelkit.formats.mjcf.write_geoms import COLLISION, CONTACT_PRIORITY, GeomWriter, shared_stems
@@ -134,6 +135,7 @@ class MjcfWriter:
         self.geoms.defaults(self.sections["default"], self.robot.name)
         self._surface_note()
         note_foreign_extras(self.robot, self.ctx)
+        write_source_pairs(self.root, self.sections["contact"], self.robot, self.ctx)
         self._meshdir()
         if any(el.get("euler") is not None for el in self.root.iter()):
             self.sections["compiler"].set("eulerseq", EULER_SEQUENCE)  # set_pose's euler: URDF's rpy
