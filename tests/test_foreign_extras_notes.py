@@ -133,3 +133,26 @@ def test_mjcf_contact_pairs_and_excludes_are_written_back_or_said(tmp_path: Path
         notes = convert([source], tmp_path / target.replace(".", "_") / target).notes
         said = [n for n in notes if n.code == "MK851" and "contact pairs" in n.message]
         assert len(said) == 1, target
+
+
+WALKER = """<mujoco model="w"><default><geom contype="1" conaffinity="0" friction=".7 .1 .1"/></default>
+  <worldbody><body name="a" pos="0 0 1"><freejoint/><geom type="capsule" size="0.05 0.2" mass="1"/>
+    <body name="b" pos="0 0 -0.3"><joint name="j" type="hinge"/>
+      <geom type="capsule" size="0.05 0.2" mass="1"/></body></body></worldbody>
+</mujoco>"""
+
+
+def test_mjcf_collision_filter_and_idle_coefficients_survive_mjcf(tmp_path: Path) -> None:
+    """dm_control's walker: limbs of contype 1, conaffinity 0 touch the floor, never each other; its
+    friction ".7 .1 .1" keeps torsional and rolling 0.1 for contacts MuJoCo mixes with a larger condim.
+    Before, the output let the limbs collide (and excluded the touching pair) and wrote ".7" only."""
+    source = tmp_path / "w.xml"
+    source.write_text(WALKER)
+    out = tmp_path / "m" / "w.xml"
+    convert([source], out)
+    a, b = mujoco.MjModel.from_xml_path(str(source)), mujoco.MjModel.from_xml_path(str(out))
+    solid = [g for g in range(b.ngeom) if b.geom_contype[g] or b.geom_conaffinity[g]]
+    assert len(solid) == a.ngeom == 2 and b.nexclude == 0
+    for g, h in zip(range(a.ngeom), solid, strict=True):
+        assert (b.geom_contype[h], b.geom_conaffinity[h]) == (1, 0)
+        assert list(b.geom_friction[h]) == pytest.approx(list(a.geom_friction[g]))

@@ -58,12 +58,16 @@ GEOM_CONTACT_DEFAULTS: dict[str, tuple[float, ...]] = {
     "solmix": (1.0,),
     "condim": (3.0,),
     "priority": (0.0,),
+    "contype": (1.0,),
+    "conaffinity": (1.0,),
 }
 """A geom's contact parameters besides its friction coefficients, with MuJoCo's defaults. ``condim``
 and ``priority`` decide, with MuJoCo's mixing rule, which geom's friction a contact uses: an MJCF
 source's own are written back as they were (MJCF output keeps MuJoCo's rules, see
-``formats.mjcf.write_geoms``)."""
-INTEGER_CONTACT = frozenset({"condim", "priority"})
+``formats.mjcf.write_geoms``). ``contype`` and ``conaffinity`` are the geom's collision filter (dm_control's
+walker: 1 and 0, its limbs touch the floor but not each other)."""
+INTEGER_CONTACT = frozenset({"condim", "priority", "contype", "conaffinity"})
+MUJOCO_FRICTION = (1.0, 0.005, 0.0001)
 
 
 @dataclass

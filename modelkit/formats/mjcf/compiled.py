@@ -17,6 +17,7 @@ from modelkit import rot3
 from modelkit.formats.mjcf.bodies import (
     GEOM_CONTACT_DEFAULTS,
     INTEGER_CONTACT,
+    MUJOCO_FRICTION,
     MjBody,
     MjGeom,
     MjInertial,
@@ -323,4 +324,8 @@ def contact_attributes(m: Any, g: int) -> dict[str, str]:
         values = tuple(float(x) for x in (raw if hasattr(raw, "__len__") else (raw,)))
         if any(abs(a - b) > 1e-12 * max(1.0, abs(b)) for a, b in zip(values, default, strict=True)):
             out[name] = str(int(values[0])) if name in INTEGER_CONTACT else fmt_vec(values)
+    friction = tuple(float(x) for x in m.geom_friction[g])
+    acting = 3 if int(m.geom_condim[g]) >= 6 else 2 if int(m.geom_condim[g]) >= 4 else 1
+    if friction[acting:] != MUJOCO_FRICTION[acting:]:  # coefficients its condim leaves idle, which
+        out["friction"] = fmt_vec(friction)  # still count when MuJoCo mixes it with a larger condim
     return out

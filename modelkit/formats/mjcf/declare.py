@@ -36,6 +36,8 @@ FORMAT = FormatDeclaration(
             ("mjcf_option", "MK853", "MJCF simulator options (<option>)"),
             ("mjcf_contact_pairs", "MK851", "MJCF contact pairs and exclusions (<contact>)"),
         ),
-        dropped_link=(("mjcf_contact", "MK851", "MJCF contact parameters other than friction"),),
+        dropped_link=(
+            ("mjcf_contact", "MK851", "MJCF contact parameters beyond the friction the target holds"),
+        ),
     ),
 )
