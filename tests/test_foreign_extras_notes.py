@@ -156,3 +156,21 @@ def test_mjcf_collision_filter_and_idle_coefficients_survive_mjcf(tmp_path: Path
     for g, h in zip(range(a.ngeom), solid, strict=True):
         assert (b.geom_contype[h], b.geom_conaffinity[h]) == (1, 0)
         assert list(b.geom_friction[h]) == pytest.approx(list(a.geom_friction[g]))
+
+
+TOUCH = """<mujoco model="t"><worldbody><camera name="fixed" pos="0 -2 1"/>
+  <body name="a" pos="0 0 1"><freejoint/><geom type="sphere" size="0.1" mass="1"/>
+    <site name="toe" pos="0 0 -0.1"/></body></worldbody>
+  <sensor><touch name="toe_touch" site="toe"/><subtreelinvel name="vel" body="a"/></sensor>
+</mujoco>"""
+
+
+def test_mjcf_to_mjcf_says_which_of_its_own_elements_it_does_not_write(tmp_path: Path) -> None:
+    """Touch sensors, the sites they use and a world camera are not in the model's devices; MJCF to
+    MJCF dropped them without a word (dm_control's hopper lost 3 sensors, 2 sites and 2 cameras)."""
+    source = tmp_path / "t.xml"
+    source.write_text(TOUCH)
+    notes = convert([source], tmp_path / "m" / "t.xml").notes
+    assert any(n.code == "MK806" and "toe_touch" in n.message and "sensors" in n.message for n in notes)
+    assert any(n.code == "MK808" and "toe" in n.message and "sites" in n.message for n in notes)
+    assert any(n.code == "MK806" and "fixed" in n.message and "cameras" in n.message for n in notes)

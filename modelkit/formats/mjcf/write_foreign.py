@@ -11,6 +11,8 @@ noted by ``convert`` itself (:func:`modelkit.convert.api.prepare`).
 
 from __future__ import annotations
 
+from lxml.etree import _Element as Element
+
 from modelkit.convert.context import WriteContext
 from modelkit.convert.extras_notes import shown_extras
 from modelkit.formats.registry import EXTRAS_DROPPED, EXTRAS_QUIET
@@ -31,3 +33,58 @@ def note_foreign_extras(robot: Robot, ctx: WriteContext) -> None:
             continue
         code, what = EXTRAS_DROPPED.get(key, ("MK808", f"<{key}> extension data"))
         ctx.note(code, f"{what} ({shown}): MJCF has no equivalent; left out", robot.source, "mujoco")
+
+
+OWN_ELEMENTS = {  # an MJCF source's kept lists → the output elements that may hold them again
+    "mjcf_sensors": ("sensor", None),
+    "mjcf_sites": ("site", None),
+    "mjcf_world_sites": ("site", None),
+    "mjcf_cameras": ("camera", None),
+    "mjcf_lights": ("light", None),
+    "mjcf_keyframes": ("key", None),
+    "mjcf_equalities": ("equality", None),
+    "mjcf_world_geoms": ("geom", None),
+}
+
+
+def note_unwritten_own(root: Element, robot: Robot, ctx: WriteContext) -> None:
+    """MJCF to MJCF: what of the source's own elements kept as data (sensors, sites, cameras, lights,
+    keyframes, equalities, world geoms) the output does not hold again, by name; one note per kind
+    with the code and words the MJCF declaration gives (a tendon is reported by the reader, MK172)."""
+    if robot.source_format != "mjcf":
+        return
+    written: dict[str, set[str]] = {}
+    for element in root.iter():
+        if isinstance(element.tag, str) and element.get("name"):
+            written.setdefault(_kind(element), set()).add(str(element.get("name")))
+    for key in OWN_ELEMENTS:
+        kept = robot.extras.get(key) or []
+        kind = OWN_ELEMENTS[key][0]
+        lost = [
+            item
+            for item in kept
+            if not isinstance(item, dict) or item.get("name") not in written.get(kind, set())
+        ]
+        if not lost:
+            continue
+        code, what = EXTRAS_DROPPED.get(key, ("MK808", key))
+        shown = ", ".join(
+            sorted({str(i.get("name") or i.get("type") or "unnamed") for i in lost if isinstance(i, dict)})[
+                :6
+            ]
+        )
+        ctx.note(
+            code,
+            f"{len(lost)} of {len(kept)} {what} not written ({shown}{', ...' if len(lost) > 6 else ''}): "
+            "only what the model holds (devices on links, frames, the home keyframe, mimic joints) is",
+            robot.source,
+            kind,
+        )
+
+
+def _kind(element: Element) -> str:
+    """The kind of a written element as ``OWN_ELEMENTS`` names it (a sensor by its section)."""
+    parent = element.getparent()
+    if parent is not None and isinstance(parent.tag, str) and parent.tag in ("sensor", "equality"):
+        return str(parent.tag)
+    return str(element.tag)
