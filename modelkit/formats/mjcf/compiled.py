@@ -315,17 +315,25 @@ def mesh_path(model_dir: Path, meshdir: str, written: str) -> Path:
 
 
 def contact_attributes(m: Any, g: int) -> dict[str, str]:
-    """Geom ``g``'s contact parameters that differ from MuJoCo's defaults, as MJCF attribute text."""
-    from modelkit.convert.numbers import fmt_vec
-
+    """Geom ``g``'s contact parameters that differ from MuJoCo's defaults, as MJCF attribute text
+    (numpy-free: the reader may run on the tuples of the ctypes stand-in)."""
     out: dict[str, str] = {}
     for name, default in GEOM_CONTACT_DEFAULTS.items():
         raw = getattr(m, f"geom_{name}")[g]
         values = tuple(float(x) for x in (raw if hasattr(raw, "__len__") else (raw,)))
         if any(abs(a - b) > 1e-12 * max(1.0, abs(b)) for a, b in zip(values, default, strict=True)):
-            out[name] = str(int(values[0])) if name in INTEGER_CONTACT else fmt_vec(values)
+            out[name] = str(int(values[0])) if name in INTEGER_CONTACT else _plain(values)
     friction = tuple(float(x) for x in m.geom_friction[g])
     acting = 3 if int(m.geom_condim[g]) >= 6 else 2 if int(m.geom_condim[g]) >= 4 else 1
     if friction[acting:] != MUJOCO_FRICTION[acting:]:  # coefficients its condim leaves idle, which
-        out["friction"] = fmt_vec(friction)  # still count when MuJoCo mixes it with a larger condim
+        out["friction"] = _plain(friction)  # still count when MuJoCo mixes it with a larger condim
     return out
+
+
+def _plain(values: tuple[float, ...]) -> str:
+    """Numbers as the shortest decimals that give them back (``0.015 1``), ``0`` for ±0."""
+    texts = []
+    for x in values:
+        text = "0" if x == 0.0 else repr(float(x))
+        texts.append(text[:-2] if text.endswith(".0") else text)
+    return " ".join(texts)
