@@ -8,12 +8,12 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from modelkit.convert.commit import CommitRefused, Entry, identity
 from modelkit.convert.context import WriteContext
+from modelkit.convert.extras_notes import note_foreign_extras
 from modelkit.convert.meshes import MeshExporter
 from modelkit.convert.notes import ConversionNote, NoteSink
 from modelkit.convert.numbers import length_scale
@@ -74,7 +74,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     from modelkit.formats.mjcf.site_frames import sites_as_links
 
     _check_mass_properties(robot)
-    _foreign_extras(robot, target, notes)
+    note_foreign_extras(robot, target.name, notes)
     out = copy.deepcopy(robot)
     settle_base(out, options.base, notes)
     if not target.tracks_native:
@@ -85,54 +85,6 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     if options.merge_fixed:
         merge_fixed_joints(out, notes)
     return out
-
-
-def _foreign_extras(robot: Robot, target: TargetInfo, notes: NoteSink) -> None:
-    """A note for each link's and joint's extras that its format declares dropped by the other
-    targets (``dropped_link``, ``dropped_joint``), unless this target's writer handles the key."""
-    from modelkit.convert.extras_notes import shown_extras
-    from modelkit.formats.registry import EXTRAS_DROPPED_JOINT, EXTRAS_DROPPED_LINK, declared
-
-    output = declared(target.name).output
-    handled = output.handles if output is not None else frozenset()
-    if output is not None and not output.walks_extras:
-        _foreign_robot_extras(robot, target.name, handled, notes)
-    owners: list[tuple[str, Any, dict[str, tuple[str, str, str]], frozenset[str]]] = [
-        *((f"link {link.name}", link, EXTRAS_DROPPED_LINK, handled) for link in robot.links),
-        *((f"joint {joint.name}", joint, EXTRAS_DROPPED_JOINT, frozenset()) for joint in robot.joints),
-    ]
-    for label, element, table, skip in owners:
-        for key in sorted(element.extras):
-            entry = table.get(key)
-            value = element.extras[key]
-            if entry is None or entry[0] == target.name or key in skip or not value:
-                continue
-            _, code, what = entry
-            shown = shown_extras(value)
-            if not shown:
-                continue
-            notes.note(code, f"{label}: {what} ({shown}): no {target.name} equivalent; left out",
-                       element.source, f"{label.split(' ', 1)[0]}[{element.name}]")
-
-
-
-
-def _foreign_robot_extras(robot: Robot, target: str, handled: frozenset[str], notes: NoteSink) -> None:
-    """For a target whose writer does not walk the robot's ``extras``: a note for each key another
-    format declares dropped (tendons, keyframes, simulator options...)."""
-    from modelkit.convert.extras_notes import shown_extras
-    from modelkit.formats.registry import EXTRAS_DROPPED, EXTRAS_OWNER, EXTRAS_PARTLY_CARRIED
-
-    for key in sorted(robot.extras):
-        value = robot.extras[key]
-        owner = EXTRAS_OWNER.get(key)
-        if owner is None or owner == target or key in handled or key in EXTRAS_PARTLY_CARRIED or not value:
-            continue
-        shown = shown_extras(value) if not isinstance(value, list) else f"{len(value)}"
-        if not shown:
-            continue
-        code, what = EXTRAS_DROPPED[key]
-        notes.note(code, f"{what} ({shown}): no {target} equivalent; left out", robot.source, "robot")
 
 
 def _check_mass_properties(robot: Robot) -> None:

@@ -1,8 +1,18 @@
-"""How a note names extras data a target leaves out: short, and without what the model carries."""
+"""Notes for another format's own data (``extras``) that a target cannot hold, and how they name it.
+
+Each format declares its keys once (``ExtrasDeclaration``: ``dropped``, ``dropped_link``,
+``dropped_joint``, ``partly_carried``); :func:`note_foreign_extras` gives one note per such key a
+conversion meets, for every target but the owner, unless the target's writer notes the key itself
+(``OutputDeclaration.handles``; ``walks_extras``: the URDF writer, which notes every robot key).
+A note lists what is lost, not what the model carries.
+"""
 
 from __future__ import annotations
 
 from typing import Any
+
+from modelkit.convert.notes import NoteSink
+from modelkit.model import Robot
 
 CARRIED_BLOCK_TAGS = frozenset({"mu1", "mu2", "selfCollide", "sensor"})
 """Children of a kept extension block (a URDF ``<gazebo>``) the model holds in its own fields: the
@@ -39,3 +49,38 @@ def shown_extras(value: Any) -> str:
     else:
         text = str(value)
     return text if len(text) <= 120 else text[:117] + "..."
+
+
+def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
+    """One note per robot, link and joint extras key another format declares dropped."""
+    from modelkit.formats.registry import (
+        EXTRAS_DROPPED,
+        EXTRAS_DROPPED_JOINT,
+        EXTRAS_DROPPED_LINK,
+        EXTRAS_OWNER,
+        EXTRAS_PARTLY_CARRIED,
+        declared,
+    )
+
+    output = declared(target).output
+    handled = output.handles if output is not None else frozenset()
+    found: list[tuple[str, str, str, Any, Any, str]] = []  # owner, code, words, value, source, target
+    if output is None or not output.walks_extras:
+        for key in sorted(robot.extras):
+            if key in EXTRAS_OWNER and key not in EXTRAS_PARTLY_CARRIED and key not in handled:
+                code, what = EXTRAS_DROPPED[key]
+                found.append((EXTRAS_OWNER[key], code, what, robot.extras[key], robot.source, "robot"))
+    elements: list[tuple[str, Any, dict[str, tuple[str, str, str]], frozenset[str]]] = [
+        *(("link", link, EXTRAS_DROPPED_LINK, handled) for link in robot.links),
+        *(("joint", joint, EXTRAS_DROPPED_JOINT, frozenset()) for joint in robot.joints),
+    ]
+    for kind, element, table, skip in elements:
+        for key in sorted(element.extras):
+            if key in table and key not in skip:
+                owner, code, what = table[key]
+                found.append((owner, code, f"{kind} {element.name}: {what}", element.extras[key],
+                              element.source, f"{kind}[{element.name}]"))
+    for owner, code, what, value, source, where in found:
+        shown = shown_extras(value) if owner != target and value else ""
+        if shown:
+            notes.note(code, f"{what} ({shown}): no {target} equivalent; left out", source, where)

@@ -14,7 +14,6 @@ FORMAT = FormatDeclaration(
         suffixes=(".xml", ".mjcf"),
         auto_wheel="sphere",  # MuJoCo: a cylinder rolling on a plane gets odd contacts
         sites_native=True,
-        walks_extras=True,  # write_foreign
     ),
     extras=ExtrasDeclaration(
         quiet=frozenset({"mjcf_compiled"}),

@@ -53,7 +53,7 @@ from modelkit.formats.mjcf.write_actuators import ActuatorWriter
 from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_contact_pairs import write_source_pairs
 from modelkit.formats.mjcf.write_devices import DeviceWriter
-from modelkit.formats.mjcf.write_foreign import note_foreign_extras, note_unwritten_own
+from modelkit.formats.mjcf.write_foreign import note_unwritten_own
 from modelkit.formats.mjcf.write_geoms import COLLISION, CONTACT_PRIORITY, GeomWriter, shared_stems
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, quat_wxyz, set_pose, sub
@@ -134,7 +134,6 @@ class MjcfWriter:
         self._home()
         self.geoms.defaults(self.sections["default"], self.robot.name)
         self._surface_note()
-        note_foreign_extras(self.robot, self.ctx)
         note_unwritten_own(self.root, self.robot, self.ctx)
         write_source_pairs(self.root, self.sections["contact"], self.robot, self.ctx)
         self._meshdir()
