@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -430,21 +431,28 @@ EXAMPLE_LEGGED = (
 STAND_SECONDS, STAND_SAG, STAND_TILT = 3.0, 0.015, 0.05  # s, m, rad
 
 
-def stand_on_a_plain_floor(path: Path) -> tuple[float, float]:
-    """The written MJCF with only a default-contact plane added, reset to ``home``, lowered onto the
-    floor and left alone: (how far the base sank in m, how far it tilted in rad)."""
+
+def _home_on_a_plain_floor(path: Path) -> tuple[Any, Any]:
+    """The written MJCF as a user loads it: a default plane added, reset to the ``home`` keyframe and
+    lifted until no contact is deeper than 0.1 mm."""
     spec = mujoco.MjSpec.from_file(str(path))
     spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0])
     m = spec.compile()
     d = mujoco.MjData(m)
     mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home"))
-    assert m.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE, "a legged robot is free"
-    for _ in range(100):  # lift it out of the floor: no contact deeper than 0.1 mm
+    for _ in range(100):
         mujoco.mj_forward(m, d)
         depth = min([c.dist for c in d.contact[:d.ncon]] or [0.0])
         if depth >= -1e-4:
             break
         d.qpos[2] -= depth
+    return m, d
+
+def stand_on_a_plain_floor(path: Path) -> tuple[float, float]:
+    """The written MJCF with only a default-contact plane added, reset to ``home``, lowered onto the
+    floor and left alone: (how far the base sank in m, how far it tilted in rad)."""
+    m, d = _home_on_a_plain_floor(path)
+    assert m.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE, "a legged robot is free"
     start = float(d.qpos[2])
     for _ in range(round(STAND_SECONDS / m.opt.timestep)):
         mujoco.mj_step(m, d)
@@ -595,17 +603,7 @@ def test_spirit40_given_a_stance_holds_it_with_its_legs_share_of_the_weight(tmp_
                                   "1": 1.6, "3": 1.6, "5": 1.6, "7": 1.6}.get(joint.name, 0.0)
     out, notes = convert(robot, tmp_path)
     assert not [n for n in notes if n.code == "MK856"], "a stance: its toes carry it"
-    spec = mujoco.MjSpec.from_file(str(out))
-    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0])
-    m = spec.compile()
-    d = mujoco.MjData(m)
-    mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home"))
-    for _ in range(100):  # lift it out of the floor: no contact deeper than 0.1 mm
-        mujoco.mj_forward(m, d)
-        depth = min([c.dist for c in d.contact[:d.ncon]] or [0.0])
-        if depth >= -1e-4:
-            break
-        d.qpos[2] -= depth
+    m, d = _home_on_a_plain_floor(out)
     toes = [g for g in range(m.ngeom) if m.geom_condim[g] == 4]
     assert len(toes) == 4 and all(float(m.geom_friction[g][0]) == 3.0 for g in toes)  # the source's
     home, start = d.qpos[7:].copy(), float(d.qpos[2])
