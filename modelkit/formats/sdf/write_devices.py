@@ -18,7 +18,15 @@ from modelkit.convert.names import unique_name
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.formats.sdf.ros_plugins import RosPlugin, ros_plugin
 from modelkit.formats.sdf.sensors import CONFIG_ELEMENT
-from modelkit.formats.sdf.write_xml import add_pose, data_to_element, num, parse_fragment, rgba, sub
+from modelkit.formats.sdf.write_xml import (
+    add_pose,
+    child_or_sub,
+    data_to_element,
+    num,
+    parse_fragment,
+    rgba,
+    sub,
+)
 from modelkit.model import CAMERA_KINDS, LIGHT_KINDS, Device, DeviceKind
 from modelkit.spatial import Pose
 
@@ -223,8 +231,7 @@ class DeviceWriter:
             holder = element
             *parents, leaf = path.split("/")
             for tag in parents:
-                found = holder.find(tag)
-                holder = found if found is not None else sub(holder, tag)
+                holder = child_or_sub(holder, tag)
             sub(holder, leaf, text)
         frame = dict(plugin.elements).get("frame_name")
         carried = f"; it carries {', '.join(sorted(plugin.consumed))}" if plugin.consumed else ""

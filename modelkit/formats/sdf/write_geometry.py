@@ -13,7 +13,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import PairFriction, describe
 from modelkit.convert.names import unique_name
 from modelkit.convert.numbers import fmt, fmt_vec
-from modelkit.formats.sdf.write_xml import add_pose, num, rgba, sub
+from modelkit.formats.sdf.write_xml import add_pose, child_or_sub, num, rgba, sub
 from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere, SurfaceFriction
 from modelkit.spatial import Pose
 
@@ -126,11 +126,11 @@ class GeomWriter:
         and ``<rolling_friction>``. Torsional friction is not written: SDF's ``<torsional>`` is Gazebo
         ODE's contact-patch model, with no coefficient of MuJoCo's or PyBullet's meaning."""
         second = friction.sliding if friction.sliding2 is None else friction.sliding2
-        friction_el = _child(_child(collision, "surface"), "friction")
-        ode = _child(friction_el, "ode")
+        friction_el = child_or_sub(child_or_sub(collision, "surface"), "friction")
+        ode = child_or_sub(friction_el, "ode")
         _first(ode, "mu", friction.sliding)
         _first(ode, "mu2", second, after="mu")
-        bullet = _child(friction_el, "bullet")
+        bullet = child_or_sub(friction_el, "bullet")
         _first(bullet, "friction", friction.sliding)
         _first(bullet, "friction2", second, after="friction")
         if friction.rolling is not None:
@@ -183,12 +183,6 @@ class GeomWriter:
             link.loc("material"),
             target,
         )
-
-
-def _child(parent: Element, tag: str) -> Element:
-    """The first child ``tag`` of ``parent`` (a kept ``<surface>`` may hold it), made when absent."""
-    found = parent.find(tag)
-    return found if found is not None else sub(parent, tag)
 
 
 def _first(parent: Element, tag: str, value: float, after: str | None = None) -> None:

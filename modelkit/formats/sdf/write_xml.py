@@ -22,6 +22,12 @@ def sub(parent: Element, tag: str, text: str | None = None, **attrib: str) -> El
     return el
 
 
+def child_or_sub(parent: Element, tag: str) -> Element:
+    """The first child ``tag`` of ``parent``, made when there is none."""
+    found = parent.find(tag)
+    return found if found is not None else sub(parent, tag)
+
+
 def num(parent: Element, tag: str, value: float) -> Element:
     return sub(parent, tag, fmt(value))
 
