@@ -21,6 +21,7 @@ from modelkit.convert.choices import (
     GAZEBO_CHOICES,
     MESH_FORMATS,
     SDF_VERSIONS,
+    SOURCE_ACTUATORS,
     WHEEL_COLLISIONS,
 )
 from modelkit.diagnostics import (
@@ -466,7 +467,12 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
               help="MJCF: the actuator of every hinge and slide joint when the source has no actuators; "
                    "auto: a position servo on each joint with a range or in a leg (the model holds its home "
                    "pose), a motor on each other (wheels: torque-driven). Servos get gains from each joint's "
-                   "reflected inertia (MK840, MK841). A source's own actuators are always written.")
+                   "reflected inertia (MK840, MK841). A source's own actuators are written unless "
+                   "--source-actuators replace.")
+@click.option("--source-actuators", type=click.Choice(SOURCE_ACTUATORS), default="keep", show_default=True,
+              help="MJCF: keep the source's own actuators, or replace them with the --actuators choice on "
+                   "every joint (MK855), e.g. position servos for a legged robot whose URDF names effort "
+                   "interfaces (its legs are limp under motors at zero control, MK857).")
 @reading_options
 def convert(
     words: tuple[str, ...],
@@ -491,6 +497,7 @@ def convert(
     wheel_collision: str,
     base: str,
     actuators: str,
+    source_actuators: str,
     **kwargs: Any,
 ) -> None:
     """Convert model files to URDF, SDF, MJCF or .body; every approximation is reported.
@@ -520,6 +527,7 @@ def convert(
         wheel_collision=wheel_collision,
         base=base,
         actuators=actuators,
+        source_actuators=source_actuators,
     )
     with _interruptible("convert", output):
         result = run_convert(files, output, target, _read_options(kwargs, True, xacro_args), options, force,

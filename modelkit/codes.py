@@ -1387,7 +1387,17 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MJCF: the source names effort actuators on a legged robot's leg joints (URDF "
         "`EffortJointInterface` transmissions: Unitree's Go1 and A1, HyQ, B1), written as `<motor>`s: at "
         "zero control the legs are limp and the robot lies down on a floor until a controller drives them "
-        "(without the transmissions, `--actuators auto` gives them position servos).",
+        "(`--source-actuators replace` gives them the `--actuators` choice: with `auto`, position servos).",
+    ),
+    CodeInfo(
+        "MK855",
+        "source-actuators-replaced",
+        "info",
+        "MJCF: `--source-actuators replace` set the source's own actuators aside (URDF transmissions and "
+        "ros2_control interfaces, Choreonoid actuation modes, MJCF actuators, SDF joint controllers) and "
+        "gave every hinge and slide the `--actuators` choice instead, as for a source without any; the "
+        "note counts both. The joints keep what the source said of them (effort limits as `forcerange`, "
+        "rotor inertia as armature).",
     ),
     CodeInfo(
         "MK851",

@@ -564,6 +564,64 @@ def test_source_motors_on_legs_are_said(tmp_path: Path) -> None:
     assert not [n for n in notes if n.code == "MK856"]
 
 
+# Legged robots whose URDFs name an EffortJointInterface on every leg joint (MK857 above): the user who
+# wants them to stand in MuJoCo asks ``--source-actuators replace`` and gets ``--actuators auto``'s
+# position servos. Measured: Go1 sank 6.4 mm and tilted 0.016 rad in 3 s, B1 4.8 mm and 0.006, HyQ
+# 9.2 mm and 0.004; with the source's motors (the default) each lies down.
+EFFORT_LEGGED = ("go1_description/urdf/go1.urdf", "b1_description/urdf/b1.urdf",
+                 "hyq_description/robots/hyq_no_sensors.urdf")
+
+
+def _convert_cli(source: Path, target: Path, *options: str) -> str:
+    from click.testing import CliRunner
+
+    from modelkit.cli import main
+
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(target), *options],
+                                env={"ROS_PACKAGE_PATH": str(robots_dir())})
+    assert result.exit_code == 0, result.output
+    return result.output
+
+
+@pytest.mark.parametrize("relative", EFFORT_LEGGED)
+def test_source_motors_replaced_by_servos_stand(tmp_path: Path, relative: str) -> None:
+    """``convert go1.urdf -o go1.xml --source-actuators replace``: the source's 12 effort transmissions
+    are set aside (MK855 counts them), each leg joint gets a position servo, MK857 is not said, and the
+    written file stands at home on a plain floor."""
+    out = tmp_path / "m.xml"
+    said = _convert_cli(example_robot(relative), out, "--source-actuators", "replace")
+    assert [el.tag for el in actuator_elements(out)] == ["position"] * 12
+    assert "MK855 the source's 12 actuator(s) (12 effort) set aside" in said
+    assert "written instead: 12 <position> (--actuators auto)" in said and "MK857" not in said
+    sag, tilt = stand_on_a_plain_floor(out)
+    assert sag < STAND_SAG and tilt < STAND_TILT, f"{relative}: sank {sag * 1e3:.1f} mm, tilted {tilt:.3f}"
+
+
+def test_source_motors_kept_by_default_leave_the_legs_limp(tmp_path: Path) -> None:
+    """The contrast: the default keeps HyQ's motors (MK857), and at zero control it does not stand."""
+    out = tmp_path / "m.xml"
+    said = _convert_cli(example_robot(EFFORT_LEGGED[2]), out)
+    assert {el.tag for el in actuator_elements(out)} == {"motor"} and "MK857" in said
+    assert "--source-actuators replace" in said
+    sag, tilt = stand_on_a_plain_floor(out)
+    assert sag > STAND_SAG or tilt > STAND_TILT
+
+
+def test_replace_sets_aside_every_mjcf_actuator(tmp_path: Path) -> None:
+    """An MJCF source's five actuators (four the model holds, an intvelocity it does not) are all set
+    aside by ``--source-actuators replace --actuators velocity``: five velocity servos, no MK842."""
+    path = tmp_path / "four.xml"
+    path.write_text(MJCF)
+    out = tmp_path / "out" / "four.xml"
+    said = _convert_cli(path, out, "--source-actuators", "replace", "--actuators", "velocity")
+    assert [(el.tag, el.get("joint")) for el in actuator_elements(out)] == [
+        ("velocity", f"j{i}") for i in range(1, 6)]
+    assert ("the source's 5 actuator(s) (1 effort, 2 position, 1 velocity, 1 other MJCF) set aside" in said)
+    assert "MK842" not in said and "MK841" not in said
+    m = mujoco.MjModel.from_xml_path(str(out))
+    assert m.nu == 5 and {int(b) for b in m.actuator_biastype} == {int(mujoco.mjtBias.mjBIAS_AFFINE)}
+
+
 @pytest.mark.parametrize("relative", STANDING_LEGGED)
 def test_no_leg_notes_on_robots_whose_home_stands(tmp_path: Path, relative: str) -> None:
     """Legged robots whose home puts their feet on the floor and whose joints get servos: neither note."""

@@ -32,8 +32,12 @@ class WriteOptions:
     base: str = "auto"  # fixed | floating | auto: how the root meets the world (modelkit/convert/base.py)
     # actuators for a source without any (MJCF): auto (default: a position servo on each joint with a
     # range or in a leg, a motor on each other) | motor | position | velocity | none; the source's own
-    # actuators are always written as they are (docs/convert.md, "Actuators")
+    # actuators are written as they are unless ``source_actuators`` replaces them (docs/convert.md,
+    # "Actuators")
     actuators: str = "auto"
+    # MJCF: the source's own actuators: keep (default: written as they are) | replace (set aside, MK855:
+    # every joint gets the ``actuators`` choice, as for a source without any)
+    source_actuators: str = "keep"
     # MJCF: massless frame links (modelkit/convert/frames.py) as <site>s in the body they hang on, as
     # MuJoCo Menagerie writes them (MK873); False writes them as empty bodies
     frame_sites: bool = True

@@ -65,15 +65,17 @@ class ActuatorWriter:
         by_name: dict[str, Joint] = {}
         for each in self.robot.joints:
             by_name.setdefault(each.name, each)
+        replaced = self._replaced()
         planned: list[tuple[Actuator, Joint | None]] = [
             (a, by_name.get(a.joint)) for a in self.robot.actuators
+            if not (replaced and a.source_kind != TRACK_ROLLER)
         ]
         # The track approximation's roller servos are the writer's, not the source's: the rest of a
         # tracked robot is as silent as any other source (convert.tracks).
-        made_up = not any(a.source_kind != TRACK_ROLLER for a in self.robot.actuators)
+        made_up = replaced or not any(a.source_kind != TRACK_ROLLER for a in self.robot.actuators)
         chosen: list[Actuator] = []
         if made_up:
-            taken = {a.joint for a in self.robot.actuators}
+            taken = {a.joint for a, _ in planned}
             for free in self.robot.joints:
                 kind = self._chosen_kind(free)
                 if kind is not None and free.name not in taken:
@@ -96,11 +98,36 @@ class ActuatorWriter:
             on_joint.setdefault(joint.name, actuator)
             if actuator.source_kind == "--actuators":
                 written[actuator.kind] = written.get(actuator.kind, 0) + 1
-        self._uncanonical()
         movable = any(j.type in (JointType.REVOLUTE, JointType.PRISMATIC) for j in self.robot.joints)
-        if made_up and movable:
-            self._said_choice(written)
+        if replaced:
+            self._said_replaced(written)
+        else:
+            self._uncanonical()
+            if made_up and movable:
+                self._said_choice(written)
         self._said_legs(on_joint)
+
+    def _replaced(self) -> bool:
+        """Whether ``--source-actuators replace`` sets the source's own actuators aside (it has some)."""
+        own = any(a.source_kind != TRACK_ROLLER for a in self.robot.actuators)
+        return self.ctx.options.source_actuators == "replace" and (
+            own or bool(self.robot.extras.get("mjcf_actuators")))
+
+    def _said_replaced(self, written: dict[ActuatorKind, int]) -> None:
+        """MK855: the source's actuators set aside by ``--source-actuators replace``, and what was written."""
+        own = [a for a in self.robot.actuators if a.source_kind != TRACK_ROLLER]
+        kinds: dict[str, int] = {}
+        for actuator in own:
+            kinds[actuator.kind.value] = kinds.get(actuator.kind.value, 0) + 1
+        unheld = len(self.robot.extras.get("mjcf_actuators") or []) - len(own)
+        parts = [f"{count} {kind}" for kind, count in sorted(kinds.items())]
+        if unheld > 0:
+            parts.append(f"{unheld} other MJCF")
+        what = " and ".join(f"{count} <{ELEMENTS[kind]}>" for kind, count in
+                            sorted(written.items(), key=lambda item: ORDER.index(item[0]))) or "none"
+        self.ctx.note("MK855", f"the source's {len(own) + max(unheld, 0)} actuator(s) ({', '.join(parts)}) "
+                      f"set aside (--source-actuators replace); written instead: {what} "
+                      f"(--actuators {self.ctx.options.actuators})", self.robot.source, "actuator")
 
     def _said_legs(self, on_joint: dict[str, Actuator]) -> None:
         """MK857: the source's motors leave a legged robot's legs limp; MK856: its home pose, which the
@@ -116,8 +143,8 @@ class ActuatorWriter:
             shown = ", ".join(limp[:4]) + (" ..." if len(limp) > 4 else "")
             self.ctx.note("MK857", f"{len(limp)} of the {len(legs)} leg joints ({shown}) have the source's "
                           "effort actuators, written as <motor>: at zero control those legs are limp and the "
-                          "robot lies down on a floor until a controller drives them (without its "
-                          "transmissions, --actuators auto would give them position servos)",
+                          "robot lies down on a floor until a controller drives them (--source-actuators "
+                          "replace gives them the --actuators choice: auto, position servos)",
                           self.robot.source, "actuator")
         held = [name for name in legs if name in on_joint and on_joint[name].kind is ActuatorKind.POSITION]
         if not held:
