@@ -16,7 +16,7 @@ from modelkit.api import validate
 from modelkit.convert.api import write
 from modelkit.convert.compare import compare_poses
 from modelkit.convert.notes import renames
-from modelkit.convert.numbers import clean_angle, clean_length, clean_rotation, fmt, length_scale
+from modelkit.convert.numbers import clean_angle, clean_length, clean_rotation, fmt, fmt_text, length_scale
 from modelkit.formats.mjcf.write_xml import euler_text, quat_wxyz, set_pose, z_turn, zaxis_text
 from modelkit.spatial import Pose, matrix_from_rpy
 
@@ -46,6 +46,14 @@ def test_dust_goes_and_written_decimals_stay() -> None:
     assert clean_length(-2.0e-13) == 0.0
     with length_scale(1e-3):  # a millimetre robot: 2e-13 m is no longer dust below 1e-12 of it
         assert clean_length(-2.0e-13) == -2.0e-13
+
+
+def test_source_text_numbers_in_the_writers_form() -> None:
+    """Attribute text a source wrote (an MJCF <option>, a <pair>): number lists re-printed, words kept."""
+    assert fmt_text(".005") == "0.005" and fmt_text(" 0  0 -9.810 ") == "0 0 -9.81"
+    assert fmt_text("1E-4 5e-3 100") == "0.0001 0.005 100"
+    for kept in ("implicitfast", "0.5 soft", "inf", "1 nan", "1_000", ""):
+        assert fmt_text(kept) == kept
 
 
 def test_quaternions_and_euler_angles_are_exact_values() -> None:

@@ -7,6 +7,7 @@ model's plugins. Each case converts a small file and reads the notes a user sees
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import mujoco
@@ -133,6 +134,27 @@ def test_mjcf_contact_pairs_and_excludes_are_written_back_or_said(tmp_path: Path
         notes = convert([source], tmp_path / target.replace(".", "_") / target).notes
         said = [n for n in notes if n.code == "MK851" and "contact pairs" in n.message]
         assert len(said) == 1, target
+
+
+def test_mjcf_options_and_pairs_are_written_in_clean_numbers(tmp_path: Path) -> None:
+    """An MJCF source's <option> and <pair> numbers as the writers print every number (``.005`` →
+    ``0.005``, ``5e-3`` → ``0.005``), names and words as written; MuJoCo compiles the same values."""
+    source = tmp_path / "cn.xml"
+    source.write_text(PAIRS.replace('<mujoco model="cp">', '<mujoco model="cp"><option timestep=".005" '
+                                    'gravity="0 0 -9.810" integrator="implicitfast"/>')
+                      .replace('friction="0.5 0.5 0.005 0.0001 0.0001"',
+                               'friction=".5 .50 5e-3 1E-4 0.00010"'))
+    out = tmp_path / "m" / "cn.xml"
+    convert([source], out)
+    text = out.read_text()
+    option = ET.fromstring(text).find("option")
+    assert option is not None
+    assert [option.get(k) for k in ("timestep", "gravity", "integrator")] == ["0.005", "0 0 -9.81", "implicitfast"]
+    assert 'friction="0.5 0.5 0.005 0.0001 0.0001"' in text and 'geom1="ga" geom2="gb"' in text
+    assert ".005" not in text.replace("0.005", "") and "9.810" not in text
+    got, want = mujoco.MjModel.from_xml_path(str(out)), mujoco.MjModel.from_xml_path(str(source))
+    assert got.opt.timestep == want.opt.timestep and list(got.opt.gravity) == list(want.opt.gravity)
+    assert list(got.pair_friction[0]) == list(want.pair_friction[0])
 
 
 WALKER = """<mujoco model="w"><default><geom contype="1" conaffinity="0" friction=".7 .1 .1"/></default>

@@ -74,6 +74,21 @@ def _tidy(text: str) -> str:
     return "0" if text in ("-0", "") else text
 
 
+def fmt_text(text: str) -> str:
+    """An attribute a source wrote, in the writers' form when it is a list of finite numbers
+    (``".005"`` → ``"0.005"``, ``"0 0 -9.81000"`` → ``"0 0 -9.81"``); any other text as it is."""
+    numbers: list[str] = []
+    for token in text.split():
+        try:
+            x = float(token)
+        except ValueError:
+            return text
+        if not math.isfinite(x) or "_" in token:
+            return text
+        numbers.append(fmt(x))
+    return " ".join(numbers) if numbers else text
+
+
 def fmt_vec(values: Iterable[float] | np.ndarray) -> str:
     """Numbers separated by single spaces (XML attribute lists)."""
     return " ".join(fmt(v) for v in np.asarray(list(values) if not isinstance(values, np.ndarray) else values,

@@ -1,8 +1,9 @@
 """An MJCF file's own ``<option>``: the simulator settings its author chose, kept for MJCF output.
 
 Read from the source text (every ``<option>`` section, included files too; a later one's attribute
-wins, as MuJoCo merges them): the attributes as written and the ``<flag>`` switches. Other targets
-cannot hold them and say so (MK853).
+wins, as MuJoCo merges them): the attributes as written and the ``<flag>`` switches. The MJCF writer
+prints their numbers in its own form (``timestep=".005"`` → ``"0.005"``); other targets cannot hold
+them and say so (MK853).
 """
 
 from __future__ import annotations

@@ -1,8 +1,9 @@
 """An MJCF source's own ``<contact>`` section (``<pair>`` and ``<exclude>``), written back.
 
 The reader keeps each element's attributes as written (``robot.extras["mjcf_contact_pairs"]``); an
-element is written when every geom and body it names is in the output (names the writer kept), and
-otherwise left out with MK851. They go in before the self-contact check, which then finds only the
+element is written when every geom and body it names is in the output (names the writer kept), its
+numbers in the writers' form (:func:`modelkit.convert.numbers.fmt_text`), and otherwise left out with
+MK851. They go in before the self-contact check, which then finds only the
 touching pairs the source does not already exclude.
 """
 
@@ -11,11 +12,13 @@ from __future__ import annotations
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.numbers import fmt_text
 from modelkit.formats.mjcf.write_xml import sub
 from modelkit.model import Robot
 
 KEY = "mjcf_contact_pairs"
 REFERENCES = {"pair": ("geom1", "geom2"), "exclude": ("body1", "body2")}
+NAMES = {"name", "geom1", "geom2", "body1", "body2"}  # written as they are; the numbers in the writers' form
 
 
 def write_source_pairs(root: Element, contact: Element, robot: Robot, ctx: WriteContext) -> None:
@@ -37,4 +40,4 @@ def write_source_pairs(root: Element, contact: Element, robot: Robot, ctx: Write
                      f"not written: {', '.join(repr(m) for m in missing) or 'its kind'} is not in the "
                      "written file", robot.source, f"contact/{tag}")
             continue
-        sub(contact, tag, **attributes)
+        sub(contact, tag, **{k: v if k in NAMES else fmt_text(v) for k, v in attributes.items()})

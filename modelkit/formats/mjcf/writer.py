@@ -46,7 +46,7 @@ from lxml import etree
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.meshes import MESH_FOLDER
-from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.convert.numbers import fmt, fmt_text, fmt_vec
 from modelkit.convert.self_contact import touching_pairs
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.formats.mjcf.write_actuators import ActuatorWriter
@@ -100,7 +100,7 @@ class MjcfWriter:
             if isinstance(value, dict):  # <flag>
                 sub(self.sections["option"], key, **{k: str(v) for k, v in sorted(value.items())})
             else:
-                self.sections["option"].set(key, str(value))
+                self.sections["option"].set(key, fmt_text(str(value)))
         if options:
             stiff = (f"; the collision geoms have solref {CONTACT['solref']!r} and solimp "
                      f"{CONTACT['solimp']!r} (stiff contact: the wheels keep their rolling radius)"
