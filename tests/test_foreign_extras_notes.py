@@ -149,7 +149,8 @@ def test_mjcf_options_and_pairs_are_written_in_clean_numbers(tmp_path: Path) -> 
     text = out.read_text()
     option = ET.fromstring(text).find("option")
     assert option is not None
-    assert [option.get(k) for k in ("timestep", "gravity", "integrator")] == ["0.005", "0 0 -9.81", "implicitfast"]
+    got = [option.get(k) for k in ("timestep", "gravity", "integrator")]
+    assert got == ["0.005", "0 0 -9.81", "implicitfast"]
     assert 'friction="0.5 0.5 0.005 0.0001 0.0001"' in text and 'geom1="ga" geom2="gb"' in text
     assert ".005" not in text.replace("0.005", "") and "9.810" not in text
     got, want = mujoco.MjModel.from_xml_path(str(out)), mujoco.MjModel.from_xml_path(str(source))
