@@ -457,6 +457,10 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
 @click.option("--ros-plugins/--no-ros-plugins", default=True, show_default=True,
               help="Gazebo classic: a sensor the source gave no plugin gets the gazebo_ros plugin that "
                    "publishes it to ROS 2 (LaserScan/PointCloud2, camera and depth images, Imu; MK850).")
+@click.option("--drive-plugin/--no-drive-plugin", default=True, show_default=True,
+              help="URDF/SDF: a robot on two sides of wheels that the source gives no controller gets "
+                   "Gazebo's differential-drive plugin (Sim's DiffDrive or classic's gazebo_ros diff "
+                   "drive, by --gazebo), driven by a Twist on cmd_vel (MK858).")
 @click.option("--wheel-collision", type=click.Choice(WHEEL_COLLISIONS), default="auto", show_default=True,
               help="Collision shape of wheels (auto: a sphere for MJCF and URDF, the cylinder for SDF and "
                    ".body; MK826).")
@@ -494,6 +498,7 @@ def convert(
     urdf_sensor_links: bool,
     gazebo: str,
     ros_plugins: bool,
+    drive_plugin: bool,
     wheel_collision: str,
     base: str,
     actuators: str,
@@ -524,6 +529,7 @@ def convert(
         urdf_sensor_links=urdf_sensor_links,
         gazebo=gazebo,
         ros_plugins=ros_plugins,
+        drive_plugin=drive_plugin,
         wheel_collision=wheel_collision,
         base=base,
         actuators=actuators,

@@ -1390,6 +1390,23 @@ _TABLE: tuple[CodeInfo, ...] = (
         "(`--source-actuators replace` gives them the `--actuators` choice: with `auto`, position servos).",
     ),
     CodeInfo(
+        "MK858",
+        "drive-plugin-written",
+        "info",
+        "URDF/SDF: the robot rolls on two sides of wheels and the source gives them no controller, so "
+        "Gazebo's differential-drive plugin is written (Gazebo Sim's DiffDrive system, or gazebo_ros's "
+        "diff drive for Gazebo classic): the note names the wheels, their separation and radius and the "
+        "command and odometry topics. `--no-drive-plugin` leaves it out.",
+    ),
+    CodeInfo(
+        "MK859",
+        "drive-plugin-not-written",
+        "info",
+        "URDF/SDF: the robot has wheels but no differential-drive plugin is written, and the note says why "
+        "(the source names its own drive plugin, the wheels have the source's actuators, are steered, are "
+        "not in pairs, differ in radius, or turn the other way).",
+    ),
+    CodeInfo(
         "MK855",
         "source-actuators-replaced",
         "info",

@@ -28,6 +28,9 @@ class WriteOptions:
     # Gazebo classic: a sensor the source gave no plugin gets the gazebo_ros plugin that publishes it to
     # ROS 2 (MK850; modelkit/formats/sdf/ros_plugins.py)
     ros_plugins: bool = True
+    # URDF and SDF: Gazebo's differential-drive plugin for a robot on two sides of wheels that the source
+    # gives no controller (MK858; modelkit/convert/drive_plugin.py)
+    drive_plugin: bool = True
     wheel_collision: str = "auto"  # auto|cylinder|sphere|ellipsoid: the wheels' collision (convert.wheels)
     base: str = "auto"  # fixed | floating | auto: how the root meets the world (modelkit/convert/base.py)
     # actuators for a source without any (MJCF): auto (default: a position servo on each joint with a

@@ -37,6 +37,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.drive_plugin import find_drive, plugin_elements, say
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.joint_springs import note_spring_dropped
@@ -534,9 +535,25 @@ class _ModelWriter:
 
     # -- model-level data ------------------------------------------------------------------------
 
+    def _drive_plugin(self, model: Element) -> None:
+        """Gazebo's differential drive for a robot on wheels without a controller (convert.drive_plugin)."""
+        robot = self.robot
+        drive, why = find_drive(robot)
+        family = self.devices.gazebo
+        say(drive, why, family, str(model.get("name")), self.ctx.notes, robot.source)
+        if drive is None:
+            return
+        filename, name, children = plugin_elements(drive, family, self.axis_joints,
+                                                   self.names.links[drive.base])
+        plugin = sub(model, "plugin", filename=filename, name=name)
+        for tag, text in children:
+            sub(plugin, tag).text = text
+
     def _model_extras(self, model: Element) -> None:
         robot, ctx = self.robot, self.ctx
         ActuatorWriter(robot, ctx, self.devices.gazebo, self.axis_joints).write(model)
+        if ctx.options.drive_plugin:
+            self._drive_plugin(model)
         for plugin in robot.extras.get("sdf_plugins", []):
             if plugin.get("actuates"):
                 continue  # written from the canonical actuators (write_actuators)

@@ -18,6 +18,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.drive_plugin import find_drive, plugin_elements, say
 from modelkit.convert.friction import describe, floor_friction, link_surface
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.numbers import fmt
@@ -182,6 +183,8 @@ def write_extensions(
         written_ref = names.link(reference) if reference in names.link_map else reference
         _kept_blocks(robot_el, [entry], written_ref, ctx, "the robot")
     _model_plugins(robot_el, robot, gazebo, ctx)
+    if ctx.options.drive_plugin:
+        _drive_plugin(robot_el, robot, gazebo, names, ctx)
     _transmissions(robot_el, robot, names, ctx)
     write_transmissions(robot_el, robot, names.joint_map, ctx)
     for key in ("ros2_control", "mujoco", "sensor"):
@@ -218,6 +221,20 @@ def _model_plugins(robot_el: Element, robot: Robot, gazebo: str, ctx: WriteConte
                      "left out", robot.source, "gazebo")
             continue
         _gazebo(robot_el, None).append(block)
+
+
+def _drive_plugin(robot_el: Element, robot: Robot, gazebo: str, names: NameTable, ctx: WriteContext) -> None:
+    """Gazebo's differential drive, in a robot-level ``<gazebo>`` block (libsdformat's URDF import puts
+    it in the model), for a robot on wheels without a controller (convert.drive_plugin)."""
+    drive, why = find_drive(robot)
+    say(drive, why, gazebo, robot.name or "robot", ctx.notes, robot.source)
+    if drive is None:
+        return
+    joints = {name: names.joint(name) for name in (*drive.left, *drive.right)}
+    filename, name, children = plugin_elements(drive, gazebo, joints, names.link(drive.base))
+    plugin = etree.SubElement(_gazebo(robot_el, None), "plugin", filename=filename, name=name)
+    for tag, text in children:
+        etree.SubElement(plugin, tag).text = text
 
 
 def _transmissions(robot_el: Element, robot: Robot, names: NameTable, ctx: WriteContext) -> None:
