@@ -747,6 +747,17 @@ _TABLE: tuple[CodeInfo, ...] = (
     ),
     # (urdf joints and mass MK324-MK339) (sdf joints and inertials MK340-MK359)
     CodeInfo(
+        "MK324",
+        "massless-link-inertia",
+        "warning",
+        "URDF: a link on a fixed joint has mass 0 but a rotational inertia (pybullet_data's Panda: "
+        "`panda_link8`, 0.1 kg·m² per axis). A body without mass has no rotational inertia; the loaders "
+        "that fuse fixed links (MuJoCo's and Pinocchio's URDF imports) add the tensor to the parent link, "
+        "and modelkit reads it so: the parent's inertia about its centre of mass grows by the tensor, its "
+        "mass and centre of mass unchanged, and the link is a massless frame. Give the link a mass, or "
+        "remove its `<inertial>`.",
+    ),
+    CodeInfo(
         "MK340",
         "sdf-joint-type-unsupported",
         "warning",
