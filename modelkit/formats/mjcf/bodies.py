@@ -115,6 +115,7 @@ class MjSite:
     kind: str
     pose: Pose
     size: V3
+    shown: dict[str, Any] = field(default_factory=dict)  # group, rgba: when not MuJoCo's default
 
 
 @dataclass

@@ -437,6 +437,7 @@ class RobotBuilder:
                 type=site.kind,
                 size=[float(x) for x in site.size],
                 source=str(self.loc.site(site.index)),
+                **site.shown,
             )
             for site in sites
         ]

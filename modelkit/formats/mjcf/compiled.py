@@ -30,6 +30,8 @@ from modelkit.spatial import Pose
 
 JOINT_KINDS = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
 DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)
+SITE_RGBA = (0.5, 0.5, 0.5, 1.0)  # MuJoCo's default site colour (as stored in float32)
+CAMERA_IPD = 0.068  # m: MuJoCo's default inter-pupillary distance of a camera
 
 
 def all_close(a: tuple[float, ...], b: tuple[float, ...], rtol: float = 1e-5, atol: float = 1e-8) -> bool:
@@ -173,12 +175,19 @@ class CompiledModel:
 
     def site(self, s: int) -> MjSite:
         m = self.m
+        shown: dict[str, Any] = {}  # what MuJoCo shows of the site, when not its default
+        if int(m.site_group[s]) != 0:
+            shown["group"] = int(m.site_group[s])
+        rgba = [float(x) for x in m.site_rgba[s]]
+        if not all_close(tuple(rgba), SITE_RGBA, rtol=0.0, atol=1e-7):
+            shown["rgba"] = rgba
         return MjSite(
             index=s,
             name=self.name("site", s),
             kind=enum_word(self.mj.mjtGeom(int(m.site_type[s])), "mjGEOM_"),
             pose=pose_of(m.site_pos[s], m.site_quat[s]),
             size=rot3.vec3(m.site_size[s]),
+            shown=shown,
         )
 
     # -- what the model keeps as data ---------------------------------------------------------
@@ -189,16 +198,42 @@ class CompiledModel:
         out: list[tuple[int, str, str | None, Pose, dict[str, Any]]] = []
         for c in range(m.ncam):
             pose = pose_of(m.cam_pos[c], m.cam_quat[c])
-            out.append(
-                (int(m.cam_bodyid[c]), "camera", self.name("camera", c), pose, {"fovy": float(m.cam_fovy[c])})
-            )
+            params: dict[str, Any] = {"fovy": float(m.cam_fovy[c])}
+            params.update(self._tracking("cam", c))
+            resolution = [int(x) for x in m.cam_resolution[c]]
+            if resolution != [1, 1]:
+                params["resolution"] = resolution
+            if abs(float(m.cam_ipd[c]) - CAMERA_IPD) > 1e-12:
+                params["ipd"] = float(m.cam_ipd[c])
+            out.append((int(m.cam_bodyid[c]), "camera", self.name("camera", c), pose, params))
         for lt in range(m.nlight):
             pose = translation(m.light_pos[lt])
             params = {
                 "dir": [float(x) for x in m.light_dir[lt]],
                 "diffuse": [float(x) for x in m.light_diffuse[lt]],
+                "type": enum_word(self.mj.mjtLightType(int(m.light_type[lt])), "mjLIGHT_"),
+                "castshadow": bool(m.light_castshadow[lt]),
+                "active": bool(m.light_active[lt]),
+                "attenuation": [float(x) for x in m.light_attenuation[lt]],
+                "cutoff": float(m.light_cutoff[lt]),
+                "exponent": float(m.light_exponent[lt]),
+                "ambient": [float(x) for x in m.light_ambient[lt]],
+                "specular": [float(x) for x in m.light_specular[lt]],
             }
+            params.update(self._tracking("light", lt))
             out.append((int(m.light_bodyid[lt]), "light", self.name("light", lt), pose, params))
+        return out
+
+    def _tracking(self, prefix: str, index: int) -> dict[str, Any]:
+        """A camera's or light's ``mode`` and ``target`` body, when it moves otherwise than with its body."""
+        m = self.m
+        mode = enum_word(self.mj.mjtCamLight(int(getattr(m, f"{prefix}_mode")[index])), "mjCAMLIGHT_")
+        if mode == "fixed":
+            return {}
+        out: dict[str, Any] = {"mode": mode}
+        target = int(getattr(m, f"{prefix}_targetbodyid")[index])
+        if target >= 0:
+            out["target"] = self.name("body", target)
         return out
 
     def equalities(self) -> list[dict[str, Any]]:
@@ -258,14 +293,21 @@ class CompiledModel:
         out = []
         for s in range(m.nsensor):
             objtype = enum_word(self.mj.mjtObj(int(m.sensor_objtype[s])), "mjOBJ_")
-            out.append(
-                {
-                    "name": self.name("sensor", s),
-                    "type": enum_word(self.mj.mjtSensor(int(m.sensor_type[s])), "mjSENS_"),
-                    "objtype": objtype,
-                    "object": self._object_name(objtype, int(m.sensor_objid[s])),
-                }
-            )
+            entry: dict[str, Any] = {
+                "name": self.name("sensor", s),
+                "type": enum_word(self.mj.mjtSensor(int(m.sensor_type[s])), "mjSENS_"),
+                "objtype": objtype,
+                "object": self._object_name(objtype, int(m.sensor_objid[s])),
+            }
+            reftype = enum_word(self.mj.mjtObj(int(m.sensor_reftype[s])), "mjOBJ_")
+            if int(m.sensor_refid[s]) >= 0 and reftype not in ("unknown", ""):
+                entry["reftype"] = reftype
+                entry["refname"] = self._object_name(reftype, int(m.sensor_refid[s]))
+            for key in ("cutoff", "noise"):  # only when set: 0 is MuJoCo's "none"
+                value = float(getattr(m, f"sensor_{key}")[s])
+                if value > 0.0:
+                    entry[key] = value
+            out.append(entry)
         return out
 
     def tendons(self) -> list[dict[str, Any]]:

@@ -6,6 +6,8 @@ and nothing else uses it: no sensor, equality, actuator transmission or tendon o
 (the reader marks such sites ``used``: the file's sensors and equalities are on its main robot only),
 and no device was made of it. The MJCF writer writes named frames back as sites; the frame links of a
 model (:mod:`modelkit.convert.frames`) go the other way, MJCF → URDF → MJCF keeps them as sites.
+MJCF → MJCF writes back every site (:func:`own_sites`): the used ones too, which the source's own
+sensors, written back by :mod:`.write_own`, refer to.
 
 URDF, SDF and ``.body`` have no sites: :func:`sites_as_links` (run by ``convert.api.prepare`` for those
 targets, ``WriteOptions.frame_sites``) makes each named frame a massless link on a fixed joint from
@@ -55,6 +57,20 @@ def named_frames(robot: Robot) -> list[dict[str, Any]]:
     links = {link.name for link in robot.links}
     used = used_sites(robot)
     return [s for s in sites if s.get("name") and s.get("link") in links and s["name"] not in used]
+
+
+def device_sites(robot: Robot) -> set[str]:
+    """Names of the sites the MJCF reader made devices of (an accelerometer's, a rangefinder's...)."""
+    return {str(d.params["site"]) for link in robot.links for d in link.devices if "site" in d.params}
+
+
+def own_sites(robot: Robot) -> list[dict[str, Any]]:
+    """MJCF to MJCF: every site of ``mjcf_sites`` on a link of the model, named or used, but those a
+    device was made of (the device writes its own site), in the source's order."""
+    links = {link.name for link in robot.links}
+    devices = device_sites(robot)
+    sites = robot.extras.get(SITES) or []
+    return [s for s in sites if s.get("link") in links and s.get("name") not in devices]
 
 
 def site_pose(site: dict[str, Any]) -> Pose:

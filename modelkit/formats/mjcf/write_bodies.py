@@ -27,6 +27,9 @@
   nothing) are ``<site name pos quat>``s in the nearest body above them, their poses composed up to it,
   written after that body's own contents in tree order (``WriteOptions.frame_sites``; one MK873 note
   lists them). With ``frame_sites`` off they are bodies without ``<inertial>`` (MK816).
+* An MJCF source's sites (``mjcf_sites``) in the body of their link, at their pose, with their type,
+  size, group and colour: every one of them from an MJCF source (the source's own sensors refer to
+  them, :mod:`.write_own`), only those naming a frame from another (:mod:`.site_frames`).
 """
 
 from __future__ import annotations
@@ -41,7 +44,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.frames import frame_links
 from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_position, fmt_vec
 from modelkit.convert.servo_gains import home_position
-from modelkit.formats.mjcf.site_frames import named_frames, site_pose
+from modelkit.formats.mjcf.site_frames import named_frames, own_sites, site_pose
 from modelkit.formats.mjcf.write_chains import Chain, ChainFinder, shifted
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_geoms import GeomWriter
@@ -117,8 +120,10 @@ class BodyTree:
         self.chains = ChainFinder(self.robot, self.children)
         self.absorbed: set[str] = set()  # intermediate links written as joints of their chain's body
         self.frame_links = set(frame_links(self.robot)) if self.ctx.options.frame_sites else set()
-        self.kept_sites: dict[str, list[dict[str, Any]]] = {}  # an MJCF source's named frames, by link
-        for site in named_frames(self.robot):
+        self.kept_sites: dict[str, list[dict[str, Any]]] = {}  # an MJCF source's sites, by link
+        self.written_sites: list[dict[str, Any]] = []  # those written, in the order written
+        mjcf = self.robot.source_format == "mjcf"
+        for site in own_sites(self.robot) if mjcf else named_frames(self.robot):
             self.kept_sites.setdefault(str(site["link"]), []).append(site)
         for joint in self.robot.joints:
             chain = self.chains.below(joint)
@@ -320,19 +325,30 @@ class BodyTree:
         return pending
 
     def _kept_sites(self, el: Element, link: str, frame: Pose) -> None:
-        """An MJCF source's sites that name frames (:mod:`.site_frames`), written back."""
+        """An MJCF source's sites written back (:mod:`.site_frames`): those that name frames, and from
+        an MJCF source every site, with its group and colour (the source's sensors may use it)."""
         for site in self.kept_sites.get(link, []):
+            self.kept_site(el, site, frame)
+            self.written_sites.append(site)
+
+    def kept_site(self, el: Element, site: dict[str, Any], frame: Pose) -> None:
+        """One kept site in ``el`` (``frame``: its link's frame in the body's)."""
+        written = sub(el, "site")
+        if site.get("name"):
             wanted = str(site["name"])
-            name = self.names.claim("site", wanted, None, f"site[{wanted}]")
-            written = sub(el, "site", name=name)
-            set_pose(written, frame @ site_pose(site))
-            kind = str(site.get("type") or "sphere")
-            if kind != "sphere":
-                written.set("type", kind)
-            size = [float(v) for v in site.get("size") or []]
-            used = {"sphere": 1, "capsule": 2, "cylinder": 2}.get(kind, 3)
-            if size and size[:used] != [DEFAULT_SITE_SIZE] * used:
-                written.set("size", fmt_vec(size[:used]))
+            written.set("name", self.names.claim("site", wanted, None, f"site[{wanted}]"))
+        set_pose(written, frame @ site_pose(site))
+        kind = str(site.get("type") or "sphere")
+        if kind != "sphere":
+            written.set("type", kind)
+        size = [float(v) for v in site.get("size") or []]
+        used = {"sphere": 1, "capsule": 2, "cylinder": 2}.get(kind, 3)
+        if size and size[:used] != [DEFAULT_SITE_SIZE] * used:
+            written.set("size", fmt_vec(size[:used]))
+        if site.get("group") is not None:
+            written.set("group", str(int(site["group"])))
+        if site.get("rgba") is not None:
+            written.set("rgba", fmt_vec([float(v) for v in site["rgba"]]))
 
     def _frame_sites(self, el: Element, body_link: str, frames: list[tuple[str, Pose]]) -> None:
         """The frame links below a body as its ``<site>``s, each frame's chain in pre-order."""

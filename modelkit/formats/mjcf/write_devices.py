@@ -7,6 +7,8 @@ The model's device frame has +X forward (viewing / scanning direction), +Y left,
   with +Y up, so its frame is the device frame turned by R = [x: −Y, y: +Z, z: −X]. ``fovy`` is
   the vertical field of view in degrees, 2·atan(tan(hfov/2)·height/width); ``resolution="w h"``.
   Clip distances, frame rate and noise have no per-camera field (MK807).
+* Each sensor device gets a ``<site>`` named after it; devices the MJCF reader made of one MuJoCo site
+  (``params["site"]``: an accelerometer and a gyro on an IMU site) share the first one's.
 * ``lidar`` → a ``<site>`` and a ``<rangefinder>`` sensor (``cutoff`` = range_max). A rangefinder
   casts one ray along the site's +Z, so the site is turned to put +Z on the device's +X (MK807: one
   ray, not a scan).
@@ -27,7 +29,7 @@ Sensor names are ``<device>`` (one sensor) or ``<device>_acc``/``_gyro``/``_forc
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -68,6 +70,11 @@ class DeviceWriter:
     ctx: WriteContext
     names: NameTable
     sensor: Element
+    # what an MJCF source's own elements written back need (:mod:`.write_own`): the source site of a
+    # device → the site written for it; a camera's or light's device name → its element
+    site_for: dict[str, str] = field(default_factory=dict)
+    written: dict[tuple[str, str], Element] = field(default_factory=dict)
+    site_body: dict[str, Element] = field(default_factory=dict)  # a device site → the body it is in
 
     def link_devices(self, body: Element, link: Link, body_name: str) -> None:
         for device in link.devices:
@@ -91,6 +98,7 @@ class DeviceWriter:
     def camera(self, body: Element, device: Device, target: str) -> None:
         p = device.canonical_params
         el = sub(body, "camera", name=self.names.claim("camera", device.name, device.source, target))
+        self.written[("camera", device.name)] = el
         set_pose(el, Pose(device.pose.rotation @ CAMERA_FROM_DEVICE, device.pose.translation))
         hfov = p.get("horizontal_fov")
         width, height = p.get("width"), p.get("height")
@@ -125,6 +133,7 @@ class DeviceWriter:
             DeviceKind.DIRECTIONAL_LIGHT: "directional",
         }[device.canonical]
         el = sub(body, "light", name=self.names.claim("light", device.name, device.source, target), type=kind)
+        self.written[("light", device.name)] = el
         el.set("pos", fmt_position(device.pose.translation))
         direction = np.asarray(p.get("direction", (0.0, 0.0, -1.0)), dtype=float)
         el.set("dir", fmt_vec(device.pose.rotation @ direction))
@@ -155,9 +164,17 @@ class DeviceWriter:
     def sensors(self, body: Element, device: Device, target: str) -> None:
         p = device.canonical_params
         turn = RAY_FROM_DEVICE if device.canonical is DeviceKind.LIDAR else np.eye(3)
-        site_name = self.names.claim("site", device.name, device.source, target)
-        site = sub(body, "site", name=site_name, size=SITE_SIZE)
-        set_pose(site, Pose(device.pose.rotation @ turn, device.pose.translation))
+        source_site = str(device.params.get("site") or "")
+        shared = self.site_for.get(source_site) if source_site else None
+        if shared is not None and self.site_body.get(shared) is body:
+            site_name = shared  # an MJCF site that carries several sensors (accelerometer and gyro): one site
+        else:
+            site_name = self.names.claim("site", device.name, device.source, target, remember=False)
+            site = sub(body, "site", name=site_name, size=SITE_SIZE)
+            set_pose(site, Pose(device.pose.rotation @ turn, device.pose.translation))
+            self.site_body[site_name] = body
+            if source_site:
+                self.site_for[source_site] = site_name
         for element, suffix in SENSORS[device.canonical]:
             name = self.names.claim("sensor", device.name + suffix, device.source, target)
             el = sub(self.sensor, element, name=name, site=site_name)

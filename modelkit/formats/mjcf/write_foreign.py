@@ -1,10 +1,16 @@
 """MJCF to MJCF: which of the source's own elements kept as data the output does not hold again.
 
+Sites, cameras, lights and sensors are written back by :mod:`.write_own`, which says which it could not
+write; keyframes other than ``home``, equalities other than joint couplings and world geoms are not
+written back, and count as written when an element of their kind has their name.
+
 Another format's data is noted by ``convert`` itself
 (:func:`modelkit.convert.extras_notes.note_foreign_extras`).
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 from lxml.etree import _Element as Element
 
@@ -22,14 +28,26 @@ OWN_ELEMENTS = {  # an MJCF source's kept lists → the output elements that may
     "mjcf_equalities": "equality",
     "mjcf_world_geoms": "geom",
 }
+WHY = "only what the model holds (devices on links, frames, the home keyframe, mimic joints) is"
+WHY_WRITE_OWN = (  # the kinds write_own writes back
+    "the body each is on, or an object it names (a tendon, a body written at another frame...), is not in "
+    "the output (user, plugin, contact and tactile sensors are never written back)"
+)
 
 
-def note_unwritten_own(root: Element, robot: Robot, ctx: WriteContext) -> None:
+def note_unwritten_own(
+    root: Element, robot: Robot, ctx: WriteContext, unwritten: dict[str, list[dict[str, Any]]] | None = None
+) -> None:
     """MJCF to MJCF: what of the source's own elements kept as data (sensors, sites, cameras, lights,
     keyframes, equalities, world geoms) the output does not hold again, by name; one note per kind
-    with the code and words the MJCF declaration gives (a tendon is reported by the reader, MK172)."""
+    with the code and words the MJCF declaration gives (a tendon is reported by the reader, MK172).
+
+    ``unwritten``: for the kinds :mod:`.write_own` writes back, what it could not write (an object a
+    sensor names is missing...); the other kinds count as written when an element of their kind has
+    their name."""
     if robot.source_format != "mjcf":
         return
+    unwritten = unwritten or {}
     written: dict[str, set[str]] = {}
     for element in root.iter():
         if isinstance(element.tag, str) and element.get("name"):
@@ -37,7 +55,7 @@ def note_unwritten_own(root: Element, robot: Robot, ctx: WriteContext) -> None:
     for key in OWN_ELEMENTS:
         kept = robot.extras.get(key) or []
         kind = OWN_ELEMENTS[key]
-        lost = [
+        lost = unwritten[key] if key in unwritten else [
             item
             for item in kept
             if not isinstance(item, dict) or item.get("name") not in written.get(kind, set())
@@ -53,7 +71,7 @@ def note_unwritten_own(root: Element, robot: Robot, ctx: WriteContext) -> None:
         ctx.note(
             code,
             f"{len(lost)} of {len(kept)} {what} not written ({shown}{', ...' if len(lost) > 6 else ''}): "
-            "only what the model holds (devices on links, frames, the home keyframe, mimic joints) is",
+            + (WHY_WRITE_OWN if key in unwritten else WHY),
             robot.source,
             kind,
         )

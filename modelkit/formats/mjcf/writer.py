@@ -30,6 +30,9 @@ body pairs touching at rest. The style is MuJoCo Menagerie's (docs/convert.md, "
   or velocity servos set ``<option integrator="implicitfast">`` (MK825) unless an integrator is set.
 * A multi-joint MuJoCo body that the MJCF reader made a chain of links is written back as one body
   with its joints (:mod:`.write_chains`).
+* From an MJCF source, its own sites, cameras, lights and sensors that the model keeps as data are
+  written back where every object they name is written (:mod:`.write_own`); the rest is named in an
+  MK806/MK808 note (:mod:`.write_foreign`).
 * Massless frame links (a tool flange, a TCP, an optical frame) are ``<site>``s in the body they hang
   on (:mod:`.write_bodies`, MK873), unless ``WriteOptions.frame_sites`` is off.
 * Self-collision follows MuJoCo's defaults (parent–child and welded pairs never collide), and any
@@ -39,6 +42,8 @@ body pairs touching at rest. The style is MuJoCo Menagerie's (docs/convert.md, "
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 from lxml import etree
@@ -56,6 +61,7 @@ from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_foreign import note_unwritten_own
 from modelkit.formats.mjcf.write_geoms import COLLISION, CONTACT_PRIORITY, GeomWriter, shared_stems
 from modelkit.formats.mjcf.write_names import NameTable
+from modelkit.formats.mjcf.write_own import OwnWriter
 from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, quat_wxyz, set_pose, sub
 from modelkit.model import WORLD_LINK, LoopConstraint, Robot
 from modelkit.spatial import Pose
@@ -134,13 +140,20 @@ class MjcfWriter:
         self._home()
         self.geoms.defaults(self.sections["default"], self.robot.name)
         self._surface_note()
-        note_unwritten_own(self.root, self.robot, self.ctx)
+        lost = self._own() if self.robot.source_format == "mjcf" else {}
+        note_unwritten_own(self.root, self.robot, self.ctx, lost)
         write_source_pairs(self.root, self.sections["contact"], self.robot, self.ctx)
         self._meshdir()
         if any(el.get("euler") is not None for el in self.root.iter()):
             self.sections["compiler"].set("eulerseq", EULER_SEQUENCE)  # set_pose's euler: URDF's rpy
         self._self_contact()
         return self._text()
+
+    def _own(self) -> dict[str, list[dict[str, Any]]]:
+        """MJCF to MJCF: the source's own cameras, lights, world sites and sensors (:mod:`.write_own`)."""
+        own = OwnWriter(self.robot, self.ctx, self.names, self.tree, self.devices, self.sections["worldbody"],
+                        self.sections["sensor"])
+        return own.write()
 
     def _surface_note(self) -> None:
         """Once per file: how MuJoCo combines the source's shape frictions the geoms now hold."""
