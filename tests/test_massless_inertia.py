@@ -68,7 +68,8 @@ CHAIN = """<robot name="c">
     </inertial></link>
   <link name="b"><inertial><mass value="0"/><inertia ixx="1" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/>
     </inertial></link>
-  <joint name="ja" type="fixed"><parent link="base"/><child link="a"/><origin rpy="0 0 1.5707963267948966"/></joint>
+  <joint name="ja" type="fixed"><parent link="base"/><child link="a"/>
+    <origin rpy="0 0 1.5707963267948966"/></joint>
   <joint name="jb" type="fixed"><parent link="a"/><child link="b"/></joint>
 </robot>
 """
