@@ -124,3 +124,35 @@ def test_a_mimic_joint_is_held_not_left_free() -> None:
     assert law.amplitude[follower] == 0.0
     assert law.kp[follower] > 0.0 and law.kd[follower] > 0.0
     assert law.kp[follower] == pytest.approx(law.kp[leader])
+
+
+def _stiffened(factor: float):  # type: ignore[no-untyped-def]
+    """``default_law`` at ``factor`` times its bandwidth (kp × factor², kd × factor)."""
+    import dataclasses
+
+    def law(source, dt=DT):  # type: ignore[no-untyped-def]
+        base = default_law(source, dt)
+        return dataclasses.replace(base, kp=tuple(k * factor**2 for k in base.kp),
+                                   kd=tuple(k * factor for k in base.kd))
+    return law
+
+
+def test_a_law_the_reference_cannot_integrate_is_softened(monkeypatch: pytest.MonkeyPatch) -> None:
+    """robosuite's GR1 humanoid (layers 1–3a equal to 1e-15) blew up in MuJoCo at 4.48 s under the
+    replay law, and verify failed a sound conversion; at half the bandwidth the engines agreed to
+    2.6e-13 rad. Reproduced on the hopper with the law at 32× its bandwidth (ω·dt 3.2, beyond semi-
+    implicit Euler's limit of 2): verify halves the bandwidth until MuJoCo integrates it (3 times,
+    ω·dt 0.4), says so, and the replay passes; with no halving allowed the same run fails."""
+    from modelkit.verify import api
+    from modelkit.verify.layers import replay
+
+    monkeypatch.setattr(replay, "default_law", _stiffened(32.0))
+    report = api.verify(HOPPER)
+    graded = ("replay", "stability", "engine-error")
+    layer3 = [c for c in report.checks if c.layer == 3 and c.quantity in graded]
+    assert layer3 and all(c.passed for c in layer3), [c.message for c in layer3 if not c.passed]
+    (said,) = [s.reason for s in report.skips if "softened" in s.reason]
+    assert said.startswith("layer 3b's law softened 3×") and "0.125× the bandwidth" in said
+    monkeypatch.setattr(api, "LAW_SOFTENINGS", 0)
+    report = api.verify(HOPPER)
+    assert [c for c in report.checks if c.layer == 3 and not c.passed and c.engine == "mujoco"]

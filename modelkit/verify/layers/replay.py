@@ -23,6 +23,7 @@ bandwidth halved until it is.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Any
@@ -252,6 +253,11 @@ def default_law(source: Robot, dt: float = 1e-3) -> TorqueLaw:
             kp[i] *= scale**2
             kd[i] *= scale
     return TorqueLaw(tuple(names), tuple(kp), tuple(kd), tuple(amp), tuple(freq), tuple(phase))
+
+
+def soften(law: TorqueLaw) -> TorqueLaw:
+    """``law`` at half the bandwidth: kp/4 and kd/2, so the damping ratio is kept."""
+    return dataclasses.replace(law, kp=tuple(k * 0.25 for k in law.kp), kd=tuple(k * 0.5 for k in law.kd))
 
 
 def _run(sim: Simulator, law: TorqueLaw, seconds: float, dt: float) -> tuple[Array | None, float, str]:
