@@ -219,3 +219,26 @@ def test_urdf_world_weld_is_the_source_answer_and_keeps_its_name(tmp_path: Path)
     notes = _convert(source, free, "floating")
     assert b"<freejoint" in free.read_bytes()
     assert [c for c, _ in notes if c == "MK831"] == ["MK831"]
+
+
+def test_our_urdf_of_a_robot_on_a_caster_floats_again(tmp_path: Path) -> None:
+    """The tutorial's pan-tilt robot (a .body whose root is free) written to URDF has no `world` link
+    (URDF's convention for a floating root) and a caster sphere fixed to its chassis that touches the
+    ground. Read back, --base auto welded it ("the root's own body rests on the ground") and did not
+    see its sphere wheels, so URDF → MJCF gave a robot nailed to the world without the wheels'
+    simulator options. Now the two sphere wheels are wheels, and wheels float the robot."""
+    body = Path(__file__).resolve().parents[1] / "samples" / "choreonoid_ros2_mobile_robot_tutorial" / \
+        "model" / "mobile_robot_pantilt.body"
+    urdf = tmp_path / "a" / "robot.urdf"
+    assert CliRunner().invoke(main, ["convert", str(body), "-o", str(urdf)]).exit_code == 0
+    checked = validate(urdf)
+    assert checked.robot is not None
+    decision = decide(checked.robot)
+    assert decision.kind is JointType.FLOATING
+    assert '"LeftWheel", "RightWheel"' in decision.reason and "beside a caster" in decision.reason
+    mjcf = tmp_path / "b" / "robot.xml"
+    result = CliRunner().invoke(main, ["convert", str(urdf), "-o", str(mjcf)])
+    assert result.exit_code == 0, result.output
+    assert "MK825" in result.output  # the wheels' <option> and stiff contact
+    model = mujoco.MjModel.from_xml_path(str(mjcf))
+    assert model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE

@@ -117,6 +117,27 @@ def test_the_sources_own_drive_plugin_is_the_only_one(tmp_path: Path) -> None:
         assert "MK859 no Gazebo drive plugin written: the source names its own" in said
 
 
+def test_a_source_plugin_the_target_drops_is_replaced(tmp_path: Path) -> None:
+    """A URDF's own <gazebo> diff drive stays the only one in URDF, but SDF holds no <gazebo> block
+    (MK808), so the SDF gets the writer's; an SDF's Gazebo Sim DiffDrive written for Gazebo classic is
+    left out (MK848), so the URDF gets gazebo_ros's."""
+    urdf = tmp_path / "a" / "robot.urdf"
+    _convert(MODELS / "mobile_robot_pantilt.body", urdf, "--urdf-distinct-names")
+    kept = tmp_path / "b" / "robot.urdf"
+    said = _convert(urdf, kept)
+    assert len(_drive_plugins(etree.parse(str(kept)).getroot())) == 1 and "MK858" not in said
+    sdf = tmp_path / "c" / "robot.sdf"
+    said = _convert(urdf, sdf)
+    (plugin,) = _drive_plugins(etree.parse(str(sdf)).getroot())
+    assert plugin.get("filename") == SIM[0] and "MK858" in said
+    first = tmp_path / "d" / "robot.sdf"
+    _convert(MODELS / "mobile_robot_pantilt.body", first)
+    classic = tmp_path / "e" / "robot.urdf"
+    said = _convert(first, classic, "--gazebo", "classic")
+    (plugin,) = _drive_plugins(etree.parse(str(classic)).getroot())
+    assert plugin.get("filename") == CLASSIC[0] and "MK848" in said and "MK858" in said
+
+
 WHEELS = """<robot name="cart">
   <link name="base"><inertial><mass value="5"/>
     <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>

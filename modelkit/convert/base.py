@@ -10,11 +10,13 @@ with a fixed joint, or no ``world`` link; .body: ``jointType: fixed|free``).
 * Where the source is silent (a URDF without ``world``: ``Robot.root_joint is None``), ``--base`` decides;
   ``auto`` floats a robot that moves itself and welds the others (MK830 says which and why):
 
-  - a robot whose root's own rigid body (the root and what is fixed to it) touches the lowest level
-    rests on its base: welded (arms, fixtures);
   - wheels: at least two revolute joints with a horizontal axis whose child's shapes touch the lowest
     level with a round section about that axis (a cylinder or sphere on the axis, or any shape whose
-    extents across the axis are equal within 10 % and centred on it): floating;
+    extents across the axis are equal within 10 % and centred on it): floating, also when a shape of
+    the root's own body touches too (a caster ball or skid fixed to the base, as on most
+    differential-drive robots: the tutorial's robot written to URDF came back welded);
+  - otherwise a robot whose root's own rigid body (the root and what is fixed to it) touches the
+    lowest level rests on its base: welded (arms, fixtures);
   - legs: at least two branches (from different first moving joints below the root) whose shapes
     touch the lowest level through two or more moving joints: floating;
   - legs that do not reach the ground at q = 0 (folded or sideways, as some quadrupeds are modelled):
@@ -182,14 +184,18 @@ def decide(robot: Robot) -> BaseDecision:
     touching = {name for name, (low, _) in lows.items() if low - ground <= tolerance}
     parent_joint = {joint.child: joint for joint in robot.joints}
     above = {name: _moving_above(parent_joint, name) for name in sorted(touching)}
-    if any(not moving for moving in above.values()):
-        return _by_limbs(limbs, "the root's own body rests on the ground (an arm or a fixture"
-                         + (f"; {raised} limb(s) point up, as a hand's fingers do" if raised else "") + ")")
+    # Wheels first: a differential-drive robot's caster is often a shape of the root's own body that
+    # touches the ground (a fixed ball or skid), and the robot still drives.
     wheels = _wheels(robot, poses, touching, use_collisions)
     if len(wheels) >= 2:
         shown = ", ".join(f'"{j.name}"' for j in wheels[:4]) + (" ..." if len(wheels) > 4 else "")
+        caster = (" beside a caster of the root's own body" if any(not moving for moving in above.values())
+                  else "")
         return BaseDecision(JointType.FLOATING, f"it drives on wheels (joint(s) {shown}: a round shape "
-                            "on a horizontal axis touching the ground)")
+                            f"on a horizontal axis touching the ground{caster})")
+    if any(not moving for moving in above.values()):
+        return _by_limbs(limbs, "the root's own body rests on the ground (an arm or a fixture"
+                         + (f"; {raised} limb(s) point up, as a hand's fingers do" if raised else "") + ")")
     feet = _feet(above)
     if len(feet) >= 2:
         shown = ", ".join(f'"{name}"' for name in feet[:6])

@@ -18,7 +18,8 @@ plugin, which turns a ``geometry_msgs/Twist`` (forward speed v, yaw rate ω) int
 Which robots: wheels whose axes lie along the root's Y at q = 0, as many at +Y (left) as at −Y
 (right), one radius, each axis pointing to +Y (a positive turn rolls the robot towards +X: both
 plugins command one sign for all wheels). None where the wheels carry the model's own actuators (the
-writers turn those into joint controllers) or the source already names a drive plugin (it is kept).
+writers turn those into joint controllers) or the output keeps a drive plugin the source names (an
+SDF model plugin, a URDF ``<gazebo>`` block where the target holds it).
 ``--no-drive-plugin`` leaves it out. MK858 says what was written, MK859 why a robot with wheels got none.
 """
 
@@ -54,12 +55,13 @@ class DiffDrive:
     base: str  # the root link (source name)
 
 
-def find_drive(robot: Robot) -> tuple[DiffDrive | None, str]:
-    """The model's differential drive, or None and why (an empty why: the model has no wheels)."""
+def find_drive(robot: Robot, target: str, family: str) -> tuple[DiffDrive | None, str]:
+    """The model's differential drive for a ``target`` (``urdf``/``sdf``) written for Gazebo
+    ``family``, or None and why (an empty why: the model has no wheels)."""
     wheels = robot.extras.get(WHEELS_KEY)
     if not isinstance(wheels, dict) or not wheels or robot.root is None:
         return None, ""
-    if _source_drive(robot):
+    if _kept_source_drive(robot, target, family):
         return None, "the source names its own drive plugin, which is kept"
     joints = {j.name: j for j in robot.joints}
     actuated = sorted(a.joint for a in robot.actuators if a.joint in wheels.values())
@@ -127,15 +129,24 @@ def _round_shape(link: Link) -> tuple[float, np.ndarray] | None:
     return best
 
 
-def _source_drive(robot: Robot) -> bool:
-    """Whether the source names a drive plugin of its own (an SDF model plugin, a URDF ``<gazebo>``)."""
+def _kept_source_drive(robot: Robot, target: str, family: str) -> bool:
+    """Whether the output keeps a drive plugin of the source's own: an SDF model plugin (the SDF writer
+    copies an SDF source's; the URDF writer those of ``family`` or of none), a URDF robot-level
+    ``<gazebo>`` block (the URDF writer keeps them; SDF has no place for them, MK808)."""
+    from modelkit.convert.gazebo import plugin_family
+
     texts: list[str] = []
     for entry in robot.extras.get("sdf_plugins") or []:
-        if isinstance(entry, dict):
-            texts += [str(entry.get("filename", "")), str(entry.get("name", ""))]
-    for entry in robot.extras.get("gazebo") or []:
-        if isinstance(entry, dict):
-            texts.append(str(entry.get("xml", "")))
+        if not isinstance(entry, dict):
+            continue
+        filename = str(entry.get("filename", ""))
+        kept = robot.source_format == "sdf" if target == "sdf" else plugin_family(filename) in (None, family)
+        if kept:
+            texts += [filename, str(entry.get("name", ""))]
+    if target == "urdf":
+        for entry in robot.extras.get("gazebo") or []:
+            if isinstance(entry, dict):
+                texts.append(str(entry.get("xml", "")))
     lowered = " ".join(texts).lower()
     return any(word in lowered for word in DRIVE_WORDS)
 

@@ -1,7 +1,8 @@
 """Wheel collisions: which links are wheels, and the collision shape a target gets for them.
 
 A **wheel** is the child link of a revolute joint (unlimited, not a mimic follower, not a track
-roller ``convert.tracks`` wrote) that has a cylinder collision coaxial with the joint axis, the axis
+roller ``convert.tracks`` wrote) that has a cylinder collision coaxial with the joint axis (or a
+sphere centred on it: the wheels of this module's own URDF and MJCF outputs), the axis
 horizontal at q = 0 (perpendicular to the root's Z), and the cylinder's lowest point on the lowest
 level of the robot's collision shapes (within :data:`GROUND_LEVEL` of it). A tilt head, a roller of a
 track or a wheel of a robot welded to the world (fixed root) is not a wheel.
@@ -43,6 +44,8 @@ GROUND_LEVEL = 1e-3
 HORIZONTAL = 1e-6
 """|axis · z| below this: a joint axis is horizontal."""
 PARALLEL = 1e-6
+ON_AXIS = 1e-6
+"""m: a sphere wheel's centre lies within this of the joint axis."""
 SPHERE_TARGETS = frozenset(t.name for t in TARGETS if t.auto_wheel == "sphere")
 """Targets whose ``auto`` wheel collision is a sphere (the formats MuJoCo and PyBullet load), as each
 format declares it (``auto_wheel`` in its ``declare.py``)."""
@@ -104,11 +107,17 @@ def find_wheels(robot: Robot) -> dict[str, tuple[str, int]]:
         best: tuple[float, int] | None = None
         for i, geom in enumerate(link.collisions):
             g = geom.geometry
-            if not isinstance(g, Cylinder) or g.radius <= 0.0:
+            if not isinstance(g, Cylinder | Sphere) or g.radius <= 0.0:
                 continue
-            along = geom.pose.rotation @ z
-            if abs(1.0 - abs(float(along @ axis))) > PARALLEL:
-                continue
+            if isinstance(g, Cylinder):
+                along = geom.pose.rotation @ z
+                if abs(1.0 - abs(float(along @ axis))) > PARALLEL:
+                    continue
+            else:  # a sphere wheel (our own URDF and MJCF outputs): its centre on the axis
+                centre_local = np.asarray(geom.pose.translation, dtype=float)
+                off_axis = centre_local - float(centre_local @ axis) * axis
+                if float(np.linalg.norm(off_axis)) > ON_AXIS:
+                    continue
             centre = pose.rotation @ geom.pose.translation + pose.translation
             bottom = float(centre[2]) - g.radius
             if abs(bottom - floor) > GROUND_LEVEL:
@@ -135,7 +144,8 @@ def approximate_wheels(robot: Robot, choice: str, target: str, notes: NoteSink) 
         link = links[name]
         geom = link.collisions[index]
         g = geom.geometry
-        assert isinstance(g, Cylinder)
+        if not isinstance(g, Cylinder):  # already a sphere: nothing to replace
+            continue
         if shape == "sphere":
             new: Geom = Geom(Sphere(g.radius), Pose(translation=geom.pose.translation.copy()),
                              name=geom.name, material=geom.material, source=geom.source)

@@ -538,8 +538,8 @@ class _ModelWriter:
     def _drive_plugin(self, model: Element) -> None:
         """Gazebo's differential drive for a robot on wheels without a controller (convert.drive_plugin)."""
         robot = self.robot
-        drive, why = find_drive(robot)
         family = self.devices.gazebo
+        drive, why = find_drive(robot, "sdf", family)
         say(drive, why, family, str(model.get("name")), self.ctx.notes, robot.source)
         if drive is None:
             return

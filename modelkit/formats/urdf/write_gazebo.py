@@ -226,7 +226,7 @@ def _model_plugins(robot_el: Element, robot: Robot, gazebo: str, ctx: WriteConte
 def _drive_plugin(robot_el: Element, robot: Robot, gazebo: str, names: NameTable, ctx: WriteContext) -> None:
     """Gazebo's differential drive, in a robot-level ``<gazebo>`` block (libsdformat's URDF import puts
     it in the model), for a robot on wheels without a controller (convert.drive_plugin)."""
-    drive, why = find_drive(robot)
+    drive, why = find_drive(robot, "urdf", gazebo)
     say(drive, why, gazebo, robot.name or "robot", ctx.notes, robot.source)
     if drive is None:
         return
