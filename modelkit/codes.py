@@ -758,6 +758,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "remove its `<inertial>`.",
     ),
     CodeInfo(
+        "MK325",
+        "mimic-on-fixed-joint",
+        "warning",
+        "URDF: a `<mimic>` whose joint or leader is fixed (example-robot-data's `talos_reduced.urdf`: "
+        "its fixed gripper joints keep the full model's mimics). A fixed joint has no position to follow "
+        "or lead; urdfdom, PyBullet and MuJoCo ignore the mimic and Drake refuses the file, so modelkit "
+        "drops it and no output repeats it.",
+    ),
+    CodeInfo(
         "MK340",
         "sdf-joint-type-unsupported",
         "warning",

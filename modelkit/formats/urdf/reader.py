@@ -154,7 +154,8 @@ def _check_children(ctx: Context, robot: Robot) -> None:
 
 def _unknown_mimic_leaders(ctx: Context, robot: Robot) -> None:
     """A ``<mimic joint>`` naming no joint: urdfdom, libsdformat's URDF conversion, PyBullet and MuJoCo
-    load the robot and the joint moves on its own, so it is a warning here and the mimic is dropped."""
+    load the robot and the joint moves on its own, so it is a warning here and the mimic is dropped
+    (MK320). A mimic whose follower or leader is a fixed joint is dropped too (MK325)."""
     names = {joint.name for joint in robot.joints}
     for joint in robot.joints:
         mimic = joint.mimic
@@ -167,6 +168,25 @@ def _unknown_mimic_leaders(ctx: Context, robot: Robot) -> None:
             "drops the mimic)",
             mimic.source or joint.loc("mimic"),
             hint=did_you_mean(mimic.joint, names),
+            severity=Severity.WARNING,
+        )
+        joint.mimic = None
+    types = {joint.name: joint.type for joint in robot.joints}
+    for joint in robot.joints:
+        mimic = joint.mimic
+        if mimic is None:
+            continue
+        still = [name for name in (joint.name, mimic.joint) if types.get(name) is JointType.FIXED]
+        if not still:
+            continue
+        ctx.emit(
+            "MK325",
+            f'joint "{joint.name}" mimics "{mimic.joint}", but {" and ".join(f"{n!r}" for n in still)} '
+            f"{'is' if len(still) == 1 else 'are'} fixed: a fixed joint has no position to follow or to "
+            "lead. urdfdom, PyBullet and MuJoCo ignore the mimic, Drake refuses the file (\"which has 0 "
+            "DOF cannot mimic\"); modelkit drops it, so no output repeats it",
+            mimic.source or joint.loc("mimic"),
+            hint="remove the <mimic>, or give the joint its moving type",
             severity=Severity.WARNING,
         )
         joint.mimic = None
