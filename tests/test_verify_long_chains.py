@@ -65,7 +65,7 @@ def test_verify_of_a_200_link_chain_skips_what_the_engines_cannot_hold(tmp_path:
                     driven=False)
     assert not report.errors and not report.failed and report.exit_code == 0, report.failed[:3]
     reasons = {(s.engine, s.layer): s.reason for s in report.skips}
-    assert "199 moving joints" in reasons[("pybullet", 0)]
+    assert "199 joints" in reasons[("pybullet", 0)]
     assert "199 degrees of freedom" in reasons[("pinocchio", 0)]
     assert {c.engine for c in report.checks if c.layer == 2} >= {"mujoco", "yourdfpy"}
 
@@ -88,7 +88,7 @@ def test_pybullets_joint_limit_is_its_own(tmp_path: Path) -> None:
     finally:
         model.close()
     beyond = chain_support.write(tmp_path, "urdf", MAX_MOVING_JOINTS + 2)
-    with pytest.raises(TooManyJoints, match=f"{MAX_MOVING_JOINTS + 1} moving joints"):
+    with pytest.raises(TooManyJoints, match=f"{MAX_MOVING_JOINTS + 1} joints"):
         load(beyond, {}, root="link0")
     unchecked = PyBulletModel(beyond, {}, "link0")  # past the check: PyBullet itself fails
     try:
@@ -107,3 +107,36 @@ def test_mujocos_refusal_of_a_deep_mjcf_is_explained(tmp_path: Path) -> None:
     [load_check] = [c for c in report.checks if c.quantity == "load"]
     assert not load_check.passed and report.exit_code == 1
     assert "XML_ELEMENT_DEPTH_EXCEEDED" in load_check.detail and "MK872" in load_check.detail
+
+
+def _star(path: Path, moving: int, fixed: int) -> Path:
+    """A base with ``moving`` revolute and ``fixed`` fixed children (a tree, as example-robot-data's
+    tiago_dual: 101 moving and 28 fixed joints)."""
+    inertial = ('<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" '
+                'iyz="0"/></inertial>')
+    parts = [f'<robot name="star"><link name="base">{inertial}</link>']
+    for i in range(moving + fixed):
+        kind = "revolute" if i < moving else "fixed"
+        parts.append(f'<link name="l{i}">{inertial}</link><joint name="j{i}" type="{kind}">'
+                     f'<parent link="base"/><child link="l{i}"/><origin xyz="{0.01 * i} 0 0"/>'
+                     '<axis xyz="0 1 0"/>'
+                     '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>')
+    path.write_text("\n".join([*parts, "</robot>"]))
+    return path
+
+
+def test_pybullets_limit_counts_fixed_joints_too(tmp_path: Path) -> None:
+    """100 moving and 28 fixed joints: PyBullet answers no getJointState (tiago_dual failed layers 2
+    and 3 so), so verify's check counts every joint and skips PyBullet, as for a long chain."""
+    pytest.importorskip("pybullet")
+    from modelkit.verify.engines.pybullet import PyBulletError, PyBulletModel, TooManyJoints, load
+
+    tree = _star(tmp_path / "star.urdf", 100, 28)
+    with pytest.raises(TooManyJoints, match="128 joints"):
+        load(tree, {}, root="base")
+    unchecked = PyBulletModel(tree, {}, "base")
+    try:
+        with pytest.raises(PyBulletError, match="getJointState failed"):
+            unchecked.link_poses({})
+    finally:
+        unchecked.close()

@@ -382,14 +382,15 @@ class PyBulletModel:
         self.close()
 
 
-# PyBullet 3.2.7 answers getJointState for a fixed-base multibody of at most 127 moving joints (its
+# PyBullet 3.2.7 answers getJointState for a multibody of at most 127 joints, fixed ones included (its
 # shared-memory status holds MAX_DEGREE_OF_FREEDOM values; measured on serial chains: 127 answer, 128
-# fail with "getJointState failed" for every joint).
+# fail with "getJointState failed" for every joint; example-robot-data's tiago_dual, 101 moving and
+# 28 fixed joints: every one of its 129 fails).
 MAX_MOVING_JOINTS = 127
 
 
 class TooManyJoints(PyBulletError):
-    """The URDF has more moving joints than PyBullet reports states for."""
+    """The URDF has more joints than PyBullet reports states for."""
 
     engine_limit = True  # verify reports a skip, not a failed load
 
@@ -401,11 +402,11 @@ def _check_size(model: Path) -> None:
         root = etree.parse(str(model)).getroot()
     except (OSError, etree.XMLSyntaxError):
         return  # PyBullet's own load says what is wrong with the file
-    moving = sum(1 for joint in root.iterchildren("joint")
-                 if joint.get("type") in ("revolute", "continuous", "prismatic"))
-    if moving > MAX_MOVING_JOINTS:
-        raise TooManyJoints(f"{moving} moving joints: PyBullet reports the joint states of at most "
-                            f"{MAX_MOVING_JOINTS} (getJointState fails for every joint beyond that)")
+    joints = sum(1 for _ in root.iterchildren("joint"))
+    if joints > MAX_MOVING_JOINTS:
+        raise TooManyJoints(f"{joints} joints: PyBullet reports the joint states of a body of at most "
+                            f"{MAX_MOVING_JOINTS} joints, fixed ones included (getJointState fails for "
+                            "every joint beyond that)")
 
 
 def load(model: Path, renames: Renames, *, root: str, pose_path: str = "com-frame",
