@@ -73,6 +73,16 @@ def _pose(a: mujoco.MjModel, b: mujoco.MjModel) -> tuple[mujoco.MjData, mujoco.M
     return da, db
 
 
+def _same_readings(a, da, b, db) -> None:  # type: ignore[no-untyped-def]
+    """Every sensor of model ``a`` reads in ``b`` (found by name) what it reads in ``a``, to 1e-9."""
+    for s in range(a.nsensor):
+        name = _name(a, mujoco.mjtObj.mjOBJ_SENSOR, s)
+        t = mujoco.mj_name2id(b, mujoco.mjtObj.mjOBJ_SENSOR, name)
+        x = da.sensordata[a.sensor_adr[s] : a.sensor_adr[s] + a.sensor_dim[s]]
+        y = db.sensordata[b.sensor_adr[t] : b.sensor_adr[t] + b.sensor_dim[t]]
+        np.testing.assert_allclose(y, x, rtol=0.0, atol=1e-9, err_msg=f"sensor {name}")
+
+
 @pytest.mark.parametrize(
     ("model", "counts"),
     [
@@ -99,12 +109,7 @@ def test_dm_control_sensors_sites_cameras_and_lights_come_back(
     da, db = _pose(a, b)
     assert da.ncon == db.ncon == 0  # no floor contact: the touch sensors read what the robot does
     assert np.max(np.abs(da.qvel)) > 0.1 and np.max(np.abs(da.qpos)) > 0.1
-    for s in range(a.nsensor):
-        name = _name(a, mujoco.mjtObj.mjOBJ_SENSOR, s)
-        t = mujoco.mj_name2id(b, mujoco.mjtObj.mjOBJ_SENSOR, name)
-        x = da.sensordata[a.sensor_adr[s] : a.sensor_adr[s] + a.sensor_dim[s]]
-        y = db.sensordata[b.sensor_adr[t] : b.sensor_adr[t] + b.sensor_dim[t]]
-        np.testing.assert_allclose(y, x, rtol=0.0, atol=1e-9, err_msg=f"sensor {name}")
+    _same_readings(a, da, b, db)
     for kind in OWN_KINDS:
         assert f"{kind}" not in said, f"{model}: a note still says {kind} are not written:\n{said}"
 
@@ -166,12 +171,7 @@ def test_each_kind_comes_back_and_only_what_names_a_missing_object_is_noted(tmp_
     da.ctrl[:] = db.ctrl[:] = 0.7
     mujoco.mj_forward(a, da)
     mujoco.mj_forward(b, db)
-    for s in range(b.nsensor):
-        name = _name(b, mujoco.mjtObj.mjOBJ_SENSOR, s)
-        t = mujoco.mj_name2id(a, mujoco.mjtObj.mjOBJ_SENSOR, name)
-        x = da.sensordata[a.sensor_adr[t] : a.sensor_adr[t] + a.sensor_dim[t]]
-        y = db.sensordata[b.sensor_adr[s] : b.sensor_adr[s] + b.sensor_dim[s]]
-        np.testing.assert_allclose(y, x, rtol=0.0, atol=1e-9, err_msg=f"sensor {name}")
+    _same_readings(b, db, a, da)
     assert b.sensor_cutoff[mujoco.mj_name2id(b, mujoco.mjtObj.mjOBJ_SENSOR, "swing_vel")] == 3.0
 
 

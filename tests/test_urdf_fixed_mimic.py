@@ -15,6 +15,7 @@ import pytest
 from modelkit.api import load, validate
 from modelkit.convert.api import write
 from modelkit.verify.layers.static import _limit_error
+from tests.test_sdf_actuators import _drake_loads
 
 SOURCE = """<robot name="g">
   <link name="base"><inertial><mass value="1"/>
@@ -31,22 +32,11 @@ SOURCE = """<robot name="g">
 """
 
 
-def _drake_joints(path: Path) -> int:
-    pytest.importorskip("pydrake")
-    from pydrake.multibody.parsing import Parser
-    from pydrake.multibody.plant import MultibodyPlant
-
-    plant = MultibodyPlant(0.0)
-    Parser(plant).AddModels(str(path))
-    plant.Finalize()
-    return int(plant.num_joints())
-
-
 def test_a_mimic_on_a_fixed_joint_is_said_and_dropped(tmp_path: Path) -> None:
     source = tmp_path / "g.urdf"
     source.write_text(SOURCE)
     with pytest.raises(Exception, match="0 DOF cannot mimic"):
-        _drake_joints(source)
+        _drake_loads(source)
     (said,) = [d for d in validate(source).diagnostics if d.code == "MK325"]
     assert said.severity == "warning" and "'pad_joint' is fixed" in said.message
     robot = load(source)
@@ -54,7 +44,7 @@ def test_a_mimic_on_a_fixed_joint_is_said_and_dropped(tmp_path: Path) -> None:
     out = tmp_path / "out" / "g.urdf"
     write(robot, out, force=True)
     assert "<mimic" not in out.read_text()
-    assert _drake_joints(out) >= 2  # it loads: finger_joint, pad_joint (and the base's joint to the world)
+    assert _drake_loads(out) >= 2  # it loads: finger_joint, pad_joint (and the base's joint to the world)
 
 
 def test_sdf_no_limit_equals_infinity() -> None:
