@@ -137,8 +137,7 @@ def _compile(path: Path, root: str, actuated: bool = False,
             spec.delete(joint)
             welded = True
     if actuated:
-        for actuator in list(spec.actuators):
-            spec.delete(actuator)
+        drop_actuators(spec)
         for joint in spec.joints:
             if joint.type in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
                 act = spec.add_actuator()
@@ -148,6 +147,16 @@ def _compile(path: Path, root: str, actuated: bool = False,
     model = spec.compile()
     reference_world(model)
     return model, welded
+
+
+def drop_actuators(spec: Any) -> None:
+    """The file's actuators deleted, and the keyframes' controls with them (a ``home`` keyframe holds one
+    control per position servo; MuJoCo refuses a keyframe whose ``ctrl`` has another length: the layer-4
+    worlds of example-robot-data's TIAGo, whose arm has servos, did not load)."""
+    for actuator in list(spec.actuators):
+        spec.delete(actuator)
+    for key in spec.keys:
+        key.ctrl = []
 
 
 def reference_world(model: Any) -> None:
@@ -705,8 +714,7 @@ class MujocoDriver:
             self.file_timestep = float(o.timestep)
             if o.timestep != scenario.dt:  # the scenario's step; said in the settings
                 o.timestep = scenario.dt
-            for actuator in list(spec.actuators):
-                spec.delete(actuator)
+            drop_actuators(spec)
             floor = spec.worldbody.add_geom()  # MuJoCo's default contact: what a user's floor has
             floor.name, floor.type = "modelkit_floor", mujoco.mjtGeom.mjGEOM_PLANE
             floor.size = [0.0, 0.0, 1.0]
