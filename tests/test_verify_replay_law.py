@@ -150,7 +150,7 @@ def test_a_law_the_reference_cannot_integrate_is_softened(monkeypatch: pytest.Mo
     report = api.verify(HOPPER)
     graded = ("replay", "stability", "engine-error")
     layer3 = [c for c in report.checks if c.layer == 3 and c.quantity in graded]
-    assert layer3 and all(c.passed for c in layer3), [c.message for c in layer3 if not c.passed]
+    assert layer3 and all(c.passed for c in layer3), [c.detail for c in layer3 if not c.passed]
     (said,) = [s.reason for s in report.skips if "softened" in s.reason]
     assert said.startswith("layer 3b's law softened 3×") and "0.125× the bandwidth" in said
     monkeypatch.setattr(api, "LAW_SOFTENINGS", 0)

@@ -1,6 +1,9 @@
 """Layer 3a, dynamics without contact: the joint-space mass matrix and bias forces of each engine at
 random (q, dq) against the reference (Pinocchio built from the source), in the reference's dof order
-(errors relative to the largest entry; bias relative to max(1e-6, largest entry)).
+(errors relative to the largest entry; bias relative to max(1e-6, largest entry, max |M|·max |dq|²):
+the last is the scale of the bias's velocity terms, whose round-off is what two engines differ by
+when gravity loads no joint; pybullet_data's r2d2, whose wheels and gripper feel neither gravity nor
+Coriolis forces, had a bias of 0 against Drake's 1.1e-15 N·m, 1.1e-9 "relative" to the 1e-6 floor).
 """
 
 from __future__ import annotations
@@ -62,11 +65,14 @@ def layer3a(reference: EngineModel, eng: Loaded,
         bdiff = np.abs(ba - bb)
         if bdiff.size:
             n = int(np.argmax(bdiff))
-            bscale = max(1e-6, float(np.max(np.abs(ba))))
+            speed = max((abs(v) for v in dq.values()), default=0.0)
+            velocity_terms = (float(np.max(np.abs(ma))) if ma.size else 0.0) * speed**2
+            bscale = max(1e-6, float(np.max(np.abs(ba))), velocity_terms)
             err = float(bdiff[n]) / bscale
             if bias.beats(err):
                 bias.see(err, ref_dofs[n], f"sample {k}: bias {ba[n]:.12g}, engine {bb[n]:.12g} "
-                                           f"(relative to max(1e-6, max |b|) = {bscale:.6g})")
+                                           f"(relative to max(1e-6, max |b|, max |M|·max |dq|²) = "
+                                           f"{bscale:.6g})")
     what = f"{len(samples)} random (q, dq), {len(ref_dofs)} dofs"
     return [mm.check(3, label, "mass-matrix", eng.tolerance("mass-matrix"), what),
             bias.check(3, label, "bias", eng.tolerance("bias"), what)]
