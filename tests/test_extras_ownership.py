@@ -22,6 +22,10 @@ EXCEPTIONS: dict[tuple[str, str], str] = {
         "MK211's verdict on a joint named like a link depends on the SDF file's version",
     ("convert/gazebo.py", "sdf_plugins"):
         "Gazebo plugins are the same XML in SDF and in URDF <gazebo> blocks: which Gazebo they are for",
+    ("convert/drive_plugin.py", "sdf_plugins"):
+        "a drive plugin the source names and the output keeps (an SDF model plugin) stands in for the "
+        "writer's: no second one",
+    ("convert/drive_plugin.py", "gazebo"): "the same for a URDF source's robot-level <gazebo> block",
     ("formats/urdf/write_gazebo.py", "sdf_plugins"): "an SDF model's plugins are written as <gazebo> blocks",
     ("formats/urdf/writer.py", "sdf_plugins"): "the same: written, so no MK808 note",
     ("formats/urdf/writer.py", "mjcf_actuators"):

@@ -48,8 +48,11 @@ def test_a_mimic_on_a_fixed_joint_is_said_and_dropped(tmp_path: Path) -> None:
 
 
 def test_sdf_no_limit_equals_infinity() -> None:
-    """Layer 1 compares a limit of ±1e16 (SDF's default, "none") with ±inf as equal; real limits as before."""
+    """Layer 1 compares a limit of ±1e16 (SDF's default, "none") with ±inf as equal; finite limits as
+    numbers, as before."""
     assert _limit_error(1e16, math.inf) == 0.0 and _limit_error(-1e16, -math.inf) == 0.0
     assert _limit_error(1e16, -math.inf) == math.inf
     assert _limit_error(1e15, math.inf) == math.inf
     assert _limit_error(1.0, 1.0 + 1e-12) < 1e-9
+    assert _limit_error(1e16, 1e15) == pytest.approx(0.9)  # finite stand-ins are held exactly
+    assert _limit_error(1e16, 1e17) == pytest.approx(0.9)

@@ -28,10 +28,13 @@ NO_LIMIT = 1e16  # SDF's default limits, ±1e16, mean none: libsdformat's reader
 
 
 def _limit_error(a: float, b: float) -> float:
-    """Relative difference of two joint limits; a limit at or beyond ±1e16 is no limit (example-robot-
-    data's iris rotors: URDF limits ±1e16, read back from the SDF by Drake as ±inf)."""
-    a = math.copysign(math.inf, a) if abs(a) >= NO_LIMIT else a
-    b = math.copysign(math.inf, b) if abs(b) >= NO_LIMIT else b
+    """Relative difference of two joint limits. Against an infinite limit, a finite one at or beyond
+    ±1e16 (same sign) is no limit either (example-robot-data's iris rotors: URDF limits ±1e16, read
+    back from the SDF by Drake as ±inf); two finite limits are compared as numbers (a URDF stand-in of
+    ±1e16 must be held exactly)."""
+    if math.isinf(a) != math.isinf(b):
+        a = math.copysign(math.inf, a) if abs(a) >= NO_LIMIT else a
+        b = math.copysign(math.inf, b) if abs(b) >= NO_LIMIT else b
     if math.isinf(a) or math.isinf(b):
         return 0.0 if a == b else math.inf
     return abs(a - b) / max(1.0, abs(a), abs(b))
