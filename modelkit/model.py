@@ -430,6 +430,30 @@ class Robot:
             out.setdefault(joint.parent, []).append(joint)
         return out
 
+    def tree_order(self) -> tuple[list[Link], dict[str, Joint]]:
+        """Links depth-first from the root, every parent before its children (siblings in joint order;
+        iterative, a link reached twice is taken once), and each reached link's parent joint. Empty when
+        the root is unknown."""
+        links: dict[str, Link] = {}
+        for link in self.links:
+            links.setdefault(link.name, link)
+        children = self.children_of()
+        parent_joint: dict[str, Joint] = {}
+        order: list[Link] = []
+        if self.root is None or self.root not in links:
+            return order, parent_joint
+        stack = [self.root]
+        seen = {self.root}
+        while stack:
+            name = stack.pop()
+            order.append(links[name])
+            kids = [j for j in children.get(name, []) if j.child in links and j.child not in seen]
+            for joint in kids:
+                seen.add(joint.child)
+                parent_joint[joint.child] = joint
+            stack.extend(j.child for j in reversed(kids))
+        return order, parent_joint
+
     def world_poses(self, positions: dict[str, float] | None = None) -> dict[str, Pose]:
         """Forward kinematics: each link's pose in the world (root at ``root_pose``).
 

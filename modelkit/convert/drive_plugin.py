@@ -30,7 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from modelkit.convert.gazebo import plugin_family
 from modelkit.convert.notes import NoteSink
+from modelkit.convert.numbers import fmt
 from modelkit.convert.wheels import WHEELS_KEY
 from modelkit.diagnostics import SourceLocation
 from modelkit.model import Cylinder, Ellipsoid, Link, Robot, Sphere
@@ -133,8 +135,6 @@ def _kept_source_drive(robot: Robot, target: str, family: str) -> bool:
     """Whether the output keeps a drive plugin of the source's own: an SDF model plugin (the SDF writer
     copies an SDF source's; the URDF writer those of ``family`` or of none), a URDF robot-level
     ``<gazebo>`` block (the URDF writer keeps them; SDF has no place for them, MK808)."""
-    from modelkit.convert.gazebo import plugin_family
-
     texts: list[str] = []
     for entry in robot.extras.get("sdf_plugins") or []:
         if not isinstance(entry, dict):
@@ -155,8 +155,6 @@ def plugin_elements(drive: DiffDrive, family: str, joint: dict[str, str], base: 
                     ) -> tuple[str, str, list[tuple[str, str]]]:
     """(filename, name, children as (tag, text) in order) of the plugin for Gazebo ``family``;
     ``joint`` maps source joint names to written ones, ``base`` is the written root link."""
-    from modelkit.convert.numbers import fmt
-
     if family == "classic":
         children: list[tuple[str, str]] = []
         if len(drive.left) > 1:
@@ -175,11 +173,17 @@ def plugin_elements(drive: DiffDrive, family: str, joint: dict[str, str], base: 
     return SIM_FILE, SIM_NAME, children
 
 
-def say(drive: DiffDrive | None, why: str, family: str, model: str, notes: NoteSink,
-        where: SourceLocation | None) -> None:
-    """MK858 (written: which plugin, wheels, numbers, topics) or MK859 (wheels, but no plugin: why)."""
-    from modelkit.convert.numbers import fmt
+def planned_drive(robot: Robot, target: str, family: str, model: str, notes: NoteSink) -> DiffDrive | None:
+    """The drive a ``target`` writer (``urdf``/``sdf``) writes for Gazebo ``family`` into the model named
+    ``model``, said (MK858), or None, with MK859 when the robot has wheels."""
+    drive, why = find_drive(robot, target, family)
+    _say(drive, why, family, model, notes, robot.source)
+    return drive
 
+
+def _say(drive: DiffDrive | None, why: str, family: str, model: str, notes: NoteSink,
+         where: SourceLocation | None) -> None:
+    """MK858 (written: which plugin, wheels, numbers, topics) or MK859 (wheels, but no plugin: why)."""
     if drive is None:
         if why:
             notes.note("MK859", f"no Gazebo drive plugin written: {why}", where, "gazebo")

@@ -98,29 +98,6 @@ def body_renames(robot: Robot) -> dict[str, str]:
     return {src: dst for src, dst in names.by_name.items() if src != dst}
 
 
-def _tree_order(robot: Robot) -> tuple[list[Link], dict[str, Joint]]:
-    """Links depth-first from the root (siblings in joint order) and each link's parent joint."""
-    links: dict[str, Link] = {}
-    for link in robot.links:
-        links.setdefault(link.name, link)
-    children = robot.children_of()
-    parent_joint: dict[str, Joint] = {}
-    order: list[Link] = []
-    if robot.root is None or robot.root not in links:
-        return order, parent_joint
-    stack = [robot.root]
-    seen = {robot.root}
-    while stack:
-        name = stack.pop()
-        order.append(links[name])
-        kids = [j for j in children.get(name, []) if j.child in links and j.child not in seen]
-        for joint in kids:
-            seen.add(joint.child)
-            parent_joint[joint.child] = joint
-        stack.extend(j.child for j in reversed(kids))
-    return order, parent_joint
-
-
 def write_body(robot: Robot, ctx: WriteContext) -> bytes:
     from modelkit.checks.masses import lumped_masses
 
@@ -135,7 +112,7 @@ def write_body(robot: Robot, ctx: WriteContext) -> bytes:
         written = names.joints[id(joint)]
         if not joint.implicit_name and written != wanted:
             ctx.rename("joint", wanted, written, "joint names must be unique", joint.source)
-    order, parent_joint = _tree_order(robot)
+    order, parent_joint = robot.tree_order()
     from_body = robot.source_format == "body"
     root_name = names.by_name.get(robot.root or "", robot.root or "")
     doc: dict[str, Any] = {

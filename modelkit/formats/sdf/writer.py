@@ -37,7 +37,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.drive_plugin import find_drive, plugin_elements, say
+from modelkit.convert.drive_plugin import planned_drive, plugin_elements
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.joint_springs import note_spring_dropped
@@ -539,8 +539,7 @@ class _ModelWriter:
         """Gazebo's differential drive for a robot on wheels without a controller (convert.drive_plugin)."""
         robot = self.robot
         family = self.devices.gazebo
-        drive, why = find_drive(robot, "sdf", family)
-        say(drive, why, family, str(model.get("name")), self.ctx.notes, robot.source)
+        drive = planned_drive(robot, "sdf", family, str(model.get("name")), self.ctx.notes)
         if drive is None:
             return
         filename, name, children = plugin_elements(drive, family, self.axis_joints,

@@ -27,9 +27,9 @@ from modelkit.rot3 import peek
 
 def fold_massless_inertia(robot: Robot, sink: DiagnosticSink) -> None:
     """In place: each massless link's tensor on a fixed joint moved to its parent (module docstring)."""
-    by_child = {j.child: j for j in robot.joints}
-    links = {link.name: link for link in robot.links}
-    for link in reversed(_parents_first(robot, links)):
+    order, by_child = robot.tree_order()
+    links = {link.name: link for link in order}
+    for link in reversed(order):
         inertial = link.inertial
         joint = by_child.get(link.name)
         if inertial is None or inertial.mass != 0.0 or joint is None or joint.type is not JointType.FIXED:
@@ -67,22 +67,3 @@ def _held_above(parent: Link, by_child: dict[str, Joint], links: dict[str, Link]
             return False
         link = links.get(up.parent)
     return False
-
-
-def _parents_first(robot: Robot, links: dict[str, Link]) -> list[Link]:
-    """The links reachable from the root, every parent before its children (iterative; a cycle or a
-    second parent ends the walk there)."""
-    children: dict[str, list[str]] = {}
-    for joint in robot.joints:
-        children.setdefault(joint.parent, []).append(joint.child)
-    order: list[Link] = []
-    seen: set[str] = set()
-    stack = [robot.root] if robot.root is not None else []
-    while stack:
-        name = stack.pop()
-        if name in seen or name not in links:
-            continue
-        seen.add(name)
-        order.append(links[name])
-        stack.extend(reversed(children.get(name, [])))
-    return order

@@ -18,7 +18,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.drive_plugin import find_drive, plugin_elements, say
+from modelkit.convert.drive_plugin import planned_drive, plugin_elements
 from modelkit.convert.friction import describe, floor_friction, link_surface
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.numbers import fmt
@@ -226,8 +226,7 @@ def _model_plugins(robot_el: Element, robot: Robot, gazebo: str, ctx: WriteConte
 def _drive_plugin(robot_el: Element, robot: Robot, gazebo: str, names: NameTable, ctx: WriteContext) -> None:
     """Gazebo's differential drive, in a robot-level ``<gazebo>`` block (libsdformat's URDF import puts
     it in the model), for a robot on wheels without a controller (convert.drive_plugin)."""
-    drive, why = find_drive(robot, "urdf", gazebo)
-    say(drive, why, gazebo, robot.name or "robot", ctx.notes, robot.source)
+    drive = planned_drive(robot, "urdf", gazebo, robot.name or "robot", ctx.notes)
     if drive is None:
         return
     joints = {name: names.joint(name) for name in (*drive.left, *drive.right)}
