@@ -217,9 +217,15 @@ def test_gazebo_mu_of_a_urdf_link_reaches_mujoco_and_sdf(tmp_path: Path) -> None
     assert not [n for n in result.notes if n.code == "MK808"]  # the block is carried as <surface>
     robot = read_model(tmp_path / "s" / "r.sdf").robot
     assert robot is not None and robot.links[0].collisions[0].friction == SurfaceFriction(0.7)
-    same = tmp_path / "u" / "r.urdf"  # URDF to URDF: the block as written, no <contact> made up
-    convert([path], same)
-    assert "<contact>" not in same.read_text() and same.read_text().count("<mu1>") == 1
+    # URDF to URDF: the block as written, and the same friction as PyBullet's <contact>, which
+    # PyBullet reads (it ignores <gazebo>: the source in PyBullet has its default 0.5), said in MK852
+    assert _base_dynamics(path)[1] == pytest.approx(0.5)
+    same = tmp_path / "u" / "r.urdf"
+    result = convert([path], same)
+    assert same.read_text().count("<mu1>") == 1
+    assert _base_dynamics(same)[1] == pytest.approx(0.7)
+    said = [n for n in result.notes if n.code == "MK852" and "PyBullet reads no <gazebo> block" in n.message]
+    assert len(said) == 1 and "mu1 0.7" in said[0].message
 
 
 SURFACE = """<sdf version="1.9"><model name="r"><link name="a">

@@ -21,6 +21,7 @@ from modelkit.convert.meshes import MeshRef
 from modelkit.convert.numbers import clean_inertia, fmt, fmt_position, fmt_rpy, fmt_vec
 from modelkit.convert.output import safe_file_name
 from modelkit.diagnostics import SourceLocation
+from modelkit.formats.urdf.links import PYBULLET_LATERAL_DEFAULT
 from modelkit.model import (
     Box,
     Capsule,
@@ -211,10 +212,21 @@ def link_element(
             el.append(item)
     surface, others = link_surface(link)
     kept = link.extras.get(CONTACT_EXTRAS)
-    # a URDF source's friction came from its <contact> when it had one (else from its kept <gazebo> mu1)
-    if surface is not None and (robot.source_format != "urdf" or kept is not None):
+    if surface is not None:
         contact = contact_element(el, surface.sliding, surface.rolling or 0.0, surface.torsional or 0.0)
         _surface_losses(link, surface, others, ctx, target)
+        if robot.source_format == "urdf" and kept is None:
+            # the friction came from the source's <gazebo> mu1, which PyBullet does not read
+            ctx.note(
+                "MK852",
+                f"link {link.name}: the source's Gazebo friction (mu1 {fmt(surface.sliding)}) is also "
+                "written "
+                "as PyBullet's <contact> lateral_friction, which PyBullet multiplies by the floor's; "
+                "PyBullet reads no <gazebo> block and would give the link its default "
+                f"{fmt(PYBULLET_LATERAL_DEFAULT)}",
+                link.loc("collision"),
+                target,
+            )
     elif friction is not None and link.collisions:
         contact = contact_element(el, friction.dynamic, 0.0, 0.0)
     elif kept:
