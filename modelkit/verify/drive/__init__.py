@@ -193,7 +193,8 @@ class Trajectory:
     ``x``, ``y``, ``yaw``: the root link frame's planar pose relative to its pose at command start
     (yaw unwrapped). ``joints``: positions of the controlled joints (source names), relative to
     command start. ``wheels``: (left, right) joint angles relative to command start (for tracks,
-    roller 0's). ``settings``: every engine setting that matters for reproducing it."""
+    roller 0's). ``settings``: every engine setting that matters for reproducing it. ``support``
+    (engines): the links touching the floor at rest, after the settle, and the load each carries."""
 
     source: str  # "mujoco", "pybullet", "noslip", "unicycle", "odometry:mujoco", ...
     profile: str
@@ -206,6 +207,8 @@ class Trajectory:
     joints: dict[str, Array] = field(default_factory=dict)
     settings: dict[str, Any] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
+    # engines: each link touching the floor at rest (after the settle) → its normal load, N
+    support: dict[str, float] = field(default_factory=dict)
 
 
 class Driver(Protocol):

@@ -18,7 +18,7 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-from collections.abc import Iterator
+from collections.abc import Collection, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -149,14 +149,26 @@ def _compile(path: Path, root: str, actuated: bool = False,
     return model, welded
 
 
-def drop_actuators(spec: Any) -> None:
+def drop_actuators(spec: Any, driven: Collection[str] | None = None) -> list[str]:
     """The file's actuators deleted, and the keyframes' controls with them (a ``home`` keyframe holds one
     control per position servo; MuJoCo refuses a keyframe whose ``ctrl`` has another length: the layer-4
-    worlds of example-robot-data's TIAGo, whose arm has servos, did not load)."""
-    for actuator in list(spec.actuators):
-        spec.delete(actuator)
+    worlds of example-robot-data's TIAGo, whose arm has servos, did not load).
+
+    ``driven`` (layer 4): only the actuators on those joints go, where verify's controllers take over;
+    the others stay, as the user's robot has them (TIAGo's arm and torso servos hold them while the
+    base drives; deleted, the arm folded and the robot left its path by 71 cm). Returns the names of
+    the actuators kept (unnamed ones as ``actuator <i>``)."""
+    actuators = list(spec.actuators)
+    kept: list[int] = []
+    for i, actuator in enumerate(actuators):
+        if driven is None or (actuator.trntype == mujoco.mjtTrn.mjTRN_JOINT and actuator.target in driven):
+            spec.delete(actuator)
+        else:
+            kept.append(i)
     for key in spec.keys:
-        key.ctrl = []
+        ctrl = list(key.ctrl)
+        key.ctrl = [ctrl[i] for i in kept] if len(ctrl) == len(actuators) and kept else []
+    return [actuators[i].name or f"actuator {i}" for i in kept]
 
 
 def reference_world(model: Any) -> None:
@@ -675,8 +687,9 @@ class MujocoDriver:
     The robot is loaded as written (its ``<option>``, contact parameters and collision filters
     untouched, MK825); the world around it: a floor plane with MuJoCo's default contact
     (``modelkit_floor``, z = 0: what a user adds); the timestep set to the scenario's ``dt`` only when
-    the file's differs (said in the settings); the file's actuators deleted, as a controller takes
-    the joints (torques go through ``qfrc_applied`` on the controlled dofs, not clamped; a
+    the file's differs (said in the settings); the file's actuators on the joints verify drives
+    deleted, as a controller takes them, the others kept and holding the start pose (torques go
+    through ``qfrc_applied`` on the controlled dofs, not clamped; a
     velocity-mode joint gets a ``velocity`` actuator, the tracks' servo)."""
 
     engine = "mujoco"
@@ -697,6 +710,11 @@ class MujocoDriver:
         controlled = v.controlled_joints(self.controllers)
         velocity = [j for j, mode in controlled if mode == "velocity"]
         servoed = [g for j in velocity for g in v.driven_groups(drive, j)]
+        # The joints verify drives (controllers, servoed rollers, wheels): the file's actuators on
+        # them go; the others' stay and hold their joints as in the user's world.
+        driven_joints = {joints.get(j, j) for j in
+                         {j for j, _ in controlled} | set(servoed) | set(v.wheel_joints(drive))
+                         | {r for rollers in drive.rollers.values() for r in rollers}}
         # The laws' gains at the zero command: one explicit damping actuator per torque joint of
         # non-zero gain. A velocity-mode law with a q̇ term is not the servo's: per step, then.
         probe = affine_laws(self.controllers, Command(0.0)) if fast else None
@@ -714,7 +732,7 @@ class MujocoDriver:
             self.file_timestep = float(o.timestep)
             if o.timestep != scenario.dt:  # the scenario's step; said in the settings
                 o.timestep = scenario.dt
-            drop_actuators(spec)
+            self.file_actuators = drop_actuators(spec, driven_joints)
             floor = spec.worldbody.add_geom()  # MuJoCo's default contact: what a user's floor has
             floor.name, floor.type = "modelkit_floor", mujoco.mjtGeom.mjGEOM_PLANE
             floor.size = [0.0, 0.0, 1.0]
@@ -863,7 +881,10 @@ class MujocoDriver:
                                "mimic equality); beside each, an intvelocity actuator kp "
                                f"{self.servo_kp:.4g} N·m/rad (kv / SERVO_INTEGRAL_TIME), same bound: the "
                                "servo's integral part") if servoed else "none",
-            "file_actuators": "deleted", "start_height": self._start_height,
+            "file_actuators": (("deleted on the driven joints; kept, holding the start pose, on the others: "
+                                + ", ".join(self.file_actuators)) if self.file_actuators
+                               else "deleted (none on a joint verify does not drive)"),
+            "start_height": self._start_height,
             "settle": "zero torque; velocity servos held at 0",
             "controllers": [f"{c.name} ({c.mode}: {', '.join(c.joints)})" for c in self.controllers],
         }
@@ -884,6 +905,14 @@ class MujocoDriver:
         gap = floor_clearance(m, d, self.floor)
         self._start_height = 0.0 if not math.isfinite(gap) else -gap
         d.qpos[self.root_qadr + 2] = self._start_height
+        mujoco.mj_forward(m, d)
+        # The file's kept actuators (the first ones, see drop_actuators) hold the start pose: a
+        # position-type one (affine bias on its length) gets its length as its control, others 0.
+        self._start_ctrl = np.zeros(m.nu)
+        for a in range(len(self.file_actuators)):
+            affine = int(m.actuator_biastype[a]) == int(mujoco.mjtBias.mjBIAS_AFFINE)
+            if affine and m.actuator_biasprm[a, 1] != 0.0:
+                self._start_ctrl[a] = float(d.actuator_length[a])
         return np.array(d.qpos)
 
     def run(self, profile: Any, scenario: Any, drive: Any) -> Any:
@@ -905,10 +934,12 @@ class MujocoDriver:
         with quiet(self.warnings):
             mujoco.mj_resetData(m, d)
             d.qpos[:] = self._start
+            d.ctrl[:] = self._start_ctrl
             mujoco.mj_forward(m, d)
             step = mujoco.mj_step
-            if settle:  # zero torque, servos at 0, law actuators inert (gear 0)
+            if settle:  # zero torque, servos at 0, law actuators inert (gear 0), file servos holding
                 step(m, d, nstep=settle)
+            support = self._support()
             if laws is not None:
                 self._run_laws(laws, changes, steps, every, base, qrec)
             else:
@@ -918,10 +949,27 @@ class MujocoDriver:
                        v.rotations_wxyz(base[:, 3:]),
                        {name: qrec[:, i] for i, name in enumerate(self.recorded)}, v.wheel_joints(drive))
         out.settings = dict(self.settings)
+        out.support = support
         if laws is None and self._law_gain is not None:
             out.settings["control"] = ("the controllers' output() called before every mj_step: a law's "
                                        "gain changed with the command")
         out.warnings = self.warnings[warned:]  # "unstable" ones: MuJoCo reset the state mid-run
+        return out
+
+    def _support(self) -> dict[str, float]:
+        """Each body touching the floor (a contact within 1 mm): the sum of its contacts' normal
+        forces, N."""
+        m, d = self.model, self.data
+        out: dict[str, float] = {}
+        force = np.zeros(6)
+        for i in range(d.ncon):
+            contact = d.contact[i]
+            if self.floor not in (contact.geom1, contact.geom2) or contact.dist > 1.0e-3:
+                continue
+            other = contact.geom2 if contact.geom1 == self.floor else contact.geom1
+            mujoco.mj_contactForce(m, d, i, force)
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[other])) or ""
+            out[name] = out.get(name, 0.0) + float(force[0])
         return out
 
     def _laws(self, changes: dict[int, Any]) -> dict[int, list[tuple[np.ndarray, np.ndarray]]] | None:

@@ -196,6 +196,38 @@ class Worker:
         self._stderr.close()
 
 
+def _largest_diagonalisation_change(urdf: Path) -> float:
+    """The largest relative change PyBullet's importer makes to a link tensor of ``urdf``
+    (:func:`~modelkit.verify.engines.bullet_inertia.diagonalised`; relative to the largest element, in
+    the link frame: layer 1's inertia measure)."""
+    from lxml import etree
+
+    from modelkit import rot3
+    from modelkit.verify.engines.bullet_inertia import diagonalised
+
+    worst = 0.0
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False)
+    for inertial in etree.parse(str(urdf), parser).iterfind("./link/inertial"):
+        el = inertial.find("inertia")
+        if el is None:
+            continue
+        try:
+            ixx, ixy, ixz, iyy, iyz, izz = (float(el.get(k, "0"))
+                                            for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"))
+            origin = inertial.find("origin")
+            rpy = [float(v) for v in (origin.get("rpy", "0 0 0") if origin is not None else "0 0 0").split()]
+        except ValueError:
+            continue
+        tensor = np.array(rot3.inertia_from_moments(ixx, ixy, ixz, iyy, iyz, izz))
+        rotation = np.array(rot3.from_rpy(*rpy)) if len(rpy) == 3 else np.eye(3)
+        file_tensor = rotation @ tensor @ rotation.T
+        scale = float(np.max(np.abs(file_tensor)))
+        if scale > 0.0 and np.all(np.isfinite(tensor)):
+            change = rotation @ (diagonalised(tensor) - tensor) @ rotation.T
+            worst = max(worst, float(np.max(np.abs(change))) / scale)
+    return worst
+
+
 class PyBulletModel:
     """A written URDF in PyBullet, base welded: the :class:`~modelkit.verify.engines.protocol.EngineModel`
     and the :class:`~modelkit.verify.engines.protocol.Simulator` of layer 3b. Names are the URDF's."""
@@ -245,9 +277,14 @@ class PyBulletModel:
         #   a link whose inertial frame stays the identity did not take that path;
         # * getLinkState[4:6] is float32 (2.4e-8 m / 4.2e-7 rad measured), used for poses only with
         #   pose_path="link-frame".
+        #   The diagonalisation stops at 1e-6 × the trace, so the change, relative to the largest
+        #   element (layer 1's measure), can exceed 1e-6: the inertia tolerance is the largest change
+        #   Bullet's own algorithm makes to a tensor of the file (bullet_inertia, emulated exactly;
+        #   TIAGo's wheel: 1.21e-6), plus 1e-9 of rounding, and never below 1e-6.
         tolerances: dict[str, float] = {}
         if any(not np.allclose(d["inertial_orn"], (0.0, 0.0, 0.0, 1.0), rtol=0.0, atol=1e-15) for d in dyn):
-            tolerances.update({"inertia": 1e-6, "mass-matrix": 1e-6, "bias": 1e-6})
+            tolerances.update({"inertia": max(1e-6, _largest_diagonalisation_change(Path(urdf)) + 1e-9),
+                               "mass-matrix": 1e-6, "bias": 1e-6})
         if pose_path == "link-frame":
             tolerances["pose"] = 1e-6
         if tolerances:
@@ -541,7 +578,10 @@ class PyBulletDriver:
                         + ("; while a profile's commands run, the torque-law joints' jointDamping is the "
                            "controller's gain (the law's −gain·q̇, see control), nothing else"
                            if fast else "")),
-            "default_motors": "off (VELOCITY_CONTROL force 0)",
+            "default_motors": ("off (VELOCITY_CONTROL force 0) on the driven and the unbounded joints; "
+                               "kept (velocity 0, force the URDF effort: what a user's world has) on the "
+                               "bounded joints nothing drives: " + ", ".join(info["held"])
+                               if info.get("held") else "off (VELOCITY_CONTROL force 0)"),
             "torque": "TORQUE_CONTROL re-sent before every stepSimulation",
             "control": self._control_setting(fast),
             "velocity_servo": ("VELOCITY_CONTROL (a velocity constraint), max force "
@@ -622,6 +662,7 @@ class PyBulletDriver:
                        {name: q[:, i].copy() for i, name in enumerate(self.recorded)},
                        v.wheel_joints(self.drive))
         out.settings = dict(self.settings)
+        out.support = {str(k): float(f) for k, f in raw.get("support", {}).items()}
         if raw.get("law") == "per-step" and self.fast:
             out.settings["control"] = self._control_setting(False)  # a controller without an affine law
         return out

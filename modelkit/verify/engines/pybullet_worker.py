@@ -29,6 +29,10 @@ import traceback
 from array import array
 from typing import Any, BinaryIO
 
+SUPPORT_GAP = 1.0e-3
+"""m: a link whose closest contact point with the floor is within this distance touches it (its load,
+at rest after the settle, goes into the run's ``support``)."""
+
 
 class _DriveLog:
     """The samples of a driven run: the base pose (position, quaternion) and the recorded joints' q."""
@@ -314,8 +318,9 @@ class Engine:
         run starts from the same state): gravity, dt, solver iterations, the engine parameters the
         robot's notes name (MK825), pybullet_data's ``plane.urdf`` as shipped, the URDF as written
         (floating; its contact, friction and link damping untouched: no ``changeDynamics`` on it but
-        the control law's joint damping, zero until a profile's law sets it), default motors off, the
-        root link frame at the origin lowered until the closest point touches the floor."""
+        the control law's joint damping, zero until a profile's law sets it), default motors off but on
+        bounded joints nothing drives (they hold the start pose, as in a user's world), the root link
+        frame at the origin lowered until the closest point touches the floor."""
         p, cfg = self.p, self.drive_cfg
         if getattr(self, "drive_client", -1) < 0:
             self.drive_client = p.connect(p.DIRECT)
@@ -353,9 +358,20 @@ class Engine:
                              physicsClientId=c)
             # Bullet multiplies the two bodies' lateral friction: the contact's value against the floor
             friction[name] = float(p.getDynamicsInfo(body, link, physicsClientId=c)[1]) * floor_mu
+        # PyBullet's default motors (velocity 0, force the URDF effort) off on the joints verify drives
+        # and on unbounded ones (casters, passive wheels: a user frees them); kept, as the user's
+        # world has them, on bounded joints nothing drives (TIAGo's arm and torso: freed, the arm
+        # folded and the robot tipped over).
+        driven = {self.drive_names.get(j, j) for ctl in self.controllers for j in ctl.joints}
+        driven |= {self.drive_names.get(j, j) for group in self.drive_rollers.values() for j in group}
+        driven |= set(cfg["contact_joints"])
+        self.held_joints = sorted(j[1].decode() for j in joints
+                                  if j[2] in (p.JOINT_REVOLUTE, p.JOINT_PRISMATIC) and j[8] < j[9]
+                                  and j[1].decode() not in driven)
         for j in range(n):
-            p.setJointMotorControl2(body, j, p.VELOCITY_CONTROL, targetVelocity=0.0, force=0.0,
-                                    physicsClientId=c)
+            if joints[j][1].decode() not in self.held_joints:
+                p.setJointMotorControl2(body, j, p.VELOCITY_CONTROL, targetVelocity=0.0, force=0.0,
+                                        physicsClientId=c)
         self.drive_gears = self._belts(body, joint_index)
         inertial = p.getDynamicsInfo(body, -1, physicsClientId=c)
         self.base_inertial = (tuple(inertial[3]), tuple(inertial[4]))
@@ -367,6 +383,7 @@ class Engine:
         p.resetBasePositionAndOrientation(body, com, inertial[4], physicsClientId=c)
         self.drive_start_height = -gap
         self.drive_joint_index = joint_index
+        self.drive_link_names = {index: name for name, index in link_index.items()}
         # The velocity servos' bound, SERVO_FRICTION_SHARE·m·g·μ·r / rollers
         # (``variant.servo_torque_limit``; MuJoCo's too).
         mass = sum(p.getDynamicsInfo(body, link, physicsClientId=c)[0] for link in range(-1, n))
@@ -377,7 +394,8 @@ class Engine:
         self.servo_limit = servo_torque_limit(mass, mu, cfg["roller_radius"], count, abs(cfg["gravity"]))
         return {"links": sorted(link_index), "friction": friction, "start_height": -gap,
                 "servo_limit": self.servo_limit, "belts": [list(pair) for pair in self.drive_gears],
-                "base_inertial": self.base_inertial, "joints": sorted(joint_index)}
+                "base_inertial": self.base_inertial, "joints": sorted(joint_index),
+                "held": self.held_joints}
 
     BELT_MAX_TORQUE = 1.0e4
     """N·m: the gear constraints' bound (far above any servo's; the belt never gives way)."""
@@ -476,6 +494,7 @@ class Engine:
                           physicsClientId=c)
             step(physicsClientId=c)
         settled = time.perf_counter() - start
+        self._support_at_rest = self._support()
         command = Command(0.0)
         log = _DriveLog(p, body, c, rec_cols)
         asarray = np.array
@@ -505,7 +524,18 @@ class Engine:
 
     def _drive_result(self, log: _DriveLog, wall: float, settled: float, law: str) -> dict[str, Any]:
         return {"base": log.base.tobytes(), "q": log.q.tobytes(), "wall": wall, "settle_wall": settled,
-                "base_inertial": self.base_inertial, "start_height": self.drive_start_height, "law": law}
+                "base_inertial": self.base_inertial, "start_height": self.drive_start_height, "law": law,
+                "support": self._support_at_rest}
+
+    def _support(self) -> dict[str, float]:
+        """Each robot link touching the floor (a contact point within 1 mm): the sum of its contact
+        points' normal forces, N (0 for a link that touches but carries nothing)."""
+        out: dict[str, float] = {}
+        for point in self.p.getContactPoints(self.drive_body, self.floor, physicsClientId=self.drive_client):
+            if point[8] <= SUPPORT_GAP:
+                name = self.drive_link_names.get(point[3], str(point[3]))
+                out[name] = out.get(name, 0.0) + float(point[9])
+        return out
 
     @staticmethod
     def _drive_laws(plan: list[Any], commands: list[Any], torque_ids: list[int]
@@ -577,6 +607,7 @@ class Engine:
         for _ in range(settle):
             step(physicsClientId=c)
         settled = time.perf_counter() - start
+        self._support_at_rest = self._support()
         damping = [0.0] * len(torque_ids)
         targets: list[float] | None = None
         forces: list[float] = []

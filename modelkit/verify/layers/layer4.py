@@ -61,6 +61,7 @@ from modelkit.verify.drive.reference_skid import (
     skid_tolerance,
 )
 from modelkit.verify.engines.protocol import Check, Observation, Skip
+from modelkit.verify.layers.stance import unloaded_wheel
 
 LAYER = 4
 DRIVERS = {
@@ -194,8 +195,14 @@ def run(
                 continue
             result.trajectories.extend(runs.values())
             graded = profile.graded and job.proxy == scenario.wheel_proxy
+            unloaded = unloaded_wheel(runs, drive, job.link_names) if graded else None
+            if unloaded is not None:
+                skip = Skip(LAYER, unloaded.engine, unloaded.reason())
+                if skip not in result.skips:
+                    result.skips.append(skip)
             _compare(profile, job.proxy, graded, runs, ref, model, drive, scenario, result,
-                     skid.tolerances.get(profile.name) if skid is not None else None)
+                     skid.tolerances.get(profile.name) if skid is not None else None,
+                     frozenset({unloaded.engine}) if unloaded is not None else frozenset())
     if skid is not None:
         result.settings["reference"]["skid_tolerances"] = {
             k: v.as_dict() for k, v in sorted(skid.tolerances.items())}
@@ -237,6 +244,7 @@ class _Job:
     drivers: dict[str, Any] = field(default_factory=dict)
     pending: list[str] = field(default_factory=list)
     runs: dict[str, dict[str, Trajectory]] = field(default_factory=dict)  # engine → profile → trajectory
+    link_names: dict[str, dict[str, str]] = field(default_factory=dict)  # engine → source link → its file's
 
     def run_here(self, scenario: Scenario, drive: Drive, result: Layer4Result) -> None:
         for e, d in self.drivers.items():
@@ -317,6 +325,7 @@ def _setup(
         except ImportError as exc:
             result.skips.append(Skip(LAYER, e, f"not installed ({exc})"))
             continue
+        job.link_names[e] = dict(maps[kinds[e]].get("link", {}))
         try:
             job.drivers[e] = make(files[kinds[e]], maps[kinds[e]], drive=drive, scenario=scenario)
         except Exception as exc:
@@ -478,7 +487,10 @@ def _compare(
     scenario: Scenario,
     result: Layer4Result,
     skid_tol: SkidTolerance | None = None,
+    ungraded: frozenset[str] = frozenset(),
 ) -> None:
+    """The profile's comparisons: checks when ``graded``, else observations; an engine in ``ungraded``
+    (and the pair with it) is reported only (:mod:`modelkit.verify.layers.stance`)."""
     tol = scenario.tolerances
     where = profile.name if proxy == "sphere" else f"{profile.name} ({proxy} wheels)"
     native = proxy == "native"
@@ -503,11 +515,14 @@ def _compare(
         unit: str = "m",
         grade: bool = True,
     ) -> None:
-        if grade:
+        stance = engine in ungraded or (engine == PAIR and bool(ungraded))
+        if grade and not stance:
             result.checks.append(Check(LAYER, engine, quantity, where, value, tolerance, detail))
         else:
+            why = (f"not graded: {', '.join(sorted(ungraded))} leaves a drive wheel unloaded (see the skip). "
+                   if stance and grade else "")
             result.observations.append(
-                Observation(LAYER, engine, prefix + quantity, where, value, unit, note + detail)
+                Observation(LAYER, engine, prefix + quantity, where, value, unit, why + note + detail)
             )
 
     mj, pb = runs.get("mujoco"), runs.get("pybullet")

@@ -140,6 +140,12 @@ def scope(report: VerifyReport) -> str:
         parts.append(f"layer 4 graded {', '.join(graded)}{against}{on}")
     if reported:
         parts.append(f"not graded (reported only): {', '.join(reported)}")
+    checked = {(c.engine, c.where) for c in report.checks if c.layer == 4}
+    engines_out = sorted({o.engine for o in report.observations
+                          if o.layer == 4 and o.quantity in COMPARISONS and o.where in graded
+                          and (o.engine, o.where) not in checked and "~" not in o.engine})
+    for engine in engines_out:
+        parts.append(f"{engine} not graded on layer 4 (see its skip)")
     return "; ".join(parts)
 
 
