@@ -67,7 +67,10 @@ def test_sdf_keeps_its_own_link_block_note_without_a_second(tmp_path: Path) -> N
 
 def test_urdf_to_urdf_says_nothing_of_its_own_blocks(tmp_path: Path) -> None:
     notes = _notes(tmp_path, "urdf")
-    assert _about(notes, "<safety_controller>") == [] and _about(notes, "<gazebo>") == []
+    # nothing left out; the one note on a <gazebo> block says its friction is also PyBullet's <contact>
+    assert _about(notes, "<safety_controller>") == []
+    assert [n.code for n in _about(notes, "<gazebo>")] == ["MK852"]
+    assert _about(notes, "link a", "mu1 0.2", "also written as PyBullet's <contact>")
     written = (tmp_path / "out" / "r.urdf").read_text()
     assert "<safety_controller" in written and "<calibration" in written and "provideFeedback" in written
 

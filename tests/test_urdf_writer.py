@@ -162,8 +162,9 @@ def expected_after_urdf(robot: Robot) -> Robot:
     prismatic joint (and of a revolute joint limited on one side only), ±1e16 where there is none;
     a welded root hangs from a `world` link by a fixed joint at the robot's placement; a camera, LiDAR
     or IMU is a link of a tiny inertial on a fixed joint at its pose, a camera's optical frame one more
-    (MK847)."""
+    (MK847); a massless link on a moving joint has a tiny inertial (MK816)."""
     from modelkit.formats.urdf.write_frames import FRAME_INERTIA, FRAME_MASS, FRAMED_KINDS
+    from modelkit.formats.urdf.write_links import MOVING_INERTIA, MOVING_MASS
 
     def frame_link(name: str) -> Link:
         return Link(name, inertial=Inertial(FRAME_MASS, (0.0, 0.0, 0.0), np.eye(3) * FRAME_INERTIA))
@@ -184,6 +185,11 @@ def expected_after_urdf(robot: Robot) -> Robot:
                 out.links.append(frame_link(optical))
                 out.joints.append(Joint(unique_name(f"{optical}_joint", taken), JointType.FIXED, frame,
                                         optical, origin=rep103))
+    # a massless link on a moving joint gets a tiny explicit inertial (MK816)
+    moving = {joint.child for joint in out.joints if joint.type is not JointType.FIXED}
+    for link in out.links:
+        if link.name in moving and (link.inertial is None or link.inertial.mass <= 0.0):
+            link.inertial = Inertial(MOVING_MASS, (0.0, 0.0, 0.0), np.eye(3) * MOVING_INERTIA)
     if out.root_joint is JointType.FIXED and out.root not in (None, "world"):
         root = str(out.root)
         out.links.insert(0, Link("world"))

@@ -175,8 +175,31 @@ def test_replay_passes(source: Path, tmp_path: Path, monkeypatch: pytest.MonkeyP
     monkeypatch.chdir(tmp_path)
     report = verify(source, None, ("mujoco", "pybullet", "pinocchio"), configurations=1, samples=1)
     assert list(tmp_path.iterdir()) == []
-    assert [c for c in report.checks if c.quantity == "replay"], "no replay check"
+    if source.stem in NOT_INTEGRABLE:
+        said = [s.reason for s in report.skips if s.reason.startswith("layer 3b (replay) not graded")]
+        assert len(said) == 1 and "mass matrix and bias equal to the source's" in said[0]
+        assert not [c for c in report.checks if c.quantity in ("replay", "stability", "engine-error")]
+    else:
+        assert [c for c in report.checks if c.quantity == "replay"], "no replay check"
     _only_known(report.failed, REPLAY_KNOWN.get(source.stem, {}))
+
+
+# Swinging free without its armature, damping and limits (what the replay integrates), the CMU
+# humanoid blows up in MuJoCo on the source itself (1.25 s at 1 ms, 1.91 s at 0.125 ms): the replay
+# is skipped with the engine's message. It passed before only because PyBullet's 1 kg for a massless
+# URDF link (its bodies' intermediate joint links) made it a heavier robot.
+NOT_INTEGRABLE = {"humanoid_CMU"}
+
+
+def test_a_replay_that_blows_up_on_a_sound_file_is_skipped_and_on_a_faulty_one_fails(tmp_path: Path) -> None:
+    """The skip needs MuJoCo's layer 3a to pass: a mass fault in the written files (injected) keeps
+    the blow-up a failure."""
+    if not _installed(("pybullet",)):
+        pytest.skip("PyBullet is not installed")
+    report = verify(SUITE / "humanoid_CMU.xml", None, ("mujoco", "pybullet", "pinocchio"), configurations=1,
+                    samples=1, inject=["mass:lhumerus:10%"])
+    assert not [s for s in report.skips if s.reason.startswith("layer 3b (replay) not graded")]
+    assert {c.quantity for c in report.failed if c.layer == 3 and c.engine == "mujoco"} >= {"mass-matrix"}
 
 
 def test_drake_uses_its_world_body_for_a_world_root(tmp_path: Path) -> None:

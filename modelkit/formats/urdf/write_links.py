@@ -49,6 +49,30 @@ def origin_element(parent: Element, pose: Pose, always: bool = False) -> None:
         etree.SubElement(parent, "origin", xyz=xyz, rpy=rpy)
 
 
+MOVING_MASS = 1e-6  # kg: the explicit inertial of a massless link that moves (as the SDF writer's)
+MOVING_INERTIA = 1e-12  # kg·m², each principal moment
+
+
+def moving_massless_inertial(parent: Element, link: Link, ctx: WriteContext, target: str) -> None:
+    """A tiny explicit ``<inertial>`` for a massless link on a moving joint (MK816). Without one,
+    PyBullet gives the link 1 kg and a unit inertia, and libsdformat's URDF to SDF conversion (what
+    Gazebo loads) drops it with everything below it. An MJCF body with several joints is read as a
+    chain of such links (dm_control's rodent has 16, its humanoid 9: PyBullet made it 9 kg heavier)."""
+    ctx.note(
+        "MK816",
+        f'link "{link.name}" has no mass but moves; PyBullet would give it 1 kg and libsdformat would drop '
+        f"it with its subtree, so it is written with a tiny explicit inertial (mass {fmt(MOVING_MASS)} kg, "
+        f"inertia {fmt(MOVING_INERTIA)} kg·m²)",
+        link.loc("mass"),
+        f"{target}/inertial",
+    )
+    el = etree.SubElement(parent, "inertial")
+    etree.SubElement(el, "origin", xyz="0 0 0", rpy="0 0 0")
+    etree.SubElement(el, "mass", value=fmt(MOVING_MASS))
+    moment = fmt(MOVING_INERTIA)
+    etree.SubElement(el, "inertia", ixx=moment, ixy="0", ixz="0", iyy=moment, iyz="0", izz=moment)
+
+
 def inertial_element(parent: Element, link: Link, ctx: WriteContext, target: str) -> None:
     """The link's ``<inertial>``: COM as origin (rpy 0), the full tensor about the COM in link axes."""
     inertial = link.inertial
@@ -186,12 +210,16 @@ def _dropped_appearance(material: VisualMaterial) -> list[str]:
 def link_element(
     robot_el: Element, link: Link, name: str, robot: Robot, ctx: WriteContext, materials: MaterialTable,
     friction: PairFriction | None = None,
+    moving: bool = False,
 ) -> Element:
     """The ``<link>`` element with its inertial, visuals, collisions and (with ``friction``, the link's
     contact material against the floor) PyBullet's ``<contact>``."""
     el = etree.SubElement(robot_el, "link", name=name)
     target = f"link[{name}]"
-    inertial_element(el, link, ctx, target)
+    if moving and (link.inertial is None or link.inertial.mass <= 0.0):
+        moving_massless_inertial(el, link, ctx, target)
+    else:
+        inertial_element(el, link, ctx, target)
     for kind, geoms in (("visual", link.visuals), ("collision", link.collisions)):
         for i, geom in enumerate(geoms):
             where = f"{target}/{kind}[{i}]"

@@ -85,8 +85,10 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
     if add_world:
         etree.SubElement(links, "link", name=WORLD_LINK)
     friction = floor_friction(robot)
+    moving = _moving_links(robot)
     for index, link in enumerate(robot.links):
-        link_element(links, link, names.links[index], robot, ctx, materials, friction.get(link.name))
+        link_element(links, link, names.links[index], robot, ctx, materials, friction.get(link.name),
+                     link.name in moving)
         _link_extras(link.extras, link.name, names.links[index], ctx)
     joints: list[Element] = []
     extra_links: list[str] = []
@@ -206,13 +208,21 @@ def _free_links(robot: Robot, names: NameTable, ctx: WriteContext) -> list[Eleme
     return out
 
 
+def _moving_links(robot: Robot) -> set[str]:
+    """The links on a joint that is not fixed."""
+    return {joint.child for joint in robot.joints if joint.type is not JointType.FIXED}
+
+
 def _massless(robot: Robot, names: NameTable, ctx: WriteContext) -> None:
-    """One note for the source's links written without ``<inertial>`` (frames), with what peers do to
-    them (the sensor frames the writer adds carry a tiny inertial: ``write_frames.FRAME_MASS``)."""
+    """One note for the source's links written without ``<inertial>`` (frames: the root, or on a
+    fixed joint), with what peers do to them (the sensor frames the writer adds and the massless
+    links that move carry a tiny inertial: ``write_frames.FRAME_MASS``, ``write_links.MOVING_MASS``)."""
+    moving = _moving_links(robot)
     massless = [
         names.links[i]
         for i, link in enumerate(robot.links)
         if (link.inertial is None or link.inertial.mass <= 0.0) and link.name != WORLD_LINK
+        and link.name not in moving
     ]
     if not massless:
         return
@@ -222,8 +232,8 @@ def _massless(robot: Robot, names: NameTable, ctx: WriteContext) -> None:
     ctx.note(
         "MK816",
         f"{len(massless)} massless link(s) written without <inertial>, as URDF frames: {shown}; "
-        "PyBullet gives such a link 1 kg and a unit inertia, and libsdformat's URDF to SDF conversion drops "
-        "it (with its subtree) unless its joint is fixed",
+        "PyBullet gives such a link 1 kg and a unit inertia (libsdformat's URDF to SDF conversion merges a "
+        "massless link on a fixed joint into its parent)",
         robot.source,
         "link",
     )

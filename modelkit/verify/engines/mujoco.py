@@ -161,7 +161,8 @@ def drop_actuators(spec: Any, driven: Collection[str] | None = None) -> list[str
     actuators = list(spec.actuators)
     kept: list[int] = []
     for i, actuator in enumerate(actuators):
-        if driven is None or (actuator.trntype == mujoco.mjtTrn.mjTRN_JOINT and actuator.target in driven):
+        on_joint = actuator.trntype in (mujoco.mjtTrn.mjTRN_JOINT, mujoco.mjtTrn.mjTRN_JOINTINPARENT)
+        if driven is None or (on_joint and actuator.target in driven):
             spec.delete(actuator)
         else:
             kept.append(i)
