@@ -886,7 +886,10 @@ def test_pioneer3dx_zero_collision_boxes_convert_to_a_model_mujoco_loads(tmp_pat
     ("1e-14 1e-14 1e-14 0 0 0", False),  # diaginertia: MuJoCo takes it down to mjMINVAL (1e-15)
     ("5e-15 5e-15 5e-15 0 0 0", True),   # within the 10× margin of mjMINVAL
     ("2e-13 2e-13 2e-13 5e-14 0 0", False),  # fullinertia, smallest eigenvalue 1.5e-13
-    ("8e-14 8e-14 8e-14 2e-14 0 0", True),   # fullinertia, smallest eigenvalue 6e-14: under 10 × mjEPS
+    # products of inertia, smallest eigenvalue 6e-14: under 10 × mjEPS as a fullinertia, so written as
+    # its principal moments and axes (diaginertia + quat), which MuJoCo checks against mjMINVAL
+    ("8e-14 8e-14 8e-14 2e-14 0 0", False),
+    ("8e-15 8e-15 8e-15 2e-15 0 0", True),   # smallest principal moment 6e-15: within 10× of mjMINVAL
 ])
 def test_a_small_inertia_mujoco_takes_is_written_as_it_is(tmp_path: Path, inertia: str, lifted: bool) -> None:
     """pybullet_data's thrower.xml has a wrist of 4.46e-13, 7.96e-14, 4.46e-13 kg·m² that MuJoCo itself

@@ -49,7 +49,7 @@ from modelkit.formats.mjcf.write_chains import Chain, ChainFinder, shifted
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_geoms import GeomWriter
 from modelkit.formats.mjcf.write_names import NameTable
-from modelkit.formats.mjcf.write_xml import Element, set_pose, sub
+from modelkit.formats.mjcf.write_xml import Element, quat_wxyz, set_pose, sub
 from modelkit.model import WORLD_LINK, Inertial, Joint, JointType, Link, Robot
 from modelkit.spatial import Pose, combine_mass_properties, principal_moments, rotate_inertia
 
@@ -65,6 +65,17 @@ SINGULAR = 1e-12  # below this a mass counts as zero (MuJoCo's mjMINVAL is 1e-15
 SINGULAR_DIAGONAL = 1e-14
 SINGULAR_FULL = 1e-13
 MOVING = (JointType.REVOLUTE, JointType.PRISMATIC, JointType.BALL, JointType.PLANAR, JointType.FLOATING)
+
+def _principal_form(tensor: np.ndarray) -> bool:
+    """A tensor with products of inertia whose smallest principal moment is under
+    :data:`SINGULAR_FULL` is written as ``diaginertia`` and ``quat`` (its principal moments and axes):
+    MuJoCo checks those against mjMINVAL, while a ``fullinertia`` goes through an eigen-decomposition
+    that refuses a smallest eigenvalue under mjEPS. dm_control's fruit fly has leg segments of
+    2.5e-13 kg·m² whose smallest moment is 4e-14: they were lifted by 1e-9 kg·m² per axis before."""
+    if _diagonal(tensor):
+        return False
+    return float(np.min(np.linalg.eigvalsh(0.5 * (tensor + tensor.T)))) < SINGULAR_FULL
+
 
 def _diagonal(tensor: np.ndarray) -> bool:
     """Whether the tensor is written as ``diaginertia`` (no product of inertia)."""
@@ -555,7 +566,8 @@ class BodyTree:
                 )
                 mass, com = mass + MIN_MASS, com if mass > 0.0 else np.zeros(3)
                 tensor = tensor + MIN_INERTIA * np.eye(3)
-            elif float(np.min(moments)) < (SINGULAR_DIAGONAL if _diagonal(tensor) else SINGULAR_FULL):
+            elif float(np.min(moments)) < (SINGULAR_DIAGONAL if _diagonal(tensor) or _principal_form(tensor)
+                                           else SINGULAR_FULL):
                 self.ctx.note(
                     "MK870",
                     f"link {link.name} moves but its inertia (with what is welded to it) is "
@@ -577,7 +589,13 @@ class BodyTree:
             return
         el = sub(body, "inertial", pos=fmt_position(com), mass=fmt(mass))
         off = (tensor[0, 1], tensor[0, 2], tensor[1, 2])
-        if any(v != 0.0 for v in off):
+        if _principal_form(tensor):
+            moments, axes = np.linalg.eigh(0.5 * (tensor + tensor.T))
+            if np.linalg.det(axes) < 0.0:
+                axes[:, 0] = -axes[:, 0]
+            el.set("quat", fmt_vec(quat_wxyz(axes)))
+            el.set("diaginertia", fmt_vec(moments))
+        elif any(v != 0.0 for v in off):
             el.set("fullinertia", fmt_vec([tensor[0, 0], tensor[1, 1], tensor[2, 2], *off]))
         else:
             el.set("diaginertia", fmt_vec([tensor[0, 0], tensor[1, 1], tensor[2, 2]]))
