@@ -908,11 +908,13 @@ class MujocoDriver:
         d.qpos[self.root_qadr + 2] = self._start_height
         mujoco.mj_forward(m, d)
         # The file's kept actuators (the first ones, see drop_actuators) hold the start pose: a
-        # position-type one (affine bias on its length) gets its length as its control, others 0.
+        # position-type one (affine bias on its length, its control not integrated) gets its length as
+        # its control, others 0 (an intvelocity servo's control is a velocity).
         self._start_ctrl = np.zeros(m.nu)
+        integrated = int(mujoco.mjtDyn.mjDYN_INTEGRATOR)
         for a in range(len(self.file_actuators)):
             affine = int(m.actuator_biastype[a]) == int(mujoco.mjtBias.mjBIAS_AFFINE)
-            if affine and m.actuator_biasprm[a, 1] != 0.0:
+            if affine and m.actuator_biasprm[a, 1] != 0.0 and int(m.actuator_dyntype[a]) != integrated:
                 self._start_ctrl[a] = float(d.actuator_length[a])
         return np.array(d.qpos)
 
