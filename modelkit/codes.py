@@ -1206,8 +1206,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK816",
         "massless-link-frame",
         "info",
-        "A link without mass is written as a frame (SDF `<frame>`, MJCF massless body) so no consumer "
-        "drops it.",
+        "A link without mass is written as a frame (URDF link without `<inertial>`, SDF `<frame>`, MJCF "
+        "site or massless body), or, where it moves or carries shapes, with a tiny explicit inertial, so "
+        "that no consumer drops it or gives it a default mass; the note says which.",
     ),
     CodeInfo(
         "MK817",
