@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from modelkit.model import Robot
+
 REPO = Path(__file__).resolve().parents[1]
 CORPUS = REPO.parent / "shared" / "corpus"
 SAMPLES = REPO / "samples"
@@ -137,3 +139,16 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
         for line in unexplained:
             reporter.write_line("  " + line, red=True)
         session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
+def links_below(robot: Robot, tops: set[str]) -> set[str]:
+    """``tops`` and every link below them in ``robot``."""
+    out = set(tops)
+    changed = True
+    while changed:
+        changed = False
+        for joint in robot.joints:
+            if joint.parent in out and joint.child not in out:
+                out.add(joint.child)
+                changed = True
+    return out

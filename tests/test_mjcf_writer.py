@@ -46,7 +46,7 @@ from modelkit.model import (
 )
 from modelkit.spatial import Pose
 
-from .conftest import CORPUS, REPO, TUTORIAL
+from .conftest import CORPUS, REPO, TUTORIAL, links_below
 
 SUFFIXES = (".body", ".urdf", ".xacro", ".sdf", ".xml", ".world")
 TARGET_OF_NOTE = re.compile(r"body\[([^\]]*)\]")
@@ -127,9 +127,9 @@ def explained(diff: Difference, written: Written, renames: dict[str, str]) -> bo
             return True
         if world_body:  # the bodies hanging from the world are top-level: each is read as a robot
             hanging = {j.child for j in written.source.joints if j.parent == "world"}
-            if diff.where in _below(written.source, hanging):
+            if diff.where in links_below(written.source, hanging):
                 return True
-        moved = _below(written.source, {k for k, v in renames.items() if v in top_level} | top_level)
+        moved = links_below(written.source, {k for k, v in renames.items() if v in top_level} | top_level)
         return diff.where in moved
     if diff.quantity.startswith("limit-"):
         return any(n.code == "MK820" and f"joint {diff.where} is locked" in n.message for n in notes)
@@ -139,18 +139,6 @@ def explained(diff: Difference, written: Written, renames: dict[str, str]) -> bo
         return joint is not None and all(f" {x} (in " in sites or f" {x} as site " in sites
                                          for x in (joint.parent, joint.child))
     return False
-
-
-def _below(robot: Robot, tops: set[str]) -> set[str]:
-    out = set(tops)
-    changed = True
-    while changed:
-        changed = False
-        for joint in robot.joints:
-            if joint.parent in out and joint.child not in out:
-                out.add(joint.child)
-                changed = True
-    return out
 
 
 # Every round-trip difference the corpus is allowed, per file (``<path under the corpus or the

@@ -23,7 +23,7 @@ from modelkit.convert.api import write
 from modelkit.model import JointType
 from modelkit.verify.api import verify
 
-from .conftest import example_robot
+from .conftest import example_robot, links_below
 
 
 @pytest.fixture(scope="module")
@@ -34,13 +34,7 @@ def romeo(tmp_path_factory: pytest.TempPathFactory) -> Path:
     hands = {link.name for link in robot.links
              if link.name in moving and (link.inertial is None or link.inertial.mass == 0.0)}
     assert len(hands) == 24
-    grew = True
-    while grew:
-        grew = False
-        for joint in robot.joints:
-            if joint.parent in hands and joint.child not in hands:
-                hands.add(joint.child)
-                grew = True
+    hands = links_below(robot, hands)
     robot.links = [link for link in robot.links if link.name not in hands]
     robot.joints = [joint for joint in robot.joints if joint.child not in hands]
     out = tmp_path_factory.mktemp("romeo") / "romeo.urdf"
