@@ -398,8 +398,16 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
     for eng in loaded:
         # An engine holding a documented approximation (MK816 tiny masses, PyBullet's 1 kg) is
         # compared with the source with that approximation applied; the report lists it.
-        eng_static = (source_static(approximations.applied(reference, approx[eng.label]))
-                      if approx[eng.label] else src_static)
+        # A URDF engine holds each ball joint as the writer's chain of three joints (MK813): layer 1
+        # compares it with the source holding those chains, and the report says so.
+        kind = INPUTS.get(eng.label, "robot")
+        chains = approximations.ball_chains(kind, written.get(kind, []))
+        chains_entry = approximations.chains_skip(eng.label, chains)
+        if chains_entry is not None:
+            report.skips.append(chains_entry)
+        eng_static = (source_static(approximations.applied(approximations.applied_chains(reference, chains),
+                                                           approx[eng.label]))
+                      if approx[eng.label] or chains else src_static)
         # ... and so is one holding the URDF writer's ±1e16 for an infinite position bound (MK819).
         stand_ins = approximations.limits_for_engine(INPUTS.get(eng.label, "robot"), reference)
         eng_static = approximations.applied_limits(eng_static, stand_ins)
@@ -422,8 +430,12 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                                            "model): no dynamics to verify"))
         replay = False
     elif not dof_joints(reference):
-        report.skips.append(Skip(3, "all", "no revolute or prismatic joint: the mass matrix and bias forces "
-                                           "are empty and nothing moves, no dynamics to verify"))
+        others = sorted({j.type.value for j in reference.joints if j.type.moves})
+        report.skips.append(Skip(3, "all", (
+            f"its moving joints are {' and '.join(others)} joints only: layer 3 needs the Pinocchio "
+            "reference, which holds revolute, prismatic and fixed joints; these dynamics are not verified")
+            if others else ("no revolute or prismatic joint: the mass matrix and bias forces are empty and "
+                            "nothing moves, no dynamics to verify")))
         replay = False
     elif pin_ref is None:
         report.skips.append(Skip(3, "all", "layer 3a needs Pinocchio (the dynamics reference built from the "

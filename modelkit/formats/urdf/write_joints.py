@@ -9,13 +9,15 @@ prismatic joints. Where the model has no finite value a documented one is writte
   ±:data:`SYNTHESISED_POSITION` = ±1e16, the value libsdformat itself writes for an unlimited axis.
 
 An unlimited revolute joint is ``continuous``. A ball joint (URDF has none) becomes three
-``continuous`` joints about the child's X, Y and Z axes through two massless links (MK813): the
-same motion, though the read-back model has two more links and three joints instead of one.
+``continuous`` joints about the child's X, Y and Z axes through two links that carry nothing but a
+tiny explicit inertial (MK813, MK816: without one PyBullet gives each 1 kg): the same motion, though
+the read-back model has two more links and three joints instead of one.
 """
 
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 from lxml import etree
@@ -26,7 +28,7 @@ from modelkit.convert.joint_springs import note_spring_dropped
 from modelkit.convert.numbers import fmt, fmt_direction
 from modelkit.formats.urdf.write_links import origin_element
 from modelkit.formats.urdf.write_names import NameTable
-from modelkit.model import Joint, JointLimits, JointType
+from modelkit.model import Joint, JointLimits, JointType, Link
 from modelkit.spatial import Pose
 
 SYNTHESISED_EFFORT = 1e6
@@ -41,6 +43,12 @@ URDF_TYPE = {
     JointType.PLANAR: "planar",
 }
 BALL_AXES = (("x", (1.0, 0.0, 0.0)), ("y", (0.0, 1.0, 0.0)), ("z", (0.0, 0.0, 1.0)))
+# The MK813 note of a ball joint, as :func:`_ball` writes it: the source joint, the three written
+# joints, the child as written and the two added links (verify reads the chain back from it).
+BALL_NOTE = re.compile(r'joint "(?P<joint>.+)" is a ball joint, which URDF lacks; written as three '
+                       r'continuous joints \((?P<x>[^,]+), (?P<y>[^,]+), (?P<z>[^)]+)\) '
+                       r'about the X, Y and Z axes of '
+                       r'"(?P<child>.+)" through the links "(?P<link_x>.+)" and "(?P<link_y>.+)", which')
 
 
 def _velocity(limits: JointLimits) -> tuple[float, bool]:
@@ -132,9 +140,10 @@ def _axis(joint: Joint) -> str:
 
 
 def joint_elements(
-    joint: Joint, index: int, names: NameTable, ctx: WriteContext, extra_links: list[str]
+    joint: Joint, index: int, names: NameTable, ctx: WriteContext, extra_links: list[Link]
 ) -> list[Element]:
-    """The ``<joint>`` element(s) for one model joint; ``extra_links`` receives links to add."""
+    """The ``<joint>`` element(s) for one model joint; ``extra_links`` receives the links to add (each
+    massless and moving: the writer gives it a tiny inertial)."""
     name = names.joints[index]
     parent, child = names.link(joint.parent), names.link(joint.child)
     if joint.type is JointType.BALL:
@@ -208,9 +217,10 @@ def _ball(
     child: str,
     names: NameTable,
     ctx: WriteContext,
-    extra_links: list[str],
+    extra_links: list[Link],
 ) -> list[Element]:
-    """Three continuous joints (X, Y, Z of the child frame) through two massless links."""
+    """Three continuous joints (X, Y, Z of the child frame) through two links without mass of their
+    own, named in the MK813 note (:data:`BALL_NOTE` reads it back)."""
     links = [parent, names.fresh(f"{child}_ball_x"), names.fresh(f"{child}_ball_y"), child]
     out = []
     for i, (suffix, axis) in enumerate(BALL_AXES):
@@ -222,12 +232,12 @@ def _ball(
         etree.SubElement(el, "axis", xyz=fmt_direction(axis))
         _dynamics(el, joint)
         out.append(el)
-    extra_links.extend(links[1:3])
+    extra_links.extend(Link(link, source=joint.source) for link in links[1:3])
     ctx.note(
         "MK813",
         f'joint "{joint.name}" is a ball joint, which URDF lacks; written as three continuous '
         f'joints ({", ".join(e.get("name", "") for e in out)}) about the X, Y and Z axes of "{child}" '
-        f'through the massless links "{links[1]}" and "{links[2]}"',
+        f'through the links "{links[1]}" and "{links[2]}", which carry only a tiny inertial (MK816)',
         joint.source,
         f"joint[{out[0].get('name', '')}]",
     )

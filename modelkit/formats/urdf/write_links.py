@@ -51,17 +51,19 @@ def origin_element(parent: Element, pose: Pose, always: bool = False) -> None:
 
 MOVING_MASS = 1e-6  # kg: the explicit inertial of a massless link that moves (as the SDF writer's)
 MOVING_INERTIA = 1e-12  # kg·m², each principal moment
+TINY_WORDS = "written with a tiny explicit inertial"  # the MK816 note's words (verify reads them back)
 
 
 def moving_massless_inertial(parent: Element, link: Link, ctx: WriteContext, target: str) -> None:
     """A tiny explicit ``<inertial>`` for a massless link on a moving joint (MK816). Without one,
     PyBullet gives the link 1 kg and a unit inertia, and libsdformat's URDF to SDF conversion (what
     Gazebo loads) drops it with everything below it. An MJCF body with several joints is read as a
-    chain of such links (dm_control's rodent has 16, its humanoid 9: PyBullet made it 9 kg heavier)."""
+    chain of such links (dm_control's rodent has 16, its humanoid 9: PyBullet made it 9 kg heavier),
+    and a ball joint is written as one (two links per ball)."""
     ctx.note(
         "MK816",
         f'link "{link.name}" has no mass but moves; PyBullet would give it 1 kg and libsdformat would drop '
-        f"it with its subtree, so it is written with a tiny explicit inertial (mass {fmt(MOVING_MASS)} kg, "
+        f"it with its subtree, so it is {TINY_WORDS} (mass {fmt(MOVING_MASS)} kg, "
         f"inertia {fmt(MOVING_INERTIA)} kg·m²)",
         link.loc("mass"),
         f"{target}/inertial",

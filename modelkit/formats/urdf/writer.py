@@ -31,10 +31,16 @@ from modelkit.formats.registry import EXTRAS_DROPPED, EXTRAS_DROPPED_LINK, EXTRA
 from modelkit.formats.urdf.write_frames import frame_link, sensor_frames
 from modelkit.formats.urdf.write_gazebo import write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
-from modelkit.formats.urdf.write_links import CONTACT_EXTRAS, MaterialTable, link_element, origin_element
+from modelkit.formats.urdf.write_links import (
+    CONTACT_EXTRAS,
+    MaterialTable,
+    link_element,
+    moving_massless_inertial,
+    origin_element,
+)
 from modelkit.formats.urdf.write_names import NameTable
 from modelkit.formats.urdf.write_self_collide import write_self_collision
-from modelkit.model import WORLD_LINK, JointType, Robot
+from modelkit.model import WORLD_LINK, JointType, Link, Robot
 from modelkit.spatial import Pose
 
 __all__ = ["urdf_renames", "write_urdf"]
@@ -91,15 +97,16 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
                      link.name in moving)
         _link_extras(link.extras, link.name, names.links[index], ctx)
     joints: list[Element] = []
-    extra_links: list[str] = []
+    extra_links: list[Link] = []
     for index, joint in enumerate(robot.joints):
         joints.extend(joint_elements(joint, index, names, ctx, extra_links))
     joints.extend(_root(robot, names, ctx, add_world))
     joints.extend(_free_links(robot, names, ctx))
     frames = sensor_frames(robot, names, ctx)
     joints.extend(frames.joints)
-    for name in extra_links:
-        etree.SubElement(links, "link", name=name)
+    for link in extra_links:  # a ball joint's intermediate links: massless, moving
+        element = etree.SubElement(links, "link", name=link.name)
+        moving_massless_inertial(element, link, ctx, f"link[{link.name}]")
     for name in frames.links:
         links.append(frame_link(name, ctx))
 

@@ -89,10 +89,10 @@ def from_notes(fmt: str, notes: Iterable[ConversionNote], renames: Renames) -> d
                 name = back.get(match[1], match[1])
                 out[name] = Approximated(name, TINY_MASS, TINY_INERTIA, note.code, "the SDF writer")
         elif fmt == "urdf":
-            from modelkit.formats.urdf.write_links import MOVING_INERTIA, MOVING_MASS
+            from modelkit.formats.urdf.write_links import MOVING_INERTIA, MOVING_MASS, TINY_WORDS
 
             match = re.fullmatch(r"link\[(.+)\]/inertial", note.target)
-            if match and "no mass but moves" in note.message:
+            if match and TINY_WORDS in note.message:
                 name = back.get(match[1], match[1])
                 out[name] = Approximated(name, MOVING_MASS, MOVING_INERTIA, note.code, "the URDF writer")
         elif fmt == "mjcf":
@@ -370,3 +370,70 @@ def limits_skip(engine: str, stand_ins: dict[str, LimitStandIn]) -> Skip | None:
     return Skip(1, engine, f"approximation: {first.by} writes the infinite position bounds of {len(names)} "
                 f"joint(s) as ±1e16 ({first.code}: URDF has no unlimited prismatic joint): {shown}. Layer 1 "
                 "checks this engine holds exactly these bounds")
+
+
+@dataclass(frozen=True)
+class BallChain:
+    """A source ball joint as the URDF writer wrote it (MK813): three continuous joints about the
+    child's X, Y and Z axes through two links that carry only the writer's tiny inertial (MK816)."""
+
+    joint: str  # source name
+    joints: tuple[str, str, str]  # the written X, Y and Z joints
+    links: tuple[str, str]  # the written links between them
+
+
+def ball_chains(fmt: str, notes: Iterable[ConversionNote]) -> list[BallChain]:
+    """The URDF writer's ball-joint chains, read from its MK813 notes (none for another format)."""
+    if fmt != "urdf":
+        return []
+    from modelkit.formats.urdf.write_joints import BALL_NOTE
+
+    out = []
+    for note in notes:
+        match = BALL_NOTE.match(note.message) if note.code == "MK813" else None
+        if match:
+            out.append(BallChain(match["joint"], (match["x"], match["y"], match["z"]),
+                                 (match["link_x"], match["link_y"])))
+    return out
+
+
+def applied_chains(robot: Robot, chains: list[BallChain]) -> Robot:
+    """A copy of ``robot`` whose ball joints are the written chains: the model as the URDF holds it.
+    The first joint keeps the ball's origin, the last one keeps the source joint's name and child,
+    the two added links have no mass (the writer's tiny inertial comes with :func:`applied`)."""
+    if not chains:
+        return robot
+    from modelkit.formats.urdf.write_joints import BALL_AXES
+    from modelkit.model import Joint, JointLimits, Link
+    from modelkit.spatial import Pose
+
+    out = copy.deepcopy(robot)
+    by_name = {joint.name: joint for joint in out.joints}
+    for chain in chains:
+        ball = by_name.get(chain.joint)
+        if ball is None or ball.type is not JointType.BALL:
+            continue
+        frames = [ball.parent, *chain.links, ball.child]
+        added = []
+        for i, (_, axis) in enumerate(BALL_AXES):
+            name = chain.joint if i == 2 else chain.joints[i]
+            added.append(Joint(name, JointType.REVOLUTE, frames[i], frames[i + 1],
+                               origin=ball.origin if i == 0 else Pose(), axis=np.asarray(axis, dtype=float),
+                               limits=JointLimits(), damping=ball.damping, synthesised=i < 2,
+                               source=ball.source))
+        index = out.joints.index(ball)
+        out.joints[index:index + 1] = added
+        out.links.extend(Link(name, synthesised=True, source=ball.source) for name in chain.links)
+    return out
+
+
+def chains_skip(engine: str, chains: list[BallChain]) -> Skip | None:
+    """The report's entry for the ball joints an engine reads as chains (never a silent pass)."""
+    if not chains:
+        return None
+    shown = "; ".join(f"{c.joint} as {', '.join(c.joints)} through {', '.join(c.links)}"
+                      for c in chains[:4]) + (f" and {len(chains) - 4} more" if len(chains) > 4 else "")
+    return Skip(1, engine, f"approximation: the URDF writer writes {len(chains)} ball joint(s) as three "
+                f"continuous joints each (MK813; URDF has no ball joint): {shown}. Layer 1 compares this "
+                "engine with the source model holding these chains (link and joint sets, types, axes, the "
+                "added links' tiny inertials)")

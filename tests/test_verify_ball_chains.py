@@ -1,0 +1,74 @@
+"""A ball joint written to URDF is three continuous joints through two added links (MK813). Verify
+compares the engines reading that URDF with the source holding the same chains, so a sound conversion
+passes (dm_control's model_with_ball_joints.xml failed link-set and joint-type for PyBullet, yourdfpy
+and drake-urdf), while a chain written wrong still fails. The added links carry the URDF writer's tiny
+inertial: without one PyBullet gave each of them 1 kg, four times this robot's mass."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pybullet
+import pytest
+
+from modelkit.convert.api import convert
+from modelkit.verify.api import verify
+
+BALLS = """<mujoco model="balls"><default><geom type="capsule" size=".01"/><joint type="ball" damping=".005"/>
+  </default><worldbody><body name="body1"><geom fromto="0 0 0 0 0 .1"/>
+  <body name="body2" pos="0 0 .1"><geom fromto="0 0 0 0 .1 .1"/><joint name="joint_1"/>
+  <body name="body3" pos="0 .1 .1"><geom fromto="0 0 0 0 .1 0"/><joint name="joint_2"/>
+  </body></body></body></worldbody></mujoco>"""
+
+URDF_ENGINES = ("pybullet", "yourdfpy")
+
+
+def _source(tmp_path: Path) -> Path:
+    source = tmp_path / "balls.xml"
+    source.write_text(BALLS)
+    return source
+
+
+def _layer1(report, engine: str) -> dict[str, object]:
+    return {c.quantity: c for c in report.checks if c.layer == 1 and c.engine == engine}
+
+
+def test_a_sound_ball_conversion_passes_layer_1_in_the_urdf_engines(tmp_path: Path) -> None:
+    report = verify(_source(tmp_path), tmp_path / "out", ("mujoco", *URDF_ENGINES), configurations=2,
+                    samples=1, replay=False, driven=False)
+    for engine in URDF_ENGINES:
+        checks = _layer1(report, engine)
+        for quantity in ("link-set", "joint-set", "joint-type", "axis", "mass", "inertia"):
+            assert checks[quantity].passed, (engine, checks[quantity].detail)
+        said = [s.reason for s in report.skips if s.engine == engine and "ball joint(s)" in s.reason]
+        chain = "joint_1 as joint_1_x, joint_1_y, joint_1_z through body2_ball_x, body2_ball_y"
+        assert said and chain in said[0]
+    assert not [s for s in report.skips if s.engine == "mujoco" and "ball joint(s)" in s.reason]
+    layer3 = [s.reason for s in report.skips if s.layer == 3]
+    assert layer3 and "ball joints only" in layer3[0] and "nothing moves" not in layer3[0]
+
+
+@pytest.mark.parametrize("engine", URDF_ENGINES)
+@pytest.mark.parametrize(("fault", "quantity", "where"), [("axis:joint_1_y:flip", "axis", "joint_1_y"),
+                                                         ("mass:body2_ball_x:50%", "mass", "body2_ball_x")])
+def test_a_chain_written_wrong_fails(tmp_path: Path, engine: str, fault: str, quantity: str,
+                                     where: str) -> None:
+    report = verify(_source(tmp_path), tmp_path / "out", (engine,), inject=[fault], configurations=2,
+                    samples=1, replay=False, driven=False)
+    assert report.injected and report.injected[0].startswith(fault)
+    check = _layer1(report, engine)[quantity]
+    assert not check.passed and check.where == where, check.detail
+
+
+def test_pybullet_holds_the_source_mass(tmp_path: Path) -> None:
+    """The added links weigh 1e-6 kg each in PyBullet, not its 1 kg default for a link without mass."""
+    urdf = tmp_path / "balls.urdf"
+    convert([_source(tmp_path)], urdf)
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        body = pybullet.loadURDF(str(urdf), physicsClientId=client)
+        masses = [pybullet.getDynamicsInfo(body, i, physicsClientId=client)[0]
+                  for i in range(-1, pybullet.getNumJoints(body, physicsClientId=client))]
+    finally:
+        pybullet.disconnect(client)
+    assert sum(masses) == pytest.approx(0.0356047167406843 * 2 + 0.0486176195863701 + 4e-6, rel=1e-6)
