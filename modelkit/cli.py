@@ -202,9 +202,12 @@ def _collector_paused() -> Iterator[None]:
 
 
 def _validate_one(path: Path, options: Any, input_format: str | None, target: str | None) -> list[Diagnostic]:
-    """The findings of one file (a top-level function, so that worker processes can run it)."""
+    """The findings of one file (a top-level function, so that worker processes can run it). Mesh
+    checks are kept between runs (:mod:`modelkit.geometry.mesh_cache`)."""
     from modelkit.api import validate as validate_file
+    from modelkit.geometry import mesh_cache
 
+    mesh_cache.enable()
     with _collector_paused():
         return list(validate_file(path, options, input_format, str(path), target).diagnostics)
 

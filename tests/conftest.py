@@ -12,6 +12,10 @@ import pytest
 
 from modelkit.model import Robot
 
+# Mesh-check outcomes are not kept on disk between tests (a test that damages a mesh or counts loads must
+# see every load); tests/test_mesh_cache.py turns the cache on in a folder of its own.
+os.environ["MODELKIT_CACHE_DIR"] = "off"
+
 REPO = Path(__file__).resolve().parents[1]
 CORPUS = REPO.parent / "shared" / "corpus"
 SAMPLES = REPO / "samples"

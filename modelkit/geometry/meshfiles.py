@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from modelkit.geometry import mesh_cache
 from modelkit.geometry.objcheck import UNDECIDED, obj_problem
 from modelkit.model import TriangleMeshData
 from modelkit.textio import DEFAULT_MAX_BYTES, UnreadableFile, read_regular
@@ -210,7 +211,8 @@ def mesh_problem(
 ) -> str | None:
     """None when :func:`load_mesh` loads ``path`` (``fragment``), else ``"CODE\tmessage"`` of its
     :class:`MeshLoadError`. Outcomes for regular files are kept for the process, keyed by the resolved
-    path, modification time, size, fragment and metadata, so a changed file is loaded again."""
+    path, modification time, size, fragment and metadata, so a changed file is loaded again; without
+    metadata also on disk between runs (:mod:`modelkit.geometry.mesh_cache`)."""
     import os
     import stat
 
@@ -224,6 +226,15 @@ def mesh_problem(
         key = None
     if key is not None and key in _OUTCOMES:
         return _OUTCOMES[key]
+    kept = key is not None and metadata is None  # kept on disk too
+    if kept and key is not None:
+        found, outcome, corners = mesh_cache.lookup(key)
+        if found:
+            _OUTCOMES[key] = outcome
+            if corners is not None:
+                _BOUNDS[(str(path), fragment)] = (key[1], key[2], corners)
+            return outcome
+    corners = None
     try:
         outcome = _fast_obj_problem(Path(path), fragment, metadata, max_bytes)
         if outcome == UNDECIDED:
@@ -233,12 +244,14 @@ def mesh_problem(
                 warnings.simplefilter("ignore")
                 loaded = load_mesh(path, fragment, metadata, max_bytes)
             outcome = None
-            if key is not None and metadata is None:
-                _keep_bounds(str(path), key[1], key[2], fragment, loaded.mesh.vertices)
+            if kept and key is not None:
+                corners = _keep_bounds(str(path), key[1], key[2], fragment, loaded.mesh.vertices)
     except MeshLoadError as exc:
         outcome = f"{exc.code}\t{exc}"
     if key is not None:
         _OUTCOMES[key] = outcome
+    if kept and key is not None:
+        mesh_cache.store(key, outcome, corners)
     return outcome
 
 
@@ -265,11 +278,15 @@ _BOUNDS: dict[tuple[str, str | None], tuple[int, int, Corners]] = {}
 
 
 def _keep_bounds(path: str, mtime: int, size: int, fragment: str | None,
-                 vertices: NDArray[np.float64]) -> None:
-    if len(vertices):
-        low, high = vertices.min(axis=0), vertices.max(axis=0)
-        _BOUNDS[(path, fragment)] = (mtime, size, (
-            (float(low[0]), float(low[1]), float(low[2])), (float(high[0]), float(high[1]), float(high[2]))))
+                 vertices: NDArray[np.float64]) -> Corners | None:
+    """Keep the corners of ``vertices`` for the process; returns them (None for no vertex)."""
+    if not len(vertices):
+        return None
+    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    corners = ((float(low[0]), float(low[1]), float(low[2])),
+               (float(high[0]), float(high[1]), float(high[2])))
+    _BOUNDS[(path, fragment)] = (mtime, size, corners)
+    return corners
 
 
 def known_bounds(path: str | Path, fragment: str | None = None) -> Corners | None:
