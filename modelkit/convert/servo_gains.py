@@ -20,6 +20,8 @@ taken with gravity along the root's −Z (an arm standing upright on its base, a
 A joint in a leg of a legged robot also carries its share of the robot's weight through its foot
 (:func:`modelkit.convert.legs.carried_loads`): that torque is added to ``τ_g``, and ``R`` is at least
 the distance to the foot, so a leg's servos hold the robot standing at home as an arm's hold the arm.
+A drive wheel also carries its share of the robot it pushes, ``(M / n) r²`` about its axis
+(:mod:`modelkit.convert.wheel_loads`), so a wheel's velocity servo tracks with the robot on it.
 A subtree without mass gets ``MIN_INERTIA`` so that every gain is positive.
 """
 
@@ -31,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from modelkit.convert.legs import carried_loads
+from modelkit.convert.wheel_loads import carried_inertias
 from modelkit.model import Joint, JointType, Link, Robot
 from modelkit.spatial import Pose
 
@@ -50,6 +53,7 @@ class JointLoad:
     inertia: float
     gravity: float = 0.0
     reach: float = 0.0
+    pushed: float = 0.0  # of ``inertia``: a drive wheel's share of the robot it pushes (wheel_loads)
 
 
 def home_position(joint: Joint) -> float:
@@ -87,6 +91,10 @@ def joint_loads(robot: Robot) -> dict[str, JointLoad]:
         if name in out:
             own = out[name]
             out[name] = JointLoad(own.inertia, own.gravity + torque, max(own.reach, lever))
+    for name, inertia in carried_inertias(robot).items():
+        if name in out:
+            own = out[name]
+            out[name] = JointLoad(own.inertia + inertia, own.gravity, own.reach, inertia)
     return out
 
 

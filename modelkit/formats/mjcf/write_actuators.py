@@ -305,7 +305,10 @@ class ActuatorWriter:
         self.ctx.note(
             "MK840",
             f"{actuator.kind.value} actuator on joint {joint.name}: {gains} from its reflected inertia "
-            f"{fmt(load.inertia)} {unit} at home and {why} "
+            f"{fmt(load.inertia)} {unit} at home"
+            + (f" (with {fmt(load.pushed)} {unit}, its share of the robot it pushes as a drive wheel)"
+               if load.pushed else "")
+            + f" and {why} "
             f"(the source{' ' + actuator.source_kind if actuator.source_kind else ''} gives no gains)",
             actuator.source or joint.source,
             f"actuator[{target}]",
