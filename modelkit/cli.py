@@ -22,6 +22,7 @@ from modelkit.convert.choices import (
     MESH_FORMATS,
     SDF_VERSIONS,
     SOURCE_ACTUATORS,
+    SUPPORT_CONTACTS,
     WHEEL_COLLISIONS,
 )
 from modelkit.diagnostics import (
@@ -467,6 +468,12 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
 @click.option("--wheel-collision", type=click.Choice(WHEEL_COLLISIONS), default="auto", show_default=True,
               help="Collision shape of wheels (auto: a sphere for MJCF and URDF, the cylinder for SDF and "
                    ".body; MK826).")
+@click.option("--support-contact", type=click.Choice(SUPPORT_CONTACTS), default="compliant",
+              show_default=True,
+              help="URDF: a wheeled robot standing on more than three links (drive wheels and casters) gets "
+                   "PyBullet contact stiffness and damping on each, so that PyBullet shares its weight among "
+                   "them (MK861); rigid leaves PyBullet's rigid contacts, which can leave a drive wheel "
+                   "unloaded.")
 @click.option("--base", type=click.Choice(["auto", "fixed", "floating"]), default="auto", show_default=True,
               help="Weld the root to the world or let it float; auto keeps the source's answer and, where "
                    "it has none (URDF), floats robots with wheels or legs and welds the others.")
@@ -503,6 +510,7 @@ def convert(
     ros_plugins: bool,
     drive_plugin: bool,
     wheel_collision: str,
+    support_contact: str,
     base: str,
     actuators: str,
     source_actuators: str,
@@ -534,6 +542,7 @@ def convert(
         ros_plugins=ros_plugins,
         drive_plugin=drive_plugin,
         wheel_collision=wheel_collision,
+        support_contact=support_contact,
         base=base,
         actuators=actuators,
         source_actuators=source_actuators,

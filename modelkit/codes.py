@@ -1457,6 +1457,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "simulator.",
     ),
     CodeInfo(
+        "MK861",
+        "contact-compliance-written",
+        "info",
+        "A wheeled robot that stands on more than three links in one plane gets PyBullet contact stiffness "
+        "and damping on each (URDF <contact>): rigid contact does not fix how its weight splits among them, "
+        "and PyBullet could leave a drive wheel unloaded.",
+    ),
+    CodeInfo(
         "MK852",
         "surface-friction-written",
         "info",

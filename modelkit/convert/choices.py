@@ -9,3 +9,4 @@ ACTUATOR_CHOICES = ("auto", "motor", "position", "velocity", "none")  # where th
 SOURCE_ACTUATORS = ("keep", "replace")  # the source's own actuators: written, or set aside for --actuators
 GAZEBO_CHOICES = ("auto", "classic", "sim")  # convert.gazebo says what each means
 WHEEL_COLLISIONS = ("auto", "cylinder", "sphere", "ellipsoid")  # convert.wheels says what each means
+SUPPORT_CONTACTS = ("compliant", "rigid")  # convert.contact_compliance says what each means

@@ -32,6 +32,9 @@ class WriteOptions:
     # gives no controller (MK858; modelkit/convert/drive_plugin.py)
     drive_plugin: bool = True
     wheel_collision: str = "auto"  # auto|cylinder|sphere|ellipsoid: the wheels' collision (convert.wheels)
+    # URDF: compliant (PyBullet contact stiffness and damping on the links a wheeled robot stands on, when
+    # they are more than three; MK861, modelkit/convert/contact_compliance.py) | rigid (PyBullet's own)
+    support_contact: str = "compliant"
     base: str = "auto"  # fixed | floating | auto: how the root meets the world (modelkit/convert/base.py)
     # actuators for a source without any (MJCF): auto (default: a position servo on each joint with a
     # range or in a leg, a motor on each other) | motor | position | velocity | none; the source's own

@@ -38,6 +38,11 @@ from modelkit.model import (
 )
 from modelkit.spatial import Pose
 
+# PyBullet lateral friction of a support link (modelkit.convert.contact_compliance) whose source gives
+# none: MuJoCo's default sliding friction, which the MJCF of the same robot gets, instead of PyBullet's
+# own default 0.5 (the two written files then mean the same robot)
+SUPPORT_FRICTION = 1.0
+
 TEXTURE_FOLDER = "textures"
 
 
@@ -213,9 +218,11 @@ def link_element(
     robot_el: Element, link: Link, name: str, robot: Robot, ctx: WriteContext, materials: MaterialTable,
     friction: PairFriction | None = None,
     moving: bool = False,
+    compliance: tuple[float, float] | None = None,
 ) -> Element:
     """The ``<link>`` element with its inertial, visuals, collisions and (with ``friction``, the link's
-    contact material against the floor) PyBullet's ``<contact>``."""
+    contact material against the floor) PyBullet's ``<contact>``, with ``compliance`` (stiffness N/m,
+    damping N·s/m: :mod:`modelkit.convert.contact_compliance`) in it."""
     el = etree.SubElement(robot_el, "link", name=name)
     target = f"link[{name}]"
     if moving and (link.inertial is None or link.inertial.mass <= 0.0):
@@ -261,10 +268,16 @@ def link_element(
         contact = contact_element(el, friction.dynamic, 0.0, 0.0)
     elif kept:
         contact = etree.SubElement(el, "contact")
+    elif compliance is not None:  # a support without a friction of its own: MuJoCo's default, as the MJCF
+        contact = contact_element(el, SUPPORT_FRICTION, 0.0, 0.0)
     else:
         return el
     for tag, value in sorted((kept or {}).items()):
         etree.SubElement(contact, tag, **({"value": value} if value else {}))
+    if compliance is not None and not {"stiffness", "damping"} & set(kept or {}):  # the source's own wins
+        # in the order a kept <contact> is written (sorted), so that URDF → URDF gives the same bytes
+        etree.SubElement(contact, "damping", value=fmt(compliance[1]))
+        etree.SubElement(contact, "stiffness", value=fmt(compliance[0]))
     return el
 
 

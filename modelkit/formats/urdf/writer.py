@@ -23,6 +23,7 @@ from collections.abc import Iterable
 from lxml import etree
 from lxml.etree import _Element as Element
 
+from modelkit.convert.contact_compliance import pybullet_compliance
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.notes import ConversionNote, renames
@@ -92,9 +93,12 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
         etree.SubElement(links, "link", name=WORLD_LINK)
     friction = floor_friction(robot)
     moving = _moving_links(robot)
+    compliance, why = pybullet_compliance(robot) if ctx.options.support_contact == "compliant" else ({}, "")
+    if compliance:
+        ctx.note("MK861", why, robot.source, "link")
     for index, link in enumerate(robot.links):
         link_element(links, link, names.links[index], robot, ctx, materials, friction.get(link.name),
-                     link.name in moving)
+                     link.name in moving, compliance.get(link.name))
         _link_extras(link.extras, link.name, names.links[index], ctx)
     joints: list[Element] = []
     extra_links: list[Link] = []
