@@ -23,8 +23,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from modelkit.model import Robot
 
 DEFLECTION = 1e-3  # m: a support's sink under its equal share of the robot's weight
@@ -34,18 +32,9 @@ MIN_SUPPORTS = 4  # three supports are statically determinate
 
 def support_links(robot: Robot) -> list[str]:
     """The links whose collision shapes reach the robot's lowest point at q = 0, in model order."""
-    from modelkit.convert.tracks import extent
-    from modelkit.convert.wheels import GROUND_LEVEL
+    from modelkit.convert.wheels import GROUND_LEVEL, link_lows
 
-    poses = robot.world_poses()
-    lows: dict[str, float] = {}
-    for link in robot.links:
-        pose = poses.get(link.name)
-        if pose is None or not link.collisions:
-            continue
-        found = extent(link.collisions, pose.rotation.T @ np.array([0.0, 0.0, 1.0]))
-        if found is not None:
-            lows[link.name] = float(pose.translation[2]) + found[0]
+    lows = link_lows(robot, robot.world_poses())
     if not lows:
         return []
     floor = min(lows.values())

@@ -60,19 +60,25 @@ def resolve(choice: str, target: str) -> str:
     return "sphere" if target in SPHERE_TARGETS else "cylinder"
 
 
-def _lowest(robot: Robot, poses: dict[str, Pose]) -> float | None:
-    """The lowest world z of the robot's collision shapes at q = 0 (None without any)."""
+def link_lows(robot: Robot, poses: dict[str, Pose]) -> dict[str, float]:
+    """Link → the lowest world z of its collision shapes at ``poses`` (links without any left out)."""
     from modelkit.convert.tracks import extent
 
-    lows = []
+    lows: dict[str, float] = {}
     for link in robot.links:
         pose = poses.get(link.name)
         if pose is None or not link.collisions:
             continue
         found = extent(link.collisions, pose.rotation.T @ np.array([0.0, 0.0, 1.0]))
         if found is not None:
-            lows.append(float(pose.translation[2]) + found[0])
-    return min(lows) if lows else None
+            lows[link.name] = float(pose.translation[2]) + found[0]
+    return lows
+
+
+def _lowest(robot: Robot, poses: dict[str, Pose]) -> float | None:
+    """The lowest world z of the robot's collision shapes at q = 0 (None without any)."""
+    lows = link_lows(robot, poses)
+    return min(lows.values()) if lows else None
 
 
 def find_wheels(robot: Robot) -> dict[str, tuple[str, int]]:
