@@ -126,3 +126,36 @@ def test_support_links_of_tiago() -> None:
     robot = modelkit.load(example_robot("tiago_description/robots/tiago_no_hand.urdf"))
     assert isinstance(robot, Robot)
     assert set(support_links(robot)) == SUPPORTS
+
+
+def _four_wheels(own: str) -> str:
+    """A 10 kg box on four cylinder wheels (continuous joints about Y); the front-left wheel's
+    <contact> is ``own``."""
+    wheels = []
+    for name, x, y in (("fl", 0.2, 0.2), ("fr", 0.2, -0.2), ("bl", -0.2, 0.2), ("br", -0.2, -0.2)):
+        contact = own if name == "fl" else ""
+        wheels.append(
+            f'<link name="{name}"><inertial><mass value="0.5"/><inertia ixx="1e-3" iyy="1e-3" izz="1e-3" '
+            'ixy="0" ixz="0" iyz="0"/></inertial><collision><origin rpy="1.5707963267948966 0 0"/>'
+            f'<geometry><cylinder radius="0.05" length="0.03"/></geometry></collision>{contact}</link>'
+            f'<joint name="{name}_joint" type="continuous"><parent link="base"/><child link="{name}"/>'
+            f'<origin xyz="{x} {y} 0"/><axis xyz="0 1 0"/></joint>')
+    return ('<robot name="cart"><link name="base"><inertial><mass value="10"/><inertia ixx="0.1" iyy="0.1" '
+            'izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.5 0.3 0.05"/>'
+            f'</geometry></collision></link>{"".join(wheels)}</robot>')
+
+
+def test_a_source_stiffness_is_kept(tmp_path: Path) -> None:
+    from lxml import etree
+
+    source = tmp_path / "cart.urdf"
+    source.write_text(_four_wheels('<contact><stiffness value="5000"/><damping value="10"/></contact>'))
+    out = tmp_path / "out" / "cart.urdf"
+    result = convert([source], out)
+    tree = etree.parse(str(out))
+    stiffness = {link.get("name"): float(link.find("contact/stiffness").get("value"))
+                 for link in tree.iterfind("link") if link.find("contact/stiffness") is not None}
+    assert stiffness["fl"] == 5000.0  # the source's own
+    assert set(stiffness) == {"fl", "fr", "bl", "br"}
+    assert stiffness["fr"] == pytest.approx(12 * 9.81 / 4 / 1e-3, rel=1e-2)  # 12 kg on four, 1 mm
+    assert [n for n in result.notes if n.code == "MK861"]
