@@ -128,3 +128,17 @@ def test_convert_writes_no_cache_entry(tmp_path: Path) -> None:
     assert done.returncode in (0, 1), done.stderr
     assert (tmp_path / "out" / "r.xml").exists()
     assert not (tmp_path / "cache").exists()
+
+
+def test_two_names_of_one_file_are_two_meshes(cache: Path, tmp_path: Path) -> None:
+    """The suffix as given picks the parser and the message names the file: a link named .dae to an
+    STL is judged as COLLADA (and fails), the .stl link to the same bytes loads."""
+    mesh = _box(tmp_path / "box.stl")
+    as_dae = tmp_path / "box.dae"
+    as_dae.symlink_to(mesh)
+    assert meshfiles.mesh_problem(mesh) is None
+    judged = meshfiles.mesh_problem(as_dae)
+    assert judged is not None and "box.dae" in judged
+    meshfiles.clear_mesh_cache()
+    assert meshfiles.mesh_problem(mesh) is None
+    assert meshfiles.mesh_problem(as_dae) == judged

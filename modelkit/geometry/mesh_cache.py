@@ -5,9 +5,10 @@ Parsing is what a real robot's validation spends its time on: example-robot-data
 arm holds 50 MB of COLLADA text, 1.7 s of the 2.4 s ``validate`` takes on the 2-core VM. An entry
 holds what :func:`modelkit.geometry.meshfiles.mesh_problem` learns from a file: the outcome (None,
 or "CODE\\tmessage") and the corners of its triangles (the rules' mesh extent). It is keyed, as the
-in-process cache is, by the resolved path, modification time (ns), size, the fragment and the size
-limit, and also by modelkit's version, :data:`SCHEMA` and the modification time of the mesh-checking
-module itself: a changed mesh file, a new modelkit or an edited checker never reads an old outcome.
+in-process cache is, by the resolved path, modification time (ns), size, the fragment, the size limit
+and the file's name as given (its suffix picks the parser), and also by modelkit's version,
+:data:`SCHEMA` and the modification time of the mesh-checking module itself: a changed mesh file, a
+new modelkit or an edited checker never reads an old outcome.
 
 Who: the ``validate`` command (and the pre-commit hook, which runs it) turns it on with :func:`enable`;
 ``convert``, ``verify``, ``tree`` and the library write nothing outside their outputs (they parse a

@@ -198,9 +198,9 @@ def _read_mesh_bytes(path: Path, max_bytes: int) -> bytes:
 
 # ---- per-run outcome cache --------------------------------------------------------------------
 
-# (resolved path, mtime_ns, size, fragment, metadata, max_bytes) -> None (loads) or "CODE\tmessage".
-# Validating many files that share meshes loads each once per process (one CLI run).
-_OUTCOMES: dict[tuple[str, int, int, str | None, MeshMetadata | None, int], str | None] = {}
+# (resolved path, mtime_ns, size, fragment, metadata, max_bytes, name as given) -> None (loads) or
+# "CODE\tmessage". Validating many files that share meshes loads each once per process (one CLI run).
+_OUTCOMES: dict[tuple[str, int, int, str | None, MeshMetadata | None, int, str], str | None] = {}
 
 
 def mesh_problem(
@@ -221,7 +221,9 @@ def mesh_problem(
         info = os.stat(path)
         if stat.S_ISREG(info.st_mode):
             resolved = str(Path(path).resolve())
-            key = (resolved, info.st_mtime_ns, info.st_size, fragment, metadata, max_bytes)
+            # the name as given too: the suffix picks the parser and messages name the file (two links
+            # to one file, a.dae and b.stl, are two meshes)
+            key = (resolved, info.st_mtime_ns, info.st_size, fragment, metadata, max_bytes, Path(path).name)
     except (OSError, RuntimeError, ValueError):  # missing, a loop: load_mesh reports it
         key = None
     if key is not None and key in _OUTCOMES:
