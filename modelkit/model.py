@@ -417,6 +417,10 @@ class Robot:
     materials_file: Path | None = None
     extras: dict[str, Any] = field(default_factory=dict)  # one format's own data, kept as is
 
+    def total_mass(self) -> float:
+        """The sum of the links' masses (a negative mass, which validate refuses, counts as 0)."""
+        return sum(max(float(link.inertial.mass), 0.0) for link in self.links if link.inertial is not None)
+
     def link(self, name: str) -> Link | None:
         for link in self.links:
             if link.name == name:

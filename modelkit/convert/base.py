@@ -164,7 +164,7 @@ def _settle_world_root(robot: Robot, choice: str, notes: NoteSink) -> None:
 
 def decide(robot: Robot) -> BaseDecision:
     """Float a robot that moves itself (wheels, legs), weld the others (see the module docstring)."""
-    if sum(max(link.inertial.mass, 0.0) for link in robot.links if link.inertial is not None) <= 0.0:
+    if robot.total_mass() <= 0.0:
         return BaseDecision(JointType.FIXED, "the robot has no mass to float")
     if not any(joint.type.moves for joint in robot.joints):
         return BaseDecision(JointType.FLOATING, "it has no moving joint (an object), so URDF's own "

@@ -52,7 +52,7 @@ def pybullet_compliance(robot: Robot) -> tuple[dict[str, tuple[float, float]], s
     supports = support_links(robot)
     if len(supports) < MIN_SUPPORTS:
         return {}, ""
-    mass = sum(float(link.inertial.mass) for link in robot.links if link.inertial is not None)
+    mass = robot.total_mass()
     if not mass > 0.0:
         return {}, ""
     share = mass / len(supports)

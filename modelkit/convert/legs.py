@@ -93,7 +93,7 @@ def carried_loads(robot: Robot, home: dict[str, float]) -> dict[str, tuple[float
     children = robot.children_of()
     by_name = {joint.name: joint for joint in robot.joints}
     firsts = [name for name in _limbs(robot) if name in legs]
-    mass = sum(max(link.inertial.mass, 0.0) for link in robot.links if link.inertial is not None)
+    mass = robot.total_mass()
     share = np.array([0.0, 0.0, mass * 9.81 / len(firsts)])  # the floor's push on each foot
     out: dict[str, tuple[float, float]] = {}
     for first in firsts:

@@ -34,7 +34,7 @@ def carried_inertias(robot: Robot) -> dict[str, float]:
     wheels = robot.extras.get(WHEELS_KEY)
     if not isinstance(wheels, dict) or not wheels:
         return {}
-    mass = sum(float(link.inertial.mass) for link in robot.links if link.inertial is not None)
+    mass = robot.total_mass()
     share = mass / len(wheels)
     out = {}
     for link_name, joint_name in wheels.items():

@@ -409,7 +409,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                                                            approx[eng.label]))
                       if approx[eng.label] or chains else src_static)
         # ... and so is one holding the URDF writer's ±1e16 for an infinite position bound (MK819).
-        stand_ins = approximations.limits_for_engine(INPUTS.get(eng.label, "robot"), reference)
+        stand_ins = approximations.limits_for_engine(kind, reference)
         eng_static = approximations.applied_limits(eng_static, stand_ins)
         limits_entry = approximations.limits_skip(eng.label, stand_ins)
         if limits_entry is not None:
