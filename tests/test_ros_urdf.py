@@ -18,9 +18,10 @@ from modelkit.api import validate
 from modelkit.convert.api import render_model
 from modelkit.convert.gazebo import plugin_family, source_family
 from modelkit.convert.notes import ConversionNote
+from modelkit.convert.numbers import fmt
 from modelkit.convert.options import WriteOptions
 from modelkit.convert.output import OutputPlan
-from modelkit.formats.urdf.write_frames import FRAME_MASS
+from modelkit.formats.urdf.write_links import TINY_MASS
 from modelkit.model import Robot
 from tests.conftest import SAMPLES, TUTORIAL, require_tool
 from tests.test_sdf_reader import oracle_has_errors, sdf_oracle  # noqa: F401 (the fixture)
@@ -150,7 +151,7 @@ def test_sensors_are_tf_frames_where_the_body_file_puts_them(tmp_path: Path) -> 
 
 
 def test_sensor_links_round_trip_and_can_be_left_out(tmp_path: Path) -> None:
-    """Read back, a sensor link keeps its sensor and its tiny inertial and is written again unchanged
+    """Read back, a sensor link keeps its sensor, is a massless frame, and is written again unchanged
     (no LiDAR_2, no other mass);
     validate finds no error in the output; --no-urdf-sensor-links keeps the sensors on TiltLink."""
     robot = _read(SENSORS)
@@ -161,7 +162,8 @@ def test_sensor_links_round_trip_and_can_be_left_out(tmp_path: Path) -> None:
     assert back is not None
     lidar = back.link("LiDAR")
     assert lidar is not None and [d.name for d in lidar.devices] == ["LiDAR"]
-    assert lidar.inertial is not None and lidar.inertial.mass == FRAME_MASS  # not PyBullet's 1 kg
+    assert lidar.inertial is None  # a frame: its tiny inertial (not PyBullet's 1 kg) reads back as none
+    assert path.read_text().count(f'<mass value="{fmt(TINY_MASS)}"/>') == 3
     # the floating root reads back open (URDF's convention): ask for the floating root it had
     again, notes = _write(back, tmp_path / "again", WriteOptions(base="floating"))
     for tag in ("joint", "gazebo"):  # (the PyBullet <contact> of the links is not read back: MK123)

@@ -14,7 +14,7 @@ import pytest
 from modelkit.api import validate
 from modelkit.convert.api import convert
 from modelkit.convert.numbers import fmt
-from modelkit.formats.urdf.write_links import MOVING_INERTIA, MOVING_MASS
+from modelkit.formats.urdf.write_links import TINY_INERTIA, TINY_MASS
 
 from .conftest import CORPUS
 
@@ -49,18 +49,41 @@ def test_the_humanoids_joint_links_weigh_nothing_in_pybullet_and_stay_in_gazebo(
     back = validate(out)
     assert not [d for d in back.diagnostics if d.code == "MK322"]  # libsdformat keeps every link
     text = out.read_text()
-    assert text.count(f'<mass value="{fmt(MOVING_MASS)}"/>') >= len(synthesised)
-    assert f'ixx="{fmt(MOVING_INERTIA)}"' in text
+    assert text.count(f'<mass value="{fmt(TINY_MASS)}"/>') >= len(synthesised)
+    assert f'ixx="{fmt(TINY_INERTIA)}"' in text
 
 
-def test_a_massless_frame_on_a_fixed_joint_stays_without_inertial(tmp_path: Path) -> None:
+def test_a_massless_frame_below_the_root_weighs_nothing_in_pybullet(tmp_path: Path) -> None:
+    """A massless link on a fixed joint (an MJCF site, an SDF frame, a URDF tool frame) is written
+    with the tiny inertial: PyBullet, loaded with no flags, then weighs the robot as its source. The
+    massless root stays without one (KDL refuses an inertia on the root), and the frame reads back
+    as a massless frame."""
     path = tmp_path / "r.urdf"
     path.write_text(
-        '<robot name="r"><link name="a"><inertial><mass value="1"/>'
+        '<robot name="r"><link name="base_footprint"/>'
+        '<link name="a"><inertial><mass value="2"/>'
         '<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>'
         '<link name="tool"/><joint name="f" type="fixed"><parent link="a"/><child link="tool"/></joint>'
+        '<joint name="b" type="fixed"><parent link="base_footprint"/><child link="a"/></joint>'
         "</robot>")
     out = tmp_path / "o" / "r.urdf"
     result = convert([path], out)
-    assert "<link name=\"tool\"/>" in out.read_text()
+    assert result.status == 0
+    text = out.read_text()
+    assert '<link name="base_footprint"/>' in text
+    assert text.count(f'<mass value="{fmt(TINY_MASS)}"/>') == 1
+    said = [n.message for n in result.notes if n.code == "MK816"]
+    assert said and '"tool"' in said[0] and 'massless root "base_footprint"' in said[0], said
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        body = pybullet.loadURDF(str(out), physicsClientId=client)  # as a user loads it: no flags
+        masses = {pybullet.getJointInfo(body, i, physicsClientId=client)[12].decode():
+                  pybullet.getDynamicsInfo(body, i, physicsClientId=client)[0]
+                  for i in range(pybullet.getNumJoints(body, physicsClientId=client))}
+    finally:
+        pybullet.disconnect(client)
+    assert masses == {"a": 2.0, "tool": TINY_MASS}
+    back = validate(out).robots[0]
+    tool = back.link("tool")
+    assert tool is not None and tool.inertial is None
     assert not [n for n in result.notes if n.code == "MK816" and "no mass but moves" in n.message]

@@ -161,13 +161,11 @@ def expected_after_urdf(robot: Robot) -> Robot:
     """The model with the writer's documented substitutions: URDF needs both position bounds of a
     prismatic joint (and of a revolute joint limited on one side only), ±1e16 where there is none;
     a welded root hangs from a `world` link by a fixed joint at the robot's placement; a camera, LiDAR
-    or IMU is a link of a tiny inertial on a fixed joint at its pose, a camera's optical frame one more
-    (MK847); a massless link on a moving joint has a tiny inertial (MK816)."""
-    from modelkit.formats.urdf.write_frames import FRAME_INERTIA, FRAME_MASS, FRAMED_KINDS
-    from modelkit.formats.urdf.write_links import MOVING_INERTIA, MOVING_MASS
-
-    def frame_link(name: str) -> Link:
-        return Link(name, inertial=Inertial(FRAME_MASS, (0.0, 0.0, 0.0), np.eye(3) * FRAME_INERTIA))
+    or IMU is a massless frame link on a fixed joint at its pose, a camera's optical frame one more
+    (MK847: the tiny inertial a frame is written with reads back as none); a massless link on a moving
+    joint has a tiny inertial (MK816)."""
+    from modelkit.formats.urdf.write_frames import FRAMED_KINDS
+    from modelkit.formats.urdf.write_links import TINY_INERTIA, TINY_MASS
 
     out = copy.deepcopy(robot)
     taken = {lk.name for lk in out.links} | {j.name for j in out.joints}
@@ -176,20 +174,29 @@ def expected_after_urdf(robot: Robot) -> Robot:
             if device.canonical not in FRAMED_KINDS or device.name == link.name or "xml" in device.params:
                 continue
             frame = unique_name(device.name, taken)
-            out.links.append(frame_link(frame))
+            out.links.append(Link(frame))
             out.joints.append(Joint(unique_name(f"{frame}_joint", taken), JointType.FIXED, link.name, frame,
                                     origin=device.pose))
             if device.canonical in CAMERA_KINDS:  # REP-103: z forward, x right, y down
                 optical = unique_name(f"{frame}_optical", taken)
                 rep103 = Pose(matrix_from_rpy(-math.pi / 2, 0.0, -math.pi / 2), np.zeros(3))
-                out.links.append(frame_link(optical))
+                out.links.append(Link(optical))
                 out.joints.append(Joint(unique_name(f"{optical}_joint", taken), JointType.FIXED, frame,
                                         optical, origin=rep103))
+    # a link of a fixed joint with exactly the tiny inertial reads back as a massless frame
+    # (dm_control's manipulator gives its "pinch site" body that inertial)
+    fixed = {joint.child for joint in out.joints if joint.type is JointType.FIXED}
+    for link in out.links:
+        inertial = link.inertial
+        if (link.name in fixed and inertial is not None and inertial.mass == TINY_MASS
+                and np.array_equal(inertial.com, np.zeros(3))
+                and np.array_equal(inertial.inertia, np.eye(3) * TINY_INERTIA)):
+            link.inertial = None
     # a massless link on a moving joint gets a tiny explicit inertial (MK816)
     moving = {joint.child for joint in out.joints if joint.type is not JointType.FIXED}
     for link in out.links:
         if link.name in moving and (link.inertial is None or link.inertial.mass <= 0.0):
-            link.inertial = Inertial(MOVING_MASS, (0.0, 0.0, 0.0), np.eye(3) * MOVING_INERTIA)
+            link.inertial = Inertial(TINY_MASS, (0.0, 0.0, 0.0), np.eye(3) * TINY_INERTIA)
     if out.root_joint is JointType.FIXED and out.root not in (None, "world"):
         root = str(out.root)
         out.links.insert(0, Link("world"))
@@ -292,8 +299,8 @@ def test_tutorial_body_matches_the_hand_written_urdf(tmp_path: Path) -> None:
     assert {j.name for j in ours.joints} >= {"LeftWheel", "RightWheel", "PanJoint", "TiltJoint"}
     for link in ours.links:
         other_link = hand.link(link.name)
-        if link.name in ("LiDAR", "RealSense", "RealSense_optical"):  # TF frames of a tiny inertial
-            assert link.inertial is not None and link.inertial.mass == 1e-6
+        if link.name in ("LiDAR", "RealSense", "RealSense_optical"):  # TF frames (tiny inertial: massless)
+            assert link.inertial is None
             assert not link.visuals and not link.collisions
             continue
         assert other_link is not None and link.inertial is not None and other_link.inertial is not None

@@ -23,7 +23,7 @@ from modelkit.formats.urdf.actuators import read_actuators
 from modelkit.formats.urdf.extensions import canonical_xml, read_gazebo, read_transmission
 from modelkit.formats.urdf.joints import read_joint
 from modelkit.formats.urdf.links import Materials, read_link
-from modelkit.formats.urdf.massless import fold_massless_inertia
+from modelkit.formats.urdf.massless import fold_massless_inertia, read_tiny_frames
 from modelkit.formats.urdf.schema import check_structure
 from modelkit.formats.urdf.values import VERSIONS, Context
 from modelkit.limits import too_many_links
@@ -82,6 +82,7 @@ def read_urdf_document(
     _unknown_mimic_leaders(ctx, robot)
     _root(robot)
     fold_massless_inertia(robot, sink)
+    read_tiny_frames(robot)
     _extensions(ctx, root, robot)
     _newer_features(ctx)
     return robot

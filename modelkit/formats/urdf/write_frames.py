@@ -14,34 +14,32 @@ and a device that already is its link's (a link named like the device: a URDF re
 whose name a link or joint already has gets a fresh one (``_2``...). One MK847 note lists the frames;
 ``WriteOptions.urdf_sensor_links=False`` keeps every sensor on its link instead.
 
-The frames carry a tiny explicit inertial (:data:`FRAME_MASS`, :data:`FRAME_INERTIA`, as the SDF
-writer's massless links): PyBullet reads a link without ``<inertial>`` as 1 kg with a unit inertia, so
-massless frames made the tutorial's sensor robot 3 kg heavier there (20.6 kg for 17.6 kg); a zero
-``<inertial>`` is refused by libsdformat's URDF conversion ("Pose values must be finite"). With
-1e-6 kg each the robot is 3e-6 kg heavier in every consumer, and ``verify`` grades the default file.
+The frames carry the tiny explicit inertial of every massless link below the root
+(:data:`~modelkit.formats.urdf.write_links.TINY_MASS`): PyBullet reads a link without ``<inertial>`` as
+1 kg with a unit inertia, so massless frames made the tutorial's sensor robot 3 kg heavier there
+(20.6 kg for 17.6 kg); a zero ``<inertial>`` is refused by libsdformat's URDF conversion ("Pose values
+must be finite"). With 1e-6 kg each the robot is 3e-6 kg heavier in every consumer, and the URDF
+reader reads that exact inertial on a fixed joint back as a massless frame.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import numpy as np
 from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
 from modelkit.formats.devices import OPTICAL_IN_ROBOTICS
-from modelkit.formats.urdf.write_links import inertial_element, origin_element
+from modelkit.formats.urdf.write_links import TINY_MASS, origin_element, tiny_inertial
 from modelkit.formats.urdf.write_names import NameTable
-from modelkit.model import CAMERA_KINDS, Device, DeviceKind, Inertial, Link, Robot
+from modelkit.model import CAMERA_KINDS, Device, DeviceKind, Robot
 from modelkit.spatial import Pose
 
 FRAMED_KINDS = frozenset(
     {*CAMERA_KINDS, DeviceKind.LIDAR, DeviceKind.IMU, DeviceKind.ACCELEROMETER, DeviceKind.GYRO}
 )
 OPTICAL_POSE = Pose(OPTICAL_IN_ROBOTICS, (0.0, 0.0, 0.0))
-FRAME_MASS = 1e-6  # kg: a sensor frame's explicit inertial (see the module docstring)
-FRAME_INERTIA = 1e-12  # kg·m², each principal moment
 
 
 @dataclass
@@ -94,7 +92,7 @@ def sensor_frames(robot: Robot, names: NameTable, ctx: WriteContext) -> SensorFr
         ctx.note(
             "MK847",
             f"{len(listed)} sensor(s) written as links on fixed joints (their TF frames for ROS; a tiny "
-            f"inertial each, {FRAME_MASS:g} kg, so that PyBullet does not give them 1 kg; "
+            f"inertial each, {TINY_MASS:g} kg, so that PyBullet does not give them 1 kg; "
             "their <gazebo reference> names them): " + ", ".join(listed) + "; cameras' optical frames are "
             "REP-103 (z forward, x right, y down; rpy -π/2 0 -π/2); option urdf_sensor_links "
             "(--no-urdf-sensor-links) keeps the sensors on their links",
@@ -104,12 +102,11 @@ def sensor_frames(robot: Robot, names: NameTable, ctx: WriteContext) -> SensorFr
     return out
 
 
-def frame_link(name: str, ctx: WriteContext) -> Element:
-    """A sensor frame's ``<link>``, with its tiny explicit inertial written as any link's (so that a
-    read-back frame, now a link of the model, is written again byte for byte)."""
+def frame_link(name: str) -> Element:
+    """A sensor frame's ``<link>``, with the tiny explicit inertial of every massless link below the
+    root (so that a read-back frame, now a link of the model, is written again byte for byte)."""
     element = etree.Element("link", name=name)
-    inertial = Inertial(FRAME_MASS, (0.0, 0.0, 0.0), np.eye(3) * FRAME_INERTIA)
-    inertial_element(element, Link(name, inertial=inertial), ctx, f"link[{name}]")
+    tiny_inertial(element)
     return element
 
 

@@ -22,6 +22,7 @@ from modelkit.convert.numbers import clean_inertia, fmt, fmt_position, fmt_rpy, 
 from modelkit.convert.output import safe_file_name
 from modelkit.diagnostics import SourceLocation
 from modelkit.formats.urdf.links import PYBULLET_LATERAL_DEFAULT
+from modelkit.formats.urdf.massless import TINY_INERTIA, TINY_MASS
 from modelkit.model import (
     Box,
     Capsule,
@@ -54,8 +55,6 @@ def origin_element(parent: Element, pose: Pose, always: bool = False) -> None:
         etree.SubElement(parent, "origin", xyz=xyz, rpy=rpy)
 
 
-MOVING_MASS = 1e-6  # kg: the explicit inertial of a massless link that moves (as the SDF writer's)
-MOVING_INERTIA = 1e-12  # kg·m², each principal moment
 TINY_WORDS = "written with a tiny explicit inertial"  # the MK816 note's words (verify reads them back)
 
 
@@ -68,15 +67,20 @@ def moving_massless_inertial(parent: Element, link: Link, ctx: WriteContext, tar
     ctx.note(
         "MK816",
         f'link "{link.name}" has no mass but moves; PyBullet would give it 1 kg and libsdformat would drop '
-        f"it with its subtree, so it is {TINY_WORDS} (mass {fmt(MOVING_MASS)} kg, "
-        f"inertia {fmt(MOVING_INERTIA)} kg·m²)",
+        f"it with its subtree, so it is {TINY_WORDS} (mass {fmt(TINY_MASS)} kg, "
+        f"inertia {fmt(TINY_INERTIA)} kg·m²)",
         link.loc("mass"),
         f"{target}/inertial",
     )
+    tiny_inertial(parent)
+
+
+def tiny_inertial(parent: Element) -> None:
+    """The explicit ``<inertial>`` of a massless link below the root (:data:`TINY_MASS`)."""
     el = etree.SubElement(parent, "inertial")
     etree.SubElement(el, "origin", xyz="0 0 0", rpy="0 0 0")
-    etree.SubElement(el, "mass", value=fmt(MOVING_MASS))
-    moment = fmt(MOVING_INERTIA)
+    etree.SubElement(el, "mass", value=fmt(TINY_MASS))
+    moment = fmt(TINY_INERTIA)
     etree.SubElement(el, "inertia", ixx=moment, ixy="0", ixz="0", iyy=moment, iyz="0", izz=moment)
 
 
@@ -219,14 +223,20 @@ def link_element(
     friction: PairFriction | None = None,
     moving: bool = False,
     compliance: tuple[float, float] | None = None,
+    below_root: bool = False,
 ) -> Element:
     """The ``<link>`` element with its inertial, visuals, collisions and (with ``friction``, the link's
     contact material against the floor) PyBullet's ``<contact>``, with ``compliance`` (stiffness N/m,
-    damping N·s/m: :mod:`modelkit.convert.contact_compliance`) in it."""
+    damping N·s/m: :mod:`modelkit.convert.contact_compliance`) in it. A massless link that moves, or
+    hangs ``below_root`` on a fixed joint, gets the tiny inertial (:func:`tiny_inertial`); the root
+    stays without one (KDL, hence ``robot_state_publisher``, refuses an inertia on the root)."""
     el = etree.SubElement(robot_el, "link", name=name)
     target = f"link[{name}]"
-    if moving and (link.inertial is None or link.inertial.mass <= 0.0):
+    massless = link.inertial is None or link.inertial.mass <= 0.0
+    if moving and massless:
         moving_massless_inertial(el, link, ctx, target)
+    elif below_root and massless:
+        tiny_inertial(el)
     else:
         inertial_element(el, link, ctx, target)
     for kind, geoms in (("visual", link.visuals), ("collision", link.collisions)):

@@ -27,6 +27,7 @@ from modelkit.convert.contact_compliance import pybullet_compliance
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.notes import ConversionNote, renames
+from modelkit.convert.numbers import fmt
 from modelkit.convert.simulator import pybullet_settings
 from modelkit.formats.registry import EXTRAS_DROPPED, EXTRAS_DROPPED_LINK, EXTRAS_QUIET, EXTRAS_QUIET_LINK
 from modelkit.formats.urdf.write_frames import frame_link, sensor_frames
@@ -34,6 +35,8 @@ from modelkit.formats.urdf.write_gazebo import write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
 from modelkit.formats.urdf.write_links import (
     CONTACT_EXTRAS,
+    TINY_INERTIA,
+    TINY_MASS,
     MaterialTable,
     link_element,
     moving_massless_inertial,
@@ -98,7 +101,7 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
         ctx.note("MK861", why, robot.source, "link")
     for index, link in enumerate(robot.links):
         link_element(links, link, names.links[index], robot, ctx, materials, friction.get(link.name),
-                     link.name in moving, compliance.get(link.name))
+                     link.name in moving, compliance.get(link.name), add_world or link.name != robot.root)
         _link_extras(link.extras, link.name, names.links[index], ctx)
     joints: list[Element] = []
     extra_links: list[Link] = []
@@ -112,7 +115,7 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
         element = etree.SubElement(links, "link", name=link.name)
         moving_massless_inertial(element, link, ctx, f"link[{link.name}]")
     for name in frames.links:
-        links.append(frame_link(name, ctx))
+        links.append(frame_link(name))
 
     out = etree.Element("robot", name=robot.name or "robot")
     materials.write(out)
@@ -131,7 +134,7 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
         out.append(el)
     write_extensions(out, robot, names, frames, ctx)
     write_self_collision(out, robot, names.link_map, ctx)
-    _massless(robot, names, ctx)
+    _massless(robot, names, ctx, add_world)
     _notes(robot, ctx)
     settings = pybullet_settings(robot)
     if settings:
@@ -224,30 +227,38 @@ def _moving_links(robot: Robot) -> set[str]:
     return {joint.child for joint in robot.joints if joint.type is not JointType.FIXED}
 
 
-def _massless(robot: Robot, names: NameTable, ctx: WriteContext) -> None:
-    """One note for the source's links written without ``<inertial>`` (frames: the root, or on a
-    fixed joint), with what peers do to them (the sensor frames the writer adds and the massless
-    links that move carry a tiny inertial: ``write_frames.FRAME_MASS``, ``write_links.MOVING_MASS``)."""
+def _massless(robot: Robot, names: NameTable, ctx: WriteContext, add_world: bool) -> None:
+    """One note for the source's massless links that do not move: below the root they carry the tiny
+    inertial (``write_links.TINY_MASS``), so that PyBullet does not give each 1 kg; a massless root
+    stays without ``<inertial>``, as ROS expects (KDL refuses an inertia on the root), and weighs 1 kg
+    in PyBullet unless it is named ``world``. Massless links that move have a note each."""
     moving = _moving_links(robot)
-    massless = [
-        names.links[i]
-        for i, link in enumerate(robot.links)
-        if (link.inertial is None or link.inertial.mass <= 0.0) and link.name != WORLD_LINK
-        and link.name not in moving
-    ]
-    if not massless:
-        return
-    shown = ", ".join(f'"{n}"' for n in massless[:8]) + (
-        f" and {len(massless) - 8} more" if len(massless) > 8 else ""
-    )
-    ctx.note(
-        "MK816",
-        f"{len(massless)} massless link(s) written without <inertial>, as URDF frames: {shown}; "
-        "PyBullet gives such a link 1 kg and a unit inertia (libsdformat's URDF to SDF conversion merges a "
-        "massless link on a fixed joint into its parent)",
-        robot.source,
-        "link",
-    )
+    frames: list[str] = []
+    bare: list[str] = []
+    for index, link in enumerate(robot.links):
+        has_mass = link.inertial is not None and link.inertial.mass > 0.0
+        if has_mass or link.name == WORLD_LINK or link.name in moving:
+            continue
+        (frames if add_world or link.name != robot.root else bare).append(names.links[index])
+    parts: list[str] = []
+    if frames:
+        parts.append(
+            f"{len(frames)} massless frame link(s) written with a tiny explicit inertial "
+            f"({fmt(TINY_MASS)} kg, {fmt(TINY_INERTIA)} kg·m²; PyBullet would give a link without "
+            f"<inertial> 1 kg and a unit inertia): {_listed(frames)}"
+        )
+    if bare:
+        parts.append(
+            f'the massless root "{bare[0]}" is written without <inertial>, as ROS expects (KDL refuses an '
+            "inertia on the root link); PyBullet gives it 1 kg and a unit inertia"
+        )
+    if parts:
+        ctx.note("MK816", "; ".join(parts), robot.source, "link")
+
+
+def _listed(names: list[str], shown: int = 8) -> str:
+    more = f" and {len(names) - shown} more" if len(names) > shown else ""
+    return ", ".join(f'"{n}"' for n in names[:shown]) + more
 
 
 def _link_extras(extras: dict[str, object], source_name: str, name: str, ctx: WriteContext) -> None:

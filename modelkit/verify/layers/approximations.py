@@ -11,7 +11,7 @@ A massless link (a frame in the source) cannot always stay massless (MK816):
   ``MIN_INERTIA`` kg·m² on each axis (MuJoCo refuses a massless moving body); target
   ``body[NAME]/inertial``;
 * the URDF writer gives a massless link on a moving joint an explicit tiny inertial
-  (``MOVING_MASS`` kg, ``MOVING_INERTIA`` kg·m² on each axis; target ``link[NAME]/inertial``), and
+  (``TINY_MASS`` kg, ``TINY_INERTIA`` kg·m² on each axis; target ``link[NAME]/inertial``), and
   writes the other massless links (frames) without ``<inertial>`` (URDF's own meaning: no mass);
   **PyBullet** reads such a frame as 1 kg with a unit inertia at the link origin (its URDF parser's
   default; the URDF note MK816 says so). Other URDF readers (yourdfpy, Drake) keep it massless.
@@ -89,12 +89,12 @@ def from_notes(fmt: str, notes: Iterable[ConversionNote], renames: Renames) -> d
                 name = back.get(match[1], match[1])
                 out[name] = Approximated(name, TINY_MASS, TINY_INERTIA, note.code, "the SDF writer")
         elif fmt == "urdf":
-            from modelkit.formats.urdf.write_links import MOVING_INERTIA, MOVING_MASS, TINY_WORDS
+            from modelkit.formats.urdf.write_links import TINY_INERTIA, TINY_MASS, TINY_WORDS
 
             match = re.fullmatch(r"link\[(.+)\]/inertial", note.target)
             if match and TINY_WORDS in note.message:
                 name = back.get(match[1], match[1])
-                out[name] = Approximated(name, MOVING_MASS, MOVING_INERTIA, note.code, "the URDF writer")
+                out[name] = Approximated(name, TINY_MASS, TINY_INERTIA, note.code, "the URDF writer")
         elif fmt == "mjcf":
             from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, MIN_MASS
 
