@@ -1206,9 +1206,11 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK816",
         "massless-link-frame",
         "info",
-        "A link without mass is written as a frame (URDF link without `<inertial>`, SDF `<frame>`, MJCF "
-        "site or massless body), or, where it moves or carries shapes, with a tiny explicit inertial, so "
-        "that no consumer drops it or gives it a default mass; the note says which.",
+        "A link without mass is written as a frame (SDF `<frame>`, MJCF site or massless body; in URDF "
+        "a link with a tiny explicit inertial below the root, as PyBullet gives a link without "
+        "`<inertial>` 1 kg, and a root without one, as KDL refuses a root inertia), or, where it moves or "
+        "carries shapes, with a tiny explicit inertial, so that no consumer drops it or gives it a "
+        "default mass; the note says which.",
     ),
     CodeInfo(
         "MK817",
