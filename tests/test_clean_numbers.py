@@ -18,6 +18,7 @@ from modelkit.convert.compare import compare_poses
 from modelkit.convert.notes import renames
 from modelkit.convert.numbers import clean_angle, clean_length, clean_rotation, fmt, fmt_text, length_scale
 from modelkit.formats.mjcf.write_xml import euler_text, quat_wxyz, set_pose, z_turn, zaxis_text
+from modelkit.formats.urdf.massless import TINY_INERTIA
 from modelkit.spatial import Pose, matrix_from_rpy
 
 pybullet_data = pytest.importorskip("pybullet_data")
@@ -97,8 +98,8 @@ def test_real_robots_are_written_clean_and_read_back_equal(source: str, tmp_path
         notes = write(robot, path)
         text = path.read_text()
         dusty = sorted({n for n in NUMBER.findall(text) if DUST.search(n)})
-        # the SDF writer's tiny inertial of a massless frame (writer.TINY_INERTIA) is a chosen value
-        dusty = [n for n in dusty if not (target == "sdf" and n == "1e-12")]
+        # the URDF and SDF writers' tiny inertial of a massless link (TINY_INERTIA) is a chosen value
+        dusty = [n for n in dusty if not (target in ("sdf", "urdf") and n == fmt(TINY_INERTIA))]
         assert dusty == [], f"{source} → {target}: {dusty}"
         if target == "xml":
             mujoco.MjModel.from_xml_path(str(path))

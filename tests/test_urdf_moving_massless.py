@@ -53,11 +53,10 @@ def test_the_humanoids_joint_links_weigh_nothing_in_pybullet_and_stay_in_gazebo(
     assert f'ixx="{fmt(TINY_INERTIA)}"' in text
 
 
-def test_a_massless_frame_below_the_root_weighs_nothing_in_pybullet(tmp_path: Path) -> None:
-    """A massless link on a fixed joint (an MJCF site, an SDF frame, a URDF tool frame) is written
-    with the tiny inertial: PyBullet, loaded with no flags, then weighs the robot as its source. The
-    massless root stays without one (KDL refuses an inertia on the root), and the frame reads back
-    as a massless frame."""
+def test_massless_frames_and_root_weigh_nothing_in_pybullet(tmp_path: Path) -> None:
+    """A massless link on a fixed joint (an MJCF site, an SDF frame, a URDF tool frame) and a massless
+    root are written with the tiny inertial: PyBullet, loaded with no flags, then weighs the robot as
+    its source (the root's 1 kg·m² made TIAGo turn short), and both read back as massless frames."""
     path = tmp_path / "r.urdf"
     path.write_text(
         '<robot name="r"><link name="base_footprint"/>'
@@ -70,20 +69,22 @@ def test_a_massless_frame_below_the_root_weighs_nothing_in_pybullet(tmp_path: Pa
     result = convert([path], out)
     assert result.status == 0
     text = out.read_text()
-    assert '<link name="base_footprint"/>' in text
-    assert text.count(f'<mass value="{fmt(TINY_MASS)}"/>') == 1
+    assert text.count(f'<mass value="{fmt(TINY_MASS)}"/>') == 2
     said = [n.message for n in result.notes if n.code == "MK816"]
-    assert said and '"tool"' in said[0] and 'massless root "base_footprint"' in said[0], said
+    assert said and '"tool"' in said[0] and 'on the root "base_footprint"' in said[0], said
     client = pybullet.connect(pybullet.DIRECT)
     try:
         body = pybullet.loadURDF(str(out), physicsClientId=client)  # as a user loads it: no flags
         masses = {pybullet.getJointInfo(body, i, physicsClientId=client)[12].decode():
                   pybullet.getDynamicsInfo(body, i, physicsClientId=client)[0]
                   for i in range(pybullet.getNumJoints(body, physicsClientId=client))}
+        base_mass, _, base_inertia = pybullet.getDynamicsInfo(body, -1, physicsClientId=client)[:3]
     finally:
         pybullet.disconnect(client)
     assert masses == {"a": 2.0, "tool": TINY_MASS}
+    assert base_mass == TINY_MASS and max(base_inertia) < 1e-9  # not 1 kg and 1 kg·m²
     back = validate(out).robots[0]
-    tool = back.link("tool")
-    assert tool is not None and tool.inertial is None
+    for name in ("tool", "base_footprint"):
+        frame = back.link(name)
+        assert frame is not None and frame.inertial is None, name
     assert not [n for n in result.notes if n.code == "MK816" and "no mass but moves" in n.message]

@@ -14,9 +14,9 @@ mass (no parallel-axis term without mass; the parent's mass and centre of mass a
 the link keeps mass 0 with a zero tensor. A link with no ancestor with mass over fixed joints is left
 as written.
 
-The other way, a massless link below the root is written with a tiny explicit inertial
-(:data:`TINY_MASS`, :data:`TINY_INERTIA`; PyBullet gives a link without ``<inertial>`` 1 kg and a unit
-inertia), and the reader takes exactly that inertial on a fixed joint as what it stands for: a massless
+The other way, the URDF writer gives a massless link a tiny explicit inertial (:data:`TINY_MASS`,
+:data:`TINY_INERTIA`; PyBullet gives a link without ``<inertial>`` 1 kg and a unit inertia), and the
+reader takes exactly that inertial, on the root or a fixed joint, as what it stands for: a massless
 frame (:func:`read_tiny_frames`), so that an MJCF site or an SDF frame comes back as one. Pure Python
 (:mod:`modelkit.rot3`): the validate path does not import numpy.
 """
@@ -30,21 +30,22 @@ from modelkit.diagnostics import DiagnosticSink
 from modelkit.model import Inertial, Joint, JointType, Link, Robot
 from modelkit.rot3 import peek
 
-# The explicit inertial the URDF writer gives a massless link below the root (and the SDF writer a
-# massless link): 1e-6 kg at the link origin, 1e-12 kg·m² on each axis.
+# The explicit inertial the URDF and SDF writers give a massless link: 1e-6 kg at the link origin,
+# 1e-12 kg·m² on each axis.
 TINY_MASS = 1e-6  # kg
 TINY_INERTIA = 1e-12  # kg·m², each principal moment
 _TINY_TENSOR = ((TINY_INERTIA, 0.0, 0.0), (0.0, TINY_INERTIA, 0.0), (0.0, 0.0, TINY_INERTIA))
 
 
 def read_tiny_frames(robot: Robot) -> None:
-    """In place: a link on a fixed joint whose inertial is exactly the tiny one is a massless frame."""
-    fixed = {joint.child for joint in robot.joints if joint.type is JointType.FIXED}
+    """In place: the root or a link on a fixed joint whose inertial is exactly the tiny one is a
+    massless frame."""
+    moving = {joint.child for joint in robot.joints if joint.type is not JointType.FIXED}
     for link in robot.links:
         inertial = link.inertial
         if (
             inertial is not None
-            and link.name in fixed
+            and link.name not in moving
             and inertial.mass == TINY_MASS
             and rot3.mat3(peek(inertial, "inertia")) == _TINY_TENSOR
             and tuple(float(x) for x in peek(inertial, "com")) == (0.0, 0.0, 0.0)

@@ -24,6 +24,7 @@ from modelkit.diagnostics import SourceLocation
 from modelkit.formats.urdf.links import PYBULLET_LATERAL_DEFAULT
 from modelkit.formats.urdf.massless import TINY_INERTIA, TINY_MASS
 from modelkit.model import (
+    WORLD_LINK,
     Box,
     Capsule,
     Cone,
@@ -76,7 +77,7 @@ def moving_massless_inertial(parent: Element, link: Link, ctx: WriteContext, tar
 
 
 def tiny_inertial(parent: Element) -> None:
-    """The explicit ``<inertial>`` of a massless link below the root (:data:`TINY_MASS`)."""
+    """The explicit ``<inertial>`` of a massless link (:data:`TINY_MASS`)."""
     el = etree.SubElement(parent, "inertial")
     etree.SubElement(el, "origin", xyz="0 0 0", rpy="0 0 0")
     etree.SubElement(el, "mass", value=fmt(TINY_MASS))
@@ -223,19 +224,18 @@ def link_element(
     friction: PairFriction | None = None,
     moving: bool = False,
     compliance: tuple[float, float] | None = None,
-    below_root: bool = False,
 ) -> Element:
     """The ``<link>`` element with its inertial, visuals, collisions and (with ``friction``, the link's
     contact material against the floor) PyBullet's ``<contact>``, with ``compliance`` (stiffness N/m,
-    damping N·s/m: :mod:`modelkit.convert.contact_compliance`) in it. A massless link that moves, or
-    hangs ``below_root`` on a fixed joint, gets the tiny inertial (:func:`tiny_inertial`); the root
-    stays without one (KDL, hence ``robot_state_publisher``, refuses an inertia on the root)."""
+    damping N·s/m: :mod:`modelkit.convert.contact_compliance`) in it. A massless link gets the tiny
+    inertial (:func:`tiny_inertial`; with a note of its own where it moves), except a ``world`` link,
+    which PyBullet and the other URDF loaders take as the fixed world."""
     el = etree.SubElement(robot_el, "link", name=name)
     target = f"link[{name}]"
     massless = link.inertial is None or link.inertial.mass <= 0.0
     if moving and massless:
         moving_massless_inertial(el, link, ctx, target)
-    elif below_root and massless:
+    elif massless and link.name != WORLD_LINK:
         tiny_inertial(el)
     else:
         inertial_element(el, link, ctx, target)

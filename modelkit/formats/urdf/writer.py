@@ -101,7 +101,7 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
         ctx.note("MK861", why, robot.source, "link")
     for index, link in enumerate(robot.links):
         link_element(links, link, names.links[index], robot, ctx, materials, friction.get(link.name),
-                     link.name in moving, compliance.get(link.name), add_world or link.name != robot.root)
+                     link.name in moving, compliance.get(link.name))
         _link_extras(link.extras, link.name, names.links[index], ctx)
     joints: list[Element] = []
     extra_links: list[Link] = []
@@ -134,7 +134,7 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
         out.append(el)
     write_extensions(out, robot, names, frames, ctx)
     write_self_collision(out, robot, names.link_map, ctx)
-    _massless(robot, names, ctx, add_world)
+    _massless(robot, names, ctx)
     _notes(robot, ctx)
     settings = pybullet_settings(robot)
     if settings:
@@ -227,33 +227,33 @@ def _moving_links(robot: Robot) -> set[str]:
     return {joint.child for joint in robot.joints if joint.type is not JointType.FIXED}
 
 
-def _massless(robot: Robot, names: NameTable, ctx: WriteContext, add_world: bool) -> None:
-    """One note for the source's massless links that do not move: below the root they carry the tiny
-    inertial (``write_links.TINY_MASS``), so that PyBullet does not give each 1 kg; a massless root
-    stays without ``<inertial>``, as ROS expects (KDL refuses an inertia on the root), and weighs 1 kg
-    in PyBullet unless it is named ``world``. Massless links that move have a note each."""
+def _massless(robot: Robot, names: NameTable, ctx: WriteContext) -> None:
+    """One note for the source's massless links that do not move (those that move have a note each):
+    each carries the tiny inertial (``write_links.TINY_MASS``), so that PyBullet does not give it 1 kg
+    and a unit inertia. On a massless root that is what ROS tools do not expect: KDL warns that it
+    ignores an inertia on the root link; without it the robot turns on PyBullet's 1 kg·m²."""
     moving = _moving_links(robot)
-    frames: list[str] = []
-    bare: list[str] = []
-    for index, link in enumerate(robot.links):
-        has_mass = link.inertial is not None and link.inertial.mass > 0.0
-        if has_mass or link.name == WORLD_LINK or link.name in moving:
-            continue
-        (frames if add_world or link.name != robot.root else bare).append(names.links[index])
-    parts: list[str] = []
-    if frames:
-        parts.append(
-            f"{len(frames)} massless frame link(s) written with a tiny explicit inertial "
-            f"({fmt(TINY_MASS)} kg, {fmt(TINY_INERTIA)} kg·m²; PyBullet would give a link without "
-            f"<inertial> 1 kg and a unit inertia): {_listed(frames)}"
+    frames = [
+        names.links[index]
+        for index, link in enumerate(robot.links)
+        if (link.inertial is None or link.inertial.mass <= 0.0) and link.name != WORLD_LINK
+        and link.name not in moving
+    ]
+    if not frames:
+        return
+    text = (
+        f"{len(frames)} massless link(s) written with a tiny explicit inertial ({fmt(TINY_MASS)} kg, "
+        f"{fmt(TINY_INERTIA)} kg·m²; PyBullet gives a link without <inertial> 1 kg and a unit inertia): "
+        f"{_listed(frames)}"
+    )
+    root = names.link(robot.root) if robot.root is not None else None
+    if root in frames:
+        text += (
+            f'; on the root "{root}" robot_state_publisher (KDL) warns that it ignores the inertia '
+            "(PyBullet's unit inertia on a floating root made example-robot-data's TIAGo turn 240 mrad "
+            "short in 10 s)"
         )
-    if bare:
-        parts.append(
-            f'the massless root "{bare[0]}" is written without <inertial>, as ROS expects (KDL refuses an '
-            "inertia on the root link); PyBullet gives it 1 kg and a unit inertia"
-        )
-    if parts:
-        ctx.note("MK816", "; ".join(parts), robot.source, "link")
+    ctx.note("MK816", text, robot.source, "link")
 
 
 def _listed(names: list[str], shown: int = 8) -> str:
