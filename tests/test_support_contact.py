@@ -157,5 +157,5 @@ def test_a_source_stiffness_is_kept(tmp_path: Path) -> None:
                  for link in tree.iterfind("link") if link.find("contact/stiffness") is not None}
     assert stiffness["fl"] == 5000.0  # the source's own
     assert set(stiffness) == {"fl", "fr", "bl", "br"}
-    assert stiffness["fr"] == pytest.approx(12 * 9.81 / 4 / 1e-3, rel=1e-2)  # 12 kg on four, 1 mm
+    assert stiffness["fr"] == pytest.approx(12 * 9.81 / 4 / 2.5e-4, rel=1e-2)  # 12 kg on four, 0.25 mm
     assert [n for n in result.notes if n.code == "MK861"]

@@ -118,19 +118,25 @@ def test_tiago_holds_its_arm_and_pybullet_is_reported_with_the_loads(
     assert "kept, holding the start pose" in settings["mujoco"]["sphere"]["file_actuators"]
 
 
-def test_with_compliant_supports_pybullet_loads_both_wheels_and_is_graded(
+def test_with_compliant_supports_pybullet_loads_both_wheels_and_passes(
     tiago: tuple[Robot, Drive], tmp_path: Path
 ) -> None:
     """The default URDF (MK861): PyBullet shares TIAGo's weight among its six supports as MuJoCo does,
-    so no wheel is unloaded and PyBullet is graded. It is not asserted to pass: under the seed's P-only
-    torque law PyBullet's straight line leaves the no-slip reference by about 3 cm (docs/verify.md)."""
+    so no wheel is unloaded, and PyBullet is graded and passes on the straight line and the spin.
+    Two causes made it fail before (13 checks): PyBullet's 1 kg and 1 kg·m² on the massless root
+    ``base_footprint`` (written without ``<inertial>``; spin 240 mrad short), and a 1 mm sink that is not
+    the same under the 163 N and 52 N wheels (straight 1.8 cm off; now 0.25 mm: 0.4 cm)."""
     robot, drive = tiago
-    result = layer4.run(robot, drive, _straight(default_scenario()), tmp_path)
+    scenario = default_scenario()
+    profiles = tuple(p for p in scenario.profiles if p.name in ("straight", "spin"))
+    scenario = dataclasses.replace(scenario, native_report=False, profiles=profiles)
+    result = layer4.run(robot, drive, scenario, tmp_path)
     assert not [s for s in result.skips if "drive wheel" in s.reason]
-    graded = {(c.engine, c.quantity) for c in result.checks}
-    assert {("pybullet", "noslip-position"), ("mujoco~pybullet", "path-position")} <= graded
-    assert [c for c in result.checks if c.engine == "mujoco" and not c.passed] == []
-    (loads,) = [t.support for t in result.trajectories if t.source == "pybullet" and t.support]
+    graded = {(c.engine, c.quantity, c.where) for c in result.checks}
+    for where in ("straight", "spin"):
+        assert {("pybullet", "noslip-position", where), ("mujoco~pybullet", "path-yaw", where)} <= graded
+    assert [c for c in result.checks if not c.passed] == []
+    (loads, *_) = [t.support for t in result.trajectories if t.source == "pybullet" and t.support]
     assert min(loads["wheel_left_link"], loads["wheel_right_link"]) > 20.0, loads
 
 
