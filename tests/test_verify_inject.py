@@ -438,3 +438,27 @@ def test_swapped_wheels_fail_layer_4_naming_the_quantity(tmp_path: Path) -> None
     assert (2, "mujoco", "pose-rotation", "LeftWheel") in failed
     assert {(4, e, "noslip-yaw", "spin") for e in ("mujoco", "pybullet")} <= failed
     assert any("swap:LeftWheel:RightWheel" in line and "layer 4" in line for line in report.injected)
+
+
+def test_a_given_file_is_never_edited_the_fault_goes_into_a_copy(tmp_path: Path) -> None:
+    """``verify SRC --urdf F --mjcf G --inject ...`` edited F and G in place (the user's files): now the
+    faults go into copies in ``OUT/injected``, whose relative references (meshes) point at the
+    originals' folder, and the engines still read and fail the injected value."""
+    from modelkit.verify.api import verify
+
+    source = TUTORIAL / "mobile_robot.body"
+    given = tmp_path / "given"
+    for name in ("r.urdf", "r.xml"):
+        write(modelkit.load(source), given / name)
+    before = {p: p.read_bytes() for p in given.rglob("*") if p.is_file()}
+    assert any(p.suffix == ".stl" for p in before)  # the copies must find these meshes
+    out = tmp_path / "out"
+    report = verify(source, out, engines=("mujoco", "pybullet"), urdf=given / "r.urdf", mjcf=given / "r.xml",
+                    inject=["mass:Chassis:50%"], replay=False, driven=False)
+    assert {p: p.read_bytes() for p in given.rglob("*") if p.is_file()} == before
+    assert sorted(p.name for p in (out / "injected").iterdir()) == ["r.urdf", "r.xml"]
+    assert "/meshes/" in (out / "injected" / "r.urdf").read_text()
+    assert not report.errors, report.errors
+    failed = {(c.engine, c.quantity, c.where) for c in report.checks if not c.passed}
+    assert {("mujoco", "mass", "Chassis"), ("pybullet", "mass", "Chassis")} <= failed
+    assert any("is left as it is" in line for line in report.injected)

@@ -165,6 +165,25 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
     return files, maps
 
 
+def _copy_given(files: dict[str, Path], given: dict[str, Path | None], out_dir: Path,
+                report: VerifyReport) -> None:
+    """``--inject`` edits files: a file the user gave is copied into ``out_dir/injected`` first (its
+    relative references made absolute), and the engines load the edited copy."""
+    from lxml import etree
+
+    from modelkit.verify.layers.relocate import relocated_copy
+
+    for fmt, user in sorted(given.items()):
+        if user is None:
+            continue
+        try:
+            files[fmt] = relocated_copy(user, out_dir / "injected")
+        except (OSError, etree.LxmlError) as exc:
+            raise VerifyError(f"--{fmt} {user}: cannot copy it to inject faults: {exc}") from exc
+        report.injected.append(f"--{fmt} {user} is left as it is: the faults go into the copy "
+                               f"injected/{files[fmt].name}")
+
+
 def _load_engines(names: Sequence[str], reference: Robot, files: dict[str, Path], maps: dict[str, Renames],
                   report: VerifyReport) -> list[Any]:
     from modelkit.verify.layers.common import Loaded
@@ -372,6 +391,8 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         written: dict[str, list[Any]] = {}
         files, maps = _convert(welded, out_dir, given, report, needed, written)
         t1 = time.perf_counter()
+        if inject:
+            _copy_given(files, given, out_dir, report)
         for spec in inject:
             try:
                 apply = _resolve(INJECT)

@@ -11,10 +11,11 @@ A massless link (a frame in the source) cannot always stay massless (MK816):
   ``MIN_INERTIA`` kg·m² on each axis (MuJoCo refuses a massless moving body); target
   ``body[NAME]/inertial``;
 * the URDF writer gives a massless link on a moving joint an explicit tiny inertial
-  (``TINY_MASS`` kg, ``TINY_INERTIA`` kg·m² on each axis; target ``link[NAME]/inertial``), and
-  writes the other massless links (frames) without ``<inertial>`` (URDF's own meaning: no mass);
-  **PyBullet** reads such a frame as 1 kg with a unit inertia at the link origin (its URDF parser's
-  default; the URDF note MK816 says so). Other URDF readers (yourdfpy, Drake) keep it massless.
+  (``TINY_MASS`` kg, ``TINY_INERTIA`` kg·m² on each axis; target ``link[NAME]/inertial``), and the
+  other massless links (frames, the root) the same inertial without a note each;
+* a URDF given to ``verify`` (``--urdf``) may hold frames without ``<inertial>`` (URDF's own meaning:
+  no mass): **PyBullet** reads such a frame as 1 kg with a unit inertia at the link origin (its URDF
+  parser's default); other URDF readers (yourdfpy, Drake) keep it massless.
 
 For each engine, :func:`for_engine` returns these links (source names) with the values the engine
 should hold; the caller compares the engine with the source model **with those values applied**
