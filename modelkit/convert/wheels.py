@@ -135,6 +135,17 @@ def find_wheels(robot: Robot) -> dict[str, tuple[str, int]]:
     return out
 
 
+def wheel_proxy(geom: Geom, cylinder: Cylinder, shape: str) -> tuple[Geom, str]:
+    """The ``shape`` ("sphere" or "ellipsoid") written for a wheel's collision cylinder, and its words."""
+    if shape == "sphere":
+        new = Geom(Sphere(cylinder.radius), Pose(translation=geom.pose.translation.copy()),
+                   name=geom.name, material=geom.material, source=geom.source)
+        return new, f"a sphere of radius {cylinder.radius:g} m at the cylinder's centre"
+    radii = (cylinder.radius, cylinder.radius, 0.5 * cylinder.length)
+    new = Geom(Ellipsoid(radii), geom.pose, name=geom.name, material=geom.material, source=geom.source)
+    return new, f"an ellipsoid of radii ({radii[0]:g}, {radii[1]:g}, {radii[2]:g}) m in the cylinder's frame"
+
+
 def approximate_wheels(robot: Robot, choice: str, target: str, notes: NoteSink) -> None:
     """Find the wheels, record them, and give each the wheel collision ``choice`` means for ``target``
     (in place; an MK826 note per replaced shape)."""
@@ -152,16 +163,7 @@ def approximate_wheels(robot: Robot, choice: str, target: str, notes: NoteSink) 
         g = geom.geometry
         if not isinstance(g, Cylinder):  # already a sphere: nothing to replace
             continue
-        if shape == "sphere":
-            new: Geom = Geom(Sphere(g.radius), Pose(translation=geom.pose.translation.copy()),
-                             name=geom.name, material=geom.material, source=geom.source)
-            what = f"a sphere of radius {g.radius:g} m at the cylinder's centre"
-        else:
-            new = Geom(Ellipsoid((g.radius, g.radius, 0.5 * g.length)), geom.pose, name=geom.name,
-                       material=geom.material, source=geom.source)
-            what = (f"an ellipsoid of radii ({g.radius:g}, {g.radius:g}, {0.5 * g.length:g}) m in the "
-                    "cylinder's frame")
-        link.collisions[index] = new
+        link.collisions[index], what = wheel_proxy(geom, g, shape)
         notes.note(
             "MK826",
             f"wheel {name} (joint {joint}): its collision cylinder (radius {g.radius:g} m, width "

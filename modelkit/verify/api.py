@@ -321,26 +321,29 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
             return
     progress(f"reading and converting {source.name}; layers 1-3 (static, kinematics, dynamics)")
     try:
-        robot = _layers_1_to_3(report, source, out_dir, engines, mjcf, urdf, sdf, inject, seed,
-                               configurations, samples, replay, reading)
+        done = _layers_1_to_3(report, source, out_dir, engines, mjcf, urdf, sdf, inject, seed,
+                              configurations, samples, replay, reading)
     except VerifyError as exc:
         report.errors.append(str(exc))
         return
-    if robot is None:
+    if done is None:
         return
+    robot, given = done
     if not driven:
         report.skips.append(Skip(4, "all", "layer 4 (driven scenarios) not run: switched off (--no-driven)"))
         return
     progress("layer 4: driving the robot in MuJoCo and PyBullet")
     if report.prepared is not None:  # the plotting processes import matplotlib while layer 4 runs
         report.prepared.start_plotters()
-    _layer4(report, robot, out_dir, engines, inject, chosen)
+    _layer4(report, robot, out_dir, engines, inject, chosen, given)
 
 
 def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence[str], inject: Sequence[str],
-            chosen: Any) -> None:
+            chosen: Any, given: Mapping[str, Path]) -> None:
     """Layer 4: the source driven by the seed's controllers in MuJoCo and PyBullet, on a floor;
-    ``chosen``: the scenario read from the user's file (None: the built-in one)."""
+    ``chosen``: the scenario read from the user's file (None: the built-in one); ``given``: the MJCF
+    and URDF the user gave (as layers 1-3 loaded them: copies with the faults of ``inject``), which
+    the graded runs drive instead of writing them."""
     from modelkit.verify.drive import scenario as scenarios
     from modelkit.verify.drive import vehicle
     from modelkit.verify.layers import layer4
@@ -352,7 +355,7 @@ def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence
         return
     chosen = chosen or scenarios.default_scenario(drive.kind, bool(drive.pan or drive.tilt))
     t0 = time.perf_counter()
-    result = layer4.run(robot, drive, chosen, out_dir / "layer4", list(engines), inject=inject)
+    result = layer4.run(robot, drive, chosen, out_dir / "layer4", list(engines), inject=inject, given=given)
     report.checks.extend(result.checks)
     report.observations.extend(result.observations)
     report.skips.extend(result.skips)
@@ -368,8 +371,9 @@ def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence
 def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str],
                    mjcf: str | Path | None, urdf: str | Path | None, sdf: str | Path | None,
                    inject: Sequence[str], seed: int, configurations: int, samples: int, replay: bool,
-                   reading: Mapping[str, Any] | None = None) -> Robot | None:
-    """Layers 1–3 on the welded model; returns the source model as read (None when nothing ran)."""
+                   reading: Mapping[str, Any] | None = None) -> tuple[Robot, dict[str, Path]] | None:
+    """Layers 1–3 on the welded model; returns the source model as read and the MJCF and URDF the user
+    gave, as the engines loaded them (None when nothing ran)."""
     from modelkit.verify.engines.reference import SourceModel, dof_joints, source_static
     from modelkit.verify.layers import approximations, dynamics, kinematics, shapes, static
 
@@ -426,9 +430,16 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         chains_entry = approximations.chains_skip(eng.label, chains)
         if chains_entry is not None:
             report.skips.append(chains_entry)
-        eng_static = (source_static(approximations.applied(approximations.applied_chains(reference, chains),
-                                                           approx[eng.label]))
-                      if approx[eng.label] or chains else src_static)
+        # A file given with --mjcf/--urdf is usually convert's default, with sphere wheels (MK826).
+        wheels = approximations.wheel_proxies(robot, _engine_shapes(eng), eng.link)
+        wheels_entry = approximations.wheels_skip(eng.label, wheels)
+        if wheels_entry is not None:
+            report.skips.append(wheels_entry)
+        held = approximations.applied_chains(reference, chains)
+        if wheels is not None:
+            held = approximations.applied_wheels(held, robot, wheels)
+        eng_static = (source_static(approximations.applied(held, approx[eng.label]))
+                      if approx[eng.label] or chains or wheels else src_static)
         # ... and so is one holding the URDF writer's ±1e16 for an infinite position bound (MK819).
         stand_ins = approximations.limits_for_engine(kind, reference)
         eng_static = approximations.applied_limits(eng_static, stand_ins)
@@ -490,7 +501,18 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         report.checks.extend(engine_warnings(report, eng.label, messages, "runtime_warnings", "layers 1-3a"))
         eng.model.close()
     report.timings.update({"layer 1": t3 - t2, "layer 2": t4 - t3, "layer 3a": t5 - t4, "layer 3b": t6 - t5})
-    return robot
+    return robot, {fmt: files[fmt] for fmt in ("mjcf", "urdf") if given[fmt] is not None}
+
+
+def _engine_shapes(eng: Any) -> dict[str, list[Any]]:
+    """The collision shapes an engine reports, by link (none when it cannot report its facts: layer 1
+    then fails it with the reason)."""
+    from modelkit.verify.engines.protocol import EngineError
+
+    try:
+        return dict(eng.model.static().shapes)
+    except EngineError:
+        return {}
 
 
 def _held(approximated: Any) -> tuple[float, ...] | None:

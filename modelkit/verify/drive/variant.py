@@ -49,15 +49,16 @@ WRITE_CHOICE: dict[str, str] = {"sphere": "auto", "native": "cylinder"}
 native run what ``convert --wheel-collision cylinder`` writes."""
 
 
-def write_variant(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path, proxy: WheelProxy
-                  ) -> tuple[dict[str, Path], dict[str, Renames]]:
+def write_variant(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path, proxy: WheelProxy,
+                  formats: tuple[str, ...] = ("mjcf", "urdf")) -> tuple[dict[str, Path], dict[str, Renames]]:
     """Write the floating-base ``robot`` (the source model, root not welded) as MJCF and URDF into
     ``out_dir`` exactly as ``convert`` writes it (``<name>.xml`` / ``.urdf``; the native run's
     ``<name>_cylinder.*``; meshes in ``meshes/``): no edit of the written files, the engines load
     them as they are, with ``convert``'s default options but the wheels' collision (``proxy``).
 
-    Returns the files (``"mjcf"``, ``"urdf"``) and each file's renames (``{"link": {source:
-    written}, "joint": {...}}``, from the writers' MK800 notes), as ``verify``'s conversion does."""
+    Returns the files (``"mjcf"``, ``"urdf"``: those of ``formats``) and each file's renames
+    (``{"link": {source: written}, "joint": {...}}``, from the writers' MK800 notes), as ``verify``'s
+    conversion does."""
     from modelkit.convert.api import write
     from modelkit.convert.notes import renames
     from modelkit.convert.options import WriteOptions
@@ -71,7 +72,7 @@ def write_variant(robot: Robot, drive: Drive, scenario: Scenario, out_dir: Path,
     stem = _safe(robot.name or "robot") + ("" if proxy == "sphere" else "_cylinder")
     files: dict[str, Path] = {}
     maps: dict[str, Renames] = {}
-    for fmt in ("mjcf", "urdf"):
+    for fmt in formats:
         path = out_dir / f"{stem}{SUFFIX[fmt]}"
         notes = write(robot, path, fmt, options=options, force=True)
         files[fmt] = path

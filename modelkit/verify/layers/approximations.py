@@ -39,15 +39,16 @@ import copy
 import dataclasses
 import math
 import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from lxml import etree
 
 from modelkit.convert.notes import ConversionNote
-from modelkit.model import Inertial, JointType, Robot
+from modelkit.model import Cylinder, Inertial, JointType, Robot
 from modelkit.verify.engines.protocol import Skip, StaticFacts
 
 Renames = dict[str, dict[str, str]]
@@ -438,3 +439,66 @@ def chains_skip(engine: str, chains: list[BallChain]) -> Skip | None:
                 f"continuous joints each (MK813; URDF has no ball joint): {shown}. Layer 1 compares this "
                 "engine with the source model holding these chains (link and joint sets, types, axes, the "
                 "added links' tiny inertials)")
+
+
+@dataclass(frozen=True)
+class WheelProxy:
+    """``convert``'s wheel collision (MK826) held by an engine in place of the source's cylinders."""
+
+    shape: str  # "sphere" or "ellipsoid" (--wheel-collision)
+    links: tuple[str, ...]  # source names
+
+
+def wheel_proxies(source: Robot, engine_shapes: Mapping[str, Sequence[Any]],
+                  written: Callable[[str], str]) -> WheelProxy | None:
+    """The wheel collision an engine holds for every wheel of ``source`` (the model as read, its root
+    not welded) whose collision is a cylinder there, when it is one of ``convert``'s choices for it
+    (``--wheel-collision auto`` writes spheres for MJCF and URDF, MK826). Found from the engine's own
+    shapes: a file given with ``--mjcf/--urdf`` carries no notes, and is usually ``convert``'s default."""
+    from modelkit.convert.wheels import find_wheels
+
+    wheels = {link: index for link, (_, index) in find_wheels(source).items()
+              if isinstance(_collision(source, link, index), Cylinder)}
+    held = set()
+    for link in sorted(wheels):
+        kinds = {shape.type for shape in engine_shapes.get(written(link), [])}
+        proxy = [kind for kind in ("sphere", "ellipsoid") if kind in kinds]
+        if "cylinder" in kinds or len(proxy) != 1:
+            return None
+        held.add(proxy[0])
+    if len(held) != 1:
+        return None
+    return WheelProxy(held.pop(), tuple(sorted(wheels)))
+
+
+def applied_wheels(robot: Robot, source: Robot, proxy: WheelProxy) -> Robot:
+    """``robot`` (the reference) with the wheels' cylinders of ``source`` replaced by ``proxy``'s shape,
+    as ``convert`` writes them."""
+    from modelkit.convert.wheels import find_wheels, wheel_proxy
+
+    wheels = find_wheels(source)
+    out = copy.deepcopy(robot)
+    for link in out.links:
+        if link.name not in proxy.links or link.name not in wheels:
+            continue
+        index = wheels[link.name][1]
+        geom = link.collisions[index]
+        if isinstance(geom.geometry, Cylinder):
+            link.collisions[index] = wheel_proxy(geom, geom.geometry, proxy.shape)[0]
+    return out
+
+
+def wheels_skip(engine: str, proxy: WheelProxy | None) -> Skip | None:
+    """The report's entry for an engine holding ``convert``'s wheel collisions."""
+    if proxy is None:
+        return None
+    return Skip(1, engine, "approximation: the file holds convert's wheel collision (MK826, "
+                           f"--wheel-collision): a {proxy.shape} in place of the source's cylinder on "
+                           f"{', '.join(proxy.links)}; layer 1 compares its shapes with those")
+
+
+def _collision(robot: Robot, link_name: str, index: int) -> object:
+    link = robot.link(link_name)
+    if link is None or index >= len(link.collisions):
+        return None
+    return link.collisions[index].geometry

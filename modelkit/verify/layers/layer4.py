@@ -43,7 +43,7 @@ import copy
 import importlib
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -127,14 +127,17 @@ def run(
     engines: Sequence[str] = ("mujoco", "pybullet"),
     inject: Sequence[str] = (),
     prepared: Robot | None = None,
+    given: Mapping[str, Path] | None = None,
 ) -> Layer4Result:
     """Run every profile of ``scenario`` in every engine, compute the references, compare.
 
     ``source``: the model as read (its root free, not welded); ``prepared``: the model with its track
     approximation (``convert``'s prepare), needed for tracked robots (computed when None).
     ``inject``: fault specs (:mod:`modelkit.verify.layers.inject`) applied to the verification variant's
-    files, as ``verify --inject`` applies them to the converted files. Never raises for a model
-    problem: an engine failing is a failed check."""
+    files, as ``verify --inject`` applies them to the converted files. ``given``: "mjcf"/"urdf" → a file
+    the user gave (``verify --mjcf/--urdf``), which the graded runs drive instead of the written one
+    (as it is: ``inject`` is not applied to it again). Never raises for a model problem: an engine
+    failing is a failed check."""
     result = Layer4Result()
     t0 = time.perf_counter()
     try:
@@ -172,7 +175,7 @@ def run(
         for proxy in proxies:
             profiles = list(scenario.profiles) if proxy == scenario.wheel_proxy else native_profiles(scenario)
             jobs.append(_Job(proxy, profiles))
-            _setup(jobs[-1], robot, drive, scenario, out_dir, wanted, inject, result)
+            _setup(jobs[-1], robot, drive, scenario, out_dir, wanted, inject, result, given or {})
         t1 = time.perf_counter()
         for job in jobs:  # MuJoCo here while PyBullet's children step their batches
             job.run_here(scenario, drive, result)
@@ -286,14 +289,18 @@ def _setup(
     engines: list[str],
     inject: Sequence[str],
     result: Layer4Result,
+    given: Mapping[str, Path],
 ) -> None:
-    """Write the variant, apply the injected faults, load every engine and start the engines that run
-    in a child process (PyBullet) on the job's profiles."""
+    """Write the variant (the graded one: but the files the user gave), apply the injected faults to
+    what was written, load every engine and start the engines that run in a child process (PyBullet)
+    on the job's profiles."""
     from modelkit.verify.drive.variant import write_variant
 
     proxy = job.proxy
     try:
-        files, maps = write_variant(robot, drive, scenario, out_dir, proxy)
+        graded = proxy == scenario.wheel_proxy
+        files, maps = write_variant(robot, drive, scenario, out_dir, proxy,
+                                    tuple(k for k in ("mjcf", "urdf") if not (graded and k in given)))
     except Exception as exc:  # a conversion defect: every engine's layer 4 fails
         for e in engines:
             result.checks.append(
@@ -308,13 +315,17 @@ def _setup(
                 )
             )
         return
+    written = dict(files)
+    if graded:  # the graded run: the files convert writes by default, as they are, or the user's
+        for kind, path in sorted(given.items()):
+            files[kind], maps[kind] = Path(path), {"link": {}, "joint": {}}
+        result.settings["files"] = {k: (str(p) if k in given else p.name) for k, p in sorted(files.items())}
+        result.settings["given"] = sorted(given)
     result.settings.setdefault("variant", {})[proxy] = {k: p.name for k, p in sorted(files.items())}
-    if proxy == "sphere":  # the graded run: the files convert writes by default, as they are
-        result.settings["files"] = {k: p.name for k, p in sorted(files.items())}
-    for spec in inject:
+    for spec in inject if written else ():
         apply = _resolve("modelkit.verify.layers.inject:apply")
         try:
-            result.injected.append(f"layer 4 {proxy} variant: {apply(spec, files, maps)}")
+            result.injected.append(f"layer 4 {proxy} variant: {apply(spec, written, maps)}")
         except ValueError as exc:  # e.g. cylinder-y on a variant whose wheels are sphere proxies
             reason = str(exc).splitlines()[0]
             result.injected.append(f"layer 4 {proxy} variant: {spec}: not applicable ({reason})")

@@ -132,9 +132,12 @@ def scope(report: VerifyReport) -> str:
     reported = sorted({o.where for o in report.observations
                        if o.layer == 4 and o.quantity.removeprefix("native-") in COMPARISONS} - set(graded))
     files = report.engines.get("layer4", {}).get("files", {})
+    given = set(report.engines.get("layer4", {}).get("given", []))
     parts = []
     if graded:
-        on = f" on the written {', '.join(str(v) for _, v in sorted(files.items()))}" if files else ""
+        named = [f"{'the given' if kind in given else 'the written'} {name}"
+                 for kind, name in sorted(files.items())]
+        on = f" on {', '.join(named)}" if named else ""
         skid = any(c.layer == 4 and c.quantity.startswith("skid-") for c in report.checks)
         against = " against the skid-steer reference" if skid else ""
         parts.append(f"layer 4 graded {', '.join(graded)}{against}{on}")

@@ -1,0 +1,49 @@
+"""``verify SOURCE --mjcf F --urdf G``: check a conversion someone already made, usually ``convert``'s
+default output. Before, such files failed layer 1 (``convert`` writes sphere wheel collisions, MK826,
+where the source has cylinders) and layer 4 drove files it wrote itself, not F and G."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import modelkit
+from modelkit.convert import write
+from modelkit.verify.api import verify
+
+from .conftest import TUTORIAL
+
+
+def test_convert_default_files_given_pass_and_layer4_drives_them(tmp_path: Path) -> None:
+    source = TUTORIAL / "mobile_robot.body"
+    given = tmp_path / "given"
+    for name in ("r.urdf", "r.xml"):
+        write(modelkit.load(source), given / name)
+    assert '<sphere radius="0.076"/>' in (given / "r.urdf").read_text()  # convert's default wheels
+    out = tmp_path / "out"
+    report = verify(source, out, engines=("mujoco", "pybullet"), urdf=given / "r.urdf", mjcf=given / "r.xml",
+                    replay=False)
+    assert not report.errors, report.errors
+    assert [c for c in report.checks if not c.passed] == []
+    wheels = [s.reason for s in report.skips if "convert's wheel collision" in s.reason]
+    assert len(wheels) == 2 and all("a sphere in place of the source's cylinder on LeftWheel, RightWheel" in w
+                                    for w in wheels), wheels
+    layer4 = report.engines["layer4"]
+    assert layer4["files"] == {"mjcf": str(given / "r.xml"), "urdf": str(given / "r.urdf")}
+    assert {("mujoco", "straight"), ("pybullet", "spin")} <= {(c.engine, c.where) for c in report.checks
+                                                              if c.layer == 4 and c.quantity == "noslip-yaw"}
+    written = sorted(p.name for p in (out / "layer4").iterdir() if p.is_file())
+    assert written == ["MobileRobot_cylinder.urdf", "MobileRobot_cylinder.xml"]  # the report-only run's
+
+
+def test_a_given_file_with_a_wrong_wheel_fails_layer4_on_that_file(tmp_path: Path) -> None:
+    """The given URDF's left wheel is 5 % too large: layer 1 names it, and layer 4, driving that very
+    file in PyBullet, leaves the no-slip reference."""
+    source = TUTORIAL / "mobile_robot.body"
+    given = tmp_path / "given"
+    write(modelkit.load(source), given / "r.urdf")
+    path = given / "r.urdf"
+    path.write_text(path.read_text().replace('<sphere radius="0.076"/>', '<sphere radius="0.0798"/>', 1))
+    report = verify(source, tmp_path / "out", engines=("pybullet",), urdf=path, replay=False)
+    failed = {(c.layer, c.quantity, c.where) for c in report.checks if not c.passed}
+    assert (1, "shape-size", "LeftWheel") in failed
+    assert (4, "noslip-yaw", "straight") in failed
