@@ -1207,10 +1207,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "massless-link-frame",
         "info",
         "A link without mass is written as a frame (SDF `<frame>`, MJCF site or massless body; in URDF "
-        "a link with a tiny explicit inertial below the root, as PyBullet gives a link without "
-        "`<inertial>` 1 kg, and a root without one, as KDL refuses a root inertia), or, where it moves or "
-        "carries shapes, with a tiny explicit inertial, so that no consumer drops it or gives it a "
-        "default mass; the note says which.",
+        "a link with a tiny explicit inertial, the root included, as PyBullet gives a link without "
+        "`<inertial>` 1 kg and 1 kg·m²), or, where it moves or carries shapes, with a tiny explicit "
+        "inertial, so that no consumer drops it or gives it a default mass; the note says which.",
     ),
     CodeInfo(
         "MK817",
