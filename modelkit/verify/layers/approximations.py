@@ -192,9 +192,13 @@ def zero_inertias(fmt: str, notes: Iterable[ConversionNote], renames: Renames, s
     return out
 
 
-def pybullet_defaults(urdf: Path, source: Robot, renames: Renames) -> dict[str, Approximated]:
-    """Links of the written URDF without ``<inertial>`` that are massless in the source: PyBullet
-    reads each as 1 kg with a unit inertia (URDF itself says massless)."""
+def urdf_frames(urdf: Path, source: Robot, renames: Renames, engine: str) -> dict[str, Approximated]:
+    """Links of a URDF that are massless in the source and that its readers give a mass: those with
+    the URDF writer's tiny inertial (every massless link it writes, MK816; the URDF reader reads it
+    back as none, the engines as written), and, for PyBullet, those without ``<inertial>`` (URDF's own
+    meaning: no mass; a URDF given to verify), which PyBullet reads as 1 kg with a unit inertia."""
+    from modelkit.formats.urdf.write_links import TINY_INERTIA, TINY_MASS
+
     back = _source_names(renames)
     massless = {link.name for link in source.links if link.inertial is None or link.inertial.mass == 0.0}
     tree = etree.parse(str(urdf))
@@ -202,9 +206,30 @@ def pybullet_defaults(urdf: Path, source: Robot, renames: Renames) -> dict[str, 
     for el in tree.iterfind("./link"):
         written = str(el.get("name"))
         name = back.get(written, written)
-        if el.find("inertial") is None and name in massless:
-            out[name] = Approximated(name, *PYBULLET_NO_INERTIAL, "MK816", "PyBullet reading the URDF")
+        if name not in massless:
+            continue
+        inertial = el.find("inertial")
+        if inertial is None:
+            if engine == "pybullet":
+                out[name] = Approximated(name, *PYBULLET_NO_INERTIAL, "MK816", "PyBullet reading the URDF")
+        elif _is_tiny(inertial, TINY_MASS, TINY_INERTIA):
+            out[name] = Approximated(name, TINY_MASS, TINY_INERTIA, "MK816", "the URDF writer")
     return out
+
+
+def _is_tiny(inertial: etree._Element, mass: float, moment: float) -> bool:
+    """Whether an ``<inertial>`` is exactly ``mass`` kg at the link origin with ``moment`` on each axis."""
+    mass_el, tensor, origin = inertial.find("mass"), inertial.find("inertia"), inertial.find("origin")
+    if mass_el is None or tensor is None:
+        return False
+    xyz = (origin.get("xyz", "0 0 0") if origin is not None else "0 0 0").split()
+    try:
+        got = float(mass_el.get("value", "nan"))
+        moments = [float(tensor.get(k, "0")) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")]
+        at_origin = all(float(v) == 0.0 for v in xyz)
+    except ValueError:
+        return False
+    return got == mass and at_origin and moments == [moment, moment, moment, 0.0, 0.0, 0.0]
 
 
 # validate's codes of a tensor a URDF reader refuses: singular (a zero principal moment, MK302) or
@@ -261,8 +286,8 @@ def for_engine(engine: str, fmt: str, notes: Iterable[ConversionNote], file: Pat
     out = from_notes(fmt, notes, renames)
     out.update(lifted_inertias(fmt, notes, renames, source))
     out.update(zero_inertias(fmt, notes, renames, source))
-    if engine == "pybullet" and fmt == "urdf":
-        out.update(pybullet_defaults(file, source, renames))
+    if fmt == "urdf":
+        out.update(urdf_frames(file, source, renames, engine))
     out.update(refused_inertias(engine, fmt, source))
     return out
 
