@@ -57,11 +57,20 @@ def _se3(pose: Pose) -> pin.SE3:
 
 
 def _inertia(robot: Robot, link_name: str) -> pin.Inertia:
+    """The link's inertia. A principal moment below zero by no more than ``ZERO_MOMENT`` is zero
+    (validate's MK302 rule): iCub's ``r_hip_2`` gives -5.4e-20 on the diagonal, which Pinocchio refuses
+    ("The 3d inertia should be positive") and PyBullet and Drake hold as a zero inertia."""
+    from modelkit.checks.physics import ZERO_MOMENT
+
     link = robot.link(link_name)
     if link is None or link.inertial is None:
         return pin.Inertia.Zero()
     i = link.inertial
-    return pin.Inertia(float(i.mass), np.array(i.com, dtype=float), np.array(i.inertia, dtype=float))
+    tensor = np.array(i.inertia, dtype=float)
+    moments, axes = np.linalg.eigh(0.5 * (tensor + tensor.T))
+    if -ZERO_MOMENT <= moments.min() < 0.0:
+        tensor = axes @ np.diag(np.maximum(moments, 0.0)) @ axes.T
+    return pin.Inertia(float(i.mass), np.array(i.com, dtype=float), tensor)
 
 
 class PinocchioModel:
