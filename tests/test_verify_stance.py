@@ -28,7 +28,7 @@ from modelkit.verify.drive.scenario import default_scenario
 from modelkit.verify.drive.vehicle import find_drive
 from modelkit.verify.engines import mujoco as engine_mujoco
 from modelkit.verify.engines.bullet_inertia import diagonalised
-from modelkit.verify.engines.protocol import Check, Observation
+from modelkit.verify.engines.protocol import Check, Observation, Skip
 from modelkit.verify.layers import layer4
 from modelkit.verify.layers.stance import unloaded_wheel
 from modelkit.verify.report import VerifyReport, scope
@@ -81,6 +81,16 @@ def test_the_verdict_line_names_an_engine_not_graded() -> None:
     assert scope(report) == "not graded (reported only): straight"
     report.checks.append(Check(4, "mujoco", "noslip-position", "straight", 0.001, 0.015, ""))
     assert scope(report) == "layer 4 graded straight; pybullet not graded on layer 4 (see its skip)"
+
+
+def test_the_verdict_line_says_layer4_did_not_run() -> None:
+    """example-robot-data's TIAGo dual (its casters' wheels are continuous joints too) passed with
+    "PASS: 59 checks passed, 15 skipped" and nothing on the line said that it was never driven."""
+    report = VerifyReport("r.urdf")
+    report.checks.append(Check(1, "mujoco", "mass", "base", 0.0, 1e-9, ""))
+    assert scope(report) == ""
+    report.skips.append(Skip(4, "all", "layer 4 (driven scenarios) not run: not a two-wheeled robot"))
+    assert scope(report) == "layer 4 not run: see its skip"
 
 
 @pytest.fixture(scope="module")

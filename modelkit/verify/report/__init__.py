@@ -127,8 +127,11 @@ COMPARISONS = frozenset({"path-position", "path-yaw", "wheel-angle", "pan-tilt-a
 
 def scope(report: VerifyReport) -> str:
     """What layer 4 graded and what it only reported, for the verdict line (so that nothing
-    report-only hides inside a PASS); "" when layer 4 did not run."""
+    report-only hides inside a PASS); that it did not run, when a skip says so."""
     graded = sorted({c.where for c in report.checks if c.layer == 4})
+    not_run = any(s.layer == 4 and s.engine == "all" and " not run" in s.reason for s in report.skips)
+    if not graded and not_run:
+        return "layer 4 not run: see its skip"
     reported = sorted({o.where for o in report.observations
                        if o.layer == 4 and o.quantity.removeprefix("native-") in COMPARISONS} - set(graded))
     files = report.engines.get("layer4", {}).get("files", {})
