@@ -1466,6 +1466,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "and PyBullet could leave a drive wheel unloaded.",
     ),
     CodeInfo(
+        "MK862",
+        "pybullet-joint-limit",
+        "warning",
+        "The URDF has more than 127 joints, fixed ones included: PyBullet loads it, but getJointState "
+        "fails for every joint of a body that large (its shared-memory status holds 127); merging fixed "
+        "joints or leaving out the sensor frames writes fewer.",
+    ),
+    CodeInfo(
         "MK852",
         "surface-friction-written",
         "info",

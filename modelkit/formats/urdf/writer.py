@@ -134,6 +134,7 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
         out.append(el)
     write_extensions(out, robot, names, frames, ctx)
     write_self_collision(out, robot, names.link_map, ctx)
+    _pybullet_joint_limit(len(joints), robot, ctx)
     _massless(robot, names, ctx)
     _notes(robot, ctx)
     settings = pybullet_settings(robot)
@@ -225,6 +226,27 @@ def _free_links(robot: Robot, names: NameTable, ctx: WriteContext) -> list[Eleme
 def _moving_links(robot: Robot) -> set[str]:
     """The links on a joint that is not fixed."""
     return {joint.child for joint in robot.joints if joint.type is not JointType.FIXED}
+
+
+# PyBullet 3.2.7 answers getJointState for a multibody of at most 127 joints, fixed ones included (its
+# shared-memory status holds MAX_DEGREE_OF_FREEDOM values; measured on serial chains: 127 answer, 128
+# fail with "getJointState failed" for every joint; example-robot-data's tiago_dual written with its
+# sensor frames, 129 joints: every one fails).
+PYBULLET_MAX_JOINTS = 127
+
+
+def _pybullet_joint_limit(count: int, robot: Robot, ctx: WriteContext) -> None:
+    """MK862 when PyBullet will load the file but not report its joint states."""
+    if count <= PYBULLET_MAX_JOINTS:
+        return
+    ctx.note(
+        "MK862",
+        f"the URDF has {count} joints (fixed ones included); PyBullet loads it but reports the joint "
+        f"states of a body of at most {PYBULLET_MAX_JOINTS} (getJointState fails for every joint): "
+        "--merge-fixed or --no-urdf-sensor-links write fewer",
+        robot.source,
+        "joint",
+    )
 
 
 def _massless(robot: Robot, names: NameTable, ctx: WriteContext) -> None:

@@ -40,6 +40,7 @@ from typing import IO, Any
 import numpy as np
 
 from modelkit.convert.tracks import PYBULLET_SOLVER_ITERATIONS
+from modelkit.formats.urdf.writer import PYBULLET_MAX_JOINTS
 from modelkit.lifeline import preexec
 from modelkit.spatial import Pose
 from modelkit.verify.engines.protocol import (
@@ -419,11 +420,9 @@ class PyBulletModel:
         self.close()
 
 
-# PyBullet 3.2.7 answers getJointState for a multibody of at most 127 joints, fixed ones included (its
-# shared-memory status holds MAX_DEGREE_OF_FREEDOM values; measured on serial chains: 127 answer, 128
-# fail with "getJointState failed" for every joint; example-robot-data's tiago_dual, 101 moving and
-# 28 fixed joints: every one of its 129 fails).
-MAX_MOVING_JOINTS = 127
+# PyBullet answers getJointState for a multibody of at most 127 joints, fixed ones included (the URDF
+# writer's MK862 says so for a file it writes).
+MAX_MOVING_JOINTS = PYBULLET_MAX_JOINTS
 
 
 class TooManyJoints(PyBulletError):
@@ -702,5 +701,7 @@ def driver(model: Path, renames: Renames, *, drive: Any, scenario: Any, factory:
     """Layer 4's entry point (:class:`modelkit.verify.drive.Driver`, plus ``start``/``result``).
     ``fast`` False: the controllers' ``output`` every step even when they have affine laws (the
     reference the fast path is tested against, ``tests/test_verify_drivers_pybullet_fast.py``).
-    ``floor``: :data:`FLOOR` (layer 4's) or :data:`ANALYTIC_FLOOR` (see there; tests only)."""
+    ``floor``: :data:`FLOOR` (layer 4's) or :data:`ANALYTIC_FLOOR` (see there; tests only). Raises
+    :class:`TooManyJoints` for a URDF whose joint states PyBullet cannot report."""
+    _check_size(Path(model))
     return PyBulletDriver(Path(model), renames, drive, scenario, factory, sys_path, timeout, fast, floor)
