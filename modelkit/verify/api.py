@@ -141,7 +141,7 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
         if user is not None:
             if not user.exists():
                 raise VerifyError(f"--{fmt} {user}: no such file")
-            files[fmt], maps[fmt] = user, {"link": {}, "joint": {}}
+            files[fmt], maps[fmt] = user, _given_renames(welded, fmt, user, out_dir)
             report.files[fmt] = str(user)
             continue
         if fmt not in needed:
@@ -163,6 +163,32 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
         report.notes[fmt] = sorted({n.code for n in notes})
     report.renames = {fmt: {k: dict(sorted(v.items())) for k, v in m.items() if v} for fmt, m in maps.items()}
     return files, maps
+
+
+def _given_renames(robot: Robot, fmt: str, path: Path, out_dir: Path) -> Renames:
+    """The renames of a file the user gave: those ``convert`` makes for ``fmt`` (its MK800 notes, from
+    a conversion staged in memory and never written), each kept where the file has the written name
+    and not the source's (a file ``convert`` wrote; SDF renames a joint named like its link, the
+    tutorial's ``RightWheel`` → ``RightWheel_joint``). A file from elsewhere keeps the source's names."""
+    from lxml import etree
+
+    from modelkit.convert.api import render_model
+    from modelkit.convert.notes import renames
+    from modelkit.convert.output import OutputPlan
+
+    try:
+        notes = render_model(robot, fmt, OutputPlan(out_dir / ".renames"), path.name, WriteOptions())
+        parser = etree.XMLParser(resolve_entities=False, no_network=True)
+        root = etree.parse(str(path), parser).getroot()
+    except Exception:  # the engines' own loading says what is wrong with the file
+        return {"link": {}, "joint": {}}
+    tags = {"link": ("link", "body"), "joint": ("joint",)}
+    out: Renames = {}
+    for kind, elements in tags.items():
+        names = {str(el.get("name")) for el in root.iter(*elements) if el.get("name")}
+        out[kind] = {source: written for source, written in renames(notes, kind).items()
+                     if written in names and source not in names}
+    return out
 
 
 def _copy_given(files: dict[str, Path], given: dict[str, Path | None], out_dir: Path,
@@ -339,7 +365,7 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
 
 
 def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence[str], inject: Sequence[str],
-            chosen: Any, given: Mapping[str, Path]) -> None:
+            chosen: Any, given: Mapping[str, tuple[Path, Renames]]) -> None:
     """Layer 4: the source driven by the seed's controllers in MuJoCo and PyBullet, on a floor;
     ``chosen``: the scenario read from the user's file (None: the built-in one); ``given``: the MJCF
     and URDF the user gave (as layers 1-3 loaded them: copies with the faults of ``inject``), which
@@ -371,9 +397,10 @@ def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence
 def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str],
                    mjcf: str | Path | None, urdf: str | Path | None, sdf: str | Path | None,
                    inject: Sequence[str], seed: int, configurations: int, samples: int, replay: bool,
-                   reading: Mapping[str, Any] | None = None) -> tuple[Robot, dict[str, Path]] | None:
+                   reading: Mapping[str, Any] | None = None
+                   ) -> tuple[Robot, dict[str, tuple[Path, Renames]]] | None:
     """Layers 1–3 on the welded model; returns the source model as read and the MJCF and URDF the user
-    gave, as the engines loaded them (None when nothing ran)."""
+    gave, as the engines loaded them, with their renames (None when nothing ran)."""
     from modelkit.verify.engines.reference import SourceModel, dof_joints, source_static
     from modelkit.verify.layers import approximations, dynamics, kinematics, shapes, static
 
@@ -501,7 +528,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         report.checks.extend(engine_warnings(report, eng.label, messages, "runtime_warnings", "layers 1-3a"))
         eng.model.close()
     report.timings.update({"layer 1": t3 - t2, "layer 2": t4 - t3, "layer 3a": t5 - t4, "layer 3b": t6 - t5})
-    return robot, {fmt: files[fmt] for fmt in ("mjcf", "urdf") if given[fmt] is not None}
+    return robot, {fmt: (files[fmt], maps[fmt]) for fmt in ("mjcf", "urdf") if given[fmt] is not None}
 
 
 def _engine_shapes(eng: Any) -> dict[str, list[Any]]:

@@ -61,6 +61,7 @@ from modelkit.verify.drive.reference_skid import (
     skid_tolerance,
 )
 from modelkit.verify.engines.protocol import Check, Observation, Skip
+from modelkit.verify.layers.common import Renames
 from modelkit.verify.layers.stance import unloaded_wheel
 
 LAYER = 4
@@ -127,7 +128,7 @@ def run(
     engines: Sequence[str] = ("mujoco", "pybullet"),
     inject: Sequence[str] = (),
     prepared: Robot | None = None,
-    given: Mapping[str, Path] | None = None,
+    given: Mapping[str, tuple[Path, Renames]] | None = None,
 ) -> Layer4Result:
     """Run every profile of ``scenario`` in every engine, compute the references, compare.
 
@@ -135,9 +136,9 @@ def run(
     approximation (``convert``'s prepare), needed for tracked robots (computed when None).
     ``inject``: fault specs (:mod:`modelkit.verify.layers.inject`) applied to the verification variant's
     files, as ``verify --inject`` applies them to the converted files. ``given``: "mjcf"/"urdf" → a file
-    the user gave (``verify --mjcf/--urdf``), which the graded runs drive instead of the written one
-    (as it is: ``inject`` is not applied to it again). Never raises for a model problem: an engine
-    failing is a failed check."""
+    the user gave (``verify --mjcf/--urdf``) and its renames, which the graded runs drive instead of
+    the written one (as it is: ``inject`` is not applied to it again). Never raises for a model
+    problem: an engine failing is a failed check."""
     result = Layer4Result()
     t0 = time.perf_counter()
     try:
@@ -289,7 +290,7 @@ def _setup(
     engines: list[str],
     inject: Sequence[str],
     result: Layer4Result,
-    given: Mapping[str, Path],
+    given: Mapping[str, tuple[Path, Renames]],
 ) -> None:
     """Write the variant (the graded one: but the files the user gave), apply the injected faults to
     what was written, load every engine and start the engines that run in a child process (PyBullet)
@@ -317,8 +318,8 @@ def _setup(
         return
     written = dict(files)
     if graded:  # the graded run: the files convert writes by default, as they are, or the user's
-        for kind, path in sorted(given.items()):
-            files[kind], maps[kind] = Path(path), {"link": {}, "joint": {}}
+        for kind, (path, renamed) in sorted(given.items()):
+            files[kind], maps[kind] = Path(path), renamed
         result.settings["files"] = {k: (str(p) if k in given else p.name) for k, p in sorted(files.items())}
         result.settings["given"] = sorted(given)
     result.settings.setdefault("variant", {})[proxy] = {k: p.name for k, p in sorted(files.items())}
