@@ -302,6 +302,16 @@ def primitive_triangles(geometry: Cone | Capsule | Ellipsoid) -> TriangleMeshDat
     return TriangleMeshData(np.asarray(tm.vertices, dtype=float), np.asarray(tm.faces, dtype=np.int64))
 
 
+def converted_stem(stem: str, source_ext: str, written_ext: str) -> str:
+    """The file stem of a mesh converted from ``source_ext`` to ``written_ext``: the source's suffix
+    kept in it (``base.dae`` → ``base_dae.stl``), so that it never takes the name of a mesh copied as
+    it is (UR5's ``base.stl`` beside ``base.dae``). Names then follow from the files, not from the order
+    in which a writer meets them: the MJCF writer met UR5's collision first and the URDF writer its
+    visual, so the two gave ``base.stl`` and ``base_2.stl`` the other way round, and the two outputs
+    could not share a folder (with ``--force`` one replaced the other's meshes)."""
+    return stem if source_ext == written_ext else f"{stem}_{source_ext}"
+
+
 class MeshExporter:
     """Turns the model's mesh geometry into files in the output plan, once each."""
 
@@ -392,7 +402,7 @@ class MeshExporter:
                               "the convex hull it collides with")
             file_name = safe_file_name(path.name, "mesh")
             if ready.converted is not None:
-                file_name = f"{safe_file_name(path.stem, 'mesh')}.stl"
+                file_name = f"{safe_file_name(converted_stem(path.stem, ext, 'stl'), 'mesh')}.stl"
                 why = "the only STL MuJoCo reads" if ext == "stl" else "which MuJoCo reads whole"
                 self.notes.note("MK804", f"mesh {path.name} ({ready.converted}) converted to binary STL, "
                                 f"{why}", source, target)
@@ -406,7 +416,9 @@ class MeshExporter:
         unit = f", unit scale {loaded.unit_scale:g} applied" if loaded.unit_scale != 1.0 else ""
         self.notes.note("MK804", f"mesh {path.name}{part} ({loaded.source_format}) converted to "
                         f"{self.options.mesh_format.upper()}{unit}", source, target)
-        stem = path.stem + (f"_{geometry.fragment}" if geometry.fragment else "")
+        written = "stl" if mujoco else self.options.mesh_format
+        part_stem = path.stem + (f"_{geometry.fragment}" if geometry.fragment else "")
+        stem = converted_stem(part_stem, ext, written)
         if mujoco:
             return self._mujoco_triangles(loaded.mesh, stem, scale, f"mesh {uri}", collision)
         return self.triangles(loaded.mesh, stem, scale), ""
