@@ -34,6 +34,10 @@ WORLD_LINK = "world"
 """The name of the link that stands for the world itself (every format's convention)."""
 
 AXIS_UNIT_TOLERANCE = 1e-3
+BALL_KEYS = ("#x", "#y", "#z")
+"""A ball joint's position in a configuration (``Robot.world_poses``): the angles about the joint
+frame's X, Y and Z axes, applied in that order (R = Rx·Ry·Rz, the URDF writer's chain of three joints),
+under the keys ``NAME#x``, ``NAME#y`` and ``NAME#z``."""
 """A written joint axis whose length is off 1 by more than this is not a rounded unit vector
 ("0.7071 0 0.7071" has length 0.99999): URDF and SDF readers warn (MK306). The ``.body`` reader warns
 from 1e-6 on, since Choreonoid uses the axis unnormalised."""
@@ -461,7 +465,8 @@ class Robot:
     def world_poses(self, positions: dict[str, float] | None = None) -> dict[str, Pose]:
         """Forward kinematics: each link's pose in the world (root at ``root_pose``).
 
-        ``positions`` maps joint names to q (default 0). Links unreachable from the root are absent.
+        ``positions`` maps joint names to q (default 0), and a ball joint's three angles to
+        ``NAME#x``... (:data:`BALL_KEYS`). Links unreachable from the root are absent.
         """
         import numpy as np
 
@@ -485,6 +490,13 @@ class Robot:
                     motion = Pose(axis_angle(axis, q), np.zeros(3))
                 elif joint.type is JointType.PRISMATIC and q != 0.0:
                     motion = Pose(np.eye(3), axis * q)
+                elif joint.type is JointType.BALL:
+                    rotation = np.eye(3)
+                    for key, unit in zip(BALL_KEYS, np.eye(3), strict=True):
+                        angle = positions.get(joint.name + key, 0.0)
+                        if angle != 0.0:
+                            rotation = rotation @ axis_angle(unit, angle)
+                    motion = Pose(rotation, np.zeros(3))
                 poses[joint.child] = poses[parent] @ joint.origin @ motion
                 stack.append(joint.child)
         return poses

@@ -72,3 +72,30 @@ def test_pybullet_holds_the_source_mass(tmp_path: Path) -> None:
     finally:
         pybullet.disconnect(client)
     assert sum(masses) == pytest.approx(0.0356047167406843 * 2 + 0.0486176195863701 + 4e-6, rel=1e-6)
+
+
+def test_layer2_turns_the_ball_joints_in_every_engine(tmp_path: Path) -> None:
+    """Layer 2 held ball joints at zero. Now each configuration turns them by three angles about X, Y
+    and Z (``NAME#x``...): MuJoCo and Drake turn their ball joint, the URDF engines the writer's chain."""
+    import modelkit
+    from modelkit.verify.layers.kinematics import configurations
+
+    robot = modelkit.load(_source(tmp_path))
+    configs = configurations(robot, 3, 0)
+    assert {"joint_1#x", "joint_1#y", "joint_1#z", "joint_2#z"} <= set(configs[1])
+    turned = robot.world_poses(configs[1])["body3"].rotation
+    assert abs(turned - robot.world_poses()["body3"].rotation).max() > 0.1  # the reference moves it
+    report = verify(_source(tmp_path), tmp_path / "out", ("mujoco", "drake", *URDF_ENGINES), configurations=5,
+                    samples=1, replay=False, driven=False)
+    layer2 = [c for c in report.checks if c.layer == 2]
+    assert {c.engine for c in layer2} == {"mujoco", "drake", *URDF_ENGINES}
+    assert all(c.passed and "held at zero" not in c.detail for c in layer2), layer2
+
+
+def test_layer2_finds_a_chain_axis_written_wrong(tmp_path: Path) -> None:
+    """With the ball held at zero, a flipped chain axis changed no pose: only layer 1 saw it."""
+    report = verify(_source(tmp_path), tmp_path / "out", ("pybullet",), configurations=5, samples=1,
+                    replay=False, driven=False, inject=["axis:joint_1_y:flip"])
+    assert not report.errors, report.errors
+    failed = {(c.layer, c.engine, c.quantity) for c in report.checks if not c.passed}
+    assert (2, "pybullet", "pose-rotation") in failed

@@ -68,7 +68,7 @@ from typing import Any
 import numpy as np
 
 from modelkit.convert.options import WriteOptions
-from modelkit.model import JointType, Robot
+from modelkit.model import BALL_KEYS, JointType, Robot
 from modelkit.verify.engines.protocol import Check, Skip
 from modelkit.verify.engines.registry import DEFAULT_ENGINES, ENGINES, INPUTS
 from modelkit.verify.report import VerifyReport
@@ -481,7 +481,12 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
     t3 = time.perf_counter()
     configs = kinematics.configurations(reference, configurations, seed)
     for eng in loaded:
-        report.checks.extend(_guarded(2, eng, lambda eng=eng: kinematics.layer2(src, eng, configs)))
+        # a URDF holds a ball joint as the writer's chain of three joints (MK813)
+        chains = approximations.ball_chains(INPUTS.get(eng.label, "robot"), written.get("urdf", []))
+        chain_joints = {c.joint + key: written_joint for c in chains
+                        for key, written_joint in zip(BALL_KEYS, c.joints, strict=True)}
+        report.checks.extend(_guarded(2, eng, lambda eng=eng, cj=chain_joints: kinematics.layer2(
+            src, eng, configs, cj)))
     t4 = time.perf_counter()
     pin_ref = next((e.model for e in loaded if e.label == "pinocchio"), None)
     if dynamics.kinematic_only(reference):

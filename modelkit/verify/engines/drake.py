@@ -53,10 +53,11 @@ from typing import Any
 
 import numpy as np
 from lxml import etree
-from pydrake.math import RigidTransform
+from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import (
+    BallRpyJoint,
     Frame,
     Joint,
     JointIndex,
@@ -66,8 +67,8 @@ from pydrake.multibody.tree import (
     RigidBody,
 )
 
-from modelkit.model import Robot
-from modelkit.spatial import Pose
+from modelkit.model import BALL_KEYS, Robot
+from modelkit.spatial import Pose, axis_angle
 from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, StaticFacts
 
 Renames = dict[str, dict[str, str]]
@@ -248,6 +249,7 @@ class DrakeModel:
             if j.position_start() != j.velocity_start():
                 raise DrakeLoadError(f"{path.name}: joint {j.name()!r}: position and velocity index differ")
         self._dofs = dofs
+        self._balls = [j for j in self._joints if isinstance(j, BallRpyJoint)]
         self.settings: dict[str, Any] = {
             "version": _version(),
             "file": path.name,
@@ -319,6 +321,12 @@ class DrakeModel:
             positions[joint.position_start()] = q.get(joint.name(), 0.0)
             if dq is not None:
                 velocities[joint.velocity_start()] = dq.get(joint.name(), 0.0)
+        for ball in self._balls:  # R = Rx·Ry·Rz from the three angles (BALL_KEYS) as Drake's rpy
+            turn = np.eye(3)
+            for key, unit in zip(BALL_KEYS, np.eye(3), strict=True):
+                turn = turn @ axis_angle(unit, q.get(ball.name() + key, 0.0))
+            start = ball.position_start()
+            positions[start:start + 3] = RollPitchYaw(RotationMatrix(turn)).vector()
         plant.SetPositions(context, _vec(positions))
         plant.SetVelocities(context, _vec(velocities))
 

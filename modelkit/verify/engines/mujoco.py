@@ -27,7 +27,7 @@ import mujoco
 import numpy as np
 
 from modelkit.formats.mjcf.quiet import collected_warnings
-from modelkit.model import Robot
+from modelkit.model import BALL_KEYS, Robot
 from modelkit.spatial import Pose, axis_angle, matrix_from_quat_wxyz
 from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, ShapeFacts, StaticFacts, TorqueLaw
 
@@ -216,11 +216,14 @@ class MujocoModel:
         self._dofs: list[str] = []
         self._qadr: list[int] = []
         self._vadr: list[int] = []
+        self._balls: list[tuple[str, int]] = []  # ball joints: name, qpos address of the quaternion
         for j in range(m.njnt):
             if int(m.jnt_type[j]) in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
                 self._dofs.append(self._jname(j))
                 self._qadr.append(int(m.jnt_qposadr[j]))
                 self._vadr.append(int(m.jnt_dofadr[j]))
+            elif int(m.jnt_type[j]) == int(mujoco.mjtJoint.mjJNT_BALL):
+                self._balls.append((self._jname(j), int(m.jnt_qposadr[j])))
         self._bodies = [self._body(b) for b in range(1, m.nbody)]
         self._link_of = {link: body for body in self._bodies for link in body.links}
         self._sites = self._frame_sites()
@@ -388,6 +391,14 @@ class MujocoModel:
             d.qpos[qa] = q.get(name, 0.0)
             if dq is not None:
                 d.qvel[va] = dq.get(name, 0.0)
+        for name, qa in self._balls:  # R = Rx·Ry·Rz from the three angles (BALL_KEYS), after qpos0
+            turn = np.eye(3)
+            for key, unit in zip(BALL_KEYS, np.eye(3), strict=True):
+                turn = turn @ axis_angle(unit, q.get(name + key, 0.0))
+            start = matrix_from_quat_wxyz(np.array(self.model.qpos0[qa:qa + 4], dtype=float))
+            quat = np.zeros(4)
+            mujoco.mju_mat2Quat(quat, np.ascontiguousarray(start @ turn).ravel())
+            d.qpos[qa:qa + 4] = quat
 
     def _motion(self, j: int) -> Pose:
         """Joint j's motion from MuJoCo's qpos (relative to ``qpos0``, where the body sits as compiled),

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from modelkit.model import BALL_KEYS
 from modelkit.verify.engines.protocol import Array, Check, EngineModel
 
 TOLERANCE = 1e-9
@@ -68,5 +69,14 @@ def rotation_angle(a: Array, b: Array) -> float:
 
 
 def engine_q(q: dict[str, float], eng: Loaded) -> dict[str, float]:
-    """A configuration keyed by the engine's (written) joint names."""
-    return {eng.joint(name): value for name, value in q.items()}
+    """A configuration keyed by the engine's (written) joint names. A ball joint's angles
+    (``NAME#x``..., ``BALL_KEYS``) follow the ball's written name, unless the engine's renames name
+    them (a URDF's chain of three joints)."""
+    out: dict[str, float] = {}
+    for name, value in q.items():
+        base, mark, axis = name.rpartition("#")
+        renamed = eng.renames.get("joint", {}).get(name)
+        if renamed is None and mark and base and mark + axis in BALL_KEYS:
+            renamed = f"{eng.joint(base)}#{axis}"
+        out[renamed or eng.joint(name)] = value
+    return out

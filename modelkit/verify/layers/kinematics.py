@@ -5,22 +5,32 @@ rotations in radians, the angle of R_aᵀR_b).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from modelkit.convert.compare import random_configuration
-from modelkit.model import Robot
+from modelkit.model import BALL_KEYS, JointType, Robot
 from modelkit.spatial import Pose
 from modelkit.verify.engines.protocol import Check, EngineModel
 from modelkit.verify.layers.common import Loaded, Worst, engine_q, rotation_angle, vec
 
+BALL_ANGLE = 1.0  # rad: each of a ball joint's three angles is drawn in ±this (no gimbal lock in rpy)
+
 
 def configurations(robot: Robot, count: int, seed: int) -> list[dict[str, float]]:
     """q = 0, then ``count`` random configurations inside the limits (±π / ±0.5 m where unlimited),
-    mimic joints set from their leaders."""
+    mimic joints set from their leaders; a ball joint turned by three angles about its X, Y and Z
+    (``BALL_KEYS``), drawn from a stream of their own (the other joints' draws are those of a model
+    without ball joints)."""
     rng = np.random.default_rng(seed)
+    balls = [joint.name for joint in robot.joints if joint.type is JointType.BALL]
+    ball_rng = np.random.default_rng([seed, 1])
     out: list[dict[str, float]] = [{}]
     for _ in range(count):
         q = random_configuration(robot, rng)
+        for name in balls:
+            q.update({name + key: float(ball_rng.uniform(-BALL_ANGLE, BALL_ANGLE)) for key in BALL_KEYS})
         for joint in robot.joints:  # a mimic joint follows its leader (yourdfpy and URDF readers apply it)
             if joint.mimic is not None and joint.name in q and joint.mimic.joint in q:
                 q[joint.name] = joint.mimic.multiplier * q[joint.mimic.joint] + joint.mimic.offset
@@ -28,12 +38,23 @@ def configurations(robot: Robot, count: int, seed: int) -> list[dict[str, float]
     return out
 
 
-def layer2(reference: EngineModel, eng: Loaded, configs: list[dict[str, float]]) -> list[Check]:
-    """Link poses relative to the root link, source FK vs the engine, over every configuration."""
+def layer2(reference: EngineModel, eng: Loaded, configs: list[dict[str, float]],
+           chain_joints: Mapping[str, str] | None = None) -> list[Check]:
+    """Link poses relative to the root link, source FK vs the engine, over every configuration.
+
+    A ball joint turns by its three angles (``BALL_KEYS``) in an engine that holds it as a ball joint
+    (MuJoCo, Drake's SDF), or as the URDF writer's chain of three joints (``chain_joints``: ``NAME#x``...
+    → the written joint); an engine that holds it neither way compares with it at zero (said in the
+    check's detail)."""
     position, rotation = Worst(), Worst()
+    chain_joints = dict(chain_joints or {})
+    held = _ball_keys_held(eng, configs, chain_joints)
     for i, q in enumerate(configs):
+        q = {k: v for k, v in q.items() if k not in held}
         ref = reference.link_poses(q)
-        got: dict[str, Pose] = eng.model.link_poses(engine_q(q, eng))
+        qe = engine_q({k: v for k, v in q.items() if k not in chain_joints}, eng)
+        qe.update({chain_joints[k]: v for k, v in q.items() if k in chain_joints})
+        got: dict[str, Pose] = eng.model.link_poses(qe)
         for name, pa in ref.items():
             pb = got.get(eng.link(name))
             if pb is None:
@@ -46,5 +67,28 @@ def layer2(reference: EngineModel, eng: Loaded, configs: list[dict[str, float]])
             if rotation.beats(da):
                 rotation.see(da, name, f"configuration {i}: orientation differs by {da:.3g} rad")
     n = f"{len(configs)} configurations, every link"
+    if held:
+        balls = sorted({k.rpartition("#")[0] for k in held})
+        n += ("; ball joint(s) held at zero, which the engine holds neither as a ball nor as a chain: "
+              + ", ".join(balls))
     return [position.check(2, eng.label, "pose-position", eng.tolerance("pose"), n),
             rotation.check(2, eng.label, "pose-rotation", eng.tolerance("pose"), n)]
+
+
+def _ball_keys_held(eng: Loaded, configs: list[dict[str, float]],
+                    chain_joints: Mapping[str, str]) -> set[str]:
+    """The ball angles (``NAME#x``...) the engine cannot take: kept at zero in both models."""
+    keys = {k for q in configs for k in q if k.rpartition("#")[0] and k[k.rindex("#"):] in BALL_KEYS}
+    if not keys:
+        return set()
+    facts = eng.model.static()
+    balls = {name for name, joint in facts.joints.items() if joint.type == "ball"}
+    dofs = set(eng.model.dof_names())
+    held = set()
+    for key in keys:
+        if key in chain_joints and chain_joints[key] in dofs:
+            continue
+        if eng.joint(key.rpartition("#")[0]) in balls:
+            continue
+        held.add(key)
+    return held
