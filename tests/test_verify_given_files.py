@@ -51,3 +51,18 @@ def test_a_given_file_with_a_wrong_wheel_fails_layer4_on_that_file(tmp_path: Pat
     failed = {(c.layer, c.quantity, c.where) for c in report.checks if not c.passed}
     assert (1, "shape-size", "LeftWheel") in failed
     assert (4, "noslip-yaw", "straight") in failed
+
+
+def test_a_given_file_with_a_welded_base_is_not_driven(tmp_path: Path) -> None:
+    """``convert --base fixed`` writes the mobile robot welded: layer 4, which drives it on a floor,
+    says it did not run that engine (it failed to load the file before it drove the given files)."""
+    from modelkit.convert.options import WriteOptions
+
+    source = TUTORIAL / "mobile_robot.body"
+    given = tmp_path / "given" / "r.xml"
+    write(modelkit.load(source), given, options=WriteOptions(base="fixed"))
+    assert "freejoint" not in given.read_text()
+    report = verify(source, tmp_path / "out", engines=("mujoco",), mjcf=given, replay=False)
+    assert [c for c in report.checks if not c.passed] == []
+    said = [s.reason for s in report.skips if s.layer == 4 and s.engine == "mujoco"]
+    assert any("welds the robot's base" in s for s in said), said

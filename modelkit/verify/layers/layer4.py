@@ -50,7 +50,7 @@ from typing import Any
 
 import numpy as np
 
-from modelkit.model import JointType, Robot
+from modelkit.model import WORLD_LINK, JointType, Robot
 from modelkit.verify.drive import Array, Drive, Profile, Scenario, Trajectory, WheelProxy
 from modelkit.verify.drive.reference import PlanarModel, noslip, odometry, planar_model, unicycle
 from modelkit.verify.drive.reference_skid import (
@@ -332,6 +332,11 @@ def _setup(
             result.injected.append(f"layer 4 {proxy} variant: {spec}: not applicable ({reason})")
     kinds = {"mujoco": "mjcf", "pybullet": "urdf"}
     for e in engines:
+        if graded and kinds[e] in given and _welds_the_base(files[kinds[e]], kinds[e]):
+            result.skips.append(Skip(LAYER, e, (
+                f"not run: the given {kinds[e].upper()} {files[kinds[e]].name} welds the robot's base to "
+                "the world (convert --base fixed), and layer 4 drives the robot on a floor")))
+            continue
         try:
             make = _resolve(DRIVERS[e])
         except ImportError as exc:
@@ -361,6 +366,24 @@ def _setup(
             lambda d=d: d.start(job.profiles, scenario, drive) or True, e, proxy, result
         ):
             job.pending.append(e)
+
+
+def _welds_the_base(path: Path, kind: str) -> bool:
+    """Whether a given file holds the robot welded: an MJCF whose top bodies have no free joint, a URDF
+    with a ``world`` link (what ``convert --base fixed`` writes)."""
+    from lxml import etree
+
+    try:
+        root = etree.parse(str(path), etree.XMLParser(resolve_entities=False, no_network=True)).getroot()
+    except (OSError, etree.XMLSyntaxError):
+        return False  # the driver's own loading says what is wrong
+    if kind == "urdf":
+        return any(link.get("name") == WORLD_LINK for link in root.iterchildren("link"))
+    tops = [body for world in root.iter("worldbody") for body in world.iterchildren("body")]
+    return bool(tops) and not any(
+        body.find("freejoint") is not None
+        or any(j.get("type") == "free" for j in body.iterchildren("joint"))
+        for body in tops)
 
 
 def _guard(call: Any, engine: str, proxy: str, result: Layer4Result) -> Any:
