@@ -447,13 +447,16 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
     report.engines["source"] = dict(src.settings)
     src_static = source_static(reference)
     approx = _approximations(reference, loaded, files, maps, written, report)
+    # A URDF engine holds each ball joint as the writer's chain of three joints (MK813): layer 1
+    # compares it with the source holding those chains, layer 2 turns the chain, the report says so.
+    chains_of = {eng.label: approximations.ball_chains(INPUTS.get(eng.label, "robot"),
+                                                       written.get(INPUTS.get(eng.label, "robot"), []))
+                 for eng in loaded}
     for eng in loaded:
         # An engine holding a documented approximation (MK816 tiny masses, PyBullet's 1 kg) is
         # compared with the source with that approximation applied; the report lists it.
-        # A URDF engine holds each ball joint as the writer's chain of three joints (MK813): layer 1
-        # compares it with the source holding those chains, and the report says so.
         kind = INPUTS.get(eng.label, "robot")
-        chains = approximations.ball_chains(kind, written.get(kind, []))
+        chains = chains_of[eng.label]
         chains_entry = approximations.chains_skip(eng.label, chains)
         if chains_entry is not None:
             report.skips.append(chains_entry)
@@ -481,9 +484,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
     t3 = time.perf_counter()
     configs = kinematics.configurations(reference, configurations, seed)
     for eng in loaded:
-        # a URDF holds a ball joint as the writer's chain of three joints (MK813)
-        chains = approximations.ball_chains(INPUTS.get(eng.label, "robot"), written.get("urdf", []))
-        chain_joints = {c.joint + key: written_joint for c in chains
+        chain_joints = {c.joint + key: written_joint for c in chains_of[eng.label]
                         for key, written_joint in zip(BALL_KEYS, c.joints, strict=True)}
         report.checks.extend(_guarded(2, eng, lambda eng=eng, cj=chain_joints: kinematics.layer2(
             src, eng, configs, cj)))
