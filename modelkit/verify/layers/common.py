@@ -69,14 +69,11 @@ def rotation_angle(a: Array, b: Array) -> float:
 
 
 def engine_q(q: dict[str, float], eng: Loaded) -> dict[str, float]:
-    """A configuration keyed by the engine's (written) joint names. A ball joint's angles
-    (``NAME#x``..., ``BALL_KEYS``) follow the ball's written name, unless the engine's renames name
-    them (a URDF's chain of three joints)."""
+    """A configuration keyed by the engine's (written) joint names; a ball joint's angles
+    (``NAME#x``..., ``BALL_KEYS``) follow the ball's written name."""
     out: dict[str, float] = {}
     for name, value in q.items():
         base, mark, axis = name.rpartition("#")
-        renamed = eng.renames.get("joint", {}).get(name)
-        if renamed is None and mark and base and mark + axis in BALL_KEYS:
-            renamed = f"{eng.joint(base)}#{axis}"
-        out[renamed or eng.joint(name)] = value
+        ball = base and mark + axis in BALL_KEYS
+        out[f"{eng.joint(base)}#{axis}" if ball else eng.joint(name)] = value
     return out
