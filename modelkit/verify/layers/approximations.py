@@ -111,11 +111,11 @@ def triangle_moments(tensor: np.ndarray) -> tuple[float, float, float] | None:
     """The principal moments (ascending) of ``tensor`` when they violate a + b ≥ c (MK303), else None;
     None too for a tensor whose moments are all within ``ZERO_MOMENT`` of zero (validate's rule: a
     zero inertia, which the URDF readers hold as zero, as iCub's ``head``: -2.4e-35, 0, 2.4e-35)."""
-    from modelkit.checks.physics import ZERO_MOMENT
+    from modelkit.verify.layers.common import zero_inertia
 
-    a, b, c = (float(v) for v in np.linalg.eigvalsh(0.5 * (tensor + tensor.T)))
-    if max(abs(a), abs(c)) <= ZERO_MOMENT:
+    if zero_inertia(tensor):
         return None
+    a, b, c = (float(v) for v in np.linalg.eigvalsh(0.5 * (tensor + tensor.T)))
     return (a, b, c) if a + b < c else None
 
 

@@ -68,6 +68,15 @@ def rotation_angle(a: Array, b: Array) -> float:
     return math.atan2(s, c)
 
 
+def zero_inertia(tensor: Array) -> bool:
+    """Whether validate calls ``tensor`` zero: every principal moment within ``ZERO_MOMENT`` of 0
+    (MK302; iCub's ``head`` gives ±2.4e-35, which the engines hold as 0)."""
+    from modelkit.checks.physics import ZERO_MOMENT
+
+    tensor = np.asarray(tensor, dtype=float)
+    return bool(np.all(np.abs(np.linalg.eigvalsh(0.5 * (tensor + tensor.T))) <= ZERO_MOMENT))
+
+
 def engine_q(q: dict[str, float], eng: Loaded) -> dict[str, float]:
     """A configuration keyed by the engine's (written) joint names; a ball joint's angles
     (``NAME#x``..., ``BALL_KEYS``) follow the ball's written name."""

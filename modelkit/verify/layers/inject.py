@@ -201,7 +201,7 @@ def inject(path: Path, fault: Fault | str, renames: Renames | None = None) -> In
             raise InjectError(fault.spec, fault.other_column, f"{path.name} has no joint {fault.other!r}; "
                               f"its joints: {', '.join(valid) or '(none)'}")
         _swap_names(root, fmt_name, written, other, result.changes)
-        _save(path, tree)
+        save(path, tree)
         return result
     edit = _EDITS[(fault.kind, fmt_name)]
     try:
@@ -211,13 +211,14 @@ def inject(path: Path, fault: Fault | str, renames: Renames | None = None) -> In
     if not result.changes:  # a zero inertia or mass scaled: the file would not change
         raise InjectError(fault.spec, fault.name_column, f"{path.name}: {fault.kind} of {written!r} is zero; "
                           "the fault would change nothing")
-    _save(path, tree)
+    save(path, tree)
     return result
 
 
-def _save(path: Path, tree: etree._ElementTree) -> None:
-    """Write the edited tree back with the file's own XML declaration (if any) and a final newline."""
-    head = path.read_bytes()[:200].lstrip()
+def save(path: Path, tree: etree._ElementTree, like: Path | None = None) -> None:
+    """Write the tree with the XML declaration (if any) of ``like`` (default: the file it replaces)
+    and a final newline."""
+    head = (like or path).read_bytes()[:200].lstrip()
     declaration = head.split(b"?>", 1)[0] + b"?>\n" if head.startswith(b"<?xml") else b""
     body = etree.tostring(tree.getroot(), encoding="utf-8")
     path.write_bytes(declaration + body + b"\n")

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from lxml import etree
 
-from modelkit.verify.layers.inject import file_format
+from modelkit.verify.layers.inject import file_format, save
 
 _MJCF_DIRS = ("meshdir", "texturedir")
 _MJCF_MODEL_RELATIVE = ("include", "model")  # file attributes resolved against the model's folder
@@ -43,10 +43,8 @@ def relocated_copy(path: Path, folder: Path) -> Path:
         _mjcf(root, origin)
     folder.mkdir(parents=True, exist_ok=True)
     copy = folder / path.name
-    head = path.read_bytes()[:200].lstrip()
-    declaration = head.split(b"?>", 1)[0] + b"?>\n" if head.startswith(b"<?xml") else b""
     temporary = copy.with_name(f".{copy.name}.tmp")
-    temporary.write_bytes(declaration + etree.tostring(root, encoding="utf-8") + b"\n")
+    save(temporary, tree, like=path)
     os.replace(temporary, copy)
     return copy
 

@@ -19,11 +19,10 @@ import math
 
 import numpy as np
 
-from modelkit.checks.physics import ZERO_MOMENT
 from modelkit.model import WORLD_LINK
 from modelkit.verify.engines.protocol import Check, Skip, StaticFacts
 from modelkit.verify.layers import shapes
-from modelkit.verify.layers.common import Loaded, Worst, vec
+from modelkit.verify.layers.common import Loaded, Worst, vec, zero_inertia
 
 NO_LIMIT = 1e16  # SDF's default limits, ±1e16, mean none: libsdformat's readers (Drake) report ±inf
 
@@ -105,7 +104,7 @@ def layer1(source: StaticFacts, eng: Loaded) -> list[Check]:
         diff = float(np.max(np.abs(ia - ib)))
         # relative to the tensor; two tensors validate calls zero (every principal moment within
         # ZERO_MOMENT of 0, MK302: iCub's head gives ±2.4e-35, which the engines hold as 0) are equal
-        if not diff or (_zero_inertia(ia) and _zero_inertia(ib)):
+        if not diff or (zero_inertia(ia) and zero_inertia(ib)):
             err = 0.0
         else:
             err = diff / max(float(np.max(np.abs(ia))), 1e-300)
@@ -116,10 +115,6 @@ def layer1(source: StaticFacts, eng: Loaded) -> list[Check]:
     checks.append(inertia.check(1, label, "inertia", eng.tolerance("inertia")))
     checks.extend(shapes.compare(source, facts, eng))  # collision shapes (modelkit.verify.layers.shapes)
     return checks
-
-
-def _zero_inertia(tensor: np.ndarray) -> bool:
-    return bool(np.all(np.abs(np.linalg.eigvalsh(0.5 * (tensor + tensor.T))) <= ZERO_MOMENT))
 
 
 def massless_skips(source: StaticFacts, eng: Loaded) -> list[Skip]:
