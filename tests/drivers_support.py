@@ -50,14 +50,15 @@ def run_difference(a: Trajectory, b: Trajectory, until: int | None = None) -> fl
 
 def assert_same_layer4(robot: Any, engine: str, per_step: str, tmp_path: Path, monkeypatch: Any
                        ) -> list[tuple[Trajectory, Trajectory]]:
-    """Layer 4 on ``robot`` (its default scenario) with ``engine``'s fast driver, then with the per-step
-    one (``per_step``: "module:function" building it), every check and observation the same to
-    round-off and the same pass/fail; returns the engine's pairs of runs (each equal to round-off)."""
+    """Layer 4 on ``robot`` (its default scenario, with the report-only native run asked for) with
+    ``engine``'s fast driver, then with the per-step one (``per_step``: "module:function" building
+    it), every check and observation the same to round-off and the same pass/fail; returns the
+    engine's pairs of runs (each equal to round-off)."""
     from modelkit.verify.drive import vehicle
     from modelkit.verify.drive.scenario import default_scenario
     from modelkit.verify.layers import layer4
 
-    scenario = default_scenario("wheels", True)
+    scenario = dataclasses.replace(default_scenario("wheels", True), native_report=True)
     drive = vehicle.find_drive(robot, scenario)
     fast = layer4.run(robot, drive, scenario, tmp_path / "fast", engines=(engine,))
     monkeypatch.setitem(layer4.DRIVERS, engine, per_step)

@@ -282,8 +282,25 @@ def test_the_drive_tester_reference_accelerates_at_2_tau_over_r_m_eff(
 def pantilt_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Drive, Scenario, layer4.Layer4Result]:
     robot = _robot("pantilt")
     drive = find_drive(robot, default_scenario())
-    scenario = default_scenario(drive.kind, has_pan_tilt=True)
+    # the report-only native run asked for, so that this one run covers it too
+    scenario = dataclasses.replace(default_scenario(drive.kind, has_pan_tilt=True), native_report=True)
     return drive, scenario, layer4.run(robot, drive, scenario, tmp_path_factory.mktemp("layer4"))
+
+
+def test_the_default_scenario_drives_only_the_files_convert_writes(tmp_path: Path) -> None:
+    """By default layer 4 runs no file the user did not get: no native (cylinder-wheel) variant is
+    written or driven unless a scenario asks for it (``contact: native_report: true``)."""
+    robot = _robot("pantilt")
+    drive = find_drive(robot, default_scenario())
+    scenario = default_scenario(drive.kind, has_pan_tilt=True)
+    assert scenario.native_report is False
+    straight = tuple(p for p in scenario.profiles if p.name == "straight")
+    short = dataclasses.replace(scenario, profiles=straight)
+    result = layer4.run(robot, drive, short, tmp_path, ["mujoco"])
+    assert set(result.settings["variant"]) == {"sphere"}
+    assert {t.variant for t in result.trajectories} == {"sphere", ""}
+    assert not list(tmp_path.rglob("*_cylinder.*"))
+    assert not any("native" in o.where for o in result.observations)
 
 
 def test_the_pantilt_robot_passes_layer_4(pantilt_run: tuple[Drive, Scenario, layer4.Layer4Result]) -> None:
