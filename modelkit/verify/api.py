@@ -707,6 +707,8 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
             extra = {**({"armature": False} if with_armature else {}),
                      **({"inertials": inertials} if inertials else {}),
                      **({"principal": principal} if principal else {})}
+        elif name == "pybullet":  # its child from layers 1-3, reused when it holds the same file
+            extra = {"loaded": next(e.model for e in loaded if e.label == name)}
         try:
             make = _resolve(ENGINES[name].replace(":load", ":simulator"))
             sims.append(make(files[kind], maps[kind], root=root, dt=REPLAY_DT, **extra))
