@@ -26,23 +26,17 @@ the child link frame with the child's inertial orientation.
 from __future__ import annotations
 
 import math
-import os
-import pickle
-import select
-import struct
-import subprocess
 import sys
-import tempfile
-import time
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 import numpy as np
 
 from modelkit.convert.tracks import PYBULLET_SOLVER_ITERATIONS
 from modelkit.formats.urdf.writer import PYBULLET_MAX_JOINTS
-from modelkit.lifeline import preexec
 from modelkit.spatial import Pose
+from modelkit.verify.engines import child
+from modelkit.verify.engines.child import Worker
 from modelkit.verify.engines.protocol import (
     Array,
     EngineError,
@@ -59,7 +53,7 @@ WORKER = Path(__file__).with_name("pybullet_worker.py")
 # -P: the worker's folder must not go first on sys.path, or this module (engines/pybullet.py) would
 # shadow the real ``pybullet`` package (and engines/mujoco.py ``mujoco``) in the child.
 GRAVITY = -9.81
-DEFAULT_TIMEOUT = 60.0  # seconds for one request (load, a batch of poses, a 10 s replay takes ~0.1 s)
+DEFAULT_TIMEOUT = child.DEFAULT_TIMEOUT  # one request (load, a batch of poses; a 10 s replay takes ~0.1 s)
 SETTINGS: dict[str, Any] = {
     "flags": "URDF_USE_INERTIA_FROM_FILE|URDF_USE_IMPLICIT_CYLINDER",
     "useFixedBase": True,
@@ -106,95 +100,8 @@ def _pose(pos: tuple[float, ...], orn: tuple[float, ...]) -> Pose:
     return Pose(quat_xyzw_matrix(orn), np.array(pos, dtype=float))
 
 
-class Worker:
-    """The child process and its framed pickle pipe (see ``pybullet_worker``)."""
-
-    def __init__(self) -> None:
-        self._stderr: IO[bytes] = tempfile.TemporaryFile()  # noqa: SIM115 (closed in close())
-        env = dict(os.environ, PYTHONUNBUFFERED="1")
-        self.proc = subprocess.Popen(
-            [sys.executable, "-P", str(WORKER)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-            stderr=self._stderr, env=env, close_fds=True, preexec_fn=preexec(),
-        )
-
-    def _stderr_tail(self, since: int = 0) -> str:
-        """The last lines PyBullet printed (it explains a refused file there, not in the exception)."""
-        self._stderr.seek(since)
-        text = self._stderr.read().decode(errors="replace")
-        self._stderr.seek(0, os.SEEK_END)
-        lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("pybullet build time")]
-        return "\n".join(lines[-12:])
-
-    def _died(self, what: str) -> PyBulletError:
-        code = self.proc.wait(timeout=5)
-        how = f"killed by signal {-code}" if code < 0 else f"exit status {code}"
-        tail = self._stderr_tail()
-        message = f"PyBullet child process died during {what} ({how})"
-        return PyBulletError(message + (f":\n{tail}" if tail else ""))
-
-    def _read_exactly(self, n: int, deadline: float, what: str) -> bytes:
-        assert self.proc.stdout is not None
-        fd = self.proc.stdout.fileno()
-        data = b""
-        while len(data) < n:
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                self.kill()
-                raise PyBulletError(f"PyBullet did not answer {what} within the timeout; child killed")
-            ready, _, _ = select.select([fd], [], [], remaining)
-            if not ready:
-                continue
-            chunk = os.read(fd, n - len(data))
-            if not chunk:
-                raise self._died(what)
-            data += chunk
-        return data
-
-    def request(self, command: str, timeout: float = DEFAULT_TIMEOUT, **kwargs: Any) -> Any:
-        return self.receive(command, self.send(command, **kwargs), timeout)
-
-    def send(self, command: str, **kwargs: Any) -> int:
-        """Send a request without waiting for its answer (the child works while the parent does
-        something else); returns where the child's stderr stood, for :meth:`receive`."""
-        if self.proc.poll() is not None:
-            raise self._died(command)
-        printed = self._stderr.seek(0, os.SEEK_END)
-        payload = pickle.dumps((command, kwargs), protocol=pickle.HIGHEST_PROTOCOL)
-        assert self.proc.stdin is not None
-        try:
-            self.proc.stdin.write(struct.pack(">I", len(payload)) + payload)
-            self.proc.stdin.flush()
-        except BrokenPipeError:
-            raise self._died(command) from None
-        return int(printed)
-
-    def receive(self, command: str, printed: int, timeout: float = DEFAULT_TIMEOUT) -> Any:
-        """The answer to the request :meth:`send` sent (``printed``: what it returned)."""
-        deadline = time.monotonic() + timeout
-        size = struct.unpack(">I", self._read_exactly(4, deadline, command))[0]
-        status, result = pickle.loads(self._read_exactly(size, deadline, command))
-        if status != "ok":
-            said = self._stderr_tail(printed)
-            raise PyBulletError(f"PyBullet {command} failed: {result}".rstrip()
-                                + (f"\nPyBullet printed:\n{said}" if said else ""))
-        return result
-
-    def kill(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait(timeout=5)
-
-    def close(self) -> None:
-        if self.proc.poll() is None:
-            try:
-                self.request("quit", timeout=5.0)
-                self.proc.wait(timeout=5)
-            except (PyBulletError, subprocess.TimeoutExpired, OSError):
-                self.kill()
-        for stream in (self.proc.stdin, self.proc.stdout):
-            if stream is not None:
-                stream.close()
-        self._stderr.close()
+def _worker() -> Worker:
+    return Worker([sys.executable, "-P", str(WORKER)], "PyBullet", PyBulletError)
 
 
 def _largest_diagonalisation_change(urdf: Path) -> float:
@@ -245,7 +152,7 @@ class PyBulletModel:
         self.timeout = timeout
         self.dt = dt
         self.last_replay_wall = math.nan
-        self._worker = Worker()
+        self._worker = _worker()
         try:
             info = self._worker.request("load", timeout=timeout, path=str(Path(urdf).resolve()),
                                         gravity=GRAVITY, dt=dt)
@@ -464,7 +371,7 @@ def render(urdfs: dict[str, Path], configurations: list[dict[str, float]], camer
     """TinyRenderer pictures for the report (``modelkit.verify.report.pictures``), in a child worker of its
     own: (view, configuration index) → (RGB (H, W, 3) uint8, robot mask (H, W) bool). Joint names
     are the URDF's."""
-    worker = Worker()
+    worker = _worker()
     try:
         paths = {k: str(Path(v).resolve()) for k, v in urdfs.items()}
         raw = worker.request("render", timeout=timeout, paths=paths, configurations=configurations,
@@ -558,7 +465,7 @@ class PyBulletDriver:
         for rollers in drive.rollers.values():
             for j in rollers:
                 joint_names.setdefault(j, j)
-        self._worker = Worker()
+        self._worker = _worker()
         self._pending: tuple[int, list[Any], Any, Any] | None = None
         try:
             info = self._worker.request(

@@ -3,10 +3,9 @@
 PyBullet keeps global state and can crash (segfault, abort) on bad input, so it never runs in the
 verifying process. This script is started by path (``python -P pybullet_worker.py``: ``-P`` keeps its folder,
 whose ``pybullet.py`` is the parent's adapter, off ``sys.path``), imports only the
-standard library and ``pybullet``, and answers requests on stdin. Framing, both ways: a 4-byte
-big-endian length, then a pickle. A request is ``(command, kwargs)``; a reply is ``("ok", result)``
-or ``("error", message)``. PyBullet's C code prints to file descriptor 1, so the replies go to a
-duplicate of the original stdout and fd 1 is pointed at stderr before PyBullet is imported.
+standard library, ``pybullet`` and :mod:`modelkit.verify.engines.child` (itself standard library
+only), and answers requests on stdin through :func:`~modelkit.verify.engines.child.serve` (the
+framing, and PyBullet's C prints kept out of the replies, are described there).
 
 The worker returns raw PyBullet numbers (link COM frames, inertial frames, joint infos); the frame
 algebra lives in the parent, where it can be tested and typed.
@@ -21,13 +20,10 @@ from __future__ import annotations
 
 import math
 import os
-import pickle
-import struct
 import sys
 import time
-import traceback
 from array import array
-from typing import Any, BinaryIO
+from typing import Any
 
 SUPPORT_GAP = 1.0e-3
 """m: a link whose closest contact point with the floor is within this distance touches it (its load,
@@ -720,44 +716,10 @@ class Engine:
                                         physicsClientId=self.drive_client)
 
 
-def _read(stream: BinaryIO, n: int) -> bytes | None:
-    data = b""
-    while len(data) < n:
-        chunk = stream.read(n - len(data))
-        if not chunk:
-            return None
-        data += chunk
-    return data
-
-
-def _send(stream: BinaryIO, message: Any) -> None:
-    payload = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
-    stream.write(struct.pack(">I", len(payload)) + payload)
-    stream.flush()
-
-
 def main() -> int:
-    replies = os.fdopen(os.dup(1), "wb")
-    os.dup2(2, 1)  # PyBullet's own prints go to stderr, never into the reply stream
-    requests = sys.stdin.buffer
-    engine = Engine()
-    while True:
-        header = _read(requests, 4)
-        if header is None:
-            return 0
-        body = _read(requests, struct.unpack(">I", header)[0])
-        if body is None:
-            return 0
-        command, kwargs = pickle.loads(body)
-        if command == "quit":
-            _send(replies, ("ok", None))
-            return 0
-        try:
-            result = getattr(engine, command)(**kwargs)
-        except Exception as exc:  # every failure goes back to the parent as a message
-            _send(replies, ("error", f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=3)}"))
-            continue
-        _send(replies, ("ok", result))
+    from modelkit.verify.engines.child import serve
+
+    return serve(Engine)
 
 
 if __name__ == "__main__":
