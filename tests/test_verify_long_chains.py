@@ -22,11 +22,11 @@ pytest.importorskip("pinocchio")
 def test_yourdfpy_poses_are_its_own_path_products(tmp_path: Path) -> None:
     """The per-joint composition gives what ``get_transform(link, root)`` gives (to rounding), also
     for a root below the URDF's base link, and does not grow with the square of the chain."""
-    from modelkit.verify.engines.reference import YourdfpyModel
+    from modelkit.verify.engines.reference import YourdfpyKinematics
 
     path = chain_support.write(tmp_path, "urdf", 60, branches=3)
     for root in ("link0", "link5"):
-        model = YourdfpyModel(path, root)
+        model = YourdfpyKinematics(path, root)
         rng = np.random.default_rng(3)
         q = {name: float(rng.uniform(-1.0, 1.0)) for name in model.dof_names()}
         ours = model.link_poses(q)

@@ -70,7 +70,7 @@ import numpy as np
 from modelkit.convert.options import WriteOptions
 from modelkit.model import BALL_KEYS, JointType, Robot
 from modelkit.verify.engines.protocol import Check, Skip
-from modelkit.verify.engines.registry import DEFAULT_ENGINES, ENGINES, INPUTS
+from modelkit.verify.engines.registry import DEFAULT_ENGINES, ENGINES, INPUTS, PRESTART
 from modelkit.verify.report import VerifyReport
 from modelkit.verify.source import VerifyError, read_robot, root_tree_only, welded_copy
 
@@ -210,8 +210,26 @@ def _copy_given(files: dict[str, Path], given: dict[str, Path | None], out_dir: 
                                f"injected/{files[fmt].name}")
 
 
+def _prestart(names: Sequence[str]) -> dict[str, Any]:
+    """The child processes of the engines that start ahead (:data:`PRESTART`), started: each imports
+    its library on the other core while verify reads and converts. An engine that is not installed
+    or whose child cannot start gets none (its loader then says why, as without a head start)."""
+    warm: dict[str, Any] = {}
+    for name in names:
+        if name not in PRESTART:
+            continue
+        try:
+            worker = _resolve(PRESTART[name])()
+        except (ImportError, OSError):
+            continue
+        if worker is not None:
+            warm[name] = worker
+    return warm
+
+
 def _load_engines(names: Sequence[str], reference: Robot, files: dict[str, Path], maps: dict[str, Renames],
-                  report: VerifyReport) -> list[Any]:
+                  report: VerifyReport, warm: Mapping[str, Any] | None = None) -> list[Any]:
+    """Each engine's model of its file; ``warm``: the children :func:`_prestart` started, by engine."""
     from modelkit.verify.layers.common import Loaded
 
     loaded: list[Loaded] = []
@@ -227,8 +245,9 @@ def _load_engines(names: Sequence[str], reference: Robot, files: dict[str, Path]
         except ImportError as exc:
             report.skips.append(Skip(0, name, f"not installed ({exc})"))
             continue
+        extra = {"worker": warm[name]} if warm and name in warm else {}
         try:
-            model = load(model_in, renames, root=root)
+            model = load(model_in, renames, root=root, **extra)
         except Exception as exc:
             if getattr(type(exc), "engine_limit", False):  # e.g. Pinocchio's Data, cubic in the joints
                 report.skips.append(Skip(0, name, f"not run: {exc}"))
@@ -346,12 +365,17 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
             report.errors.extend(f"--scenario: {render_text(d)}" for d in diagnostics)
             return
     progress(f"reading and converting {source.name}; layers 1-3 (static, kinematics, dynamics)")
+    warm = _prestart(engines)
     try:
         done = _layers_1_to_3(report, source, out_dir, engines, mjcf, urdf, sdf, inject, seed,
-                              configurations, samples, replay, reading)
+                              configurations, samples, replay, reading, warm)
     except VerifyError as exc:
         report.errors.append(str(exc))
         return
+    finally:  # a child no engine took (verify stopped before loading): ended, not waited for
+        for worker in warm.values():
+            worker.kill()
+            worker.close()
     if done is None:
         return
     robot, given = done
@@ -397,7 +421,7 @@ def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence
 def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[str],
                    mjcf: str | Path | None, urdf: str | Path | None, sdf: str | Path | None,
                    inject: Sequence[str], seed: int, configurations: int, samples: int, replay: bool,
-                   reading: Mapping[str, Any] | None = None
+                   reading: Mapping[str, Any] | None = None, warm: Mapping[str, Any] | None = None
                    ) -> tuple[Robot, dict[str, tuple[Path, Renames]]] | None:
     """Layers 1–3 on the welded model; returns the source model as read and the MJCF and URDF the user
     gave, as the engines loaded them, with their renames (None when nothing ran)."""
@@ -435,7 +459,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                 raise VerifyError(f"--inject {spec}: {exc}") from exc
         if report.prepared is not None:  # the pictures of the files as verified, on another core
             report.prepared.start_pictures(report, out_dir, welded, files)
-        loaded = _load_engines(engines, reference, files, maps, report)
+        loaded = _load_engines(engines, reference, files, maps, report, warm)
     except VerifyError as exc:
         report.errors.append(str(exc))
         return None

@@ -16,6 +16,9 @@ ENGINES: dict[str, str] = {
     "yourdfpy": "modelkit.verify.engines.reference:load_yourdfpy",
 }
 DEFAULT_ENGINES = ("mujoco", "pybullet", "pinocchio", "drake", "drake-urdf", "yourdfpy")
+# Engines whose child process starts when verify starts (it imports its library while verify reads and
+# converts); the loader takes it as ``worker=``. The function returns None when the engine is missing.
+PRESTART: dict[str, str] = {"yourdfpy": "modelkit.verify.engines.reference:start_yourdfpy"}
 
 # Which written file each engine reads ("robot" = the in-memory source model).
 INPUTS: dict[str, str] = {
