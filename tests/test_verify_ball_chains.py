@@ -99,3 +99,24 @@ def test_layer2_finds_a_chain_axis_written_wrong(tmp_path: Path) -> None:
     assert not report.errors, report.errors
     failed = {(c.layer, c.engine, c.quantity) for c in report.checks if not c.passed}
     assert (2, "pybullet", "pose-rotation") in failed
+
+
+def test_a_given_urdf_from_convert_is_graded_with_its_chains(tmp_path: Path) -> None:
+    """``--urdf`` with the file ``convert`` wrote by default (a ``world`` link welds the root; each ball
+    a chain): the chains are read from the conversion staged in memory, so layers 1 and 2 grade the file
+    as they grade verify's own URDF, and a flipped chain axis in it still fails. Before, PyBullet and
+    yourdfpy failed link-set and joint-type on the chain links and layer 2 held the balls at zero."""
+    source = _source(tmp_path)
+    given = tmp_path / "given" / "balls.urdf"
+    convert([source], given)
+    assert '<link name="world"' in given.read_text()
+    report = verify(source, tmp_path / "out", ("mujoco", *URDF_ENGINES), urdf=given, configurations=5,
+                    samples=1, replay=False, driven=False)
+    assert not report.errors, report.errors
+    assert [c for c in report.checks if not c.passed] == []
+    layer2 = [c for c in report.checks if c.layer == 2 and c.engine in URDF_ENGINES]
+    assert {c.engine for c in layer2} == set(URDF_ENGINES)
+    assert all("held at zero" not in c.detail for c in layer2)
+    faulty = verify(source, tmp_path / "out2", ("pybullet",), urdf=given, configurations=5, samples=1,
+                    replay=False, driven=False, inject=["axis:joint_1_y:flip"])
+    assert (2, "pybullet", "pose-rotation") in {(c.layer, c.engine, c.quantity) for c in faulty.failed}

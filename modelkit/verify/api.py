@@ -141,7 +141,9 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
         if user is not None:
             if not user.exists():
                 raise VerifyError(f"--{fmt} {user}: no such file")
-            files[fmt], maps[fmt] = user, _given_renames(welded, fmt, user, out_dir)
+            files[fmt], maps[fmt], held = _given_renames(welded, fmt, user, out_dir)
+            if written is not None and held:
+                written[fmt] = held
             report.files[fmt] = str(user)
             continue
         if fmt not in needed:
@@ -165,30 +167,39 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
     return files, maps
 
 
-def _given_renames(robot: Robot, fmt: str, path: Path, out_dir: Path) -> Renames:
-    """The renames of a file the user gave: those ``convert`` makes for ``fmt`` (its MK800 notes, from
-    a conversion staged in memory and never written), each kept where the file has the written name
-    and not the source's (a file ``convert`` wrote; SDF renames a joint named like its link, the
-    tutorial's ``RightWheel`` → ``RightWheel_joint``). A file from elsewhere keeps the source's names."""
+def _given_renames(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Path, Renames, list[Any]]:
+    """A file the user gave, with its renames and the ball-joint chains it holds.
+
+    The renames are those ``convert`` makes for ``fmt`` (its MK800 notes, from a conversion staged in
+    memory and never written), each kept where the file has the written name and not the source's (a
+    file ``convert`` wrote; SDF renames a joint named like its link, the tutorial's ``RightWheel`` →
+    ``RightWheel_joint``). A file from elsewhere keeps the source's names. The chains are the staged
+    conversion's MK813 notes (a ball joint as three joints through two links, URDF) whose joints and
+    links are all in the file, so that the layers compare it as they compare the URDF verify writes."""
     from lxml import etree
 
     from modelkit.convert.api import render_model
     from modelkit.convert.notes import renames
     from modelkit.convert.output import OutputPlan
+    from modelkit.verify.layers import approximations
 
     try:
         notes = render_model(robot, fmt, OutputPlan(out_dir / ".renames"), path.name, WriteOptions())
         parser = etree.XMLParser(resolve_entities=False, no_network=True)
         root = etree.parse(str(path), parser).getroot()
     except Exception:  # the engines' own loading says what is wrong with the file
-        return {"link": {}, "joint": {}}
+        return path, {"link": {}, "joint": {}}, []
     tags = {"link": ("link", "body"), "joint": ("joint",)}
     out: Renames = {}
+    names: dict[str, set[str]] = {}
     for kind, elements in tags.items():
-        names = {str(el.get("name")) for el in root.iter(*elements) if el.get("name")}
+        names[kind] = {str(el.get("name")) for el in root.iter(*elements) if el.get("name")}
         out[kind] = {source: written for source, written in renames(notes, kind).items()
-                     if written in names and source not in names}
-    return out
+                     if written in names[kind] and source not in names[kind]}
+    held = [note for note in notes if any(
+        set(chain.joints) <= names["joint"] and set(chain.links) <= names["link"]
+        for chain in approximations.ball_chains(fmt, [note]))]
+    return path, out, held
 
 
 def _copy_given(files: dict[str, Path], given: dict[str, Path | None], out_dir: Path,

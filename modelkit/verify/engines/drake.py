@@ -7,7 +7,8 @@ Loading: ``MultibodyPlant(time_step=0)`` (continuous: no discrete solver, no con
 no geometry), gravity (0, 0, −9.81). The root is welded to the world at the identity: a joint the
 file itself declares between the world and the root (SDF ``<joint>`` to ``world``, URDF ``world``
 link) is removed with ``RemoveJoint`` and replaced by ``WeldFrames(world, root, identity)``, which
-is also what a free root gets; then the plant is finalized. The base weld is not reported as a
+is also what a free root gets, unless it is a weld without rotation, which is kept
+(:func:`_unrotated_weld`); then the plant is finalized. The base weld is not reported as a
 joint (the source's root joint is not a tree joint either). A root named ``world`` (the MJCF
 reader's synthesised link that top-level bodies hang from by their joints, or a URDF ``world``
 link) is Drake's world body itself: nothing is welded, the file's joints to it are the model's
@@ -86,6 +87,20 @@ _TYPES = {
     "universal": "universal",
     "screw": "screw",
 }
+
+
+def _unrotated_weld(joint: Any) -> bool:
+    """Whether ``joint`` welds its child without rotating it (a URDF ``world`` link's fixed joint, what
+    ``convert --base fixed`` writes at the root's pose). Such a weld is kept rather than replaced by
+    the identity: poses are taken relative to the root and gravity points the same way in its frame,
+    so the layers see the same robot, and Drake cannot remove a joint once its URDF parser added a
+    constraint (a mimic joint's coupler: example-robot-data's Panda given as convert's URDF)."""
+    if joint.type_name() != "weld":
+        return False
+    parent = joint.frame_on_parent().GetFixedPoseInBodyFrame().rotation().matrix()
+    child = joint.frame_on_child().GetFixedPoseInBodyFrame().rotation().matrix()
+    rotation = parent @ joint.X_FM().rotation().matrix() @ child.T
+    return bool(np.abs(rotation - np.eye(3)).max() <= 1e-12)
 
 
 class DrakeLoadError(RuntimeError):
@@ -206,6 +221,7 @@ class DrakeModel:
         # that name in the model instance and nothing to weld; the file's joints to it are the model's.
         self._world_root = root == WORLD and not plant.HasBodyNamed(root, self._instance)
         removed: list[str] = []
+        kept: str | None = None
         if self._world_root:
             root_body = world
         else:
@@ -216,10 +232,15 @@ class DrakeModel:
             for index in list(plant.GetJointIndices()):
                 joint = plant.get_joint(index)
                 ends = {joint.parent_body().index(), joint.child_body().index()}
-                if ends == {world.index(), root_body.index()}:
-                    removed.append(f"{joint.name()} ({joint.type_name()})")
-                    plant.RemoveJoint(joint)
-            plant.WeldFrames(world.body_frame(), root_body.body_frame(), RigidTransform())
+                if ends != {world.index(), root_body.index()}:
+                    continue
+                if _unrotated_weld(joint):
+                    kept = joint.name()
+                    continue
+                removed.append(f"{joint.name()} ({joint.type_name()})")
+                plant.RemoveJoint(joint)
+            if kept is None:
+                plant.WeldFrames(world.body_frame(), root_body.body_frame(), RigidTransform())
         plant.mutable_gravity_field().set_gravity_vector(_vec(GRAVITY))
         try:
             plant.Finalize()
@@ -255,7 +276,9 @@ class DrakeModel:
             "file": path.name,
             "plant": "MultibodyPlant(time_step=0) (continuous), no SceneGraph",
             "base": ("the root is Drake's world body (the file's joints to 'world' are the model's)"
-                     if self._world_root else (
+                     if self._world_root else
+                     f"the file's weld {kept} to the world kept (no rotation: the same robot in the root's "
+                     "frame)" if kept is not None else (
                          f"file's world joint removed ({', '.join(removed)}), " if removed else "free root, "
                      ) + f"WeldFrames(world, {root}, identity)"),
             "gravity": list(GRAVITY),

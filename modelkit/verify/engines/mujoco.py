@@ -468,6 +468,41 @@ def load(model: Path | Robot, renames: Renames, *, root: str) -> MujocoModel:
     return MujocoModel(Path(model), root)
 
 
+
+def _add_point_inertia(m: Any, body: int, mass: float, moment: float, pos: Array) -> None:
+    """Add ``mass`` kg with ``moment`` kg·m² on each axis at ``pos`` (body frame) to the compiled
+    ``body``: what a URDF's link on a fixed joint adds to its parent in any rigid-body engine. The
+    body's COM, principal moments and axes are recomputed (parallel axis theorem, then ``eigh``)."""
+    m0 = float(m.body_mass[body])
+    c0 = np.array(m.body_ipos[body], dtype=float)
+    flat = np.zeros(9)
+    mujoco.mju_quat2Mat(flat, np.array(m.body_iquat[body], dtype=float))
+    r0 = flat.reshape(3, 3)
+    total = m0 + mass
+    com = (m0 * c0 + mass * pos) / total
+
+    def shifted(d: Array) -> Array:
+        return float(d @ d) * np.eye(3) - np.outer(d, d)
+
+    tensor = (r0 @ np.diag(np.array(m.body_inertia[body], dtype=float)) @ r0.T + m0 * shifted(c0 - com)
+              + moment * np.eye(3) + mass * shifted(pos - com))
+    moments, axes = np.linalg.eigh(0.5 * (tensor + tensor.T))
+    if np.linalg.det(axes) < 0.0:
+        axes[:, 2] = -axes[:, 2]
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, axes.reshape(-1))
+    set_inertial(m, body, total, com, moments, quat)
+
+
+def set_inertial(m: Any, body: int, mass: float, ipos: Any, moments: Any, iquat: Any) -> None:
+    """A compiled body's mass, COM, principal moments and axes, set. ``body_sameframe`` is cleared:
+    MuJoCo takes a body flagged there (its COM frame was its body frame at compile time) to have its
+    COM at the body origin whatever ``body_ipos`` says (the replay of example-robot-data's UR5 given as
+    convert's MJCF, whose ``tool0`` site's 1e-6 kg went to ``wrist_3_link``: 3.7e-7 rad off PyBullet)."""
+    m.body_mass[body], m.body_ipos[body] = mass, ipos
+    m.body_inertia[body], m.body_iquat[body] = moments, iquat
+    m.body_sameframe[body] = 0
+
 class MujocoSimulator:
     """The fixed-base model integrated by MuJoCo (semi-implicit Euler, contacts off)."""
 
@@ -486,12 +521,16 @@ class MujocoSimulator:
             b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, body)
             if b == 0 or body == root:
                 continue  # the world, or the welded root: its mass takes part in no dynamics
+            if b < 0 and body in self.inner._sites:  # a frame the MJCF holds as a site (MK873)
+                site = self.inner._sites[body]
+                if int(m.site_bodyid[site]) != self.inner._root_id:
+                    _add_point_inertia(m, int(m.site_bodyid[site]), mass, moment, np.array(m.site_pos[site]))
+                continue
             if b < 0:
                 raise ValueError(f"{path.name}: no body named {body!r}")
             # At the link origin (where the other engine puts it): the body's last joint's anchor, which
             # is not the body frame when the joint has a pos (humanoid's abdomen joints: 0 0 .065).
-            m.body_mass[b], m.body_inertia[b] = mass, (moment, moment, moment)
-            m.body_ipos[b], m.body_iquat[b] = offsets[b], (1.0, 0.0, 0.0, 0.0)
+            set_inertial(m, b, mass, offsets[b], (moment, moment, moment), (1.0, 0.0, 0.0, 0.0))
         # Another engine's diagonalised tensors (``principal``: mass, COM in the link frame, principal
         # moments, axes as a quaternion xyzw), for bodies that are one link each: both engines then
         # integrate the same numbers, and the replay tests the dynamics, not PyBullet's importer.
@@ -500,9 +539,8 @@ class MujocoSimulator:
             b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, body)
             if b <= 0 or body == root or b not in single:
                 continue
-            m.body_mass[b], m.body_inertia[b] = mass, moments
-            m.body_ipos[b] = offsets[b] + com
-            m.body_iquat[b] = (quat_xyzw[3], quat_xyzw[0], quat_xyzw[1], quat_xyzw[2])
+            set_inertial(m, b, mass, offsets[b] + com, moments,
+                         (quat_xyzw[3], quat_xyzw[0], quat_xyzw[1], quat_xyzw[2]))
         m.opt.timestep = dt
         m.opt.integrator = int(mujoco.mjtIntegrator.mjINT_EULER)
         m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)

@@ -34,6 +34,7 @@ import numpy as np
 
 from modelkit.convert.tracks import PYBULLET_SOLVER_ITERATIONS
 from modelkit.formats.urdf.writer import PYBULLET_MAX_JOINTS
+from modelkit.model import WORLD_LINK
 from modelkit.spatial import Pose
 from modelkit.verify.engines import child
 from modelkit.verify.engines.child import Worker
@@ -163,7 +164,13 @@ class PyBulletModel:
         self._types = {v: k for k, v in info["types"].items()}
         self._joints: list[dict[str, Any]] = info["joints"]
         self.base: str = info["base"]
-        if root is not None and root != self.base:
+        self.root = root if root is not None else self.base
+        # A URDF that welds its root itself (``convert --base fixed``: a ``world`` link and a fixed
+        # joint to the root): by the URDF convention ``world`` is the world, so neither that link nor
+        # that joint is the robot's, and poses are taken in the root's frame (PyBullet's base is
+        # ``world`` then).
+        self.world_joint = self._world_joint(self.root)
+        if self.root != self.base and self.world_joint is None:
             self._worker.close()
             raise PyBulletError(f"PyBullet's base link is {self.base!r}, not the root {root!r}")
         self._links = [self.base] + [j["child"] for j in self._joints]  # index + 1 = PyBullet link index
@@ -199,6 +206,18 @@ class PyBulletModel:
         if tolerances:
             self.settings["tolerances"] = tolerances
 
+    def _world_joint(self, root: str) -> str | None:
+        """The fixed joint from the base link ``world`` to ``root``, when the file welds it so."""
+        if self.base != WORLD_LINK or root == WORLD_LINK:
+            return None
+        return next((str(j["name"]) for j in self._joints
+                     if j["parent"] == -1 and j["child"] == root and self._types.get(j["type"]) == "fixed"),
+                    None)
+
+    def _robots(self, name: str) -> bool:
+        """Whether the link ``name`` is the robot's (not the file's ``world``)."""
+        return self.world_joint is None or name != WORLD_LINK
+
     def diagonalised_inertials(self) -> dict[str, tuple[float, Array, Array, Array]]:
         """The links whose URDF inertia PyBullet's importer diagonalised (products of inertia: its
         inertial frame is rotated), as PyBullet holds them: mass, COM in the link frame, principal
@@ -223,11 +242,15 @@ class PyBulletModel:
     def static(self) -> StaticFacts:
         facts = StaticFacts()
         for name, d in self._dynamics.items():
+            if not self._robots(name):
+                continue
             rot = self._inertial[name].rotation
             inertia = rot @ np.diag(np.asarray(d["inertia_diagonal"], dtype=float)) @ rot.T
             facts.links[name] = LinkFacts(float(d["mass"]), np.asarray(d["inertial_pos"], dtype=float),
                                           0.5 * (inertia + inertia.T))
         for j in self._joints:
+            if j["name"] == self.world_joint:
+                continue
             kind = self._types.get(j["type"], f"type-{j['type']}")
             moves = kind in ("revolute", "prismatic")
             axis = np.zeros(3)
@@ -269,8 +292,8 @@ class PyBulletModel:
                 world[name] = _pose(com_pos, com_orn) @ self._inertial[name].inverse()
             else:
                 world[name] = _pose(link_pos, link_orn)
-        to_root = base.inverse()
-        return {name: to_root @ pose for name, pose in world.items()}
+        to_root = world[self.root].inverse()
+        return {name: to_root @ pose for name, pose in world.items() if self._robots(name)}
 
     def mass_matrix(self, q: dict[str, float]) -> Array:
         m = self._worker.request("mass_matrix", timeout=self.timeout, q=self._q_vector(q))

@@ -15,7 +15,19 @@ from typing import Any
 
 import numpy as np
 
-from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, JointType, Mesh, Robot, Sphere
+from modelkit.model import (
+    WORLD_LINK,
+    Box,
+    Capsule,
+    Cone,
+    Cylinder,
+    Ellipsoid,
+    Geom,
+    JointType,
+    Mesh,
+    Robot,
+    Sphere,
+)
 from modelkit.spatial import Pose
 from modelkit.verify.engines.child import Worker, serve
 from modelkit.verify.engines.protocol import (
@@ -168,6 +180,13 @@ class YourdfpyKinematics:
             "fk": "URDF.get_transform(child, parent) per joint, composed from the base link"}
         self._dofs = [j.name for j in self.urdf.robot.joints
                       if j.type in ("revolute", "continuous", "prismatic") and j.mimic is None]
+        # A URDF that welds its root itself (a ``world`` link, a fixed joint to the root): by the URDF
+        # convention that link is the world, not the robot's (as in the PyBullet adapter).
+        self._world_joint = next((j.name for j in self.urdf.robot.joints if j.parent == WORLD_LINK
+                                  and j.child == root and j.type == "fixed" and root != WORLD_LINK), None)
+
+    def _robots(self, link: str) -> bool:
+        return self._world_joint is None or link != WORLD_LINK
 
     def dof_names(self) -> list[str]:
         return list(self._dofs)
@@ -175,6 +194,8 @@ class YourdfpyKinematics:
     def static(self) -> StaticFacts:
         facts = StaticFacts()
         for link in self.urdf.robot.links:
+            if not self._robots(link.name):
+                continue
             inertial = link.inertial
             if inertial is None:
                 facts.links[link.name] = LinkFacts(0.0, np.zeros(3), np.zeros((3, 3)))
@@ -184,6 +205,8 @@ class YourdfpyKinematics:
             facts.links[link.name] = LinkFacts(float(inertial.mass or 0.0), origin[:3, 3].copy(),
                                                rot @ np.asarray(inertial.inertia, dtype=float) @ rot.T)
         for joint in self.urdf.robot.joints:
+            if joint.name == self._world_joint:
+                continue
             jtype = {"continuous": "revolute"}.get(joint.type, joint.type)
             moving = jtype in ("revolute", "prismatic")
             lower, upper = -math.inf, math.inf
@@ -225,6 +248,8 @@ class YourdfpyKinematics:
             root_inverse[:3, 3] = -rotation.T @ translation
         out: dict[str, Pose] = {}
         for link in urdf.robot.links:
+            if not self._robots(link.name):
+                continue
             if root_inverse is not None and link.name in in_base:
                 t = root_inverse @ in_base[link.name]
             else:  # not below the base link: yourdfpy's own path search

@@ -223,6 +223,39 @@ def urdf_frames(urdf: Path, source: Robot, renames: Renames, engine: str) -> dic
     return out
 
 
+def sdf_frames(sdf: Path, source: Robot, renames: Renames) -> dict[str, Approximated]:
+    """Links of an SDF that are massless in the source and hold the SDF writer's tiny inertial (a
+    massless link it keeps, MK816), read from the file: a file given to verify comes without the
+    writer's notes, and Drake reads the mass as written."""
+    from modelkit.formats.sdf.writer import TINY_INERTIA, TINY_MASS
+
+    back = _source_names(renames)
+    massless = {link.name for link in source.links if link.inertial is None or link.inertial.mass == 0.0}
+    parser = etree.XMLParser(resolve_entities=False, no_network=True)
+    out: dict[str, Approximated] = {}
+    for el in etree.parse(str(sdf), parser).iter("link"):
+        written = str(el.get("name"))
+        name = back.get(written, written)
+        inertial = el.find("inertial")
+        if name in massless and inertial is not None and _is_sdf_tiny(inertial, TINY_MASS, TINY_INERTIA):
+            out[name] = Approximated(name, TINY_MASS, TINY_INERTIA, "MK816", "the SDF writer")
+    return out
+
+
+def _is_sdf_tiny(inertial: etree._Element, mass: float, moment: float) -> bool:
+    """Whether an SDF ``<inertial>`` is exactly ``mass`` kg at the link origin with ``moment`` on each
+    axis (its ``<pose>``, if any, moves no COM: a rotation of an isotropic tensor changes nothing)."""
+    try:
+        got = float((inertial.findtext("mass") or "nan").strip())
+        pose = [float(v) for v in (inertial.findtext("pose") or "0 0 0").split()[:3]]
+        tensor = inertial.find("inertia")
+        moments = [float((tensor.findtext(k) if tensor is not None else None) or "0")
+                   for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")]
+    except ValueError:
+        return False
+    return got == mass and pose == [0.0, 0.0, 0.0] and moments == [moment, moment, moment, 0.0, 0.0, 0.0]
+
+
 def _is_tiny(inertial: etree._Element, mass: float, moment: float) -> bool:
     """Whether an ``<inertial>`` is exactly ``mass`` kg at the link origin with ``moment`` on each axis."""
     mass_el, tensor, origin = inertial.find("mass"), inertial.find("inertia"), inertial.find("origin")
@@ -294,6 +327,8 @@ def for_engine(engine: str, fmt: str, notes: Iterable[ConversionNote], file: Pat
     out.update(zero_inertias(fmt, notes, renames, source))
     if fmt == "urdf":
         out.update(urdf_frames(file, source, renames, engine))
+    elif fmt == "sdf":
+        out.update(sdf_frames(file, source, renames))
     out.update(refused_inertias(engine, fmt, source))
     return out
 
