@@ -163,7 +163,17 @@ def load(model: Path | Robot, renames: Renames, *, root: str) -> SourceModel:
     return SourceModel(model)
 
 
-class YourdfpyKinematics:
+class _KinematicsOnly:
+    """yourdfpy computes no dynamics: the layers skip layer 3 for it."""
+
+    def mass_matrix(self, q: dict[str, float]) -> Array:
+        raise NotImplementedError("yourdfpy computes kinematics only")
+
+    def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
+        raise NotImplementedError("yourdfpy computes kinematics only")
+
+
+class YourdfpyKinematics(_KinematicsOnly):
     """yourdfpy's forward kinematics on the written URDF (an independent URDF parser; poses only), in
     this process: what :class:`YourdfpyModel` runs in its child."""
 
@@ -257,12 +267,6 @@ class YourdfpyKinematics:
             out[link.name] = Pose(t[:3, :3].copy(), t[:3, 3].copy())
         return out
 
-    def mass_matrix(self, q: dict[str, float]) -> Array:
-        raise NotImplementedError("yourdfpy computes kinematics only")
-
-    def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
-        raise NotImplementedError("yourdfpy computes kinematics only")
-
     def close(self) -> None:
         return None
 
@@ -316,7 +320,7 @@ def start_yourdfpy() -> Worker | None:
     return yourdfpy_worker()
 
 
-class YourdfpyModel:
+class YourdfpyModel(_KinematicsOnly):
     """yourdfpy's forward kinematics on the written URDF (an independent URDF parser; poses only),
     computed by :class:`YourdfpyKinematics` in the child process ``worker`` (:func:`yourdfpy_worker`),
     which this model owns from now on."""
@@ -344,12 +348,6 @@ class YourdfpyModel:
     def link_poses(self, q: dict[str, float]) -> dict[str, Pose]:
         poses: dict[str, Pose] = self._worker.request("link_poses", q=dict(q))
         return poses
-
-    def mass_matrix(self, q: dict[str, float]) -> Array:
-        raise NotImplementedError("yourdfpy computes kinematics only")
-
-    def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
-        raise NotImplementedError("yourdfpy computes kinematics only")
 
     def close(self) -> None:
         self._worker.close()
