@@ -110,3 +110,36 @@ def test_a_fault_in_the_given_files_still_fails(given: dict[str, Path], tmp_path
                     samples=2, driven=False)
     failed = {(c.engine, c.quantity, c.where) for c in report.failed}
     assert {("mujoco", "mass", "link2"), ("pybullet", "mass", "link2")} <= failed
+
+
+def test_a_floating_robot_with_a_repaired_inertia_given_as_convert_wrote_it(tmp_path: Path) -> None:
+    """``convert --base floating``: the MJCF has a free joint and a ``home`` keyframe of 7 + n numbers,
+    which MuJoCo refused once verify deleted the free joint to weld the base ("keyframe 'home': invalid
+    qpos size", example-robot-data's A1, Solo12 and ANYmal C); and a source tensor that violates the
+    triangle inequality, which the SDF writer lifts (MK860): Drake's layer 1 compared the lifted tensor
+    with the source's and failed (ANYmal C's ``hatch``)."""
+    source = tmp_path / "arm.urdf"
+    violating = 'ixx="0.012" iyy="0.011" izz="0.03"'  # 0.012 + 0.011 < 0.03
+    source.write_text(ARM.replace('ixx="0.012" iyy="0.011" izz="0.002"', violating))
+    given = {}
+    for kind, suffix in (("mjcf", "xml"), ("sdf", "sdf")):
+        given[kind] = tmp_path / "given" / f"arm.{suffix}"
+        result = CliRunner().invoke(main, ["convert", str(source), "-o", str(given[kind]),
+                                           "--base", "floating"])
+        assert result.exit_code == 0, result.output
+    assert "<freejoint" in given["mjcf"].read_text() and '<key name="home"' in given["mjcf"].read_text()
+    engines = ("mujoco", "pinocchio", *(("drake",) if "drake" in _installed() else ()))
+    report = verify(source, tmp_path / "out", engines, mjcf=given["mjcf"], sdf=given["sdf"],
+                    configurations=3, samples=3, replay=False, driven=False)
+    assert report.errors == []
+    assert [f"{c.engine} {c.quantity} {c.where}: {c.detail}" for c in report.failed] == []
+    assert {c.engine for c in report.checks} == set(engines)
+    if "drake" in engines:
+        inertia = [c for c in report.checks if c.engine == "drake" and c.quantity == "inertia"]
+        assert inertia and inertia[0].passed
+
+
+def _installed() -> set[str]:
+    import importlib.util
+
+    return {"drake"} if importlib.util.find_spec("pydrake") is not None else set()

@@ -16,7 +16,7 @@ from modelkit.convert.api import write
 from modelkit.verify.api import ENGINE_FILES, verify, welded_copy
 
 pytest.importorskip("yourdfpy")
-from modelkit.verify.engines import reference  # noqa: E402
+from modelkit.verify.engines import reference
 
 PANTILT = (Path(__file__).resolve().parents[1] / "samples" / "choreonoid_ros2_mobile_robot_tutorial" / "model"
            / "mobile_robot_pantilt.body")

@@ -86,6 +86,7 @@ ENGINE_FILES = WriteOptions(urdf_world_link=False, urdf_sensor_links=False, actu
                             frame_sites=False)
 INJECT = "modelkit.verify.layers.inject:apply"
 
+INERTIA_REPAIRS = ("MK860", "MK870")  # the SDF and MJCF writers' repairs of a source tensor no engine holds
 CONFIGURATIONS = 50  # layer 2: q = 0 and this many random configurations
 SAMPLES = 20  # layer 3a: random (q, dq)
 REPLAY_SECONDS = 10.0
@@ -141,7 +142,7 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
         if user is not None:
             if not user.exists():
                 raise VerifyError(f"--{fmt} {user}: no such file")
-            files[fmt], maps[fmt], held = _given_renames(welded, fmt, user, out_dir)
+            files[fmt], maps[fmt], held = _given_file(welded, fmt, user, out_dir)
             if written is not None and held:
                 written[fmt] = held
             report.files[fmt] = str(user)
@@ -167,15 +168,19 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
     return files, maps
 
 
-def _given_renames(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Path, Renames, list[Any]]:
-    """A file the user gave, with its renames and the ball-joint chains it holds.
+def _given_file(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Path, Renames, list[Any]]:
+    """A file the user gave, with its renames and the writer's notes that say what it holds.
 
     The renames are those ``convert`` makes for ``fmt`` (its MK800 notes, from a conversion staged in
     memory and never written), each kept where the file has the written name and not the source's (a
     file ``convert`` wrote; SDF renames a joint named like its link, the tutorial's ``RightWheel`` →
     ``RightWheel_joint``). A file from elsewhere keeps the source's names. The chains are the staged
     conversion's MK813 notes (a ball joint as three joints through two links, URDF) whose joints and
-    links are all in the file, so that the layers compare it as they compare the URDF verify writes."""
+    links are all in the file, so that the layers compare it as they compare the URDF verify writes.
+    The writer's inertia repairs (SDF MK860, MJCF MK870: a source tensor no engine holds, lifted to
+    the nearest valid one) come along: the engines are compared with the repaired tensor, as for
+    verify's own files (a file that repairs it otherwise fails layer 1 there, as it did against the
+    source's tensor)."""
     from lxml import etree
 
     from modelkit.convert.api import render_model
@@ -196,7 +201,7 @@ def _given_renames(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[P
         names[kind] = {str(el.get("name")) for el in root.iter(*elements) if el.get("name")}
         out[kind] = {source: written for source, written in renames(notes, kind).items()
                      if written in names[kind] and source not in names[kind]}
-    held = [note for note in notes if any(
+    held = [note for note in notes if note.code in INERTIA_REPAIRS or any(
         set(chain.joints) <= names["joint"] and set(chain.links) <= names["link"]
         for chain in approximations.ball_chains(fmt, [note]))]
     return path, out, held

@@ -136,6 +136,9 @@ def _compile(path: Path, root: str, actuated: bool = False,
         if joint.type == mujoco.mjtJoint.mjJNT_FREE:
             spec.delete(joint)
             welded = True
+    if welded:  # a keyframe holds the free joint's 7 qpos (convert's `home` of a legged robot): MuJoCo
+        for key in list(spec.keys):  # refuses it without the joint, and layers 1-3 use no keyframe
+            spec.delete(key)
     if actuated:
         drop_actuators(spec)
         for joint in spec.joints:
@@ -517,14 +520,15 @@ class MujocoSimulator:
         self.runtime_warnings = self.inner.runtime_warnings  # compiling and stepping (see ``quiet``)
         m = self.inner.model
         offsets = {body.index: body.offset for body in self.inner._bodies}
+        on_sites: list[tuple[int, float, float, Array]] = []
         for body, (mass, moment) in (inertials or {}).items():
             b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, body)
             if b == 0 or body == root:
                 continue  # the world, or the welded root: its mass takes part in no dynamics
-            if b < 0 and body in self.inner._sites:  # a frame the MJCF holds as a site (MK873)
-                site = self.inner._sites[body]
+            if b < 0 and body in self.inner._sites:  # a frame the MJCF holds as a site (MK873): added
+                site = self.inner._sites[body]  # to its body after that body's own inertia is set
                 if int(m.site_bodyid[site]) != self.inner._root_id:
-                    _add_point_inertia(m, int(m.site_bodyid[site]), mass, moment, np.array(m.site_pos[site]))
+                    on_sites.append((int(m.site_bodyid[site]), mass, moment, np.array(m.site_pos[site])))
                 continue
             if b < 0:
                 raise ValueError(f"{path.name}: no body named {body!r}")
@@ -541,6 +545,8 @@ class MujocoSimulator:
                 continue
             set_inertial(m, b, mass, offsets[b] + com, moments,
                          (quat_xyzw[3], quat_xyzw[0], quat_xyzw[1], quat_xyzw[2]))
+        for b, mass, moment, pos in on_sites:  # after ``principal``, which sets the whole body
+            _add_point_inertia(m, b, mass, moment, pos)
         m.opt.timestep = dt
         m.opt.integrator = int(mujoco.mjtIntegrator.mjINT_EULER)
         m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
