@@ -142,7 +142,8 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
         if user is not None:
             if not user.exists():
                 raise VerifyError(f"--{fmt} {user}: no such file")
-            files[fmt], maps[fmt], held = _given_file(welded, fmt, user, out_dir)
+            files[fmt] = user
+            maps[fmt], held = _given_file(welded, fmt, user, out_dir)
             if written is not None and held:
                 written[fmt] = held
             report.files[fmt] = str(user)
@@ -168,19 +169,19 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
     return files, maps
 
 
-def _given_file(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Path, Renames, list[Any]]:
-    """A file the user gave, with its renames and the writer's notes that say what it holds.
+def _given_file(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Renames, list[Any]]:
+    """A file the user gave: its renames, and the writer's notes that say what it holds.
 
     The renames are those ``convert`` makes for ``fmt`` (its MK800 notes, from a conversion staged in
     memory and never written), each kept where the file has the written name and not the source's (a
     file ``convert`` wrote; SDF renames a joint named like its link, the tutorial's ``RightWheel`` →
-    ``RightWheel_joint``). A file from elsewhere keeps the source's names. The chains are the staged
-    conversion's MK813 notes (a ball joint as three joints through two links, URDF) whose joints and
-    links are all in the file, so that the layers compare it as they compare the URDF verify writes.
-    The writer's inertia repairs (SDF MK860, MJCF MK870: a source tensor no engine holds, lifted to
-    the nearest valid one) come along: the engines are compared with the repaired tensor, as for
-    verify's own files (a file that repairs it otherwise fails layer 1 there, as it did against the
-    source's tensor)."""
+    ``RightWheel_joint``). A file from elsewhere keeps the source's names. The notes kept are the
+    staged conversion's ball-joint chains (MK813: three joints through two links, URDF) whose joints
+    and links are all in the file, so that the layers compare it as they compare the URDF verify
+    writes, and the writer's inertia repairs (SDF MK860, MJCF MK870: a source tensor no engine
+    holds, lifted to the nearest valid one): the engines are compared with the repaired tensor, as
+    for verify's own files (a file that repairs it otherwise fails layer 1 there, as it did against
+    the source's tensor)."""
     from lxml import etree
 
     from modelkit.convert.api import render_model
@@ -193,7 +194,7 @@ def _given_file(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Path
         parser = etree.XMLParser(resolve_entities=False, no_network=True)
         root = etree.parse(str(path), parser).getroot()
     except Exception:  # the engines' own loading says what is wrong with the file
-        return path, {"link": {}, "joint": {}}, []
+        return {"link": {}, "joint": {}}, []
     tags = {"link": ("link", "body"), "joint": ("joint",)}
     out: Renames = {}
     names: dict[str, set[str]] = {}
@@ -204,7 +205,7 @@ def _given_file(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Path
     held = [note for note in notes if note.code in INERTIA_REPAIRS or any(
         set(chain.joints) <= names["joint"] and set(chain.links) <= names["link"]
         for chain in approximations.ball_chains(fmt, [note]))]
-    return path, out, held
+    return out, held
 
 
 def _copy_given(files: dict[str, Path], given: dict[str, Path | None], out_dir: Path,
