@@ -67,3 +67,33 @@ def test_a_given_file_with_a_welded_base_is_not_driven(tmp_path: Path) -> None:
     assert [c for c in report.checks if not c.passed] == []
     said = [s.reason for s in report.skips if s.layer == 4 and s.engine == "mujoco"]
     assert any("welds the robot's base" in s for s in said), said
+
+
+def test_given_urdf_sensor_links_are_graded_where_the_sensors_are(tmp_path: Path) -> None:
+    """convert's default URDF writes each camera, LiDAR and IMU as a link on a fixed joint (MK847, with
+    the writer's 1e-6 kg). verify compares the URDF engines with the source holding those frames at
+    the sensors' poses: the given files pass, and a frame moved by 1 cm fails layer 2 there. Before,
+    the frames were extra links (layer 1) and their 1e-6 kg failed layer 3 and the replay (the
+    tutorial's tracked robot: 8 of 99 checks)."""
+    source = TUTORIAL / "mobile_robot_sensors.body"
+    given = tmp_path / "given"
+    for name in ("r.urdf", "r.xml"):
+        write(modelkit.load(source), given / name)
+    urdf = (given / "r.urdf").read_text()
+    assert '<link name="LiDAR">' in urdf and '<link name="RealSense_optical">' in urdf
+    engines = ("mujoco", "pybullet", "pinocchio", "yourdfpy")
+    report = verify(source, tmp_path / "out", engines, urdf=given / "r.urdf", mjcf=given / "r.xml",
+                    configurations=3, samples=3, driven=False)
+    assert not report.errors, report.errors
+    assert [f"{c.engine} {c.quantity} {c.where}: {c.detail}" for c in report.failed] == []
+    assert [c for c in report.checks if c.quantity == "replay" and c.passed]
+    said = [s.reason for s in report.skips if s.engine == "pybullet" and "sensor frame" in s.reason]
+    assert said and "RealSense_optical on RealSense" in said[0]
+    moved = given / "moved.urdf"  # beside the meshes
+    start = urdf.index('<joint name="LiDAR_joint"')
+    head, tail = urdf[:start], urdf[start:]
+    moved.write_text(head + tail.replace('<origin xyz="0 0 0.025"', '<origin xyz="0.01 0 0.025"', 1))
+    faulty = verify(source, tmp_path / "out2", ("pybullet", "yourdfpy"), urdf=moved, configurations=3,
+                    samples=1, replay=False, driven=False)
+    assert {("pybullet", "pose-position", "LiDAR"), ("yourdfpy", "pose-position", "LiDAR")} <= {
+        (c.engine, c.quantity, c.where) for c in faulty.failed}

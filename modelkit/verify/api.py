@@ -86,7 +86,9 @@ ENGINE_FILES = WriteOptions(urdf_world_link=False, urdf_sensor_links=False, actu
                             frame_sites=False)
 INJECT = "modelkit.verify.layers.inject:apply"
 
-INERTIA_REPAIRS = ("MK860", "MK870")  # the SDF and MJCF writers' repairs of a source tensor no engine holds
+# The writers' notes that say what a given file holds where the file itself is checked later: sensor
+# frames (MK847, each looked up in the file) and repairs of a source tensor no engine holds (MK860/MK870).
+GIVEN_NOTES = ("MK847", "MK860", "MK870")
 CONFIGURATIONS = 50  # layer 2: q = 0 and this many random configurations
 SAMPLES = 20  # layer 3a: random (q, dq)
 REPLAY_SECONDS = 10.0
@@ -178,7 +180,8 @@ def _given_file(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Rena
     ``RightWheel_joint``). A file from elsewhere keeps the source's names. The notes kept are the
     staged conversion's ball-joint chains (MK813: three joints through two links, URDF) whose joints
     and links are all in the file, so that the layers compare it as they compare the URDF verify
-    writes, and the writer's inertia repairs (SDF MK860, MJCF MK870: a source tensor no engine
+    writes, its sensor links (MK847, each looked up in the file by ``approximations.sensor_frames``),
+    and the writer's inertia repairs (SDF MK860, MJCF MK870: a source tensor no engine
     holds, lifted to the nearest valid one): the engines are compared with the repaired tensor, as
     for verify's own files (a file that repairs it otherwise fails layer 1 there, as it did against
     the source's tensor)."""
@@ -202,7 +205,7 @@ def _given_file(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Rena
         names[kind] = {str(el.get("name")) for el in root.iter(*elements) if el.get("name")}
         out[kind] = {source: written for source, written in renames(notes, kind).items()
                      if written in names[kind] and source not in names[kind]}
-    held = [note for note in notes if note.code in INERTIA_REPAIRS or any(
+    held = [note for note in notes if note.code in GIVEN_NOTES or any(
         set(chain.joints) <= names["joint"] and set(chain.links) <= names["link"]
         for chain in approximations.ball_chains(fmt, [note]))]
     return out, held
@@ -487,7 +490,19 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
     src = SourceModel(reference)
     report.engines["source"] = dict(src.settings)
     src_static = source_static(reference)
-    approx = _approximations(reference, loaded, files, maps, written, report)
+    # A URDF engine reading convert's default file holds its sensors as links on fixed joints (MK847):
+    # layers 1-3 compare it with the source holding them (``models``), the report says so.
+    models: dict[str, Robot] = {}
+    for eng in loaded:
+        kind = INPUTS.get(eng.label, "robot")
+        notes = written.get(kind, [])
+        frames = [] if kind == "robot" else approximations.sensor_frames(kind, notes, reference, maps[kind],
+                                                                         files[kind])
+        models[eng.label] = approximations.applied_frames(reference, frames)
+        frames_entry = approximations.frames_skip(eng.label, frames)
+        if frames_entry is not None:
+            report.skips.append(frames_entry)
+    approx = _approximations(models, loaded, files, maps, written, report)
     # A URDF engine holds each ball joint as the writer's chain of three joints (MK813): layer 1
     # compares it with the source holding those chains, layer 2 turns the chain, the report says so.
     chains_of = {eng.label: approximations.ball_chains(INPUTS.get(eng.label, "robot"),
@@ -506,7 +521,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         wheels_entry = approximations.wheels_skip(eng.label, wheels)
         if wheels_entry is not None:
             report.skips.append(wheels_entry)
-        held = approximations.applied_chains(reference, chains)
+        held = approximations.applied_chains(models[eng.label], chains)
         if wheels is not None:
             held = approximations.applied_wheels(held, robot, wheels)
         eng_static = (source_static(approximations.applied(held, approx[eng.label]))
@@ -527,8 +542,9 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
     for eng in loaded:
         chain_joints = {c.joint + key: written_joint for c in chains_of[eng.label]
                         for key, written_joint in zip(BALL_KEYS, c.joints, strict=True)}
-        report.checks.extend(_guarded(2, eng, lambda eng=eng, cj=chain_joints: kinematics.layer2(
-            src, eng, configs, cj)))
+        fk = src if models[eng.label] is reference else SourceModel(models[eng.label])
+        report.checks.extend(_guarded(2, eng, lambda eng=eng, cj=chain_joints, fk=fk: kinematics.layer2(
+            fk, eng, configs, cj)))
     t4 = time.perf_counter()
     pin_ref = next((e.model for e in loaded if e.label == "pinocchio"), None)
     if dynamics.kinematic_only(reference):
@@ -553,7 +569,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
             if eng.label == "pinocchio":
                 continue
             dropped = bool(with_armature) and INPUTS.get(eng.label) in ("urdf", "sdf")
-            model = approximations.applied(reference, approx[eng.label])
+            model = approximations.applied(models[eng.label], approx[eng.label])
             ref = (_without_armature(model) if dropped
                    else pin_ref if model is reference else _pinocchio(model))
             try:
@@ -568,7 +584,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                 report.skips.append(dynamics.no_dynamics(eng))
     t5 = time.perf_counter()
     if replay:
-        _replay(reference, files, maps, loaded, report, approx)
+        _replay(reference, files, maps, loaded, report, approx, models.get("pybullet"))
     t6 = time.perf_counter()
     for eng in loaded:
         messages = list(getattr(eng.model, "runtime_warnings", []))
@@ -643,10 +659,11 @@ def _guarded(layer: int, eng: Any, run: Any, checks: list[Check] | None = None) 
         return [failed]
 
 
-def _approximations(reference: Robot, loaded: list[Any], files: dict[str, Path], maps: dict[str, Renames],
-                    written: dict[str, list[Any]], report: VerifyReport) -> dict[str, Any]:
-    """Per loaded engine, the documented mass approximations it holds (see ``approximations``), each
-    listed in the report."""
+def _approximations(models: Mapping[str, Robot], loaded: list[Any], files: dict[str, Path],
+                    maps: dict[str, Renames], written: dict[str, list[Any]], report: VerifyReport
+                    ) -> dict[str, Any]:
+    """Per loaded engine, the documented mass approximations it holds (see ``approximations``) against
+    ``models`` (the source as that engine's file holds it), each listed in the report."""
     from modelkit.verify.layers import approximations
 
     out: dict[str, Any] = {}
@@ -656,10 +673,27 @@ def _approximations(reference: Robot, loaded: list[Any], files: dict[str, Path],
             out[eng.label] = {}
             continue
         out[eng.label] = approximations.for_engine(eng.label, kind, written.get(kind, []), files[kind],
-                                                   reference, maps[kind])
+                                                   models[eng.label], maps[kind])
         entry = approximations.skip(eng.label, out[eng.label])
         if entry is not None:
             report.skips.append(entry)
+    return out
+
+
+def _frame_placements(held: Robot, inertials: Mapping[str, Any], renames: Renames
+                      ) -> dict[str, tuple[str, Any]]:
+    """Where each link of ``inertials`` (MJCF names) hangs in ``held``, when it hangs by a fixed joint:
+    the parent (MJCF name) and the link's pose in it. The MJCF may hold such a link not as a body (a
+    massless frame as a ``<site>``, MK873; a sensor as its device), and MuJoCo's replay then adds the
+    mass to the body it hangs from, at that pose."""
+    written = renames.get("link", {})
+    back = {w: source for source, w in written.items()}
+    joints = {joint.child: joint for joint in held.joints if joint.type is JointType.FIXED}
+    out: dict[str, tuple[str, Any]] = {}
+    for name in inertials:
+        joint = joints.get(back.get(name, name))
+        if joint is not None:
+            out[name] = (written.get(joint.parent, joint.parent), joint.origin)
     return out
 
 
@@ -696,8 +730,9 @@ def _without_armature(robot: Robot) -> Any:
 
 
 def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], loaded: list[Any],
-            report: VerifyReport, approx: dict[str, Any] | None = None) -> None:
-    """Layer 3b through the replay module (MuJoCo against PyBullet), when it is there."""
+            report: VerifyReport, approx: dict[str, Any] | None = None, held: Robot | None = None) -> None:
+    """Layer 3b through the replay module (MuJoCo against PyBullet), when it is there; ``held``: the
+    source as PyBullet's file holds it (its sensor frames), where PyBullet's approximated links hang."""
     names = [e.label for e in loaded if e.label in ("mujoco", "pybullet")]
     if len(names) < 2:
         report.skips.append(Skip(3, "mujoco+pybullet", "layer 3b (replay) needs both MuJoCo and PyBullet "
@@ -740,6 +775,7 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
             if mine is None or (mine.mass, mine.inertia) != (a.mass, a.inertia):
                 inertials[maps["mjcf"].get("link", {}).get(link, link)] = (a.mass, a.inertia)
     principal = _diagonalised(loaded, maps) if "mjcf" in maps else {}
+    frames = _frame_placements(held or reference, inertials, maps.get("mjcf", {}))
     for name in names:
         kind = INPUTS[name]
         root = maps[kind].get("link", {}).get(str(reference.root), str(reference.root))
@@ -747,7 +783,8 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
         if kind == "mjcf":
             extra = {**({"armature": False} if with_armature else {}),
                      **({"inertials": inertials} if inertials else {}),
-                     **({"principal": principal} if principal else {})}
+                     **({"principal": principal} if principal else {}),
+                     **({"frames": frames} if frames else {})}
         elif name == "pybullet":  # its child from layers 1-3, reused when it holds the same file
             extra = {"loaded": next(e.model for e in loaded if e.label == name)}
         try:

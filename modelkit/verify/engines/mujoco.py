@@ -18,7 +18,7 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-from collections.abc import Collection, Iterator
+from collections.abc import Collection, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -472,6 +472,25 @@ def load(model: Path | Robot, renames: Renames, *, root: str) -> MujocoModel:
 
 
 
+def _hanging(m: Any, link: str, frames: Mapping[str, tuple[str, Pose]], offsets: Mapping[int, Array]
+             ) -> tuple[int, Array] | None:
+    """The body ``link`` hangs from by fixed joints (``frames``: link → parent, pose in the parent) and
+    the link origin in that body's frame; None when it hangs from nothing the model holds. A link
+    frame is its body's frame moved to the body's last joint's anchor (``offsets``), not turned."""
+    position = np.zeros(3)
+    for _ in range(len(frames) + 1):
+        if link not in frames:
+            return None
+        parent, pose = frames[link]
+        rotation = np.asarray(pose.rotation, dtype=float)
+        position = np.asarray(pose.translation, dtype=float) + rotation @ position
+        b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, parent)
+        if b >= 0:
+            return b, (offsets[b] if b > 0 else np.zeros(3)) + position
+        link = parent
+    return None
+
+
 def _add_point_inertia(m: Any, body: int, mass: float, moment: float, pos: Array) -> None:
     """Add ``mass`` kg with ``moment`` kg·m² on each axis at ``pos`` (body frame) to the compiled
     ``body``: what a URDF's link on a fixed joint adds to its parent in any rigid-body engine. The
@@ -506,6 +525,7 @@ def set_inertial(m: Any, body: int, mass: float, ipos: Any, moments: Any, iquat:
     m.body_inertia[body], m.body_iquat[body] = moments, iquat
     m.body_sameframe[body] = 0
 
+
 class MujocoSimulator:
     """The fixed-base model integrated by MuJoCo (semi-implicit Euler, contacts off)."""
 
@@ -513,25 +533,26 @@ class MujocoSimulator:
 
     def __init__(self, path: Path, renames: Renames, root: str, dt: float, armature: bool = True,
                  inertials: dict[str, tuple[float, float]] | None = None,
-                 principal: dict[str, tuple[float, Array, Array, Array]] | None = None) -> None:
+                 principal: dict[str, tuple[float, Array, Array, Array]] | None = None,
+                 frames: dict[str, tuple[str, Pose]] | None = None) -> None:
         # Another engine's documented approximation: a mass on links that are no MuJoCo body of their
         # own (the intermediates of a multi-joint body) needs the body split (same kinematics).
         self.inner = MujocoModel(path, root, actuated=True, split={n for n in inertials or {} if "__" in n})
         self.runtime_warnings = self.inner.runtime_warnings  # compiling and stepping (see ``quiet``)
         m = self.inner.model
         offsets = {body.index: body.offset for body in self.inner._bodies}
-        on_sites: list[tuple[int, float, float, Array]] = []
+        hung: list[tuple[int, float, float, Array]] = []
         for body, (mass, moment) in (inertials or {}).items():
             b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, body)
             if b == 0 or body == root:
                 continue  # the world, or the welded root: its mass takes part in no dynamics
-            if b < 0 and body in self.inner._sites:  # a frame the MJCF holds as a site (MK873): added
-                site = self.inner._sites[body]  # to its body after that body's own inertia is set
-                if int(m.site_bodyid[site]) != self.inner._root_id:
-                    on_sites.append((int(m.site_bodyid[site]), mass, moment, np.array(m.site_pos[site])))
+            if b < 0:  # a link the MJCF holds as no body (a frame as a site, MK873; a sensor): its mass
+                placed = _hanging(m, body, frames or {}, offsets)  # goes to the body it hangs from,
+                if placed is None:  # once that body's own inertia is set
+                    raise ValueError(f"{path.name}: no body named {body!r}")
+                if placed[0] not in (0, self.inner._root_id):
+                    hung.append((placed[0], mass, moment, placed[1]))
                 continue
-            if b < 0:
-                raise ValueError(f"{path.name}: no body named {body!r}")
             # At the link origin (where the other engine puts it): the body's last joint's anchor, which
             # is not the body frame when the joint has a pos (humanoid's abdomen joints: 0 0 .065).
             set_inertial(m, b, mass, offsets[b], (moment, moment, moment), (1.0, 0.0, 0.0, 0.0))
@@ -545,7 +566,7 @@ class MujocoSimulator:
                 continue
             set_inertial(m, b, mass, offsets[b] + com, moments,
                          (quat_xyzw[3], quat_xyzw[0], quat_xyzw[1], quat_xyzw[2]))
-        for b, mass, moment, pos in on_sites:  # after ``principal``, which sets the whole body
+        for b, mass, moment, pos in hung:  # after ``principal``, which sets the whole body
             _add_point_inertia(m, b, mass, moment, pos)
         m.opt.timestep = dt
         m.opt.integrator = int(mujoco.mjtIntegrator.mjINT_EULER)
@@ -660,8 +681,9 @@ class MujocoSimulator:
 
 def simulator(model: Path, renames: Renames, *, root: str, dt: float, armature: bool = True,
               inertials: dict[str, tuple[float, float]] | None = None,
-              principal: dict[str, tuple[float, Array, Array, Array]] | None = None) -> MujocoSimulator:
-    return MujocoSimulator(Path(model), renames, root, dt, armature, inertials, principal)
+              principal: dict[str, tuple[float, Array, Array, Array]] | None = None,
+              frames: dict[str, tuple[str, Pose]] | None = None) -> MujocoSimulator:
+    return MujocoSimulator(Path(model), renames, root, dt, armature, inertials, principal, frames)
 
 
 # ---- layer 4: the floating-base robot driven on a floor ----------------------------------------

@@ -49,6 +49,7 @@ from lxml import etree
 
 from modelkit.convert.notes import ConversionNote
 from modelkit.model import Cylinder, Inertial, JointType, Robot
+from modelkit.spatial import Pose
 from modelkit.verify.engines.protocol import Skip, StaticFacts
 
 Renames = dict[str, dict[str, str]]
@@ -465,6 +466,82 @@ def ball_chains(fmt: str, notes: Iterable[ConversionNote]) -> list[BallChain]:
     return out
 
 
+SENSOR_FRAME = re.compile(r'"(?P<frame>[^"]+)" on "(?P<parent>[^"]+)"'
+                          r'(?: \(the name "(?P<wanted>[^"]+)" is taken\))?'
+                          r'(?: with its optical frame "(?P<optical>[^"]+)")?')
+"""One sensor in the URDF writer's MK847 note (``formats/urdf/write_frames.sensor_frames`` writes it)."""
+
+
+@dataclass(frozen=True)
+class SensorFrame:
+    """A sensor the URDF writer wrote as a link of its own on a fixed joint (MK847): the frame link,
+    the link it hangs from (a source name; a camera's optical frame hangs from the camera's frame),
+    the written fixed joint, and the frame's pose in that link, taken from the source's device (the
+    optical frame's is REP-103's), so that the layers compare where the file put it."""
+
+    link: str
+    parent: str
+    joint: str
+    origin: Pose
+
+
+def sensor_frames(fmt: str, notes: Iterable[ConversionNote], source: Robot, renames: Renames,
+                  file: Path) -> list[SensorFrame]:
+    """The URDF writer's sensor frames that ``file`` holds, read from its MK847 note (none for another
+    format, or where the file has no such link on a joint)."""
+    notes = [note for note in notes if note.code == "MK847"]
+    if fmt != "urdf" or not notes:
+        return []
+    from modelkit.formats.urdf.write_frames import OPTICAL_POSE
+
+    back = _source_names(renames)
+    parser = etree.XMLParser(resolve_entities=False, no_network=True)
+    joint_of = {str(child.get("link")): str(joint.get("name"))
+                for joint in etree.parse(str(file), parser).iterfind("./joint")
+                for child in joint.iterfind("child")}
+    out: list[SensorFrame] = []
+    for note in notes:
+        for match in SENSOR_FRAME.finditer(note.message):
+            parent = back.get(match["parent"], match["parent"])
+            link = source.link(parent)
+            wanted = match["wanted"] or match["frame"]
+            devices = link.devices if link is not None else []
+            device = next((d for d in devices if (d.name or d.canonical.value) == wanted), None)
+            if device is None or match["frame"] not in joint_of:
+                continue
+            out.append(SensorFrame(match["frame"], parent, joint_of[match["frame"]], device.pose))
+            if match["optical"] and match["optical"] in joint_of:
+                optical = match["optical"]
+                out.append(SensorFrame(optical, match["frame"], joint_of[optical], OPTICAL_POSE))
+    return out
+
+
+def applied_frames(robot: Robot, frames: list[SensorFrame]) -> Robot:
+    """A copy of ``robot`` holding the sensor frames as massless links on fixed joints, as the URDF
+    does (the writer's tiny inertial comes with :func:`applied`)."""
+    if not frames:
+        return robot
+    from modelkit.model import Joint, Link
+
+    out = copy.deepcopy(robot)
+    for frame in frames:
+        out.links.append(Link(frame.link))
+        out.joints.append(Joint(frame.joint, JointType.FIXED, frame.parent, frame.link, origin=frame.origin,
+                                synthesised=True))
+    return out
+
+
+def frames_skip(engine: str, frames: list[SensorFrame]) -> Skip | None:
+    """The report's entry for an engine holding sensor frames (never a silent pass)."""
+    if not frames:
+        return None
+    shown = ", ".join(f"{f.link} on {f.parent}" for f in frames)
+    return Skip(1, engine, (
+        f"approximation: the URDF writes {len(frames)} sensor frame(s) as links on fixed joints (MK847; the "
+        f"TF frames ROS tools need): {shown}. Layers 1-3 compare this engine with the source holding them "
+        "at the sensors' poses, with the writer's tiny inertial"))
+
+
 def applied_chains(robot: Robot, chains: list[BallChain]) -> Robot:
     """A copy of ``robot`` whose ball joints are the written chains: the model as the URDF holds it.
     The first joint keeps the ball's origin, the last one keeps the source joint's name and child,
@@ -473,7 +550,6 @@ def applied_chains(robot: Robot, chains: list[BallChain]) -> Robot:
         return robot
     from modelkit.formats.urdf.write_joints import BALL_AXES
     from modelkit.model import Joint, JointLimits, Link
-    from modelkit.spatial import Pose
 
     out = copy.deepcopy(robot)
     by_name = {joint.name: joint for joint in out.joints}
