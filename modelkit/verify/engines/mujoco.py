@@ -471,7 +471,6 @@ def load(model: Path | Robot, renames: Renames, *, root: str) -> MujocoModel:
     return MujocoModel(Path(model), root)
 
 
-
 def _hanging(m: Any, link: str, frames: Mapping[str, tuple[str, Pose]], offsets: Mapping[int, Array]
              ) -> tuple[int, Array] | None:
     """The body ``link`` hangs from by fixed joints (``frames``: link → parent, pose in the parent) and
