@@ -219,6 +219,43 @@ def test_without_ray_the_cluster_option_says_how_to_get_it() -> None:
     assert "modelkit[cluster]" in done.stderr
 
 
+def test_a_ray_server_that_fails_to_start_is_tried_again_a_refusal_is_not(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The connection policy alone (Ray's client stands in: the failure is Ray's proxy's, which no
+    local cluster produces on demand). CI saw "Initialization failure from server" once, a
+    ``ConnectionAbortedError`` from the proxy whose per-client server process had died at start; the
+    next connection gets a new server. Any other error is said at once."""
+    from modelkit.verify import cluster
+
+    class Client:
+        def __init__(self, failures: list[Exception]) -> None:
+            self.failures, self.calls, self.shutdowns = failures, 0, 0
+
+        def init(self, **kwargs: Any) -> None:
+            self.calls += 1
+            if self.failures:
+                raise self.failures.pop(0)
+
+        def shutdown(self) -> None:
+            self.shutdowns += 1
+
+    monkeypatch.setattr(cluster, "CONNECT_PAUSE", 0.0)
+    transient = Client([ConnectionAbortedError("Initialization failure from server")])
+    monkeypatch.setattr(cluster, "_ray", lambda: transient)
+    assert cluster.connect("ray://127.0.0.1:1") is transient
+    assert (transient.calls, transient.shutdowns) == (2, 1)
+    lasting = Client([ConnectionAbortedError("down")] * 5)
+    monkeypatch.setattr(cluster, "_ray", lambda: lasting)
+    with pytest.raises(cluster.ClusterError, match="cannot connect: ConnectionAbortedError: down"):
+        cluster.connect("ray://127.0.0.1:1")
+    assert lasting.calls == cluster.CONNECT_ATTEMPTS
+    refused = Client([ConnectionRefusedError("refused")])
+    monkeypatch.setattr(cluster, "_ray", lambda: refused)
+    with pytest.raises(cluster.ClusterError, match="ConnectionRefusedError: refused"):
+        cluster.connect("ray://127.0.0.1:1")
+    assert refused.calls == 1
+
+
 # ---------------------------------------------------------------- Ray
 
 def _free_port() -> int:

@@ -21,8 +21,10 @@ gets verdict "error" with Ray's reason and the others go on.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -56,15 +58,36 @@ def connect(address: str, num_cpus: int | None = None) -> Any:
         kwargs = {"address": address, "logging_level": logging.WARNING, "log_to_driver": False}
     else:
         raise ClusterError(f"--cluster {address!r}: expected ray://HOST:PORT or local")
-    try:
-        ray.init(**kwargs)
-    except Exception as exc:
-        hint = ""
-        if address.startswith("ray://") and os.environ.get("RAY_AUTH_MODE", "").lower() != "token":
-            hint = (" (if the cluster uses token authentication, as Ray's local clusters do by default, set "
-                    "RAY_AUTH_MODE=token and its token in RAY_AUTH_TOKEN or ~/.ray/auth_token)")
-        raise ClusterError(f"--cluster {address}: cannot connect: {type(exc).__name__}: {exc}{hint}") from exc
+    for attempt in range(CONNECT_ATTEMPTS):
+        try:
+            ray.init(**kwargs)
+            break
+        except ConnectionAbortedError as exc:  # "Initialization failure from server" (see below)
+            if not address.startswith("ray://") or attempt == CONNECT_ATTEMPTS - 1:
+                raise _unreachable(address, exc) from exc
+            with contextlib.suppress(Exception):
+                ray.shutdown()
+            time.sleep(CONNECT_PAUSE)
+        except Exception as exc:
+            raise _unreachable(address, exc) from exc
     return ray
+
+
+CONNECT_ATTEMPTS = 3
+CONNECT_PAUSE = 1.0  # seconds between attempts
+"""The Ray client's proxy starts a server process for each connection; when that process dies at
+start, the proxy answers "Initialization failure from server" (seen in this project's CI: the proxy
+found the process a zombie, ``psutil.ZombieProcess``, while another connection of the same test
+session had just ended), and the next connection gets a new one. So a ``ConnectionAbortedError`` is
+tried again, a refused address or a bad token is not."""
+
+
+def _unreachable(address: str, exc: Exception) -> ClusterError:
+    hint = ""
+    if address.startswith("ray://") and os.environ.get("RAY_AUTH_MODE", "").lower() != "token":
+        hint = (" (if the cluster uses token authentication, as Ray's local clusters do by default, set "
+                "RAY_AUTH_MODE=token and its token in RAY_AUTH_TOKEN or ~/.ray/auth_token)")
+    return ClusterError(f"--cluster {address}: cannot connect: {type(exc).__name__}: {exc}{hint}")
 
 
 def run_ray(jobs: Sequence[Job], out_root: Path | None, address: str,
