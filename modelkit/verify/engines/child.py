@@ -150,6 +150,10 @@ class Worker:
                              + (f"\n{self.name} printed:\n{said}" if said else ""))
         return result
 
+    def alive(self) -> bool:
+        """Whether the child still runs (it ends at :meth:`close`, :meth:`kill`, or when it crashed)."""
+        return self.proc.poll() is None
+
     def kill(self) -> None:
         if self.proc.poll() is None:
             self.proc.kill()

@@ -343,7 +343,7 @@ class PyBulletModel:
 
     def alive(self) -> bool:
         """Whether the child process still runs (it ends at :meth:`close`, or when PyBullet crashed)."""
-        return self._worker.proc.poll() is None
+        return self._worker.alive()
 
     def close(self) -> None:
         self._worker.close()

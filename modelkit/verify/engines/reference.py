@@ -359,6 +359,6 @@ def load_yourdfpy(model: Path | Robot, renames: Renames, *, root: str,
     started one, else in this process."""
     if isinstance(model, Robot):
         raise TypeError("yourdfpy reads the written URDF")
-    if worker is not None and worker.proc.poll() is None:
+    if worker is not None and worker.alive():
         return YourdfpyModel(Path(model), root, worker)
     return YourdfpyKinematics(Path(model), root)
