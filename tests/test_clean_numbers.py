@@ -14,7 +14,7 @@ from lxml import etree
 
 from modelkit.api import validate
 from modelkit.convert.api import write
-from modelkit.convert.compare import compare_poses
+from modelkit.convert.compare import compare_poses, compare_robots
 from modelkit.convert.notes import renames
 from modelkit.convert.numbers import clean_angle, clean_length, clean_rotation, fmt, fmt_text, length_scale
 from modelkit.formats.mjcf.write_xml import euler_text, quat_wxyz, set_pose, z_turn, zaxis_text
@@ -45,8 +45,15 @@ def test_dust_goes_and_written_decimals_stay() -> None:
     assert clean_angle(2.06823107110214e-13) == 0.0
     assert clean_angle(1.5708) == 1.5708
     assert clean_length(-2.0e-13) == 0.0
-    with length_scale(1e-3):  # a millimetre robot: 2e-13 m is no longer dust below 1e-12 of it
+    assert clean_length(2.28232e-12) == 0.0 and clean_length(-5.54343e-11) == 0.0  # iCub's, and ten times it
+    assert clean_length(-8.66e-10) == -8.66e-10  # ANYmal's COM: over 1e-10 of a metre robot, a value
+    with length_scale(1e-3):  # a millimetre robot: 2e-13 m is no longer dust below 1e-10 of it
         assert clean_length(-2.0e-13) == -2.0e-13
+        assert clean_length(-5.0e-14) == 0.0
+    assert clean_angle(1.53106e-11) == 0.0 and clean_angle(-9e-11) == 0.0  # iCub's
+    assert clean_angle(2e-10) == 2e-10
+    assert clean_angle(math.pi / 2 + 5e-11) == math.pi / 2 + 5e-11  # only zero takes the 1e-10
+    assert clean_rotation(5e-11) == 0.0 and clean_rotation(2e-10) == 2e-10
 
 
 def test_source_text_numbers_in_the_writers_form() -> None:
@@ -119,6 +126,7 @@ def test_axis_dust_is_written_as_zero(tmp_path: Path) -> None:
 
     assert fmt_direction([0.0, -1.0, 6.123233995736766e-17]) == "0 -1 0"
     assert fmt_direction([0.0, -2.0, 1e-9]) == "0 -2 1e-9"  # 5e-10 of the length: not dust
+    assert fmt_direction([0.0, -2.0, 1e-10]) == "0 -2 0"  # 5e-11 of the length: dust
     source = tmp_path / "axis.urdf"
     source.write_text("""<robot name="axis">
   <link name="a"><inertial><mass value="1"/>
@@ -220,3 +228,107 @@ def test_a_pitch_past_a_right_angle_keeps_its_source_text(tmp_path: Path) -> Non
 
         again = matrix_from_rpy(*(float(v) for v in fmt_rpy(matrix_from_rpy(*rpy)).split()))
         assert np.allclose(again, matrix_from_rpy(*rpy), atol=1e-12)
+
+
+SUB_NANO = """<robot name="cad">
+  <link name="base"><inertial><mass value="2"/>
+    <inertia ixx="0.00159938741862" iyy="0.00159938741932" izz="5.4423177329e-5"
+             ixy="-9.32e-13" ixz="1.039e-11" iyz="1.7563e-11"/></inertial></link>
+  <link name="finger"><inertial><origin xyz="0.01 0 0"/><mass value="0.00645"/>
+    <inertia ixx="8.2671e-7" iyy="1.98028e-6" izz="2.64638e-6"
+             ixy="-1.08876e-6" ixz="-3.7e-10" iyz="8.1e-10"/>
+  </inertial></link>
+  <link name="tip"><inertial><mass value="0.01"/>
+    <inertia ixx="1e-6" iyy="1e-6" izz="1e-6" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="knuckle" type="revolute"><parent link="base"/><child link="finger"/>
+    <origin xyz="0 2.28232e-12 0.9" rpy="1.5708 1.53106e-11 5.10376e-12"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="pad" type="revolute"><parent link="finger"/><child link="tip"/>
+    <origin xyz="0.05 -5.54343e-12 0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+def test_sub_nanometre_source_values_are_written_as_zero_or_in_principal_form(tmp_path: Path) -> None:
+    """A CAD export's values far under a nanometre (iCub's ``2.28232e-12`` offsets, ``1.53106e-11`` and
+    ``5.10376e-12`` angles, from example-robot-data) are written as 0, and a finger's tensor with a
+    product under 1e-9 kg·m² (``ixz="-3.7e-10"``, 1.4e-4 of its moments) as its principal axes and
+    moments, with no ``e-1x`` number. ANYmal B's base-like tensor keeps ``fullinertia``: its products
+    of 1e-11 beside moments 4e-10 apart leave no principal axes but round-off. The tensors and the poses
+    read back equal to 1e-9, and MuJoCo compiles the finger's principal moments and axes from the
+    source's tensor to 1e-15."""
+    source = tmp_path / "cad.urdf"
+    source.write_text(SUB_NANO)
+    robot = validate(source).robot
+    assert robot is not None
+    out = tmp_path / "cad.xml"
+    notes = write(robot, out)
+    text = out.read_text()
+    base = ('<inertial pos="0 0 0" mass="2" fullinertia="0.00159938741862 0.00159938741932 5.4423177329e-5 0 '
+            '1.039e-11 1.7563e-11"/>')
+    assert base in text  # ixy -9.32e-13 is under 1e-12 of 2 kg × the robot's size²: 0
+    dusty = re.findall(r'\w+="[^"]*e-1[0-9][^"]*"', text.replace(base, ""))
+    assert dusty == []
+    assert '<body name="finger" pos="0 0 0.9" quat="0.707105482511236 0.707108079859474 0 0">' in text
+    assert '<body name="tip" pos="0.05 0 0">' in text
+    finger = etree.parse(str(out)).getroot().find(".//body[@name='finger']/inertial")
+    assert finger is not None and finger.get("fullinertia") is None and finger.get("quat") is not None
+    back = validate(out).robot
+    assert back is not None
+    assert compare_robots(robot, back, renames(notes, "link")) == []
+    model = mujoco.MjModel.from_xml_path(str(out))
+    finger_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "finger")
+    source_tensor = next(link for link in robot.links if link.name == "finger").inertial.inertia
+    moments = np.sort(model.body_inertia[finger_id])
+    assert np.allclose(moments, np.linalg.eigvalsh(source_tensor), rtol=1e-9, atol=0)
+    rotation = np.zeros(9)
+    mujoco.mju_quat2Mat(rotation, model.body_iquat[finger_id])
+    axes = rotation.reshape(3, 3)
+    rebuilt = axes @ np.diag(model.body_inertia[finger_id]) @ axes.T
+    assert np.allclose(rebuilt, source_tensor, rtol=0, atol=1e-15)
+
+
+def test_principal_axes_are_the_nearest_to_the_link_frame() -> None:
+    """A tensor nearly diagonal gets axes near the identity (not eigh's ascending permutation), and the
+    axes are a rotation whatever the input's order."""
+    from modelkit.formats.mjcf.write_bodies import principal_axes_near_link
+
+    tensor = np.array([[0.03, 0.0, 1e-4], [0.0, 0.01, 0.0], [1e-4, 0.0, 0.02]])
+    moments, axes = principal_axes_near_link(tensor)
+    assert np.allclose(axes @ np.diag(moments) @ axes.T, tensor, rtol=0, atol=1e-17)
+    assert np.linalg.det(axes) == pytest.approx(1.0) and np.min(np.diag(axes)) > 0.99
+    assert moments[1] == pytest.approx(0.01) and moments[0] > 0.03 > moments[2] > 0.0199
+
+
+@pytest.mark.parametrize("relative", ["alex_description/urdf/alex_psyonic_hands.urdf",
+                                      "icub_description/robots/icub_reduced.urdf",
+                                      "alexander_description/urdf/alexander_v1.lowerBodyOnly.urdf"])
+def test_example_robot_data_mjcf_has_no_sub_nanometre_number(relative: str, tmp_path: Path,
+                                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    """Three example-robot-data robots whose sources write values under 1e-9 (iCub: offsets and angles;
+    the Psyonic hands and Alexander: products of inertia beside small moments): the MJCF has no
+    ``e-1x`` number (issue 17's check), loads in MuJoCo, and reads back as the same robot to 1e-9."""
+    from tests.conftest import example_robot, example_robot_data
+
+    source = example_robot(relative)
+    assert re.search(r"e-1[0-9]", source.read_text(), re.IGNORECASE)  # the source has them
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(example_robot_data()))
+    robot = validate(source).robot
+    assert robot is not None
+    out = tmp_path / "robot.xml"
+    notes = write(robot, out)
+    text = out.read_text()
+    assert not re.search(r"e-1[0-9]", text), re.findall(r'\w+="[^"]*e-1[0-9][^"]*"', text)[:3]
+    mujoco.MjModel.from_xml_path(str(out))
+    back = validate(out).robot
+    assert back is not None
+    names = renames(notes, "link")
+    assert compare_poses(robot, back, names, tol=1e-9) == []
+    repaired = " ".join(n.message for n in notes if n.code in ("MK816", "MK819", "MK870"))  # said, not dust
+    for link in robot.links:
+        if link.inertial is None or link.inertial.mass <= 0.0 or re.search(rf"link {link.name}\b", repaired):
+            continue
+        other = next((b for b in back.links if b.name == names.get(link.name, link.name)), None)
+        if other is not None and other.inertial is not None and other.inertial.mass == link.inertial.mass:
+            assert np.allclose(other.inertial.inertia, link.inertial.inertia, rtol=0, atol=1e-9), link.name

@@ -107,8 +107,12 @@ def _check_mass_properties(robot: Robot) -> None:
 
 
 def length_scale_of(robot: Robot) -> float:
-    """The robot's size for cleaning positions: its longest joint offset (1 m when it has none)."""
+    """The robot's size for cleaning positions: the diagonal of the box around its link frames at
+    q = 0, at least its longest joint offset (a tree cut in parts); 1 m when it has no size."""
     lengths = [float(np.linalg.norm(j.origin.translation)) for j in robot.joints]
+    points = np.array([pose.translation for pose in robot.world_poses().values()], dtype=float).reshape(-1, 3)
+    if len(points):
+        lengths.append(float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))))
     return max([v for v in lengths if math.isfinite(v)] or [1.0]) or 1.0
 
 

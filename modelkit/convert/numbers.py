@@ -8,12 +8,14 @@ get at most 15 significant digits. A read-back differs from the model by at most
 Near-zero values are a question of scale, which ``fmt`` cannot know (``6.123233995736766e-17``
 is dust in a position, a real value in an inertia of a milligram part). Writers settle it where
 they know the quantity: :func:`clean_rotation` for quaternion components, Euler angles and matrix
-entries (dimensionless: below 1e-12 is 0, and within 1e-12 of ±1, ±0.5 or ±√½ is that value),
-:func:`clean_angle` for angles (within 1e-12 of a multiple of π/4 is that multiple), and
-:func:`clean_length` for positions (below 1e-12 of the model's length scale is 0; the scale is set
+entries (dimensionless: below 1e-10 is 0, and within 1e-12 of ±1, ±0.5 or ±√½ is that value),
+:func:`clean_angle` for angles (below 1e-10 is 0, within 1e-12 of another multiple of π/4 is that
+multiple), :func:`fmt_direction` for axes (a component below 1e-10 of the length is 0),
+:func:`clean_length` for positions (below 1e-10 of the model's length scale is 0; the scale is set
 with :func:`length_scale` around a write, 1 m by default; :func:`fmt_position` writes a point so),
-and :func:`clean_inertia` for inertia tensors (below 1e-12 of the link's mass × the length scale²
-is 0).
+and :func:`clean_inertia` for inertia tensors (entries below 1e-12 of the link's mass × the length
+scale² are 0). Zero is 1e-10 (:data:`ZERO`): a tenth of a nanometre or of a nanoradian on a metre
+robot is no measurement, and a read-back still equals the model to 1e-9.
 """
 
 from __future__ import annotations
@@ -26,6 +28,11 @@ from contextlib import contextmanager
 import numpy as np
 
 SNAP = 1e-12  # relative: what a written number may differ from the model's
+# relative: below this a length, angle or rotation value is written as 0. A tenth of a nanometre on
+# a metre robot, a tenth of a nanoradian: below the precision of any CAD export or measurement
+# (iCub's ``pos="0 2.28232e-12 ..."``), and ten of them in a chain still within the 1e-9 m a
+# read-back and verify compare poses to.
+ZERO = 1e-10
 _LENGTH_SCALE: contextvars.ContextVar[float] = contextvars.ContextVar("length_scale", default=1.0)
 _EXACT_ROTATION_VALUES = (0.0, 1.0, 0.5, math.sqrt(0.5))
 
@@ -167,13 +174,14 @@ def _wrap(angle: float) -> float:
 
 
 def fmt_direction(values: Iterable[float] | np.ndarray) -> str:
-    """A direction (a joint axis): each component within 1e-12 of the vector's length written as 0, as
-    a dimensionless rotation value would be (``0 -1 6.12323e-17`` → ``0 -1 0``: a cosine of π/2 that a
-    source's generator left in); the rest as :func:`fmt_vec`. The direction moves by at most 1e-12 rad."""
+    """A direction (a joint axis): each component within 1e-10 (:data:`ZERO`) of the vector's length
+    written as 0, as a dimensionless rotation value would be (``0 -1 6.12323e-17`` → ``0 -1 0``: a
+    cosine of π/2 that a source's generator left in); the rest as :func:`fmt_vec`. The direction moves
+    by at most 1e-10 rad."""
     vector = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel()
     length = float(np.linalg.norm(vector))
     if length > 0.0 and math.isfinite(length):
-        vector = np.where(np.abs(vector) <= SNAP * length, 0.0, vector)
+        vector = np.where(np.abs(vector) <= ZERO * length, 0.0, vector)
     return fmt_vec(vector)
 
 
@@ -184,33 +192,43 @@ def clean(value: float, tol: float = 1e-15) -> float:
 
 def clean_rotation(value: float) -> float:
     """A dimensionless rotation number (quaternion component, angle, matrix entry) with dust removed:
-    within 1e-12 of 0, ±1, ±0.5 or ±√½ it is that value exactly."""
+    within 1e-10 of 0 (:data:`ZERO`) it is 0, within 1e-12 of ±1, ±0.5 or ±√½ it is that value exactly."""
     x = float(value)
-    for exact in _EXACT_ROTATION_VALUES:
+    if abs(x) <= ZERO:
+        return 0.0
+    for exact in _EXACT_ROTATION_VALUES[1:]:
         if abs(abs(x) - exact) <= SNAP:
             return math.copysign(exact, x) if exact else 0.0
     return x
 
 
 def clean_angle(value: float) -> float:
-    """An angle in radians with dust removed: within 1e-12 of a multiple of π/4 it is that
-    multiple (``2.07e-13`` → 0, ``-3.14159265358959`` → -π)."""
+    """An angle in radians with dust removed: within 1e-10 of 0 (:data:`ZERO`) it is 0 (iCub's
+    ``1.53106e-11``), within 1e-12 of another multiple of π/4 it is that multiple
+    (``-3.14159265358959`` → -π)."""
     x = float(value)
+    if abs(x) <= ZERO:
+        return 0.0
     quarter = round(x / (math.pi / 4.0))
     exact = quarter * (math.pi / 4.0)
     return exact + 0.0 if abs(x - exact) <= SNAP else x
 
 
 def clean_length(value: float) -> float:
-    """A position coordinate with dust below 1e-12 of the model's length scale set to 0."""
+    """A position coordinate with dust below 1e-10 of the model's length scale (:data:`ZERO`) set to 0."""
     x = float(value)
-    return 0.0 if abs(x) <= SNAP * _LENGTH_SCALE.get() else x
+    return 0.0 if abs(x) <= ZERO * _LENGTH_SCALE.get() else x
 
 
 def clean_inertia(tensor: np.ndarray, mass: float) -> np.ndarray:
-    """An inertia tensor (kg·m²) with entries below 1e-12 of ``mass`` × the model's length scale²
-    set to 0: iCub's ``ixz="1.35525e-20"`` on a link whose other five entries are 0 is float dust of
-    a zero tensor, and written as it is, MuJoCo refuses it (a negative eigenvalue)."""
+    """An inertia tensor (kg·m²) with entries below 1e-12 (:data:`SNAP`) of ``mass`` × the model's
+    length scale² set to 0: iCub's ``ixz="1.35525e-20"`` on a link whose other five entries are 0 is
+    float dust of a zero tensor, and written as it is, MuJoCo refuses it (a negative eigenvalue).
+
+    Not 1e-10 (:data:`ZERO`) of it, as lengths and angles: verify compares each tensor with the source's to
+    1e-9 of its own size, and a link's tensor is far smaller than its mass × the robot's size² (Kinova
+    Gen3's forearm in robosuite: ``ixz`` 3.4e-10 beside 8.3e-3 kg·m², 4e-8 of it). A product that small
+    is written by the MJCF writer in the tensor's principal form instead (no ``e-10`` in the file)."""
     t = np.asarray(tensor, dtype=float)
     scale = SNAP * abs(float(mass)) * _LENGTH_SCALE.get() ** 2
     if not math.isfinite(scale) or scale <= 0.0:

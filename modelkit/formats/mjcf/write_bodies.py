@@ -16,11 +16,13 @@
   ``stiffness`` only, pulling towards its zero orientation); a finite effort limit →
   ``actuatorfrcrange``; initial positions → the ``home`` keyframe (writer.py).
 * Inertials: ``<inertial pos mass diaginertia>`` when the tensor is diagonal, else ``fullinertia="Ixx
-  Iyy Izz Ixy Ixz Iyz"``; MuJoCo never recomputes them (``inertiafromgeom="false"``). A massless
-  link on a fixed joint is a body without ``<inertial>`` (MK816). MuJoCo refuses a moving body
-  whose weld group (the body and what is welded to it) has no mass or a singular inertia; such a body
-  gets ``MIN_MASS`` kg and/or ``MIN_INERTIA`` kg·m² on each principal axis at its origin (MK816 /
-  MK819, the note says the value).
+  Iyy Izz Ixy Ixz Iyz"``, or ``quat`` and ``diaginertia`` (the principal axes and moments) when a
+  product is under 1e-9 kg·m² and that form is clean (:func:`_unreadable_product`) or the smallest
+  moment nearly zero; MuJoCo never recomputes them (``inertiafromgeom="false"``). A massless link on
+  a fixed joint is a body without ``<inertial>`` (MK816). MuJoCo refuses a moving body whose weld
+  group (the body and what is welded to it) has no mass or a singular inertia; such a body gets
+  ``MIN_MASS`` kg and/or ``MIN_INERTIA`` kg·m² on each principal axis at its origin (MK816 / MK819,
+  the note says the value).
 * A chain the MJCF reader made from a multi-joint MuJoCo body is written back as that one body with
   its joints (:mod:`.write_chains`): no massless moving bodies, so no made-up mass.
 * Frame links (:func:`modelkit.convert.frames.frame_links`: massless, on fixed joints, carrying
@@ -34,6 +36,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -64,6 +67,9 @@ SINGULAR = 1e-12  # below this a mass counts as zero (MuJoCo's mjMINVAL is 1e-15
 # a wrist of 7.96e-14 kg·m² that MuJoCo itself compiled: it is written as it is.
 SINGULAR_DIAGONAL = 1e-14
 SINGULAR_FULL = 1e-13
+# kg·m²: a product of inertia under this is written in the tensor's principal form (_unreadable_product)
+UNREADABLE_PRODUCT = 1e-9
+WELL_APART = 1e-6  # relative: principal moments closer than this leave their axes to round-off
 MOVING = (JointType.REVOLUTE, JointType.PRISMATIC, JointType.BALL, JointType.PLANAR, JointType.FLOATING)
 
 def _principal_form(tensor: np.ndarray) -> bool:
@@ -75,6 +81,42 @@ def _principal_form(tensor: np.ndarray) -> bool:
     if _diagonal(tensor):
         return False
     return float(np.min(np.linalg.eigvalsh(0.5 * (tensor + tensor.T)))) < SINGULAR_FULL
+
+
+def _unreadable_product(tensor: np.ndarray) -> bool:
+    """Whether ``fullinertia`` would print a product of inertia under :data:`UNREADABLE_PRODUCT` (a SolidWorks
+    export's ``ixz="-3.7e-10"`` beside a finger's 2.6e-6 kg·m²) and the principal form prints none:
+    well-defined axes (moments apart by 1e-6 of the largest: no eigenvector left to round-off) whose
+    quaternion has no component under 1e-9 but 0. Such a tensor is written as ``quat`` and
+    ``diaginertia``, as MuJoCo's compiler and Menagerie write inertias, to 1e-15 of the same tensor.
+    Otherwise ``fullinertia`` keeps the source's numbers: ANYmal B's leg adapters have products of
+    1e-11 beside two moments 4e-10 apart (axes left to round-off), the hextilt arm's ``-5.0883e-13``
+    beside moments far apart turns the axes by 2e-9 rad (a quaternion component of 9.9e-10)."""
+    products = (float(tensor[0, 1]), float(tensor[0, 2]), float(tensor[1, 2]))
+    if not any(0.0 < abs(p) < UNREADABLE_PRODUCT for p in products):
+        return False
+    moments, axes = principal_axes_near_link(tensor)
+    ordered = np.sort(moments)
+    if float(np.min(np.diff(ordered))) < WELL_APART * float(ordered[-1]):
+        return False
+    return not any(0.0 < abs(q) < UNREADABLE_PRODUCT for q in quat_wxyz(axes))
+
+
+def principal_axes_near_link(tensor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The principal moments and axes (a rotation, columns), the axes ordered and signed to be nearest
+    the link's own: a tensor with products of 1e-11 beside moments of 1e-3 gets a quaternion within
+    1e-8 of the identity, not a permutation of the axes (eigh's ascending order)."""
+    moments, vectors = np.linalg.eigh(0.5 * (tensor + tensor.T))
+    order = max(itertools.permutations(range(3)),
+                key=lambda p: sum(abs(float(vectors[i, p[i]])) for i in range(3)))
+    axes = vectors[:, list(order)].copy()
+    for i in range(3):
+        if axes[i, i] < 0.0:
+            axes[:, i] = -axes[:, i]
+    if np.linalg.det(axes) < 0.0:  # a reflection left: turn the axis least aligned with its own
+        worst = int(np.argmin(np.abs(np.diag(axes))))
+        axes[:, worst] = -axes[:, worst]
+    return moments[list(order)], axes
 
 
 def _diagonal(tensor: np.ndarray) -> bool:
@@ -589,10 +631,8 @@ class BodyTree:
             return
         el = sub(body, "inertial", pos=fmt_position(com), mass=fmt(mass))
         off = (tensor[0, 1], tensor[0, 2], tensor[1, 2])
-        if _principal_form(tensor):
-            moments, axes = np.linalg.eigh(0.5 * (tensor + tensor.T))
-            if np.linalg.det(axes) < 0.0:
-                axes[:, 0] = -axes[:, 0]
+        if _principal_form(tensor) or _unreadable_product(tensor):
+            moments, axes = principal_axes_near_link(tensor)
             el.set("quat", fmt_vec(quat_wxyz(axes)))
             el.set("diaginertia", fmt_vec(moments))
         elif any(v != 0.0 for v in off):
