@@ -120,3 +120,48 @@ def test_a_given_urdf_from_convert_is_graded_with_its_chains(tmp_path: Path) -> 
     faulty = verify(source, tmp_path / "out2", ("pybullet",), urdf=given, configurations=5, samples=1,
                     replay=False, driven=False, inject=["axis:joint_1_y:flip"])
     assert (2, "pybullet", "pose-rotation") in {(c.layer, c.engine, c.quantity) for c in faulty.failed}
+
+
+MIXED = """<mujoco model="mixed"><default><geom type="capsule" size=".01"/></default><worldbody>
+  <body name="body1"><geom fromto="0 0 0 0 0 .1"/>
+  <body name="body2" pos="0 0 .1"><geom fromto="0 0 0 0 .1 .1"/>
+    <joint name="joint_1" type="ball" damping=".005"/>
+  <body name="body3" pos="0 .1 .1"><geom fromto="0 0 0 0 .1 0"/>
+    <joint name="hinge" type="hinge" axis="1 0 0"/>
+  </body></body></body></worldbody></mujoco>"""
+
+
+def _mixed(tmp_path: Path) -> Path:
+    source = tmp_path / "mixed.xml"
+    source.write_text(MIXED)
+    return source
+
+
+def test_layer3_compares_a_model_with_a_ball_and_a_hinge(tmp_path: Path) -> None:
+    """A ball joint above a hinge: the Pinocchio reference holds the ball as three revolute joints at
+    each sampled orientation, at rest. MuJoCo and Drake (SDF) hold a ball and compare the hinge's
+    degree of freedom; PyBullet and Drake's URDF hold the writer's chain and compare its three joints
+    too. Before, the Pinocchio reference refused the ball, layer 3a was skipped for every engine, and
+    the replay failed on a sound model (MuJoCo asked for the chain's links)."""
+    engines = ("mujoco", "pybullet", "drake", "drake-urdf", "pinocchio")
+    report = verify(_mixed(tmp_path), tmp_path / "out", engines, configurations=2, samples=3, driven=False)
+    assert not report.errors, report.errors
+    assert report.failed == [], [c.detail for c in report.failed]
+    layer3 = {(c.engine, c.quantity): c for c in report.checks if c.layer == 3}
+    for engine in ("mujoco", "pybullet", "drake", "drake-urdf"):
+        for quantity in ("mass-matrix", "bias"):
+            check = layer3[(engine, quantity)]
+            assert check.passed and check.error < 1e-12, (engine, quantity, check.detail)
+    assert layer3[("mujoco", "mass-matrix")].where == "hinge"  # its only degree of freedom compared
+    replay = [s.reason for s in report.skips if s.layer == 3 and s.engine == "mujoco+pybullet"]
+    assert replay and "ball joint(s) joint_1" in replay[0]
+
+
+def test_layer3_with_a_ball_finds_a_mass_written_wrong(tmp_path: Path) -> None:
+    report = verify(_mixed(tmp_path), tmp_path / "out", ("mujoco", "pybullet", "pinocchio"), configurations=2,
+                    samples=3, driven=False, inject=["mass:body3:10%"])
+    failed = {(c.layer, c.engine, c.quantity): c for c in report.failed}
+    for engine in ("mujoco", "pybullet"):
+        assert (3, engine, "mass-matrix") in failed, sorted(failed)
+    assert failed[(3, "mujoco", "mass-matrix")].where == "hinge"
+    assert failed[(3, "pybullet", "mass-matrix")].where in ("hinge", "joint_1_x", "joint_1_y", "joint_1")

@@ -3,7 +3,10 @@
 The tree is rebuilt joint by joint: a revolute or prismatic joint becomes
 ``JointModelRevoluteUnaligned``/``JointModelPrismaticUnaligned`` about its (unit) axis, placed at its
 origin composed with the fixed joints above it; a fixed joint adds no Pinocchio joint, its child
-link's inertia is appended to the supporting joint at the composed placement. Every link gets a
+link's inertia is appended to the supporting joint at the composed placement. A ball joint is three
+revolute joints about its X, Y and Z through two massless bodies, turned by the configuration's
+``NAME#x``... angles; their degrees of freedom are held at rest and left out of the mass matrix and
+bias (:meth:`PinocchioModel.dof_names`), which compare the revolute and prismatic ones. Every link gets a
 body frame carrying its own inertia (read back by layer 1; ``addFrame(..., append_inertia=False)``
 so it is not counted twice). The root link is welded to the
 universe at the identity. Joint armature (rotor inertia) goes to ``model.armature``, which
@@ -20,7 +23,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from modelkit.model import Joint, JointType, Robot
+from modelkit.model import BALL_KEYS, Joint, JointType, Robot
 from modelkit.spatial import Pose
 from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, StaticFacts
 from modelkit.verify.engines.reference import unit
@@ -30,7 +33,7 @@ GRAVITY = (0.0, 0.0, -9.81)
 
 
 class UnsupportedJoint(ValueError):
-    """A joint type the fixed-base Pinocchio model cannot hold (ball, planar, floating in the tree)."""
+    """A joint type the fixed-base Pinocchio model cannot hold (planar, floating in the tree)."""
 
     engine_limit = True  # the reference's limit, not the file's fault: verify reports a skip
 
@@ -80,7 +83,8 @@ class PinocchioModel:
         if robot.root is None:
             raise ValueError("the model has no root link")
         self.robot = robot
-        dofs = sum(1 for j in robot.joints if j.type in (JointType.REVOLUTE, JointType.PRISMATIC))
+        dofs = sum(1 for j in robot.joints if j.type in (JointType.REVOLUTE, JointType.PRISMATIC)) + 3 * sum(
+            1 for j in robot.joints if j.type is JointType.BALL)
         if dofs > max_dofs():
             raise TooManyDofs(
                 f"{dofs} degrees of freedom: pinocchio.Data holds four nv³ tensors (second-order "
@@ -95,6 +99,8 @@ class PinocchioModel:
         self._support: dict[str, tuple[int, pin.SE3]] = {}
         self._joint_types: dict[str, str] = {}
         self._joint_child: dict[str, str] = {}
+        self._ball_pieces: set[str] = set()  # the three revolute joints holding each ball joint
+        self._balls: dict[str, str] = {}  # ball joint -> child link
         root_frame = model.addFrame(pin.Frame(robot.root, 0, 0, pin.SE3.Identity(), pin.FrameType.BODY,
                                               _inertia(robot, robot.root)), False)
         model.appendBodyToJoint(0, _inertia(robot, robot.root), pin.SE3.Identity())
@@ -121,6 +127,9 @@ class PinocchioModel:
                                                   pin.FrameType.JOINT))
                 frame = model.addFrame(pin.Frame(joint.child, jid, jframe, pin.SE3.Identity(),
                                                  pin.FrameType.BODY, _inertia(robot, joint.child)), False)
+            elif joint.type is JointType.BALL:
+                jid, frame = self._add_ball(model, joint, pjid, placement, parent_frame)
+                armature.extend([0.0, 0.0, 0.0])
             elif joint.type in (JointType.FIXED, JointType.PSEUDO_CONTINUOUS_TRACK):
                 model.appendBodyToJoint(pjid, _inertia(robot, joint.child), placement)
                 self._support[joint.child] = (pjid, placement)
@@ -138,23 +147,51 @@ class PinocchioModel:
         model.armature = np.array(armature, dtype=float)
         self.model = model
         self.data = model.createData()
-        self._dofs = [model.names[j] for j in range(1, model.njoints)]
+        self._all = [model.names[j] for j in range(1, model.njoints)]  # one q and one v each
+        self._visible = [i for i, name in enumerate(self._all) if name not in self._ball_pieces]
+        self._dofs = [self._all[i] for i in self._visible]
         self.settings: dict[str, Any] = {
             "version": pin.__version__,
             "built_from": "the in-memory source model (no file)",
             "joints": "JointModelRevoluteUnaligned / JointModelPrismaticUnaligned; fixed joints merged "
-                      "into the supporting body, one BODY frame per link",
+                      "into the supporting body, one BODY frame per link; a ball joint three revolute "
+                      "joints about X, Y, Z (massless between), at rest in the dynamics",
             "base": "root link welded to the universe at the identity",
             "gravity": list(GRAVITY),
             "mass_matrix": "crba (upper triangle symmetrised), armature on the diagonal",
             "bias": "rnea(q, v, 0)",
         }
 
+    def _add_ball(self, model: Any, joint: Joint, pjid: int, placement: Any,
+                  parent_frame: int) -> tuple[int, int]:
+        """A ball joint as three revolute joints about its frame's X, Y and Z (``NAME#x``...,
+        ``BALL_KEYS``: R = Rx·Ry·Rz, as the other engines turn a ball), the two between them massless.
+        Their degrees of freedom are not among :meth:`dof_names`: layer 3 holds a ball at rest at each
+        sampled orientation, and each engine parametrises a ball's velocity its own way."""
+        jid = pjid
+        for key, unit_axis in zip(BALL_KEYS, np.eye(3), strict=True):
+            name = joint.name + key
+            inf = np.array([math.inf])
+            jid = model.addJoint(jid, pin.JointModelRevoluteUnaligned(unit_axis), placement, name, inf, inf,
+                                 -inf, inf)  # no limits: a ball turns freely
+            placement = pin.SE3.Identity()
+            self._ball_pieces.add(name)
+            if key != BALL_KEYS[-1]:
+                model.appendBodyToJoint(jid, pin.Inertia.Zero(), pin.SE3.Identity())
+        model.appendBodyToJoint(jid, _inertia(self.robot, joint.child), pin.SE3.Identity())
+        self._support[joint.child] = (jid, pin.SE3.Identity())
+        self._balls[joint.name] = joint.child
+        jframe = model.addFrame(pin.Frame(joint.name, jid, parent_frame, pin.SE3.Identity(),
+                                          pin.FrameType.JOINT))
+        frame = model.addFrame(pin.Frame(joint.child, jid, jframe, pin.SE3.Identity(), pin.FrameType.BODY,
+                                         _inertia(self.robot, joint.child)), False)
+        return jid, frame
+
     def dof_names(self) -> list[str]:
         return list(self._dofs)
 
     def _q(self, q: dict[str, float]) -> Array:
-        return np.array([q.get(n, 0.0) for n in self._dofs], dtype=float)
+        return np.array([q.get(n, 0.0) for n in self._all], dtype=float)
 
     def static(self) -> StaticFacts:
         m = self.model
@@ -166,7 +203,10 @@ class PinocchioModel:
                                                     np.array(inertia.inertia, dtype=float))
         parent_of = {j.child: j.parent for j in self.robot.joints}
         for frame in m.frames:
-            if frame.type == pin.FrameType.JOINT:
+            if frame.type == pin.FrameType.JOINT and frame.name in self._balls:
+                child = self._balls[frame.name]
+                facts.joints[frame.name] = JointFacts("ball", parent_of[child], child, np.zeros(3))
+            elif frame.type == pin.FrameType.JOINT:
                 jid = m.getJointId(frame.name)
                 jm = m.joints[jid].extract()
                 child = self._joint_child[frame.name]
@@ -191,11 +231,15 @@ class PinocchioModel:
 
     def mass_matrix(self, q: dict[str, float]) -> Array:
         upper = np.array(pin.crba(self.model, self.data, self._q(q)))
-        return np.triu(upper) + np.triu(upper, 1).T
+        full = np.triu(upper) + np.triu(upper, 1).T
+        return full[np.ix_(self._visible, self._visible)]
 
     def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
-        v = np.array([dq.get(n, 0.0) for n in self._dofs], dtype=float)
-        return np.array(pin.rnea(self.model, self.data, self._q(q), v, np.zeros(self.model.nv)))
+        """rnea with zero acceleration; a ball joint's pieces at rest (their velocity 0)."""
+        hidden = self._ball_pieces
+        v = np.array([0.0 if n in hidden else dq.get(n, 0.0) for n in self._all], dtype=float)
+        full = np.array(pin.rnea(self.model, self.data, self._q(q), v, np.zeros(self.model.nv)))
+        return full[self._visible]
 
     def close(self) -> None:
         return None

@@ -48,7 +48,7 @@ import numpy as np
 from lxml import etree
 
 from modelkit.convert.notes import ConversionNote
-from modelkit.model import Cylinder, Inertial, JointType, Robot
+from modelkit.model import BALL_KEYS, Cylinder, Inertial, JointType, Robot
 from modelkit.spatial import Pose
 from modelkit.verify.engines.protocol import Skip, StaticFacts
 
@@ -568,6 +568,19 @@ def applied_chains(robot: Robot, chains: list[BallChain]) -> Robot:
         index = out.joints.index(ball)
         out.joints[index:index + 1] = added
         out.links.extend(Link(name, synthesised=True, source=ball.source) for name in chain.links)
+    return out
+
+
+def chain_configuration(q: dict[str, float], chains: list[BallChain]) -> dict[str, float]:
+    """A configuration of the source in the terms of :func:`applied_chains`' model: each ball's three
+    angles (``NAME#x``..., ``BALL_KEYS``) on its chain's three joints (the last keeps the ball's name)."""
+    if not chains:
+        return q
+    out = dict(q)
+    for chain in chains:
+        names = (*chain.joints[:2], chain.joint)
+        for key, name in zip(BALL_KEYS, names, strict=True):
+            out[name] = out.pop(chain.joint + key, 0.0)
     return out
 
 

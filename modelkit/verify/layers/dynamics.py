@@ -9,36 +9,53 @@ Coriolis forces, had a bias of 0 against Drake's 1.1e-15 N·m, 1.1e-9 "relative"
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 
 from modelkit.convert.compare import random_configuration
-from modelkit.model import Robot
+from modelkit.model import BALL_KEYS, JointType, Robot
 from modelkit.verify.engines.protocol import Check, EngineModel, Skip
 from modelkit.verify.layers.common import Loaded, Worst, engine_q
+from modelkit.verify.layers.kinematics import BALL_ANGLE
 
 State = tuple[dict[str, float], dict[str, float]]
 
 
 def states(robot: Robot, dofs: list[str], count: int, seed: int) -> list[State]:
-    """Random (q, dq): q inside the limits, dq uniform in ±2 rad/s (±0.5 m/s on prismatic joints)."""
+    """Random (q, dq): q inside the limits, dq uniform in ±2 rad/s (±0.5 m/s on prismatic joints). A
+    ball joint is turned by three angles about its X, Y and Z (``NAME#x``..., ±``BALL_ANGLE`` rad, a
+    stream of their own) and held at rest: ``dofs`` (the reference's) has no velocity of it."""
     rng = np.random.default_rng(seed + 1)
+    balls = [joint.name for joint in robot.joints if joint.type is JointType.BALL]
+    ball_rng = np.random.default_rng([seed + 1, 1])
     out = []
     for _ in range(count):
         q = random_configuration(robot, rng)
         dq = {name: float(rng.uniform(-2.0, 2.0)) for name in dofs}
+        for name in balls:
+            q.update({name + key: float(ball_rng.uniform(-BALL_ANGLE, BALL_ANGLE)) for key in BALL_KEYS})
         out.append((q, dq))
     return out
 
 
-def layer3a(reference: EngineModel, eng: Loaded,
-            samples: list[State]) -> list[Check]:
-    """Mass matrix and bias forces of the engine against the reference, in the reference's dof order."""
+def layer3a(reference: EngineModel, eng: Loaded, samples: list[State],
+            written: Mapping[str, str] | None = None) -> list[Check]:
+    """Mass matrix and bias forces of the engine against the reference, in the reference's dof order.
+    ``written``: a reference joint → the engine's, where the conversion's renames do not say (the last
+    joint of a ball's chain keeps the ball's name in the reference, the URDF writer's ``NAME_z``)."""
     eng.model.mass_matrix({})  # NotImplementedError: an engine without dynamics (the caller skips it)
+    written = dict(written or {})
+
+    def in_engine(values: dict[str, float]) -> dict[str, float]:
+        out = engine_q({k: v for k, v in values.items() if k not in written}, eng)
+        out.update({written[k]: v for k, v in values.items() if k in written})
+        return out
+
     ref_dofs = reference.dof_names()
     eng_dofs = eng.model.dof_names()
     where = {name: i for i, name in enumerate(eng_dofs)}
-    order = [where.get(eng.joint(name), -1) for name in ref_dofs]
+    order = [where.get(written[name] if name in written else eng.joint(name), -1) for name in ref_dofs]
     label = eng.label
     if -1 in order or len(eng_dofs) != len(ref_dofs):
         lost = [name for name, i in zip(ref_dofs, order, strict=True) if i < 0]
@@ -50,7 +67,7 @@ def layer3a(reference: EngineModel, eng: Loaded,
     mm, bias = Worst(), Worst()
     for k, (q, dq) in enumerate(samples):
         ma = reference.mass_matrix(q)
-        mb = eng.model.mass_matrix(engine_q(q, eng))[np.ix_(idx, idx)]
+        mb = eng.model.mass_matrix(in_engine(q))[np.ix_(idx, idx)]
         diff = np.abs(ma - mb)
         scale = max(float(np.max(np.abs(ma))) if ma.size else 0.0, 1e-300)
         if diff.size:
@@ -61,7 +78,7 @@ def layer3a(reference: EngineModel, eng: Loaded,
                        f"sample {k}: M[{i},{j}] {ma[i, j]:.12g}, engine {mb[i, j]:.12g} "
                        f"(relative to max |M| = {scale:.6g})")
         ba = reference.bias(q, dq)
-        bb = eng.model.bias(engine_q(q, eng), engine_q(dq, eng))[idx]
+        bb = eng.model.bias(in_engine(q), in_engine(dq))[idx]
         bdiff = np.abs(ba - bb)
         if bdiff.size:
             n = int(np.argmax(bdiff))
