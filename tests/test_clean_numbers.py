@@ -161,7 +161,15 @@ def test_inertia_dust_is_written_as_zero(tmp_path: Path) -> None:
         dusty = np.array([[0.0, 0.0, 1.35525e-20], [0.0, 0.0, 0.0], [1.35525e-20, 0.0, 0.0]])
         assert not clean_inertia(dusty, 0.2675).any()
         real = np.array([[1e-9, 0.0, 2e-12], [0.0, 1e-9, 0.0], [2e-12, 0.0, 1e-9]])
-        assert (clean_inertia(real, 0.001) == real).all()  # 2e-12 > 1e-12 × 0.001 kg × 1 m²: kept
+        assert (clean_inertia(real, 0.001) == real).all()  # 2e-12 > 1e-12 × 1e-9 kg·m²: kept
+        assert not clean_inertia(np.diag([1e-20, 1e-20, 1e-20]), 1.0).any()  # Drake's cart-pole: all dust
+        # dm_control's dog's tail: 3e-15 is 4e-9 of the tensor (kept), under 1e-12 of 0.01 kg × 1 m²
+        tail = np.array([[4.47e-7, 3.03e-15, -2.12e-7], [3.03e-15, 7.28e-7, 2.26e-15],
+                         [-2.12e-7, 2.26e-15, 5.74e-7]])
+        assert (clean_inertia(tail, 0.01) == tail).all()
+        dust = tail.copy()
+        dust[0, 1] = dust[1, 0] = 5e-19  # 7e-13 of the tensor's largest: dust
+        assert clean_inertia(dust, 0.01)[0, 1] == 0.0 and clean_inertia(dust, 0.01)[1, 2] == 2.26e-15
     source = tmp_path / "ankle.urdf"
     source.write_text("""<robot name="ankle">
   <link name="shin"><inertial><mass value="1"/>
@@ -265,9 +273,9 @@ def test_sub_nanometre_source_values_are_written_as_zero_or_in_principal_form(tm
     out = tmp_path / "cad.xml"
     notes = write(robot, out)
     text = out.read_text()
-    base = ('<inertial pos="0 0 0" mass="2" fullinertia="0.00159938741862 0.00159938741932 5.4423177329e-5 0 '
-            '1.039e-11 1.7563e-11"/>')
-    assert base in text  # ixy -9.32e-13 is under 1e-12 of 2 kg × the robot's size²: 0
+    base = ('<inertial pos="0 0 0" mass="2" fullinertia="0.00159938741862 0.00159938741932 5.4423177329e-5 '
+            '-9.32e-13 1.039e-11 1.7563e-11"/>')
+    assert base in text  # the source's numbers, ixy 5.8e-10 of the tensor included
     dusty = re.findall(r'\w+="[^"]*e-1[0-9][^"]*"', text.replace(base, ""))
     assert dusty == []
     assert '<body name="finger" pos="0 0 0.9" quat="0.707105482511236 0.707108079859474 0 0">' in text

@@ -13,9 +13,10 @@ entries (dimensionless: below 1e-10 is 0, and within 1e-12 of ±1, ±0.5 or ±�
 multiple), :func:`fmt_direction` for axes (a component below 1e-10 of the length is 0),
 :func:`clean_length` for positions (below 1e-10 of the model's length scale is 0; the scale is set
 with :func:`length_scale` around a write, 1 m by default; :func:`fmt_position` writes a point so),
-and :func:`clean_inertia` for inertia tensors (entries below 1e-12 of the link's mass × the length
-scale² are 0). Zero is 1e-10 (:data:`ZERO`): a tenth of a nanometre or of a nanoradian on a metre
-robot is no measurement, and a read-back still equals the model to 1e-9.
+and :func:`clean_inertia` for inertia tensors (a tensor below 1e-12 of the link's mass × the length
+scale² is 0, else its entries below 1e-12 of its largest). Zero is 1e-10 (:data:`ZERO`): a tenth of
+a nanometre or of a nanoradian on a metre robot is no measurement, and a read-back still equals the
+model to 1e-9.
 """
 
 from __future__ import annotations
@@ -221,19 +222,24 @@ def clean_length(value: float) -> float:
 
 
 def clean_inertia(tensor: np.ndarray, mass: float) -> np.ndarray:
-    """An inertia tensor (kg·m²) with entries below 1e-12 (:data:`SNAP`) of ``mass`` × the model's
-    length scale² set to 0: iCub's ``ixz="1.35525e-20"`` on a link whose other five entries are 0 is
-    float dust of a zero tensor, and written as it is, MuJoCo refuses it (a negative eigenvalue).
+    """An inertia tensor (kg·m²) with dust set to 0. A tensor whose every entry is below 1e-12
+    (:data:`SNAP`) of ``mass`` × the model's length scale² is float dust of a zero tensor, and is 0:
+    iCub's ``ixz="1.35525e-20"`` on a link whose other five entries are 0 (written as it is, MuJoCo
+    refuses it: a negative eigenvalue), Drake's cart-pole's 1e-20 on each axis. In any other tensor,
+    the entries below 1e-12 of its own largest are 0.
 
-    Not 1e-10 (:data:`ZERO`) of it, as lengths and angles: verify compares each tensor with the source's to
-    1e-9 of its own size, and a link's tensor is far smaller than its mass × the robot's size² (Kinova
-    Gen3's forearm in robosuite: ``ixz`` 3.4e-10 beside 8.3e-3 kg·m², 4e-8 of it). A product that small
-    is written by the MJCF writer in the tensor's principal form instead (no ``e-10`` in the file)."""
+    Relative to the tensor itself, not to mass × size²: verify compares each tensor with the source's
+    to 1e-9 of its own largest entry, and a small link's tensor is far below its mass × the robot's
+    size² (dm_control's dog: a tail vertebra's products of 3e-15 beside moments of 7e-7 kg·m², zeroed
+    at 1e-12 of m·L², were 4e-9 of the tensor)."""
     t = np.asarray(tensor, dtype=float)
     scale = SNAP * abs(float(mass)) * _LENGTH_SCALE.get() ** 2
-    if not math.isfinite(scale) or scale <= 0.0:
+    own = float(np.max(np.abs(t))) if t.size else 0.0
+    if not (math.isfinite(scale) and math.isfinite(own)) or scale <= 0.0:
         return t
-    cleaned: np.ndarray = np.where(np.abs(t) <= scale, 0.0, t)
+    if own <= scale:
+        return np.zeros_like(t)
+    cleaned: np.ndarray = np.where(np.abs(t) <= SNAP * own, 0.0, t)
     return cleaned
 
 
