@@ -153,9 +153,10 @@ def _compile(path: Path, root: str, actuated: bool = False,
 
 
 def drop_actuators(spec: Any, driven: Collection[str] | None = None) -> list[str]:
-    """The file's actuators deleted, and the keyframes' controls with them (a ``home`` keyframe holds one
-    control per position servo; MuJoCo refuses a keyframe whose ``ctrl`` has another length: the layer-4
-    worlds of example-robot-data's TIAGo, whose arm has servos, did not load).
+    """The file's actuators deleted, with the sensors that read them and the keyframes' controls (a
+    ``home`` keyframe holds one control per position servo; MuJoCo refuses a keyframe whose ``ctrl`` has
+    another length: the layer-4 worlds of example-robot-data's TIAGo, whose arm has servos, did not
+    load).
 
     ``driven`` (layer 4): only the actuators on those joints go, where verify's controllers take over;
     the others stay, as the user's robot has them (TIAGo's arm and torso servos hold them while the
@@ -163,12 +164,18 @@ def drop_actuators(spec: Any, driven: Collection[str] | None = None) -> list[str
     the actuators kept (unnamed ones as ``actuator <i>``)."""
     actuators = list(spec.actuators)
     kept: list[int] = []
+    deleted: set[str] = set()
     for i, actuator in enumerate(actuators):
         on_joint = actuator.trntype in (mujoco.mjtTrn.mjTRN_JOINT, mujoco.mjtTrn.mjTRN_JOINTINPARENT)
         if driven is None or (on_joint and actuator.target in driven):
+            deleted.add(actuator.name)
             spec.delete(actuator)
         else:
             kept.append(i)
+    for sensor in list(spec.sensors):  # an actuatorpos/vel/frc sensor of a deleted actuator: MuJoCo
+        # refuses the model ("unrecognized name of sensorized object": gymnasium-robotics' Adroit hand)
+        if sensor.objtype == mujoco.mjtObj.mjOBJ_ACTUATOR and sensor.objname in deleted - {""}:
+            spec.delete(sensor)
     for key in spec.keys:
         ctrl = list(key.ctrl)
         key.ctrl = [ctrl[i] for i in kept] if len(ctrl) == len(actuators) and kept else []
