@@ -7,8 +7,8 @@ holds what :func:`modelkit.geometry.meshfiles.mesh_problem` learns from a file: 
 or "CODE\\tmessage") and the corners of its triangles (the rules' mesh extent). It is keyed, as the
 in-process cache is, by the resolved path, modification time (ns), size, the fragment, the size limit
 and the file's name as given (its suffix picks the parser), and also by modelkit's version,
-:data:`SCHEMA` and the modification time of the mesh-checking module itself: a changed mesh file, a
-new modelkit or an edited checker never reads an old outcome.
+:data:`SCHEMA` and the modification times of the mesh-checking modules (meshfiles, dae_sources,
+objcheck, vrml): a changed mesh file, a new modelkit or an edited checker never reads an old outcome.
 
 Who: the ``validate`` command (and the pre-commit hook, which runs it) turns it on with :func:`enable`;
 ``convert``, ``verify``, ``tree`` and the library write nothing outside their outputs (they parse a
@@ -54,14 +54,17 @@ def folder() -> Path | None:
 
 
 def _checker_stamp() -> str:
+    """The schema, modelkit's version and the modification times of the modules a mesh check runs."""
     from modelkit import __version__
-    from modelkit.geometry import meshfiles
+    from modelkit.geometry import dae_sources, meshfiles, objcheck, vrml
 
-    try:
-        stamp = os.stat(meshfiles.__file__).st_mtime_ns
-    except (OSError, TypeError):
-        stamp = 0
-    return f"{SCHEMA}|{__version__}|{stamp}"
+    stamps = []
+    for module in (meshfiles, dae_sources, objcheck, vrml):
+        try:
+            stamps.append(str(os.stat(str(module.__file__)).st_mtime_ns))
+        except (OSError, TypeError):
+            stamps.append("0")
+    return f"{SCHEMA}|{__version__}|{','.join(stamps)}"
 
 
 def _entry(key: tuple[Any, ...]) -> Path | None:

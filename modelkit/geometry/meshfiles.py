@@ -957,8 +957,11 @@ def _load_dae(data: bytes, name: str, fragment: str | None, metadata: MeshMetada
     import collada
     from collada.common import DaeBrokenRefError, DaeError, DaeUnsupportedError
 
+    from modelkit.geometry.dae_sources import positions_only
+
     try:
-        dae = collada.Collada(io.BytesIO(data), ignore=[DaeUnsupportedError, DaeBrokenRefError])
+        with positions_only():  # normals and texture coordinates are not decoded: nothing reads them
+            dae = collada.Collada(io.BytesIO(data), ignore=[DaeUnsupportedError, DaeBrokenRefError])
     except DaeError as e:
         msg = str(getattr(e, "msg", "") or e)
         at = re.search(r"line (\d+), column", msg)
