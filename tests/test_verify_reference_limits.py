@@ -1,6 +1,7 @@
-"""A joint the Pinocchio reference cannot hold (a ball) is the reference's limit, not the file's
-fault: verify skips Pinocchio with the reason instead of failing its load (dm_control's
-model_with_ball_joints.xml failed "pinocchio load" before)."""
+"""A joint the Pinocchio reference cannot hold (a planar joint) is the reference's limit, not the
+file's fault: verify skips Pinocchio with the reason instead of failing its load. A ball joint, which
+it once refused the same way (dm_control's model_with_ball_joints.xml failed "pinocchio load", then
+was skipped), it now holds."""
 
 from __future__ import annotations
 
@@ -13,10 +14,34 @@ BALL = """<mujoco><worldbody><body name="base"><geom size=".1" mass="1"/>
     fromto="0 0 0 0 0 .3" mass=".5"/></body></body></worldbody></mujoco>"""
 
 
-def test_a_ball_joint_skips_the_pinocchio_reference(tmp_path: Path) -> None:
+def test_a_ball_joint_is_held_by_the_pinocchio_reference(tmp_path: Path) -> None:
+    """The reference holds a ball joint as three revolute joints (before, it refused the model and
+    was skipped): its layers 1 and 2 pass, the ball turned in layer 2; a model whose only moving
+    joint is a ball has no revolute or prismatic degree of freedom for layer 3, which says so."""
     source = tmp_path / "ball.xml"
     source.write_text(BALL)
+    report = verify(source, None, ("mujoco", "pinocchio"), configurations=2, samples=1, replay=False)
+    assert not [c for c in report.checks if c.engine == "pinocchio" and c.quantity == "load"]
+    assert not [s for s in report.skips if s.engine == "pinocchio" and s.reason.startswith("not run")]
+    mine = {(c.layer, c.quantity): c for c in report.checks if c.engine == "pinocchio"}
+    assert mine[(1, "joint-type")].passed and mine[(2, "pose-rotation")].passed
+    assert report.failed == []
+    layer3 = [s.reason for s in report.skips if s.layer == 3]
+    assert layer3 and "ball joints only" in layer3[0]
+
+
+PLANAR = """<robot name="slider"><link name="base"><inertial><mass value="1"/>
+  <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="puck"><inertial><mass value="0.5"/>
+  <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="glide" type="planar"><parent link="base"/><child link="puck"/><axis xyz="0 0 1"/></joint>
+</robot>"""
+
+
+def test_a_planar_joint_skips_the_pinocchio_reference(tmp_path: Path) -> None:
+    source = tmp_path / "slider.urdf"
+    source.write_text(PLANAR)
     report = verify(source, None, ("mujoco", "pinocchio"), configurations=1, samples=1, replay=False)
     assert not [c for c in report.checks if c.engine == "pinocchio" and c.quantity == "load"]
     said = [s.reason for s in report.skips if s.engine == "pinocchio"]
-    assert any("'shoulder' is ball" in reason and reason.startswith("not run") for reason in said)
+    assert any("'glide' is planar" in reason and reason.startswith("not run") for reason in said), said
