@@ -17,8 +17,8 @@
   ``actuatorfrcrange``; initial positions → the ``home`` keyframe (writer.py).
 * Inertials: ``<inertial pos mass diaginertia>`` when the tensor is diagonal, else ``fullinertia="Ixx
   Iyy Izz Ixy Ixz Iyz"``, or ``quat`` and ``diaginertia`` (the principal axes and moments) when a
-  product is under 1e-9 kg·m² and that form is clean (:func:`_unreadable_product`) or the smallest
-  moment nearly zero; MuJoCo never recomputes them (``inertiafromgeom="false"``). A massless link on
+  product is under 1e-9 kg·m² and that form is clean, or the smallest moment is nearly zero
+  (:func:`_principal`); MuJoCo never recomputes them (``inertiafromgeom="false"``). A massless link on
   a fixed joint is a body without ``<inertial>`` (MK816). MuJoCo refuses a moving body whose weld
   group (the body and what is welded to it) has no mass or a singular inertia; such a body gets
   ``MIN_MASS`` kg and/or ``MIN_INERTIA`` kg·m² on each principal axis at its origin (MK816 / MK819,
@@ -67,7 +67,7 @@ SINGULAR = 1e-12  # below this a mass counts as zero (MuJoCo's mjMINVAL is 1e-15
 # a wrist of 7.96e-14 kg·m² that MuJoCo itself compiled: it is written as it is.
 SINGULAR_DIAGONAL = 1e-14
 SINGULAR_FULL = 1e-13
-# kg·m²: a product of inertia under this is written in the tensor's principal form (_unreadable_product)
+# kg·m²: a product of inertia under this is written in the tensor's principal form (_principal)
 UNREADABLE_PRODUCT = 1e-9
 WELL_APART = 1e-6  # relative: principal moments closer than this leave their axes to round-off
 MOVING = (JointType.REVOLUTE, JointType.PRISMATIC, JointType.BALL, JointType.PLANAR, JointType.FLOATING)
@@ -83,23 +83,32 @@ def _principal_form(tensor: np.ndarray) -> bool:
     return float(np.min(np.linalg.eigvalsh(0.5 * (tensor + tensor.T)))) < SINGULAR_FULL
 
 
-def _unreadable_product(tensor: np.ndarray) -> bool:
-    """Whether ``fullinertia`` would print a product of inertia under :data:`UNREADABLE_PRODUCT` (a SolidWorks
-    export's ``ixz="-3.7e-10"`` beside a finger's 2.6e-6 kg·m²) and the principal form prints none:
-    well-defined axes (moments apart by 1e-6 of the largest: no eigenvector left to round-off) whose
-    quaternion has no component under 1e-9 but 0. Such a tensor is written as ``quat`` and
-    ``diaginertia``, as MuJoCo's compiler and Menagerie write inertias, to 1e-15 of the same tensor.
-    Otherwise ``fullinertia`` keeps the source's numbers: ANYmal B's leg adapters have products of
-    1e-11 beside two moments 4e-10 apart (axes left to round-off), the hextilt arm's ``-5.0883e-13``
-    beside moments far apart turns the axes by 2e-9 rad (a quaternion component of 9.9e-10)."""
+def _principal(tensor: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The principal moments and axes to write as ``diaginertia`` and ``quat``, or None for
+    ``fullinertia``/``diaginertia`` as given.
+
+    * :func:`_principal_form`: a nearly singular tensor (MuJoCo checks a principal form against
+      mjMINVAL, a full one against mjEPS).
+    * A product of inertia ``fullinertia`` would print under :data:`UNREADABLE_PRODUCT` (a SolidWorks
+      export's ``ixz="-3.7e-10"`` beside a finger's 2.6e-6 kg·m²), when the principal form prints
+      none: well-defined axes (moments apart by :data:`WELL_APART` of the largest: no eigenvector left
+      to round-off) whose quaternion has no component under 1e-9 but 0. It is written as MuJoCo's
+      compiler and Menagerie write inertias, to 1e-15 of the same tensor. Otherwise ``fullinertia``
+      keeps the source's numbers: ANYmal B's leg adapters have products of 1e-11 beside two moments
+      4e-10 apart (axes left to round-off), the hextilt arm's ``-5.0883e-13`` beside moments far apart
+      turns the axes by 2e-9 rad (a quaternion component of 9.9e-10)."""
+    if _principal_form(tensor):
+        return principal_axes_near_link(tensor)
     products = (float(tensor[0, 1]), float(tensor[0, 2]), float(tensor[1, 2]))
     if not any(0.0 < abs(p) < UNREADABLE_PRODUCT for p in products):
-        return False
+        return None
     moments, axes = principal_axes_near_link(tensor)
     ordered = np.sort(moments)
     if float(np.min(np.diff(ordered))) < WELL_APART * float(ordered[-1]):
-        return False
-    return not any(0.0 < abs(q) < UNREADABLE_PRODUCT for q in quat_wxyz(axes))
+        return None
+    if any(0.0 < abs(q) < UNREADABLE_PRODUCT for q in quat_wxyz(axes)):
+        return None
+    return moments, axes
 
 
 def principal_axes_near_link(tensor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -631,8 +640,9 @@ class BodyTree:
             return
         el = sub(body, "inertial", pos=fmt_position(com), mass=fmt(mass))
         off = (tensor[0, 1], tensor[0, 2], tensor[1, 2])
-        if _principal_form(tensor) or _unreadable_product(tensor):
-            moments, axes = principal_axes_near_link(tensor)
+        principal = _principal(tensor)
+        if principal is not None:
+            moments, axes = principal
             el.set("quat", fmt_vec(quat_wxyz(axes)))
             el.set("diaginertia", fmt_vec(moments))
         elif any(v != 0.0 for v in off):

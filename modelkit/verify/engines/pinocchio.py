@@ -83,8 +83,8 @@ class PinocchioModel:
         if robot.root is None:
             raise ValueError("the model has no root link")
         self.robot = robot
-        dofs = sum(1 for j in robot.joints if j.type in (JointType.REVOLUTE, JointType.PRISMATIC)) + 3 * sum(
-            1 for j in robot.joints if j.type is JointType.BALL)
+        widths = {JointType.REVOLUTE: 1, JointType.PRISMATIC: 1, JointType.BALL: 3}
+        dofs = sum(widths.get(j.type, 0) for j in robot.joints)
         if dofs > max_dofs():
             raise TooManyDofs(
                 f"{dofs} degrees of freedom: pinocchio.Data holds four nv³ tensors (second-order "
@@ -121,15 +121,11 @@ class PinocchioModel:
                 jid = model.addJoint(pjid, jm, placement, joint.name, inf, inf,
                                      np.array([joint.limits.lower]), np.array([joint.limits.upper]))
                 armature.append(float(joint.armature))
-                model.appendBodyToJoint(jid, _inertia(robot, joint.child), pin.SE3.Identity())
-                self._support[joint.child] = (jid, pin.SE3.Identity())
-                jframe = model.addFrame(pin.Frame(joint.name, jid, parent_frame, pin.SE3.Identity(),
-                                                  pin.FrameType.JOINT))
-                frame = model.addFrame(pin.Frame(joint.child, jid, jframe, pin.SE3.Identity(),
-                                                 pin.FrameType.BODY, _inertia(robot, joint.child)), False)
+                frame = self._carry(model, joint, jid, parent_frame)
             elif joint.type is JointType.BALL:
-                jid, frame = self._add_ball(model, joint, pjid, placement, parent_frame)
+                frame = self._carry(model, joint, self._add_ball(model, joint, pjid, placement), parent_frame)
                 armature.extend([0.0, 0.0, 0.0])
+                self._balls[joint.name] = joint.child
             elif joint.type in (JointType.FIXED, JointType.PSEUDO_CONTINUOUS_TRACK):
                 model.appendBodyToJoint(pjid, _inertia(robot, joint.child), placement)
                 self._support[joint.child] = (pjid, placement)
@@ -139,7 +135,7 @@ class PinocchioModel:
                                                  _inertia(robot, joint.child)), False)
             else:
                 raise UnsupportedJoint(f"joint {joint.name!r} is {joint.type.value}: the fixed-base "
-                                       "Pinocchio reference holds revolute, prismatic and fixed joints")
+                                       "Pinocchio reference holds revolute, prismatic, ball and fixed joints")
             self._joint_child[joint.name] = joint.child
             self._joint_types[joint.name] = ("fixed" if joint.type is JointType.PSEUDO_CONTINUOUS_TRACK
                                              else joint.type.value)
@@ -162,30 +158,32 @@ class PinocchioModel:
             "bias": "rnea(q, v, 0)",
         }
 
-    def _add_ball(self, model: Any, joint: Joint, pjid: int, placement: Any,
-                  parent_frame: int) -> tuple[int, int]:
-        """A ball joint as three revolute joints about its frame's X, Y and Z (``NAME#x``...,
-        ``BALL_KEYS``: R = Rx·Ry·Rz, as the other engines turn a ball), the two between them massless.
-        Their degrees of freedom are not among :meth:`dof_names`: layer 3 holds a ball at rest at each
-        sampled orientation, and each engine parametrises a ball's velocity its own way."""
-        jid = pjid
-        for key, unit_axis in zip(BALL_KEYS, np.eye(3), strict=True):
-            name = joint.name + key
-            inf = np.array([math.inf])
-            jid = model.addJoint(jid, pin.JointModelRevoluteUnaligned(unit_axis), placement, name, inf, inf,
-                                 -inf, inf)  # no limits: a ball turns freely
-            placement = pin.SE3.Identity()
-            self._ball_pieces.add(name)
-            if key != BALL_KEYS[-1]:
-                model.appendBodyToJoint(jid, pin.Inertia.Zero(), pin.SE3.Identity())
-        model.appendBodyToJoint(jid, _inertia(self.robot, joint.child), pin.SE3.Identity())
+    def _carry(self, model: Any, joint: Joint, jid: int, parent_frame: int) -> int:
+        """The child link on the moving joint ``jid``: its inertia, a JOINT frame named after the
+        joint and the link's BODY frame (returned)."""
+        inertia = _inertia(self.robot, joint.child)
+        model.appendBodyToJoint(jid, inertia, pin.SE3.Identity())
         self._support[joint.child] = (jid, pin.SE3.Identity())
-        self._balls[joint.name] = joint.child
         jframe = model.addFrame(pin.Frame(joint.name, jid, parent_frame, pin.SE3.Identity(),
                                           pin.FrameType.JOINT))
-        frame = model.addFrame(pin.Frame(joint.child, jid, jframe, pin.SE3.Identity(), pin.FrameType.BODY,
-                                         _inertia(self.robot, joint.child)), False)
-        return jid, frame
+        return int(model.addFrame(pin.Frame(joint.child, jid, jframe, pin.SE3.Identity(), pin.FrameType.BODY,
+                                            inertia), False))
+
+    def _add_ball(self, model: Any, joint: Joint, pjid: int, placement: Any) -> int:
+        """A ball joint as three revolute joints about its frame's X, Y and Z (``NAME#x``...,
+        ``BALL_KEYS``: R = Rx·Ry·Rz, as the other engines turn a ball), the two between them massless;
+        returns the last. Their degrees of freedom are not among :meth:`dof_names`: layer 3 holds a ball
+        at rest at each sampled orientation, and each engine parametrises a ball's velocity its own way."""
+        jid = pjid
+        inf = np.array([math.inf])
+        for key, unit_axis in zip(BALL_KEYS, np.eye(3), strict=True):
+            jid = model.addJoint(jid, pin.JointModelRevoluteUnaligned(unit_axis), placement, joint.name + key,
+                                 inf, inf, -inf, inf)  # no limits: a ball turns freely
+            placement = pin.SE3.Identity()
+            self._ball_pieces.add(joint.name + key)
+            if key != BALL_KEYS[-1]:
+                model.appendBodyToJoint(jid, pin.Inertia.Zero(), pin.SE3.Identity())
+        return int(jid)
 
     def dof_names(self) -> list[str]:
         return list(self._dofs)
