@@ -14,18 +14,18 @@ from collections.abc import Mapping
 import numpy as np
 
 from modelkit.convert.compare import random_configuration
-from modelkit.model import BALL_KEYS, JointType, Robot
+from modelkit.model import JointType, Robot
 from modelkit.verify.engines.protocol import Check, EngineModel, Skip
 from modelkit.verify.layers.common import Loaded, Worst, engine_q
-from modelkit.verify.layers.kinematics import BALL_ANGLE
+from modelkit.verify.layers.kinematics import ball_angles
 
 State = tuple[dict[str, float], dict[str, float]]
 
 
 def states(robot: Robot, dofs: list[str], count: int, seed: int) -> list[State]:
     """Random (q, dq): q inside the limits, dq uniform in ±2 rad/s (±0.5 m/s on prismatic joints). A
-    ball joint is turned by three angles about its X, Y and Z (``NAME#x``..., ±``BALL_ANGLE`` rad, a
-    stream of their own) and held at rest: ``dofs`` (the reference's) has no velocity of it."""
+    ball joint is turned by three angles about its X, Y and Z (``kinematics.ball_angles``, a stream of
+    their own) and held at rest: ``dofs`` (the reference's) has no velocity of it."""
     rng = np.random.default_rng(seed + 1)
     balls = [joint.name for joint in robot.joints if joint.type is JointType.BALL]
     ball_rng = np.random.default_rng([seed + 1, 1])
@@ -33,8 +33,7 @@ def states(robot: Robot, dofs: list[str], count: int, seed: int) -> list[State]:
     for _ in range(count):
         q = random_configuration(robot, rng)
         dq = {name: float(rng.uniform(-2.0, 2.0)) for name in dofs}
-        for name in balls:
-            q.update({name + key: float(ball_rng.uniform(-BALL_ANGLE, BALL_ANGLE)) for key in BALL_KEYS})
+        q.update(ball_angles(balls, ball_rng))
         out.append((q, dq))
     return out
 

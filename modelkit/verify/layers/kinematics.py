@@ -18,6 +18,12 @@ from modelkit.verify.layers.common import Loaded, Worst, engine_q, rotation_angl
 BALL_ANGLE = 1.0  # rad: each of a ball joint's three angles is drawn in ±this (no gimbal lock in rpy)
 
 
+def ball_angles(balls: list[str], rng: np.random.Generator) -> dict[str, float]:
+    """Each ball joint's three angles about its X, Y and Z (``NAME#x``..., ``BALL_KEYS``), drawn in
+    ±:data:`BALL_ANGLE`."""
+    return {name + key: float(rng.uniform(-BALL_ANGLE, BALL_ANGLE)) for name in balls for key in BALL_KEYS}
+
+
 def configurations(robot: Robot, count: int, seed: int) -> list[dict[str, float]]:
     """q = 0, then ``count`` random configurations inside the limits (±π / ±0.5 m where unlimited),
     mimic joints set from their leaders; a ball joint turned by three angles about its X, Y and Z
@@ -29,8 +35,7 @@ def configurations(robot: Robot, count: int, seed: int) -> list[dict[str, float]
     out: list[dict[str, float]] = [{}]
     for _ in range(count):
         q = random_configuration(robot, rng)
-        for name in balls:
-            q.update({name + key: float(ball_rng.uniform(-BALL_ANGLE, BALL_ANGLE)) for key in BALL_KEYS})
+        q.update(ball_angles(balls, ball_rng))
         for joint in robot.joints:  # a mimic joint follows its leader (yourdfpy and URDF readers apply it)
             if joint.mimic is not None and joint.name in q and joint.mimic.joint in q:
                 q[joint.name] = joint.mimic.multiplier * q[joint.mimic.joint] + joint.mimic.offset
