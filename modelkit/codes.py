@@ -1529,6 +1529,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "joints in URDF, SDF and `.body`. `--frame-bodies` keeps frames as bodies and leaves sites out.",
     ),
     CodeInfo(
+        "MK874",
+        "sdf-frames-as-links",
+        "info",
+        "An SDF model's `<frame>`s (named poses attached to a link: a tool flange, a sensor mount) are "
+        "written as massless links on fixed joints in URDF and `.body` (a URDF link is a TF frame) and as "
+        "`<site>`s in MJCF (MK873), named after the frame; the note lists them. The SDF writer writes such "
+        "links back as `<frame>`s.",
+    ),
+    CodeInfo(
         "MK875",
         "mjcf-camera-fovy-clamped",
         "warning",

@@ -34,8 +34,6 @@ EXCEPTIONS: dict[tuple[str, str], str] = {
     ("formats/urdf/writer.py", "mjcf_cameras"):
         "the MJCF reader keeps every camera, also those on links (devices): only the others are noted",
     ("formats/urdf/writer.py", "mjcf_lights"): "the same, for lights",
-    ("formats/urdf/writer.py", "sdf_link"):
-        "an SDF link's flags are noted only where they differ from SDF's defaults",
     ("formats/body/writer.py", "sdf_world_joint"):
         "a model fixed without a world joint is a static SDF model: its free links are written fixed",
     ("formats/body/writer.py", "gazebo"): "URDF extension blocks are noted as not carried over",

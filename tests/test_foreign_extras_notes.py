@@ -205,3 +205,63 @@ def test_mjcf_to_mjcf_says_which_of_its_own_elements_it_does_not_write(tmp_path:
     assert "1 of 3 MJCF sensors not written (cord_length)" in sensors.message
     others = [n for n in notes if "sites" in n.message or "cameras" in n.message]
     assert not any("not written" in n.message for n in others)
+
+
+SDF_FLAGS = """<?xml version="1.0"?>
+<sdf version="1.9">
+  <model name="m">
+    <link name="base"><gravity>false</gravity><kinematic>true</kinematic><enable_wind>false</enable_wind>
+      <velocity_decay><linear>0.1</linear></velocity_decay>
+      <inertial><mass>1</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial>
+      <visual name="v"><geometry><box><size>0.1 0.1 0.1</size></box></geometry>
+        <material><ambient>1 0 0 1</ambient><diffuse>1 0 0 1</diffuse></material></visual>
+    </link>
+    <link name="plain"><gravity>true</gravity>
+      <inertial><mass>1</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial>
+    </link>
+    <joint name="j" type="fixed"><parent>base</parent><child>plain</child></joint>
+  </model>
+</sdf>
+"""
+
+
+@pytest.mark.parametrize("target", ["xml", "urdf", "body"])
+def test_sdf_link_flags_and_material_parameters_are_said(tmp_path: Path, target: str) -> None:
+    """An SDF link's <gravity>, <kinematic>, <velocity_decay> (MJCF and .body said nothing before; URDF
+    printed the reader's dict) and a visual's ambient colour; flags at SDFormat's defaults say nothing."""
+    source = tmp_path / "m.sdf"
+    source.write_text(SDF_FLAGS)
+    notes = convert([source], tmp_path / "out" / f"m.{target}").notes
+    flags = _about(notes, "SDF link flags")
+    assert len(flags) == 1 and flags[0].code == "MK808", [n.message for n in notes]
+    assert "gravity false, kinematic true, velocity_decay (linear 0.1)" in flags[0].message
+    assert "enable_wind" not in flags[0].message and "link plain" not in flags[0].message
+    # the ambient colour: the model's material holds its intensity (.body writes it, URDF says it drops
+    # it); the SDF reader's exact colour is for SDF round trips, no note of its own
+    assert len([n for n in notes if "ambient" in n.message]) == (1 if target == "urdf" else 0)
+    assert not any("{" in n.message or "'" in n.message for n in notes), [n.message for n in notes]
+
+
+MOCAP = """<mujoco model="mc"><worldbody>
+ <body name="target" mocap="true" pos="0 0 1">
+  <geom type="box" size="0.1 0.1 0.1" contype="0" conaffinity="0"/></body>
+ <body name="arm" pos="0 0 0.5"><joint name="b" type="ball" range="0 45"/>
+  <inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/>
+  <geom type="capsule" fromto="0 0 0 0 0 0.3" size="0.02"/></body>
+</worldbody></mujoco>"""
+
+
+def test_mjcf_mocap_and_ball_cone_are_kept_in_mjcf_and_said_elsewhere(tmp_path: Path) -> None:
+    source = tmp_path / "mc.xml"
+    source.write_text(MOCAP)
+    out = tmp_path / "out" / "back.xml"
+    convert([source], out)
+    target = mujoco.MjModel.from_xml_path(str(out.with_name("back_target.xml")))
+    assert target.body_mocapid[1] == 0  # the mocap body is one again (it was a plain welded body)
+    arm = mujoco.MjModel.from_xml_path(str(out.with_name("back_mc.xml")))
+    assert arm.jnt_limited[0] and abs(arm.jnt_range[0][1] - 0.785398163397) < 1e-9
+    for suffix in ("urdf", "sdf", "body"):
+        notes = convert([source], tmp_path / suffix / f"mc.{suffix}").notes
+        assert len(_about(notes, "link target", "MJCF mocap flag")) == 1, suffix
+        cone = _about(notes, "joint b", "cone limit")
+        assert len(cone) == 1 and "(0 0.785398)" in cone[0].message and cone[0].code == "MK820", suffix

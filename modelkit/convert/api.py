@@ -66,12 +66,14 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     """A copy of ``robot`` shaped for the target: tracks approximated where the target has none,
     wheel collisions as ``options.wheel_collision`` says (MK826), fixed joints merged on request, the
     base settled (welded or free), an MJCF source's named-frame sites made frame links where the target
-    has no sites (MK873). The source model is never changed."""
+    has no sites (MK873), an SDF source's frames where it has no frames (MK874). The source model is
+    never changed."""
     from modelkit.convert.base import settle_base
     from modelkit.convert.merge import merge_fixed_joints
     from modelkit.convert.tracks import approximate_tracks
     from modelkit.convert.wheels import approximate_wheels
     from modelkit.formats.mjcf.site_frames import sites_as_links
+    from modelkit.formats.sdf.frame_links import frames_as_links
 
     _check_mass_properties(robot)
     note_foreign_extras(robot, target.name, notes)
@@ -82,6 +84,8 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     approximate_wheels(out, options.wheel_collision, target.name, notes)
     if options.frame_sites and not target.sites_native:
         sites_as_links(out, notes)
+    if not target.frames_native:
+        frames_as_links(out, notes, keep=options.frame_sites)
     if options.merge_fixed:
         merge_fixed_joints(out, notes)
     return out

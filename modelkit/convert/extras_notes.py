@@ -27,9 +27,13 @@ def shown_extras(value: Any) -> str:
     """An extras value in a note ("" when nothing of it is lost): a kept XML block by its children's
     tags (those the model carries left out), a plugin by its library, a dict's non-empty values as
     ``key value``, a list item by item."""
+    if isinstance(value, list) and value and all(isinstance(v, int | float) for v in value):
+        return _plain(value)  # numbers: a range, a vector
     if isinstance(value, list):
         return "; ".join(text for text in (shown_extras(v) for v in value) if text)
-    if isinstance(value, dict) and "xml" in value and (value.get("filename") or value.get("name")):
+    if isinstance(value, dict) and "element" in value and "data" in value:
+        text = f"<{value['element']}>"  # an element kept only as data (an SDF link's <audio_sink>)
+    elif isinstance(value, dict) and "xml" in value and (value.get("filename") or value.get("name")):
         text = str(value.get("filename") or value.get("name"))  # a plugin: by its library or name
     elif isinstance(value, dict) and "xml" in value:
         from lxml import etree
@@ -45,15 +49,29 @@ def shown_extras(value: Any) -> str:
             ((k, v) for k, v in value.items() if v not in (None, "", [], {}) and k not in BOOKKEEPING),
             key=lambda kv: str(kv[0]),
         )
-        text = ", ".join(f"{k} {v}".rstrip() for k, v in items)
+        text = ", ".join(f"{k} {_plain(v)}".rstrip() for k, v in items)
     else:
-        text = str(value)
+        text = _plain(value)
     return text if len(text) <= 120 else text[:117] + "..."
+
+
+def _plain(value: Any) -> str:
+    """A kept value as a person writes it: ``true``, ``0.1``, ``1 0 0 1``, ``(linear 0.1)``."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, list | tuple) and all(isinstance(v, int | float) for v in value):
+        return " ".join(_plain(float(v)) if not isinstance(v, bool) else _plain(v) for v in value)
+    if isinstance(value, dict):
+        return "(" + ", ".join(f"{k} {_plain(v)}" for k, v in value.items()) + ")"
+    return str(value)
 
 
 def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
     """One note per robot, link and joint extras key another format declares dropped."""
     from modelkit.formats.registry import (
+        EXTRAS_DEFAULTS,
         EXTRAS_DROPPED,
         EXTRAS_DROPPED_JOINT,
         EXTRAS_DROPPED_LINK,
@@ -65,11 +83,13 @@ def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
     output = declared(target).output
     handled = output.handles if output is not None else frozenset()
     found: list[tuple[str, str, str, Any, Any, str]] = []  # owner, code, words, value, source, target
+    # a dict value's entries that say only the owner's default are no loss (EXTRAS_DEFAULTS)
     if output is None or not output.walks_extras:
         for key in sorted(robot.extras):
             if key in EXTRAS_OWNER and key not in EXTRAS_PARTLY_CARRIED and key not in handled:
                 code, what = EXTRAS_DROPPED[key]
-                found.append((EXTRAS_OWNER[key], code, what, robot.extras[key], robot.source, "robot"))
+                value = _without_defaults(robot.extras[key], EXTRAS_DEFAULTS.get(key))
+                found.append((EXTRAS_OWNER[key], code, what, value, robot.source, "robot"))
     elements: list[tuple[str, Any, dict[str, tuple[str, str, str]], frozenset[str]]] = [
         *(("link", link, EXTRAS_DROPPED_LINK, handled) for link in robot.links),
         *(("joint", joint, EXTRAS_DROPPED_JOINT, frozenset()) for joint in robot.joints),
@@ -78,9 +98,17 @@ def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
         for key in sorted(element.extras):
             if key in table and key not in skip:
                 owner, code, what = table[key]
-                found.append((owner, code, f"{kind} {element.name}: {what}", element.extras[key],
+                value = _without_defaults(element.extras[key], EXTRAS_DEFAULTS.get(key))
+                found.append((owner, code, f"{kind} {element.name}: {what}", value,
                               element.source, f"{kind}[{element.name}]"))
     for owner, code, what, value, source, where in found:
         shown = shown_extras(value) if owner != target and value else ""
         if shown:
             notes.note(code, f"{what} ({shown}): no {target} equivalent; left out", source, where)
+
+
+def _without_defaults(value: Any, defaults: dict[str, object] | None) -> Any:
+    """``value`` without the dict entries equal to the owning format's defaults."""
+    if not defaults or not isinstance(value, dict):
+        return value
+    return {k: v for k, v in value.items() if k not in defaults or defaults[k] != v}

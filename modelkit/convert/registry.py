@@ -35,6 +35,7 @@ class TargetInfo:
     tracks_native: bool = False  # the target holds pseudo continuous tracks itself
     auto_wheel: str = "cylinder"  # the wheel collision `--wheel-collision auto` writes
     sites_native: bool = False  # the target holds MJCF sites itself (else they become frame links)
+    frames_native: bool = False  # the target holds SDF <frame>s itself (else they become frame links)
 
 
 def _target(declaration: FormatDeclaration) -> TargetInfo:
@@ -42,7 +43,7 @@ def _target(declaration: FormatDeclaration) -> TargetInfo:
     if out is None:
         raise ValueError(f"format {declaration.name} declares no output")
     return TargetInfo(declaration.name, out.suffix, out.suffixes, out.writer, out.tracks_native,
-                      out.auto_wheel, out.sites_native)
+                      out.auto_wheel, out.sites_native, out.frames_native)
 
 
 TARGETS: tuple[TargetInfo, ...] = tuple(_target(d) for d in WRITTEN)

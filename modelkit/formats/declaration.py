@@ -20,6 +20,7 @@ class OutputDeclaration(NamedTuple):
     tracks_native: bool = False  # the format holds pseudo continuous tracks itself
     auto_wheel: str = "cylinder"  # the wheel collision `--wheel-collision auto` writes: cylinder or sphere
     sites_native: bool = False  # the format holds MJCF sites (named frames on a body) itself
+    frames_native: bool = False  # the format holds SDF <frame>s (named poses on a link) itself
     handles: frozenset[str] = frozenset()  # other formats' robot/link extras keys its writer notes itself
     walks_extras: bool = False  # its writer notes every other format's robot extras key itself
 
@@ -45,6 +46,9 @@ class ExtrasDeclaration(NamedTuple):
     dropped_link: tuple[tuple[str, str, str], ...] = ()  # the same for link keys, noted by convert itself
     dropped_joint: tuple[tuple[str, str, str], ...] = ()  # and for joint keys
     partly_carried: frozenset[str] = frozenset()  # dropped robot keys the model's fields carry in part
+    # (key, ((entry, value), ...)): entries of a dropped dict-valued key that say only the format's default
+    # (an SDF link's <gravity>true</gravity>): nothing is lost, so a note leaves them out
+    defaults: tuple[tuple[str, tuple[tuple[str, object], ...]], ...] = ()
 
 
 class FormatDeclaration(NamedTuple):

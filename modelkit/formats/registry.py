@@ -46,6 +46,10 @@ EXTRAS_DROPPED_JOINT: dict[str, tuple[str, str, str]] = {
     key: (d.name, code, what) for d in DECLARED for key, code, what in d.extras.dropped_joint
 }
 """The same for joint ``extras`` keys."""
+EXTRAS_DEFAULTS: dict[str, dict[str, object]] = {
+    key: dict(entries) for d in DECLARED for key, entries in d.extras.defaults
+}
+"""Dropped key → its entries that say only the owning format's default (left out of a note)."""
 
 
 def declared(name: str) -> FormatDeclaration:

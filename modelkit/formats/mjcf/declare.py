@@ -37,6 +37,10 @@ FORMAT = FormatDeclaration(
         ),
         dropped_link=(
             ("mjcf_contact", "MK851", "MJCF contact parameters beyond the friction the target holds"),
+            ("mjcf_mocap", "MK808", "MJCF mocap flag, a body the program moves (mocap_pos, mocap_quat)"),
+        ),
+        dropped_joint=(
+            ("mjcf_ball_range", "MK820", "the ball joint's cone limit (MJCF range, radians)"),
         ),
     ),
 )

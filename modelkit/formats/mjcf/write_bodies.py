@@ -344,6 +344,8 @@ class BodyTree:
             moving = True
         else:
             moving = self._joint(el, joint, name)
+        if link.extras.get("mjcf_mocap") and not moving and parent.tag == "worldbody":
+            el.set("mocap", "true")  # an MJCF source's mocap body (moved by the program), written back
         return self._fill(el, link, name, moving)
 
     def _chain_body(self, parent: Element, chain: Chain, pose: Pose) -> list[_Pending]:
@@ -469,6 +471,9 @@ class BodyTree:
         if kind is JointType.BALL:
             el = sub(body, "joint", name=name, type="ball")
             self._anchor(el, anchor)
+            cone = joint.extras.get("mjcf_ball_range")  # an MJCF source's cone limit, written back
+            if cone:
+                el.set("range", f"0 {fmt(float(cone[1]))}")
             self._dynamics(el, joint, target)
             return True
         el = sub(body, "joint", name=name, type="hinge" if kind is JointType.REVOLUTE else "slide")

@@ -12,11 +12,14 @@ FORMAT = FormatDeclaration(
         writer="modelkit.formats.sdf.writer:write_sdf",
         suffix=".sdf",
         suffixes=(".sdf",),
+        frames_native=True,
         handles=frozenset({"gazebo"}),  # a URDF's <gazebo> blocks: written or noted (write_self_collide)
     ),
     extras=ExtrasDeclaration(
         quiet=frozenset({"sdf_canonical_link", "sdf_version", "sdf_model_pose", "sdf_world_joint"}),
-        quiet_link=frozenset({"sdf_link_pose"}),
+        # sdf_materials: a visual's exact SDF colours and script, for SDF round trips; the model's material
+        # holds the colour and the ambient intensity, and each writer says what of it its target drops
+        quiet_link=frozenset({"sdf_link_pose", "sdf_materials"}),
         dropped=(
             ("sdf_world", "MK822", "the SDF world around the model"),
             ("sdf_plugins", "MK808", "SDF model plugins"),
@@ -24,6 +27,11 @@ FORMAT = FormatDeclaration(
         dropped_link=(
             ("sdf_plugins", "MK808", "SDF plugins of a visual or collision"),
             ("sdf_surface", "MK851", "SDF surface parameters other than friction"),
+            ("sdf_link", "MK808", "SDF link flags"),
+            ("sdf_other", "MK808", "SDF link elements kept only as data by validate's MK155"),
         ),
+        # an SDF link's flags at SDFormat's defaults say nothing a target misses
+        defaults=(("sdf_link", (("gravity", True), ("kinematic", False), ("enable_wind", False),
+                                ("must_be_base_link", False))),),
     ),
 )

@@ -65,13 +65,6 @@ SILENT_EXTRAS = WRITTEN_EXTRAS | EXTRAS_QUIET | PASS_EXTRAS
 SILENT_LINK_EXTRAS = (
     frozenset({"gazebo", CONTACT_EXTRAS}) | EXTRAS_QUIET_LINK | frozenset(EXTRAS_DROPPED_LINK)
 )
-SDF_LINK_DEFAULTS = {
-    "gravity": True,
-    "kinematic": False,
-    "self_collide": False,
-    "enable_wind": False,
-    "must_be_base_link": False,
-}
 
 
 def urdf_renames(notes: Iterable[ConversionNote]) -> dict[str, str]:
@@ -285,10 +278,6 @@ def _listed(names: list[str], shown: int = 8) -> str:
 
 def _link_extras(extras: dict[str, object], source_name: str, name: str, ctx: WriteContext) -> None:
     for key, value in sorted(extras.items()):
-        if key == "sdf_link" and isinstance(value, dict):
-            # self_collide is written as <gazebo><selfCollide> (write_self_collide)
-            value = {k: v for k, v in value.items()
-                     if k != "self_collide" and SDF_LINK_DEFAULTS.get(k, not v) != v}
         if key in SILENT_LINK_EXTRAS or not value:
             continue
         ctx.note(
