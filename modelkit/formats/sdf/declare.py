@@ -23,12 +23,18 @@ FORMAT = FormatDeclaration(
         dropped=(
             ("sdf_world", "MK822", "the SDF world around the model"),
             ("sdf_plugins", "MK808", "SDF model plugins"),
+            ("sdf_model_elements", "MK808", "SDF model flags"),
         ),
         dropped_link=(
             ("sdf_plugins", "MK808", "SDF plugins of a visual or collision"),
             ("sdf_surface", "MK851", "SDF surface parameters other than friction"),
             ("sdf_link", "MK808", "SDF link flags"),
             ("sdf_other", "MK808", "SDF link elements kept only as data by validate's MK155"),
+            ("sdf_shape_elements", "MK808", "SDF visual and collision elements"),
+        ),
+        dropped_joint=(
+            ("sdf_joint_elements", "MK820", "SDF joint solver parameters"),
+            ("sdf_limit_elements", "MK820", "SDF joint stop parameters"),
         ),
         # an SDF link's flags at SDFormat's defaults say nothing a target misses
         defaults=(("sdf_link", (("gravity", True), ("kinematic", False), ("enable_wind", False),

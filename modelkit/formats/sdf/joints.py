@@ -22,6 +22,7 @@ from modelkit import rot3
 from modelkit.diagnostics import Severity, SourceLocation, did_you_mean
 from modelkit.formats.sdf.collect import MODEL_FRAME, Item
 from modelkit.formats.sdf.context import Context
+from modelkit.formats.sdf.kept import JOINT_KEY, JOINT_TAGS, LIMIT_KEY, LIMIT_TAGS, keep
 from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import sensor_device
 from modelkit.formats.sdf.values import child, children
@@ -86,6 +87,7 @@ def read_joint(ctx: Context, graph: FrameGraph, item: Item) -> JointData:
     axis2_el = child(el, "axis2")
     if axis2_el is not None:
         data.axis2 = _axis(ctx, graph, data, axis2_el)
+    keep(joint.extras, JOINT_KEY, el, JOINT_TAGS, "joint")  # <physics>
     if data.word in ("universal", "revolute2", "gearbox", "screw"):
         _keep_unsupported(data)
     for sensor_el in children(el, "sensor"):
@@ -252,6 +254,7 @@ def _axis_details(ctx: Context, data: JointData, axis_el: Element) -> None:
     limits = JointLimits()
     if limit is not None:
         joint.sources["range"] = values.loc(limit)
+        keep(joint.extras, LIMIT_KEY, limit, LIMIT_TAGS, "limit")  # the stop's <stiffness>, <dissipation>
         if joint.type in (JointType.REVOLUTE, JointType.PRISMATIC) and data.word != "continuous":
             limits.lower = _bound(values.child_number(limit, "lower", -math.inf, allow_inf=True))
             limits.upper = _bound(values.child_number(limit, "upper", math.inf, allow_inf=True))

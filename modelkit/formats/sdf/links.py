@@ -24,6 +24,7 @@ from modelkit.diagnostics import Severity
 from modelkit.formats.sdf.collect import Item
 from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.geometry import element_data, read_geometry, read_material
+from modelkit.formats.sdf.kept import keep_shape
 from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import light_device, plugin_data, sensor_device
 from modelkit.formats.sdf.values import Values, child, children
@@ -87,6 +88,7 @@ def read_link(ctx: Context, graph: FrameGraph, item: Item) -> LinkData:
                     severity=Severity.WARNING,
                 )
             shape = read_geometry(ctx, src, geometry_el, label, visual_only=(kind == "visual"))
+            keep_shape(link.extras, kind, name, geom_el)  # <laser_retro>, <max_contacts>, <cast_shadows>
             placed = place(child(geom_el, "pose"), src, item.name, label)
             if shape.unmodelled is not None:
                 entry = {"element": kind, "name": name, "pose": placed, **shape.unmodelled}

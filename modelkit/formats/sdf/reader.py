@@ -25,6 +25,7 @@ from modelkit.formats.sdf.collect import Collector, ModelTree, Scope
 from modelkit.formats.sdf.context import Context
 from modelkit.formats.sdf.document import SdfDocument, version_text
 from modelkit.formats.sdf.joints import read_joint
+from modelkit.formats.sdf.kept import MODEL_KEY, MODEL_TAGS, keep
 from modelkit.formats.sdf.links import read_link
 from modelkit.formats.sdf.poses import FrameGraph
 from modelkit.formats.sdf.sensors import light_device, plugin_data
@@ -178,6 +179,7 @@ class _Reader:
             robot.extras["sdf_plugins"] = plugins
             pairs = zip(tree.plugins, plugins, strict=True)
             read_actuators(robot, [(src, el, data) for (_, src, el), data in pairs])
+        keep(robot.extras, MODEL_KEY, tree.scope.element, MODEL_TAGS, "model")
         self_collide = child(tree.scope.element, "self_collide")
         if self_collide is not None:
             robot.self_collide = tree.scope.src.values.boolean(self_collide)

@@ -13,6 +13,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import PairFriction, describe
 from modelkit.convert.names import unique_name
 from modelkit.convert.numbers import fmt, fmt_vec
+from modelkit.formats.sdf.kept import shape_entries, write_back
 from modelkit.formats.sdf.write_xml import add_pose, child_or_sub, num, rgba, sub
 from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere, SurfaceFriction
 from modelkit.spatial import Pose
@@ -40,6 +41,7 @@ class GeomWriter:
         the frame the pose is written in (identity when the link frame is the written frame)."""
         kept = {str(e.get("collision")): str(e.get("xml")) for e in link.extras.get("sdf_surface", [])}
         for kind, geoms in (("visual", link.visuals), ("collision", link.collisions)):
+            elements = shape_entries(link.extras, kind)  # <laser_retro>, <cast_shadows>... (kept.py)
             used: set[str] = set()
             for index, geom in enumerate(geoms):
                 name = unique_name(geom.name or f"{kind}_{index}", used)
@@ -49,6 +51,8 @@ class GeomWriter:
                 if not self._geometry(shape, geom, f"{written}_{kind}_{name}", target):
                     el.remove(shape)
                     continue
+                if geom.name in elements:
+                    write_back(shape, elements[geom.name])
                 if kind == "collision" and geom.name in kept:
                     shape.append(etree.fromstring(kept[geom.name]))  # the source's surface, friction aside
                 if kind == "visual":

@@ -42,6 +42,7 @@ from modelkit.convert.friction import floor_friction
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.joint_springs import note_spring_dropped
 from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_vec
+from modelkit.formats.sdf.kept import JOINT_KEY, LIMIT_KEY, MODEL_KEY, write_back
 from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
 from modelkit.formats.sdf.write_geometry import GeomWriter
@@ -169,6 +170,7 @@ class _ModelWriter:
         if self.frames_ok and not self.world_root and robot.root in self.links:
             model.set("canonical_link", self.names.links[robot.root or ""])
         self._root(model)
+        write_back(model, robot.extras.get(MODEL_KEY))  # <allow_auto_disable>, <enable_wind> (kept.py)
         self.self_collide = self_collide_policy(robot, ctx, model, {lk.name for lk in written_links})
         for link in written_links:
             self._link(model, link)
@@ -396,6 +398,7 @@ class _ModelWriter:
                 self.axis_joints[joint.name] = name
         else:
             self._axisless_dynamics(joint, kind, name)
+        write_back(el, joint.extras.get(JOINT_KEY))  # <physics> (kept.py)
         if joint.armature:
             ctx.note(
                 "MK820",
@@ -458,7 +461,8 @@ class _ModelWriter:
                 joint.source,
                 f"joint[{name}]/axis",
             )
-        if limited or finite_rates or self._continuous_as_revolute(joint):
+        stop = joint.extras.get(LIMIT_KEY)  # the stop's <stiffness>, <dissipation> (kept.py)
+        if limited or finite_rates or self._continuous_as_revolute(joint) or stop:
             limit = sub(axis, "limit")
             num(limit, "lower", lim.lower if math.isfinite(lim.lower) else -UNLIMITED)
             num(limit, "upper", lim.upper if math.isfinite(lim.upper) else UNLIMITED)
@@ -466,6 +470,7 @@ class _ModelWriter:
                 num(limit, "effort", lim.effort)
             if math.isfinite(lim.velocity):
                 num(limit, "velocity", lim.velocity)
+            write_back(limit, stop)
         spring = joint.spring_stiffness or joint.spring_reference
         if joint.damping or joint.friction or spring:
             dyn = sub(axis, "dynamics")
