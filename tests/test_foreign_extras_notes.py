@@ -265,3 +265,53 @@ def test_mjcf_mocap_and_ball_cone_are_kept_in_mjcf_and_said_elsewhere(tmp_path: 
         assert len(_about(notes, "link target", "MJCF mocap flag")) == 1, suffix
         cone = _about(notes, "joint b", "cone limit")
         assert len(cone) == 1 and "(0 0.785398)" in cone[0].message and cone[0].code == "MK820", suffix
+
+
+PHYSICS = """<mujoco model="ph"><compiler angle="radian"/><worldbody>
+ <body name="a" pos="0 0 1" gravcomp="1">
+  <joint name="j" type="hinge" axis="0 1 0" range="-1 1" margin="0.01" solreflimit="0.02 1"
+    solimplimit="0.8 0.9 0.01" solreffriction="0.03 1" frictionloss="0.1" actuatorgravcomp="true"/>
+  <inertial pos="0 0 -0.1" mass="1" diaginertia="0.01 0.01 0.001"/>
+  <geom type="sphere" size="0.05"/></body>
+</worldbody><actuator><motor joint="j" gear="2"/></actuator></mujoco>"""
+
+
+def test_mjcf_gravity_compensation_and_joint_solver_parameters_kept_and_said(tmp_path: Path) -> None:
+    """Before, MJCF → MJCF dropped gravcomp (the body then falls), the limit's and dry friction's
+    solver parameters and actuatorgravcomp, and every other target said nothing of them."""
+    source = tmp_path / "ph.xml"
+    source.write_text(PHYSICS)
+    out = tmp_path / "out" / "ph.xml"
+    notes = convert([source], out).notes
+    assert not _about(notes, "gravity compensation") and not _about(notes, "solver parameters")
+    given, written = mujoco.MjModel.from_xml_path(str(source)), mujoco.MjModel.from_xml_path(str(out))
+    for array in ("body_gravcomp", "jnt_margin", "jnt_solref", "jnt_solimp", "dof_solref", "dof_solimp",
+                  "jnt_actgravcomp", "dof_frictionloss"):
+        assert (getattr(given, array) == getattr(written, array)).all(), array
+    for suffix in ("urdf", "sdf", "body"):
+        notes = convert([source], tmp_path / suffix / f"ph.{suffix}").notes
+        grav = _about(notes, "link a: MJCF gravity compensation (gravcomp 1)")
+        assert len(grav) == 1 and grav[0].code == "MK808", suffix
+        solver = _about(notes, "joint j: MJCF joint solver parameters")
+        assert len(solver) == 1 and solver[0].code == "MK820", suffix
+        # solreflimit is MuJoCo's default: nothing lost, not named
+        for word in ("margin 0.01", "solimplimit 0.8 0.9 0.01 0.5 2", "solreffriction 0.03 1",
+                     "actuatorgravcomp true"):
+            assert word in solver[0].message, (suffix, solver[0].message)
+        assert "solreflimit" not in solver[0].message
+
+
+def test_robot_records_are_named_not_dumped(tmp_path: Path) -> None:
+    """A robot's MJCF tendons, equalities and keyframes are named (or counted) in the notes, not printed
+    as the reader's records (before: ``wraps [{'type': 'joint', ...}]``, ``obj1id 1, obj2id 2``)."""
+    source = tmp_path / "t.xml"
+    source.write_text("""<mujoco model="t"><worldbody><body name="b"><joint name="j1" axis="0 1 0"/>
+      <geom type="sphere" size="0.1"/><body name="c"><joint name="j2" axis="0 1 0"/>
+      <geom type="sphere" size="0.1"/></body></body></worldbody>
+      <tendon><fixed name="t1"><joint joint="j1" coef="1"/><joint joint="j2" coef="-1"/></fixed></tendon>
+      <equality><joint joint1="j1" joint2="j2" polycoef="0 2 0 0 0"/></equality>
+      <keyframe><key name="home"/><key name="other"/></keyframe></mujoco>""")
+    notes = convert([source], tmp_path / "out" / "t.sdf").notes
+    assert len(_about(notes, "MJCF tendons (1: t1)")) == 1
+    assert len(_about(notes, "MJCF keyframes (stored joint positions) (2: home, other)")) == 1
+    assert not any("{" in n.message or "obj1id" in n.message for n in notes), [n.message for n in notes]

@@ -23,12 +23,18 @@ BOOKKEEPING = frozenset({"collision", "name", "source", "reference"})
 """Keys of a kept entry that place it rather than hold data (a collision's index, a block's link)."""
 
 
-def shown_extras(value: Any) -> str:
+def shown_extras(value: Any, records: bool = False) -> str:
     """An extras value in a note ("" when nothing of it is lost): a kept XML block by its children's
     tags (those the model carries left out), a plugin by its library, a dict's non-empty values as
-    ``key value``, a list item by item."""
+    ``key value``, a list item by item; with ``records``, a list of a reader's records (a robot's MJCF
+    tendons, equalities, keyframes) by their names, or their count."""
     if isinstance(value, list) and value and all(isinstance(v, int | float) for v in value):
         return _plain(value)  # numbers: a range, a vector
+    if records and isinstance(value, list) and value and all(_record(v) for v in value):
+        # a reader's records (MJCF tendons, equalities, keyframes): their names, else how many
+        names = [str(v["name"]) for v in value if v.get("name")]
+        shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
+        return f"{len(value)}: {shown}" if names else str(len(value))
     if isinstance(value, list):
         return "; ".join(text for text in (shown_extras(v) for v in value) if text)
     if isinstance(value, dict) and "element" in value and "data" in value:
@@ -53,6 +59,11 @@ def shown_extras(value: Any) -> str:
     else:
         text = _plain(value)
     return text if len(text) <= 120 else text[:117] + "..."
+
+
+def _record(value: Any) -> bool:
+    """A dict that is a reader's record of one element (not a kept XML block, plugin or data element)."""
+    return isinstance(value, dict) and not {"xml", "element"} & value.keys()
 
 
 def _plain(value: Any) -> str:
@@ -102,7 +113,7 @@ def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
                 found.append((owner, code, f"{kind} {element.name}: {what}", value,
                               element.source, f"{kind}[{element.name}]"))
     for owner, code, what, value, source, where in found:
-        shown = shown_extras(value) if owner != target and value else ""
+        shown = shown_extras(value, records=where == "robot") if owner != target and value else ""
         if shown:
             notes.note(code, f"{what} ({shown}): no {target} equivalent; left out", source, where)
 

@@ -48,6 +48,22 @@ class MjJoint:
     springref: float = 0.0
     actfrc: tuple[float, float] | None = None
     qpos_address: int | None = None  # where the joint's values start in qpos (compiled models)
+    physics: dict[str, str] = field(default_factory=dict)  # margin, solreflimit... where not MuJoCo's default
+
+
+# MJCF joint attribute -> (the compiled array's row kind "jnt" or "dof", its field, MuJoCo's default): the
+# limit's and the dry friction's solver parameters, the limit margin, gravity compensation by actuators
+JOINT_PHYSICS_DEFAULTS: dict[str, tuple[str, str, tuple[float, ...]]] = {
+    "margin": ("jnt", "margin", (0.0,)),
+    "solreflimit": ("jnt", "solref", (0.02, 1.0)),
+    "solimplimit": ("jnt", "solimp", (0.9, 0.95, 0.001, 0.5, 2.0)),
+    "solreffriction": ("dof", "solref", (0.02, 1.0)),
+    "solimpfriction": ("dof", "solimp", (0.9, 0.95, 0.001, 0.5, 2.0)),
+    "actuatorgravcomp": ("jnt", "actgravcomp", (0.0,)),
+}
+BODY_PHYSICS_DEFAULTS: dict[str, tuple[str, str, tuple[float, ...]]] = {
+    "gravcomp": ("body", "gravcomp", (0.0,)),
+}
 
 
 GEOM_CONTACT_DEFAULTS: dict[str, tuple[float, ...]] = {
@@ -131,3 +147,4 @@ class MjBody:
     sites: list[MjSite] = field(default_factory=list)
     inertial: MjInertial | None = None
     mocap: bool = False
+    physics: dict[str, str] = field(default_factory=dict)  # gravcomp where not MuJoCo's default

@@ -311,6 +311,8 @@ class RobotBuilder:
             # springref is ignored; the model's reference 0 says so
             joint.spring_stiffness, joint.spring_reference = mj.stiffness, 0.0
         joint.extras.update(extras)
+        if mj.physics:  # margin, solreflimit, ... actuatorgravcomp: written back by the MJCF writer only
+            joint.extras["mjcf_joint_physics"] = dict(mj.physics)
         self.joints[mj.index] = joint
         return joint
 
@@ -340,6 +342,8 @@ class RobotBuilder:
             link.extras["mjcf_body_offset"] = [float(x) for x in shift]
         if body.mocap:
             link.extras["mjcf_mocap"] = True
+        if body.physics:  # gravcomp
+            link.extras["mjcf_body_physics"] = dict(body.physics)
         back = offset.inverse()
         inertial = body.inertial
         if inertial is not None:

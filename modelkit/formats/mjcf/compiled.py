@@ -15,8 +15,10 @@ from typing import Any
 
 from modelkit import rot3
 from modelkit.formats.mjcf.bodies import (
+    BODY_PHYSICS_DEFAULTS,
     GEOM_CONTACT_DEFAULTS,
     INTEGER_CONTACT,
+    JOINT_PHYSICS_DEFAULTS,
     MUJOCO_FRICTION,
     MjBody,
     MjGeom,
@@ -81,6 +83,7 @@ class CompiledModel:
                     rot3.rotate_inertia(diagonal(m.body_inertia[b]), rot3.from_quat_wxyz(m.body_iquat[b])),
                 ),
                 mocap=int(m.body_mocapid[b]) >= 0,
+                physics=non_default(m, BODY_PHYSICS_DEFAULTS, {"body": b}),
             )
             for b in range(1, m.nbody)
         ]
@@ -125,6 +128,7 @@ class CompiledModel:
             if bool(m.jnt_actfrclimited[j])
             else None,
             qpos_address=qadr,
+            physics=non_default(m, JOINT_PHYSICS_DEFAULTS, {"jnt": j, "dof": dadr}),
         )
 
     def geom(self, g: int) -> MjGeom:
@@ -369,6 +373,24 @@ def contact_attributes(m: Any, g: int) -> dict[str, str]:
     acting = 3 if int(m.geom_condim[g]) >= 6 else 2 if int(m.geom_condim[g]) >= 4 else 1
     if friction[acting:] != MUJOCO_FRICTION[acting:]:  # coefficients its condim leaves idle, which
         out["friction"] = _plain(friction)  # still count when MuJoCo mixes it with a larger condim
+    return out
+
+
+def non_default(m: Any, table: dict[str, tuple[str, str, tuple[float, ...]]],
+                index: dict[str, int]) -> dict[str, str]:
+    """The attributes of ``table`` (MJCF attribute → the compiled array's row kind and field, MuJoCo's
+    default) whose compiled value differs from the default, as MJCF attribute text; ``index`` gives the
+    row per kind (``jnt``, ``dof``, ``body``). An array the loaded library lacks is skipped."""
+    out: dict[str, str] = {}
+    for attribute, (row, name, default) in table.items():
+        try:
+            raw = getattr(m, f"{row}_{name}")[index[row]]
+        except AttributeError:
+            continue
+        values = tuple(float(x) for x in (raw if hasattr(raw, "__len__") else (raw,)))
+        if any(abs(a - b) > 1e-12 * max(1.0, abs(b)) for a, b in zip(values, default, strict=True)):
+            flag = attribute == "actuatorgravcomp"
+            out[attribute] = ("true" if values[0] else "false") if flag else _plain(values)
     return out
 
 

@@ -38,9 +38,11 @@ FORMAT = FormatDeclaration(
         dropped_link=(
             ("mjcf_contact", "MK851", "MJCF contact parameters beyond the friction the target holds"),
             ("mjcf_mocap", "MK808", "MJCF mocap flag, a body the program moves (mocap_pos, mocap_quat)"),
+            ("mjcf_body_physics", "MK808", "MJCF gravity compensation"),
         ),
         dropped_joint=(
             ("mjcf_ball_range", "MK820", "the ball joint's cone limit (MJCF range, radians)"),
+            ("mjcf_joint_physics", "MK820", "MJCF joint solver parameters"),
         ),
     ),
 )

@@ -346,6 +346,8 @@ class BodyTree:
             moving = self._joint(el, joint, name)
         if link.extras.get("mjcf_mocap") and not moving and parent.tag == "worldbody":
             el.set("mocap", "true")  # an MJCF source's mocap body (moved by the program), written back
+        for attribute, value in (link.extras.get("mjcf_body_physics") or {}).items():
+            el.set(attribute, str(value))  # gravcomp
         return self._fill(el, link, name, moving)
 
     def _chain_body(self, parent: Element, chain: Chain, pose: Pose) -> list[_Pending]:
@@ -582,6 +584,8 @@ class BodyTree:
                 joint.loc("limits"),
                 target,
             )
+        for attribute, value in (joint.extras.get("mjcf_joint_physics") or {}).items():
+            el.set(attribute, str(value))  # an MJCF source's margin, solreflimit... written back
         lost = []
         if math.isfinite(joint.limits.velocity) or math.isfinite(joint.limits.velocity_upper):
             lost.append("velocity limit")
