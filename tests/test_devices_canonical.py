@@ -555,3 +555,42 @@ def test_body_node_rotation_inverts_the_optical_frame() -> None:
             canonical = canonical_rotation("Camera", params, node)
             np.testing.assert_allclose(node_rotation("Camera", params, canonical), node, atol=1e-12)
     assert canonical_rotation("SpotLight", {}, node) is node
+
+
+SENSOR_RANGES_BODY = """format: ChoreonoidBody
+format_version: 2.0
+angle_unit: degree
+name: Ranges
+links:
+  - name: Base
+    joint_type: free
+    mass: 1.0
+    inertia: [ 0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01 ]
+    elements:
+      - { type: RateGyroSensor, name: gyro, max_angular_velocity: [ 10, 10, 10 ] }
+      - { type: AccelerationSensor, name: acc, max_acceleration: [ 20, 30, 40 ] }
+      - { type: ForceSensor, name: ft, max_force: [ 100, 100, 100 ] }
+      - { type: IMU, name: imu }
+"""
+
+
+def test_sensor_ranges_become_mujoco_cutoffs(tmp_path: Path) -> None:
+    """Choreonoid's per-axis sensor ranges clamp the reading, as MuJoCo's cutoff does (one number per
+    sensor: three different ones are written as the largest, with an MK807 note); no range, no cutoff.
+    Before, the ranges were left out of the MJCF without a note."""
+    import mujoco
+
+    from modelkit.convert.api import convert
+
+    source = tmp_path / "ranges.body"
+    source.write_text(SENSOR_RANGES_BODY)
+    out = tmp_path / "out" / "ranges.xml"
+    notes = convert([source], out).notes
+    model = mujoco.MjModel.from_xml_path(str(out))
+    cutoff = {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SENSOR, s): float(model.sensor_cutoff[s])
+              for s in range(model.nsensor)}
+    assert cutoff == {"gyro": 10.0, "acc": 40.0, "ft_force": 100.0, "ft_torque": 0.0, "imu_acc": 0.0,
+                      "imu_gyro": 0.0}
+    said = [n.message for n in notes if n.code == "MK807"]
+    assert len(said) == 1, said
+    assert "acc: max_acceleration 20 30 40 per axis" in said[0] and "largest, 40" in said[0]

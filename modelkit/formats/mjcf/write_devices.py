@@ -14,7 +14,11 @@ The model's device frame has +X forward (viewing / scanning direction), +Y left,
   ray, not a scan).
 * ``imu`` → site + ``accelerometer`` + ``gyro``; ``accelerometer``/``gyro`` → site + that sensor;
   ``force_torque`` → site + ``force`` + ``torque`` (MuJoCo measures the force between the body and
-  its parent, expressed in the site frame, as Choreonoid's force sensor does).
+  its parent, expressed in the site frame, as Choreonoid's force sensor does). A sensor's range
+  (``max_acceleration``, ``max_angular_velocity``, ``max_force``, ``max_torque``: Choreonoid's
+  per-axis limits) is MuJoCo's ``cutoff``, which clamps each component's absolute value: one number,
+  so three different ones are written as the largest (MK807). ``noise_stddev`` is ``noise``;
+  ``update_rate`` has no MJCF field (MK807: MuJoCo computes sensors every step).
 * ``contact`` → left out (MK806): MuJoCo's ``touch`` needs a sensing volume the model does not
   give.
 * Lights → ``<light type="spot|point|directional">`` at the device position, ``dir`` = the
@@ -46,6 +50,9 @@ CAMERA_FROM_DEVICE = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.
 # The rangefinder site's x, y, z axes in the device frame (its +Z is the device's +X).
 RAY_FROM_DEVICE = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 SITE_SIZE = "0.005"
+# MuJoCo sensor -> the device parameter that is its range (cutoff)
+RANGES = {"accelerometer": "max_acceleration", "gyro": "max_angular_velocity", "force": "max_force",
+          "torque": "max_torque"}
 SENSORS: dict[DeviceKind, tuple[tuple[str, str], ...]] = {
     DeviceKind.IMU: (("accelerometer", "_acc"), ("gyro", "_gyro")),
     DeviceKind.ACCELEROMETER: (("accelerometer", ""),),
@@ -163,6 +170,7 @@ class DeviceWriter:
 
     def sensors(self, body: Element, device: Device, target: str) -> None:
         p = device.canonical_params
+        lost: list[str] = []
         turn = RAY_FROM_DEVICE if device.canonical is DeviceKind.LIDAR else np.eye(3)
         source_site = str(device.params.get("site") or "")
         shared = self.site_for.get(source_site) if source_site else None
@@ -180,7 +188,14 @@ class DeviceWriter:
             el = sub(self.sensor, element, name=name, site=site_name)
             if element == "rangefinder" and p.get("range_max") is not None:
                 el.set("cutoff", fmt(float(p["range_max"])))
+            self._cutoff(el, element, p, lost)
             self._noise(el, p)
+        rate = p.get("update_rate")
+        if rate is not None and math.isfinite(float(rate)) and float(rate) > 0.0:
+            lost.append(f"update rate {fmt(float(rate))} Hz (MuJoCo computes sensors every step)")
+        if lost:
+            self.ctx.note("MK807", f"{device.canonical.value} {device.name}: " + "; ".join(lost),
+                          device.source, target)
         if device.canonical is DeviceKind.LIDAR:
             samples = p.get("horizontal_samples")
             scan = f"; the scan had {samples} samples" if samples else ""
@@ -191,6 +206,24 @@ class DeviceWriter:
                 device.source,
                 target,
             )
+
+    @staticmethod
+    def _cutoff(el: Element, element: str, p: dict[str, Any], lost: list[str]) -> None:
+        """The sensor's range as MuJoCo's ``cutoff`` (module docstring)."""
+        key = RANGES.get(element)
+        given = p.get(key) if key else None
+        if given is None:
+            return
+        values = [abs(float(v)) for v in (given if isinstance(given, list | tuple) else [given])]
+        if not values or not all(math.isfinite(v) for v in values):
+            return  # no range (Choreonoid's default: unlimited)
+        largest = max(values)
+        if largest <= 0.0:
+            return
+        el.set("cutoff", fmt(largest))
+        if any(v != largest for v in values):
+            lost.append(f"{key} {fmt_vec(values)} per axis: cutoff is one number, written as the largest, "
+                        f"{fmt(largest)}")
 
     @staticmethod
     def _noise(el: Element, p: dict[str, Any]) -> None:
