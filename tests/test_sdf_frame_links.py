@@ -139,9 +139,45 @@ def test_a_frame_whose_joint_name_is_taken_gets_another(tmp_path: Path) -> None:
     assert joints["tool0_joint"] == "l1" and joints["tool0_joint_2"] == "tool0"
 
 
-def test_frame_bodies_leaves_the_frames_out_and_says_which(arm: Path, tmp_path: Path) -> None:
-    for suffix in ("urdf", "xml", "body"):
-        out = tmp_path / f"arm.{suffix}"
-        said = _convert(arm, out, "--frame-bodies")
-        assert "MK808 3 SDF frame(s) left out (--frame-bodies" in said, said
-        assert "tool0" not in out.read_text()
+def test_frame_bodies_writes_the_frames_as_bodies_in_mjcf(arm: Path, tmp_path: Path) -> None:
+    """``--frame-bodies`` is about how MJCF writes frame links (bodies instead of sites); URDF and .body
+    hold the frames as links either way."""
+    import mujoco
+
+    out = tmp_path / "arm.xml"
+    _convert(arm, out, "--frame-bodies")
+    model = mujoco.MjModel.from_xml_path(str(out))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert model.nsite == 0
+    for name, where in EXPECTED.items():
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
+        assert body >= 0 and model.body_mass[body] == 0.0, name
+        assert np.allclose(data.xpos[body], where, atol=1e-12), name
+    for suffix in ("urdf", "body"):
+        frames = tmp_path / f"fb.{suffix}"
+        _convert(arm, frames, "--frame-bodies")
+        assert "tool0_joint" in frames.read_text()
+
+
+def test_verify_grades_where_each_engine_puts_a_frame(arm: Path, tmp_path: Path) -> None:
+    """verify's reference holds the frames as links (MK874), so layer 2 compares each frame's pose in
+    every engine; a URDF whose frame is 1 mm off fails there, naming the frame."""
+    from modelkit.verify.api import verify
+
+    report = verify(arm, tmp_path / "ok", engines=("mujoco", "pybullet", "drake"), configurations=5,
+                    samples=3, replay=False, driven=False)
+    assert not report.errors and all(c.passed for c in report.checks), [c for c in report.checks
+                                                                         if not c.passed]
+    assert {c.detail for c in report.checks if c.quantity == "link-set"} == {"5 links"}
+    moved = tmp_path / "moved.urdf"
+    _convert(arm, moved)
+    text = moved.read_text()
+    assert '<origin xyz="0 0 0.3" rpy="0 1.5707963267949 0"/>' in text
+    moved.write_text(text.replace('<origin xyz="0 0 0.3" rpy="0 1.5707963267949 0"/>',
+                                  '<origin xyz="0 0 0.301" rpy="0 1.5707963267949 0"/>'))
+    report = verify(arm, tmp_path / "bad", engines=("pybullet",), urdf=moved, configurations=5,
+                    samples=3, replay=False, driven=False)
+    failed = [c for c in report.checks if not c.passed]
+    assert failed and {c.quantity for c in failed} == {"pose-position"}, failed
+    assert {c.where for c in failed} <= {"tool0", "tcp"} and abs(failed[0].error - 1e-3) < 1e-9

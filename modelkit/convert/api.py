@@ -85,7 +85,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     if options.frame_sites and not target.sites_native:
         sites_as_links(out, notes)
     if not target.frames_native:
-        frames_as_links(out, notes, keep=options.frame_sites)
+        frames_as_links(out, notes)
     if options.merge_fixed:
         merge_fixed_joints(out, notes)
     return out

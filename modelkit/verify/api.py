@@ -104,16 +104,23 @@ def _resolve(target: str) -> Any:
 
 
 def _reference(welded: Robot, report: VerifyReport) -> Robot:
-    """The model the layers compare with: the source, or its track approximation (said in a Skip)."""
+    """The model the layers compare with: the source, or its track approximation (said in a Skip). An
+    SDF source's frames are links of it, as every file verify writes holds them (MK874), so layers 1
+    and 2 check each frame's place in every engine."""
     from modelkit.convert.api import prepare
     from modelkit.convert.notes import NoteSink
     from modelkit.convert.registry import target_info
+    from modelkit.formats.sdf.frame_links import frames_as_links
 
     notes = NoteSink()
     prepared = prepare(welded, target_info("mjcf"), WriteOptions(), notes)
     tracks = [n for n in notes.items if n.code == "MK809"]
     if not tracks:
         report.reference = "the source model"
+        if any(n.code == "MK874" for n in notes.items):
+            welded = copy.deepcopy(welded)
+            frames_as_links(welded, NoteSink())
+            report.reference = "the source model, its SDF frames as links on fixed joints (MK874)"
         return welded
     report.reference = ("the source model with its tracks approximated by rollers as every writer does "
                         "(MK809): the written files are compared with that approximation")

@@ -10,8 +10,9 @@ flange, a sensor mount), the MJCF writer writes such a link as a ``<site>`` (MK8
 ``.body`` writer as a link. One MK874 note lists them; a name a link already has gets ``_2``...
 (MK800). This is the same representation an MJCF source's named-frame sites get
 (:mod:`modelkit.formats.mjcf.site_frames`), so the SDF writer writes either kind back as a
-``<frame>``. As for those sites, ``--frame-bodies`` (``WriteOptions.frame_sites=False``, also what
-``verify``'s layers 1-3 read) leaves the frames out instead, with one MK808 note that names them.
+``<frame>``. ``--frame-bodies`` (``WriteOptions.frame_sites=False``) makes the MJCF writer write such
+links as bodies without inertial instead of sites; ``verify`` compares them as links of the source
+(its reference runs this same pass), so layers 1 and 2 check where every engine puts each frame.
 """
 
 from __future__ import annotations
@@ -24,16 +25,10 @@ from modelkit.spatial import Pose
 FRAMES = "sdf_frames"
 
 
-def frames_as_links(robot: Robot, notes: NoteSink, keep: bool = True) -> None:
-    """Each SDF frame of ``robot`` a massless link on a fixed joint, or (``keep`` false) left out with a
-    note (module docstring)."""
+def frames_as_links(robot: Robot, notes: NoteSink) -> None:
+    """Each SDF frame of ``robot`` a massless link on a fixed joint (module docstring)."""
     hosts = [link for link in robot.links if link.extras.get(FRAMES)]
     if not hosts:
-        return
-    if not keep:
-        left = [f"{name} (on {host.name})" for host in hosts for name in host.extras.pop(FRAMES)]
-        notes.note("MK808", f"{len(left)} SDF frame(s) left out (--frame-bodies; the target has no "
-                   f"<frame>): {', '.join(left)}", robot.source, "link")
         return
     link_names = {link.name for link in robot.links}
     joint_names = {joint.name for joint in robot.joints}

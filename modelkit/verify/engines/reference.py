@@ -77,11 +77,11 @@ def source_static(robot: Robot) -> StaticFacts:
 
 
 def named_frames(robot: Robot) -> list[str]:
-    """The names of the source's frames that are not links: SDF ``<frame>``s and MJCF sites, which
-    the readers keep with the link they hang on (``extras``)."""
+    """The names of the source's frames that are not links: MJCF sites, which the reader keeps with the
+    link they hang on (``extras``). An SDF source's ``<frame>``s are links of verify's reference
+    (``verify.api._reference``, MK874), compared as links."""
     out: list[str] = []
     for link in robot.links:
-        out.extend(str(name) for name in (link.extras.get("sdf_frames") or {}))
         out.extend(str(site.get("name")) for site in (link.extras.get("mjcf_sites") or [])
                    if isinstance(site, dict) and site.get("name"))
     return out
