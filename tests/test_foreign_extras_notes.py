@@ -112,7 +112,7 @@ def test_mjcf_options_and_contact_parameters_survive_mjcf_and_are_said_elsewhere
         notes = convert([source], tmp_path / target.replace(".", "_") / target).notes
         options = [n for n in notes if n.code == "MK853"]
         assert len(options) == 1 and "<option>" in options[0].message, target
-        contact = [n for n in notes if n.code == "MK851" and "contact parameters" in n.message]
+        contact = [n for n in notes if n.code == "MK851" and "contact (and fluid) parameters" in n.message]
         assert len(contact) == 1 and "solref 0.01 1" in contact[0].message, target
 
 
@@ -315,3 +315,20 @@ def test_robot_records_are_named_not_dumped(tmp_path: Path) -> None:
     assert len(_about(notes, "MJCF tendons (1: t1)")) == 1
     assert len(_about(notes, "MJCF keyframes (stored joint positions) (2: home, other)")) == 1
     assert not any("{" in n.message or "obj1id" in n.message for n in notes), [n.message for n in notes]
+
+
+def test_mjcf_fluid_model_kept_and_said(tmp_path: Path) -> None:
+    """A geom's ellipsoid fluid model (fluidshape, fluidcoef: forces when the option sets a density or
+    viscosity) was lost in every target without a note; MJCF → MJCF now writes it back."""
+    source = tmp_path / "fl.xml"
+    source.write_text("""<mujoco model="fl"><option density="1.2" viscosity="2e-5"/><worldbody>
+      <body name="a" pos="0 0 1"><freejoint/><geom type="sphere" size="0.05" fluidshape="ellipsoid"
+        fluidcoef="0.4 0.25 1.5 1 1"/></body></worldbody></mujoco>""")
+    out = tmp_path / "out" / "fl.xml"
+    convert([source], out)
+    given, written = mujoco.MjModel.from_xml_path(str(source)), mujoco.MjModel.from_xml_path(str(out))
+    assert (given.geom_fluid[0] == written.geom_fluid[0]).all()  # the collision geom (the visual copy: none)
+    assert not written.geom_fluid[1:].any()
+    notes = convert([source], tmp_path / "urdf" / "fl.urdf").notes
+    said = _about(notes, "link a: MJCF contact (and fluid) parameters")
+    assert len(said) == 1 and "fluidcoef 0.4 0.25 1.5 1 1, fluidshape ellipsoid" in said[0].message

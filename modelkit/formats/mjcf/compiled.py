@@ -373,6 +373,28 @@ def contact_attributes(m: Any, g: int) -> dict[str, str]:
     acting = 3 if int(m.geom_condim[g]) >= 6 else 2 if int(m.geom_condim[g]) >= 4 else 1
     if friction[acting:] != MUJOCO_FRICTION[acting:]:  # coefficients its condim leaves idle, which
         out["friction"] = _plain(friction)  # still count when MuJoCo mixes it with a larger condim
+    out.update(fluid_attributes(m, g))
+    return out
+
+
+FLUID_COEFFICIENTS = (0.5, 0.25, 1.5, 1.0, 1.0)  # MuJoCo's fluidcoef default (blunt, slender, angular
+# drag, Kutta lift, Magnus lift)
+
+
+def fluid_attributes(m: Any, g: int) -> dict[str, str]:
+    """Geom ``g``'s ellipsoid fluid model (``fluidshape``, ``fluidcoef``), which acts when the option's
+    ``density`` or ``viscosity`` is set: compiled ``geom_fluid`` is (shape flag, five coefficients,
+    virtual mass and inertia MuJoCo derives)."""
+    try:
+        row = m.geom_fluid[g]
+    except AttributeError:
+        return {}
+    if float(row[0]) <= 0.0:
+        return {}
+    coefficients = tuple(float(x) for x in row[1:6])
+    out = {"fluidshape": "ellipsoid"}
+    if any(abs(a - b) > 1e-12 for a, b in zip(coefficients, FLUID_COEFFICIENTS, strict=True)):
+        out["fluidcoef"] = _plain(coefficients)
     return out
 
 

@@ -36,7 +36,8 @@ FORMAT = FormatDeclaration(
             ("mjcf_contact_pairs", "MK851", "MJCF contact pairs and exclusions (<contact>)"),
         ),
         dropped_link=(
-            ("mjcf_contact", "MK851", "MJCF contact parameters beyond the friction the target holds"),
+            ("mjcf_contact", "MK851",
+             "MJCF contact (and fluid) parameters beyond the friction the target holds"),
             ("mjcf_mocap", "MK808", "MJCF mocap flag, a body the program moves (mocap_pos, mocap_quat)"),
             ("mjcf_body_physics", "MK808", "MJCF gravity compensation"),
         ),

@@ -92,7 +92,7 @@ class GeomWriter:
         for i, geom in enumerate(link.collisions):
             el = self.geom(body, geom, f"body[{body_name}]/collision[{i}]", link, collision=True)
             if el is not None and i in contact:  # an MJCF source's own solref, solimp, margin...
-                for key in (*GEOM_CONTACT_DEFAULTS, "friction"):
+                for key in (*GEOM_CONTACT_DEFAULTS, "friction", "fluidshape", "fluidcoef"):
                     if key in contact[i]:
                         el.set(key, str(contact[i][key]))
         for i, geom in enumerate(link.visuals):
