@@ -332,3 +332,22 @@ def test_mjcf_fluid_model_kept_and_said(tmp_path: Path) -> None:
     notes = convert([source], tmp_path / "urdf" / "fl.urdf").notes
     said = _about(notes, "link a: MJCF contact (and fluid) parameters")
     assert len(said) == 1 and "fluidcoef 0.4 0.25 1.5 1 1, fluidshape ellipsoid" in said[0].message
+
+
+def test_mjcf_size_visual_and_statistic_written_back(tmp_path: Path) -> None:
+    """<size memory>, <visual> and <statistic> (MuJoCo's memory, viewer and camera extent) were lost MJCF
+    → MJCF without a note; they are written back, and another target says nothing of them (nothing of
+    the robot is lost there)."""
+    source = tmp_path / "g.xml"
+    source.write_text("""<mujoco model="g"><size memory="10M"/>
+      <visual><headlight ambient="0.5 0.5 0.5"/><global offwidth="800"/></visual>
+      <statistic extent="2" center="0 0 1"/>
+      <worldbody><body name="a"><freejoint/><geom type="sphere" size="0.05"/></body></worldbody></mujoco>""")
+    out = tmp_path / "out" / "g.xml"
+    convert([source], out)
+    given, written = mujoco.MjModel.from_xml_path(str(source)), mujoco.MjModel.from_xml_path(str(out))
+    assert written.narena == given.narena == 10 * 2**20
+    assert written.vis.global_.offwidth == 800 and list(written.vis.headlight.ambient) == [0.5, 0.5, 0.5]
+    assert written.stat.extent == 2.0
+    notes = convert([source], tmp_path / "urdf" / "g.urdf").notes
+    assert not [n for n in notes if "size" in n.message or "visual>" in n.message or "statistic" in n.message]

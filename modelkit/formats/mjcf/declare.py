@@ -16,7 +16,9 @@ FORMAT = FormatDeclaration(
         sites_native=True,
     ),
     extras=ExtrasDeclaration(
-        quiet=frozenset({"mjcf_compiled"}),
+        # mjcf_globals: <size>, <visual>, <statistic>: MuJoCo's memory, viewer and camera extent, nothing
+        # of the robot another simulator misses (written back for MJCF only)
+        quiet=frozenset({"mjcf_compiled", "mjcf_globals"}),
         quiet_link=frozenset({"mjcf_body_id", "mjcf_body_offset", "mjcf_intermediate_of"}),
         partly_carried=frozenset(
             {"mjcf_actuators", "mjcf_sensors", "mjcf_cameras", "mjcf_lights", "mjcf_sites"}

@@ -26,3 +26,27 @@ def source_options(index: Any) -> dict[str, Any]:
     if flags:
         out[FLAGS] = dict(sorted(flags.items()))
     return out
+
+
+GLOBAL_SECTIONS = ("size", "visual", "statistic")
+"""Top-level sections that set MuJoCo itself up rather than the robot: memory and array sizes, the
+viewer's look, the model's extent for the free camera. Kept as written for MJCF output; another
+simulator has nothing of the robot to miss in them (declared quiet)."""
+
+
+def source_globals(index: Any) -> list[str]:
+    """The file's ``<size>``, ``<visual>`` and ``<statistic>`` sections (included files too), as XML in
+    document order, whitespace dropped (the writer indents anew)."""
+    from lxml import etree
+
+    out: list[str] = []
+    for tag in GLOBAL_SECTIONS:
+        for section in index.sections(tag):
+            copy = etree.fromstring(etree.tostring(section.el, with_tail=False))
+            for part in copy.iter():
+                if part.text is not None and not part.text.strip():
+                    part.text = None
+                part.tail = None
+            if len(copy) or copy.attrib:
+                out.append(etree.tostring(copy, encoding="unicode"))
+    return out

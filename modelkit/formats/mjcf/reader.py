@@ -33,7 +33,7 @@ from modelkit.formats.mjcf.compiled import CompiledModel, mesh_path
 from modelkit.formats.mjcf.devices import add_devices
 from modelkit.formats.mjcf.errors import error_location, error_text
 from modelkit.formats.mjcf.files import check_asset_files, check_sizes
-from modelkit.formats.mjcf.options import source_options
+from modelkit.formats.mjcf.options import source_globals, source_options
 from modelkit.formats.mjcf.quiet import collected_warnings
 from modelkit.formats.mjcf.source import SourceIndex, TreeShape, locate, pair
 from modelkit.formats.mjcf.uncompiled import SpecReader
@@ -300,6 +300,9 @@ class _MjcfReader:
             options = source_options(builder.loc.index)
             if options:
                 main.extras["mjcf_option"] = options
+            settings = source_globals(builder.loc.index)
+            if settings:
+                main.extras["mjcf_globals"] = settings
             pairs = [{"tag": p.tag, "attributes": {str(k): str(v) for k, v in p.el.attrib.items()}}
                      for p in builder.loc.index.section_items("contact") if p.tag in ("pair", "exclude")]
             if pairs:

@@ -178,6 +178,12 @@ class MjcfWriter:
             el = self.sections[tag]
             if tag not in ("compiler", "worldbody") and len(el) == 0 and not el.attrib:
                 self.root.remove(el)
+        # an MJCF source's <size>, <visual>, <statistic> (memory, viewer, extent), after <compiler>/<option>
+        at = self.root.index(self.sections["compiler"]) + 1
+        if self.sections["option"].getparent() is self.root:
+            at = self.root.index(self.sections["option"]) + 1
+        for offset, text in enumerate(self.robot.extras.get("mjcf_globals") or []):
+            self.root.insert(at + offset, etree.fromstring(text))
         indent(self.root, space="  ")
         text: bytes = etree.tostring(self.root, xml_declaration=False, encoding="utf-8", pretty_print=True)
         return text
