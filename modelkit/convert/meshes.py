@@ -312,6 +312,10 @@ def converted_stem(stem: str, source_ext: str, written_ext: str) -> str:
     return stem if source_ext == written_ext else f"{stem}_{source_ext}"
 
 
+TEXTURE_FOLDER = "textures"
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
 class MeshExporter:
     """Turns the model's mesh geometry into files in the output plan, once each."""
 
@@ -324,6 +328,32 @@ class MeshExporter:
 
     def _stage(self, data: bytes, name: str) -> str:
         relpath = self.plan.add(f"{MESH_FOLDER}/{name}", data, "mesh")
+        return self.prefix + relpath
+
+    def texture(self, uri: str, base: Path | None, target: str, source: SourceLocation | None,
+                png_only: bool = False) -> str | None:
+        """The image ``uri`` (a path, relative to ``base``, or a package:// or file:// URI) copied into the
+        output's ``textures/`` folder: its reference from the model file, or None with an MK818 note
+        (unreadable; not a PNG where the target reads PNG only, as MuJoCo does)."""
+        from modelkit.resources import Resolver
+
+        path = Path(uri)
+        if not path.is_absolute():
+            where = base if base is not None else Path.cwd()
+            resolution = Resolver().resolve(uri, where, None)
+            path = resolution.path if resolution.path is not None else where / uri
+        try:
+            data = path.read_bytes()
+            self.plan.protect(path)
+        except OSError:
+            self.notes.note("MK818", f'texture "{uri}" cannot be read; the visual keeps its colour only',
+                            source, target)
+            return None
+        if png_only and not data.startswith(PNG_SIGNATURE):
+            self.notes.note("MK818", f'texture "{uri}" is not a PNG image, the only kind MuJoCo reads; the '
+                            "visual keeps its colour only", source, target)
+            return None
+        relpath = self.plan.add(f"{TEXTURE_FOLDER}/{safe_file_name(path.name, 'texture')}", data, "texture")
         return self.prefix + relpath
 
     def triangles(self, mesh: TriangleMeshData, name: str, scale: Vec3 | None = None) -> MeshRef:

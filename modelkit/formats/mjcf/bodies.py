@@ -101,6 +101,7 @@ class MjGeom:
     group: int = 0
     rgba: tuple[float, float, float, float] | None = None
     material: str | None = None
+    look: dict[str, Any] = field(default_factory=dict)  # its material: specular... (not the defaults)
     mesh_name: str | None = None
     mesh_file: str | None = None
     mesh_path: str | None = None

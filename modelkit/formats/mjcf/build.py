@@ -398,6 +398,7 @@ class RobotBuilder:
             r, g, b, a = mg.rgba
             diffuse = (float(r), float(g), float(b))
             material = VisualMaterial(name=mg.material, diffuse=diffuse, transparency=1.0 - a)
+            _look(material, mg.look, diffuse)
         friction = None if mg.visual_only else surface_friction(mg)
         return Geom(geometry, back @ mg.pose, mg.name, material, where, friction)
 
@@ -509,3 +510,19 @@ def surface_friction(mg: MjGeom) -> SurfaceFriction | None:
         rolling if mg.condim >= 6 else 0.0,
     )
     return None if acting == MUJOCO_DEFAULT_FRICTION else acting
+
+
+def _look(material: VisualMaterial, look: dict[str, Any], diffuse: tuple[float, float, float]) -> None:
+    """A MuJoCo material's specular, shininess, emission and colour texture in the model's terms:
+    specular colour (s, s, s), Phong exponent 127·shininess + 1 (Choreonoid's rule), emissive colour
+    emission × the colour, the texture's file."""
+    if "specular" in look:
+        s = float(look["specular"])
+        material.specular = (s, s, s)
+    if "shininess" in look:
+        material.specular_exponent = 127.0 * float(look["shininess"]) + 1.0
+    if "emission" in look:
+        e = float(look["emission"])
+        material.emissive = (e * diffuse[0], e * diffuse[1], e * diffuse[2])
+    if "texture" in look:
+        material.texture = str(look["texture"])

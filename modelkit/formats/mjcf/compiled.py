@@ -137,11 +137,13 @@ class CompiledModel:
         pose = pose_of(m.geom_pos[g], m.geom_quat[g])
         rgba = tuple(float(x) for x in m.geom_rgba[g])
         material = None
+        look: dict[str, Any] = {}
         matid = int(m.geom_matid[g])
         if matid >= 0:
             material = self.name("material", matid)
             if all_close(rgba, DEFAULT_RGBA):
                 rgba = tuple(float(x) for x in m.mat_rgba[matid])
+            look = self._look(matid)
         geom = MjGeom(
             index=g,
             name=self.name("geom", g),
@@ -153,6 +155,7 @@ class CompiledModel:
             group=int(m.geom_group[g]),
             rgba=(rgba[0], rgba[1], rgba[2], rgba[3]),
             material=material,
+            look=look,
             friction=rot3.vec3(m.geom_friction[g]),
             condim=int(m.geom_condim[g]),
             contact=contact_attributes(m, g),
@@ -161,6 +164,29 @@ class CompiledModel:
         if kind == "mesh" and mesh >= 0:
             self._mesh(geom, mesh)
         return geom
+
+    def _look(self, matid: int) -> dict[str, Any]:
+        """Material ``matid``'s specular, shininess and emission where not MuJoCo's defaults (0.5, 0.5,
+        0), and the file of its colour (RGB role) texture, relative to the model's folder."""
+        m = self.m
+        out: dict[str, Any] = {}
+        for key, default in MATERIAL_DEFAULTS.items():
+            value = float(getattr(m, f"mat_{key}")[matid])
+            if abs(value - default) > 1e-6:  # stored as float32
+                out[key] = round(value, 6)
+        try:
+            roles = m.mat_texid[matid]
+            texture = int(roles[TEXTURE_RGB_ROLE]) if hasattr(roles, "__len__") else int(roles)
+            if texture >= 0:
+                start = int(m.tex_pathadr[texture])
+                if start >= 0:
+                    raw = bytes(int(x) & 0xFF for x in m.paths[start:])
+                    written = raw.split(b"\0", 1)[0].decode("utf-8", "replace")
+                    if written:
+                        out["texture"] = str(self.model_dir / written)
+        except (AttributeError, IndexError):
+            pass  # an older MuJoCo: no texture paths in the model
+        return out
 
     def _mesh(self, geom: MjGeom, mesh: int) -> None:
         """Name the mesh file and undo MuJoCo's re-centring: the compiled geom frame sits at the
@@ -377,6 +403,8 @@ def contact_attributes(m: Any, g: int) -> dict[str, str]:
     return out
 
 
+MATERIAL_DEFAULTS = {"specular": 0.5, "shininess": 0.5, "emission": 0.0}  # MuJoCo's <material> defaults
+TEXTURE_RGB_ROLE = 1  # mjTEXROLE_RGB: the colour texture among a material's texture roles
 FLUID_COEFFICIENTS = (0.5, 0.25, 1.5, 1.0, 1.0)  # MuJoCo's fluidcoef default (blunt, slender, angular
 # drag, Kutta lift, Magnus lift)
 

@@ -19,8 +19,12 @@
   collision one is ``<stem>_collision``; any other clash gets ``_2``... (MK800). One asset per
   (written file, scale). Each ``file`` is relative to the model file; the writer then moves the
   common ``meshes/`` folder into ``<compiler meshdir>`` (:mod:`.writer`).
-* Colour: ``rgba`` = (diffuse, 1 − transparency); specular, emissive and textures are not written
-  (MK818).
+* Colour: ``rgba`` = (diffuse, 1 − transparency). A visual geom whose material has a specular or
+  emissive colour, a specular exponent or a texture also gets a ``<material>`` asset (one per distinct
+  look, named after the source's material): MuJoCo's scalar ``specular`` (the colour's mean),
+  ``shininess`` = (exponent − 1)/127, ``emission`` (the emissive colour over the colour, means' ratio)
+  and a ``<texture type="2d">`` of the image copied into ``textures/`` (PNG only: MuJoCo reads no
+  other). What that only approximates (a coloured specular...) is noted (MK818).
 * Friction: a link with a contact material gets, on each collision geom, its friction against
   Choreonoid's floor material ``Ground`` (the pair table's dynamic friction, or Choreonoid's
   √roughness rule) with MuJoCo's default torsional and rolling values, ``friction="mu 0.005
@@ -35,7 +39,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import PurePosixPath
+from pathlib import Path, PurePosixPath
 
 import numpy as np
 
@@ -46,7 +50,19 @@ from modelkit.diagnostics import SourceLocation
 from modelkit.formats.mjcf.bodies import GEOM_CONTACT_DEFAULTS
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, set_pose, sub
-from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere, SurfaceFriction
+from modelkit.model import (
+    Box,
+    Capsule,
+    Cone,
+    Cylinder,
+    Ellipsoid,
+    Geom,
+    Link,
+    Mesh,
+    Sphere,
+    SurfaceFriction,
+    VisualMaterial,
+)
 
 MESH_READABLE = ("stl", "obj")
 COLLISION_GROUP = "3"
@@ -67,6 +83,9 @@ class GeomWriter:
     shared_stems: set[str] = field(default_factory=set)  # stems of both a collision and a visual file
     used: set[str] = field(default_factory=set)  # the classes (VISUAL, COLLISION) a geom names
     surface_links: set[str] = field(default_factory=set)  # links whose geoms got the source's friction
+    materials: dict[tuple[tuple[str, str], ...], str] = field(default_factory=dict)  # attributes → asset
+    textures: dict[str, str] = field(default_factory=dict)  # the source's image → its <texture> asset
+    texture_base: Path | None = None  # the source model's folder (relative texture paths)
     mujoco_rules: bool = False
     """An MJCF source: its geoms' friction, condim and priority are written as they were, and mix with
     a floor's by MuJoCo's rules as in the source (no collision-class priority above a floor's)."""
@@ -128,7 +147,7 @@ class GeomWriter:
         role = COLLISION if collision else VISUAL
         el.set("class", role)
         self.used.add(role)
-        self.appearance(el, geom, target)
+        self.appearance(el, geom, target, collision)
         if collision and geom.friction is not None:
             self.set_surface_friction(el, geom.friction, link, target)
         elif collision and link.name in self.friction:
@@ -187,31 +206,54 @@ class GeomWriter:
         self.mesh_assets[key] = name
         return name
 
-    def appearance(self, el: Element, geom: Geom, target: str) -> None:
+    def appearance(self, el: Element, geom: Geom, target: str, collision: bool = False) -> None:
+        """``rgba``; on a visual geom also a ``<material>`` with MuJoCo's scalar specular, shininess and
+        emission (:func:`mujoco_material`); what MuJoCo cannot hold is noted (MK818)."""
         material = geom.material
         if material is None:
             return
         rgba = material.rgba
         if rgba is not None:
             el.set("rgba", fmt_vec(rgba))
-        dropped = [
-            word
-            for word, value in (
-                ("texture", material.texture),
-                ("specular colour", material.specular),
-                ("emissive colour", material.emissive),
-                ("specular exponent", material.specular_exponent),
-            )
-            if value is not None
-        ]
-        if dropped:
+        if collision:
+            return  # the visual geom carries the look (a collision geom is hidden, group 3)
+        attributes, approximated = mujoco_material(material)
+        if material.texture is not None:
+            texture = self._texture(material.texture, geom, target)
+            if texture is not None:
+                attributes["texture"] = texture
+        if attributes:
+            key = tuple(sorted(attributes.items()))
+            name = self.materials.get(key)
+            if name is None:
+                name = self.names.claim("material", material.name or "material", None,
+                                        f"asset/material (for {target})", note=False)
+                sub(self.asset, "material", name=name, **dict(key))
+                self.materials[key] = name
+            el.set("material", name)
+        if approximated:
             self.ctx.note(
                 "MK818",
-                f"{', '.join(dropped)} of material {material.name or '(unnamed)'} not "
-                "written; the geom has only its rgba",
+                f"material {material.name or '(unnamed)'}: {'; '.join(approximated)} (a MuJoCo material "
+                "holds a colour and a scalar specular, shininess and emission)",
                 geom.source,
                 target,
             )
+
+    def _texture(self, uri: str, geom: Geom, target: str) -> str | None:
+        """A ``<texture type="2d">`` asset of the image copied into the output (PNG only: MuJoCo reads no
+        other), named after its file; None (MK818 said why) when it cannot be."""
+        known = self.textures.get(uri)
+        if known is not None:
+            return known
+        written = self.ctx.meshes.texture(uri, self.texture_base, target, geom.source, png_only=True)
+        if written is None:
+            return None
+        name = self.names.claim("texture", PurePosixPath(written).stem or "texture", None,
+                                f"asset/texture (for {target})", note=False)
+        sub(self.asset, "texture", name=name, type="2d", file=written)
+        self.textures[uri] = name
+        return name
 
     def set_surface_friction(self, el: Element, friction: SurfaceFriction, link: Link, target: str) -> None:
         """A shape's own friction: ``condim`` says which coefficients act (1 none, 3 sliding, 4 and
@@ -303,3 +345,37 @@ def shared_stems(links: list[Link]) -> set[str]:
                     files.setdefault((stem, collision), set()).add(g.uri or "")
     return {stem for (stem, collision), uris in files.items()
             if collision and files.get((stem, False), set()) - uris}
+
+
+def mujoco_material(material: VisualMaterial) -> tuple[dict[str, str], list[str]]:
+    """MuJoCo ``<material>`` attributes for the model's material, and what they only approximate.
+
+    MuJoCo's specular is one number (the colour's mean), its shininess (exponent − 1) / 127 (the
+    inverse of Choreonoid's and modelkit's reader's exponent = 127·shininess + 1) and its emission the
+    emissive colour as a multiple of the colour (the means' ratio); a texture is not written."""
+    out: dict[str, str] = {}
+    approximated: list[str] = []
+    if material.specular is not None:
+        specular = [float(x) for x in material.specular]
+        out["specular"] = fmt(min(max(sum(specular) / 3.0, 0.0), 1.0))
+        if max(specular) - min(specular) > 1e-9:
+            approximated.append(f"specular colour {fmt_vec(specular)} written as its mean")
+    if material.specular_exponent is not None:
+        shininess = (float(material.specular_exponent) - 1.0) / 127.0
+        out["shininess"] = fmt(min(max(shininess, 0.0), 1.0))
+        if not 0.0 <= shininess <= 1.0:
+            approximated.append(f"specular exponent {fmt(float(material.specular_exponent))} clamped to "
+                                "MuJoCo's shininess range")
+    if material.emissive is not None:
+        emissive = [float(x) for x in material.emissive]
+        diffuse = [float(x) for x in material.diffuse] if material.diffuse is not None else [1.0, 1.0, 1.0]
+        base = sum(diffuse) / 3.0
+        if base > 0.0 and any(emissive):
+            ratio = (sum(emissive) / 3.0) / base
+            out["emission"] = fmt(ratio)
+            if any(abs(e - ratio * d) > 1e-9 for e, d in zip(emissive, diffuse, strict=True)):
+                approximated.append(f"emissive colour {fmt_vec(emissive)} written as {fmt(ratio)} × the "
+                                    "colour")
+        elif any(emissive):
+            approximated.append(f"emissive colour {fmt_vec(emissive)} left out (the colour is black)")
+    return out, approximated

@@ -43,6 +43,7 @@ body pairs touching at rest. The style is MuJoCo Menagerie's (docs/convert.md, "
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -95,7 +96,9 @@ class MjcfWriter:
         compiler.set("inertiafromgeom", "false")
         self.geoms = GeomWriter(ctx, self.names, self.sections["asset"], floor_friction(robot),
                                 mujoco_contact(robot), shared_stems=shared_stems(robot.links),
-                                mujoco_rules=robot.source_format == "mjcf")
+                                mujoco_rules=robot.source_format == "mjcf",
+                                texture_base=Path(robot.source.file).parent
+                                if robot.source is not None and robot.source.file else None)
         self.devices = DeviceWriter(ctx, self.names, self.sections["sensor"])
         self.tree = BodyTree(robot, ctx, self.names, self.geoms, self.devices)
         options, why = mujoco_options(robot)  # wheels or tracks (convert.simulator says why)
@@ -182,8 +185,8 @@ class MjcfWriter:
         at = self.root.index(self.sections["compiler"]) + 1
         if self.sections["option"].getparent() is self.root:
             at = self.root.index(self.sections["option"]) + 1
-        for offset, text in enumerate(self.robot.extras.get("mjcf_globals") or []):
-            self.root.insert(at + offset, etree.fromstring(text))
+        for offset, kept in enumerate(self.robot.extras.get("mjcf_globals") or []):
+            self.root.insert(at + offset, etree.fromstring(kept))
         indent(self.root, space="  ")
         text: bytes = etree.tostring(self.root, xml_declaration=False, encoding="utf-8", pretty_print=True)
         return text

@@ -19,7 +19,6 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import PairFriction, describe, link_surface
 from modelkit.convert.meshes import MeshRef
 from modelkit.convert.numbers import clean_inertia, fmt, fmt_position, fmt_rpy, fmt_vec
-from modelkit.convert.output import safe_file_name
 from modelkit.diagnostics import SourceLocation
 from modelkit.formats.urdf.links import PYBULLET_LATERAL_DEFAULT
 from modelkit.formats.urdf.massless import TINY_INERTIA, TINY_MASS
@@ -45,7 +44,6 @@ from modelkit.spatial import Pose
 # own default 0.5 (the two written files then mean the same robot)
 SUPPORT_FRICTION = 1.0
 
-TEXTURE_FOLDER = "textures"
 
 
 def origin_element(parent: Element, pose: Pose, always: bool = False) -> None:
@@ -159,21 +157,8 @@ def _texture(
     uri = material.texture
     if not uri:
         return None
-    from modelkit.resources import Resolver
-
-    path = Path(uri)
-    if not path.is_absolute():
-        base = Path(robot.source.file).parent if robot.source and robot.source.file else Path.cwd()
-        resolution = Resolver().resolve(uri, base, Path(robot.source.file) if robot.source else None)
-        path = resolution.path if resolution.path is not None else path
-    try:
-        data = path.read_bytes()
-        ctx.meshes.plan.protect(path)
-    except OSError:
-        ctx.note("MK818", f'texture "{uri}" cannot be read; the visual keeps its colour only', source, target)
-        return None
-    relpath = ctx.meshes.plan.add(f"{TEXTURE_FOLDER}/{safe_file_name(path.name, 'texture')}", data, "texture")
-    return ctx.meshes.prefix + relpath
+    base = Path(robot.source.file).parent if robot.source and robot.source.file else None
+    return ctx.meshes.texture(uri, base, target, source)
 
 
 def _mesh_element(parent: Element, ref: MeshRef) -> None:
