@@ -45,6 +45,17 @@ def mask_markup(text: str) -> str:
     return _SKIPPED.sub(lambda m: " " * len(m.group(0)), text)
 
 
+def bare_copy(element: Element) -> Element:
+    """A detached copy of ``element`` without layout whitespace (blank texts and every tail), for a
+    writer that keeps a source's element as data and indents it anew."""
+    copy = etree.fromstring(etree.tostring(element, with_tail=False))
+    for part in copy.iter():
+        if part.text is not None and not part.text.strip():
+            part.text = None
+        part.tail = None
+    return copy
+
+
 def location_at(text: str, display: str, offset: int) -> SourceLocation:
     """The 1-based line and column of ``offset`` in ``text``."""
     line = text.count("\n", 0, offset) + 1

@@ -39,14 +39,12 @@ def source_globals(index: Any) -> list[str]:
     document order, whitespace dropped (the writer indents anew)."""
     from lxml import etree
 
+    from modelkit.xmlsource import bare_copy
+
     out: list[str] = []
     for tag in GLOBAL_SECTIONS:
         for section in index.sections(tag):
-            copy = etree.fromstring(etree.tostring(section.el, with_tail=False))
-            for part in copy.iter():
-                if part.text is not None and not part.text.strip():
-                    part.text = None
-                part.tail = None
+            copy = bare_copy(section.el)
             if len(copy) or copy.attrib:
                 out.append(etree.tostring(copy, encoding="unicode"))
     return out

@@ -23,6 +23,8 @@ from typing import Any
 from lxml import etree
 from lxml.etree import _Element as Element
 
+from modelkit.xmlsource import bare_copy
+
 MODEL_KEY = "sdf_model_elements"
 JOINT_KEY = "sdf_joint_elements"
 LIMIT_KEY = "sdf_limit_elements"
@@ -56,12 +58,7 @@ def kept(element: Element, tags: dict[str, str | None], wrapper: str) -> str | N
     out = etree.Element(wrapper)
     for node in element:
         if isinstance(node.tag, str) and node.tag in tags and not _is_default(node, tags[node.tag]):
-            copy = etree.fromstring(etree.tostring(node, with_tail=False))
-            for part in copy.iter():
-                if part.text is not None and not part.text.strip():
-                    part.text = None
-                part.tail = None
-            out.append(copy)
+            out.append(bare_copy(node))
     return etree.tostring(out, encoding="unicode") if len(out) else None
 
 

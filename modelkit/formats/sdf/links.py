@@ -322,11 +322,9 @@ def surface_rest(surface: Element) -> str | None:
     write back (bounce, contact stiffness, torsional friction, slip...); None when nothing is left."""
     from lxml import etree
 
-    copy = etree.fromstring(etree.tostring(surface, with_tail=False))
-    for element in copy.iter():  # the writer indents it anew
-        if element.text is not None and not element.text.strip():
-            element.text = None
-        element.tail = None
+    from modelkit.xmlsource import bare_copy
+
+    copy = bare_copy(surface)  # the writer indents it anew
     friction = child(copy, "friction")
     if friction is not None:
         for engine, tags in CARRIED_FRICTION.items():
