@@ -68,7 +68,7 @@ from typing import Any
 import numpy as np
 
 from modelkit.convert.options import WriteOptions
-from modelkit.model import BALL_KEYS, JointType, Robot
+from modelkit.model import BALL_KEYS, WORLD_LINK, JointType, Robot
 from modelkit.verify.engines.protocol import Check, Skip
 from modelkit.verify.engines.registry import DEFAULT_ENGINES, ENGINES, INPUTS, PRESTART
 from modelkit.verify.report import VerifyReport
@@ -212,10 +212,76 @@ def _given_file(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Rena
         names[kind] = {str(el.get("name")) for el in root.iter(*elements) if el.get("name")}
         out[kind] = {source: written for source, written in renames(notes, kind).items()
                      if written in names[kind] and source not in names[kind]}
+    _joints_by_child(robot, fmt, root, out, names["joint"])
     held = [note for note in notes if note.code in GIVEN_NOTES or any(
         set(chain.joints) <= names["joint"] and set(chain.links) <= names["link"]
         for chain in approximations.ball_chains(fmt, [note]))]
+    held.extend(_merged_links(robot, fmt, path, out_dir, out, names["link"]))
     return out, held
+
+
+def _merged(robot: Robot) -> Robot:
+    """A copy of ``robot`` with its fixed joints merged as ``convert --merge-fixed`` does."""
+    from modelkit.convert.merge import merge_fixed_joints
+    from modelkit.convert.notes import NoteSink
+
+    out = copy.deepcopy(robot)
+    merge_fixed_joints(out, NoteSink())
+    return out
+
+
+def _merged_links(robot: Robot, fmt: str, path: Path, out_dir: Path, renames_of: Renames,
+                  written: set[str]) -> list[Any]:
+    """The MK815 notes of ``convert --merge-fixed`` when the given file is such a conversion: every
+    source link missing from it is one that option fuses into its parent (the layers then compare the
+    engines reading it with the source merged the same way); none otherwise."""
+    from modelkit.convert.api import render_model
+    from modelkit.convert.output import OutputPlan
+
+    missing = {link.name for link in robot.links
+               if renames_of["link"].get(link.name, link.name) not in written and link.name != WORLD_LINK}
+    if not missing:
+        return []
+    try:
+        notes = render_model(robot, fmt, OutputPlan(out_dir / ".merged"), path.name,
+                             WriteOptions(merge_fixed=True))
+    except Exception:  # the engines' own loading says what is wrong with the file
+        return []
+    merged = [note for note in notes if note.code == "MK815"]
+    fused = {name for note in merged for name in missing if note.message.startswith(f"link {name} (")}
+    return merged if fused == missing else []
+
+
+def _joints_by_child(robot: Robot, fmt: str, root: Any, out: Renames, written: set[str]) -> None:
+    """A source joint the file names otherwise (written with options other than convert's defaults:
+    ``--urdf-distinct-names`` gives ``LeftWheel_joint``) is found by the link it moves: in place, the
+    file's joint whose child is the source joint's child (under its written name)."""
+    child_of: dict[str, str] = {}  # written joint -> written child link
+    if fmt == "mjcf":
+        for body in root.iter("body"):
+            for joint in body.findall("joint"):
+                if joint.get("name") and body.get("name"):
+                    child_of[str(joint.get("name"))] = str(body.get("name"))
+    else:
+        for joint in root.iter("joint"):
+            child = joint.find("child")
+            text = child.get("link") if fmt == "urdf" and child is not None else (
+                child.text if child is not None else None)
+            if joint.get("name") and text:
+                child_of[str(joint.get("name"))] = text.strip()
+    by_child: dict[str, list[str]] = {}
+    for joint, child in child_of.items():
+        by_child.setdefault(child, []).append(joint)
+    claimed = set(out["joint"].values())
+    for joint in robot.joints:
+        if joint.name in written or joint.name in out["joint"]:
+            continue
+        child = out["link"].get(joint.child, joint.child)
+        found = [j for j in by_child.get(child, []) if j not in claimed and j not in
+                 {s.name for s in robot.joints}]
+        if len(found) == 1:
+            out["joint"][joint.name] = found[0]
+            claimed.add(found[0])
 
 
 def _copy_given(files: dict[str, Path], given: dict[str, Path | None], out_dir: Path,
@@ -506,6 +572,11 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         frames = [] if kind == "robot" else approximations.sensor_frames(kind, notes, reference, maps[kind],
                                                                          files[kind])
         models[eng.label] = approximations.applied_frames(reference, frames)
+        if any(note.code == "MK815" for note in notes):  # a given file written with --merge-fixed
+            models[eng.label] = _merged(models[eng.label])
+            report.skips.append(Skip(1, eng.label, (
+                "the given file fuses links on fixed joints into their parents (convert --merge-fixed, "
+                "MK815): layers 1-3 compare this engine with the source merged the same way")))
         frames_entry = approximations.frames_skip(eng.label, frames)
         if frames_entry is not None:
             report.skips.append(frames_entry)
@@ -532,7 +603,8 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         if wheels is not None:
             held = approximations.applied_wheels(held, robot, wheels)
         eng_static = (source_static(approximations.applied(held, approx[eng.label]))
-                      if approx[eng.label] or chains or wheels else src_static)
+                      if approx[eng.label] or chains or wheels or models[eng.label] is not reference
+                      else src_static)
         # ... and so is one holding the URDF writer's ±1e16 for an infinite position bound (MK819).
         stand_ins = approximations.limits_for_engine(kind, reference)
         eng_static = approximations.applied_limits(eng_static, stand_ins)

@@ -192,8 +192,10 @@ class YourdfpyKinematics(_KinematicsOnly):
                       if j.type in ("revolute", "continuous", "prismatic") and j.mimic is None]
         # A URDF that welds its root itself (a ``world`` link, a fixed joint to the root): by the URDF
         # convention that link is the world, not the robot's (as in the PyBullet adapter).
+        # (--urdf-world-link hangs a floating root from it by a floating joint: the same world)
         self._world_joint = next((j.name for j in self.urdf.robot.joints if j.parent == WORLD_LINK
-                                  and j.child == root and j.type == "fixed" and root != WORLD_LINK), None)
+                                  and j.child == root and j.type in ("fixed", "floating")
+                                  and root != WORLD_LINK), None)
 
     def _robots(self, link: str) -> bool:
         return self._world_joint is None or link != WORLD_LINK
