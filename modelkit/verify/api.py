@@ -232,9 +232,10 @@ def _merged(robot: Robot) -> Robot:
 
 def _merged_links(robot: Robot, fmt: str, path: Path, out_dir: Path, renames_of: Renames,
                   written: set[str]) -> list[Any]:
-    """The MK815 notes of ``convert --merge-fixed`` when the given file is such a conversion: every
-    source link missing from it is one that option fuses into its parent (the layers then compare the
-    engines reading it with the source merged the same way); none otherwise."""
+    """The MK815 notes of ``convert --merge-fixed`` when the given file is such a conversion: the source
+    links missing from it are exactly those that option fuses into their parents (the layers then
+    compare the engines reading it with the source merged the same way); none otherwise (a file that
+    holds a massless frame as an MJCF site misses that link, and keeps the others)."""
     from modelkit.convert.api import render_model
     from modelkit.convert.output import OutputPlan
 
@@ -248,7 +249,7 @@ def _merged_links(robot: Robot, fmt: str, path: Path, out_dir: Path, renames_of:
     except Exception:  # the engines' own loading says what is wrong with the file
         return []
     merged = [note for note in notes if note.code == "MK815"]
-    fused = {name for note in merged for name in missing if note.message.startswith(f"link {name} (")}
+    fused = {note.message[len("link "):].split(" (fixed joint ", 1)[0] for note in merged}
     return merged if fused == missing else []
 
 
