@@ -60,9 +60,13 @@ def test_mjcf_says_what_of_the_gazebo_blocks_it_leaves_out_and_not_what_it_carri
     assert [float(model.geom_friction[g][0]) for g in range(model.ngeom) if model.geom_contype[g]] == [0.2]
 
 
-def test_sdf_keeps_its_own_link_block_note_without_a_second(tmp_path: Path) -> None:
+def test_sdf_writes_a_link_blocks_tags_and_notes_nothing_twice(tmp_path: Path) -> None:
+    """Link a's block holds mu1, mu2 (its friction) and kp, which the SDF writer writes as libsdformat
+    does (tests/test_sdf_gazebo_tags.py): nothing is left out, and convert adds no note of its own."""
     notes = _notes(tmp_path, "sdf")
-    assert len(_about(notes, "<gazebo>", 'link "a"')) + len(_about(notes, "link a", "<gazebo>")) == 1
+    assert len(_about(notes, "<gazebo>", 'link "a"')) + len(_about(notes, "link a", "<gazebo>")) == 0
+    written = (tmp_path / "out" / "r.sdf").read_text()
+    assert "<kp>1e6</kp>" in written
 
 
 def test_urdf_to_urdf_says_nothing_of_its_own_blocks(tmp_path: Path) -> None:

@@ -45,6 +45,7 @@ from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_vec
 from modelkit.formats.sdf.kept import JOINT_KEY, LIMIT_KEY, MODEL_KEY, write_back
 from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
+from modelkit.formats.sdf.write_gazebo_tags import write_link_tags
 from modelkit.formats.sdf.write_geometry import GeomWriter
 from modelkit.formats.sdf.write_names import Names
 from modelkit.formats.sdf.write_self_collide import only_carried, self_collide_policy
@@ -277,13 +278,15 @@ class _ModelWriter:
                 f"link[{name}]",
             )
         if link.extras.get("gazebo") and not only_carried(link.extras["gazebo"]):
-            ctx.note(
-                "MK808",
-                f'<gazebo> extension of link "{link.name}" is not carried over'
-                + (" (its selfCollide is, as <self_collide>)" if link.name in self.self_collide else ""),
-                link.source,
-                f"link[{name}]",
-            )
+            left = write_link_tags(el, link.extras["gazebo"])  # gravity, maxContacts, kp... as SDF elements
+            if left:
+                ctx.note(
+                    "MK808",
+                    f'<gazebo> extension of link "{link.name}": {", ".join(f"<{t}>" for t in left)} not '
+                    "carried over (its other tags are written as the SDF elements libsdformat makes of them)",
+                    link.source,
+                    f"link[{name}]",
+                )
         for frame_name, pose in sorted(link.extras.get("sdf_frames", {}).items()):
             if self.frames_ok:
                 fname = self.names.claim("frame", frame_name, link.source)

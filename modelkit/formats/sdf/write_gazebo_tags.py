@@ -1,0 +1,105 @@
+"""SDF writer: a URDF link's ``<gazebo reference>`` tags written as the SDF elements Gazebo reads them as.
+
+A URDF made for Gazebo keeps its simulation settings in ``<gazebo reference="LINK">`` blocks, and
+libsdformat's URDF parser (what ``gz sdf -p`` and Gazebo's URDF spawning run) turns each tag into an
+SDF element. ``convert`` from URDF to SDF does the same for the tags below; before, only ``mu1``,
+``mu2``, ``selfCollide`` and ``<sensor>`` were carried and the rest of the block was dropped with one
+note ("not carried over"):
+
+* ``gravity`` → the link's ``<gravity>``; ``turnGravityOff`` → ``<gravity>`` negated;
+* ``kinematic`` → ``<kinematic>``; ``dampingFactor`` → ``<velocity_decay>`` ``<linear>`` and
+  ``<angular>``, both that factor (libsdformat's own rule);
+* on every collision of the link: ``maxContacts`` → ``<max_contacts>``, ``laserRetro`` →
+  ``<laser_retro>``, ``kp``/``kd``/``maxVel``/``minDepth`` → ``<surface><contact><ode>`` ``kp``, ``kd``,
+  ``max_vel``, ``min_depth``, ``fdir1`` → ``<surface><friction><ode><fdir1>``;
+* ``material`` (a Gazebo classic material script name, ``Gazebo/Red``) → each visual's ``<material>``
+  ``<script>`` with that name and Gazebo's stock ``gazebo.material`` URI (the colour stays as the
+  diffuse colour, which gz-sim uses).
+
+What else a block holds (``<plugin>``, ``<visual>``...) is named in one MK808 note per link.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from lxml import etree
+from lxml.etree import _Element as Element
+
+from modelkit.formats.sdf.write_self_collide import CARRIED
+from modelkit.formats.sdf.write_xml import child_or_sub, sub
+
+LINK_FLAGS = {"gravity": "gravity", "kinematic": "kinematic"}
+COLLISION_TAGS = {"maxContacts": ("max_contacts",), "laserRetro": ("laser_retro",),
+                  "kp": ("surface", "contact", "ode", "kp"), "kd": ("surface", "contact", "ode", "kd"),
+                  "maxVel": ("surface", "contact", "ode", "max_vel"),
+                  "minDepth": ("surface", "contact", "ode", "min_depth"),
+                  "fdir1": ("surface", "friction", "ode", "fdir1")}
+OTHER_TAGS = frozenset({"turnGravityOff", "dampingFactor", "material"})
+MATERIAL_URI = "file://media/materials/scripts/gazebo.material"
+WRITTEN = frozenset(LINK_FLAGS) | frozenset(COLLISION_TAGS) | OTHER_TAGS | CARRIED
+
+
+def _blocks(entries: object) -> list[Element]:
+    out = []
+    for entry in entries if isinstance(entries, list) else []:
+        try:
+            out.append(etree.fromstring(str(entry.get("xml", ""))) if isinstance(entry, dict) else None)
+        except etree.XMLSyntaxError:
+            continue
+    return [block for block in out if block is not None]
+
+
+def _text(element: Element) -> str:
+    return " ".join((element.text or "").split())
+
+
+def _truth(text: str) -> bool:
+    return text.lower() in ("true", "1")
+
+
+def write_link_tags(link_el: Element, entries: object) -> list[str]:
+    """Write the tags of a link's ``<gazebo>`` blocks into ``link_el`` (its visuals and collisions are
+    written already); return the tags left out, in order."""
+    left: list[str] = []
+    for block in _blocks(entries):
+        for tag_el in block:
+            if not isinstance(tag_el.tag, str):
+                continue
+            tag, text = tag_el.tag, _text(tag_el)
+            if tag in CARRIED:
+                continue
+            if len(tag_el) or not text:
+                if tag not in left:
+                    left.append(tag)
+                continue
+            if tag in LINK_FLAGS:
+                _set(link_el, LINK_FLAGS[tag], "true" if _truth(text) else "false")
+            elif tag == "turnGravityOff":
+                _set(link_el, "gravity", "false" if _truth(text) else "true")
+            elif tag == "dampingFactor":
+                decay = child_or_sub(link_el, "velocity_decay")
+                _set(decay, "linear", text)
+                _set(decay, "angular", text)
+            elif tag in COLLISION_TAGS:
+                for collision in link_el.findall("collision"):
+                    target = collision
+                    for part in COLLISION_TAGS[tag][:-1]:
+                        target = child_or_sub(target, part)
+                    _set(target, COLLISION_TAGS[tag][-1], text)
+            elif tag == "material":
+                for visual in link_el.findall("visual"):
+                    script = child_or_sub(child_or_sub(visual, "material"), "script")
+                    _set(script, "uri", MATERIAL_URI)
+                    _set(script, "name", text)
+            elif tag not in left:
+                left.append(tag)
+    return left
+
+
+def _set(parent: Element, tag: str, text: str) -> None:
+    """``parent``'s child ``tag`` holding ``text`` (a later block's value wins, as in libsdformat)."""
+    found: Any = parent.find(tag)
+    if found is None:
+        found = sub(parent, tag)
+    found.text = text

@@ -1,0 +1,70 @@
+"""URDF → SDF writes a link's ``<gazebo reference>`` tags as the SDF elements libsdformat's own URDF
+parser makes of them (:mod:`modelkit.formats.sdf.write_gazebo_tags`). Before, only ``mu1``/``mu2``,
+``selfCollide`` and sensors were carried and the rest of the block was dropped ("not carried over").
+Oracle: libsdformat 12's URDF to SDF conversion of the same file (``sdf_check --print``)."""
+
+from __future__ import annotations
+
+import contextlib
+import subprocess
+from pathlib import Path
+
+from lxml import etree
+
+from modelkit.convert.api import convert
+from tests.test_sdf_reader import sdf_oracle  # noqa: F401 (the fixture)
+
+URDF = """<?xml version="1.0"?>
+<robot name="gz">
+  <link name="base">
+    <inertial><mass value="2"/><inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial>
+    <collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision>
+  </link>
+  <link name="arm">
+    <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.001"/></inertial>
+    <visual><geometry><cylinder radius="0.02" length="0.2"/></geometry></visual>
+    <collision><geometry><cylinder radius="0.02" length="0.2"/></geometry></collision>
+  </link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><origin xyz="0 0 0.1"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="10" velocity="2"/></joint>
+  <gazebo reference="arm"><mu1>0.5</mu1><mu2>0.5</mu2><kp>1e5</kp><kd>10</kd><maxVel>0.1</maxVel>
+    <minDepth>0.001</minDepth><fdir1>1 0 0</fdir1><maxContacts>4</maxContacts><laserRetro>50</laserRetro>
+    <material>Gazebo/Red</material><turnGravityOff>true</turnGravityOff><kinematic>1</kinematic>
+    <dampingFactor>0.05</dampingFactor><plugin name="p" filename="libp.so"/></gazebo>
+</robot>
+"""
+PATHS = ("gravity", "kinematic", "velocity_decay/linear", "velocity_decay/angular",
+         "collision/max_contacts", "collision/laser_retro", "collision/surface/contact/ode/kp",
+         "collision/surface/contact/ode/kd", "collision/surface/contact/ode/max_vel",
+         "collision/surface/contact/ode/min_depth", "collision/surface/friction/ode/fdir1",
+         "visual/material/script/name", "visual/material/script/uri")
+
+
+def _values(sdf: str) -> dict[str, str]:
+    link = next(el for el in etree.fromstring(sdf.encode()).iter("link") if el.get("name") == "arm")
+    out = {}
+    for path in PATHS:
+        found = link.find(path)
+        assert found is not None, path
+        text = " ".join((found.text or "").split())
+        if path in ("gravity", "kinematic"):  # true and 1 are the same flag
+            text = "true" if text in ("true", "1") else "false"
+        else:
+            with contextlib.suppress(ValueError):
+                text = repr(float(text))  # 1e5 and 100000 are the same number
+        out[path] = text
+    return out
+
+
+def test_gazebo_link_tags_are_the_sdf_libsdformat_makes(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+    source = tmp_path / "gz.urdf"
+    source.write_text(URDF)
+    out = tmp_path / "out" / "gz.sdf"
+    notes = convert([source], out).notes
+    theirs = subprocess.run([str(sdf_oracle), "--print", source.name], cwd=tmp_path, capture_output=True,
+                            text=True, timeout=60, check=True).stdout
+    ours = _values(out.read_text())
+    assert ours == _values(theirs)
+    assert ours["gravity"] == "false" and ours["collision/max_contacts"] == "4.0"
+    left = [n.message for n in notes if n.code == "MK808" and "<gazebo> extension" in n.message]
+    assert len(left) == 1 and "<plugin> not carried over" in left[0], left
