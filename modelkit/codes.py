@@ -417,6 +417,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "MuJoCo warned while reading the file (its message is given; nothing goes to MUJOCO_LOG.TXT).",
     ),
+    CodeInfo(
+        "MK178",
+        "mjcf-texture-not-held",
+        "info",
+        "A robot geom's material has a texture the model cannot hold: one MuJoCo generates (`builtin`: "
+        "a checker, gradient or flat pattern) or a cube or skybox texture. Converted files keep the "
+        "material's colour, specular, shininess and emission; a 2d texture from a PNG file is carried.",
+    ),
     # -- MK18x: .body values -----------------------------------------------------------------
     CodeInfo(
         "MK181",

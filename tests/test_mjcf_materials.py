@@ -79,3 +79,21 @@ def test_tutorial_sensor_robot_mjcf_loads_with_its_material(tmp_path: Path) -> N
     convert([TUTORIAL / "mobile_robot_sensors.body"], out)
     model = mujoco.MjModel.from_xml_path(str(out))
     assert model.nmat == 1 and np.isclose(model.mat_specular[0], 1.0)
+
+
+def test_a_generated_texture_is_named_not_carried(tmp_path: Path) -> None:
+    """A builtin (generated) texture has no image file: MK178 names it; the material's look is kept."""
+    from modelkit.api import validate
+
+    source = tmp_path / "gen.xml"
+    source.write_text("""<mujoco model="gen"><asset>
+      <texture name="c" type="2d" builtin="checker" width="8" height="8"/>
+      <material name="checks" texture="c" specular="0.9"/></asset>
+      <worldbody><body name="a"><freejoint/><geom type="sphere" size="0.05" material="checks"/></body>
+      </worldbody></mujoco>""")
+    found = [d for d in validate(source).diagnostics if d.code == "MK178"]
+    assert len(found) == 1 and "material checks: its texture c" in found[0].message
+    out = tmp_path / "out" / "gen.xml"
+    convert([source], out)
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert model.ntex == 0 and model.nmat == 1 and np.isclose(model.mat_specular[0], 0.9)

@@ -179,11 +179,14 @@ class CompiledModel:
             texture = int(roles[TEXTURE_RGB_ROLE]) if hasattr(roles, "__len__") else int(roles)
             if texture >= 0:
                 start = int(m.tex_pathadr[texture])
-                if start >= 0:
+                written = ""
+                if start >= 0 and int(m.tex_type[texture]) == TEXTURE_2D:
                     raw = bytes(int(x) & 0xFF for x in m.paths[start:])
                     written = raw.split(b"\0", 1)[0].decode("utf-8", "replace")
-                    if written:
-                        out["texture"] = str(self.model_dir / written)
+                if written:
+                    out["texture"] = str(self.model_dir / written)
+                else:  # generated (builtin), or a cube or skybox texture: no image file the model holds
+                    out["texture_not_held"] = self.name("texture", texture) or f"#{texture}"
         except (AttributeError, IndexError):
             pass  # an older MuJoCo: no texture paths in the model
         return out
@@ -405,6 +408,7 @@ def contact_attributes(m: Any, g: int) -> dict[str, str]:
 
 MATERIAL_DEFAULTS = {"specular": 0.5, "shininess": 0.5, "emission": 0.0}  # MuJoCo's <material> defaults
 TEXTURE_RGB_ROLE = 1  # mjTEXROLE_RGB: the colour texture among a material's texture roles
+TEXTURE_2D = 0  # mjTEXTURE_2D
 FLUID_COEFFICIENTS = (0.5, 0.25, 1.5, 1.0, 1.0)  # MuJoCo's fluidcoef default (blunt, slender, angular
 # drag, Kutta lift, Magnus lift)
 
