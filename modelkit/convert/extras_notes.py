@@ -93,6 +93,7 @@ def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
 
     output = declared(target).output
     handled = output.handles if output is not None else frozenset()
+    handled_joint = output.handles_joint if output is not None else frozenset()
     found: list[tuple[str, str, str, Any, Any, str]] = []  # owner, code, words, value, source, target
     # a dict value's entries that say only the owner's default are no loss (EXTRAS_DEFAULTS)
     if output is None or not output.walks_extras:
@@ -103,7 +104,7 @@ def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
                 found.append((EXTRAS_OWNER[key], code, what, value, robot.source, "robot"))
     elements: list[tuple[str, Any, dict[str, tuple[str, str, str]], frozenset[str]]] = [
         *(("link", link, EXTRAS_DROPPED_LINK, handled) for link in robot.links),
-        *(("joint", joint, EXTRAS_DROPPED_JOINT, frozenset()) for joint in robot.joints),
+        *(("joint", joint, EXTRAS_DROPPED_JOINT, handled_joint) for joint in robot.joints),
     ]
     for kind, element, table, skip in elements:
         for key in sorted(element.extras):

@@ -22,6 +22,7 @@ class OutputDeclaration(NamedTuple):
     sites_native: bool = False  # the format holds MJCF sites (named frames on a body) itself
     frames_native: bool = False  # the format holds SDF <frame>s (named poses on a link) itself
     handles: frozenset[str] = frozenset()  # other formats' robot/link extras keys its writer notes itself
+    handles_joint: frozenset[str] = frozenset()  # the same for joint extras keys
     walks_extras: bool = False  # its writer notes every other format's robot extras key itself
 
 

@@ -14,6 +14,7 @@ FORMAT = FormatDeclaration(
         suffixes=(".sdf",),
         frames_native=True,
         handles=frozenset({"gazebo"}),  # a URDF's <gazebo> blocks: written or noted (write_self_collide)
+        handles_joint=frozenset({"gazebo"}),  # a URDF joint's: written as libsdformat does, or noted
     ),
     extras=ExtrasDeclaration(
         quiet=frozenset({"sdf_canonical_link", "sdf_version", "sdf_model_pose", "sdf_world_joint"}),

@@ -16,7 +16,13 @@ note ("not carried over"):
   ``<script>`` with that name and Gazebo's stock ``gazebo.material`` URI (the colour stays as the
   diffuse colour, which gz-sim uses).
 
-What else a block holds (``<plugin>``, ``<visual>``...) is named in one MK808 note per link.
+A joint's block (:func:`write_joint_tags`): ``provideFeedback`` → ``<physics><provide_feedback>`` and
+``<physics><ode><provide_feedback>``, ``implicitSpringDamper``, ``cfmDamping``, ``fudgeFactor`` →
+``<physics><ode>`` ``implicit_spring_damper``, ``cfm_damping``, ``fudge_factor``, ``stopCfm``/``stopErp``
+→ ``<physics><ode><limit>`` ``cfm``/``erp``, ``springStiffness``/``springReference`` → ``<axis><dynamics>``
+``spring_stiffness``/``spring_reference``.
+
+What else a block holds (``<plugin>``, ``<visual>``...) is named in one MK808 note per link or joint.
 """
 
 from __future__ import annotations
@@ -92,6 +98,40 @@ def write_link_tags(link_el: Element, entries: object) -> list[str]:
                     script = child_or_sub(child_or_sub(visual, "material"), "script")
                     _set(script, "uri", MATERIAL_URI)
                     _set(script, "name", text)
+            elif tag not in left:
+                left.append(tag)
+    return left
+
+
+JOINT_TAGS = {"provideFeedback": (("physics", "provide_feedback"), ("physics", "ode", "provide_feedback")),
+              "implicitSpringDamper": (("physics", "ode", "implicit_spring_damper"),),
+              "cfmDamping": (("physics", "ode", "cfm_damping"),),
+              "fudgeFactor": (("physics", "ode", "fudge_factor"),),
+              "stopCfm": (("physics", "ode", "limit", "cfm"),),
+              "stopErp": (("physics", "ode", "limit", "erp"),)}
+AXIS_TAGS = {"springStiffness": "spring_stiffness", "springReference": "spring_reference"}
+BOOLEAN_JOINT_TAGS = frozenset({"provideFeedback", "implicitSpringDamper", "cfmDamping"})
+
+
+def write_joint_tags(joint_el: Element, entries: object) -> list[str]:
+    """Write the tags of a joint's ``<gazebo>`` blocks into ``joint_el`` (its axis written already);
+    return the tags left out, in order (a spring on a joint without an axis among them)."""
+    left: list[str] = []
+    for block in _blocks(entries):
+        for tag_el in block:
+            if not isinstance(tag_el.tag, str):
+                continue
+            tag, text = tag_el.tag, _text(tag_el)
+            axis = joint_el.find("axis")
+            if tag in JOINT_TAGS and text and not len(tag_el):
+                value = ("true" if _truth(text) else "false") if tag in BOOLEAN_JOINT_TAGS else text
+                for path in JOINT_TAGS[tag]:
+                    target = joint_el
+                    for part in path[:-1]:
+                        target = child_or_sub(target, part)
+                    _set(target, path[-1], value)
+            elif tag in AXIS_TAGS and text and not len(tag_el) and axis is not None:
+                _set(child_or_sub(axis, "dynamics"), AXIS_TAGS[tag], text)
             elif tag not in left:
                 left.append(tag)
     return left

@@ -45,7 +45,7 @@ from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_vec
 from modelkit.formats.sdf.kept import JOINT_KEY, LIMIT_KEY, MODEL_KEY, write_back
 from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
-from modelkit.formats.sdf.write_gazebo_tags import write_link_tags
+from modelkit.formats.sdf.write_gazebo_tags import write_joint_tags, write_link_tags
 from modelkit.formats.sdf.write_geometry import GeomWriter
 from modelkit.formats.sdf.write_names import Names
 from modelkit.formats.sdf.write_self_collide import only_carried, self_collide_policy
@@ -374,6 +374,9 @@ class _ModelWriter:
 
     def _joint(self, model: Element, joint: Joint) -> None:
         ctx = self.ctx
+        if joint.extras.get("gazebo") and (joint.child in self.as_frame or joint.child in self.unjointed):
+            ctx.note("MK808", f'<gazebo> extension of joint "{joint.name}" not carried over: the joint is '
+                     "not written as an SDF joint", joint.source, f"joint[{joint.name}]")
         if joint.child in self.as_frame:
             return
         if joint.child in self.unjointed:
@@ -402,6 +405,12 @@ class _ModelWriter:
         else:
             self._axisless_dynamics(joint, kind, name)
         write_back(el, joint.extras.get(JOINT_KEY))  # <physics> (kept.py)
+        if joint.extras.get("gazebo"):  # a URDF joint's <gazebo> block, as libsdformat converts it
+            left = write_joint_tags(el, joint.extras["gazebo"])
+            if left:
+                ctx.note("MK808", f'<gazebo> extension of joint "{joint.name}": '
+                         f'{", ".join(f"<{t}>" for t in left)} not carried over', joint.source,
+                         f"joint[{name}]")
         if joint.armature:
             ctx.note(
                 "MK820",
