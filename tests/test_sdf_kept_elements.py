@@ -93,3 +93,37 @@ def test_values_at_sdformats_defaults_are_not_kept_or_said(tmp_path: Path) -> No
         assert not [n for n in notes if "SDF model flags" in n.message or "SDF joint stop" in n.message
                     or "visual and collision elements" in n.message], [n.message for n in notes]
     assert _values(tmp_path / "out" / "m.sdf") == {}  # written as SDFormat's defaults: left out
+
+
+MATERIAL = """<?xml version="1.0"?>
+<sdf version="1.9">
+  <model name="m">
+    <link name="base">
+      <inertial><mass>1</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial>
+      <visual name="v"><geometry><box><size>0.1 0.1 0.1</size></box></geometry>
+        <material><diffuse>1 0 0 1</diffuse>
+          <script><uri>file://media/materials/scripts/gazebo.material</uri><name>Gazebo/Red</name></script>
+          <pbr><metal><metalness>0.5</metalness><roughness>0.2</roughness></metal></pbr>
+          <double_sided>true</double_sided></material></visual>
+    </link>
+  </model>
+</sdf>
+"""
+
+
+def test_material_script_pbr_written_back_and_said_elsewhere(tmp_path: Path,
+                                                            sdf_oracle: Path) -> None:  # noqa: F811
+    """A visual's Gazebo material script, PBR block and double_sided flag were lost in every target,
+    SDF included, without a note (the reader kept them, nobody wrote or named them)."""
+    source = _source(tmp_path, MATERIAL)
+    out = tmp_path / "out" / "m.sdf"
+    convert([source], out)
+    material = next(etree.parse(str(out)).iter("material"))
+    assert material.findtext("script/name") == "Gazebo/Red"
+    assert material.findtext("script/uri") == "file://media/materials/scripts/gazebo.material"
+    assert material.findtext("pbr/metal/metalness") == "0.5" and material.findtext("double_sided") == "true"
+    assert not oracle_has_errors(sdf_oracle, out)
+    for suffix in ("xml", "urdf", "body"):
+        notes = convert([source], tmp_path / suffix / f"m.{suffix}").notes
+        said = [n for n in notes if "SDF material elements beyond the colours" in n.message]
+        assert len(said) == 1 and said[0].code == "MK818" and "Gazebo/Red" in said[0].message, suffix

@@ -76,6 +76,8 @@ def _plain(value: Any) -> str:
         return " ".join(_plain(float(v)) if not isinstance(v, bool) else _plain(v) for v in value)
     if isinstance(value, dict):
         return "(" + ", ".join(f"{k} {_plain(v)}" for k, v in value.items()) + ")"
+    if isinstance(value, list | tuple):
+        return " ".join(_plain(v) for v in value)
     return str(value)
 
 

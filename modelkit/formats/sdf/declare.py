@@ -18,9 +18,7 @@ FORMAT = FormatDeclaration(
     ),
     extras=ExtrasDeclaration(
         quiet=frozenset({"sdf_canonical_link", "sdf_version", "sdf_model_pose", "sdf_world_joint"}),
-        # sdf_materials: a visual's exact SDF colours and script, for SDF round trips; the model's material
-        # holds the colour and the ambient intensity, and each writer says what of it its target drops
-        quiet_link=frozenset({"sdf_link_pose", "sdf_materials"}),
+        quiet_link=frozenset({"sdf_link_pose"}),
         dropped=(
             ("sdf_world", "MK822", "the SDF world around the model"),
             ("sdf_plugins", "MK808", "SDF model plugins"),
@@ -32,6 +30,7 @@ FORMAT = FormatDeclaration(
             ("sdf_link", "MK808", "SDF link flags"),
             ("sdf_other", "MK808", "SDF link elements kept only as data by validate's MK155"),
             ("sdf_shape_elements", "MK808", "SDF visual and collision elements"),
+            ("sdf_materials", "MK818", "SDF material elements beyond the colours"),
         ),
         dropped_joint=(
             ("sdf_joint_elements", "MK820", "SDF joint solver parameters"),

@@ -236,8 +236,7 @@ def read_material(
         result.specular = tuple(specular[:3])
     if emissive is not None:
         result.emissive = tuple(emissive[:3])
-    if ambient is not None:
-        extras["ambient"] = list(ambient)
+    if ambient is not None:  # the model holds it as an intensity of the diffuse colour
         result.ambient = _ambient_intensity(ambient, diffuse)
     script = child(material, "script")
     if script is not None:

@@ -6,6 +6,8 @@ a cone (never native) and, before 1.8, a capsule or ellipsoid are written as mes
 
 from __future__ import annotations
 
+from typing import Any
+
 from lxml import etree
 from lxml.etree import _Element as Element
 
@@ -15,7 +17,19 @@ from modelkit.convert.names import unique_name
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.formats.sdf.kept import shape_entries, write_back
 from modelkit.formats.sdf.write_xml import add_pose, child_or_sub, num, rgba, sub
-from modelkit.model import Box, Capsule, Cone, Cylinder, Ellipsoid, Geom, Link, Mesh, Sphere, SurfaceFriction
+from modelkit.model import (
+    Box,
+    Capsule,
+    Cone,
+    Cylinder,
+    Ellipsoid,
+    Geom,
+    Link,
+    Mesh,
+    Sphere,
+    SurfaceFriction,
+    VisualMaterial,
+)
 from modelkit.spatial import Pose
 
 MESH_READABLE = ("stl", "obj", "dae")
@@ -42,6 +56,7 @@ class GeomWriter:
         kept = {str(e.get("collision")): str(e.get("xml")) for e in link.extras.get("sdf_surface", [])}
         for kind, geoms in (("visual", link.visuals), ("collision", link.collisions)):
             elements = shape_entries(link.extras, kind)  # <laser_retro>, <cast_shadows>... (kept.py)
+            looks = link.extras.get("sdf_materials") or {}  # an SDF source's <script>, <pbr>...
             used: set[str] = set()
             for index, geom in enumerate(geoms):
                 name = unique_name(geom.name or f"{kind}_{index}", used)
@@ -56,7 +71,7 @@ class GeomWriter:
                 if kind == "collision" and geom.name in kept:
                     shape.append(etree.fromstring(kept[geom.name]))  # the source's surface, friction aside
                 if kind == "visual":
-                    self._material(shape, geom, target)
+                    self._material(shape, geom, target, looks.get(geom.name or ""))
                 elif geom.friction is not None:
                     self._surface(shape, geom.friction, link, target)
                 elif friction is not None:
@@ -96,15 +111,8 @@ class GeomWriter:
             return False
         return True
 
-    def _material(self, visual: Element, geom: Geom, target: str) -> None:
-        material = geom.material
-        if material is None:
-            return
-        if material.transparency:
-            num(visual, "transparency", material.transparency)
-        if material.diffuse is None and material.specular is None and material.emissive is None:
-            return
-        el = sub(visual, "material")
+    @staticmethod
+    def _colours(el: Element, material: VisualMaterial) -> None:
         if material.diffuse is not None:
             ambient = material.ambient if material.ambient is not None else 1.0
             sub(
@@ -117,6 +125,40 @@ class GeomWriter:
             sub(el, "specular", rgba(material.specular))
         if material.emissive is not None:
             sub(el, "emissive", rgba(material.emissive))
+
+    def _material(self, visual: Element, geom: Geom, target: str, kept: Any = None) -> None:
+        """The visual's ``<material>``; ``kept``: an SDF source's own material elements beyond the colours
+        (``<script>``, ``<pbr>``, ``<shader>``...), written back."""
+        material = geom.material
+        if material is None:
+            return
+        if isinstance(kept, dict) and kept:
+            if material.transparency:
+                num(visual, "transparency", material.transparency)
+            el = sub(visual, "material")
+            self._colours(el, material)
+            for key, data in kept.items():
+                if key == "pbr" and material.texture:
+                    continue  # its albedo map is a file next to the source: not copied (noted below)
+                if key == "script" and isinstance(data, dict):
+                    script = sub(el, "script")
+                    for uri in data.get("uri") or []:
+                        sub(script, "uri", str(uri))
+                    if data.get("name"):
+                        sub(script, "name", str(data["name"]))
+                else:
+                    el.append(data_element(str(key), data))
+            self._texture_note(material, geom, target)
+            return
+        if material.transparency:
+            num(visual, "transparency", material.transparency)
+        if material.diffuse is None and material.specular is None and material.emissive is None:
+            return
+        el = sub(visual, "material")
+        self._colours(el, material)
+        self._texture_note(material, geom, target)
+
+    def _texture_note(self, material: VisualMaterial, geom: Geom, target: str) -> None:
         if material.texture:
             self.ctx.note(
                 "MK818",
@@ -196,3 +238,33 @@ def _first(parent: Element, tag: str, value: float, after: str | None = None) ->
     element.text = fmt(value)
     previous = parent.find(after) if after is not None else None
     parent.insert(0 if previous is None else list(parent).index(previous) + 1, element)
+
+
+def data_element(tag: str, data: Any) -> Element:
+    """The element the SDF reader's ``element_data`` made ``data`` of: ``@name`` keys are attributes,
+    ``#text`` the text, other keys children (a list: repeated children), a scalar or a list of numbers
+    the text."""
+    el = etree.Element(tag)
+    if isinstance(data, dict):
+        for key, value in data.items():
+            if key.startswith("@"):
+                el.set(key[1:], str(value))
+            elif key == "#text":
+                el.text = _data_text(value)
+            else:
+                repeated = isinstance(value, list) and any(isinstance(v, dict) for v in value)
+                for item in value if repeated else [value]:
+                    el.append(data_element(key, item))
+    else:
+        el.text = _data_text(data)
+    return el
+
+
+def _data_text(value: Any) -> str:
+    if isinstance(value, list):
+        return " ".join(_data_text(v) for v in value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return fmt(value)
+    return str(value)
