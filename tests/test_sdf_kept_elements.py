@@ -127,3 +127,18 @@ def test_material_script_pbr_written_back_and_said_elsewhere(tmp_path: Path,
         notes = convert([source], tmp_path / suffix / f"m.{suffix}").notes
         said = [n for n in notes if "SDF material elements beyond the colours" in n.message]
         assert len(said) == 1 and said[0].code == "MK818" and "Gazebo/Red" in said[0].message, suffix
+
+
+def test_link_flags_and_data_elements_written_back(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+    """An SDF link's <gravity>, <kinematic>, <velocity_decay> and a <battery> (validate's MK155: kept
+    only as data) were lost SDF → SDF without a note; they are written back."""
+    source = _source(tmp_path, GIVEN.replace(
+        '<link name="arm">', '<link name="arm"><gravity>false</gravity><kinematic>true</kinematic>'
+        '<velocity_decay><linear>0.1</linear></velocity_decay>'
+        '<battery name="b"><voltage>12</voltage></battery>'))
+    out = tmp_path / "out" / "m.sdf"
+    convert([source], out)
+    arm = next(el for el in etree.parse(str(out)).iter("link") if el.get("name") == "arm")
+    assert arm.findtext("gravity") == "false" and arm.findtext("kinematic") == "true"
+    assert arm.findtext("velocity_decay/linear") == "0.1" and arm.findtext("battery/voltage") == "12"
+    assert not oracle_has_errors(sdf_oracle, out)

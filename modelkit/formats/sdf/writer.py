@@ -46,7 +46,7 @@ from modelkit.formats.sdf.kept import JOINT_KEY, LIMIT_KEY, MODEL_KEY, write_bac
 from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
 from modelkit.formats.sdf.write_gazebo_tags import write_joint_tags, write_link_tags
-from modelkit.formats.sdf.write_geometry import GeomWriter
+from modelkit.formats.sdf.write_geometry import GeomWriter, data_element
 from modelkit.formats.sdf.write_names import Names
 from modelkit.formats.sdf.write_self_collide import only_carried, self_collide_policy
 from modelkit.formats.sdf.write_xml import add_pose, num, sub
@@ -254,6 +254,7 @@ class _ModelWriter:
         self._link_pose(el, link.name)
         if link.name in self.self_collide:
             sub(el, "self_collide", "true" if self.self_collide[link.name] else "false")
+        self._own_link_elements(el, link)
         self._inertial(el, link, name)
         friction = floor_friction(self.robot).get(link.name) if link.contact_material else None
         self.geoms.link_geoms(el, link, name, Pose(), None, friction)
@@ -295,6 +296,19 @@ class _ModelWriter:
             else:
                 self.ctx.note("MK820", f'frame "{frame_name}" of link "{link.name}" is left out: SDFormat '
                               f"{self.ctx.options.sdf_version} has no <frame>", link.source, f"link[{name}]")
+
+    @staticmethod
+    def _own_link_elements(el: Element, link: Link) -> None:
+        """An SDF source link's flags (``<gravity>``, ``<kinematic>``, ``<velocity_decay>``...) and the
+        elements validate keeps only as data (``<battery>``, ``<audio_sink>``..., MK155), written back."""
+        for key, value in (link.extras.get("sdf_link") or {}).items():
+            if isinstance(value, bool):
+                sub(el, str(key), "true" if value else "false")
+            else:
+                el.append(data_element(str(key), value))
+        for entry in link.extras.get("sdf_other") or []:
+            if isinstance(entry, dict) and entry.get("element"):
+                el.append(data_element(str(entry["element"]), entry.get("data")))
 
     def _inertial(self, el: Element, link: Link, name: str) -> None:
         inertial = link.inertial
