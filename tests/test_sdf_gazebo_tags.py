@@ -40,33 +40,45 @@ PATHS = ("gravity", "kinematic", "velocity_decay/linear", "velocity_decay/angula
          "visual/material/script/name", "visual/material/script/uri")
 
 
-def _values(sdf: str) -> dict[str, str]:
-    link = next(el for el in etree.fromstring(sdf.encode()).iter("link") if el.get("name") == "arm")
+FLAGS = frozenset({"gravity", "kinematic", "physics/provide_feedback", "physics/ode/provide_feedback",
+                   "physics/ode/implicit_spring_damper", "physics/ode/cfm_damping"})
+
+
+def _values(sdf: str, tag: str, name: str, paths: tuple[str, ...]) -> dict[str, str]:
+    """The text at each path below the element ``tag`` named ``name``, normalised: a flag's true and 1
+    are the same, as are the numbers 1e5 and 100000."""
+    element = next(el for el in etree.fromstring(sdf.encode()).iter(tag) if el.get("name") == name)
     out = {}
-    for path in PATHS:
-        found = link.find(path)
+    for path in paths:
+        found = element.find(path)
         assert found is not None, path
         text = " ".join((found.text or "").split())
-        if path in ("gravity", "kinematic"):  # true and 1 are the same flag
+        if path in FLAGS:
             text = "true" if text in ("true", "1") else "false"
         else:
             with contextlib.suppress(ValueError):
-                text = repr(float(text))  # 1e5 and 100000 are the same number
+                text = repr(float(text))
         out[path] = text
     return out
 
 
-def test_gazebo_link_tags_are_the_sdf_libsdformat_makes(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+def _ours_and_libsdformats(tmp_path: Path, urdf: str, oracle: Path) -> tuple[list[str], str, str]:
+    """The notes and SDF of ``convert`` for ``urdf``, and libsdformat's own conversion of it."""
     source = tmp_path / "gz.urdf"
-    source.write_text(URDF)
+    source.write_text(urdf)
     out = tmp_path / "out" / "gz.sdf"
-    notes = convert([source], out).notes
-    theirs = subprocess.run([str(sdf_oracle), "--print", source.name], cwd=tmp_path, capture_output=True,
+    notes = [n.message for n in convert([source], out).notes if n.code == "MK808"]
+    theirs = subprocess.run([str(oracle), "--print", source.name], cwd=tmp_path, capture_output=True,
                             text=True, timeout=60, check=True).stdout
-    ours = _values(out.read_text())
-    assert ours == _values(theirs)
+    return notes, out.read_text(), theirs
+
+
+def test_gazebo_link_tags_are_the_sdf_libsdformat_makes(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+    notes, ours_text, theirs = _ours_and_libsdformats(tmp_path, URDF, sdf_oracle)
+    ours = _values(ours_text, "link", "arm", PATHS)
+    assert ours == _values(theirs, "link", "arm", PATHS)
     assert ours["gravity"] == "false" and ours["collision/max_contacts"] == "4.0"
-    left = [n.message for n in notes if n.code == "MK808" and "<gazebo> extension" in n.message]
+    left = [n for n in notes if "<gazebo> extension" in n]
     assert len(left) == 1 and "<plugin> not carried over" in left[0], left
 
 
@@ -81,24 +93,8 @@ JOINT_PATHS = ("physics/provide_feedback", "physics/ode/provide_feedback",
                "axis/dynamics/spring_reference")
 
 
-def _joint_values(sdf: str) -> dict[str, str]:
-    joint = next(el for el in etree.fromstring(sdf.encode()).iter("joint") if el.get("name") == "j")
-    out = {}
-    for path in JOINT_PATHS:
-        found = joint.find(path)
-        assert found is not None, path
-        text = " ".join((found.text or "").split())
-        out[path] = {"1": "true", "0": "false"}.get(text, text)
-    return out
-
-
 def test_gazebo_joint_tags_are_the_sdf_libsdformat_makes(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
-    source = tmp_path / "gzj.urdf"
-    source.write_text(JOINT_URDF)
-    out = tmp_path / "out" / "gzj.sdf"
-    notes = convert([source], out).notes
-    theirs = subprocess.run([str(sdf_oracle), "--print", source.name], cwd=tmp_path, capture_output=True,
-                            text=True, timeout=60, check=True).stdout
-    assert _joint_values(out.read_text()) == _joint_values(theirs)
-    said = [n.message for n in notes if "joint" in n.message and "<gazebo>" in n.message]
+    notes, ours, theirs = _ours_and_libsdformats(tmp_path, JOINT_URDF, sdf_oracle)
+    assert _values(ours, "joint", "j", JOINT_PATHS) == _values(theirs, "joint", "j", JOINT_PATHS)
+    said = [n for n in notes if "joint" in n and "<gazebo>" in n]
     assert said == ['<gazebo> extension of joint "j": <other> not carried over'], said

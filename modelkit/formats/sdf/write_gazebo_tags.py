@@ -27,6 +27,7 @@ What else a block holds (``<plugin>``, ``<visual>``...) is named in one MK808 no
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
 from lxml import etree
@@ -46,18 +47,18 @@ MATERIAL_URI = "file://media/materials/scripts/gazebo.material"
 WRITTEN = frozenset(LINK_FLAGS) | frozenset(COLLISION_TAGS) | OTHER_TAGS | CARRIED
 
 
-def _blocks(entries: object) -> list[Element]:
-    out = []
+def _tags(entries: object) -> Iterator[tuple[str, str, bool]]:
+    """Each tag of the kept ``<gazebo>`` blocks: its name, its text, and whether it is a plain value (a
+    text and no child elements), in order."""
     for entry in entries if isinstance(entries, list) else []:
         try:
-            out.append(etree.fromstring(str(entry.get("xml", ""))) if isinstance(entry, dict) else None)
+            block = etree.fromstring(str(entry.get("xml", ""))) if isinstance(entry, dict) else None
         except etree.XMLSyntaxError:
             continue
-    return [block for block in out if block is not None]
-
-
-def _text(element: Element) -> str:
-    return " ".join((element.text or "").split())
+        for tag_el in block if block is not None else []:
+            if isinstance(tag_el.tag, str):
+                text = " ".join((tag_el.text or "").split())
+                yield tag_el.tag, text, bool(text) and not len(tag_el)
 
 
 def _truth(text: str) -> bool:
@@ -68,38 +69,30 @@ def write_link_tags(link_el: Element, entries: object) -> list[str]:
     """Write the tags of a link's ``<gazebo>`` blocks into ``link_el`` (its visuals and collisions are
     written already); return the tags left out, in order."""
     left: list[str] = []
-    for block in _blocks(entries):
-        for tag_el in block:
-            if not isinstance(tag_el.tag, str):
-                continue
-            tag, text = tag_el.tag, _text(tag_el)
-            if tag in CARRIED:
-                continue
-            if len(tag_el) or not text:
-                if tag not in left:
-                    left.append(tag)
-                continue
-            if tag in LINK_FLAGS:
-                _set(link_el, LINK_FLAGS[tag], "true" if _truth(text) else "false")
-            elif tag == "turnGravityOff":
-                _set(link_el, "gravity", "false" if _truth(text) else "true")
-            elif tag == "dampingFactor":
-                decay = child_or_sub(link_el, "velocity_decay")
-                _set(decay, "linear", text)
-                _set(decay, "angular", text)
-            elif tag in COLLISION_TAGS:
-                for collision in link_el.findall("collision"):
-                    target = collision
-                    for part in COLLISION_TAGS[tag][:-1]:
-                        target = child_or_sub(target, part)
-                    _set(target, COLLISION_TAGS[tag][-1], text)
-            elif tag == "material":
-                for visual in link_el.findall("visual"):
-                    script = child_or_sub(child_or_sub(visual, "material"), "script")
-                    _set(script, "uri", MATERIAL_URI)
-                    _set(script, "name", text)
-            elif tag not in left:
+    for tag, text, plain in _tags(entries):
+        if tag in CARRIED:
+            continue
+        if not plain:
+            if tag not in left:
                 left.append(tag)
+            continue
+        if tag in LINK_FLAGS:
+            _set(link_el, LINK_FLAGS[tag], "true" if _truth(text) else "false")
+        elif tag == "turnGravityOff":
+            _set(link_el, "gravity", "false" if _truth(text) else "true")
+        elif tag == "dampingFactor":
+            decay = child_or_sub(link_el, "velocity_decay")
+            _set(decay, "linear", text)
+            _set(decay, "angular", text)
+        elif tag in COLLISION_TAGS:
+            for collision in link_el.findall("collision"):
+                _set_path(collision, COLLISION_TAGS[tag], text)
+        elif tag == "material":
+            for visual in link_el.findall("visual"):
+                _set_path(visual, ("material", "script", "uri"), MATERIAL_URI)
+                _set_path(visual, ("material", "script", "name"), text)
+        elif tag not in left:
+            left.append(tag)
     return left
 
 
@@ -117,24 +110,24 @@ def write_joint_tags(joint_el: Element, entries: object) -> list[str]:
     """Write the tags of a joint's ``<gazebo>`` blocks into ``joint_el`` (its axis written already);
     return the tags left out, in order (a spring on a joint without an axis among them)."""
     left: list[str] = []
-    for block in _blocks(entries):
-        for tag_el in block:
-            if not isinstance(tag_el.tag, str):
-                continue
-            tag, text = tag_el.tag, _text(tag_el)
-            axis = joint_el.find("axis")
-            if tag in JOINT_TAGS and text and not len(tag_el):
-                value = ("true" if _truth(text) else "false") if tag in BOOLEAN_JOINT_TAGS else text
-                for path in JOINT_TAGS[tag]:
-                    target = joint_el
-                    for part in path[:-1]:
-                        target = child_or_sub(target, part)
-                    _set(target, path[-1], value)
-            elif tag in AXIS_TAGS and text and not len(tag_el) and axis is not None:
-                _set(child_or_sub(axis, "dynamics"), AXIS_TAGS[tag], text)
-            elif tag not in left:
-                left.append(tag)
+    axis = joint_el.find("axis")
+    for tag, text, plain in _tags(entries):
+        if plain and tag in JOINT_TAGS:
+            value = ("true" if _truth(text) else "false") if tag in BOOLEAN_JOINT_TAGS else text
+            for path in JOINT_TAGS[tag]:
+                _set_path(joint_el, path, value)
+        elif plain and tag in AXIS_TAGS and axis is not None:
+            _set_path(axis, ("dynamics", AXIS_TAGS[tag]), text)
+        elif tag not in left:
+            left.append(tag)
     return left
+
+
+def _set_path(root: Element, path: tuple[str, ...], text: str) -> None:
+    """The element at ``path`` below ``root`` (made where missing) holding ``text``."""
+    for part in path[:-1]:
+        root = child_or_sub(root, part)
+    _set(root, path[-1], text)
 
 
 def _set(parent: Element, tag: str, text: str) -> None:

@@ -16,7 +16,7 @@ from modelkit.convert.friction import PairFriction, describe
 from modelkit.convert.names import unique_name
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.formats.sdf.kept import shape_entries, write_back
-from modelkit.formats.sdf.write_xml import add_pose, child_or_sub, num, rgba, sub
+from modelkit.formats.sdf.write_xml import add_pose, child_or_sub, data_element, num, rgba, sub
 from modelkit.model import (
     Box,
     Capsule,
@@ -239,32 +239,3 @@ def _first(parent: Element, tag: str, value: float, after: str | None = None) ->
     previous = parent.find(after) if after is not None else None
     parent.insert(0 if previous is None else list(parent).index(previous) + 1, element)
 
-
-def data_element(tag: str, data: Any) -> Element:
-    """The element the SDF reader's ``element_data`` made ``data`` of: ``@name`` keys are attributes,
-    ``#text`` the text, other keys children (a list: repeated children), a scalar or a list of numbers
-    the text."""
-    el = etree.Element(tag)
-    if isinstance(data, dict):
-        for key, value in data.items():
-            if key.startswith("@"):
-                el.set(key[1:], str(value))
-            elif key == "#text":
-                el.text = _data_text(value)
-            else:
-                repeated = isinstance(value, list) and any(isinstance(v, dict) for v in value)
-                for item in value if repeated else [value]:
-                    el.append(data_element(key, item))
-    else:
-        el.text = _data_text(data)
-    return el
-
-
-def _data_text(value: Any) -> str:
-    if isinstance(value, list):
-        return " ".join(_data_text(v) for v in value)
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, float):
-        return fmt(value)
-    return str(value)

@@ -94,3 +94,33 @@ def parse_fragment(xml: str) -> Element | None:
         return etree.fromstring(xml)
     except etree.XMLSyntaxError:
         return None
+
+
+def data_element(tag: str, data: Any) -> Element:
+    """The element the SDF reader's ``element_data`` made ``data`` of: ``@name`` keys are attributes,
+    ``#text`` the text, other keys children (a list: repeated children), a scalar or a list of numbers
+    the text."""
+    el = etree.Element(tag)
+    if isinstance(data, dict):
+        for key, value in data.items():
+            if key.startswith("@"):
+                el.set(key[1:], str(value))
+            elif key == "#text":
+                el.text = _data_text(value)
+            else:
+                repeated = isinstance(value, list) and any(isinstance(v, dict) for v in value)
+                for item in value if repeated else [value]:
+                    el.append(data_element(key, item))
+    else:
+        el.text = _data_text(data)
+    return el
+
+
+def _data_text(value: Any) -> str:
+    if isinstance(value, list):
+        return " ".join(_data_text(v) for v in value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return fmt(value)
+    return str(value)

@@ -46,10 +46,10 @@ from modelkit.formats.sdf.kept import JOINT_KEY, LIMIT_KEY, MODEL_KEY, write_bac
 from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
 from modelkit.formats.sdf.write_gazebo_tags import write_joint_tags, write_link_tags
-from modelkit.formats.sdf.write_geometry import GeomWriter, data_element
+from modelkit.formats.sdf.write_geometry import GeomWriter
 from modelkit.formats.sdf.write_names import Names
 from modelkit.formats.sdf.write_self_collide import only_carried, self_collide_policy
-from modelkit.formats.sdf.write_xml import add_pose, num, sub
+from modelkit.formats.sdf.write_xml import add_pose, data_element, num, sub
 from modelkit.model import WORLD_LINK, DeviceKind, Joint, JointType, Link, LoopConstraint, Robot
 from modelkit.spatial import Mat3, Pose, Vec3
 
