@@ -103,19 +103,38 @@ def geom_box(geom: Geom, frame: Pose | None = None) -> Aabb | None:
     """The shape's box in the link frame, or in the frame where the link frame is at ``frame`` (None for a
     mesh that is only a file reference)."""
     local = local_box(geom.geometry)
-    if local is None or not rot3.all_finite([*local.centre, *local.half]):
+    if local is None:
         return None
-    pose = geom.pose if frame is None else frame @ geom.pose
-    rotation, offset = pose.rotation_tuple, pose.translation_tuple
-    centre = rot3.add(rot3.matvec(rotation, local.centre), offset)
-    half = rot3.vec3(sum(abs(rotation[i][j]) * local.half[j] for j in range(3)) for i in range(3))
-    return Aabb(centre, half)
+    (cx, cy, cz), (hx, hy, hz) = local.centre, local.half
+    if not all(math.isfinite(v) for v in (cx, cy, cz, hx, hy, hz)):
+        return None
+    pose = geom.pose if frame is None or _is_identity(frame) else frame @ geom.pose
+    (r0, r1, r2), (tx, ty, tz) = pose.rotation_tuple, pose.translation_tuple
+    if r0 == (1.0, 0.0, 0.0) and r1 == (0.0, 1.0, 0.0) and r2 == (0.0, 0.0, 1.0):
+        return Aabb((cx + tx, cy + ty, cz + tz), (hx, hy, hz))
+    return Aabb(
+        (r0[0] * cx + r0[1] * cy + r0[2] * cz + tx,
+         r1[0] * cx + r1[1] * cy + r1[2] * cz + ty,
+         r2[0] * cx + r2[1] * cy + r2[2] * cz + tz),
+        (abs(r0[0]) * hx + abs(r0[1]) * hy + abs(r0[2]) * hz,
+         abs(r1[0]) * hx + abs(r1[1]) * hy + abs(r1[2]) * hz,
+         abs(r2[0]) * hx + abs(r2[1]) * hy + abs(r2[2]) * hz),
+    )
+
+
+def _is_identity(frame: Pose) -> bool:
+    """Whether ``frame`` is exactly the identity (the pose of a body's own top link)."""
+    return rot3.peek(frame, "translation") == rot3.ZERO3 and frame.rotation_tuple == rot3.IDENTITY
 
 
 def union(boxes: list[Aabb]) -> Aabb:
     """The box around several boxes (at least one)."""
-    low = [min(b.low[i] for b in boxes) for i in range(3)]
-    high = [max(b.high[i] for b in boxes) for i in range(3)]
+    if len(boxes) == 1:
+        return boxes[0]
+    lows = [b.low for b in boxes]
+    highs = [b.high for b in boxes]
+    low = [min(b[i] for b in lows) for i in range(3)]
+    high = [max(b[i] for b in highs) for i in range(3)]
     return Aabb(
         ((low[0] + high[0]) / 2, (low[1] + high[1]) / 2, (low[2] + high[2]) / 2),
         ((high[0] - low[0]) / 2, (high[1] - low[1]) / 2, (high[2] - low[2]) / 2),

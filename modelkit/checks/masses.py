@@ -77,6 +77,15 @@ def body_mass_properties(
     links: dict[str, Link], members: list[tuple[str, Pose]]
 ) -> tuple[float, rot3.V3, rot3.M3]:
     """Mass, centre of mass and inertia about it of one welded body, in its top link's frame (numpy-free)."""
+    if len(members) == 1:  # a link on its own: its inertial as written, no arithmetic to round
+        link = links.get(members[0][0])
+        inertial = link.inertial if link is not None else None
+        pose = members[0][1]
+        if inertial is None or inertial.mass <= 0.0:
+            return 0.0, rot3.ZERO3, rot3.ZERO33
+        if pose.rotation_tuple == rot3.IDENTITY and pose.translation_tuple == rot3.ZERO3:
+            return (inertial.mass, rot3.vec3(rot3.peek(inertial, "com")),
+                    rot3.mat3(rot3.peek(inertial, "inertia")))
     parts = []
     for name, pose in members:
         link = links.get(name)
