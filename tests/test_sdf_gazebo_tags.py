@@ -98,3 +98,86 @@ def test_gazebo_joint_tags_are_the_sdf_libsdformat_makes(tmp_path: Path, sdf_ora
     assert _values(ours, "joint", "j", JOINT_PATHS) == _values(theirs, "joint", "j", JOINT_PATHS)
     said = [n for n in notes if "joint" in n and "<gazebo>" in n]
     assert said == ['<gazebo> extension of joint "j": <other> not carried over'], said
+
+
+BLOB_URDF = """<?xml version="1.0"?>
+<robot name="blobs">
+  <material name="blue"><color rgba="0 0 1 1"/></material>
+  <link name="base">
+    <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+    <visual><geometry><box size="0.1 0.1 0.1"/></geometry><material name="blue"/></visual>
+    <visual><origin xyz="0 0 0.1"/><geometry><sphere radius="0.05"/></geometry></visual>
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>
+    <collision><origin xyz="0 0 0.1"/><geometry><sphere radius="0.05"/></geometry></collision>
+  </link>
+  <gazebo reference="base">
+    <visual>
+      <material><ambient>1 0 0 1</ambient><diffuse>1 0 0 1</diffuse>
+        <specular>0.5 0.5 0.5 1</specular></material>
+      <transparency>0.3</transparency>
+    </visual>
+    <collision><surface><bounce><restitution_coefficient>0.5</restitution_coefficient></bounce></surface></collision>
+    <mu1>0.7</mu1><kp>1000</kp><material>Gazebo/Red</material>
+    <light name="lamp" type="point"><diffuse>1 1 1 1</diffuse></light>
+    <enable_wind>true</enable_wind>
+    <plugin name="p" filename="libp.so"/>
+  </gazebo>
+  <gazebo reference="base"><visual><cast_shadows>false</cast_shadows></visual></gazebo>
+</robot>
+"""
+
+
+def _leaves(element: etree._Element, skip: tuple[str, ...] = ("pose", "geometry")) -> list[tuple[str, str]]:
+    """Every element below ``element`` that holds a text, as (path, text), sorted; numbers normalised;
+    the shape's own pose and geometry left out (they are the URDF's, compared elsewhere)."""
+    out = []
+    for leaf in element.iter():
+        path = element.getroottree().getpath(leaf)[len(element.getroottree().getpath(element)) + 1:]
+        path = "/".join(part.split("[")[0] for part in path.split("/"))
+        text = " ".join((leaf.text or "").split())
+        if not text or len(leaf) or path.split("/")[0] in skip:
+            continue
+        with contextlib.suppress(ValueError):
+            text = " ".join(repr(float(v)) for v in text.split())
+        out.append((path, text))
+    return sorted(out)
+
+
+def test_gazebo_visual_collision_and_link_blobs_are_where_libsdformat_puts_them(
+    tmp_path: Path, sdf_oracle: Path  # noqa: F811
+) -> None:
+    notes, ours_text, theirs_text = _ours_and_libsdformats(tmp_path, BLOB_URDF, sdf_oracle)
+    ours, theirs = (next(el for el in etree.fromstring(text.encode()).iter("link")
+                         if el.get("name") == "base") for text in (ours_text, theirs_text))
+    for kind in ("visual", "collision"):
+        mine, libs = ours.findall(kind), theirs.findall(kind)
+        assert len(mine) == len(libs) == 2
+        for a, b in zip(mine, libs, strict=True):
+            assert _leaves(a) == _leaves(b), kind
+    visual = _leaves(ours.find("visual"))
+    assert ("material/diffuse", "1.0 0.0 0.0 1.0") in visual and ("transparency", "0.3") in visual
+    assert ("cast_shadows", "false") in visual and ("material/script/name", "Gazebo/Red") in visual
+    collision = _leaves(ours.find("collision"))
+    assert ("surface/bounce/restitution_coefficient", "0.5") in collision
+    assert ("surface/friction/ode/mu", "0.7") in collision  # re-applied after the blob's surface
+    assert ours.findtext("enable_wind") == theirs.findtext("enable_wind") == "true"
+    light = _leaves(ours.find("light"), ())
+    assert light == [("diffuse", "1.0 1.0 1.0 1.0")] and set(light) <= set(_leaves(theirs.find("light"), ()))
+    assert ours.find("plugin") is None  # libsdformat copies it into the link, where Gazebo ignores it
+    said = [n for n in notes if "<gazebo> extension" in n]
+    assert len(said) == 1 and "<plugin> not carried over" in said[0] and "no link plugins" in said[0], said
+
+
+def test_a_literal_self_collide_tag_is_the_links_flag_as_in_libsdformat(
+    tmp_path: Path, sdf_oracle: Path  # noqa: F811
+) -> None:
+    """TIAGo Pro writes ``<self_collide>0</self_collide>`` (the SDF element, not ``selfCollide``) in a link's
+    block: libsdformat copies it into the link. It was noted as "not carried over" and the link got the
+    computed policy's flag (true) instead."""
+    urdf = URDF.replace('<gazebo reference="arm">', '<gazebo reference="base"><self_collide>0</self_collide>'
+                        '</gazebo>\n  <gazebo reference="arm">')
+    notes, ours, theirs = _ours_and_libsdformats(tmp_path, urdf, sdf_oracle)
+    flag = {text: [el.findtext("self_collide") for el in etree.fromstring(text.encode()).iter("link")
+                   if el.get("name") == "base"][0] for text in (ours, theirs)}
+    assert flag[ours] == "false" and flag[theirs] == "0"
+    assert not [n for n in notes if "self_collide" in n], notes

@@ -14,7 +14,7 @@ from typing import Any
 from modelkit.convert.notes import NoteSink
 from modelkit.model import Robot
 
-CARRIED_BLOCK_TAGS = frozenset({"mu1", "mu2", "selfCollide", "sensor"})
+CARRIED_BLOCK_TAGS = frozenset({"mu1", "mu2", "selfCollide", "self_collide", "sensor"})
 """Children of a kept extension block (a URDF ``<gazebo>``) the model holds in its own fields: the
 shapes' friction, the link's self-collision flag, the link's devices. They are written, not lost."""
 

@@ -22,7 +22,18 @@ A joint's block (:func:`write_joint_tags`): ``provideFeedback`` → ``<physics><
 → ``<physics><ode><limit>`` ``cfm``/``erp``, ``springStiffness``/``springReference`` → ``<axis><dynamics>``
 ``spring_stiffness``/``spring_reference``.
 
-What else a block holds (``<plugin>``, ``<visual>``...) is named in one MK808 note per link or joint.
+Element tags ("blobs") go where libsdformat puts them:
+
+* ``<visual>``: each of its children into every visual of the link, a ``<material>`` replacing the
+  visual's own (the URDF colour): how gz-sim users give a URDF visual its PBR or ambient/diffuse colours.
+  libsdformat itself skips a visual the URDF named (its issue #333); the SDFormat documentation says
+  every visual, and that is what is written here;
+* ``<collision>``: each child into every collision of the link, a ``<surface>`` replacing the collision's
+  own, after which the block's ``mu1``/``mu2``/``kp``... are applied again, in libsdformat's order;
+* an element an SDF ``<link>`` may hold (``<light>``, ``<battery>``, ``<velocity_decay>``...): into the
+  link. A ``<plugin>`` is not one (libsdformat copies it there, and Gazebo ignores it): it is noted.
+
+What else a block holds is named in one MK808 note per link or joint.
 """
 
 from __future__ import annotations
@@ -36,6 +47,8 @@ from lxml.etree import _Element as Element
 from modelkit.formats.sdf.write_self_collide import CARRIED
 from modelkit.formats.sdf.write_xml import child_or_sub, sub
 
+Copy = Any  # an lxml element copied into the SDF (lxml-stubs type it loosely)
+
 LINK_FLAGS = {"gravity": "gravity", "kinematic": "kinematic"}
 COLLISION_TAGS = {"maxContacts": ("max_contacts",), "laserRetro": ("laser_retro",),
                   "kp": ("surface", "contact", "ode", "kp"), "kd": ("surface", "contact", "ode", "kd"),
@@ -47,53 +60,113 @@ MATERIAL_URI = "file://media/materials/scripts/gazebo.material"
 WRITTEN = frozenset(LINK_FLAGS) | frozenset(COLLISION_TAGS) | OTHER_TAGS | CARRIED
 
 
-def _tags(entries: object) -> Iterator[tuple[str, str, bool]]:
-    """Each tag of the kept ``<gazebo>`` blocks: its name, its text, and whether it is a plain value (a
-    text and no child elements), in order."""
+def _blocks(entries: object) -> Iterator[Element]:
+    """The kept ``<gazebo>`` blocks, parsed, in order."""
     for entry in entries if isinstance(entries, list) else []:
         try:
             block = etree.fromstring(str(entry.get("xml", ""))) if isinstance(entry, dict) else None
         except etree.XMLSyntaxError:
             continue
-        for tag_el in block if block is not None else []:
-            if isinstance(tag_el.tag, str):
-                text = " ".join((tag_el.text or "").split())
-                yield tag_el.tag, text, bool(text) and not len(tag_el)
+        if block is not None:
+            yield block
+
+
+def _block_tags(block: Element) -> Iterator[tuple[Element, str, str, bool]]:
+    """Each tag of one block: the element, its name, its text, and whether it is a plain value (a text
+    and no child elements), in order."""
+    for tag_el in block:
+        if isinstance(tag_el.tag, str):
+            text = " ".join((tag_el.text or "").split())
+            yield tag_el, tag_el.tag, text, bool(text) and not len(tag_el)
+
+
+def _tags(entries: object) -> Iterator[tuple[str, str, bool]]:
+    """Each tag of the kept ``<gazebo>`` blocks: its name, its text, and whether it is a plain value."""
+    for block in _blocks(entries):
+        for _, tag, text, plain in _block_tags(block):
+            yield tag, text, plain
 
 
 def _truth(text: str) -> bool:
     return text.lower() in ("true", "1")
 
 
+# What an SDF <link> may hold that a block can give as a blob (sensor is carried as a device, the flags
+# gravity, kinematic and self_collide as plain tags). Not <plugin>: libsdformat copies it into the link, but
+# SDFormat defines no link plugins and Gazebo loads none there (the note says so).
+LINK_BLOBS = frozenset({"light", "projector", "battery", "audio_source", "audio_sink",
+                        "particle_emitter", "velocity_decay", "enable_wind", "must_be_base_link"})
+SHAPE_BLOBS = {"visual": "material", "collision": "surface"}  # the one child each replaces
+
+
 def write_link_tags(link_el: Element, entries: object) -> list[str]:
     """Write the tags of a link's ``<gazebo>`` blocks into ``link_el`` (its visuals and collisions are
     written already); return the tags left out, in order."""
     left: list[str] = []
-    for tag, text, plain in _tags(entries):
-        if tag in CARRIED:
-            continue
-        if not plain:
-            if tag not in left:
+    for block in _blocks(entries):
+        tags = list(_block_tags(block))
+        for tag_el, tag, _, _ in tags:  # libsdformat: a block's shape blobs first, then its plain tags
+            if tag in SHAPE_BLOBS:
+                _insert_into_shapes(link_el, tag_el, tag)
+        surface_blob = any(tag == "collision" and tag_el.find("surface") is not None
+                           for tag_el, tag, _, _ in tags)
+        for tag_el, tag, text, plain in tags:
+            if tag in SHAPE_BLOBS:
+                continue
+            if tag in CARRIED:
+                if surface_blob and plain and tag in ("mu1", "mu2"):  # the blob's surface replaced them
+                    for collision in link_el.findall("collision"):
+                        _set_path(collision, ("surface", "friction", "ode", "mu" if tag == "mu1" else "mu2"),
+                                  text)
+                continue
+            if not plain:
+                if tag in LINK_BLOBS:
+                    link_el.append(_copy(tag_el))
+                elif tag not in left:
+                    left.append(tag)
+                continue
+            if tag in LINK_FLAGS:
+                _set(link_el, LINK_FLAGS[tag], "true" if _truth(text) else "false")
+            elif tag == "turnGravityOff":
+                _set(link_el, "gravity", "false" if _truth(text) else "true")
+            elif tag == "dampingFactor":
+                decay = child_or_sub(link_el, "velocity_decay")
+                _set(decay, "linear", text)
+                _set(decay, "angular", text)
+            elif tag in COLLISION_TAGS:
+                for collision in link_el.findall("collision"):
+                    _set_path(collision, COLLISION_TAGS[tag], text)
+            elif tag == "material":
+                for visual in link_el.findall("visual"):
+                    _set_path(visual, ("material", "script", "uri"), MATERIAL_URI)
+                    _set_path(visual, ("material", "script", "name"), text)
+            elif tag in LINK_BLOBS:
+                link_el.append(_copy(tag_el))
+            elif tag not in left:
                 left.append(tag)
-            continue
-        if tag in LINK_FLAGS:
-            _set(link_el, LINK_FLAGS[tag], "true" if _truth(text) else "false")
-        elif tag == "turnGravityOff":
-            _set(link_el, "gravity", "false" if _truth(text) else "true")
-        elif tag == "dampingFactor":
-            decay = child_or_sub(link_el, "velocity_decay")
-            _set(decay, "linear", text)
-            _set(decay, "angular", text)
-        elif tag in COLLISION_TAGS:
-            for collision in link_el.findall("collision"):
-                _set_path(collision, COLLISION_TAGS[tag], text)
-        elif tag == "material":
-            for visual in link_el.findall("visual"):
-                _set_path(visual, ("material", "script", "uri"), MATERIAL_URI)
-                _set_path(visual, ("material", "script", "name"), text)
-        elif tag not in left:
-            left.append(tag)
     return left
+
+
+def _insert_into_shapes(link_el: Element, blob: Element, kind: str) -> None:
+    """Each child of a ``<visual>`` or ``<collision>`` blob into every such shape of the link; the
+    blob's ``<material>`` (``<surface>``) replaces the shape's own."""
+    replaced = SHAPE_BLOBS[kind]
+    for shape in link_el.findall(kind):
+        for child in blob:
+            if not isinstance(child.tag, str):
+                continue
+            if child.tag == replaced:
+                for old in shape.findall(replaced):
+                    shape.remove(old)
+            shape.append(_copy(child))
+
+
+def _copy(element: Element) -> Copy:
+    """A copy of a blob element without its source's tail text, comments or namespace declarations."""
+    copied: Copy = etree.fromstring(etree.tostring(element, with_tail=False))
+    for comment in copied.xpath("//comment()"):
+        comment.getparent().remove(comment)
+    return copied
 
 
 JOINT_TAGS = {"provideFeedback": (("physics", "provide_feedback"), ("physics", "ode", "provide_feedback")),

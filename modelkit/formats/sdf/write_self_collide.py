@@ -20,13 +20,13 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.self_collision import flags
 from modelkit.model import Robot
 
-CARRIED = frozenset({"selfCollide", "sensor", "mu1", "mu2"})
+CARRIED = frozenset({"selfCollide", "self_collide", "sensor", "mu1", "mu2"})
 
 
 def only_carried(entries: object) -> bool:
     """URDF ``<gazebo reference>`` blocks that say nothing but what the SDF writer carries on its own:
-    ``selfCollide`` (written as link flags), ``<sensor>``s (the link's devices, with their plugins) and
-    ``mu1``/``mu2`` (the collisions' own friction, written as their ``<surface>``)."""
+    ``selfCollide`` or ``self_collide`` (written as link flags), ``<sensor>``s (the link's devices, with
+    their plugins) and ``mu1``/``mu2`` (the collisions' own friction, written as their ``<surface>``)."""
     if not isinstance(entries, list) or not entries:
         return False
     for entry in entries:

@@ -284,7 +284,9 @@ class _ModelWriter:
                 ctx.note(
                     "MK808",
                     f'<gazebo> extension of link "{link.name}": {", ".join(f"<{t}>" for t in left)} not '
-                    "carried over (its other tags are written as the SDF elements libsdformat makes of them)",
+                    "carried over (its other tags are written as the SDF elements libsdformat makes of them)"
+                    + ("; SDFormat has no link plugins and Gazebo loads none from a link: put the plugin "
+                       "in a <gazebo> block without reference (the model)" if "plugin" in left else ""),
                     link.source,
                     f"link[{name}]",
                 )

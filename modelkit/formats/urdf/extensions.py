@@ -204,6 +204,9 @@ def read_gazebo(
         link = links.get(reference) if reference else None
         joint = joints.get(reference) if reference else None
     collide = dict.get(entry, "selfCollide")  # not entry.get: that would make the block's XML now
+    literal = element.find("self_collide")  # the SDF element itself: libsdformat copies it into the link
+    if collide is None and literal is not None and len(literal) == 0 and (literal.text or "").strip():
+        collide = (literal.text or "").strip().lower() in ("1", "true")
     if link is not None:
         link.extras.setdefault("gazebo", []).append(entry)
         if isinstance(collide, bool):
