@@ -1380,8 +1380,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK848",
         "gazebo-plugin-other-family",
         "warning",
-        "A sensor plugin written for the other Gazebo (classic `gazebo_ros` plugins, Gazebo Sim systems) is "
-        "left out; `--gazebo` chooses which family the file is written for.",
+        "A sensor or model plugin written for the other Gazebo (classic `gazebo_ros` plugins, Gazebo Sim "
+        "systems) is left out; `--gazebo` chooses which family the file is written for.",
     ),
     CodeInfo(
         "MK849",
@@ -1566,6 +1566,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "MuJoCo's compiler refuses the written MJCF (compiled while converting) for a reason no other note "
         "explains; the file is written, the note quotes MuJoCo, and convert exits 1.",
+    ),
+    CodeInfo(
+        "MK878",
+        "actuators-driven-by-source-plugin",
+        "info",
+        "SDF from a URDF whose robot-level `<gazebo>` block holds a ros_control plugin "
+        "(`gazebo_ros2_control`, `gz_ros2_control`...) of the Gazebo written for: the plugin is written and "
+        "drives the joints from the URDF's `<ros2_control>`/`<transmission>` tags, so no joint controllers "
+        "are generated beside it.",
     ),
     CodeInfo(
         "MK880",

@@ -118,9 +118,9 @@ def test_the_sources_own_drive_plugin_is_the_only_one(tmp_path: Path) -> None:
 
 
 def test_a_source_plugin_the_target_drops_is_replaced(tmp_path: Path) -> None:
-    """A URDF's own <gazebo> diff drive stays the only one in URDF, but SDF holds no <gazebo> block
-    (MK808), so the SDF gets the writer's; an SDF's Gazebo Sim DiffDrive written for Gazebo classic is
-    left out (MK848), so the URDF gets gazebo_ros's."""
+    """A URDF's own <gazebo> diff drive stays the only one in URDF, and in SDF too (the SDF writer copies a
+    robot-level block's plugins of the Gazebo it writes for into the model, as libsdformat does); an SDF's
+    Gazebo Sim DiffDrive written for Gazebo classic is left out (MK848), so the URDF gets gazebo_ros's."""
     urdf = tmp_path / "a" / "robot.urdf"
     _convert(MODELS / "mobile_robot_pantilt.body", urdf, "--urdf-distinct-names")
     kept = tmp_path / "b" / "robot.urdf"
@@ -129,7 +129,12 @@ def test_a_source_plugin_the_target_drops_is_replaced(tmp_path: Path) -> None:
     sdf = tmp_path / "c" / "robot.sdf"
     said = _convert(urdf, sdf)
     (plugin,) = _drive_plugins(etree.parse(str(sdf)).getroot())
-    assert plugin.get("filename") == SIM[0] and "MK858" in said
+    assert plugin.get("filename") == SIM[0] and "MK858" not in said
+    assert "MK859 no Gazebo drive plugin written: the source names its own" in said
+    classic_sdf = tmp_path / "f" / "robot.sdf"
+    said = _convert(urdf, classic_sdf, "--gazebo", "classic")  # the source's is Gazebo Sim's: replaced
+    (plugin,) = _drive_plugins(etree.parse(str(classic_sdf)).getroot())
+    assert plugin.get("filename") == CLASSIC[0] and "MK848" in said and "MK858" in said
     first = tmp_path / "d" / "robot.sdf"
     _convert(MODELS / "mobile_robot_pantilt.body", first)
     classic = tmp_path / "e" / "robot.urdf"

@@ -177,7 +177,59 @@ def test_a_literal_self_collide_tag_is_the_links_flag_as_in_libsdformat(
     urdf = URDF.replace('<gazebo reference="arm">', '<gazebo reference="base"><self_collide>0</self_collide>'
                         '</gazebo>\n  <gazebo reference="arm">')
     notes, ours, theirs = _ours_and_libsdformats(tmp_path, urdf, sdf_oracle)
-    flag = {text: [el.findtext("self_collide") for el in etree.fromstring(text.encode()).iter("link")
-                   if el.get("name") == "base"][0] for text in (ours, theirs)}
+    flag = {text: next(el.findtext("self_collide") for el in etree.fromstring(text.encode()).iter("link")
+                       if el.get("name") == "base") for text in (ours, theirs)}
     assert flag[ours] == "false" and flag[theirs] == "0"
     assert not [n for n in notes if "self_collide" in n], notes
+
+
+MODEL_URDF = URDF.replace("</robot>", """  <ros2_control name="sys" type="system">
+    <hardware><plugin>gz_ros2_control/GazeboSimSystem</plugin></hardware>
+    <joint name="j"><command_interface name="position"/><state_interface name="position"/></joint>
+  </ros2_control>
+  <gazebo>
+    <plugin filename="gz_ros2_control-system" name="gz_ros2_control::GazeboSimROS2ControlPlugin">
+      <parameters>/tmp/controllers.yaml</parameters>
+    </plugin>
+    <plugin filename="libgazebo_ros_p3d.so" name="p3d"><body_name>base</body_name></plugin>
+    <enable_wind>true</enable_wind>
+    <weird>1</weird>
+  </gazebo>
+</robot>""")
+
+
+def _model_children(sdf: str) -> dict[str, list[list[tuple[str, str]]]]:
+    model = etree.fromstring(sdf.encode()).find("model")
+    out: dict[str, list[list[tuple[str, str]]]] = {}
+    for child in model:
+        if child.tag in ("plugin", "enable_wind", "weird"):
+            out.setdefault(child.tag, []).append(sorted(child.attrib.items()) + _leaves(child, ()))
+    return out
+
+
+def test_robot_level_gazebo_blocks_go_into_the_model_as_in_libsdformat(
+    tmp_path: Path, sdf_oracle: Path  # noqa: F811
+) -> None:
+    """libsdformat copies a robot-level block's children into the model. A ros2_control plugin written
+    this way drives the joints itself: no gz-sim joint controller beside it (MK878). A plugin of the
+    other Gazebo (here a classic one, the file being written for Gazebo Sim) is named (MK848); an element
+    an SDF model cannot hold is named (MK808)."""
+    source = tmp_path / "gz.urdf"
+    source.write_text(MODEL_URDF)
+    out = tmp_path / "out" / "gz.sdf"
+    notes = convert([source], out).notes
+    theirs = subprocess.run([str(sdf_oracle), "--print", source.name], cwd=tmp_path, capture_output=True,
+                            text=True, timeout=60, check=True).stdout
+    ours, libs = _model_children(out.read_text()), _model_children(theirs)
+    assert ours["plugin"] == [libs["plugin"][0]] and ours["enable_wind"] == libs["enable_wind"]
+    assert "weird" not in ours and "weird" in libs
+    said = {n.code: n.message for n in notes}
+    assert "gz_ros2_control-system" in said["MK878"] and '"p3d"' in said["MK848"], said
+    assert any(n.code == "MK808" and "<weird>" in n.message for n in notes)
+    assert "JointPositionController" not in out.read_text()
+    without = tmp_path / "plain.urdf"  # the same robot without the plugin: its actuator is a gz-sim servo
+    without.write_text(MODEL_URDF.replace("gz_ros2_control-system", "libother.so").replace(
+        "gz_ros2_control::GazeboSimROS2ControlPlugin", "other"))
+    plain = tmp_path / "out2" / "plain.sdf"
+    assert "MK878" not in {n.code for n in convert([without], plain).notes}
+    assert "JointPositionController" in plain.read_text()

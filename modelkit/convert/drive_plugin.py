@@ -27,8 +27,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from lxml import etree
 
 from modelkit.convert.gazebo import plugin_family
 from modelkit.convert.notes import NoteSink
@@ -134,7 +136,8 @@ def _round_shape(link: Link) -> tuple[float, np.ndarray] | None:
 def _kept_source_drive(robot: Robot, target: str, family: str) -> bool:
     """Whether the output keeps a drive plugin of the source's own: an SDF model plugin (the SDF writer
     copies an SDF source's; the URDF writer those of ``family`` or of none), a URDF robot-level
-    ``<gazebo>`` block (the URDF writer keeps them; SDF has no place for them, MK808)."""
+    ``<gazebo>`` block (the URDF writer keeps them; the SDF writer copies their plugins of ``family`` or
+    of none)."""
     texts: list[str] = []
     for entry in robot.extras.get("sdf_plugins") or []:
         if not isinstance(entry, dict):
@@ -143,12 +146,25 @@ def _kept_source_drive(robot: Robot, target: str, family: str) -> bool:
         kept = robot.source_format == "sdf" if target == "sdf" else plugin_family(filename) in (None, family)
         if kept:
             texts += [filename, str(entry.get("name", ""))]
-    if target == "urdf":
-        for entry in robot.extras.get("gazebo") or []:
-            if isinstance(entry, dict):
-                texts.append(str(entry.get("xml", "")))
+    for entry in robot.extras.get("gazebo") or []:
+        if not isinstance(entry, dict) or entry.get("reference"):
+            continue
+        if target == "urdf":  # the URDF writer keeps every robot-level block
+            texts.append(str(entry.get("xml", "")))
+        else:  # the SDF writer copies their plugins of the family written for (write_gazebo_tags)
+            texts += [f'{p.get("filename", "")} {p.get("name", "")}' for p in _block_plugins(entry)
+                      if plugin_family(p.get("filename", "")) in (None, family)]
     lowered = " ".join(texts).lower()
     return any(word in lowered for word in DRIVE_WORDS)
+
+
+def _block_plugins(entry: dict[str, Any]) -> list[Any]:
+    """The ``<plugin>`` children of a kept robot-level ``<gazebo>`` block."""
+    try:
+        block = etree.fromstring(str(entry.get("xml", "")))
+    except etree.XMLSyntaxError:
+        return []
+    return [child for child in block if child.tag == "plugin"]
 
 
 def plugin_elements(drive: DiffDrive, family: str, joint: dict[str, str], base: str

@@ -34,16 +34,24 @@ Element tags ("blobs") go where libsdformat puts them:
   link. A ``<plugin>`` is not one (libsdformat copies it there, and Gazebo ignores it): it is noted.
 
 What else a block holds is named in one MK808 note per link or joint.
+
+A robot-level block (no reference, :func:`write_model_blocks`): libsdformat copies each child into the
+model. Written: its ``<plugin>``s of the Gazebo the file is written for (or of neither; another Gazebo's
+are named, MK848), ``<static>``, ``<allow_auto_disable>``, ``<enable_wind>`` and ``<gripper>``; its
+``<self_collide>`` is the model's flag. A ros_control plugin kept this way drives the joints itself, so no
+joint controllers are generated beside it (:func:`source_ros_control`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import dataclass, field
 from typing import Any
 
 from lxml import etree
 from lxml.etree import _Element as Element
 
+from modelkit.convert.gazebo import plugin_family
 from modelkit.formats.sdf.write_self_collide import CARRIED
 from modelkit.formats.sdf.write_xml import child_or_sub, sub
 
@@ -209,3 +217,68 @@ def _set(parent: Element, tag: str, text: str) -> None:
     if found is None:
         found = sub(parent, tag)
     found.text = text
+
+
+# What a URDF robot-level <gazebo> block (no reference) may give an SDF <model>: libsdformat copies every
+# child into the model. These are written: a plugin of the Gazebo the file is written for (or of neither),
+# and the model elements below; self_collide is the model's flag (written by the self-collision policy).
+MODEL_BLOBS = frozenset({"static", "allow_auto_disable", "enable_wind", "gripper"})
+ROS_CONTROL_WORDS = ("ros_control", "ros2_control")
+
+
+@dataclass
+class ModelBlocks:
+    """What :func:`write_model_blocks` did: the plugins left out as another Gazebo's (name, filename,
+    family) and the other tags left out."""
+
+    other_family: list[tuple[str, str, str]] = field(default_factory=list)
+    left: list[str] = field(default_factory=list)
+
+
+def _tag_name(element: Element) -> str:
+    """The tag as written: ``controller:gazebo_ros_p3d`` for Gazebo 1.0's namespaced elements."""
+    qname = etree.QName(element)
+    return f"{element.prefix}:{qname.localname}" if element.prefix else qname.localname
+
+
+def _kept_plugin(element: Element, family: str) -> bool:
+    """A robot-level block's ``<plugin>`` of the Gazebo ``family`` or of neither."""
+    return plugin_family(element.get("filename", "")) in (None, family)
+
+
+def source_ros_control(entries: object, family: str) -> Element | None:
+    """The URDF's robot-level ros_control plugin (``gazebo_ros2_control``, ``gz_ros2_control``...) that
+    :func:`write_model_blocks` writes for Gazebo ``family``, if any: it drives the joints itself."""
+    for block in _blocks(entries):
+        if block.get("reference"):
+            continue
+        for tag_el, tag, _, _ in _block_tags(block):
+            text = f'{tag_el.get("filename", "")} {tag_el.get("name", "")}'.lower()
+            if tag == "plugin" and _kept_plugin(tag_el, family) and any(w in text for w in ROS_CONTROL_WORDS):
+                return tag_el
+    return None
+
+
+def write_model_blocks(model_el: Element, entries: object, family: str) -> ModelBlocks:
+    """Write the children of a URDF's robot-level ``<gazebo>`` blocks into ``model_el`` as libsdformat
+    does (a copy each), except a plugin of the other Gazebo and what an SDF model cannot hold."""
+    done = ModelBlocks()
+    for block in _blocks(entries):
+        if block.get("reference"):
+            continue
+        for tag_el, _, _, _ in _block_tags(block):
+            name = _tag_name(tag_el)
+            if name == "self_collide":
+                continue
+            if name == "plugin":
+                filename = tag_el.get("filename", "")
+                if _kept_plugin(tag_el, family):
+                    model_el.append(_copy(tag_el))
+                else:
+                    done.other_family.append((tag_el.get("name", ""), filename,
+                                              plugin_family(filename) or ""))
+            elif name in MODEL_BLOBS:
+                model_el.append(_copy(tag_el))
+            elif name not in done.left:
+                done.left.append(name)
+    return done

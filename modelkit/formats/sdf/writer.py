@@ -45,7 +45,12 @@ from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_vec
 from modelkit.formats.sdf.kept import JOINT_KEY, LIMIT_KEY, MODEL_KEY, write_back
 from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
-from modelkit.formats.sdf.write_gazebo_tags import write_joint_tags, write_link_tags
+from modelkit.formats.sdf.write_gazebo_tags import (
+    source_ros_control,
+    write_joint_tags,
+    write_link_tags,
+    write_model_blocks,
+)
 from modelkit.formats.sdf.write_geometry import GeomWriter
 from modelkit.formats.sdf.write_names import Names
 from modelkit.formats.sdf.write_self_collide import only_carried, self_collide_policy
@@ -581,9 +586,40 @@ class _ModelWriter:
         for tag, text in children:
             sub(plugin, tag).text = text
 
+    def _model_blocks(self, model: Element) -> None:
+        """A URDF's robot-level ``<gazebo>`` blocks, copied into the model as libsdformat does."""
+        robot, ctx, family = self.robot, self.ctx, self.devices.gazebo
+        done = write_model_blocks(model, robot.extras.get("gazebo"), family)
+        for name, filename, other in done.other_family:
+            ctx.note("MK848", f'model plugin "{name}" ({filename}) is Gazebo {other} code and this file is '
+                     f"written for Gazebo {family} (--gazebo {other} keeps it); left out", robot.source,
+                     "model/plugin")
+        if done.left:
+            ctx.note(
+                "MK808",
+                f"robot-level <gazebo> block: {', '.join(f'<{t}>' for t in done.left)} not carried over (an "
+                "SDF model holds no such element; its plugins and model elements are written)",
+                robot.source,
+                "model",
+            )
+
     def _model_extras(self, model: Element) -> None:
         robot, ctx = self.robot, self.ctx
-        ActuatorWriter(robot, ctx, self.devices.gazebo, self.axis_joints).write(model)
+        family = self.devices.gazebo
+        ros_control = (source_ros_control(robot.extras.get("gazebo"), family)
+                       if robot.source_format == "urdf" else None)
+        if ros_control is not None and robot.actuators:
+            ctx.note(
+                "MK878",
+                f'the source\'s plugin "{ros_control.get("name", "")}" ({ros_control.get("filename", "")}) '
+                "drives the joints from the URDF's <ros2_control> or <transmission> tags (ROS publishes them "
+                "as robot_description); it is written, and no joint controllers are generated beside it for "
+                f"the {len(robot.actuators)} actuator(s)",
+                robot.source,
+                "model/plugin",
+            )
+        else:
+            ActuatorWriter(robot, ctx, family, self.axis_joints).write(model)
         if ctx.options.drive_plugin:
             self._drive_plugin(model)
         for plugin in robot.extras.get("sdf_plugins", []):
@@ -595,17 +631,19 @@ class _ModelWriter:
                 ctx.note(
                     "MK808", f'plugin "{plugin.get("name", "")}" is not carried over', robot.source, "model"
                 )
-        for key, what in (("gazebo", "<gazebo> extensions"), ("transmissions", "<transmission> elements")):
-            if robot.extras.get(key):
-                carried = (" (the actuators they name are written as gz-sim joint controllers)"
-                           if key == "transmissions" and robot.actuators else "")
-                ctx.note(
-                    "MK808",
-                    f"{what} of the source are simulator or controller data; they are not carried over"
-                    + carried,
-                    robot.source,
-                    "model",
-                )
+        if robot.extras.get("gazebo"):
+            self._model_blocks(model)
+        if robot.extras.get("transmissions"):
+            carried = ((" (the source's ros_control plugin, written, drives them)" if ros_control is not None
+                        else " (the actuators they name are written as gz-sim joint controllers)")
+                       if robot.actuators else "")
+            ctx.note(
+                "MK808",
+                "<transmission> elements of the source are simulator or controller data; they are not "
+                "carried over" + carried,
+                robot.source,
+                "model",
+            )
         world = robot.extras.get("sdf_world")
         if isinstance(world, dict) and (world.get("lights") or world.get("plugins")):
             ctx.note(
