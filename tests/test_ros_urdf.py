@@ -218,6 +218,7 @@ def test_gazebo_family_follows_the_source_or_the_option(tmp_path: Path) -> None:
     assert plugin_family("gz-sim-diff-drive-system") == "sim"
     assert plugin_family("ignition-gazebo-sensors-system") == "sim"
     assert plugin_family("libmy_controller.so") is None
+    assert plugin_family("libroboticsgroup_gazebo_mimic_joint_plugin.so") == "classic"  # a classic .so
 
 
 def test_unmapped_sensor_parameters_are_notes_and_classic_sdf_loads(

@@ -32,6 +32,8 @@ def plugin_family(filename: str) -> str | None:
         return "sim"
     if "gazebo_ros" in name or name.startswith("libgazebo") or "gazebo_plugins" in name:
         return "classic"
+    if "gazebo" in name and name.endswith(".so"):  # libroboticsgroup_gazebo_mimic_joint_plugin.so...
+        return "classic"
     return None
 
 

@@ -174,6 +174,7 @@ def _copy(element: Element) -> Copy:
     copied: Copy = etree.fromstring(etree.tostring(element, with_tail=False))
     for comment in copied.xpath("//comment()"):
         comment.getparent().remove(comment)
+    etree.cleanup_namespaces(copied)  # the URDF's xmlns:xacro... declarations, which nothing here uses
     return copied
 
 

@@ -590,10 +590,11 @@ class _ModelWriter:
         """A URDF's robot-level ``<gazebo>`` blocks, copied into the model as libsdformat does."""
         robot, ctx, family = self.robot, self.ctx, self.devices.gazebo
         done = write_model_blocks(model, robot.extras.get("gazebo"), family)
-        for name, filename, other in done.other_family:
-            ctx.note("MK848", f'model plugin "{name}" ({filename}) is Gazebo {other} code and this file is '
-                     f"written for Gazebo {family} (--gazebo {other} keeps it); left out", robot.source,
-                     "model/plugin")
+        for other in sorted({each[2] for each in done.other_family}):
+            plugins = [f'"{name}" ({filename})' for name, filename, of in done.other_family if of == other]
+            ctx.note("MK848", f"{len(plugins)} model plugin(s) of the URDF's robot-level <gazebo> blocks are "
+                     f"Gazebo {other} code and this file is written for Gazebo {family} (--gazebo {other} "
+                     f"keeps them); left out: {', '.join(plugins)}", robot.source, "model/plugin")
         if done.left:
             ctx.note(
                 "MK808",
