@@ -25,7 +25,9 @@ EXCEPTIONS: dict[tuple[str, str], str] = {
     ("convert/drive_plugin.py", "sdf_plugins"):
         "a drive plugin the source names and the output keeps (an SDF model plugin) stands in for the "
         "writer's: no second one",
-    ("convert/drive_plugin.py", "gazebo"): "the same for a URDF source's robot-level <gazebo> block",
+    ("convert/drive_plugin.py", "gazebo"):
+        "the same for a URDF source's robot-level <gazebo> block (kept by the URDF writer, its plugins "
+        "copied by the SDF writer)",
     ("formats/urdf/write_gazebo.py", "sdf_plugins"): "an SDF model's plugins are written as <gazebo> blocks",
     ("formats/urdf/writer.py", "sdf_plugins"): "the same: written, so no MK808 note",
     ("formats/urdf/writer.py", "mjcf_actuators"):
@@ -41,8 +43,8 @@ EXCEPTIONS: dict[tuple[str, str], str] = {
     ("formats/body/writer.py", "ros2_control"): "the same",
     ("formats/body/writer.py", "mujoco"): "the same",
     ("formats/sdf/writer.py", "gazebo"):
-        "URDF <gazebo> blocks are noted as not carried over, except a link's that only says what the "
-        "model holds (selfCollide, sensors)",
+        "URDF <gazebo> blocks are written as libsdformat converts them (a link's, a joint's, the robot's: "
+        "write_gazebo_tags), and what SDF cannot hold is noted",
     ("formats/sdf/writer.py", "transmissions"): "URDF transmissions are noted as not carried over",
     ("verify/engines/reference.py", "mjcf_sites"):
         "layer 1: a source's named frames are no extra link in an engine that lists them (Drake on SDF); "
