@@ -120,7 +120,7 @@ BLOB_URDF = """<?xml version="1.0"?>
     <mu1>0.7</mu1><kp>1000</kp><material>Gazebo/Red</material>
     <light name="lamp" type="point"><diffuse>1 1 1 1</diffuse></light>
     <enable_wind>true</enable_wind>
-    <plugin name="p" filename="libp.so"/>
+    <plugin name="p" filename="libp.so"/><implicitSpringDamper>1</implicitSpringDamper>
   </gazebo>
   <gazebo reference="base"><visual><cast_shadows>false</cast_shadows></visual></gazebo>
 </robot>
@@ -165,7 +165,8 @@ def test_gazebo_visual_collision_and_link_blobs_are_where_libsdformat_puts_them(
     assert light == [("diffuse", "1.0 1.0 1.0 1.0")] and set(light) <= set(_leaves(theirs.find("light"), ()))
     assert ours.find("plugin") is None  # libsdformat copies it into the link, where Gazebo ignores it
     said = [n for n in notes if "<gazebo> extension" in n]
-    assert len(said) == 1 and "<plugin> not carried over" in said[0] and "no link plugins" in said[0], said
+    assert len(said) == 1 and "<plugin>, <implicitSpringDamper> not carried over" in said[0], said
+    assert "no link plugins" in said[0] and "<implicitSpringDamper> is a joint's tag" in said[0], said
 
 
 def test_a_literal_self_collide_tag_is_the_links_flag_as_in_libsdformat(

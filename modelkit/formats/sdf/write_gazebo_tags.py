@@ -155,6 +155,20 @@ def write_link_tags(link_el: Element, entries: object) -> list[str]:
     return left
 
 
+def why_left_out(left: list[str]) -> str:
+    """What the note on a link block's left-out tags adds for the tags it knows: a plugin (SDFormat has
+    no link plugins) and a joint's tags (libsdformat reads them only in a joint's block)."""
+    said = ""
+    if "plugin" in left:
+        said += ("; SDFormat has no link plugins and Gazebo loads none from a link: put the plugin in a "
+                 "<gazebo> block without reference (the model)")
+    misplaced = [tag for tag in left if tag in JOINT_TAGS or tag in AXIS_TAGS]
+    if misplaced:
+        said += (f"; {', '.join(f'<{t}>' for t in misplaced)} is a joint's tag, which libsdformat (and so "
+                 "Gazebo) reads only in a joint's block: move it to <gazebo reference=\"JOINT\">")
+    return said
+
+
 def _insert_into_shapes(link_el: Element, blob: Element, kind: str) -> None:
     """Each child of a ``<visual>`` or ``<collision>`` blob into every such shape of the link; the
     blob's ``<material>`` (``<surface>``) replaces the shape's own."""

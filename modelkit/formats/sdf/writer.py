@@ -47,6 +47,7 @@ from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
 from modelkit.formats.sdf.write_gazebo_tags import (
     source_ros_control,
+    why_left_out,
     write_joint_tags,
     write_link_tags,
     write_model_blocks,
@@ -290,8 +291,7 @@ class _ModelWriter:
                     "MK808",
                     f'<gazebo> extension of link "{link.name}": {", ".join(f"<{t}>" for t in left)} not '
                     "carried over (its other tags are written as the SDF elements libsdformat makes of them)"
-                    + ("; SDFormat has no link plugins and Gazebo loads none from a link: put the plugin "
-                       "in a <gazebo> block without reference (the model)" if "plugin" in left else ""),
+                    + why_left_out(left),
                     link.source,
                     f"link[{name}]",
                 )
