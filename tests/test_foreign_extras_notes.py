@@ -236,14 +236,23 @@ SDF_FLAGS = """<?xml version="1.0"?>
 @pytest.mark.parametrize("target", ["xml", "urdf", "body"])
 def test_sdf_link_flags_and_material_parameters_are_said(tmp_path: Path, target: str) -> None:
     """An SDF link's <gravity>, <kinematic>, <velocity_decay> (MJCF and .body said nothing before; URDF
-    printed the reader's dict) and a visual's ambient colour; flags at SDFormat's defaults say nothing."""
+    printed the reader's dict, and now carries them in a <gazebo> block: test_sdf_gazebo_blocks) and a
+    visual's ambient colour; flags at SDFormat's defaults say nothing."""
     source = tmp_path / "m.sdf"
     source.write_text(SDF_FLAGS)
-    notes = convert([source], tmp_path / "out" / f"m.{target}").notes
+    out = tmp_path / "out" / f"m.{target}"
+    notes = convert([source], out).notes
     flags = _about(notes, "SDF link flags")
-    assert len(flags) == 1 and flags[0].code == "MK808", [n.message for n in notes]
-    assert "gravity false, kinematic true, velocity_decay (linear 0.1)" in flags[0].message
-    assert "enable_wind" not in flags[0].message and "link plain" not in flags[0].message
+    if target == "urdf":
+        assert not flags, [n.message for n in notes]
+        blocks = {b.get("reference"): b for b in ET.parse(out).getroot().findall("gazebo")}
+        assert set(blocks) == {"base"}  # "plain" says only SDFormat's defaults
+        assert [(c.tag, c.findtext("linear") if len(c) else c.text) for c in blocks["base"]] == [
+            ("gravity", "false"), ("kinematic", "true"), ("velocity_decay", "0.1")]
+    else:
+        assert len(flags) == 1 and flags[0].code == "MK808", [n.message for n in notes]
+        assert "gravity false, kinematic true, velocity_decay (linear 0.1)" in flags[0].message
+        assert "enable_wind" not in flags[0].message and "link plain" not in flags[0].message
     # the ambient colour: the model's material holds its intensity (.body writes it, URDF says it drops
     # it); the SDF reader's exact colour is for SDF round trips, no note of its own
     assert len([n for n in notes if "ambient" in n.message]) == (1 if target == "urdf" else 0)

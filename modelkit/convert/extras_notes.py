@@ -90,12 +90,14 @@ def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
         EXTRAS_DROPPED_LINK,
         EXTRAS_OWNER,
         EXTRAS_PARTLY_CARRIED,
+        carried_by,
         declared,
     )
 
     output = declared(target).output
-    handled = output.handles if output is not None else frozenset()
-    handled_joint = output.handles_joint if output is not None else frozenset()
+    carried = carried_by(target)
+    handled = (output.handles if output is not None else frozenset()) | carried
+    handled_joint = (output.handles_joint if output is not None else frozenset()) | carried
     found: list[tuple[str, str, str, Any, Any, str]] = []  # owner, code, words, value, source, target
     # a dict value's entries that say only the owner's default are no loss (EXTRAS_DEFAULTS)
     if output is None or not output.walks_extras:

@@ -50,6 +50,9 @@ class ExtrasDeclaration(NamedTuple):
     # (key, ((entry, value), ...)): entries of a dropped dict-valued key that say only the format's default
     # (an SDF link's <gravity>true</gravity>): nothing is lost, so a note leaves them out
     defaults: tuple[tuple[str, tuple[tuple[str, object], ...]], ...] = ()
+    # (key, targets): dropped keys another target's writer carries anyway, through the owning format's
+    # own code (an SDF link's flags in a URDF's <gazebo reference> blocks, which libsdformat copies back)
+    carried_to: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
 
 class FormatDeclaration(NamedTuple):

@@ -50,6 +50,15 @@ EXTRAS_DEFAULTS: dict[str, dict[str, object]] = {
     key: dict(entries) for d in DECLARED for key, entries in d.extras.defaults
 }
 """Dropped key → its entries that say only the owning format's default (left out of a note)."""
+EXTRAS_CARRIED_TO: dict[str, frozenset[str]] = {
+    key: frozenset(targets) for d in DECLARED for key, targets in d.extras.carried_to
+}
+"""Dropped key → the targets whose writers carry it all the same (so they give no note for it)."""
+
+
+def carried_by(target: str) -> frozenset[str]:
+    """The other formats' dropped keys that ``target``'s writer carries."""
+    return frozenset(key for key, targets in EXTRAS_CARRIED_TO.items() if target in targets)
 
 
 def declared(name: str) -> FormatDeclaration:

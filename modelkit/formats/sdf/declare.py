@@ -39,5 +39,8 @@ FORMAT = FormatDeclaration(
         # an SDF link's flags at SDFormat's defaults say nothing a target misses
         defaults=(("sdf_link", (("gravity", True), ("kinematic", False), ("enable_wind", False),
                                 ("must_be_base_link", False))),),
+        # written into a URDF's <gazebo> blocks, which libsdformat copies back (formats/sdf/gazebo_blocks)
+        carried_to=(("sdf_link", ("urdf",)), ("sdf_other", ("urdf",)), ("sdf_model_elements", ("urdf",)),
+                    ("sdf_joint_elements", ("urdf",))),
     ),
 )

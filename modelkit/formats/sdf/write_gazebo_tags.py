@@ -88,13 +88,6 @@ def _block_tags(block: Element) -> Iterator[tuple[Element, str, str, bool]]:
             yield tag_el, tag_el.tag, text, bool(text) and not len(tag_el)
 
 
-def _tags(entries: object) -> Iterator[tuple[str, str, bool]]:
-    """Each tag of the kept ``<gazebo>`` blocks: its name, its text, and whether it is a plain value."""
-    for block in _blocks(entries):
-        for _, tag, text, plain in _block_tags(block):
-            yield tag, text, plain
-
-
 def _truth(text: str) -> bool:
     return text.lower() in ("true", "1")
 
@@ -202,20 +195,34 @@ AXIS_TAGS = {"springStiffness": "spring_stiffness", "springReference": "spring_r
 BOOLEAN_JOINT_TAGS = frozenset({"provideFeedback", "implicitSpringDamper", "cfmDamping"})
 
 
+JOINT_BLOBS = frozenset({"physics"})  # what libsdformat copies into the joint that a joint holds once
+
+
 def write_joint_tags(joint_el: Element, entries: object) -> list[str]:
     """Write the tags of a joint's ``<gazebo>`` blocks into ``joint_el`` (its axis written already);
-    return the tags left out, in order (a spring on a joint without an axis among them)."""
+    return the tags left out, in order (a spring on a joint without an axis among them). A block's
+    ``<physics>`` (what a URDF written from SDF carries, :mod:`.gazebo_blocks`) goes into the joint first,
+    replacing one written before; the block's ``stopCfm``... then set their values in it."""
     left: list[str] = []
     axis = joint_el.find("axis")
-    for tag, text, plain in _tags(entries):
-        if plain and tag in JOINT_TAGS:
-            value = ("true" if _truth(text) else "false") if tag in BOOLEAN_JOINT_TAGS else text
-            for path in JOINT_TAGS[tag]:
-                _set_path(joint_el, path, value)
-        elif plain and tag in AXIS_TAGS and axis is not None:
-            _set_path(axis, ("dynamics", AXIS_TAGS[tag]), text)
-        elif tag not in left:
-            left.append(tag)
+    for block in _blocks(entries):
+        tags = list(_block_tags(block))
+        for tag_el, tag, _, plain in tags:
+            if tag in JOINT_BLOBS and not plain:
+                for old in joint_el.findall(tag):
+                    joint_el.remove(old)
+                joint_el.append(_copy(tag_el))
+        for _, tag, text, plain in tags:
+            if tag in JOINT_BLOBS and not plain:
+                continue
+            if plain and tag in JOINT_TAGS:
+                value = ("true" if _truth(text) else "false") if tag in BOOLEAN_JOINT_TAGS else text
+                for path in JOINT_TAGS[tag]:
+                    _set_path(joint_el, path, value)
+            elif plain and tag in AXIS_TAGS and axis is not None:
+                _set_path(axis, ("dynamics", AXIS_TAGS[tag]), text)
+            elif tag not in left:
+                left.append(tag)
     return left
 
 

@@ -23,6 +23,7 @@ from modelkit.convert.friction import describe, floor_friction, link_surface
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.numbers import fmt
 from modelkit.diagnostics import SourceLocation
+from modelkit.formats.sdf.gazebo_blocks import joint_block, link_block, model_block
 from modelkit.formats.urdf.write_actuators import rename_motor, unique_motor, write_transmissions
 from modelkit.formats.urdf.write_frames import SensorFrames
 from modelkit.formats.urdf.write_names import NameTable
@@ -73,6 +74,15 @@ def _gazebo(robot_el: Element, reference: str | None) -> Element:
     if reference is not None:
         el.set("reference", reference)
     return el
+
+
+def _sdf_block(robot_el: Element, reference: str | None, elements: list[Element]) -> None:
+    """An SDF source's Gazebo data the URDF has no element for, in a ``<gazebo>`` block libsdformat
+    copies back into the link, joint or model (:mod:`modelkit.formats.sdf.gazebo_blocks`)."""
+    if elements:
+        block = _gazebo(robot_el, reference)
+        for element in elements:
+            block.append(element)
 
 
 def _kept_blocks(
@@ -145,6 +155,7 @@ def write_extensions(
     for index, link in enumerate(robot.links):
         name = names.links[index]
         written = _kept_blocks(robot_el, link.extras.get("gazebo"), name, ctx, f'link "{link.name}"')
+        _sdf_block(robot_el, name, link_block(link))
         surface, _ = link_surface(link)
         pair = friction.get(link.name)
         if surface is not None and robot.source_format != "urdf" and not _has_mu(link):
@@ -178,6 +189,8 @@ def write_extensions(
         _device(robot_el, link, name, device, ctx, place, gazebo, frame)
     for index, joint in enumerate(robot.joints):
         _kept_blocks(robot_el, joint.extras.get("gazebo"), names.joints[index], ctx, f'joint "{joint.name}"')
+        _sdf_block(robot_el, names.joints[index], joint_block(joint))
+    _sdf_block(robot_el, None, model_block(robot))
     for entry in robot.extras.get("gazebo", []) or []:
         reference = entry.get("reference") if isinstance(entry, dict) else None
         written_ref = names.link(reference) if reference in names.link_map else reference

@@ -29,7 +29,13 @@ from modelkit.convert.friction import floor_friction
 from modelkit.convert.notes import ConversionNote, renames
 from modelkit.convert.numbers import fmt
 from modelkit.convert.simulator import pybullet_settings
-from modelkit.formats.registry import EXTRAS_DROPPED, EXTRAS_DROPPED_LINK, EXTRAS_QUIET, EXTRAS_QUIET_LINK
+from modelkit.formats.registry import (
+    EXTRAS_DROPPED,
+    EXTRAS_DROPPED_LINK,
+    EXTRAS_QUIET,
+    EXTRAS_QUIET_LINK,
+    carried_by,
+)
 from modelkit.formats.urdf.write_frames import frame_link, sensor_frames
 from modelkit.formats.urdf.write_gazebo import write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
@@ -59,7 +65,8 @@ WRITTEN_EXTRAS = frozenset(
 # the wheels and tracks themselves are written through their links, so nothing is left out. Noted as
 # "extension data ... left out" before (MK808 on the tutorial's pan-tilt and tracked robots).
 PASS_EXTRAS = frozenset({"wheels", "tracks"})
-SILENT_EXTRAS = WRITTEN_EXTRAS | EXTRAS_QUIET | PASS_EXTRAS
+# Other formats' keys this writer carries through their own code (an SDF model's flags in <gazebo> blocks).
+SILENT_EXTRAS = WRITTEN_EXTRAS | EXTRAS_QUIET | PASS_EXTRAS | carried_by("urdf")
 # Link extras written elsewhere: URDF's <gazebo> blocks.
 # Link extras other formats declare dropped are noted by convert itself (convert.api._foreign_extras).
 SILENT_LINK_EXTRAS = (
