@@ -1577,6 +1577,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "are generated beside it.",
     ),
     CodeInfo(
+        "MK879",
+        "urdf-shape-names-left-out",
+        "info",
+        "URDF from another format: a link whose `<gazebo>` block gives its visuals or collisions data (an "
+        "SDF source's friction, material script, `<cast_shadows>`...) gets those shapes written without "
+        "names, because libsdformat's URDF import (Gazebo) applies such data only to unnamed shapes "
+        "(sdformat issue 333); the note lists the links.",
+    ),
+    CodeInfo(
         "MK880",
         "body-shape-size-not-positive",
         "warning",

@@ -78,12 +78,13 @@ def test_sdf_to_sdf_writes_them_back_and_libsdformat_reads_it(tmp_path: Path,
 def test_other_targets_say_what_they_leave_out(tmp_path: Path, suffix: str) -> None:
     notes = convert([_source(tmp_path, GIVEN)], tmp_path / "out" / f"m.{suffix}").notes
     text = "\n".join(n.message for n in notes)
-    # a URDF carries the joint's <physics> and the model flags in <gazebo> blocks (test_sdf_gazebo_blocks)
+    # a URDF carries the joint's <physics>, the model flags and the elements of the link's one visual and
+    # one collision in <gazebo> blocks (test_sdf_gazebo_blocks); the joint stop's sit in the axis
     carried = suffix == "urdf"
     assert ("SDF joint solver parameters (<physics>)" in text) is not carried
     assert "SDF joint stop parameters (<stiffness>, <dissipation>)" in text
-    assert "link base: SDF visual and collision elements" in text
-    assert "<laser_retro>, <max_contacts>" in text and "<cast_shadows>" in text
+    assert ("link base: SDF visual and collision elements" in text) is not carried
+    assert ("<laser_retro>, <max_contacts>" in text and "<cast_shadows>" in text) is not carried
     assert ("SDF model flags" in text) is not carried
 
 

@@ -92,6 +92,7 @@ def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
         EXTRAS_PARTLY_CARRIED,
         carried_by,
         declared,
+        partly_carried_by,
     )
 
     output = declared(target).output
@@ -110,17 +111,28 @@ def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
         *(("link", link, EXTRAS_DROPPED_LINK, handled) for link in robot.links),
         *(("joint", joint, EXTRAS_DROPPED_JOINT, handled_joint) for joint in robot.joints),
     ]
+    partly = partly_carried_by(target)
     for kind, element, table, skip in elements:
         for key in sorted(element.extras):
             if key in table and key not in skip:
                 owner, code, what = table[key]
                 value = _without_defaults(element.extras[key], EXTRAS_DEFAULTS.get(key))
+                if key in partly:  # what the target's writer carries of it is no loss
+                    value = _function(partly[key])(value, element)
                 found.append((owner, code, f"{kind} {element.name}: {what}", value,
                               element.source, f"{kind}[{element.name}]"))
     for owner, code, what, value, source, where in found:
         shown = shown_extras(value, records=where == "robot") if owner != target and value else ""
         if shown:
             notes.note(code, f"{what} ({shown}): no {target} equivalent; left out", source, where)
+
+
+def _function(path: str) -> Any:
+    """The function a declaration names as ``"module:function"``."""
+    import importlib
+
+    module, name = path.split(":")
+    return getattr(importlib.import_module(module), name)
 
 
 def _without_defaults(value: Any, defaults: dict[str, object] | None) -> Any:

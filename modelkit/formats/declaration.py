@@ -50,9 +50,11 @@ class ExtrasDeclaration(NamedTuple):
     # (key, ((entry, value), ...)): entries of a dropped dict-valued key that say only the format's default
     # (an SDF link's <gravity>true</gravity>): nothing is lost, so a note leaves them out
     defaults: tuple[tuple[str, tuple[tuple[str, object], ...]], ...] = ()
-    # (key, targets): dropped keys another target's writer carries anyway, through the owning format's
-    # own code (an SDF link's flags in a URDF's <gazebo reference> blocks, which libsdformat copies back)
-    carried_to: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    # (key, targets, left): dropped keys another target's writer carries anyway, through the owning
+    # format's own code (an SDF link's flags in a URDF's <gazebo reference> blocks, which libsdformat
+    # copies back); ``left`` is "" when all of it is carried, else "module:function" giving, from the
+    # value and its link (joint, robot), what those targets still drop (the note names that part)
+    carried_to: tuple[tuple[str, tuple[str, ...], str], ...] = ()
 
 
 class FormatDeclaration(NamedTuple):

@@ -50,15 +50,23 @@ EXTRAS_DEFAULTS: dict[str, dict[str, object]] = {
     key: dict(entries) for d in DECLARED for key, entries in d.extras.defaults
 }
 """Dropped key → its entries that say only the owning format's default (left out of a note)."""
-EXTRAS_CARRIED_TO: dict[str, frozenset[str]] = {
-    key: frozenset(targets) for d in DECLARED for key, targets in d.extras.carried_to
+EXTRAS_CARRIED_TO: dict[str, tuple[frozenset[str], str]] = {
+    key: (frozenset(targets), left) for d in DECLARED for key, targets, left in d.extras.carried_to
 }
-"""Dropped key → the targets whose writers carry it all the same (so they give no note for it)."""
+"""Dropped key → the targets whose writers carry it all the same, and the function that tells what of a
+value they still drop ("": nothing)."""
 
 
 def carried_by(target: str) -> frozenset[str]:
-    """The other formats' dropped keys that ``target``'s writer carries."""
-    return frozenset(key for key, targets in EXTRAS_CARRIED_TO.items() if target in targets)
+    """The other formats' dropped keys that ``target``'s writer carries whole (no note for them)."""
+    return frozenset(key for key, (targets, left) in EXTRAS_CARRIED_TO.items()
+                     if target in targets and not left)
+
+
+def partly_carried_by(target: str) -> dict[str, str]:
+    """The other formats' dropped keys that ``target``'s writer carries in part → the "module:function"
+    that gives, from a value and its owner, the part it still drops."""
+    return {key: left for key, (targets, left) in EXTRAS_CARRIED_TO.items() if target in targets and left}
 
 
 def declared(name: str) -> FormatDeclaration:

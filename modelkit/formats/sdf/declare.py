@@ -40,7 +40,9 @@ FORMAT = FormatDeclaration(
         defaults=(("sdf_link", (("gravity", True), ("kinematic", False), ("enable_wind", False),
                                 ("must_be_base_link", False))),),
         # written into a URDF's <gazebo> blocks, which libsdformat copies back (formats/sdf/gazebo_blocks)
-        carried_to=(("sdf_link", ("urdf",)), ("sdf_other", ("urdf",)), ("sdf_model_elements", ("urdf",)),
-                    ("sdf_joint_elements", ("urdf",))),
+        carried_to=(("sdf_link", ("urdf",), ""), ("sdf_other", ("urdf",), ""),
+                    ("sdf_model_elements", ("urdf",), ""), ("sdf_joint_elements", ("urdf",), ""),
+                    ("sdf_materials", ("urdf",), "modelkit.formats.sdf.gazebo_blocks:materials_left"),
+                    ("sdf_shape_elements", ("urdf",), "modelkit.formats.sdf.gazebo_blocks:shapes_left")),
     ),
 )

@@ -23,7 +23,7 @@ from modelkit.convert.friction import describe, floor_friction, link_surface
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.numbers import fmt
 from modelkit.diagnostics import SourceLocation
-from modelkit.formats.sdf.gazebo_blocks import joint_block, link_block, model_block
+from modelkit.formats.sdf.gazebo_blocks import joint_block, link_block, model_block, shape_data_kinds
 from modelkit.formats.urdf.write_actuators import rename_motor, unique_motor, write_transmissions
 from modelkit.formats.urdf.write_frames import SensorFrames
 from modelkit.formats.urdf.write_names import NameTable
@@ -275,6 +275,23 @@ def _transmissions(robot_el: Element, robot: Robot, names: NameTable, ctx: Write
                     motor.set("name", written)
                     rename_motor(ctx, wanted, written, joints[0])
         robot_el.append(block)
+
+
+def unnamed_shapes(link: Link, robot: Robot) -> set[str]:
+    """The kinds of shape (``visual``, ``collision``) of ``link`` written without names: those its
+    written ``<gazebo>`` blocks give data to (an SDF source's friction, material script, shadows...).
+
+    libsdformat's URDF import applies a link block's ``<visual>``, ``<collision>``, ``<material>``,
+    ``mu1``, ``kp``... only to a visual or collision the URDF leaves unnamed (it renames a named one and
+    then fails its own name test, sdformat issue 333): Gazebo would drop them all on named shapes. A
+    URDF source's own shapes and blocks are written as they were."""
+    if robot.source_format == "urdf":
+        return set()
+    kinds = shape_data_kinds(link)
+    surface, _ = link_surface(link)
+    if link.collisions and (surface is not None or floor_friction(robot).get(link.name) is not None):
+        kinds.add("collision")
+    return kinds
 
 
 def _has_mu(link: Link) -> bool:

@@ -209,12 +209,14 @@ def link_element(
     friction: PairFriction | None = None,
     moving: bool = False,
     compliance: tuple[float, float] | None = None,
+    unnamed: frozenset[str] | set[str] = frozenset(),
 ) -> Element:
     """The ``<link>`` element with its inertial, visuals, collisions and (with ``friction``, the link's
     contact material against the floor) PyBullet's ``<contact>``, with ``compliance`` (stiffness N/m,
     damping N·s/m: :mod:`modelkit.convert.contact_compliance`) in it. A massless link gets the tiny
     inertial (:func:`tiny_inertial`; with a note of its own where it moves), except a ``world`` link,
-    which PyBullet and the other URDF loaders take as the fixed world."""
+    which PyBullet and the other URDF loaders take as the fixed world. The shapes of a kind in
+    ``unnamed`` are written without their names (:func:`..write_gazebo.unnamed_shapes`)."""
     el = etree.SubElement(robot_el, "link", name=name)
     target = f"link[{name}]"
     massless = link.inertial is None or link.inertial.mass <= 0.0
@@ -228,7 +230,7 @@ def link_element(
         for i, geom in enumerate(geoms):
             where = f"{target}/{kind}[{i}]"
             item = etree.Element(kind)
-            if geom.name:
+            if geom.name and kind not in unnamed:
                 item.set("name", geom.name)
             origin_element(item, geom.pose)
             if not geometry_element(item, geom, ctx, where, f"{name}_{kind}{i}"):

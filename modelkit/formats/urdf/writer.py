@@ -37,7 +37,7 @@ from modelkit.formats.registry import (
     carried_by,
 )
 from modelkit.formats.urdf.write_frames import frame_link, sensor_frames
-from modelkit.formats.urdf.write_gazebo import write_extensions
+from modelkit.formats.urdf.write_gazebo import unnamed_shapes, write_extensions
 from modelkit.formats.urdf.write_joints import joint_elements
 from modelkit.formats.urdf.write_links import (
     CONTACT_EXTRAS,
@@ -99,10 +99,21 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
     compliance, why = pybullet_compliance(robot) if ctx.options.support_contact == "compliant" else ({}, "")
     if compliance:
         ctx.note("MK861", why, robot.source, "link")
+    left_unnamed: list[str] = []
     for index, link in enumerate(robot.links):
+        unnamed = {kind for kind in unnamed_shapes(link, robot)
+                   if any(g.name for g in (link.visuals if kind == "visual" else link.collisions))}
+        if unnamed:
+            left_unnamed.append(f"{link.name} ({', '.join(sorted(unnamed))})")
         link_element(links, link, names.links[index], robot, ctx, materials, friction.get(link.name),
-                     link.name in moving, compliance.get(link.name))
+                     link.name in moving, compliance.get(link.name), unnamed)
         _link_extras(link.extras, link.name, names.links[index], ctx)
+    if left_unnamed:
+        ctx.note("MK879", f"{len(left_unnamed)} link(s) get their visuals or collisions written without "
+                 "names, because their <gazebo> blocks give those shapes data (friction, a material "
+                 "script...) and libsdformat's URDF import (Gazebo) applies it only to unnamed shapes: "
+                 + ", ".join(left_unnamed[:8]) + (" ..." if len(left_unnamed) > 8 else ""), robot.source,
+                 "link")
     joints: list[Element] = []
     extra_links: list[Link] = []
     for index, joint in enumerate(robot.joints):
