@@ -30,6 +30,7 @@ from lxml import etree
 from lxml.etree import _Element as Element
 
 from modelkit.formats.sdf.kept import JOINT_KEY, MODEL_KEY, SHAPE_KEY
+from modelkit.formats.sdf.write_gazebo_tags import MATERIAL_URI
 from modelkit.formats.sdf.write_xml import data_element
 from modelkit.model import Joint, Link, Robot
 
@@ -59,9 +60,6 @@ def link_block(link: Link) -> list[Element]:
     return out
 
 
-STOCK_SCRIPTS = "file://media/materials/scripts/gazebo.material"  # the one URI libsdformat writes
-
-
 def _shared_script(link: Link) -> str | None:
     """The stock Gazebo script every visual of ``link`` names, and nothing else beyond its colours."""
     looks = link.extras.get("sdf_materials") or {}
@@ -71,7 +69,7 @@ def _shared_script(link: Link) -> str | None:
         if not isinstance(look, dict) or set(look) != {"script"}:
             return None
         script = look["script"]
-        if not isinstance(script, dict) or script.get("uri") != [STOCK_SCRIPTS]:
+        if not isinstance(script, dict) or script.get("uri") != [MATERIAL_URI]:  # libsdformat's only URI
             return None
         names.add(str(script.get("name", "")))
     return names.pop() if len(names) == 1 and "" not in names else None

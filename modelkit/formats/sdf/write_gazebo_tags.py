@@ -63,9 +63,7 @@ COLLISION_TAGS = {"maxContacts": ("max_contacts",), "laserRetro": ("laser_retro"
                   "maxVel": ("surface", "contact", "ode", "max_vel"),
                   "minDepth": ("surface", "contact", "ode", "min_depth"),
                   "fdir1": ("surface", "friction", "ode", "fdir1")}
-OTHER_TAGS = frozenset({"turnGravityOff", "dampingFactor", "material"})
 MATERIAL_URI = "file://media/materials/scripts/gazebo.material"
-WRITTEN = frozenset(LINK_FLAGS) | frozenset(COLLISION_TAGS) | OTHER_TAGS | CARRIED
 
 
 def _blocks(entries: object) -> Iterator[Element]:

@@ -277,19 +277,20 @@ def _transmissions(robot_el: Element, robot: Robot, names: NameTable, ctx: Write
         robot_el.append(block)
 
 
-def unnamed_shapes(link: Link, robot: Robot) -> set[str]:
+def unnamed_shapes(link: Link, robot: Robot, pairs: dict[str, Any]) -> set[str]:
     """The kinds of shape (``visual``, ``collision``) of ``link`` written without names: those its
     written ``<gazebo>`` blocks give data to (an SDF source's friction, material script, shadows...).
 
     libsdformat's URDF import applies a link block's ``<visual>``, ``<collision>``, ``<material>``,
     ``mu1``, ``kp``... only to a visual or collision the URDF leaves unnamed (it renames a named one and
     then fails its own name test, sdformat issue 333): Gazebo would drop them all on named shapes. A
-    URDF source's own shapes and blocks are written as they were."""
+    URDF source's own shapes and blocks are written as they were. ``pairs``: the robot's
+    :func:`~modelkit.convert.friction.floor_friction`."""
     if robot.source_format == "urdf":
         return set()
     kinds = shape_data_kinds(link)
     surface, _ = link_surface(link)
-    if link.collisions and (surface is not None or floor_friction(robot).get(link.name) is not None):
+    if link.collisions and (surface is not None or pairs.get(link.name) is not None):
         kinds.add("collision")
     return kinds
 

@@ -101,7 +101,7 @@ def write_urdf(robot: Robot, ctx: WriteContext) -> bytes:
         ctx.note("MK861", why, robot.source, "link")
     left_unnamed: list[str] = []
     for index, link in enumerate(robot.links):
-        unnamed = {kind for kind in unnamed_shapes(link, robot)
+        unnamed = {kind for kind in unnamed_shapes(link, robot, friction)
                    if any(g.name for g in (link.visuals if kind == "visual" else link.collisions))}
         if unnamed:
             left_unnamed.append(f"{link.name} ({', '.join(sorted(unnamed))})")
