@@ -983,7 +983,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "A URDF colour `rgba` has values outside 0..1 (they are clamped).",
     ),
-    # (urdf materials and resources MK514-MK529) (sdf resources MK530-MK549)
+    CodeInfo(
+        "MK514",
+        "mesh-gltf-consumers",
+        "warning",
+        "A URDF mesh is glTF (.glb/.gltf): rviz and gz-sim read it; MuJoCo cannot, PyBullet refuses the "
+        "file.",
+    ),
+    # (urdf materials and resources MK515-MK529) (sdf resources MK530-MK549)
     CodeInfo(
         "MK530",
         "sdf-include-invalid",

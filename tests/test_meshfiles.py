@@ -79,7 +79,7 @@ def test_import_does_not_load_parsers() -> None:
 
 
 def test_supported_extensions() -> None:
-    assert frozenset({".stl", ".obj", ".dae", ".wrl"}) == SUPPORTED_EXTENSIONS
+    assert frozenset({".stl", ".obj", ".dae", ".wrl", ".glb", ".gltf"}) == SUPPORTED_EXTENSIONS
 
 
 # ---- STL (GR001) -------------------------------------------------------------------------------
@@ -722,7 +722,7 @@ def test_binary_stl_reads_as_trimesh_reads_it(corpus: Path) -> None:
 
     from trimesh.exchange import stl as trimesh_stl
 
-    from modelkit.geometry.meshfiles import _load_stl, _merge_identical_vertices
+    from modelkit.geometry.meshfiles import _load_stl, merge_identical_vertices
 
     files = _binary_stl_files()
     assert len(files) >= 100
@@ -731,7 +731,7 @@ def test_binary_stl_reads_as_trimesh_reads_it(corpus: Path) -> None:
         theirs = trimesh_stl.load_stl_binary(io.BytesIO(data))
         vertices = np.asarray(theirs["vertices"], dtype=np.float64).reshape(-1, 3)
         faces = np.asarray(theirs["faces"], dtype=np.int64).reshape(-1, 3)
-        expected_vertices, expected_faces = _merge_identical_vertices(vertices, faces)
+        expected_vertices, expected_faces = merge_identical_vertices(vertices, faces)
         ours = _load_stl(data, path.name)
         assert np.array_equal(ours.vertices, expected_vertices), path
         assert np.array_equal(ours.faces, expected_faces), path
@@ -807,7 +807,7 @@ def _merged_by_unique(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarr
 
 def test_identical_vertices_merge_as_np_unique_merges_them() -> None:
     # Small integer grids so that rows repeat; -0.0 against 0.0 and NaN rows included.
-    from modelkit.geometry.meshfiles import _merge_identical_vertices
+    from modelkit.geometry.meshfiles import merge_identical_vertices
 
     rng = np.random.default_rng(11)
     merges = 0
@@ -817,7 +817,7 @@ def test_identical_vertices_merge_as_np_unique_merges_them() -> None:
         if trial % 3 == 0:
             vertices[rng.random(vertices.shape) < 0.05] = np.nan
         faces = rng.integers(0, len(vertices), size=(30, 3))
-        merged, renumbered = _merge_identical_vertices(vertices, faces)
+        merged, renumbered = merge_identical_vertices(vertices, faces)
         expected, expected_faces = _merged_by_unique(vertices, faces)
         assert np.array_equal(merged, expected, equal_nan=True), trial
         assert np.array_equal(renumbered, expected_faces), trial

@@ -80,7 +80,7 @@ CASES = {
     ("png", True): (1, "MK805", 0),
     ("empty", True): (1, "MK805", 0),
     ("nan", True): (1, "MK805", 0),
-    ("huge", True): (1, "MK805", 0),
+    ("huge", True): (0, "MK804", 2),  # 327,680 faces: over MuJoCo's STL bound, written as OBJ
     ("missing", True): (1, "MK500", 0),
 }
 
@@ -108,6 +108,9 @@ def test_each_mesh_case_loads_in_mujoco_or_exits_1(mesh: str, collision: bool, t
     if mesh in ("ascii", "obj_text"):
         written = next((out.parent / "meshes").glob("*.stl")).read_bytes()
         assert len(written) == 84 + 50 * int.from_bytes(written[80:84], "little")  # binary STL
+    if mesh == "huge":
+        assert [p.name for p in (out.parent / "meshes").glob("*")] == ["huge.obj"], output
+        assert model.mesh_facenum[0] == 327_680
 
 
 def test_panoramic_camera_is_clamped_with_a_note(tmp_path: Path) -> None:

@@ -140,6 +140,33 @@ def massless_links_dropped(robot: Robot) -> Iterator[Diagnostic]:
             stack.append(child)
 
 
+GLTF_SUFFIXES = frozenset({".glb", ".gltf"})
+
+
+@rule("gltf-meshes", "MK514")
+def gltf_meshes(robot: Robot) -> Iterator[Diagnostic]:
+    """glTF meshes in a URDF, for consumers that read glTF through Assimp (rviz, gz-sim): MuJoCo has no
+    decoder for them ("no decoder found for mesh file") and PyBullet refuses the whole URDF ("failed to
+    parse link"), measured with MuJoCo 3.14 and PyBullet 3.2.7 on dexmate's grippers."""
+    if robot.source_format not in URDF_FORMATS:
+        return
+    seen: set[str] = set()
+    for link in robot.links:
+        for geom in [*link.visuals, *link.collisions]:
+            uri = getattr(geom.geometry, "uri", None)
+            if not uri or PurePosixPath(uri.split("?")[0]).suffix.lower() not in GLTF_SUFFIXES or uri in seen:
+                continue
+            seen.add(uri)
+            role = "collision" if geom in link.collisions else "visual"
+            yield diag(
+                "MK514",
+                f'{role} mesh "{uri}" is glTF, read by rviz and gz-sim (Assimp): MuJoCo cannot load it and '
+                "PyBullet refuses the whole URDF",
+                geom.source or link.loc("name"),
+                hint="`modelkit convert` writes it as STL/OBJ for every target",
+            )
+
+
 @rule("collada-for-mujoco", "MK512")
 def collada_for_mujoco(robot: Robot) -> Iterator[Diagnostic]:
     """COLLADA meshes in a URDF: MuJoCo cannot load them ("no decoder found for mesh file")."""

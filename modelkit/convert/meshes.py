@@ -15,7 +15,6 @@ from typing import Any
 import numpy as np
 
 from modelkit.convert.notes import NoteSink
-from modelkit.convert.numbers import fmt
 from modelkit.convert.options import WriteOptions
 from modelkit.convert.output import OutputPlan, safe_file_name
 from modelkit.diagnostics import Severity, SourceLocation
@@ -52,6 +51,14 @@ class Prepared:
 
 class Unusable(Exception):
     """A mesh file MuJoCo cannot use, with the reason."""
+
+
+class TooManyForStl(Unusable):
+    """Triangles MuJoCo would read from an OBJ file but not from an STL (over its STL bound)."""
+
+    def __init__(self, message: str, corners: np.ndarray) -> None:
+        super().__init__(message)
+        self.corners = corners
 
 
 def for_mujoco(data: bytes, ext: str, scale: Vec3 | None = None) -> Prepared:
@@ -226,11 +233,11 @@ def _checked(corners: np.ndarray, stl: bool = True) -> np.ndarray:
     """``corners`` (n × 3 × 3) if MuJoCo reads them (as an STL when ``stl``), else :class:`Unusable`."""
     if len(corners) == 0:
         raise Unusable("the mesh has no faces")
-    if stl and len(corners) > MUJOCO_MAX_STL_FACES:
-        raise Unusable(f"the mesh has {len(corners):,} faces, over MuJoCo's {MUJOCO_MAX_STL_FACES:,} "
-                       "for an STL")
     if not np.all(np.isfinite(corners)):
         raise Unusable("the mesh has coordinates that are not finite (NaN or infinite)")
+    if stl and len(corners) > MUJOCO_MAX_STL_FACES:
+        raise TooManyForStl(f"the mesh has {len(corners):,} faces, over MuJoCo's {MUJOCO_MAX_STL_FACES:,} "
+                            "for an STL", corners)
     return corners
 
 
@@ -269,8 +276,9 @@ def triangles_to_bytes(mesh: TriangleMeshData, file_format: str) -> bytes:
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     faces = np.asarray(mesh.faces, dtype=np.int64)
     if file_format == "obj":
+        texts = _coordinate_texts(vertices)
         lines = ["# modelkit OBJ"]
-        lines += [f"v {fmt(x)} {fmt(y)} {fmt(z)}" for x, y, z in vertices]
+        lines += [f"v {texts[i]} {texts[i + 1]} {texts[i + 2]}" for i in range(0, len(texts), 3)]
         lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in faces]
         return ("\n".join(lines) + "\n").encode("ascii")
     corners = vertices[faces] if len(faces) else np.zeros((0, 3, 3))
@@ -282,6 +290,19 @@ def triangles_to_bytes(mesh: TriangleMeshData, file_format: str) -> bytes:
     table["normal"] = normals
     table["corners"] = corners
     return STL_HEADER + np.uint32(len(faces)).astype("<u4").tobytes() + table.tobytes()
+
+
+def _coordinate_texts(vertices: np.ndarray) -> list[str]:
+    """Each coordinate as text: when all are single-precision values (an STL's), the shortest text of
+    each as a float32 (``0.05``, not ``0.0500000007450581``), exact for every reader (MuJoCo reads single
+    precision anyway); otherwise 15 significant digits, as many as :func:`fmt` writes at most. Both
+    are formatted in C: :func:`fmt`'s search for the shortest decimal of each took 16 s of the conversion
+    of a 294,002-face mesh (dexmate's gripper base); this takes under 1 s."""
+    flat = np.ascontiguousarray(vertices, dtype=np.float64).ravel() + 0.0  # -0.0 → 0.0
+    single = flat.astype(np.float32)
+    if np.array_equal(single.astype(np.float64), flat):
+        return [text[:-2] if text.endswith(".0") else text for text in map(str, single)]
+    return list(map("{:.15g}".format, flat.tolist()))
 
 
 def primitive_triangles(geometry: Cone | Capsule | Ellipsoid) -> TriangleMeshData:
@@ -300,6 +321,19 @@ def primitive_triangles(geometry: Cone | Capsule | Ellipsoid) -> TriangleMeshDat
         tm = trimesh.creation.icosphere(subdivisions=3, radius=1.0)
         tm.apply_scale(np.asarray(geometry.radii, dtype=float))
     return TriangleMeshData(np.asarray(tm.vertices, dtype=float), np.asarray(tm.faces, dtype=np.int64))
+
+
+# Why a mesh of this kind is converted, and what of it is not carried (said in its MK804 note).
+_GLTF_WHY = ("; glTF, which MuJoCo has no decoder for, PyBullet refuses a whole URDF for, and Choreonoid "
+             "does not read; its materials and textures are not carried")
+CONVERTED_WHY = {"glb": _GLTF_WHY, "gltf": _GLTF_WHY}
+
+
+def _written_as(ref: MeshRef, asked: str, triangles: int) -> str:
+    """Why a mesh for MuJoCo is an OBJ file when ``asked`` was STL (empty otherwise)."""
+    if ref.file_format == asked:
+        return ""
+    return f" ({triangles:,} triangles: MuJoCo reads at most {MUJOCO_MAX_STL_FACES:,} from an STL)"
 
 
 def converted_stem(stem: str, source_ext: str, written_ext: str) -> str:
@@ -356,8 +390,9 @@ class MeshExporter:
         relpath = self.plan.add(f"{TEXTURE_FOLDER}/{safe_file_name(path.name, 'texture')}", data, "texture")
         return self.prefix + relpath
 
-    def triangles(self, mesh: TriangleMeshData, name: str, scale: Vec3 | None = None) -> MeshRef:
-        ext = self.options.mesh_format
+    def triangles(self, mesh: TriangleMeshData, name: str, scale: Vec3 | None = None,
+                  file_format: str | None = None) -> MeshRef:
+        ext = file_format or self.options.mesh_format
         uri = self._stage(triangles_to_bytes(mesh, ext), f"{safe_file_name(name, 'mesh')}.{ext}")
         return MeshRef(uri, np.ones(3) if scale is None else np.asarray(scale, dtype=float), ext)
 
@@ -391,7 +426,12 @@ class MeshExporter:
             kind = geometry.generator or "in-memory mesh"
             self.notes.note("MK803", f"{kind} written as a mesh file", source, target)
             if mujoco:
-                return self._mujoco_triangles(geometry.data, name, scale, kind, collision)
+                ref, why = self._mujoco_triangles(geometry.data, name, scale, kind, collision)
+                if ref is not None and ref.file_format != self.options.mesh_format:
+                    self.notes.note("MK804", f"{kind} written as OBJ"
+                                    f"{_written_as(ref, self.options.mesh_format, len(geometry.data.faces))}",
+                                    source, target)
+                return ref, why
             return self.triangles(geometry.data, name, scale), ""
         uri = geometry.uri or ""
         if (self.options.keep_package_uris and uri.startswith(("package://", "model://"))
@@ -425,6 +465,16 @@ class MeshExporter:
                 return MeshRef(self._stage(data, safe_file_name(path.name, "mesh")), scale, ext), ""
             try:
                 ready = for_mujoco(data, ext, scale)
+            except TooManyForStl as exc:
+                from modelkit.geometry.meshfiles import merge_identical_vertices
+
+                faces = np.arange(exc.corners.size // 3, dtype=np.int64).reshape(-1, 3)
+                mesh = TriangleMeshData(*merge_identical_vertices(exc.corners.reshape(-1, 3), faces))
+                ref, why = self._mujoco_triangles(mesh, path.stem, scale, f"mesh {uri}", collision)
+                if ref is not None:
+                    self.notes.note("MK804", f"mesh {path.name} converted to {ref.file_format.upper()}"
+                                    f"{_written_as(ref, 'stl', len(faces))}", source, target)
+                return ref, why
             except Unusable as exc:
                 return None, f"mesh {uri} cannot be read by MuJoCo ({exc})"
             if ready.flat and collision:
@@ -444,27 +494,35 @@ class MeshExporter:
             return None, f"mesh {uri} cannot be loaded ({exc.message})"
         part = f"#{geometry.fragment}" if geometry.fragment else ""
         unit = f", unit scale {loaded.unit_scale:g} applied" if loaded.unit_scale != 1.0 else ""
-        self.notes.note("MK804", f"mesh {path.name}{part} ({loaded.source_format}) converted to "
-                        f"{self.options.mesh_format.upper()}{unit}", source, target)
         written = "stl" if mujoco else self.options.mesh_format
         part_stem = path.stem + (f"_{geometry.fragment}" if geometry.fragment else "")
         stem = converted_stem(part_stem, ext, written)
         if mujoco:
-            return self._mujoco_triangles(loaded.mesh, stem, scale, f"mesh {uri}", collision)
-        return self.triangles(loaded.mesh, stem, scale), ""
+            ref, why = self._mujoco_triangles(loaded.mesh, stem, scale, f"mesh {uri}", collision)
+        else:
+            ref, why = self.triangles(loaded.mesh, stem, scale), ""
+        if ref is not None:
+            obj_why = _written_as(ref, self.options.mesh_format, len(loaded.mesh.faces))
+            self.notes.note("MK804", f"mesh {path.name}{part} ({loaded.source_format}) converted to "
+                            f"{ref.file_format.upper()}{unit}{obj_why}{CONVERTED_WHY.get(ext, '')}",
+                            source, target)
+        return ref, why
 
     def _mujoco_triangles(self, mesh: TriangleMeshData, name: str, scale: Vec3, what: str,
                           collision: bool) -> tuple[MeshRef | None, str]:
-        """Triangles written for MuJoCo: the checks of :func:`for_mujoco`, applied before staging."""
+        """Triangles written for MuJoCo: the checks of :func:`for_mujoco`, applied before staging; as OBJ
+        when an STL would hold more triangles than MuJoCo reads from one."""
         vertices = np.asarray(mesh.vertices, dtype=np.float64)
         faces = np.asarray(mesh.faces, dtype=np.int64)
         try:
-            corners = _checked(vertices[faces] if len(faces) else np.zeros((0, 3, 3)),
-                               stl=self.options.mesh_format == "stl")
+            corners = _checked(vertices[faces] if len(faces) else np.zeros((0, 3, 3)), stl=False)
         except Unusable as exc:
             return None, f"{what} cannot be read by MuJoCo ({exc})"
         if collision and _flat(corners):
             return None, (f"{what} is flat (all its vertices in one plane): MuJoCo cannot build the convex "
                           "hull it collides with")
-        ref = self.triangles(mesh, name, scale)
+        file_format = self.options.mesh_format
+        if file_format == "stl" and len(corners) > MUJOCO_MAX_STL_FACES:
+            file_format = "obj"  # MuJoCo's OBJ reader has no such bound (dexmate's gripper base: 294,002)
+        ref = self.triangles(mesh, name, scale, file_format)
         return MeshRef(ref.uri, ref.scale, ref.file_format, _hollow(corners, scale), False), ""

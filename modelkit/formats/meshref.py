@@ -19,7 +19,7 @@ from modelkit.model import Mesh
 from modelkit.resources import Resolution, Resolver, found_report
 from modelkit.textio import UnreadableFile, check_regular
 
-MESH_FILE_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl"})
+MESH_FILE_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl", ".glb", ".gltf"})
 
 
 def _symlink_loop(path: Path) -> bool:
@@ -118,7 +118,7 @@ class MeshChecker:
                 self.sink.emit(
                     "MK506",
                     f'resource "{uri}": {suffix or "no extension"} files are not supported '
-                    "(supported: .stl .obj .dae .wrl)",
+                    "(supported: .stl .obj .dae .wrl .glb .gltf)",
                     loc,
                     severity=severity,
                 )

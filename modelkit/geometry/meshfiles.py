@@ -1,4 +1,4 @@
-"""Load mesh files (STL, OBJ, COLLADA, VRML97) into triangles, the way Choreonoid reads them.
+"""Load mesh files (STL, OBJ, COLLADA, VRML97, glTF) into triangles, the way Choreonoid reads them.
 
 One entry point, :func:`load_mesh`, returns every triangle of a file (or of one named part of it) in
 metres, in the file's root frame. The rules follow ``docs/body-format.md`` §3.6 / §4.9:
@@ -43,7 +43,7 @@ __all__ = [
     "load_mesh",
 ]
 
-SUPPORTED_EXTENSIONS: frozenset[str] = frozenset({".stl", ".obj", ".dae", ".wrl"})
+SUPPORTED_EXTENSIONS: frozenset[str] = frozenset({".stl", ".obj", ".dae", ".wrl", ".glb", ".gltf"})
 
 #: Extensions Choreonoid reads through Assimp that modelkit does not read.
 _ASSIMP_ONLY_EXTENSIONS = frozenset({".blend", ".x", ".dxf"})
@@ -97,7 +97,7 @@ class LoadedMesh:
     mesh: TriangleMeshData  # all triangles of the file (or fragment), metres, file root frame
     parts: list[str]  # named nodes found (VRML DEF names / COLLADA node names), sorted
     unit_scale: float  # scale applied (COLLADA <unit meter> × metadata length unit)
-    source_format: str  # "stl" | "obj" | "dae" | "wrl"
+    source_format: str  # "stl" | "obj" | "dae" | "wrl" | "glb" | "gltf"
     notes: list[str] = field(default_factory=list)  # facts worth telling a user
 
 
@@ -174,6 +174,8 @@ def _load_data(
                 return _finish(_load_obj(data, path.name), path.name, fragment, metadata)
             if ext == ".dae":
                 return _load_dae(data, path.name, fragment, metadata)
+            if ext in (".glb", ".gltf"):
+                return _load_gltf(data, path, fragment, metadata)
             return _load_wrl(data, path.name, fragment, metadata)
     except MeshLoadError:
         raise
@@ -588,7 +590,7 @@ def compact_mesh(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> Mes
     return np.asarray(vertices[used], dtype=np.float64), remap[faces]
 
 
-def _merge_identical_vertices(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> Mesh:
+def merge_identical_vertices(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> Mesh:
     """Merge exactly equal vertices (STL is a triangle soup), keeping first-occurrence order.
 
     Rows are grouped by a stable ``lexsort`` of the three coordinates (equal as floats: -0.0 is 0.0,
@@ -680,7 +682,7 @@ def _load_stl(data: bytes, name: str) -> _Raw:
     v_all = np.concatenate(verts) if verts else np.zeros((0, 3))
     f_all = (np.concatenate([f + o for f, o in zip(faces, offsets, strict=False)])
              if faces else np.zeros((0, 3), dtype=np.int64))
-    v_all, f_all = _merge_identical_vertices(v_all, f_all)
+    v_all, f_all = merge_identical_vertices(v_all, f_all)
     return _Raw("stl", v_all, f_all, ["ASCII STL (some tools, e.g. MuJoCo, read only binary STL)"]
                 if kind == "ASCII" else [])
 
@@ -1050,6 +1052,29 @@ def _load_dae(data: bytes, name: str, fragment: str | None, metadata: MeshMetada
     if len(flat.faces) == 0:
         notes.append("no triangles")
     return LoadedMesh(TriangleMeshData(verts, flat.faces), flat.parts, total, "dae", notes)
+
+
+# ---- glTF 2.0 (trimesh) --------------------------------------------------------------------------
+
+
+def _load_gltf(data: bytes, path: Path, fragment: str | None, metadata: MeshMetadata | None) -> LoadedMesh:
+    """A ``.glb``/``.gltf`` file's triangles where its nodes place them (:mod:`modelkit.geometry.gltf`);
+    fragments are node names, as for COLLADA."""
+    from modelkit.geometry.gltf import GltfRefused, gltf_root
+
+    binary = path.suffix.lower() == ".glb"
+    try:
+        root = gltf_root(data, binary, path.parent)
+    except GltfRefused as exc:
+        raise MeshLoadError("MK501", f"{path.name}: {exc}") from exc
+    flat = flatten_scene([root], fragment, path.name)
+    notes = list(flat.notes)
+    scale, rot = _metadata_transform(metadata, notes)
+    verts = flat.vertices @ (scale * rot).T
+    _check_finite(verts, path.name)
+    if len(flat.faces) == 0:
+        raise MeshLoadError("MK501", f"{path.name} contains no triangles")
+    return LoadedMesh(TriangleMeshData(verts, flat.faces), flat.parts, scale, path.suffix.lower()[1:], notes)
 
 
 # ---- VRML97 ---------------------------------------------------------------------------------
