@@ -42,6 +42,7 @@ from modelkit.convert.friction import floor_friction
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.joint_springs import note_spring_dropped
 from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_vec
+from modelkit.formats.sdf.gz_inertia import libsdformat_accepts
 from modelkit.formats.sdf.kept import JOINT_KEY, LIMIT_KEY, MODEL_KEY, write_back
 from modelkit.formats.sdf.write_actuators import ActuatorWriter
 from modelkit.formats.sdf.write_devices import DeviceWriter, is_sdf_native
@@ -61,7 +62,8 @@ from modelkit.spatial import Mat3, Pose, Vec3
 
 TINY_MASS = 1e-6
 TINY_INERTIA = 1e-12
-INERTIA_MARGIN = 1e-12  # relative slack kept in A + B ≥ C, far above libsdformat's 10 machine epsilons
+INERTIA_MARGIN = 1e-12  # relative slack first kept in A + B ≥ C, far above libsdformat's 10 machine epsilons
+MARGIN_TRIES = 8  # up to 1e-5 of the largest moment (the Stretch puller needs 1e-8: gz-math's closed form)
 UNLIMITED = 1e16  # SDF's "no position limit" before 1.11
 LOOP_TYPES = {"fixed": "fixed", "hinge": "revolute", "ball": "ball", "piston": "prismatic"}
 SDF_NATIVE_ONLY = ("universal", "revolute2", "screw", "gearbox")
@@ -85,28 +87,45 @@ def massless(link: Link) -> bool:
 
 
 def sdformat_valid_inertia(m: Mat3) -> tuple[Mat3, Vec3, Vec3]:
-    """``m`` (symmetrised), or the nearest tensor libsdformat accepts (gz-math
-    ``MassMatrix3::IsValid``: principal moments ≥ 0 and A + B ≥ C within 10 machine epsilons).
+    """``m`` (symmetrised) when libsdformat accepts it as written (:func:`libsdformat_accepts`, gz-math's
+    own test on the decimals the writer writes), else the nearest tensor it accepts: the two smaller
+    principal moments lifted until A + B ≥ C holds with a relative margin that gz-math's closed-form
+    moments still see (none for a diagonal tensor, whose moments gz-math reads as they are; else from
+    1e-12 of the largest moment, ten times more at each try).
     Returns the tensor, the original principal moments and the written ones (equal: unchanged)."""
     m = 0.5 * (m + m.T)
     diagonal = not np.any(m - np.diag(np.diag(m)))
     moments, axes = np.linalg.eigh(m)
-    if diagonal:  # exact moments: libsdformat's own test, A + B + 10ε·C ≥ C
+    if diagonal:  # exact moments and axes
         order = np.argsort(np.diag(m), kind="stable")
         moments, axes = np.diag(m)[order], np.eye(3)[:, order]
+    if libsdformat_accepts(as_written(m)):
+        return m, moments, moments
     top = max(0.0, float(moments[-1]))
-    # off the diagonal, gz-math's eigen-solver rounds: keep a relative margin of INERTIA_MARGIN
-    low = -10.0 * np.finfo(float).eps * top if diagonal else top * INERTIA_MARGIN
-    fixed = np.maximum(moments, 0.0)
-    short = float(fixed[2] - fixed[0] - fixed[1])
-    if short > -low and short + low > 0.0:  # A + B ≥ C fails (or within the margin): lift A and B
-        lift = 0.5 * short + max(low, 0.0)
+    margin = 0.0 if diagonal else INERTIA_MARGIN  # a diagonal's moments are exact: A + B = C is accepted
+    adjusted, fixed = m, moments
+    for _ in range(MARGIN_TRIES):
+        fixed = np.maximum(moments, 0.0)
+        short = float(fixed[2] - fixed[0] - fixed[1])
+        lift = max(0.5 * short, 0.0) + top * margin
         fixed[0] += lift
         fixed[1] += lift
-    if np.array_equal(fixed, moments):
-        return m, moments, fixed
-    adjusted: Mat3 = axes @ np.diag(fixed) @ axes.T
+        adjusted = axes @ np.diag(fixed) @ axes.T
+        adjusted = 0.5 * (adjusted + adjusted.T)
+        if libsdformat_accepts(as_written(adjusted)):
+            break
+        margin = 10.0 * margin if margin else INERTIA_MARGIN
     return adjusted, moments, fixed
+
+
+def as_written(m: Mat3) -> Mat3:
+    """The symmetric tensor the SDF writer's decimals give back (``fmt`` of each element)."""
+    out = np.empty((3, 3))
+    for i in range(3):
+        for j in range(i, 3):
+            out[i, j] = out[j, i] = float(fmt(0.5 * (m[i, j] + m[j, i])))
+    return out
+
 
 class _ModelWriter:
     def __init__(self, robot: Robot, ctx: WriteContext) -> None:
