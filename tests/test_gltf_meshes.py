@@ -208,3 +208,98 @@ def test_a_mesh_over_mujocos_stl_bound_is_written_as_obj(tmp_path: Path) -> None
     model = mujoco.MjModel.from_xml_path(str(mjcf))
     assert model.mesh_facenum[0] == count
 
+
+
+# ---- colours: MuJoCo reads none from a mesh file, so a coloured visual becomes one geom per colour ----
+
+
+def _two_colour_glb(folder: Path) -> Path:
+    """Two boxes, red and half-transparent blue, in one .glb."""
+    scene = trimesh.Scene()
+    for offset, colour in (((0.0, 0.0, 0.0), [255, 0, 0, 255]), ((0.1, 0.0, 0.0), [0, 0, 255, 128])):
+        box = trimesh.creation.box(extents=BOX)
+        box.apply_translation(offset)
+        box.visual = trimesh.visual.TextureVisuals(material=trimesh.visual.material.PBRMaterial(
+            baseColorFactor=colour))
+        scene.add_geometry(box)
+    path = folder / "part.glb"
+    path.write_bytes(scene.export(file_type="glb"))
+    return path
+
+
+def test_glb_colours_are_read_per_face(tmp_path: Path) -> None:
+    loaded = load_mesh(_two_colour_glb(tmp_path))
+    assert loaded.face_colours is not None
+    assert sorted(loaded.palette) == [(0.0, 0.0, 1.0, 128 / 255), (1.0, 0.0, 0.0, 1.0)]
+    assert sorted(np.bincount(loaded.face_colours).tolist()) == [12, 12]
+
+
+def test_collada_colours_are_read_per_face() -> None:
+    from tests.conftest import example_robot
+
+    loaded = load_mesh(example_robot("ur_description/meshes/ur5/visual/base.dae"))
+    assert loaded.face_colours is not None
+    by_colour = dict(zip(loaded.palette, np.bincount(loaded.face_colours).tolist(), strict=True))
+    # the file's two <effect> diffuse colours and the triangles bound to each
+    assert by_colour == {(0.5248, 0.5248, 0.5248, 1.0): 1795, (0.064, 0.064, 0.064, 1.0): 137}
+
+
+def _rgba(model: mujoco.MjModel, geom: int) -> tuple[float, ...]:
+    return tuple(round(float(x), 4) for x in model.geom_rgba[geom])  # MuJoCo keeps float32
+
+
+def _mesh_geoms(model: mujoco.MjModel) -> list[int]:
+    return [g for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH]
+
+
+def test_a_coloured_visual_is_one_geom_per_colour(tmp_path: Path) -> None:
+    _two_colour_glb(tmp_path)
+    source = tmp_path / "g.urdf"
+    source.write_text(URDF.format(mesh="part.glb"))
+    mjcf = tmp_path / "out" / "g.xml"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(mjcf)])
+    assert result.exit_code == 0, result.output
+    assert "converted to 2 files, one per colour" in result.output
+    model = mujoco.MjModel.from_xml_path(str(mjcf))
+    visuals = [g for g in _mesh_geoms(model) if model.geom_group[g] == 1]
+    colours = sorted(_rgba(model, g) for g in visuals)
+    assert colours == [(0.0, 0.0, 1.0, round(128 / 255, 4)), (1.0, 0.0, 0.0, 1.0)]
+    assert sum(int(model.mesh_facenum[model.geom_dataid[g]]) for g in visuals) == 24
+    collisions = [g for g in _mesh_geoms(model) if model.geom_group[g] == 3]
+    assert len(collisions) == 1 and model.mesh_facenum[model.geom_dataid[collisions[0]]] == 24  # whole
+
+
+def test_a_visual_with_its_own_colour_keeps_it_whole(tmp_path: Path) -> None:
+    _two_colour_glb(tmp_path)
+    source = tmp_path / "g.urdf"
+    source.write_text(URDF.format(mesh="part.glb").replace(
+        '<visual><geometry><mesh filename="part.glb"/></geometry></visual>',
+        '<visual><geometry><mesh filename="part.glb"/></geometry>'
+        '<material name="green"><color rgba="0 1 0 1"/></material></visual>'))
+    mjcf = tmp_path / "out" / "g.xml"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(mjcf)])
+    assert result.exit_code == 0, result.output
+    model = mujoco.MjModel.from_xml_path(str(mjcf))
+    visuals = [g for g in _mesh_geoms(model) if model.geom_group[g] == 1]
+    assert len(visuals) == 1 and tuple(model.geom_rgba[visuals[0]]) == (0.0, 1.0, 0.0, 1.0)
+
+
+def test_ur5_visuals_keep_their_colours(tmp_path: Path) -> None:
+    """example-robot-data's UR5: each COLLADA visual becomes a geom per material colour, together every
+    triangle of the file, where before each was one grey geom."""
+    from tests.conftest import example_robot, example_robot_data
+
+    source = example_robot("ur_description/urdf/ur5_robot.urdf")
+    robots = example_robot_data()
+    assert robots is not None
+    mjcf = tmp_path / "out" / "ur5.xml"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(mjcf), "--package-path",
+                                       f"example-robot-data={robots.parent}"])
+    assert result.exit_code == 0, result.output
+    model = mujoco.MjModel.from_xml_path(str(mjcf))
+    base = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "base_link")
+    visuals = [g for g in _mesh_geoms(model) if model.geom_group[g] == 1 and model.geom_bodyid[g] == base]
+    assert len(visuals) == 2
+    assert sum(int(model.mesh_facenum[model.geom_dataid[g]]) for g in visuals) == 1795 + 137
+    assert {_rgba(model, g) for g in visuals} == {(0.5248, 0.5248, 0.5248, 1.0),
+                                                                        (0.064, 0.064, 0.064, 1.0)}

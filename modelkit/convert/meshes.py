@@ -327,6 +327,8 @@ def primitive_triangles(geometry: Cone | Capsule | Ellipsoid) -> TriangleMeshDat
 _GLTF_WHY = ("; glTF, which MuJoCo has no decoder for, PyBullet refuses a whole URDF for, and Choreonoid "
              "does not read; its materials and textures are not carried")
 CONVERTED_WHY = {"glb": _GLTF_WHY, "gltf": _GLTF_WHY}
+COLOURED_FORMATS = frozenset({"dae", "glb", "gltf"})  # mesh files whose materials give colours
+Rgba = tuple[float, float, float, float]
 
 
 def _written_as(ref: MeshRef, asked: str, triangles: int) -> str:
@@ -507,6 +509,50 @@ class MeshExporter:
                             f"{ref.file_format.upper()}{unit}{obj_why}{CONVERTED_WHY.get(ext, '')}",
                             source, target)
         return ref, why
+
+    def coloured_parts(self, geometry: Mesh, name: str, target: str,
+                       source: SourceLocation | None) -> list[tuple[MeshRef, Rgba | None]] | None:
+        """For MuJoCo, which reads no colour from a mesh file: a visual COLLADA or glTF file whose
+        materials give colours, as one mesh per colour, each with its colour (RGBA; None for faces
+        without one), as MuJoCo Menagerie splits its visual meshes by material. None when the file gives
+        no colour or cannot be read (:meth:`mesh` then writes it whole, or says why not)."""
+        from modelkit.geometry.meshfiles import MeshLoadError, MeshMetadata, compact_mesh
+
+        if geometry.path is None or geometry.generator or geometry.data is not None:
+            return None
+        path = Path(geometry.path)
+        ext = path.suffix.lower().lstrip(".")
+        if ext not in COLOURED_FORMATS:
+            return None
+        meta = geometry.source_params.get("metadata")
+        metadata = (MeshMetadata(meta.get("length_unit"), meta.get("upper_axis"))
+                    if isinstance(meta, dict) and meta else None)
+        try:
+            loaded = _loaded(path, geometry.fragment, metadata)
+        except MeshLoadError:
+            return None
+        if loaded.face_colours is None:
+            return None
+        self.plan.protect(path)
+        scale = np.asarray(geometry.scale, dtype=float)
+        part = f"#{geometry.fragment}" if geometry.fragment else ""
+        stem = converted_stem(path.stem + (f"_{geometry.fragment}" if geometry.fragment else ""), ext, "stl")
+        used = [k for k in range(len(loaded.palette)) if np.any(loaded.face_colours == k)]
+        parts: list[tuple[MeshRef, Rgba | None]] = []
+        for k in used:
+            vertices, faces = compact_mesh(loaded.mesh.vertices, loaded.mesh.faces[loaded.face_colours == k])
+            part_name = stem if len(used) == 1 else f"{stem}_{len(parts)}"
+            ref, _ = self._mujoco_triangles(TriangleMeshData(vertices, faces), part_name, scale,
+                                            f"mesh {geometry.uri}", False)
+            if ref is None:
+                return None
+            parts.append((ref, loaded.palette[k]))
+        unit = f", unit scale {loaded.unit_scale:g} applied" if loaded.unit_scale != 1.0 else ""
+        files = "one file" if len(parts) == 1 else f"{len(parts)} files, one per colour"
+        self.notes.note("MK804", f"mesh {path.name}{part} ({loaded.source_format}) converted to {files} "
+                        f"(MuJoCo reads no colour from a mesh file: each part's geom has its material's "
+                        f"colour){unit}", source, target)
+        return parts
 
     def _mujoco_triangles(self, mesh: TriangleMeshData, name: str, scale: Vec3, what: str,
                           collision: bool) -> tuple[MeshRef | None, str]:

@@ -60,12 +60,32 @@ def _folder_resolver(folder: Path, max_bytes: int) -> Any:
     return FolderOnly()
 
 
+Rgba = tuple[float, float, float, float]
+
+
+def _base_colour(geometry: Any) -> Rgba | None:
+    """A primitive's material colour (``baseColorFactor``, RGBA 0..1); None without one."""
+    material = getattr(getattr(geometry, "visual", None), "material", None)
+    factor = getattr(material, "baseColorFactor", None)
+    if factor is None:
+        return None
+    values = np.asarray(factor, dtype=np.float64).reshape(-1)
+    if len(values) not in (3, 4) or not np.all(np.isfinite(values)):
+        return None
+    if np.asarray(factor).dtype == np.uint8:  # trimesh keeps the factor as bytes
+        values = values / 255.0
+    values = np.clip(values, 0.0, 1.0)
+    alpha = float(values[3]) if len(values) == 4 else 1.0
+    return (float(values[0]), float(values[1]), float(values[2]), alpha)
+
+
 def gltf_graph(data: bytes, binary: bool, folder: Path,
                max_bytes: int = DEFAULT_MAX_BYTES) -> tuple[list[tuple[str, str, NDArray[np.float64]]],
-                                                           dict[str, list[Mesh]]]:
+                                                           dict[str, list[tuple[Mesh, Rgba | None]]]]:
     """The scene of a glTF file: its edges (parent node, child node, the child's 4×4 transform in its
-    parent), from the root ``world``, and the triangles each node holds, in its own frame.
-    Raises :class:`GltfRefused` for anything that is not a usable glTF scene of triangles."""
+    parent), from the root ``world``, and the triangles each node holds, in its own frame, each mesh
+    with its material's colour. Raises :class:`GltfRefused` for anything that is not a usable glTF
+    scene of triangles."""
     import trimesh
 
     resolver = _folder_resolver(folder, max_bytes)
@@ -77,7 +97,7 @@ def gltf_graph(data: bytes, binary: bool, folder: Path,
     except Exception as exc:  # trimesh's own failures: a wrong magic number, bad JSON, short buffers
         raise GltfRefused(f"not a readable glTF file ({type(exc).__name__}: {exc})") from exc
     edges: list[tuple[str, str, NDArray[np.float64]]] = []
-    meshes: dict[str, list[Mesh]] = {}
+    meshes: dict[str, list[tuple[Mesh, Rgba | None]]] = {}
     for parent, child, attributes in scene.graph.to_edgelist():
         matrix = np.asarray(attributes.get("matrix", np.eye(4)), dtype=np.float64).reshape(4, 4)
         edges.append((str(parent), str(child), matrix))
@@ -87,7 +107,8 @@ def gltf_graph(data: bytes, binary: bool, folder: Path,
         if geometry is None or faces is None or len(faces) == 0:
             continue  # points, lines, or a node without a mesh
         vertices = np.asarray(geometry.vertices, dtype=np.float64).reshape(-1, 3)
-        meshes.setdefault(str(child), []).append((vertices, np.asarray(faces, dtype=np.int64).reshape(-1, 3)))
+        mesh = (vertices, np.asarray(faces, dtype=np.int64).reshape(-1, 3))
+        meshes.setdefault(str(child), []).append((mesh, _base_colour(geometry)))
     return edges, meshes
 
 
@@ -102,7 +123,9 @@ def gltf_root(data: bytes, binary: bool, folder: Path, max_bytes: int = DEFAULT_
     def node(name: str) -> MeshSceneNode:
         found = nodes.get(name)
         if found is None:
-            found = nodes[name] = MeshSceneNode(name=name, meshes=list(meshes.get(name, [])))
+            held = meshes.get(name, [])
+            found = nodes[name] = MeshSceneNode(name=name, meshes=[m for m, _ in held],
+                                                colours=[c for _, c in held])
         return found
 
     root = node("world")

@@ -62,6 +62,7 @@ UPPER_AXIS_Y_ROTATION: NDArray[np.float64] = np.array(
 )
 
 Mesh = tuple[NDArray[np.float64], NDArray[np.int64]]  # (vertices (n,3), faces (m,3))
+Rgba = tuple[float, float, float, float]
 
 
 # ---- public types ---------------------------------------------------------------------------
@@ -99,6 +100,10 @@ class LoadedMesh:
     unit_scale: float  # scale applied (COLLADA <unit meter> × metadata length unit)
     source_format: str  # "stl" | "obj" | "dae" | "wrl" | "glb" | "gltf"
     notes: list[str] = field(default_factory=list)  # facts worth telling a user
+    # The file's own colours (COLLADA, glTF): per face an index into ``palette`` (RGBA 0..1, None for a
+    # face without a colour of its own); None when the file gives none
+    face_colours: NDArray[np.int64] | None = None
+    palette: list[Rgba | None] = field(default_factory=list)
 
 
 # ---- entry point ----------------------------------------------------------------------------
@@ -322,6 +327,7 @@ class MeshSceneNode:
     matrix: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
     meshes: list[Mesh] = field(default_factory=list)
     children: list[MeshSceneNode] = field(default_factory=list)
+    colours: list[Rgba | None] = field(default_factory=list)  # per mesh, when the file gives colours
 
 
 @dataclass
@@ -330,6 +336,8 @@ class _Flattened:
     faces: NDArray[np.int64]
     parts: list[str]
     notes: list[str]
+    face_colours: NDArray[np.int64] | None = None
+    palette: list[Rgba | None] = field(default_factory=list)
 
 
 def _scene_names(roots: Sequence[MeshSceneNode]) -> list[str]:
@@ -400,28 +408,33 @@ def flatten_scene(roots: Sequence[MeshSceneNode], fragment: str | None, file_nam
     else:
         starts = [(r, r.matrix) for r in roots]
 
-    instances: list[tuple[Mesh, NDArray[np.float64]]] = []
+    instances: list[tuple[Mesh, NDArray[np.float64], Rgba | None]] = []
     n_tri = 0
     visits = 0
     stack = list(reversed(starts))
     while stack:
         node, acc = stack.pop()
         visits = _count_visit(visits, file_name)
-        for mesh in node.meshes:
+        for k, mesh in enumerate(node.meshes):
             n_tri += len(mesh[1])
             if n_tri > MAX_TRIANGLES:
                 raise MeshLoadError("MK501", f"{file_name} expands to more than {MAX_TRIANGLES} triangles")
-            instances.append((mesh, acc))
+            instances.append((mesh, acc, node.colours[k] if k < len(node.colours) else None))
         for child in reversed(node.children):
             stack.append((child, acc @ child.matrix))
 
     verts: list[NDArray[np.float64]] = []
     faces: list[NDArray[np.int64]] = []
+    palette: list[Rgba | None] = []
+    colour_runs: list[NDArray[np.int64]] = []
     offset = 0
     mirrored = 0
-    for (v, f), acc in instances:
+    for (v, f), acc, colour in instances:
         if len(f) == 0:
             continue
+        if colour not in palette:
+            palette.append(colour)
+        colour_runs.append(np.full(len(f), palette.index(colour), dtype=np.int64))
         lin = acc[:3, :3]
         verts.append(v @ lin.T + acc[:3, 3])
         ff = f + offset
@@ -433,7 +446,9 @@ def flatten_scene(roots: Sequence[MeshSceneNode], fragment: str | None, file_nam
     if mirrored:
         notes.append(f"{mirrored} mesh instance(s) under a mirroring transform: triangle winding reversed")
     if verts:
-        return _Flattened(np.concatenate(verts), np.concatenate(faces).astype(np.int64), parts, notes)
+        coloured = any(c is not None for c in palette)
+        return _Flattened(np.concatenate(verts), np.concatenate(faces).astype(np.int64), parts, notes,
+                          np.concatenate(colour_runs) if coloured else None, palette if coloured else [])
     return _Flattened(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), parts, notes)
 
 
@@ -848,6 +863,23 @@ def _dae_transform(t: Any) -> NDArray[np.float64]:
     return m
 
 
+def _bound_colours(instance: Any) -> dict[str, Rgba]:
+    """Material symbol → the diffuse RGBA of the material an ``<instance_geometry>`` (or controller)
+    binds to it; a textured or colourless material has none."""
+    out: dict[str, Rgba] = {}
+    for bound in getattr(instance, "materials", None) or []:
+        effect = getattr(getattr(bound, "target", None), "effect", None)
+        diffuse = getattr(effect, "diffuse", None)
+        if isinstance(diffuse, tuple) and len(diffuse) >= 3:
+            try:
+                rgba = tuple(min(max(float(x), 0.0), 1.0) for x in (*diffuse[:3], *(diffuse[3:4] or (1.0,))))
+            except (TypeError, ValueError):
+                continue
+            if all(math.isfinite(x) for x in rgba):
+                out[str(bound.symbol)] = (rgba[0], rgba[1], rgba[2], rgba[3])
+    return out
+
+
 class _DaeConverter:
     """pycollada scene → :class:`MeshSceneNode` graph (node names, float64 transforms)."""
 
@@ -855,20 +887,23 @@ class _DaeConverter:
         self.name = name
         self.notes: list[str] = []
         self._nodes: dict[int, MeshSceneNode | None] = {}
-        self._geoms: dict[int, list[Mesh]] = {}
+        self._geoms: dict[tuple[int, tuple[tuple[str, Rgba], ...]], list[tuple[Mesh, Rgba | None]]] = {}
         self._skipped_polys = 0
         self._line_prims = 0
         self._other: set[str] = set()
 
-    def geometry(self, geom: Any) -> list[Mesh]:
-        key = id(geom)
+    def geometry(self, geom: Any, colours: dict[str, Rgba] | None = None) -> list[tuple[Mesh, Rgba | None]]:
+        """The triangles of a ``<geometry>``, one mesh per vertex source and material, each with the
+        diffuse colour its ``<bind_material>`` (``colours``: symbol → RGBA) gives it (None: none)."""
+        binding = tuple(sorted((colours or {}).items()))
+        key = (id(geom), binding)
         if key in self._geoms:
             return self._geoms[key]
         from collada.lineset import LineSet
         from collada.polylist import Polylist
         from collada.triangleset import TriangleSet
 
-        groups: dict[int, tuple[NDArray[np.float64], list[NDArray[np.int64]]]] = {}
+        groups: dict[tuple[int, Rgba | None], tuple[NDArray[np.float64], list[NDArray[np.int64]]]] = {}
         for prim in geom.primitives:
             if isinstance(prim, LineSet):
                 self._line_prims += 1
@@ -891,10 +926,11 @@ class _DaeConverter:
             else:
                 self._other.add(type(prim).__name__)
                 continue
-            entry = groups.setdefault(id(vsrc), (verts, []))
+            colour = (colours or {}).get(str(getattr(prim, "material", None) or ""))
+            entry = groups.setdefault((id(vsrc), colour), (verts, []))
             entry[1].append(faces)
-        meshes = [compact_mesh(v, np.concatenate(fs)) for v, fs in groups.values()]
-        meshes = [m for m in meshes if len(m[1])]
+        meshes = [(compact_mesh(v, np.concatenate(fs)), group[1]) for group, (v, fs) in groups.items()]
+        meshes = [(m, c) for m, c in meshes if len(m[1])]
         self._geoms[key] = meshes
         return meshes
 
@@ -924,7 +960,9 @@ class _DaeConverter:
             elif isinstance(child, Node):
                 real.append(child)
             elif isinstance(child, GeometryNode):
-                out.meshes.extend(self.geometry(child.geometry))
+                for mesh, colour in self.geometry(child.geometry, _bound_colours(child)):
+                    out.meshes.append(mesh)
+                    out.colours.append(colour)
             elif isinstance(child, ControllerNode):
                 self._controller(child, out)
         # Assimp lists a node's own <node> children before its <instance_node>s
@@ -944,8 +982,9 @@ class _DaeConverter:
             self._other.add(type(ctrl).__name__)
             return
         b = np.asarray(bind, dtype=np.float64).reshape(4, 4)
-        for v, f in self.geometry(geom):
+        for (v, f), colour in self.geometry(geom, _bound_colours(child)):
             out.meshes.append((v @ b[:3, :3].T + b[:3, 3], f))
+            out.colours.append(colour)
         self.notes.append("skinned mesh (<instance_controller>) taken in its bind pose")
 
     def finish_notes(self) -> list[str]:
@@ -1051,7 +1090,8 @@ def _load_dae(data: bytes, name: str, fragment: str | None, metadata: MeshMetada
     _check_finite(verts, name)
     if len(flat.faces) == 0:
         notes.append("no triangles")
-    return LoadedMesh(TriangleMeshData(verts, flat.faces), flat.parts, total, "dae", notes)
+    return LoadedMesh(TriangleMeshData(verts, flat.faces), flat.parts, total, "dae", notes,
+                      flat.face_colours, flat.palette)
 
 
 # ---- glTF 2.0 (trimesh) --------------------------------------------------------------------------
@@ -1074,7 +1114,8 @@ def _load_gltf(data: bytes, path: Path, fragment: str | None, metadata: MeshMeta
     _check_finite(verts, path.name)
     if len(flat.faces) == 0:
         raise MeshLoadError("MK501", f"{path.name} contains no triangles")
-    return LoadedMesh(TriangleMeshData(verts, flat.faces), flat.parts, scale, path.suffix.lower()[1:], notes)
+    return LoadedMesh(TriangleMeshData(verts, flat.faces), flat.parts, scale, path.suffix.lower()[1:], notes,
+                      flat.face_colours, flat.palette)
 
 
 # ---- VRML97 ---------------------------------------------------------------------------------

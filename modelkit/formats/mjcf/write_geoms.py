@@ -45,6 +45,7 @@ import numpy as np
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import FLOOR_MATERIAL, PairFriction
+from modelkit.convert.meshes import MeshRef
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.diagnostics import SourceLocation
 from modelkit.formats.mjcf.bodies import GEOM_CONTACT_DEFAULTS
@@ -133,9 +134,12 @@ class GeomWriter:
                 target,
             )
             return None
-        shape = self.shape(
-            geom, target, f"{link.name}_{target.rsplit('/', 1)[1].replace('[', '').rstrip(']')}", collision
-        )
+        file_stem = f"{link.name}_{target.rsplit('/', 1)[1].replace('[', '').rstrip(']')}"
+        if not collision and geom.material is None and isinstance(geom.geometry, Mesh):
+            parts = self.ctx.meshes.coloured_parts(geom.geometry, file_stem, target, geom.source)
+            if parts is not None:
+                return self._coloured_geoms(body, geom, target, parts)
+        shape = self.shape(geom, target, file_stem, collision)
         if shape is None:
             return None
         el = sub(body, "geom")
@@ -185,6 +189,31 @@ class GeomWriter:
         asset = self.mesh_asset(ref.uri, np.asarray(ref.scale, dtype=float), target, ref.hollow, geom.source,
                                 stem)
         return {"type": "mesh", "mesh": asset}
+
+    def _coloured_geoms(self, body: Element, geom: Geom, target: str,
+                        parts: list[tuple[MeshRef, tuple[float, float, float, float] | None]]) -> Element:
+        """A visual mesh whose file gives colours (COLLADA, glTF), as one visual geom per colour
+        (:meth:`MeshExporter.coloured_parts`): the first is returned (it carries the source's name)."""
+        assert isinstance(geom.geometry, Mesh)
+        stem = source_stem(geom.geometry)
+        first: Element | None = None
+        for k, (ref, rgba) in enumerate(parts):
+            name = stem if stem is None or len(parts) == 1 else f"{stem}_{k}"
+            scale = np.asarray(ref.scale, dtype=float)
+            asset = self.mesh_asset(ref.uri, scale, target, ref.hollow, geom.source, name)
+            el = sub(body, "geom")
+            if first is None and geom.name:
+                el.set("name", self.names.claim("geom", geom.name, geom.source, target))
+            el.set("type", "mesh")
+            el.set("mesh", asset)
+            set_pose(el, geom.pose)
+            el.set("class", VISUAL)
+            if rgba is not None:
+                el.set("rgba", fmt_vec(rgba))
+            first = first if first is not None else el
+        self.used.add(VISUAL)
+        assert first is not None  # coloured_parts gives at least one part
+        return first
 
     def mesh_asset(self, uri: str, scale: np.ndarray, target: str, hollow: bool = False,
                    source: SourceLocation | None = None, stem: str | None = None) -> str:
