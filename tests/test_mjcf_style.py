@@ -15,6 +15,12 @@ and gave every geom priority 1; the reference now holds the source's, which the 
 exactly (each of its 19 collision geoms and the option checked against MuJoCo's compile of the
 source itself).
 
+A second one: visual COLLADA and glTF meshes are split by their materials' colours, one geom per colour
+(docs/convert.md, "A mesh file's own colours"). The reference was regenerated after checking that,
+with the visual mesh geoms left out on both sides, today's output compiled exactly to the reference
+before it on all ten robots; the visual mesh geoms went from 20 to 21 (Go1), 7 to 9 (KR16), 11 to 28
+(Panda) and 7 to 20 (UR5), unchanged elsewhere.
+
 Regenerate the reference only from a writer known to be right:
 ``python -m tests.test_mjcf_style > tests/mjcf/style_before.json``.
 """
