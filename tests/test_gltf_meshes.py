@@ -18,6 +18,7 @@ from click.testing import CliRunner
 
 from modelkit.cli import main
 from modelkit.geometry.meshfiles import MeshLoadError, load_mesh
+from tests.test_sdf_reader import oracle_has_errors, sdf_oracle  # noqa: F401 (the fixture)
 
 # A node turned 90° about Z and moved: the box's triangles must be read where the node puts them.
 NODE = trimesh.transformations.rotation_matrix(np.pi / 2, [0, 0, 1])
@@ -303,3 +304,31 @@ def test_ur5_visuals_keep_their_colours(tmp_path: Path) -> None:
     assert sum(int(model.mesh_facenum[model.geom_dataid[g]]) for g in visuals) == 1795 + 137
     assert {_rgba(model, g) for g in visuals} == {(0.5248, 0.5248, 0.5248, 1.0),
                                                                         (0.064, 0.064, 0.064, 1.0)}
+
+
+def test_urdf_and_sdf_visuals_keep_the_colours_too(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+    """The STL a glTF (or a converted COLLADA) file becomes holds no colour in any format: the URDF
+    gets a <visual> per colour with its <material> (PyBullet shows it), the SDF a <visual> per colour
+    with its <material> and, below alpha 1, <transparency> (libsdformat loads it)."""
+    _two_colour_glb(tmp_path)
+    source = tmp_path / "g.urdf"
+    source.write_text(URDF.format(mesh="part.glb"))
+    urdf, sdf = tmp_path / "out" / "g.urdf", tmp_path / "out" / "g.sdf"
+    for target in (urdf, sdf):
+        result = CliRunner().invoke(main, ["convert", str(source), "-o", str(target)])
+        assert result.exit_code == 0, result.output
+        assert "converted to 2 files, one per colour" in result.output
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        body = pybullet.loadURDF(str(urdf), physicsClientId=client)
+        base = next(i for i in range(pybullet.getNumJoints(body, physicsClientId=client))
+                    if pybullet.getJointInfo(body, i, physicsClientId=client)[12] == b"base")
+        shapes = pybullet.getVisualShapeData(body, physicsClientId=client)
+        colours = sorted(tuple(round(c, 4) for c in shape[7]) for shape in shapes if shape[1] == base)
+    finally:
+        pybullet.disconnect(client)
+    assert colours == [(0.0, 0.0, 1.0, round(128 / 255, 4)), (1.0, 0.0, 0.0, 1.0)]
+    written = sdf.read_text()
+    assert written.count("<visual ") == 2 and "<diffuse>1 0 0 1</diffuse>" in written
+    assert "<transparency>" in written
+    assert not oracle_has_errors(sdf_oracle, sdf)

@@ -3,7 +3,7 @@ lost). example-robot-data's UR5 has ``base.dae`` (visual) beside ``base.stl`` (c
 written ``base.stl`` and ``base_2.stl`` in the order each writer met them, the MJCF writer collision
 first and the URDF writer visual first, so the second conversion was refused and, with ``--force``,
 replaced the first one's meshes with other shapes. A converted mesh now keeps its source's suffix in
-its name (``base_dae.stl``)."""
+its name (``base_dae.stl``; split by its colours, ``base_dae_0.stl`` and ``base_dae_1.stl``)."""
 
 from __future__ import annotations
 
@@ -28,7 +28,8 @@ def test_mjcf_urdf_and_sdf_of_one_robot_share_a_folder(tmp_path: Path,
         result = CliRunner().invoke(main, ["convert", str(source), "-o", str(tmp_path / f"ur5.{suffix}")])
         assert result.exit_code == 0, result.output
     meshes = {p.name for p in (tmp_path / "meshes").iterdir()}
-    assert {"base.stl", "base_dae.stl"} <= meshes and "base_2.stl" not in meshes
+    # the visual base.dae, split by its two colours (docs/convert.md, "A mesh file's own colours")
+    assert {"base.stl", "base_dae_0.stl", "base_dae_1.stl"} <= meshes and "base_2.stl" not in meshes
     urdf = (tmp_path / "ur5.urdf").read_text()
-    assert 'filename="meshes/base_dae.stl"' in urdf and 'filename="meshes/base.stl"' in urdf
+    assert 'filename="meshes/base_dae_0.stl"' in urdf and 'filename="meshes/base.stl"' in urdf
     mujoco.MjModel.from_xml_path(str(tmp_path / "ur5.xml"))

@@ -325,8 +325,10 @@ def primitive_triangles(geometry: Cone | Capsule | Ellipsoid) -> TriangleMeshDat
 
 # Why a mesh of this kind is converted, and what of it is not carried (said in its MK804 note).
 _GLTF_WHY = ("; glTF, which MuJoCo has no decoder for, PyBullet refuses a whole URDF for, and Choreonoid "
-             "does not read; its materials and textures are not carried")
+             "does not read")
+_GLTF_LOST = "; its materials and textures are not carried"
 CONVERTED_WHY = {"glb": _GLTF_WHY, "gltf": _GLTF_WHY}
+NOT_CARRIED = {"glb": _GLTF_LOST, "gltf": _GLTF_LOST}  # said when the file is converted whole
 COLOURED_FORMATS = frozenset({"dae", "glb", "gltf"})  # mesh files whose materials give colours
 Rgba = tuple[float, float, float, float]
 
@@ -506,16 +508,20 @@ class MeshExporter:
         if ref is not None:
             obj_why = _written_as(ref, self.options.mesh_format, len(loaded.mesh.faces))
             self.notes.note("MK804", f"mesh {path.name}{part} ({loaded.source_format}) converted to "
-                            f"{ref.file_format.upper()}{unit}{obj_why}{CONVERTED_WHY.get(ext, '')}",
+                            f"{ref.file_format.upper()}{unit}{obj_why}{CONVERTED_WHY.get(ext, '')}"
+                            f"{NOT_CARRIED.get(ext, '')}",
                             source, target)
         return ref, why
 
-    def coloured_parts(self, geometry: Mesh, name: str, target: str,
-                       source: SourceLocation | None) -> list[tuple[MeshRef, Rgba | None]] | None:
-        """For MuJoCo, which reads no colour from a mesh file: a visual COLLADA or glTF file whose
-        materials give colours, as one mesh per colour, each with its colour (RGBA; None for faces
-        without one), as MuJoCo Menagerie splits its visual meshes by material. None when the file gives
-        no colour or cannot be read (:meth:`mesh` then writes it whole, or says why not)."""
+    def coloured_parts(self, geometry: Mesh, target: str, source: SourceLocation | None,
+                       readable: tuple[str, ...], mujoco: bool = False
+                       ) -> list[tuple[MeshRef, Rgba | None]] | None:
+        """A visual COLLADA or glTF file whose materials give colours, and which the target converts (it
+        does not read it, ``readable``), as one mesh per colour, each with its colour (RGBA; None for
+        faces without one): the STL or OBJ it becomes holds no colour, so the writer gives each part's
+        shape its colour, as MuJoCo Menagerie splits its visual meshes by material. None when the file
+        is copied as it is, gives no colour or cannot be read (:meth:`mesh` then writes it whole, or
+        says why not)."""
         from modelkit.geometry.meshfiles import MeshLoadError, MeshMetadata, compact_mesh
 
         if geometry.path is None or geometry.generator or geometry.data is not None:
@@ -527,6 +533,9 @@ class MeshExporter:
         meta = geometry.source_params.get("metadata")
         metadata = (MeshMetadata(meta.get("length_unit"), meta.get("upper_axis"))
                     if isinstance(meta, dict) and meta else None)
+        copied = ext in readable and not geometry.fragment and metadata is None
+        if copied and (ext != "dae" or self.options.keep_collada):
+            return None  # the file keeps its own colours
         try:
             loaded = _loaded(path, geometry.fragment, metadata)
         except MeshLoadError:
@@ -536,22 +545,28 @@ class MeshExporter:
         self.plan.protect(path)
         scale = np.asarray(geometry.scale, dtype=float)
         part = f"#{geometry.fragment}" if geometry.fragment else ""
-        stem = converted_stem(path.stem + (f"_{geometry.fragment}" if geometry.fragment else ""), ext, "stl")
+        written = "stl" if mujoco else self.options.mesh_format
+        fragment = f"_{geometry.fragment}" if geometry.fragment else ""
+        stem = converted_stem(path.stem + fragment, ext, written)
         used = [k for k in range(len(loaded.palette)) if np.any(loaded.face_colours == k)]
         parts: list[tuple[MeshRef, Rgba | None]] = []
         for k in used:
             vertices, faces = compact_mesh(loaded.mesh.vertices, loaded.mesh.faces[loaded.face_colours == k])
             part_name = stem if len(used) == 1 else f"{stem}_{len(parts)}"
-            ref, _ = self._mujoco_triangles(TriangleMeshData(vertices, faces), part_name, scale,
-                                            f"mesh {geometry.uri}", False)
+            mesh = TriangleMeshData(vertices, faces)
+            if mujoco:
+                ref, _ = self._mujoco_triangles(mesh, part_name, scale, f"mesh {geometry.uri}", False)
+            else:
+                ref = self.triangles(mesh, part_name, scale)
             if ref is None:
                 return None
             parts.append((ref, loaded.palette[k]))
         unit = f", unit scale {loaded.unit_scale:g} applied" if loaded.unit_scale != 1.0 else ""
         files = "one file" if len(parts) == 1 else f"{len(parts)} files, one per colour"
+        kinds = sorted({ref.file_format.upper() for ref, _ in parts})
         self.notes.note("MK804", f"mesh {path.name}{part} ({loaded.source_format}) converted to {files} "
-                        f"(MuJoCo reads no colour from a mesh file: each part's geom has its material's "
-                        f"colour){unit}", source, target)
+                        f"({'/'.join(kinds)}, which hold no colour: each part's shape has its material's "
+                        f"colour){unit}{CONVERTED_WHY.get(ext, '')}", source, target)
         return parts
 
     def _mujoco_triangles(self, mesh: TriangleMeshData, name: str, scale: Vec3, what: str,

@@ -136,7 +136,8 @@ class GeomWriter:
             return None
         file_stem = f"{link.name}_{target.rsplit('/', 1)[1].replace('[', '').rstrip(']')}"
         if not collision and geom.material is None and isinstance(geom.geometry, Mesh):
-            parts = self.ctx.meshes.coloured_parts(geom.geometry, file_stem, target, geom.source)
+            parts = self.ctx.meshes.coloured_parts(geom.geometry, target, geom.source, MESH_READABLE,
+                                                   mujoco=True)
             if parts is not None:
                 return self._coloured_geoms(body, geom, target, parts)
         shape = self.shape(geom, target, file_stem, collision)

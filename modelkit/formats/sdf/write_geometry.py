@@ -13,6 +13,7 @@ from lxml.etree import _Element as Element
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import PairFriction, describe
+from modelkit.convert.meshes import MeshRef
 from modelkit.convert.names import unique_name
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.formats.sdf.kept import shape_entries, write_back
@@ -61,6 +62,11 @@ class GeomWriter:
             for index, geom in enumerate(geoms):
                 name = unique_name(geom.name or f"{kind}_{index}", used)
                 target = f"link[{written}]/{kind}[{name}]"
+                if kind == "visual" and geom.material is None and isinstance(geom.geometry, Mesh):
+                    parts = self.ctx.meshes.coloured_parts(geom.geometry, target, geom.source, MESH_READABLE)
+                    if parts is not None:
+                        self._coloured_visuals(el, geom, name, parts, used, offset, relative_to)
+                        continue
                 shape = sub(el, kind, name=name)
                 add_pose(shape, offset @ geom.pose, relative_to)
                 if not self._geometry(shape, geom, f"{written}_{kind}_{name}", target):
@@ -76,6 +82,24 @@ class GeomWriter:
                     self._surface(shape, geom.friction, link, target)
                 elif friction is not None:
                     self._friction(shape, friction, link, target)
+
+    def _coloured_visuals(self, el: Element, geom: Geom, name: str,
+                          parts: list[tuple[MeshRef, tuple[float, float, float, float] | None]],
+                          used: set[str], offset: Pose, relative_to: str | None) -> None:
+        """A visual mesh split by its file's colours (:meth:`MeshExporter.coloured_parts`): one
+        ``<visual>`` per part (the first keeps the name), each with its colour as its material."""
+        for k, (ref, colour) in enumerate(parts):
+            visual = sub(el, "visual", name=name if k == 0 else unique_name(f"{name}_{k}", used))
+            add_pose(visual, offset @ geom.pose, relative_to)
+            mesh = sub(sub(visual, "geometry"), "mesh")
+            sub(mesh, "uri", ref.uri)
+            if any(abs(float(s) - 1.0) > 0.0 for s in ref.scale):
+                sub(mesh, "scale", fmt_vec(ref.scale))
+            if colour is not None and colour[3] < 1.0:
+                num(visual, "transparency", 1.0 - colour[3])
+            if colour is not None:
+                self._colours(sub(visual, "material"),
+                              VisualMaterial(diffuse=colour[:3], transparency=1.0 - colour[3]))
 
     def _geometry(self, parent: Element, geom: Geom, mesh_name: str, target: str) -> bool:
         g = geom.geometry

@@ -168,11 +168,31 @@ def _mesh_element(parent: Element, ref: MeshRef) -> None:
         el.set("scale", fmt_vec(scale))
 
 
+MESH_READABLE = ("stl", "obj", "dae")  # what the URDF writer copies (COLLADA with --keep-collada)
+
+
+def _coloured_visual(geom: Geom, ref: MeshRef, colour: tuple[float, float, float, float] | None,
+                     materials: MaterialTable, fallback: str, with_name: bool) -> Element:
+    """One part of a visual mesh split by its file's colours (:meth:`MeshExporter.coloured_parts`), with
+    its colour as the visual's ``<material>``."""
+    item = etree.Element("visual")
+    if with_name and geom.name:
+        item.set("name", geom.name)
+    origin_element(item, geom.pose)
+    _mesh_element(etree.SubElement(item, "geometry"), ref)
+    if colour is not None:
+        material = VisualMaterial(diffuse=colour[:3], transparency=1.0 - colour[3])
+        mat_name = materials.add(material, fallback, None)
+        if mat_name is not None:
+            etree.SubElement(item, "material", name=mat_name)
+    return item
+
+
 def geometry_element(parent: Element, geom: Geom, ctx: WriteContext, target: str, mesh_name: str) -> bool:
     """``<geometry>`` for the geom; False (nothing written) when its mesh is missing."""
     shape = geom.geometry
     if isinstance(shape, Mesh):
-        ref = ctx.meshes.mesh(shape, mesh_name, target, geom.source, readable=("stl", "obj", "dae"))
+        ref = ctx.meshes.mesh(shape, mesh_name, target, geom.source, readable=MESH_READABLE)
         if ref is None:
             return False
         _mesh_element(etree.SubElement(parent, "geometry"), ref)
@@ -229,6 +249,13 @@ def link_element(
     for kind, geoms in (("visual", link.visuals), ("collision", link.collisions)):
         for i, geom in enumerate(geoms):
             where = f"{target}/{kind}[{i}]"
+            if kind == "visual" and geom.material is None and isinstance(geom.geometry, Mesh):
+                parts = ctx.meshes.coloured_parts(geom.geometry, where, geom.source, MESH_READABLE)
+                if parts is not None:
+                    for k, (ref, colour) in enumerate(parts):
+                        el.append(_coloured_visual(geom, ref, colour, materials, f"{name}_visual{i}_{k}",
+                                                   with_name=k == 0 and "visual" not in unnamed))
+                    continue
             item = etree.Element(kind)
             if geom.name and kind not in unnamed:
                 item.set("name", geom.name)
