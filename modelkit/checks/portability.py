@@ -12,7 +12,7 @@ from pathlib import PurePosixPath
 from modelkit.checks.masses import lumped_masses, subtree
 from modelkit.checks.registry import rule
 from modelkit.diagnostics import Diagnostic, diag, did_you_mean
-from modelkit.model import WORLD_LINK, Joint, JointType, Robot
+from modelkit.model import WORLD_LINK, Geom, Joint, JointType, Link, Robot
 
 URDF_FORMATS = frozenset({"urdf", "xacro"})
 ONE_DOF = frozenset({JointType.REVOLUTE, JointType.PRISMATIC})
@@ -143,45 +143,43 @@ def massless_links_dropped(robot: Robot) -> Iterator[Diagnostic]:
 GLTF_SUFFIXES = frozenset({".glb", ".gltf"})
 
 
+def _urdf_meshes(robot: Robot, suffixes: frozenset[str]) -> Iterator[tuple[Link, Geom, str]]:
+    """A URDF's mesh shapes whose file has one of ``suffixes``, each file once (its first shape)."""
+    if robot.source_format not in URDF_FORMATS:
+        return
+    seen: set[str] = set()
+    for link in robot.links:
+        for geom in [*link.visuals, *link.collisions]:
+            uri = getattr(geom.geometry, "uri", None)
+            if not uri or PurePosixPath(uri.split("?")[0]).suffix.lower() not in suffixes or uri in seen:
+                continue
+            seen.add(uri)
+            yield link, geom, uri
+
+
 @rule("gltf-meshes", "MK514")
 def gltf_meshes(robot: Robot) -> Iterator[Diagnostic]:
     """glTF meshes in a URDF, for consumers that read glTF through Assimp (rviz, gz-sim): MuJoCo has no
     decoder for them ("no decoder found for mesh file") and PyBullet refuses the whole URDF ("failed to
     parse link"), measured with MuJoCo 3.14 and PyBullet 3.2.7 on dexmate's grippers."""
-    if robot.source_format not in URDF_FORMATS:
-        return
-    seen: set[str] = set()
-    for link in robot.links:
-        for geom in [*link.visuals, *link.collisions]:
-            uri = getattr(geom.geometry, "uri", None)
-            if not uri or PurePosixPath(uri.split("?")[0]).suffix.lower() not in GLTF_SUFFIXES or uri in seen:
-                continue
-            seen.add(uri)
-            role = "collision" if geom in link.collisions else "visual"
-            yield diag(
-                "MK514",
-                f'{role} mesh "{uri}" is glTF, read by rviz and gz-sim (Assimp): MuJoCo cannot load it and '
-                "PyBullet refuses the whole URDF",
-                geom.source or link.loc("name"),
-                hint="`modelkit convert` writes it as STL/OBJ for every target",
-            )
+    for link, geom, uri in _urdf_meshes(robot, GLTF_SUFFIXES):
+        role = "collision" if geom in link.collisions else "visual"
+        yield diag(
+            "MK514",
+            f'{role} mesh "{uri}" is glTF, read by rviz and gz-sim (Assimp): MuJoCo cannot load it and '
+            "PyBullet refuses the whole URDF",
+            geom.source or link.loc("name"),
+            hint="`modelkit convert` writes it as STL/OBJ for every target",
+        )
 
 
 @rule("collada-for-mujoco", "MK512")
 def collada_for_mujoco(robot: Robot) -> Iterator[Diagnostic]:
     """COLLADA meshes in a URDF: MuJoCo cannot load them ("no decoder found for mesh file")."""
-    if robot.source_format not in URDF_FORMATS:
-        return
-    seen: set[str] = set()
-    for link in robot.links:
-        for geom in [*link.visuals, *link.collisions]:
-            uri = getattr(geom.geometry, "uri", None)
-            if not uri or PurePosixPath(uri.split("?")[0]).suffix.lower() != ".dae" or uri in seen:
-                continue
-            seen.add(uri)
-            yield diag(
-                "MK512",
-                f'mesh "{uri}" is COLLADA: MuJoCo cannot load it from this URDF',
-                geom.source or link.loc("name"),
-                hint="`modelkit convert` writes it as STL/OBJ for MuJoCo; or use an STL/OBJ copy in the URDF",
-            )
+    for link, geom, uri in _urdf_meshes(robot, frozenset({".dae"})):
+        yield diag(
+            "MK512",
+            f'mesh "{uri}" is COLLADA: MuJoCo cannot load it from this URDF',
+            geom.source or link.loc("name"),
+            hint="`modelkit convert` writes it as STL/OBJ for MuJoCo; or use an STL/OBJ copy in the URDF",
+        )
