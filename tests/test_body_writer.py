@@ -185,15 +185,54 @@ def _same_geometry(a: Geom, b: Geom) -> bool:
     return all(_close(getattr(ga, k), getattr(gb, k)) for k in vars(ga))
 
 
-def _same_geoms(src: list[Geom], back: list[Geom]) -> bool:
+def _file_colours(g: Geom) -> list[tuple[float, ...]] | None:
+    """The colours a visual's COLLADA or glTF file gives its faces (independently of the writer: the
+    mesh loader's palette, the faces' order), or None when it gives none (or the visual has its own)."""
+    from modelkit.geometry.meshfiles import MeshLoadError, load_mesh
+
+    mesh = g.geometry
+    if g.material is not None or not isinstance(mesh, Mesh) or mesh.path is None:
+        return None
+    if Path(mesh.path).suffix.lower() not in (".dae", ".glb", ".gltf"):
+        return None
+    try:
+        loaded = load_mesh(Path(mesh.path), mesh.fragment)
+    except MeshLoadError:
+        return None
+    if loaded.face_colours is None:
+        return None
+    used = sorted(set(loaded.face_colours.tolist()))
+    return [tuple(round(float(x), 6) for x in (loaded.palette[k] or ())) for k in used]
+
+
+def _same_geoms(src: list[Geom], back: list[Geom], visuals: bool = False) -> bool:
+    """Each source shape is one shape read back; a visual whose file gives colours (written as a
+    shape per colour, docs/convert.md) is as many shapes at its pose, in exactly those colours."""
     left = list(back)
     for g in src:
+        colours = _file_colours(g) if visuals else None
+        if colours is not None:
+            for colour in colours:
+                part = next((b for b in left if isinstance(b.geometry, Mesh) and _same_pose(b.pose, g.pose)
+                             and _colour_of(b) == colour), None)
+                if part is None:
+                    return False
+                left.remove(part)
+            continue
         hit = next((b for b in left if _same_geometry(g, b) and _same_pose(b.pose, g.pose)
                     and _same_material(g, b)), None)
         if hit is None:
             return False
         left.remove(hit)
     return not left
+
+
+def _colour_of(g: Geom) -> tuple[float, ...]:
+    """A part's RGBA as the reader gives it back (rounded as the writer's decimals), () without one."""
+    m = g.material
+    if m is None or m.diffuse is None:
+        return ()
+    return tuple(round(float(x), 6) for x in (*m.diffuse, 1.0 - m.transparency))
 
 
 def _same_material(a: Geom, b: Geom) -> bool:
@@ -230,7 +269,8 @@ def test_body_round_trip_keeps_devices_materials_and_tracks(converted: list[Conv
                 for key, value in d.canonical_params.items():
                     assert _close(value, e.canonical_params[key]), (c.source, d.name, key)
             if not missing_mesh:
-                assert _same_geoms(link.visuals, other.visuals), (c.source, link.name, "visuals")
+                same_visuals = _same_geoms(link.visuals, other.visuals, visuals=True)
+                assert same_visuals, (c.source, link.name, "visuals")
                 assert _same_geoms(link.collisions, other.collisions), (c.source, link.name, "collisions")
         for joint in c.robot.joints:
             if joint.type is JointType.PSEUDO_CONTINUOUS_TRACK:

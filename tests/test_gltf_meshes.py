@@ -332,3 +332,24 @@ def test_urdf_and_sdf_visuals_keep_the_colours_too(tmp_path: Path, sdf_oracle: P
     assert written.count("<visual ") == 2 and "<diffuse>1 0 0 1</diffuse>" in written
     assert "<transparency>" in written
     assert not oracle_has_errors(sdf_oracle, sdf)
+
+
+def test_body_visuals_keep_the_colours_too(tmp_path: Path) -> None:
+    """The `.body` writer: a Shape per colour in the link's Visual, each with its material; read back
+    (Choreonoid's rules), the link has the two coloured visuals and the whole collision mesh."""
+    from modelkit import load
+
+    _two_colour_glb(tmp_path)
+    source = tmp_path / "g.urdf"
+    source.write_text(URDF.format(mesh="part.glb"))
+    body = tmp_path / "out" / "g.body"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(body)])
+    assert result.exit_code == 0, result.output
+    loaded = load(body)
+    robot = loaded[0] if isinstance(loaded, list) else loaded
+    base = next(link for link in robot.links if link.name == "base")
+    looks = [v.material for v in base.visuals if v.material is not None]
+    colours = sorted((tuple(round(float(c), 4) for c in m.diffuse), round(m.transparency, 4)) for m in looks)
+    assert colours == [((0.0, 0.0, 1.0), round(1 - 128 / 255, 4)), ((1.0, 0.0, 0.0), 0.0)]
+    arm = next(link for link in robot.links if link.name == "arm")
+    assert len(arm.collisions) == 1

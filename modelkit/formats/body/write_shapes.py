@@ -61,7 +61,13 @@ def link_elements(link: Link, ctx: WriteContext, from_body: bool = False) -> lis
     for i, geom in enumerate(link.visuals):
         is_shared = id(geom) in shared
         role = "shape" if is_shared else "visual"
-        node = shape_node(geom, ctx, f"link[{link.name}]/{role}[{i}]", f"{link.name}_{role}_{i}", from_body)
+        target = f"link[{link.name}]/{role}[{i}]"
+        if not is_shared:
+            coloured = coloured_shapes(geom, ctx, target)
+            if coloured is not None:
+                visual_only.extend(coloured)
+                continue
+        node = shape_node(geom, ctx, target, f"{link.name}_{role}_{i}", from_body)
         if node is None:
             continue
         (out if is_shared else visual_only).append(node)
@@ -76,6 +82,26 @@ def link_elements(link: Link, ctx: WriteContext, from_body: bool = False) -> lis
     if collision_only:
         out.append({"type": "Collision", "elements": collision_only})
     return out
+
+
+def coloured_shapes(geom: Geom, ctx: WriteContext, target: str) -> list[dict[str, Any]] | None:
+    """A visual COLLADA or glTF mesh without a colour of its own, whose file's materials give colours
+    and which is converted (the STL holds none): one Shape per colour, each with its colour as its
+    material (:meth:`MeshExporter.coloured_parts`); None otherwise."""
+    g = geom.geometry
+    if geom.material is not None or not isinstance(g, Mesh):
+        return None
+    parts = ctx.meshes.coloured_parts(g, target, geom.source, READABLE)
+    if parts is None:
+        return None
+    shapes = []
+    for k, (ref, colour) in enumerate(parts):
+        material = (VisualMaterial(diffuse=colour[:3], transparency=1.0 - colour[3])
+                    if colour is not None else None)
+        part = Geom(Mesh(uri=ref.uri), geom.pose, geom.name if k == 0 else None, material, geom.source)
+        shapes.append(_shape(part, {"type": "Resource", "uri": ref.uri}, geom.pose.rotation,
+                             geom.pose.translation, np.asarray(ref.scale), ctx, target))
+    return shapes
 
 
 def not_generated(g: object) -> bool:
