@@ -253,14 +253,20 @@ def _mesh_geoms(model: mujoco.MjModel) -> list[int]:
     return [g for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH]
 
 
-def test_a_coloured_visual_is_one_geom_per_colour(tmp_path: Path) -> None:
+def _converted_two_colours(tmp_path: Path, suffix: str) -> Path:
+    """The two-colour .glb robot converted by the CLI to ``suffix``; the split is said."""
     _two_colour_glb(tmp_path)
     source = tmp_path / "g.urdf"
     source.write_text(URDF.format(mesh="part.glb"))
-    mjcf = tmp_path / "out" / "g.xml"
-    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(mjcf)])
+    out = tmp_path / "out" / f"g.{suffix}"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(out)])
     assert result.exit_code == 0, result.output
     assert "converted to 2 files, one per colour" in result.output
+    return out
+
+
+def test_a_coloured_visual_is_one_geom_per_colour(tmp_path: Path) -> None:
+    mjcf = _converted_two_colours(tmp_path, "xml")
     model = mujoco.MjModel.from_xml_path(str(mjcf))
     visuals = [g for g in _mesh_geoms(model) if model.geom_group[g] == 1]
     colours = sorted(_rgba(model, g) for g in visuals)
@@ -339,13 +345,7 @@ def test_body_visuals_keep_the_colours_too(tmp_path: Path) -> None:
     (Choreonoid's rules), the link has the two coloured visuals and the whole collision mesh."""
     from modelkit import load
 
-    _two_colour_glb(tmp_path)
-    source = tmp_path / "g.urdf"
-    source.write_text(URDF.format(mesh="part.glb"))
-    body = tmp_path / "out" / "g.body"
-    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(body)])
-    assert result.exit_code == 0, result.output
-    loaded = load(body)
+    loaded = load(_converted_two_colours(tmp_path, "body"))
     robot = loaded[0] if isinstance(loaded, list) else loaded
     base = next(link for link in robot.links if link.name == "base")
     looks = [v.material for v in base.visuals if v.material is not None]
