@@ -68,7 +68,9 @@ from typing import Any
 import numpy as np
 
 from modelkit.convert.options import WriteOptions
+from modelkit.formats.urdf.massless import TINY_MASS
 from modelkit.model import BALL_KEYS, WORLD_LINK, JointType, Robot
+from modelkit.spatial import Pose
 from modelkit.verify.engines.protocol import Check, Skip
 from modelkit.verify.engines.registry import DEFAULT_ENGINES, ENGINES, INPUTS, PRESTART
 from modelkit.verify.report import VerifyReport
@@ -633,14 +635,16 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         replay = False
     elif not dof_joints(reference):
         others = sorted({j.type.value for j in reference.joints if j.type.moves})
+        balls = JointType.BALL.value in others
         report.skips.append(Skip(3, "all", (
-            f"its moving joints are {' and '.join(others)} joints only: layer 3 compares the revolute and "
+            f"its moving joints are {' and '.join(others)} joints only: layer 3a compares the revolute and "
             "prismatic degrees of freedom with the Pinocchio reference (a ball joint is held at rest at each "
-            "sampled orientation, as each engine parametrises its velocity its own way); these dynamics are "
-            "not verified")
+            "sampled orientation, as each engine parametrises its velocity its own way); "
+            + ("the ball joints' dynamics are verified by the replay (layer 3b) only" if balls
+               else "these dynamics are not verified"))
             if others else ("no revolute or prismatic joint: the mass matrix and bias forces are empty and "
                             "nothing moves, no dynamics to verify")))
-        replay = False
+        replay = replay and balls
     elif pin_ref is None:
         report.skips.append(Skip(3, "all", "layer 3a needs Pinocchio (the dynamics reference built from the "
                                            "source model), which is not among the loaded engines"))
@@ -671,14 +675,9 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
             except NotImplementedError:
                 report.skips.append(dynamics.no_dynamics(eng))
     t5 = time.perf_counter()
-    balls = [joint.name for joint in reference.joints if joint.type is JointType.BALL]
-    if replay and balls:
-        report.skips.append(Skip(3, "mujoco+pybullet", (
-            f"layer 3b (replay) not run: ball joint(s) {', '.join(balls)}: MuJoCo integrates each as a ball "
-            "(a quaternion and an angular velocity), PyBullet as the URDF writer's three continuous joints "
-            "(MK813), so their trajectories are not in the same coordinates")))
-    elif replay:
-        _replay(reference, files, maps, loaded, report, approx, models.get("pybullet"))
+    if replay:
+        _replay(reference, files, maps, loaded, report, approx, models.get("pybullet"),
+                chains_of.get("pybullet", []))
     t6 = time.perf_counter()
     for eng in loaded:
         messages = list(getattr(eng.model, "runtime_warnings", []))
@@ -774,6 +773,42 @@ def _approximations(models: Mapping[str, Robot], loaded: list[Any], files: dict[
     return out
 
 
+def _ball_chain_replay(reference: Robot, chains: Sequence[Any], maps: dict[str, Renames],
+                       inertials: dict[str, tuple[float, float]], frames: dict[str, tuple[str, Any]],
+                       report: VerifyReport) -> dict[str, Renames]:
+    """The replay of a model whose ball joints PyBullet reads as the URDF writer's chains (MK813):
+    the law's ball entries (``NAME#x``...) renamed to the chain's joints for PyBullet, and the chain
+    links' tiny mass (MK816, at the pivot) added to the ball's parent body in MuJoCo, where it is the
+    same mass; their 1e-12 kg·m² per axis turns with the chain's first angles, which no MuJoCo ball
+    can hold, so PyBullet's worker zeroes it for the replay (said in the report). ``inertials`` and
+    ``frames`` are completed in place; returns the renames to replay with."""
+    written = maps["mjcf"].get("link", {})
+    by_name = {joint.name: joint for joint in reference.joints}
+    urdf_joints = dict(maps.get("urdf", {}).get("joint", {}))
+    masses = []
+    for chain in chains:
+        ball = by_name.get(chain.joint)
+        if ball is None:
+            continue
+        for key, joint in zip(BALL_KEYS, chain.joints, strict=True):
+            urdf_joints[chain.joint + key] = joint
+        parent = written.get(ball.parent, ball.parent)
+        frames[chain.links[0]] = (parent, ball.origin)
+        frames[chain.links[1]] = (chain.links[0], Pose())
+        for link in chain.links:
+            mass = inertials.get(link, (TINY_MASS, 0.0))[0]
+            inertials[link] = (mass, 0.0)
+            masses.append(mass)
+    if masses:
+        report.skips.append(Skip(3, "mujoco+pybullet", (
+            f"replay of {len(chains)} ball joint(s) against PyBullet's chains (MK813): the {len(masses)} "
+            f"links between a chain's joints keep their {max(masses):g} kg at the pivot in both engines "
+            "(MuJoCo: on the ball's parent body) and have their 1e-12 kg·m² per axis zeroed in PyBullet, "
+            "which a MuJoCo ball cannot hold; the two engines integrate a ball in different coordinates, so "
+            "the replay is graded by the step ladder (see the replay check)")))
+    return {**maps, "urdf": {**maps.get("urdf", {}), "joint": urdf_joints}}
+
+
 def _frame_placements(held: Robot, inertials: Mapping[str, Any], renames: Renames
                       ) -> dict[str, tuple[str, Any]]:
     """Where each link of ``inertials`` (MJCF names) hangs in ``held``, when it hangs by a fixed joint:
@@ -824,9 +859,11 @@ def _without_armature(robot: Robot) -> Any:
 
 
 def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], loaded: list[Any],
-            report: VerifyReport, approx: dict[str, Any] | None = None, held: Robot | None = None) -> None:
+            report: VerifyReport, approx: dict[str, Any] | None = None, held: Robot | None = None,
+            chains: Sequence[Any] = ()) -> None:
     """Layer 3b through the replay module (MuJoCo against PyBullet), when it is there; ``held``: the
-    source as PyBullet's file holds it (its sensor frames), where PyBullet's approximated links hang."""
+    source as PyBullet's file holds it (its sensor frames), where PyBullet's approximated links hang;
+    ``chains``: the ball joints as PyBullet's file holds them (MK813)."""
     names = [e.label for e in loaded if e.label in ("mujoco", "pybullet")]
     if len(names) < 2:
         report.skips.append(Skip(3, "mujoco+pybullet", "layer 3b (replay) needs both MuJoCo and PyBullet "
@@ -870,6 +907,15 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
                 inertials[maps["mjcf"].get("link", {}).get(link, link)] = (a.mass, a.inertia)
     principal = _diagonalised(loaded, maps) if "mjcf" in maps else {}
     frames = _frame_placements(held or reference, inertials, maps.get("mjcf", {}))
+    balls = [joint.name for joint in reference.joints if joint.type is JointType.BALL]
+    unheld = sorted(set(balls) - {chain.joint for chain in chains})
+    if unheld:
+        report.skips.append(Skip(3, "mujoco+pybullet", (
+            f"layer 3b (replay) not run: PyBullet's file holds ball joint(s) {', '.join(unheld)} not as the "
+            "URDF writer's chain of three joints (MK813), so the replay cannot drive them the same way")))
+        return
+    if chains and "mjcf" in maps:
+        maps = _ball_chain_replay(reference, chains, maps, inertials, frames, report)
     for name in names:
         kind = INPUTS[name]
         root = maps[kind].get("link", {}).get(str(reference.root), str(reference.root))
@@ -908,12 +954,13 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
             "products of inertia hold the principal moments and axes PyBullet's URDF importer computed "
             "(btMatrix3x3::diagonalize, threshold 1e-6) in both engines, so the replay compares the "
             "integration of the same numbers; layer 3a compares each engine's tensor with the source")))
-    if inertials:
+    chain_links = {link for chain in chains for link in chain.links}  # said by the ball-chain entry
+    approximated = sorted(link for link in inertials if link not in chain_links)
+    if approximated:
         report.skips.append(Skip(3, "mujoco+pybullet", (
-            f"replay with PyBullet's documented approximation given to MuJoCo too: {len(inertials)} link(s) "
-            f"massless in the source ({', '.join(sorted(inertials)[:8])}) hold PyBullet's values in both "
-            "engines "
-            "(MK816, see the layer 1 approximation entry)")))
+            "replay with PyBullet's documented approximation given to MuJoCo too: "
+            f"{len(approximated)} link(s) massless in the source ({', '.join(approximated[:8])}) hold "
+            "PyBullet's values in both engines (MK816, see the layer 1 approximation entry)")))
     left_out = _left_out(sims, maps)
     if left_out:
         report.skips.append(Skip(3, "mujoco+pybullet", (

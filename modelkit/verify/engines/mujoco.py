@@ -29,6 +29,7 @@ import numpy as np
 from modelkit.formats.mjcf.quiet import collected_warnings
 from modelkit.model import BALL_KEYS, Robot
 from modelkit.spatial import Pose, axis_angle, matrix_from_quat_wxyz
+from modelkit.verify.engines import ball_law
 from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, ShapeFacts, StaticFacts, TorqueLaw
 
 Renames = dict[str, dict[str, str]]
@@ -647,13 +648,16 @@ class MujocoSimulator:
 
         m, d = self.inner.model, self.inner.data
         m.opt.timestep = dt
-        names = [self.renames.get("joint", {}).get(j, j) for j in law.joints]
+        in_balls = {c + k for _, c in law.ball_columns() for k in range(3)}
+        scalar = [i for i in range(len(law.joints)) if i not in in_balls]
+        names = [self.renames.get("joint", {}).get(law.joints[i], law.joints[i]) for i in scalar]
         where = {n: i for i, n in enumerate(self.inner.dof_names())}
         qadr = np.asarray([self.inner._qadr[where[n]] for n in names], dtype=int)
         actuator = {int(m.actuator_trnid[a, 0]): a for a in range(m.nu)}
         columns = np.asarray([actuator[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n)] for n in names],
                              dtype=int)
-        kp, kd = np.asarray(law.kp, dtype=float), np.asarray(law.kd, dtype=float)
+        kp = np.asarray([law.kp[i] for i in scalar], dtype=float)
+        kd = np.asarray([law.kd[i] for i in scalar], dtype=float)
         m.actuator_gainprm[:, 0] = 0.0
         m.actuator_biasprm[:, :3] = 0.0
         # A joint's actuatorfrcrange (the URDF effort limit, as our MJCF writer keeps it) would clamp
@@ -665,8 +669,11 @@ class MujocoSimulator:
         steps = round(seconds / dt)
         t = np.arange(steps, dtype=float)[:, None] * dt
         control = np.zeros((steps, m.nu))
-        control[:, columns] = np.asarray(law.amplitude) * np.sin(
-            2.0 * math.pi * np.asarray(law.frequency) * t + np.asarray(law.phase))
+        control[:, columns] = np.asarray([law.amplitude[i] for i in scalar]) * np.sin(
+            2.0 * math.pi * np.asarray([law.frequency[i] for i in scalar]) * t
+            + np.asarray([law.phase[i] for i in scalar]))
+        if law.balls:
+            return self._replay_with_balls(law, scalar, qadr, control, dt, start_q)
         with quiet(self.runtime_warnings):
             mujoco.mj_resetData(m, d)
             full = int(mujoco.mjtState.mjSTATE_FULLPHYSICS)
@@ -679,6 +686,51 @@ class MujocoSimulator:
         out = np.empty((steps + 1, len(names)))
         out[0] = d.qpos[qadr] if steps == 0 else start[offset + qadr]
         out[1:] = state[0][:, offset + qadr]
+        return out
+
+    def _replay_with_balls(self, law: TorqueLaw, scalar: list[int], qadr: Array, control: Array, dt: float,
+                           start_q: Array | None) -> Array:
+        """:meth:`replay_from` for a law with ball joints: stepped from Python, each ball's torque
+        (``ball_law.ball_torque``, child frame: MuJoCo's ball coordinates) set in ``qfrc_applied``
+        from the state before every ``mj_step``; the scalar joints keep their actuators. A ball's
+        columns are the rotation vector of its orientation; ``start_q`` turns it by that vector."""
+        m, d = self.inner.model, self.inner.data
+        written = self.renames.get("joint", {})
+        balls = []
+        for name, column in law.ball_columns():
+            j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, written.get(name, name))
+            balls.append((column, int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j]), law.kp[column:column + 3],
+                          law.kd[column:column + 3], law.amplitude[column:column + 3],
+                          law.frequency[column:column + 3], law.phase[column:column + 3]))
+        steps = len(control)
+        out = np.empty((steps + 1, len(law.joints)))
+        scalar_columns = np.asarray(scalar, dtype=int)
+
+        def record(row: int) -> None:
+            out[row, scalar_columns] = d.qpos[qadr]
+            for column, qa, *_ in balls:
+                orientation = ball_law.quaternion_matrix(*d.qpos[qa:qa + 4])
+                out[row, column:column + 3] = ball_law.rotation_log(orientation)
+
+        with quiet(self.runtime_warnings):
+            mujoco.mj_resetData(m, d)
+            if start_q is not None:
+                start = np.asarray(start_q, dtype=float)
+                d.qpos[qadr] += start[scalar_columns]
+                for column, qa, *_ in balls:
+                    turn = np.array(ball_law.rotation_exp(list(start[column:column + 3])), dtype=float)
+                    mujoco.mju_mat2Quat(d.qpos[qa:qa + 4], turn)
+            step, applied = mujoco.mj_step, d.qfrc_applied
+            for k in range(steps):
+                record(k)
+                d.ctrl[:] = control[k]
+                time_k = k * dt
+                for _, qa, va, kp, kd, amplitude, frequency, phase in balls:
+                    orientation = ball_law.quaternion_matrix(*d.qpos[qa:qa + 4])
+                    applied[va:va + 3] = ball_law.ball_torque(orientation, d.qvel[va:va + 3], time_k, kp, kd,
+                                                              amplitude, frequency, phase)
+                step(m, d)
+            record(steps)
         return out
 
     def close(self) -> None:

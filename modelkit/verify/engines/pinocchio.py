@@ -232,6 +232,13 @@ class PinocchioModel:
         full = np.triu(upper) + np.triu(upper, 1).T
         return full[np.ix_(self._visible, self._visible)]
 
+    def mass_matrix_with_balls(self, q: dict[str, float]) -> tuple[list[str], Array]:
+        """The mass matrix over every degree of freedom, a ball joint's three pieces (``NAME#x``...)
+        included, with their names. At a ball's zero orientation its pieces' rates are the child's
+        angular velocity in the child's frame, the coordinates MuJoCo gives a ball."""
+        upper = np.array(pin.crba(self.model, self.data, self._q(q)))
+        return list(self._all), np.triu(upper) + np.triu(upper, 1).T
+
     def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
         """rnea with zero acceleration; a ball joint's pieces at rest (their velocity 0)."""
         hidden = self._ball_pieces

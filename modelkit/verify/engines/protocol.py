@@ -112,7 +112,12 @@ class Simulator(Protocol):
 class TorqueLaw:
     """The contact-free replay's control law, the same in every engine: a PD law tracking
     sinusoids, u_i = kp_i (q*_i(t) − q_i) − kd_i dq_i, with q*_i(t) = amp_i sin(2π f_i t + φ_i).
-    Joint order is the source model's; engines map it through the renames."""
+    Joint order is the source model's; engines map it through the renames.
+
+    A ball joint named in ``balls`` takes three entries, ``NAME#x``, ``NAME#y``, ``NAME#z``
+    (``BALL_KEYS``), in that order: its position is the rotation vector of its orientation, and its
+    law the one of :mod:`modelkit.verify.engines.ball_law` (a torque in the child's frame from the
+    rotation error, not ``u_i`` above)."""
 
     joints: tuple[str, ...]
     kp: tuple[float, ...]
@@ -120,8 +125,14 @@ class TorqueLaw:
     amplitude: tuple[float, ...]
     frequency: tuple[float, ...]
     phase: tuple[float, ...]
+    balls: tuple[str, ...] = ()
+
+    def ball_columns(self) -> list[tuple[str, int]]:
+        """Each ball joint with the index of its ``NAME#x`` entry (its three entries start there)."""
+        return [(name, self.joints.index(name + "#x")) for name in self.balls]
 
     def torque(self, t: float, q: Array, dq: Array) -> Array:
+        """u_i of the scalar law (a ball's three entries follow ``ball_law`` instead)."""
         target = np.asarray(self.amplitude) * np.sin(
             2.0 * math.pi * np.asarray(self.frequency) * t + np.asarray(self.phase)
         )

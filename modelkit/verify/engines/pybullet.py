@@ -36,7 +36,7 @@ from modelkit.convert.tracks import PYBULLET_SOLVER_ITERATIONS
 from modelkit.formats.urdf.writer import PYBULLET_MAX_JOINTS
 from modelkit.model import WORLD_LINK
 from modelkit.spatial import Pose
-from modelkit.verify.engines import child
+from modelkit.verify.engines import ball_law, child
 from modelkit.verify.engines.child import Worker
 from modelkit.verify.engines.protocol import (
     Array,
@@ -326,13 +326,21 @@ class PyBulletModel:
         ``law.joints`` entry (source names, mapped through the renames), in that order. Joints the
         law does not name get no torque. ``last_replay_wall`` keeps the stepping loop's wall time."""
         steps = round(seconds / dt)
-        result = self._worker.request("replay", timeout=max(self.timeout, 20.0 * seconds),
-                                      steps=steps, dt=dt, **self.law_vectors(law))
-        self.last_replay_wall = float(result["wall"])
-        q = np.frombuffer(result["q"], dtype=np.float64).reshape(steps + 1, len(self._dofs))
         written = self.renames.get("joint", {})
         columns = [self._dofs.index(written.get(j, j)) for j in law.joints]
-        return q[:, columns].copy()
+        # a ball joint (renamed per entry NAME#x... to the URDF writer's chain joints, MK813): its three
+        # joints' positions here, which must follow one another (the chain is written that way)
+        balls = [columns[c:c + 3] for _, c in law.ball_columns()]
+        extra = {"balls": balls} if balls else {}
+        slower = 5.0 if balls else 1.0  # the ball's law is computed in Python every step
+        result = self._worker.request("replay", timeout=max(self.timeout, 20.0 * seconds * slower),
+                                      steps=steps, dt=dt, **self.law_vectors(law), **extra)
+        self.last_replay_wall = float(result["wall"])
+        q = np.frombuffer(result["q"], dtype=np.float64).reshape(steps + 1, len(self._dofs))
+        out = q[:, columns].copy()
+        for _, c in law.ball_columns():  # the chain's three angles → the rotation vector
+            out[:, c:c + 3] = [ball_law.rotation_log(ball_law.chain_matrix(*row)) for row in out[:, c:c + 3]]
+        return out
 
     def bench(self, seconds: float, dt: float) -> dict[str, float]:
         """Wall seconds of a bare ``stepSimulation`` loop and of a minimal closed loop (read states,

@@ -10,6 +10,9 @@ framing, and PyBullet's C prints kept out of the replies, are described there).
 The worker returns raw PyBullet numbers (link COM frames, inertial frames, joint infos); the frame
 algebra lives in the parent, where it can be tested and typed.
 
+The replay of a model with ball joints imports :mod:`modelkit.verify.engines.ball_law` (standard library
+only) for the ball's law on the URDF writer's chain.
+
 Layer 4's requests (``drive_setup``, ``drive_run``, ``drive_batch``, ``drive_bench``) are the
 exception to "standard library only": they import numpy, :mod:`modelkit.verify.drive` and the
 controller factory (``modelkit.verify.drive.controllers:make_controllers``) on first use, so that the seed's
@@ -184,10 +187,18 @@ class Engine:
         self.p.changeDynamics(self.body, -1, maxJointVelocity=1e4, physicsClientId=self.client)
 
     def replay(self, kp: list[float], kd: list[float], amplitude: list[float], frequency: list[float],
-               phase: list[float], steps: int, dt: float) -> dict[str, Any]:
+               phase: list[float], steps: int, dt: float, balls: list[list[int]] | None = None
+               ) -> dict[str, Any]:
         """The PD law of ``facts.TorqueLaw`` (joint order = ``movable``), from q = dq = 0, torques
         re-sent before every step (PyBullet's TORQUE_CONTROL lasts one ``stepSimulation``).
-        Returns q after every step (row 0 = the start) as a flat float64 array."""
+        Returns q after every step (row 0 = the start) as a flat float64 array.
+
+        ``balls``: per ball joint, the positions (in ``movable``) of the URDF writer's three joints
+        (MK813); their torques are ``ball_law.chain_torques`` of the state, and the two links between
+        them hold no rotational inertia here (their 1e-12 kg·m² per axis cannot be held by a ball,
+        the other engine's joint: its mass at the pivot can, and stays)."""
+        if balls:
+            return self._replay_with_balls(kp, kd, amplitude, frequency, phase, steps, dt, balls)
         p = self.p
         self._reset(dt)
         self.limits_off()
@@ -214,6 +225,47 @@ class Engine:
         out[: len(idx)] = array("d", [0.0] * len(idx))  # row 0: the reset start, exactly
         wall = time.perf_counter() - start
         return {"q": out.tobytes(), "wall": wall}
+
+    def _replay_with_balls(self, kp: list[float], kd: list[float], amplitude: list[float],
+                           frequency: list[float], phase: list[float], steps: int, dt: float,
+                           balls: list[list[int]]) -> dict[str, Any]:
+        from modelkit.verify.engines.ball_law import chain_torques
+
+        p = self.p
+        self._reset(dt)
+        self.limits_off()
+        body, client, idx = self.body, self.client, list(self.movable)
+        for triple in balls:
+            for position in triple[:2]:  # the links between the chain's joints
+                p.changeDynamics(body, idx[position], localInertiaDiagonal=[0.0, 0.0, 0.0],
+                                 physicsClientId=client)
+        in_balls = {i for triple in balls for i in triple}
+        scalar = [i for i in range(len(idx)) if i not in in_balls]
+        laws = [(triple, kp[triple[0]:triple[0] + 3], kd[triple[0]:triple[0] + 3],
+                 amplitude[triple[0]:triple[0] + 3], frequency[triple[0]:triple[0] + 3],
+                 phase[triple[0]:triple[0] + 3]) for triple in balls]
+        if any(triple != [triple[0], triple[0] + 1, triple[0] + 2] for triple in balls):
+            raise ValueError("a ball joint's three joints must be consecutive in the movable order")
+        start = time.perf_counter()
+        states_log: list[Any] = []
+        u = [0.0] * len(idx)
+        for k in range(steps):
+            t = k * dt
+            states = p.getJointStates(body, idx, physicsClientId=client)
+            states_log.append(states)
+            for i in scalar:
+                target = amplitude[i] * math.sin(2.0 * math.pi * frequency[i] * t + phase[i])
+                u[i] = kp[i] * (target - states[i][0]) - kd[i] * states[i][1]
+            for triple, gains, damping, amp, freq, ph in laws:
+                angles = [states[i][0] for i in triple]
+                rates = [states[i][1] for i in triple]
+                u[triple[0]:triple[0] + 3] = chain_torques(angles, rates, t, gains, damping, amp, freq, ph)
+            p.setJointMotorControlArray(body, idx, p.TORQUE_CONTROL, forces=u, physicsClientId=client)
+            p.stepSimulation(physicsClientId=client)
+        states_log.append(p.getJointStates(body, idx, physicsClientId=client))
+        out = array("d", [s[0] for states in states_log for s in states])
+        out[: len(idx)] = array("d", [0.0] * len(idx))
+        return {"q": out.tobytes(), "wall": time.perf_counter() - start}
 
     def bench(self, steps: int, dt: float) -> dict[str, float]:
         """Wall time of a bare stepping loop (``stepSimulation`` only, no control, no read-back)
