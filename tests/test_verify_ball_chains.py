@@ -44,8 +44,9 @@ def test_a_sound_ball_conversion_passes_layer_1_in_the_urdf_engines(tmp_path: Pa
         chain = "joint_1 as joint_1_x, joint_1_y, joint_1_z through body2_ball_x, body2_ball_y"
         assert said and chain in said[0]
     assert not [s for s in report.skips if s.engine == "mujoco" and "ball joint(s)" in s.reason]
+    # the balls' dynamics are compared (with Pinocchio, not loaded here: test_verify_ball_dynamics.py)
     layer3 = [s.reason for s in report.skips if s.layer == 3]
-    assert layer3 and "ball joints only" in layer3[0] and "nothing moves" not in layer3[0]
+    assert layer3 and "needs Pinocchio" in layer3[0] and "nothing moves" not in layer3[0]
 
 
 @pytest.mark.parametrize("engine", URDF_ENGINES)
@@ -139,10 +140,11 @@ def _mixed(tmp_path: Path) -> Path:
 
 def test_layer3_compares_a_model_with_a_ball_and_a_hinge(tmp_path: Path) -> None:
     """A ball joint above a hinge: the Pinocchio reference holds the ball as three revolute joints at
-    each sampled orientation, at rest. MuJoCo and Drake (SDF) hold a ball and compare the hinge's
-    degree of freedom; PyBullet and Drake's URDF hold the writer's chain and compare its three joints
-    too. Before, the Pinocchio reference refused the ball, layer 3a was skipped for every engine, and
-    the replay failed on a sound model (MuJoCo asked for the chain's links); then it was skipped."""
+    each sampled orientation, at rest. MuJoCo holds a ball and compares it in the chain's coordinates
+    with the hinge; Drake (SDF) compares the hinge's degree of freedom; PyBullet and Drake's URDF hold
+    the writer's chain and compare its three joints too. Before, the Pinocchio reference refused the
+    ball, layer 3a was skipped for every engine, and the replay failed on a sound model (MuJoCo asked
+    for the chain's links); then it was skipped."""
     engines = ("mujoco", "pybullet", "drake", "drake-urdf", "pinocchio")
     report = verify(_mixed(tmp_path), tmp_path / "out", engines, configurations=2, samples=3, driven=False)
     assert not report.errors, report.errors
@@ -152,8 +154,12 @@ def test_layer3_compares_a_model_with_a_ball_and_a_hinge(tmp_path: Path) -> None
         for quantity in ("mass-matrix", "bias"):
             check = layer3[(engine, quantity)]
             assert check.passed and check.error < 1e-12, (engine, quantity, check.detail)
-    assert layer3[("mujoco", "mass-matrix")].where == "hinge"  # its only degree of freedom compared
-    # the replay drives the ball and the hinge, graded by the step ladder (test_verify_ball_replay.py)
+    # MuJoCo compares the hinge and the ball's three angles (in the URDF chain's coordinates)
+    assert "4 dofs" in layer3[("mujoco", "mass-matrix")].detail
+    assert "three angles" in layer3[("mujoco", "mass-matrix")].detail
+    drake = [s.reason for s in report.skips if s.layer == 3 and s.engine == "drake"]
+    assert drake and "revolute and prismatic degrees of freedom only" in drake[0]
+    # the replay drives the ball and the hinge, graded by the step ladder (test_verify_ball_dynamics.py)
     (replay,) = [c for c in report.checks if c.quantity == "replay"]
     assert replay.passed and "step ladder" in replay.detail
     assert "hinge" in replay.detail and "joint_1#x" in replay.detail
@@ -165,5 +171,5 @@ def test_layer3_with_a_ball_finds_a_mass_written_wrong(tmp_path: Path) -> None:
     failed = {(c.layer, c.engine, c.quantity): c for c in report.failed}
     for engine in ("mujoco", "pybullet"):
         assert (3, engine, "mass-matrix") in failed, sorted(failed)
-    assert failed[(3, "mujoco", "mass-matrix")].where == "hinge"
+    assert failed[(3, "mujoco", "mass-matrix")].where in ("hinge", "joint_1#x", "joint_1#y", "joint_1#z")
     assert failed[(3, "pybullet", "mass-matrix")].where in ("hinge", "joint_1_x", "joint_1_y", "joint_1")

@@ -629,22 +629,21 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
             fk, eng, configs, cj)))
     t4 = time.perf_counter()
     pin_ref = next((e.model for e in loaded if e.label == "pinocchio"), None)
+    balls = [j.name for j in reference.joints if j.type is JointType.BALL]
+    ball_only = bool(balls) and all(j.type is JointType.BALL for j in reference.joints if j.type.moves)
     if dynamics.kinematic_only(reference):
         report.skips.append(Skip(3, "all", "no link moved by a joint has mass in the source (a kinematic "
                                            "model): no dynamics to verify"))
         replay = False
-    elif not dof_joints(reference):
+    elif not dof_joints(reference) and not ball_only:
         others = sorted({j.type.value for j in reference.joints if j.type.moves})
-        balls = JointType.BALL.value in others
         report.skips.append(Skip(3, "all", (
-            f"its moving joints are {' and '.join(others)} joints only: layer 3a compares the revolute and "
-            "prismatic degrees of freedom with the Pinocchio reference (a ball joint is held at rest at each "
-            "sampled orientation, as each engine parametrises its velocity its own way); "
-            + ("the ball joints' dynamics are verified by the replay (layer 3b) only" if balls
-               else "these dynamics are not verified"))
+            f"its moving joints are {' and '.join(others)} joints only: layer 3 compares the revolute, "
+            "prismatic and ball degrees of freedom with the Pinocchio reference; these dynamics are not "
+            "verified")
             if others else ("no revolute or prismatic joint: the mass matrix and bias forces are empty and "
                             "nothing moves, no dynamics to verify")))
-        replay = replay and balls
+        replay = False
     elif pin_ref is None:
         report.skips.append(Skip(3, "all", "layer 3a needs Pinocchio (the dynamics reference built from the "
                                            "source model), which is not among the loaded engines"))
@@ -663,10 +662,22 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
             ref = (_without_armature(model) if dropped
                    else pin_ref if model is reference else _pinocchio(model))
             held_state = [(approximations.chain_configuration(q, chains), dq) for q, dq in state]
+            # an engine holding each ball as a ball (MuJoCo) gives it in the chain's coordinates too
+            with_balls = (bool(balls) and not chains and dynamics.holds_balls_as_chains(eng.model)
+                          and dynamics.holds_balls_as_chains(ref))
+            if balls and not chains and not with_balls:
+                report.skips.append(Skip(3, eng.label, (
+                    f"ball joint(s) {', '.join(balls)}: {eng.label} parametrises a ball's velocity its own "
+                    "way, so layer 3a compares "
+                    + ("nothing for it (only ball joints move)" if ball_only else
+                       "its revolute and prismatic degrees of freedom only, each ball at rest at a sampled "
+                       "orientation"))))
+                if ball_only:
+                    continue
             try:
                 last = {chain.joint: chain.joints[2] for chain in chains}
-                report.checks.extend(_guarded(3, eng, lambda eng=eng, ref=ref, st=held_state, last=last: (
-                    dynamics.layer3a(ref, eng, st, last))))
+                report.checks.extend(_guarded(3, eng, lambda eng=eng, ref=ref, st=held_state, last=last,
+                                              wb=with_balls: dynamics.layer3a(ref, eng, st, last, wb)))
                 if dropped:
                     report.skips.append(Skip(3, eng.label, (
                         f"joint armature (rotor inertia) of {', '.join(with_armature)} cannot be written in "

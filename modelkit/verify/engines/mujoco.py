@@ -469,6 +469,51 @@ class MujocoModel:
             mujoco.mj_forward(self.model, self.data)
         return np.array(self.data.qfrc_bias[np.asarray(self._vadr, dtype=int)], dtype=float)
 
+    # ---- a ball joint in the coordinates of the URDF writer's chain (layer 3a) ----------------
+
+    def dof_names_with_balls(self) -> list[str]:
+        """The hinge and slide degrees of freedom, then each ball joint's three (``NAME#x``...)."""
+        return [*self._dofs, *(name + key for name, _ in self._balls for key in BALL_KEYS)]
+
+    def _chain_map(self, q: dict[str, float]) -> Array:
+        """T (nv × the names of :meth:`dof_names_with_balls`): qvel = T·rates, a ball's rates being
+        those of the chain's three angles at ``q`` (ω in the child's frame = J·(ȧ, ḃ, ċ),
+        ``ball_law.chain_jacobian``; the rest orientation ``qpos0`` turns nothing of it)."""
+        m = self.model
+        names = self.dof_names_with_balls()
+        out = np.zeros((m.nv, len(names)))
+        for column, va in enumerate(self._vadr):
+            out[va, column] = 1.0
+        column = len(self._vadr)
+        for name, _ in self._balls:
+            va = int(m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)])
+            pitch, yaw = (q.get(name + key, 0.0) for key in BALL_KEYS[1:])
+            jacobian = ball_law.chain_jacobian(pitch, yaw)
+            out[va:va + 3, column:column + 3] = np.array(jacobian, dtype=float).reshape(3, 3)
+            column += 3
+        return out
+
+    def mass_matrix_with_balls(self, q: dict[str, float]) -> Array:
+        """Tᵀ·M·T (:meth:`_chain_map`): the mass matrix in the chain's coordinates, a ball's three
+        angles included, comparable with the Pinocchio reference's pieces."""
+        self._set(q)
+        full = np.zeros((self.model.nv, self.model.nv))
+        with quiet(self.runtime_warnings):
+            mujoco.mj_forward(self.model, self.data)
+            if hasattr(self.data, "qM"):
+                mujoco.mj_fullM(self.model, full, self.data.qM)
+            else:
+                mujoco.mj_fullM(self.model, self.data, full)
+        t = self._chain_map(q)
+        return np.asarray(t.T @ full @ t)
+
+    def bias_with_balls(self, q: dict[str, float], dq: dict[str, float]) -> Array:
+        """Tᵀ·bias, a ball at rest (its chain rates 0, so T's derivative adds nothing)."""
+        self._set(q, dq)
+        with quiet(self.runtime_warnings):
+            mujoco.mj_forward(self.model, self.data)
+        return np.asarray(self._chain_map(q).T @ np.array(self.data.qfrc_bias, dtype=float))
+
     def close(self) -> None:
         return None
 

@@ -232,12 +232,22 @@ class PinocchioModel:
         full = np.triu(upper) + np.triu(upper, 1).T
         return full[np.ix_(self._visible, self._visible)]
 
-    def mass_matrix_with_balls(self, q: dict[str, float]) -> tuple[list[str], Array]:
-        """The mass matrix over every degree of freedom, a ball joint's three pieces (``NAME#x``...)
-        included, with their names. At a ball's zero orientation its pieces' rates are the child's
-        angular velocity in the child's frame, the coordinates MuJoCo gives a ball."""
+    def dof_names_with_balls(self) -> list[str]:
+        """Every degree of freedom, a ball joint's three pieces (``NAME#x``...) included."""
+        return list(self._all)
+
+    def mass_matrix_with_balls(self, q: dict[str, float]) -> Array:
+        """The mass matrix over :meth:`dof_names_with_balls`: a ball's pieces in the coordinates of
+        the URDF writer's chain (R = Rx·Ry·Rz). At a ball's zero orientation their rates are the
+        child's angular velocity in the child's frame, the coordinates MuJoCo gives a ball."""
         upper = np.array(pin.crba(self.model, self.data, self._q(q)))
-        return list(self._all), np.triu(upper) + np.triu(upper, 1).T
+        return np.triu(upper) + np.triu(upper, 1).T
+
+    def bias_with_balls(self, q: dict[str, float], dq: dict[str, float]) -> Array:
+        """The bias over :meth:`dof_names_with_balls`, a ball's pieces at rest."""
+        hidden = self._ball_pieces
+        v = np.array([0.0 if n in hidden else dq.get(n, 0.0) for n in self._all], dtype=float)
+        return np.array(pin.rnea(self.model, self.data, self._q(q), v, np.zeros(self.model.nv)))
 
     def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
         """rnea with zero acceleration; a ball joint's pieces at rest (their velocity 0)."""

@@ -8,13 +8,15 @@ Coriolis forces, had a bias of 0 against Drake's 1.1e-15 N·m, 1.1e-9 "relative"
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
 from modelkit.convert.compare import random_configuration
-from modelkit.model import JointType, Robot
+from modelkit.model import BALL_KEYS, JointType, Robot
 from modelkit.verify.engines.protocol import Check, EngineModel, Skip
 from modelkit.verify.layers.common import Loaded, Worst, engine_q
 from modelkit.verify.layers.kinematics import ball_angles
@@ -38,11 +40,20 @@ def states(robot: Robot, dofs: list[str], count: int, seed: int) -> list[State]:
     return out
 
 
+def holds_balls_as_chains(model: object) -> bool:
+    """Whether an engine model can give its mass matrix and bias with each ball joint in the
+    coordinates of the URDF writer's chain (``mass_matrix_with_balls``; MuJoCo does)."""
+    return all(hasattr(model, name) for name in ("dof_names_with_balls", "mass_matrix_with_balls",
+                                                 "bias_with_balls"))
+
+
 def layer3a(reference: EngineModel, eng: Loaded, samples: list[State],
-            written: Mapping[str, str] | None = None) -> list[Check]:
+            written: Mapping[str, str] | None = None, with_balls: bool = False) -> list[Check]:
     """Mass matrix and bias forces of the engine against the reference, in the reference's dof order.
     ``written``: a reference joint → the engine's, where the conversion's renames do not say (the last
-    joint of a ball's chain keeps the ball's name in the reference, the URDF writer's ``NAME_z``)."""
+    joint of a ball's chain keeps the ball's name in the reference, the URDF writer's ``NAME_z``).
+    ``with_balls``: both models hold ball joints and give them in the chain's coordinates
+    (:func:`holds_balls_as_chains`): a ball's three angles are compared too, the ball at rest."""
     eng.model.mass_matrix({})  # NotImplementedError: an engine without dynamics (the caller skips it)
     written = dict(written or {})
 
@@ -51,10 +62,23 @@ def layer3a(reference: EngineModel, eng: Loaded, samples: list[State],
         out.update({written[k]: v for k, v in values.items() if k in written})
         return out
 
-    ref_dofs = reference.dof_names()
-    eng_dofs = eng.model.dof_names()
+    def engine_dof(name: str) -> str:
+        if name in written:
+            return written[name]
+        base, mark, axis = name.rpartition("#")
+        return f"{eng.joint(base)}#{axis}" if base and mark + axis in BALL_KEYS else eng.joint(name)
+
+    mass_matrix_of, bias_of = reference.mass_matrix, reference.bias
+    engine_mass_matrix, engine_bias = eng.model.mass_matrix, eng.model.bias
+    ref_dofs, eng_dofs = reference.dof_names(), eng.model.dof_names()
+    if with_balls:
+        ref: Any = reference
+        model: Any = eng.model
+        mass_matrix_of, bias_of = ref.mass_matrix_with_balls, ref.bias_with_balls
+        engine_mass_matrix, engine_bias = model.mass_matrix_with_balls, model.bias_with_balls
+        ref_dofs, eng_dofs = ref.dof_names_with_balls(), model.dof_names_with_balls()
     where = {name: i for i, name in enumerate(eng_dofs)}
-    order = [where.get(written[name] if name in written else eng.joint(name), -1) for name in ref_dofs]
+    order = [where.get(engine_dof(name), -1) for name in ref_dofs]
     label = eng.label
     if -1 in order or len(eng_dofs) != len(ref_dofs):
         lost = [name for name, i in zip(ref_dofs, order, strict=True) if i < 0]
@@ -65,8 +89,8 @@ def layer3a(reference: EngineModel, eng: Loaded, samples: list[State],
     idx = np.asarray(order, dtype=int)
     mm, bias = Worst(), Worst()
     for k, (q, dq) in enumerate(samples):
-        ma = reference.mass_matrix(q)
-        mb = eng.model.mass_matrix(in_engine(q))[np.ix_(idx, idx)]
+        ma = mass_matrix_of(q)
+        mb = engine_mass_matrix(in_engine(q))[np.ix_(idx, idx)]
         diff = np.abs(ma - mb)
         scale = max(float(np.max(np.abs(ma))) if ma.size else 0.0, 1e-300)
         if diff.size:
@@ -76,8 +100,8 @@ def layer3a(reference: EngineModel, eng: Loaded, samples: list[State],
                 mm.see(err, ref_dofs[i] if i == j else f"{ref_dofs[i]}/{ref_dofs[j]}",
                        f"sample {k}: M[{i},{j}] {ma[i, j]:.12g}, engine {mb[i, j]:.12g} "
                        f"(relative to max |M| = {scale:.6g})")
-        ba = reference.bias(q, dq)
-        bb = eng.model.bias(in_engine(q), in_engine(dq))[idx]
+        ba = bias_of(q, dq)
+        bb = engine_bias(in_engine(q), in_engine(dq))[idx]
         bdiff = np.abs(ba - bb)
         if bdiff.size:
             n = int(np.argmax(bdiff))
@@ -90,8 +114,14 @@ def layer3a(reference: EngineModel, eng: Loaded, samples: list[State],
                                            f"(relative to max(1e-6, max |b|, max |M|·max |dq|²) = "
                                            f"{bscale:.6g})")
     what = f"{len(samples)} random (q, dq), {len(ref_dofs)} dofs"
-    return [mm.check(3, label, "mass-matrix", eng.tolerance("mass-matrix"), what),
-            bias.check(3, label, "bias", eng.tolerance("bias"), what)]
+    checks = [mm.check(3, label, "mass-matrix", eng.tolerance("mass-matrix"), what),
+              bias.check(3, label, "bias", eng.tolerance("bias"), what)]
+    if with_balls:  # say what was compared, also when the worst entry is a hinge's
+        said = (f"{what}, each ball joint's three angles included (the URDF chain's coordinates, the ball "
+                "at rest)")
+        checks = [dataclasses.replace(c, detail=f"{c.detail}; {said}" if c.detail != what else said)
+                  for c in checks]
+    return checks
 
 
 def no_dynamics(eng: Loaded) -> Skip:

@@ -1,8 +1,14 @@
-"""Layer 3b on a model with ball joints: MuJoCo integrates a ball as a quaternion, PyBullet the URDF
-writer's chain of three joints (MK813) by their angles, so the same robot parts by O(dt) between the
-engines. The replay runs the step ladder (dt, dt/2, dt/4, dt/8) and grades the difference extrapolated
-to dt → 0: a sound conversion passes near round-off, a mass 0.01 % off in one file fails. Before, the
-replay was skipped for any model with a ball joint."""
+"""Layer 3 on a model with ball joints.
+
+3a: MuJoCo gives its mass matrix and bias in the coordinates of the URDF writer's chain (Tᵀ·M·T, T the
+chain's Jacobian at the sampled orientation, the ball at rest), so a model whose only moving joints
+are balls is compared with the Pinocchio reference; before, its layer 3 was skipped.
+
+3b: MuJoCo integrates a ball as a quaternion, PyBullet the URDF writer's chain of three joints (MK813)
+by their angles, so the same robot parts by O(dt) between the engines. The replay runs the step
+ladder (dt, dt/2, dt/4, dt/8) and grades the difference extrapolated to dt → 0: a sound conversion
+passes near round-off, a mass 0.01 % off in one file fails. Before, the replay was skipped for any
+model with a ball joint."""
 
 from __future__ import annotations
 
@@ -68,6 +74,35 @@ def test_a_sound_two_ball_chain_passes_the_step_ladder(sound: VerifyReport) -> N
     jsonschema.validate(data, SCHEMA)
     assert data["replay"]["pybullet"]["method"] == "step ladder"
     assert "the step ladder" in render_html(sound)
+
+
+def test_layer3a_compares_the_balls_in_the_chain_coordinates(sound: VerifyReport) -> None:
+    layer3 = {(c.engine, c.quantity): c for c in sound.checks if c.layer == 3 and c.quantity != "replay"}
+    for engine in ("mujoco", "pybullet"):
+        for quantity in ("mass-matrix", "bias"):
+            check = layer3[(engine, quantity)]
+            assert check.passed and check.error < 1e-12, (engine, quantity, check.detail)
+    mujoco = layer3[("mujoco", "mass-matrix")]
+    assert "6 dofs" in mujoco.detail and "three angles" in mujoco.detail
+    assert mujoco.where.startswith(("joint_1#", "joint_2#"))
+
+
+def test_layer3a_finds_a_ball_link_mass_written_wrong_in_the_mjcf(tmp_path: Path) -> None:
+    """body3's mass 10 % heavier in the MJCF MuJoCo reads: its ball rows of the mass matrix differ."""
+    source = _source(tmp_path)
+    given = tmp_path / "given" / "balls.xml"
+    convert([source], given)
+    text = given.read_text()
+    body3 = text.index('<body name="body3"')
+    mass = re.compile(r'mass="([^"]+)"')
+    found = mass.search(text, body3)
+    assert found is not None
+    given.write_text(text[:found.start()] + f'mass="{float(found[1]) * 1.1!r}"' + text[found.end():])
+    report = verify(source, tmp_path / "out", ("mujoco", "pinocchio"), mjcf=given, configurations=1,
+                    samples=2, replay=False, driven=False)
+    failed = {(c.layer, c.engine, c.quantity): c for c in report.failed}
+    assert (3, "mujoco", "mass-matrix") in failed, sorted(failed)
+    assert failed[(3, "mujoco", "mass-matrix")].where.startswith(("joint_1#", "joint_2#"))
 
 
 def test_a_mass_off_in_the_urdf_alone_fails_the_ladder(tmp_path: Path) -> None:
