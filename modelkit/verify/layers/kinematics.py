@@ -32,15 +32,27 @@ def configurations(robot: Robot, count: int, seed: int) -> list[dict[str, float]
     rng = np.random.default_rng(seed)
     balls = [joint.name for joint in robot.joints if joint.type is JointType.BALL]
     ball_rng = np.random.default_rng([seed, 1])
-    out: list[dict[str, float]] = [{}]
+    # q = 0 with every mimic joint at its offset (q = multiplier · 0 + offset), as a URDF reader that
+    # applies <mimic> holds it: dexmate's F5D6 hand's thumb (offset 0.00765 rad) was 7.65e-3 rad off
+    # in yourdfpy at "q = 0" when the mimic joints were left at 0 there
+    out: list[dict[str, float]] = [_with_mimics(robot, {})]
     for _ in range(count):
         q = random_configuration(robot, rng)
         q.update(ball_angles(balls, ball_rng))
-        for joint in robot.joints:  # a mimic joint follows its leader (yourdfpy and URDF readers apply it)
-            if joint.mimic is not None and joint.name in q and joint.mimic.joint in q:
-                q[joint.name] = joint.mimic.multiplier * q[joint.mimic.joint] + joint.mimic.offset
-        out.append(q)
+        out.append(_with_mimics(robot, q))
     return out
+
+
+def _with_mimics(robot: Robot, q: dict[str, float]) -> dict[str, float]:
+    """``q`` with each mimic joint following its leader (yourdfpy and URDF readers apply it); a
+    leader ``q`` does not name is at 0. Joints in the model's order, so a mimic of a mimic follows."""
+    moving = {joint.name for joint in robot.joints if joint.type in (JointType.REVOLUTE, JointType.PRISMATIC)}
+    for joint in robot.joints:
+        if joint.mimic is not None and joint.name in moving and joint.mimic.joint in moving:
+            value = joint.mimic.multiplier * q.get(joint.mimic.joint, 0.0) + joint.mimic.offset
+            if value or joint.name in q:
+                q[joint.name] = value
+    return q
 
 
 def layer2(reference: EngineModel, eng: Loaded, configs: list[dict[str, float]],
