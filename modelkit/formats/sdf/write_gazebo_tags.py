@@ -16,8 +16,9 @@ note ("not carried over"):
   ``<script>`` with that name and Gazebo's stock ``gazebo.material`` URI (the colour stays as the
   diffuse colour, which gz-sim uses).
 
-A joint's block (:func:`write_joint_tags`): ``provideFeedback`` → ``<physics><provide_feedback>`` and
-``<physics><ode><provide_feedback>``, ``implicitSpringDamper``, ``cfmDamping``, ``fudgeFactor`` →
+A joint's block (:func:`write_joint_tags`): ``provideFeedback`` → ``<physics><provide_feedback>`` (not
+also ``<physics><ode><provide_feedback>`` as libsdformat writes it: SDFormat 1.9 does not define that
+one), ``implicitSpringDamper``, ``cfmDamping``, ``fudgeFactor`` →
 ``<physics><ode>`` ``implicit_spring_damper``, ``cfm_damping``, ``fudge_factor``, ``stopCfm``/``stopErp``
 → ``<physics><ode><limit>`` ``cfm``/``erp``, ``springStiffness``/``springReference`` → ``<axis><dynamics>``
 ``spring_stiffness``/``spring_reference``.
@@ -183,7 +184,10 @@ def _copy(element: Element) -> Copy:
     return copied
 
 
-JOINT_TAGS = {"provideFeedback": (("physics", "provide_feedback"), ("physics", "ode", "provide_feedback")),
+# provideFeedback: libsdformat's own URDF parser also writes <physics><ode><provide_feedback>, which
+# SDFormat 1.9 (the version written) does not define: libsdformat copies it with a warning, Drake refuses
+# the file (example-robot-data's TIAGo, converted, failed verify's Drake load on it). Only the defined one.
+JOINT_TAGS = {"provideFeedback": (("physics", "provide_feedback"),),
               "implicitSpringDamper": (("physics", "ode", "implicit_spring_damper"),),
               "cfmDamping": (("physics", "ode", "cfm_damping"),),
               "fudgeFactor": (("physics", "ode", "fudge_factor"),),
