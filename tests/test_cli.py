@@ -100,6 +100,15 @@ def test_unknown_extension_is_a_diagnostic(tmp_path: Path) -> None:
     assert code == 1 and "MK017" in out
 
 
+def test_an_mjcf_include_fragment_is_named_as_one(tmp_path: Path) -> None:
+    """gymnasium-robotics' adroit_model.xml is the <mujocoinclude> body of the scenes that include it."""
+    fragment = tmp_path / "hand_model.xml"
+    fragment.write_text('<mujocoinclude><body name="wrist"><geom size=".1"/></body></mujocoinclude>')
+    code, out, _ = run("validate", str(fragment))
+    assert code == 2 and "MK001" in out and "MJCF include fragment" in out
+    assert f"{fragment}:" in out and "give that model's file instead" in out
+
+
 def test_many_files_in_one_call() -> None:
     files = sorted(str(p) for p in TUTORIAL.glob("*.body"))
     code, out, err = run("validate", "--no-resources", *files)

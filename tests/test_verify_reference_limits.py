@@ -17,7 +17,8 @@ BALL = """<mujoco><worldbody><body name="base"><geom size=".1" mass="1"/>
 def test_a_ball_joint_is_held_by_the_pinocchio_reference(tmp_path: Path) -> None:
     """The reference holds a ball joint as three revolute joints (before, it refused the model and
     was skipped): its layers 1 and 2 pass, the ball turned in layer 2; a model whose only moving
-    joint is a ball has no revolute or prismatic degree of freedom for layer 3, which says so."""
+    joint is a ball gets layer 3a over the ball's three angles (MuJoCo in the URDF chain's
+    coordinates; before, it had no layer 3)."""
     source = tmp_path / "ball.xml"
     source.write_text(BALL)
     report = verify(source, None, ("mujoco", "pinocchio"), configurations=2, samples=1, replay=False)
@@ -26,8 +27,9 @@ def test_a_ball_joint_is_held_by_the_pinocchio_reference(tmp_path: Path) -> None
     mine = {(c.layer, c.quantity): c for c in report.checks if c.engine == "pinocchio"}
     assert mine[(1, "joint-type")].passed and mine[(2, "pose-rotation")].passed
     assert report.failed == []
-    layer3 = [s.reason for s in report.skips if s.layer == 3]
-    assert layer3 and "ball joints only" in layer3[0]
+    layer3 = {c.quantity: c for c in report.checks if c.layer == 3 and c.engine == "mujoco"}
+    assert layer3["mass-matrix"].passed and layer3["bias"].passed
+    assert "3 dofs" in layer3["mass-matrix"].detail and "three angles" in layer3["mass-matrix"].detail
 
 
 PLANAR = """<robot name="slider"><link name="base"><inertial><mass value="1"/>

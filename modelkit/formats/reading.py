@@ -83,9 +83,23 @@ def _read_model(path: Path, options: ReadOptions | None, fmt: str | None, displa
                 if collecting:
                     gc.enable()
             return result
+    from modelkit.xmlsource import sniff_root_tag
+
+    fragment = FRAGMENT_TAGS.get(str(sniff_root_tag(path))) if fmt is None else None
+    if fragment is not None:
+        sink.emit("MK001", f"this file is {fragment}, not a model: it is read as part of the model that "
+                  "includes it; give that model's file instead", SourceLocation(shown))
+        return ReadResult(None, sink.items)
     known = ", ".join(s for info in FORMATS for s in info.suffixes)
     tags = [f"<{tag}>" for info in FORMATS for tag in info.root_tags]
     message = f"cannot tell the format of this file (supported: {known}, or .xml with a "
     message += f"{', '.join(tags[:-1])} or {tags[-1]} top element); use --input-format"
     sink.emit("MK001", message, SourceLocation(shown))
     return ReadResult(None, sink.items)
+
+
+FRAGMENT_TAGS = {
+    "mujocoinclude": "an MJCF include fragment (<mujocoinclude>, the body of an <include file=...>)",
+}
+"""Top elements of files that are pieces of a model, each with what it is (said instead of "cannot tell
+the format": gymnasium-robotics' adroit_model.xml is one)."""
