@@ -195,3 +195,20 @@ def test_materials_table_reaches_the_written_friction(tmp_path: Path) -> None:
     code, stdout, _ = run("convert", "--materials", str(table), str(body), "-o", str(out))
     assert code == 0, stdout
     assert 'friction="0.37 0.005 0.0001"' in out.read_text()
+
+
+def test_an_undeclared_world_link_is_explained(tmp_path: Path) -> None:
+    """Drake's URDFs (its acrobot) hang the robot from an undeclared "world", which Drake takes as its
+    world body and urdfdom refuses: the root error names the link hanging from it, and the
+    undefined-parent error says what to declare."""
+    urdf = tmp_path / "welded.urdf"
+    urdf.write_text('<robot name="w"><link name="base_link"/><link name="arm"/>'
+                    '<joint name="weld" type="fixed"><parent link="world"/><child link="base_link"/></joint>'
+                    '<joint name="j" type="continuous"><parent link="base_link"/><child link="arm"/>'
+                    '<axis xyz="0 0 1"/></joint></robot>')
+    code, out, _ = run("validate", str(urdf))
+    assert code == 1
+    root = next(line for line in out.splitlines() if "error MK200" in line)
+    assert '"base_link" hangs from "world", which is not defined' in root
+    parent = next(line for line in out.splitlines() if "error MK202" in line)
+    assert 'declare <link name="world"/>' in parent and "Drake" in parent

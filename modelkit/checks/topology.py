@@ -55,12 +55,17 @@ def parents_exist(robot: Robot) -> Iterator[Diagnostic]:
                 hint='add <parent link="..."/>',
             )
         else:
+            world = joint.parent == "world" and "world" not in names
             yield diag(
                 "MK202",
                 f'parent link "{joint.parent}" of joint "{joint.name}" is not defined',
                 joint.loc("parent"),
-                hint=did_you_mean(joint.parent, names),
+                hint=WORLD_HINT if world else did_you_mean(joint.parent, names),
             )
+
+
+WORLD_HINT = ('declare <link name="world"/> to weld the robot to the world: Drake takes an undeclared '
+              '"world" as its world body, but urdfdom (check_urdf, ROS) needs the link')
 
 
 @rule("single-root", "MK200", "MK201")
@@ -73,7 +78,11 @@ def single_root(robot: Robot) -> Iterator[Diagnostic]:
     if not roots and robot.links:
         if any(True for _ in no_cycles(robot)):
             return  # every link has a parent because of a cycle: no-cycles reports it, with its path
-        yield diag("MK200", "no root link found: every link has a parent", robot.links[0].loc("name"))
+        names = {link.name for link in robot.links}
+        hanging = sorted({f'"{j.child}" hangs from "{j.parent}"' for j in robot.joints
+                          if j.parent and j.parent not in names})
+        why = f" ({'; '.join(hanging)}, which is not defined: MK202)" if hanging else ""
+        yield diag("MK200", f"no root link found: every link has a parent{why}", robot.links[0].loc("name"))
     elif len(roots) > 1:
         names = ", ".join(f'"{r.name}"' for r in roots)
         yield diag("MK201", f"{len(roots)} root links found: {names}", roots[1].loc("name"))
