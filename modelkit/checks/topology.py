@@ -78,9 +78,9 @@ def single_root(robot: Robot) -> Iterator[Diagnostic]:
     if not roots and robot.links:
         if any(True for _ in no_cycles(robot)):
             return  # every link has a parent because of a cycle: no-cycles reports it, with its path
-        names = {link.name for link in robot.links}
+        defined = {link.name for link in robot.links}
         hanging = sorted({f'"{j.child}" hangs from "{j.parent}"' for j in robot.joints
-                          if j.parent and j.parent not in names})
+                          if j.parent and j.parent not in defined})
         why = f" ({'; '.join(hanging)}, which is not defined: MK202)" if hanging else ""
         yield diag("MK200", f"no root link found: every link has a parent{why}", robot.links[0].loc("name"))
     elif len(roots) > 1:

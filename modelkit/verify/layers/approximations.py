@@ -303,6 +303,11 @@ def refused_inertias(engine: str, fmt: str, source: Robot) -> dict[str, Approxim
         moments = triangle_moments(tensor)
         if moments is None:
             continue
+        if engine == "drake-urdf":
+            from modelkit.verify.engines.drake import accepts_inertia
+
+            if accepts_inertia(tensor):  # within Drake's own rounding allowance: it keeps the tensor
+                continue
         if engine == "pybullet":
             fixed = np.zeros((3, 3))
             by = "PyBullet, refusing it (\"Bad inertia tensor properties\"), holds zero"
