@@ -45,6 +45,39 @@ def test_the_refused_tensor_is_classified_with_validate_s_code(tmp_path: Path) -
     assert approximations.refusal_code((0.19125, 0.19125, 0.45)) == "MK303"  # ClosedLinkSample-like
 
 
+PULLER = """<?xml version="1.0"?>
+<robot name="puller">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0"
+    iyz="0"/></inertial></link>
+  <link name="link_puller"><inertial><mass value="0.00292784355893436"/>
+    <inertia ixx="1.09317111513898E-07" ixy="-9.31929125413026E-13" ixz="-3.36065188387015E-16"
+      iyy="1.10835075609816E-15" iyz="1.43669784789342E-12" izz="1.09317110675672E-07"/></inertial></link>
+  <link name="bad"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.3" ixy="0" ixz="0"
+    iyz="0"/></inertial></link>
+  <joint name="slide" type="prismatic"><parent link="base"/><child link="link_puller"/><axis xyz="1 0 0"/>
+    <limit lower="0" upper="0.1" effort="1" velocity="1"/></joint>
+  <joint name="turn" type="revolute"><parent link="base"/><child link="bad"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+def test_drake_is_held_to_a_replacement_only_where_drake_refuses(tmp_path: Path) -> None:
+    """Hello Robot Stretch's link_puller misses the triangle inequality by 5.3e-23 (validate's exact
+    MK303) and Drake keeps it (its own test allows 16 ε): drake-urdf is compared with the source tensor
+    there; a clear violation (0.1 + 0.1 < 0.3) is still compared with Drake's substitute sphere."""
+    from modelkit.verify.engines.drake import accepts_inertia
+
+    path = tmp_path / "puller.urdf"
+    path.write_text(PULLER)
+    robot = modelkit.load(path)
+    tensors = {link.name: np.asarray(link.inertial.inertia) for link in robot.links if link.inertial}
+    assert approximations.triangle_moments(tensors["link_puller"]) is not None  # validate: MK303
+    assert accepts_inertia(tensors["link_puller"]) and not accepts_inertia(tensors["bad"])
+    assert set(approximations.refused_inertias("drake-urdf", "urdf", robot)) == {"bad"}
+    assert set(approximations.refused_inertias("pybullet", "urdf", robot)) == {"link_puller", "bad"}
+
+
 def test_pybullet_refusing_the_source_inertia_is_no_conversion_fail(tmp_path: Path) -> None:
     path = tmp_path / "go1_like.urdf"
     path.write_text(GO1_LIKE)
@@ -137,3 +170,18 @@ def test_links_apart_from_the_root_tree_are_said_not_graded(tmp_path: Path) -> N
     assert "finger2_base, finger2_link, finger3_base, finger3_link" in entry.reason
     assert "not graded" in entry.reason
     assert [c for c in report.checks if c.quantity == "replay" and c.passed]
+
+
+def test_a_tensor_near_the_triangle_bound_verifies_in_every_engine(tmp_path: Path) -> None:
+    """The same model verified: Drake keeps link_puller's tensor, PyBullet zeroes it, and the MJCF
+    writer adds 1e-9 kg·m² per axis, calling it singular as MuJoCo does (MK870) though validate calls
+    it MK303; each engine is compared with what it holds. Before, drake-urdf failed layers 1 and 3
+    (compared with a substitute sphere Drake never made) and MuJoCo failed layer 1 (the writer's 1e-9
+    was expected only for an MK302 tensor)."""
+    path = tmp_path / "puller.urdf"
+    path.write_text(PULLER)
+    report = verify(path, tmp_path / "out", ("mujoco", "pybullet", "drake-urdf", "pinocchio"),
+                    configurations=2, samples=2, driven=False)
+    assert report.failed == [], [c.detail for c in report.failed]
+    checked = {(c.engine, c.quantity) for c in report.checks if c.layer == 1 and c.quantity == "inertia"}
+    assert {("mujoco", "inertia"), ("drake-urdf", "inertia"), ("pybullet", "inertia")} <= checked
