@@ -1601,6 +1601,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "capsule)) is left out of the written `.body`: Choreonoid refuses the whole file otherwise.",
     ),
     CodeInfo(
+        "MK881",
+        "flat-collision-as-box",
+        "warning",
+        "MJCF: a collision mesh whose vertices all lie in one plane (a marker plate) is written as a thin "
+        "box spanning it (1 mm thick at most): MuJoCo collides with a mesh's convex hull, and a plane has "
+        "none.",
+    ),
+    CodeInfo(
         "MK890",
         "output-exists",
         "error",

@@ -76,7 +76,7 @@ CASES = {
     ("obj_text", True): (0, "MK804", 2),  # read by its content, written as binary STL
     ("flat", False): (0, "MK876", 1),  # a visual plane: inertia="shell" on its asset
     ("tiny", True): (0, "MK876", 2),
-    ("flat", True): (1, "MK805", 1),  # the visual stays; MuJoCo cannot build a plane's convex hull
+    ("flat", True): (0, "MK881", 2),  # the collision a thin box in the plane: MuJoCo has no hull of a plane
     ("png", True): (1, "MK805", 0),
     ("empty", True): (1, "MK805", 0),
     ("nan", True): (1, "MK805", 0),
@@ -108,6 +108,10 @@ def test_each_mesh_case_loads_in_mujoco_or_exits_1(mesh: str, collision: bool, t
     if mesh in ("ascii", "obj_text"):
         written = next((out.parent / "meshes").glob("*.stl")).read_bytes()
         assert len(written) == 84 + 50 * int.from_bytes(written[80:84], "little")  # binary STL
+    if (mesh, collision) == ("flat", True):  # the 1 m square as a 1 m × 1 m × 1 mm box over it
+        box = [g for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX]
+        assert len(box) == 1 and np.allclose(model.geom_size[box[0]], [0.5, 0.5, 0.0005]), output
+        assert np.allclose(model.geom_pos[box[0]], [0.5, 0.5, 0.0]), output
     if mesh == "huge":
         assert [p.name for p in (out.parent / "meshes").glob("*")] == ["huge.obj"], output
         assert model.mesh_facenum[0] == 327_680
@@ -153,7 +157,7 @@ def test_summary_counts_every_warning_printed(tmp_path: Path) -> None:
     assert status == 0
 
 
-def test_a_flat_generated_mesh_keeps_its_visual_and_loses_its_collision(tmp_path: Path) -> None:
+def test_a_flat_generated_mesh_keeps_its_visual_and_its_collision_as_a_box(tmp_path: Path) -> None:
     """A `.body` TriangleMesh (written by the writer, not copied) gets the same checks."""
     source = tmp_path / "tri.body"
     source.write_text("""\
@@ -176,10 +180,10 @@ links:
 """)
     out = tmp_path / "out" / "tri.xml"
     status, output = _convert(source, out)
-    assert status == 1, output
-    assert "error MK805" in output and "MK876" in output, output
+    assert status == 0, output
+    assert "warning MK881" in output and "MK876" in output, output
     model = mujoco.MjModel.from_xml_path(str(out))
-    assert model.ngeom == 1  # the visual plane
+    assert model.ngeom == 2  # the visual plane and its collision as a thin box
 
 
 TWO_OBJECTS_OBJ = (
@@ -256,8 +260,8 @@ FLAT_DISC_OBJ = "".join(f"v {0.037 * np.cos(a):.6f} {0.037 * np.sin(a):.6f} 0.00
 
 
 @pytest.mark.parametrize(("collision", "status", "code", "geoms"),
-                         [(False, 0, "MK876", 1), (True, 1, "MK805", 1)])
-def test_a_flat_obj_of_one_object_loads_or_exits_1(collision: bool, status: int, code: str, geoms: int,
+                         [(False, 0, "MK876", 1), (True, 0, "MK881", 2)])
+def test_a_flat_obj_of_one_object_loads(collision: bool, status: int, code: str, geoms: int,
                                                    tmp_path: Path) -> None:
     (tmp_path / "disc.obj").write_text(FLAT_DISC_OBJ)
     source = tmp_path / "robot.urdf"

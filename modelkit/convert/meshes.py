@@ -34,6 +34,83 @@ class MeshRef:
     file_format: str  # "stl" | "obj" | "dae"
     hollow: bool = False  # encloses no volume: MuJoCo needs inertia="shell" on its asset
     flat: bool = False  # all vertices in a plane: MuJoCo cannot build the convex hull it collides with
+    plate: Plate | None = None  # a flat collision mesh for MuJoCo: write this box instead (MK881)
+
+
+PLATE_THICKNESS = 1e-3
+"""m: the thickness of the box a flat collision mesh is written as for MuJoCo (at most a tenth of the
+plate's larger side): MuJoCo collides with a mesh's convex hull, and a plane has none."""
+
+
+@dataclass(frozen=True)
+class Plate:
+    """A flat mesh as a thin box: its centre and axes (the columns of ``rotation``: the plane's two
+    axes, then its normal) in the mesh's frame with the scale applied, and the box's full sizes."""
+
+    centre: tuple[float, ...]
+    rotation: tuple[tuple[float, ...], ...]
+    size: tuple[float, ...]
+
+
+def plate_of(corners: np.ndarray, scale: Vec3 | None = None) -> Plate:
+    """The thin box of a flat mesh's corners: the smallest rectangle that holds the vertices in their
+    plane (over the directions of the edges of their convex hull there, as the rotating calipers
+    find it: a square marker gives its own square, whatever way its principal axes fall), and
+    ``PLATE_THICKNESS`` across it. The plane is the one of the two largest principal axes."""
+    points = corners.reshape(-1, 3) * (np.ones(3) if scale is None else np.asarray(scale, dtype=float))
+    mean = points.mean(axis=0)
+    _, _, vt = np.linalg.svd(points - mean)
+    normal = vt[2] if vt[2][int(np.argmax(np.abs(vt[2])))] > 0 else -vt[2]
+    base_u = vt[0]
+    base_v = np.cross(normal, base_u)
+    flat = np.column_stack([(points - mean) @ base_u, (points - mean) @ base_v])
+    hull = _hull_2d(flat)
+    best: tuple[float, np.ndarray] | None = None  # area, the rectangle's 2 × 2 axes
+    for i in range(len(hull)):
+        edge = hull[(i + 1) % len(hull)] - hull[i]
+        length = float(np.hypot(edge[0], edge[1]))
+        if length == 0.0:
+            continue
+        d = edge / length
+        axes2 = np.array([[d[0], -d[1]], [d[1], d[0]]])  # columns: the edge and its normal in the plane
+        local = hull @ axes2
+        area = float(np.prod(local.max(axis=0) - local.min(axis=0)))
+        if best is None or area < best[0] * (1.0 - 1e-12):
+            best = (area, axes2)
+    axes2 = np.eye(2) if best is None else best[1]
+    u = axes2[0, 0] * base_u + axes2[1, 0] * base_v
+    u = u if u[int(np.argmax(np.abs(u)))] > 0 else -u
+    v = np.cross(normal, u)
+    axes = np.column_stack([u, v, normal])
+    local = (points - mean) @ axes
+    low, high = local.min(axis=0), local.max(axis=0)
+    centre = mean + axes @ (0.5 * (low + high))
+    extent = high - low
+    thickness = min(PLATE_THICKNESS, 0.1 * float(max(extent[0], extent[1])))
+    return Plate(tuple(float(x) for x in centre), tuple(tuple(float(x) for x in row) for row in axes),
+                 (float(extent[0]), float(extent[1]), thickness))
+
+
+def _hull_2d(points: np.ndarray) -> np.ndarray:
+    """The convex hull of 2-D points, counter-clockwise (Andrew's monotone chain)."""
+    ordered = sorted({(float(x), float(y)) for x, y in points})
+    if len(ordered) < 3:
+        return np.asarray(ordered, dtype=float).reshape(-1, 2)
+
+    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower: list[tuple[float, float]] = []
+    for point in ordered:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], point) <= 0.0:
+            lower.pop()
+        lower.append(point)
+    upper: list[tuple[float, float]] = []
+    for point in reversed(ordered):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], point) <= 0.0:
+            upper.pop()
+        upper.append(point)
+    return np.asarray(lower[:-1] + upper[:-1], dtype=float)
 
 
 MUJOCO_MAX_STL_FACES = 200_000  # MuJoCo's STL decoder: "number of faces should be between 1 and 200000"
@@ -47,6 +124,7 @@ class Prepared:
     converted: str | None  # what the bytes were ("an ASCII STL"), None when copied as is
     hollow: bool
     flat: bool
+    plate: Plate | None = None  # the thin box of a flat mesh (:func:`plate_of`), for a collision shape
 
 
 class Unusable(Exception):
@@ -76,7 +154,8 @@ def for_mujoco(data: bytes, ext: str, scale: Vec3 | None = None) -> Prepared:
     count = _binary_stl_faces(data)
     if count is not None:
         corners = _checked(_binary_stl_corners(data, count))
-        return Prepared(data, None, _hollow(corners, scale), _flat(corners))
+        return Prepared(data, None, _hollow(corners, scale), _flat(corners),
+                    _plate_if_flat(corners, scale))
     text = _text(data)
     if text is None:
         kind = "a PNG image" if data.startswith(b"\x89PNG") else "binary data that is no STL"
@@ -91,7 +170,8 @@ def for_mujoco(data: bytes, ext: str, scale: Vec3 | None = None) -> Prepared:
     corners = _checked(_text_corners(data, file_type))
     faces = np.arange(len(corners) * 3, dtype=np.int64).reshape(-1, 3)
     mesh = TriangleMeshData(corners.reshape(-1, 3), faces)
-    return Prepared(triangles_to_bytes(mesh, "stl"), kind, _hollow(corners, scale), _flat(corners))
+    return Prepared(triangles_to_bytes(mesh, "stl"), kind, _hollow(corners, scale), _flat(corners),
+                    _plate_if_flat(corners, scale))
 
 
 def _loaded(path: Path, fragment: str | None, metadata: Any) -> Any:
@@ -142,7 +222,8 @@ def _obj_for_mujoco(data: bytes, scale: Vec3 | None) -> Prepared:
         corners = _obj_corners(data)
         if corners is None or len(corners) == 0 or not np.all(np.isfinite(corners)):
             return Prepared(data, None, False, False)  # MuJoCo's own verdict comes with the model
-        return Prepared(data, None, _hollow(corners, scale), _flat(corners))
+        return Prepared(data, None, _hollow(corners, scale), _flat(corners),
+                    _plate_if_flat(corners, scale))
     from modelkit.formats.mjcf.meshprobe import faces_mujoco_reads
 
     read = faces_mujoco_reads(data, "obj")
@@ -153,7 +234,8 @@ def _obj_for_mujoco(data: bytes, scale: Vec3 | None) -> Prepared:
     mesh = TriangleMeshData(corners.reshape(-1, 3), faces)
     why = (f"an OBJ file of {groups} objects of which MuJoCo's OBJ reader keeps {read:,} of its "
            f"{triangles:,} triangles")
-    return Prepared(triangles_to_bytes(mesh, "stl"), why, _hollow(corners, scale), _flat(corners))
+    return Prepared(triangles_to_bytes(mesh, "stl"), why, _hollow(corners, scale), _flat(corners),
+                    _plate_if_flat(corners, scale))
 
 
 def _obj_corners(data: bytes) -> np.ndarray | None:
@@ -253,6 +335,10 @@ def _hollow(corners: np.ndarray, scale: Vec3 | None = None) -> bool:
     volume = abs(float(triple.sum())) / 6.0
     extent = float(np.max(corners.reshape(-1, 3).max(axis=0) - corners.reshape(-1, 3).min(axis=0)))
     return volume <= max(1e-6 * extent ** 3, 1e-12)
+
+
+def _plate_if_flat(corners: np.ndarray, scale: Vec3 | None) -> Plate | None:
+    return plate_of(corners, scale) if _flat(corners) else None
 
 
 def _flat(corners: np.ndarray) -> bool:
@@ -416,6 +502,12 @@ class MeshExporter:
         readable by MuJoCo first (:func:`for_mujoco`).
         """
         ref, missing = self._mesh(geometry, name, target, source, readable, mujoco, collision)
+        if ref is not None and ref.plate is not None:
+            size = " × ".join(f"{x:.6g}" for x in ref.plate.size)
+            what = geometry.uri or name
+            self.notes.note("MK881", f"collision mesh {what} is flat (all its vertices in one plane), and "
+                            "MuJoCo cannot build the convex hull it collides with: written as a box of "
+                            f"{size} m in that plane", source, target)
         if ref is None:
             role = "collision shape" if collision else "shape"
             self.notes.note("MK805", f"{missing}; the {role} is left out", source, target,
@@ -482,8 +574,8 @@ class MeshExporter:
             except Unusable as exc:
                 return None, f"mesh {uri} cannot be read by MuJoCo ({exc})"
             if ready.flat and collision:
-                return None, (f"mesh {uri} is flat (all its vertices in one plane): MuJoCo cannot build "
-                              "the convex hull it collides with")
+                assert ready.plate is not None  # flat: its box was computed with it
+                return MeshRef("", scale, "box", plate=ready.plate), ""
             file_name = safe_file_name(path.name, "mesh")
             if ready.converted is not None:
                 file_name = f"{safe_file_name(converted_stem(path.stem, ext, 'stl'), 'mesh')}.stl"
@@ -580,8 +672,7 @@ class MeshExporter:
         except Unusable as exc:
             return None, f"{what} cannot be read by MuJoCo ({exc})"
         if collision and _flat(corners):
-            return None, (f"{what} is flat (all its vertices in one plane): MuJoCo cannot build the convex "
-                          "hull it collides with")
+            return MeshRef("", scale, "box", plate=plate_of(corners, scale)), ""
         file_format = self.options.mesh_format
         if file_format == "stl" and len(corners) > MUJOCO_MAX_STL_FACES:
             file_format = "obj"  # MuJoCo's OBJ reader has no such bound (dexmate's gripper base: 294,002)

@@ -90,7 +90,7 @@ INJECT = "modelkit.verify.layers.inject:apply"
 
 # The writers' notes that say what a given file holds where the file itself is checked later: sensor
 # frames (MK847, each looked up in the file) and repairs of a source tensor no engine holds (MK860/MK870).
-GIVEN_NOTES = ("MK847", "MK860", "MK870")
+GIVEN_NOTES = ("MK847", "MK860", "MK870", "MK881")
 CONFIGURATIONS = 50  # layer 2: q = 0 and this many random configurations
 SAMPLES = 20  # layer 3a: random (q, dq)
 REPLAY_SECONDS = 10.0
@@ -190,10 +190,10 @@ def _given_file(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Rena
     staged conversion's ball-joint chains (MK813: three joints through two links, URDF) whose joints
     and links are all in the file, so that the layers compare it as they compare the URDF verify
     writes, its sensor links (MK847, each looked up in the file by ``approximations.sensor_frames``),
-    and the writer's inertia repairs (SDF MK860, MJCF MK870: a source tensor no engine
-    holds, lifted to the nearest valid one): the engines are compared with the repaired tensor, as
-    for verify's own files (a file that repairs it otherwise fails layer 1 there, as it did against
-    the source's tensor)."""
+    its flat collision meshes written as thin boxes (MJCF MK881), and the writer's inertia repairs (SDF
+    MK860, MJCF MK870: a source tensor no engine holds, lifted to the nearest valid one): the engines
+    are compared with the repaired tensor, as for verify's own files (a file that repairs it otherwise
+    fails layer 1 there, as it did against the source's tensor)."""
     from lxml import etree
 
     from modelkit.convert.api import render_model
@@ -602,11 +602,16 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         wheels_entry = approximations.wheels_skip(eng.label, wheels)
         if wheels_entry is not None:
             report.skips.append(wheels_entry)
+        plates = approximations.flat_collisions(kind, written.get(kind, []), maps.get(kind, {}))
+        plates_entry = approximations.plates_skip(eng.label, plates)
+        if plates_entry is not None:
+            report.skips.append(plates_entry)
         held = approximations.applied_chains(models[eng.label], chains)
         if wheels is not None:
             held = approximations.applied_wheels(held, robot, wheels)
+        held = approximations.applied_plates(held, plates)
         eng_static = (source_static(approximations.applied(held, approx[eng.label]))
-                      if approx[eng.label] or chains or wheels or models[eng.label] is not reference
+                      if approx[eng.label] or chains or wheels or plates or models[eng.label] is not reference
                       else src_static)
         # ... and so is one holding the URDF writer's ±1e16 for an infinite position bound (MK819).
         stand_ins = approximations.limits_for_engine(kind, reference)

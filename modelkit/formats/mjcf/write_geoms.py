@@ -45,7 +45,7 @@ import numpy as np
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import FLOOR_MATERIAL, PairFriction
-from modelkit.convert.meshes import MeshRef
+from modelkit.convert.meshes import MeshRef, Plate
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.diagnostics import SourceLocation
 from modelkit.formats.mjcf.bodies import GEOM_CONTACT_DEFAULTS
@@ -64,6 +64,7 @@ from modelkit.model import (
     SurfaceFriction,
     VisualMaterial,
 )
+from modelkit.spatial import Pose
 
 MESH_READABLE = ("stl", "obj")
 COLLISION_GROUP = "3"
@@ -140,15 +141,16 @@ class GeomWriter:
                                                    mujoco=True)
             if parts is not None:
                 return self._coloured_geoms(body, geom, target, parts)
-        shape = self.shape(geom, target, file_stem, collision)
-        if shape is None:
+        found = self.shape(geom, target, file_stem, collision)
+        if found is None:
             return None
+        shape, offset = found
         el = sub(body, "geom")
         if geom.name:
             el.set("name", self.names.claim("geom", geom.name, geom.source, target))
         for key, value in shape.items():
             el.set(key, value)
-        set_pose(el, geom.pose)
+        set_pose(el, geom.pose @ offset)
         role = COLLISION if collision else VISUAL
         el.set("class", role)
         self.used.add(role)
@@ -160,7 +162,18 @@ class GeomWriter:
         return el
 
     def shape(self, geom: Geom, target: str, file_stem: str,
-              collision: bool = False) -> dict[str, str] | None:
+              collision: bool = False) -> tuple[dict[str, str], Pose] | None:
+        """The geom's type and size attributes, and the pose of the written shape in the geom's frame
+        (the identity but for a flat collision mesh written as a thin box, MK881)."""
+        attributes = self._shape(geom, target, file_stem, collision)
+        if isinstance(attributes, Plate):
+            plate = attributes
+            box = {"type": "box", "size": fmt_vec(np.asarray(plate.size, dtype=float) / 2.0)}
+            return box, Pose(np.asarray(plate.rotation, dtype=float), np.asarray(plate.centre, dtype=float))
+        return None if attributes is None else (attributes, Pose())
+
+    def _shape(self, geom: Geom, target: str, file_stem: str,
+               collision: bool) -> dict[str, str] | Plate | None:
         g = geom.geometry
         if isinstance(g, Box):
             return {"type": "box", "size": fmt_vec(np.asarray(g.size, dtype=float) / 2.0)}
@@ -181,6 +194,8 @@ class GeomWriter:
                                          mujoco=True, collision=collision)
             if found is None:
                 return None
+            if found.plate is not None:
+                return found.plate
             ref = found
         else:  # pragma: no cover - the model has no other geometry
             return None

@@ -48,7 +48,7 @@ import numpy as np
 from lxml import etree
 
 from modelkit.convert.notes import ConversionNote
-from modelkit.model import BALL_KEYS, Cylinder, Inertial, JointType, Robot
+from modelkit.model import BALL_KEYS, Box, Cylinder, Inertial, JointType, Mesh, Robot
 from modelkit.spatial import Pose
 from modelkit.verify.engines.protocol import Skip, StaticFacts
 
@@ -649,6 +649,56 @@ def applied_wheels(robot: Robot, source: Robot, proxy: WheelProxy) -> Robot:
         if isinstance(geom.geometry, Cylinder):
             link.collisions[index] = wheel_proxy(geom, geom.geometry, proxy.shape)[0]
     return out
+
+
+def flat_collisions(fmt: str, notes: Iterable[ConversionNote], renames: Renames) -> dict[str, set[int]]:
+    """The collision meshes (source link → collision indices) the MJCF writer wrote as thin boxes
+    because they are flat (MK881: MuJoCo has no convex hull of a plane)."""
+    if fmt != "mjcf":
+        return {}
+    back = _source_names(renames)
+    out: dict[str, set[int]] = {}
+    for note in notes:
+        match = re.fullmatch(r"body\[(.+)\]/collision\[(\d+)\]", note.target or "")
+        if note.code == "MK881" and match:
+            out.setdefault(back.get(match[1], match[1]), set()).add(int(match[2]))
+    return out
+
+
+def applied_plates(robot: Robot, plates: Mapping[str, set[int]]) -> Robot:
+    """``robot`` with each flat collision mesh of ``plates`` replaced by the box the MJCF writer wrote
+    for it, recomputed from the source's mesh file (``convert.meshes.plate_of``)."""
+    if not plates:
+        return robot
+    from modelkit.convert.meshes import plate_of
+    from modelkit.geometry.meshfiles import load_mesh
+
+    out = copy.deepcopy(robot)
+    for link in out.links:
+        for index in sorted(plates.get(link.name, ())):
+            if index >= len(link.collisions) or not isinstance(link.collisions[index].geometry, Mesh):
+                continue
+            geom = link.collisions[index]
+            mesh = geom.geometry
+            assert isinstance(mesh, Mesh)
+            data = mesh.data if mesh.data is not None else load_mesh(Path(str(mesh.path)), mesh.fragment).mesh
+            vertices = np.asarray(data.vertices, dtype=float)
+            corners = vertices[np.asarray(data.faces, dtype=np.int64)]
+            plate = plate_of(corners, mesh.scale)
+            offset = Pose(np.asarray(plate.rotation, dtype=float), np.asarray(plate.centre, dtype=float))
+            box = Box(np.asarray(plate.size, dtype=float))
+            link.collisions[index] = dataclasses.replace(geom, geometry=box, pose=geom.pose @ offset)
+    return out
+
+
+def plates_skip(engine: str, plates: Mapping[str, set[int]]) -> Skip | None:
+    """The report's entry for an engine holding flat collision meshes as thin boxes (MK881)."""
+    if not plates:
+        return None
+    return Skip(1, engine, "approximation: the MJCF writer wrote flat collision mesh(es) as thin boxes in "
+                           "their planes (MK881; MuJoCo has no convex hull of a plane) on "
+                           f"{', '.join(sorted(plates))}; layer 1 compares the engine's shapes with those "
+                           "boxes")
 
 
 def wheels_skip(engine: str, proxy: WheelProxy | None) -> Skip | None:
