@@ -87,17 +87,22 @@ def test_layer3a_compares_the_balls_in_the_chain_coordinates(sound: VerifyReport
     assert mujoco.where.startswith(("joint_1#", "joint_2#"))
 
 
+def _body3_heavier(source: Path, given: Path, factor: float) -> Path:
+    """``convert``'s file ``given`` (its suffix picks the format) with body3's mass times ``factor``."""
+    convert([source], given)
+    text = given.read_text()
+    start = text.index('<body name="body3"' if given.suffix == ".xml" else '<link name="body3"')
+    found = re.compile(r'mass(?:="| value=")([^"]+)"').search(text, start)
+    assert found is not None
+    heavier = found[0].replace(found[1], repr(float(found[1]) * factor))
+    given.write_text(text[:found.start()] + heavier + text[found.end():])
+    return given
+
+
 def test_layer3a_finds_a_ball_link_mass_written_wrong_in_the_mjcf(tmp_path: Path) -> None:
     """body3's mass 10 % heavier in the MJCF MuJoCo reads: its ball rows of the mass matrix differ."""
     source = _source(tmp_path)
-    given = tmp_path / "given" / "balls.xml"
-    convert([source], given)
-    text = given.read_text()
-    body3 = text.index('<body name="body3"')
-    mass = re.compile(r'mass="([^"]+)"')
-    found = mass.search(text, body3)
-    assert found is not None
-    given.write_text(text[:found.start()] + f'mass="{float(found[1]) * 1.1!r}"' + text[found.end():])
+    given = _body3_heavier(source, tmp_path / "given" / "balls.xml", 1.1)
     report = verify(source, tmp_path / "out", ("mujoco", "pinocchio"), mjcf=given, configurations=1,
                     samples=2, replay=False, driven=False)
     failed = {(c.layer, c.engine, c.quantity): c for c in report.failed}
@@ -108,15 +113,7 @@ def test_layer3a_finds_a_ball_link_mass_written_wrong_in_the_mjcf(tmp_path: Path
 def test_a_mass_off_in_the_urdf_alone_fails_the_ladder(tmp_path: Path) -> None:
     """body3's mass 0.01 % heavier in the URDF PyBullet reads (MuJoCo's file sound)."""
     source = _source(tmp_path)
-    given = tmp_path / "given" / "balls.urdf"
-    convert([source], given)
-    text = given.read_text()
-    body3 = text.index('<link name="body3"')
-    mass = re.compile(r'<mass value="([^"]+)"/>')
-    found = mass.search(text, body3)
-    assert found is not None
-    heavier = f'<mass value="{float(found[1]) * 1.0001!r}"/>'
-    given.write_text(text[:found.start()] + heavier + text[found.end():])
+    given = _body3_heavier(source, tmp_path / "given" / "balls.urdf", 1.0001)
     report = verify(source, tmp_path / "out", ("mujoco", "pybullet", "pinocchio"), urdf=given,
                     configurations=1, samples=1, driven=False)
     check = _replay(report)

@@ -389,8 +389,7 @@ def replay_layer(source: Robot, sims: list[Simulator], law: TorqueLaw, seconds: 
     growth = tol / TOLERANCE
     for sim, q, _wall, error in runs[1:]:
         if q is None:
-            checks.append(Check(3, sim.engine, "replay", "", math.inf, TOLERANCE,
-                                f"{sim.engine} replay failed ({setting}): {error}"))
+            checks.append(_failed(sim.engine, setting, error))
             continue
         bad = first_nonfinite(q)
         if bad is not None:
@@ -447,8 +446,7 @@ def ladder_layer(sims: list[Simulator], law: TorqueLaw, dt: float
         for k, h in enumerate(steps):
             q, _wall, error = _run(sim, law, LADDER_SECONDS, h)
             if q is None:
-                checks.append(Check(3, sim.engine, "replay", "", math.inf, TOLERANCE,
-                                    f"{sim.engine} replay failed ({setting}): {error}"))
+                checks.append(_failed(sim.engine, setting, error))
                 break
             bad = first_nonfinite(q)
             if bad is not None:
@@ -498,6 +496,11 @@ def _compare_ladder(ref_engine: str, engine: str, extrapolated: Array, correctio
               "largest_error": float(per_step[worst_step]), "largest_error_time": worst_step * dt}
     return Check(3, engine, "replay", law.joints[joint], float(error[step, joint]), float(tol[step]),
                  detail), record
+
+
+def _failed(engine: str, setting: str, error: str) -> Check:
+    """The replay check of an engine whose replay raised or returned a wrong shape."""
+    return Check(3, engine, "replay", "", math.inf, TOLERANCE, f"{engine} replay failed ({setting}): {error}")
 
 
 def _nonfinite(engine: str, q: Array, step: int, law: TorqueLaw, dt: float, setting: str) -> Check:
