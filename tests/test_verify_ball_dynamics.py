@@ -188,3 +188,17 @@ def test_a_quaternion_gives_its_rotation() -> None:
     w, (x, y, z) = math.cos(half), math.sin(half) * axis
     rotation = _matrix(ball_law.quaternion_matrix(w, x, y, z))
     assert np.allclose(ball_law.rotation_log(tuple(rotation.ravel())), 2.0 * half * axis, atol=1e-14)
+
+
+def test_a_ball_s_armature_is_compared_in_the_chain_coordinates(tmp_path: Path) -> None:
+    """MuJoCo's ball armature is a rotor inertia per axis of the child's angular velocity: in the
+    chain's coordinates it adds a·JᵀJ, not a on the diagonal. MuJoCo's own test model (a ball wheel of
+    armature 0.1) failed layer 3a by exactly that (0.0838 against 0.1838) when the reference held none."""
+    source = tmp_path / "armature.xml"
+    source.write_text(BALLS.replace('<joint type="ball" damping=".005"/>',
+                                    '<joint type="ball" damping=".005" armature=".1"/>'))
+    report = verify(source, None, ("mujoco", "pinocchio"), configurations=1, samples=3, replay=False,
+                    driven=False)
+    layer3 = {c.quantity: c for c in report.checks if c.layer == 3 and c.engine == "mujoco"}
+    for quantity in ("mass-matrix", "bias"):
+        assert layer3[quantity].passed and layer3[quantity].error < 1e-12, layer3[quantity].detail

@@ -25,6 +25,7 @@ import pinocchio as pin
 
 from modelkit.model import BALL_KEYS, Joint, JointType, Robot
 from modelkit.spatial import Pose
+from modelkit.verify.engines import ball_law
 from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, StaticFacts
 from modelkit.verify.engines.reference import unit
 
@@ -101,6 +102,8 @@ class PinocchioModel:
         self._joint_child: dict[str, str] = {}
         self._ball_pieces: set[str] = set()  # the three revolute joints holding each ball joint
         self._balls: dict[str, str] = {}  # ball joint -> child link
+        # a ball joint's armature, per axis of the child's angular velocity (MuJoCo's ball dofs)
+        self.ball_armature: dict[str, float] = {}
         root_frame = model.addFrame(pin.Frame(robot.root, 0, 0, pin.SE3.Identity(), pin.FrameType.BODY,
                                               _inertia(robot, robot.root)), False)
         model.appendBodyToJoint(0, _inertia(robot, robot.root), pin.SE3.Identity())
@@ -124,7 +127,9 @@ class PinocchioModel:
                 frame = self._carry(model, joint, jid, parent_frame)
             elif joint.type is JointType.BALL:
                 frame = self._carry(model, joint, self._add_ball(model, joint, pjid, placement), parent_frame)
-                armature.extend([0.0, 0.0, 0.0])
+                armature.extend([0.0, 0.0, 0.0])  # a ball's is not diagonal in the pieces' rates:
+                if joint.armature:  # mass_matrix_with_balls adds it
+                    self.ball_armature[joint.name] = float(joint.armature)
                 self._balls[joint.name] = joint.child
             elif joint.type in (JointType.FIXED, JointType.PSEUDO_CONTINUOUS_TRACK):
                 model.appendBodyToJoint(pjid, _inertia(robot, joint.child), placement)
@@ -241,7 +246,13 @@ class PinocchioModel:
         the URDF writer's chain (R = Rx·Ry·Rz). At a ball's zero orientation their rates are the
         child's angular velocity in the child's frame, the coordinates MuJoCo gives a ball."""
         upper = np.array(pin.crba(self.model, self.data, self._q(q)))
-        return np.triu(upper) + np.triu(upper, 1).T
+        full = np.triu(upper) + np.triu(upper, 1).T
+        for name, armature in self.ball_armature.items():  # a·JᵀJ: a per axis of ω = J·(ȧ, ḃ, ċ)
+            first = self._all.index(name + BALL_KEYS[0])
+            pitch, yaw = (q.get(name + key, 0.0) for key in BALL_KEYS[1:])
+            jacobian = np.array(ball_law.chain_jacobian(pitch, yaw), dtype=float).reshape(3, 3)
+            full[first:first + 3, first:first + 3] += armature * jacobian.T @ jacobian
+        return full
 
     def bias_with_balls(self, q: dict[str, float], dq: dict[str, float]) -> Array:
         """The bias over :meth:`dof_names_with_balls`, a ball's pieces at rest."""

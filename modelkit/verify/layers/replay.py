@@ -167,6 +167,7 @@ def _effective_inverse(source: Robot, names: list[str]) -> Array | None:
             raise UnstableLaw(f"its stability cannot be checked: {exc}") from exc
         return None
     model.model.armature = np.zeros(model.model.nv)
+    model.ball_armature = {}
     dofs, full = model.dof_names_with_balls(), model.mass_matrix_with_balls({})
     massive = [i for i in range(len(dofs)) if full[i, i] > MIN_INERTIA]
     sub = full[np.ix_(massive, massive)]
