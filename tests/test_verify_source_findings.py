@@ -185,3 +185,31 @@ def test_a_tensor_near_the_triangle_bound_verifies_in_every_engine(tmp_path: Pat
     assert report.failed == [], [c.detail for c in report.failed]
     checked = {(c.engine, c.quantity) for c in report.checks if c.layer == 1 and c.quantity == "inertia"}
     assert {("mujoco", "inertia"), ("drake-urdf", "inertia"), ("pybullet", "inertia")} <= checked
+
+
+def test_pybullet_s_own_rounding_refusal_is_predicted() -> None:
+    """PyBullet tests the moments its diagonalisation finds (btMatrix3x3::diagonalize, threshold 1e-6),
+    exactly: Robotiq 2F-85's knuckle tensor sits on the triangle bound (8.77e-7 + 9.123e-6 = 1e-5),
+    validate finds no fault, and PyBullet refuses it by rounding."""
+    from modelkit.verify.engines.bullet_inertia import refuses
+
+    knuckle = np.array([[9e-6, -1e-6, 0.0], [-1e-6, 1e-6, 0.0], [0.0, 0.0, 1e-5]])
+    assert approximations.triangle_moments(knuckle) is None and refuses(knuckle)
+    assert refuses(np.diag([0.1, 0.1, 0.3])) and not refuses(np.diag([1.0, 1.0, 2.0]))
+    assert not refuses(np.diag([0.02, 0.05, 0.06]))
+
+
+def test_a_corpus_gripper_pybullet_refuses_by_rounding_verifies(tmp_path: Path) -> None:
+    """Choreonoid's Robotiq 2F-85 (corpus): PyBullet zeroes both knuckles' tensors; its layer 3a
+    failed by 9.5e-2 (M[0,0] short by the knuckle's 1e-5 kg·m²) and the replay by 3.6e-3 rad. Now
+    PyBullet is compared with the zero it holds, and MuJoCo's replay holds the same zero."""
+    from tests.conftest import CORPUS
+
+    source = CORPUS / "choreonoid" / "share" / "model" / "Robotiq" / "2F-85.body"
+    report = verify(source, tmp_path / "out", ("mujoco", "pybullet", "pinocchio"), configurations=2,
+                    samples=3, driven=False)
+    assert report.failed == [], [c.detail for c in report.failed]
+    (replay,) = [c for c in report.checks if c.quantity == "replay"]
+    assert replay.error < 1e-12, replay.detail
+    said = [s.reason for s in report.skips if s.engine == "pybullet" and "by rounding" in s.reason]
+    assert said and "Finger1_knuckle" in said[0] and "validate finds no fault" in said[0]

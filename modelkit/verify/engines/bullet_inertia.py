@@ -24,6 +24,27 @@ EPSILON = 2.220446049250313e-16  # SIMD_EPSILON in a double-precision build
 def diagonalised(tensor: Array, threshold: float = IMPORTER_THRESHOLD,
                  max_steps: int = IMPORTER_STEPS) -> Array:
     """The 3×3 tensor as Bullet holds it after diagonalising: R·diag·Rᵀ."""
+    rot, moments = _jacobi(tensor, threshold, max_steps)
+    out: Array = rot @ np.diag(moments) @ rot.T
+    return out
+
+
+def refuses(tensor: Array) -> bool:
+    """Whether PyBullet's URDF importer replaces ``tensor`` by zero ("Bad inertia tensor properties"):
+    its principal moments as the importer finds them (the diagonal itself when there are no products
+    of inertia, else :func:`diagonalised`'s) fail x ≥ 0 and x ≤ y + z for some axis, compared exactly.
+    A tensor on the triangle bound (Robotiq 2F-85's knuckle: moments 8.77e-7 + 9.123e-6 = 1e-5) can
+    fail by the rounding of the diagonalisation, where validate's test (MK303) finds nothing."""
+    t = np.array(tensor, dtype=float).reshape(3, 3)
+    if t[0, 1] == 0.0 and t[0, 2] == 0.0 and t[1, 2] == 0.0:
+        x, y, z = (float(v) for v in np.diag(t))
+    else:
+        x, y, z = (float(v) for v in _jacobi(t, IMPORTER_THRESHOLD, IMPORTER_STEPS)[1])
+    return x < 0 or x > y + z or y < 0 or y > x + z or z < 0 or z > x + y
+
+
+def _jacobi(tensor: Array, threshold: float, max_steps: int) -> tuple[Array, Array]:
+    """``btMatrix3x3::diagonalize``: the rotation and the diagonal it leaves."""
     a = np.array(tensor, dtype=float).reshape(3, 3)
     rot = np.eye(3)
     step = max_steps
@@ -61,5 +82,4 @@ def diagonalised(tensor: Array, threshold: float = IMPORTER_THRESHOLD,
             rot[i, p] = cos * rp - sin * rq
             rot[i, q] = cos * rq + sin * rp
         step -= 1
-    out: Array = rot @ np.diag(np.diag(a)) @ rot.T
-    return out
+    return rot, np.diag(a).copy()

@@ -227,7 +227,11 @@ class PyBulletModel:
         out = {}
         identity = (0.0, 0.0, 0.0, 1.0)
         for name, d in self._dynamics.items():
-            if name == self.base or np.allclose(d["inertial_orn"], identity, rtol=0.0, atol=1e-15):
+            # a tensor the importer refused is held as zero about unturned axes: kept here too, so that
+            # the replay gives MuJoCo the same zero (Robotiq 2F-85's knuckles, refused by rounding)
+            refused = float(d["mass"]) > 0.0 and not np.any(np.asarray(d["inertia_diagonal"], dtype=float))
+            if name == self.base or (np.allclose(d["inertial_orn"], identity, rtol=0.0, atol=1e-15)
+                                     and not refused):
                 continue
             out[name] = (float(d["mass"]), np.asarray(d["inertial_pos"], dtype=float),
                          np.asarray(d["inertia_diagonal"], dtype=float),

@@ -108,6 +108,11 @@ def from_notes(fmt: str, notes: Iterable[ConversionNote], renames: Renames) -> d
     return out
 
 
+BOUND_ROUNDING = "bound-rounding"
+"""The code of an engine's refusal of a tensor that validate accepts: its principal moments are on the
+triangle bound, and the engine's own eigen-decomposition rounds them over it (PyBullet)."""
+
+
 def triangle_moments(tensor: np.ndarray) -> tuple[float, float, float] | None:
     """The principal moments (ascending) of ``tensor`` when they violate a + b ≥ c (MK303), else None;
     None too for a tensor whose moments are all within ``ZERO_MOMENT`` of zero (validate's rule: a
@@ -304,7 +309,18 @@ def refused_inertias(engine: str, fmt: str, source: Robot) -> dict[str, Approxim
             continue
         tensor = np.asarray(link.inertial.inertia, dtype=float)
         moments = triangle_moments(tensor)
-        if moments is None:
+        code = ""
+        if engine == "pybullet":
+            from modelkit.verify.engines.bullet_inertia import refuses
+            from modelkit.verify.layers.common import zero_inertia
+
+            # PyBullet's own test, on the moments its diagonalisation finds: a tensor on the triangle
+            # bound can fail it by rounding where validate finds nothing (Robotiq 2F-85's knuckles)
+            if zero_inertia(tensor) or not refuses(tensor):
+                continue
+            if moments is None:
+                code = BOUND_ROUNDING
+        elif moments is None:
             continue
         if engine == "drake-urdf":
             from modelkit.verify.engines.drake import accepts_inertia
@@ -313,7 +329,10 @@ def refused_inertias(engine: str, fmt: str, source: Robot) -> dict[str, Approxim
                 continue
         if engine == "pybullet":
             fixed = np.zeros((3, 3))
-            by = "PyBullet, refusing it (\"Bad inertia tensor properties\"), holds zero"
+            by = ("PyBullet, refusing it (\"Bad inertia tensor properties\"), holds zero" if not code else
+                  "PyBullet's importer, whose diagonalisation puts its principal moments (on the triangle "
+                  "bound, a + b = c) over it by rounding, refuses it (\"Bad inertia tensor properties\") and "
+                  "holds zero")
         else:
             from modelkit.verify.engines.drake import substitute_moment
 
@@ -321,7 +340,8 @@ def refused_inertias(engine: str, fmt: str, source: Robot) -> dict[str, Approxim
             fixed = moment * np.eye(3)
             by = ("Drake's URDF parser, refusing it, holds its plausible-guess solid sphere at water "
                   f"density ({moment:.9g} kg·m² per axis)")
-        out[link.name] = Approximated(link.name, float(link.inertial.mass), 0.0, refusal_code(moments), by,
+        out[link.name] = Approximated(link.name, float(link.inertial.mass), 0.0,
+                                      code or refusal_code(moments or (0.0, 0.0, 0.0)), by,
                                       tuple(float(v) for v in fixed.ravel()), refused_by_engine=True)
     return out
 
@@ -365,6 +385,10 @@ def skip(engine: str, approx: dict[str, Approximated]) -> Skip | None:
     lifts = []
     findings = []
     for a in sorted(approx.values(), key=lambda a: a.link):
+        if a.code == BOUND_ROUNDING:
+            findings.append(f"{a.by} for {a.link} (validate finds no fault there): compared with that, not a "
+                            "conversion fault")
+            continue
         if a.code in REFUSED:
             what = "is singular" if a.code == "MK302" else "violates the triangle inequality"
             findings.append(f"source finding {a.code} (the source inertia of {a.link}, taken alone, {what}); "
