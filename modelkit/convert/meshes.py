@@ -87,8 +87,26 @@ def plate_of(corners: np.ndarray, scale: Vec3 | None = None) -> Plate:
     centre = mean + axes @ (0.5 * (low + high))
     extent = high - low
     thickness = min(PLATE_THICKNESS, 0.1 * float(max(extent[0], extent[1])))
+    if np.array_equal(corners, corners.astype(np.float32)):  # single-precision vertices (an STL):
+        size = float(max(extent[0], extent[1]))  # no more digits than they hold
+        centre = np.array([_single(x, size) for x in centre])
+        extent = np.array([_single(x, size) for x in extent])
     return Plate(tuple(float(x) for x in centre), tuple(tuple(float(x) for x in row) for row in axes),
                  (float(extent[0]), float(extent[1]), thickness))
+
+
+def _single(value: float, size: float) -> float:
+    """A length computed from single-precision vertices, to their precision: the shortest decimal
+    within a few of float32's ε of the plate's ``size`` (0 when that is 0): a side from -0.0300000012
+    to 0.0299999993 is 0.06, a centre 9.3e-10 m off the plate's axis is 0."""
+    tolerance = 4.0 * float(np.finfo(np.float32).eps) * size
+    if abs(value) <= tolerance:
+        return 0.0
+    for digits in range(1, 10):
+        short = float(f"{value:.{digits}g}")
+        if abs(short - value) <= tolerance:
+            return short
+    return float(value)
 
 
 def _hull_2d(points: np.ndarray) -> np.ndarray:
