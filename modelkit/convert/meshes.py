@@ -33,7 +33,6 @@ class MeshRef:
     scale: Vec3
     file_format: str  # "stl" | "obj" | "dae"
     hollow: bool = False  # encloses no volume: MuJoCo needs inertia="shell" on its asset
-    flat: bool = False  # all vertices in a plane: MuJoCo cannot build the convex hull it collides with
     plate: Plate | None = None  # a flat collision mesh for MuJoCo: write this box instead (MK881)
 
 
@@ -141,8 +140,15 @@ class Prepared:
     data: bytes
     converted: str | None  # what the bytes were ("an ASCII STL"), None when copied as is
     hollow: bool
-    flat: bool
-    plate: Plate | None = None  # the thin box of a flat mesh (:func:`plate_of`), for a collision shape
+    # all vertices in a plane (MuJoCo cannot build the convex hull it collides with): the thin box a
+    # collision shape is written as (:func:`plate_of`); None for a mesh with volume
+    plate: Plate | None = None
+
+
+def _prepared(data: bytes, converted: str | None, corners: np.ndarray, scale: Vec3 | None) -> Prepared:
+    """``data`` with what MuJoCo will make of its ``corners``: hollow, or flat (its plate)."""
+    plate = plate_of(corners, scale) if _flat(corners) else None
+    return Prepared(data, converted, _hollow(corners, scale), plate)
 
 
 class Unusable(Exception):
@@ -172,8 +178,7 @@ def for_mujoco(data: bytes, ext: str, scale: Vec3 | None = None) -> Prepared:
     count = _binary_stl_faces(data)
     if count is not None:
         corners = _checked(_binary_stl_corners(data, count))
-        return Prepared(data, None, _hollow(corners, scale), _flat(corners),
-                    _plate_if_flat(corners, scale))
+        return _prepared(data, None, corners, scale)
     text = _text(data)
     if text is None:
         kind = "a PNG image" if data.startswith(b"\x89PNG") else "binary data that is no STL"
@@ -188,8 +193,7 @@ def for_mujoco(data: bytes, ext: str, scale: Vec3 | None = None) -> Prepared:
     corners = _checked(_text_corners(data, file_type))
     faces = np.arange(len(corners) * 3, dtype=np.int64).reshape(-1, 3)
     mesh = TriangleMeshData(corners.reshape(-1, 3), faces)
-    return Prepared(triangles_to_bytes(mesh, "stl"), kind, _hollow(corners, scale), _flat(corners),
-                    _plate_if_flat(corners, scale))
+    return _prepared(triangles_to_bytes(mesh, "stl"), kind, corners, scale)
 
 
 def _loaded(path: Path, fragment: str | None, metadata: Any) -> Any:
@@ -239,21 +243,19 @@ def _obj_for_mujoco(data: bytes, scale: Vec3 | None) -> Prepared:
     if groups < 2:
         corners = _obj_corners(data)
         if corners is None or len(corners) == 0 or not np.all(np.isfinite(corners)):
-            return Prepared(data, None, False, False)  # MuJoCo's own verdict comes with the model
-        return Prepared(data, None, _hollow(corners, scale), _flat(corners),
-                    _plate_if_flat(corners, scale))
+            return Prepared(data, None, False)  # MuJoCo's own verdict comes with the model
+        return _prepared(data, None, corners, scale)
     from modelkit.formats.mjcf.meshprobe import faces_mujoco_reads
 
     read = faces_mujoco_reads(data, "obj")
     if read is None or read >= triangles:
-        return Prepared(data, None, False, False)
+        return Prepared(data, None, False)
     corners = _checked(_text_corners(data, "obj"))
     faces = np.arange(len(corners) * 3, dtype=np.int64).reshape(-1, 3)
     mesh = TriangleMeshData(corners.reshape(-1, 3), faces)
     why = (f"an OBJ file of {groups} objects of which MuJoCo's OBJ reader keeps {read:,} of its "
            f"{triangles:,} triangles")
-    return Prepared(triangles_to_bytes(mesh, "stl"), why, _hollow(corners, scale), _flat(corners),
-                    _plate_if_flat(corners, scale))
+    return _prepared(triangles_to_bytes(mesh, "stl"), why, corners, scale)
 
 
 def _obj_corners(data: bytes) -> np.ndarray | None:
@@ -353,10 +355,6 @@ def _hollow(corners: np.ndarray, scale: Vec3 | None = None) -> bool:
     volume = abs(float(triple.sum())) / 6.0
     extent = float(np.max(corners.reshape(-1, 3).max(axis=0) - corners.reshape(-1, 3).min(axis=0)))
     return volume <= max(1e-6 * extent ** 3, 1e-12)
-
-
-def _plate_if_flat(corners: np.ndarray, scale: Vec3 | None) -> Plate | None:
-    return plate_of(corners, scale) if _flat(corners) else None
 
 
 def _flat(corners: np.ndarray) -> bool:
@@ -591,8 +589,7 @@ class MeshExporter:
                 return ref, why
             except Unusable as exc:
                 return None, f"mesh {uri} cannot be read by MuJoCo ({exc})"
-            if ready.flat and collision:
-                assert ready.plate is not None  # flat: its box was computed with it
+            if ready.plate is not None and collision:
                 return MeshRef("", scale, "box", plate=ready.plate), ""
             file_name = safe_file_name(path.name, "mesh")
             if ready.converted is not None:
@@ -601,7 +598,7 @@ class MeshExporter:
                 self.notes.note("MK804", f"mesh {path.name} ({ready.converted}) converted to binary STL, "
                                 f"{why}", source, target)
             return MeshRef(self._stage(ready.data, file_name), scale, "stl" if ready.converted else ext,
-                           ready.hollow, ready.flat), ""
+                           ready.hollow), ""
         try:
             loaded = _loaded(path, geometry.fragment, metadata)
         except MeshLoadError as exc:
@@ -695,4 +692,4 @@ class MeshExporter:
         if file_format == "stl" and len(corners) > MUJOCO_MAX_STL_FACES:
             file_format = "obj"  # MuJoCo's OBJ reader has no such bound (dexmate's gripper base: 294,002)
         ref = self.triangles(mesh, name, scale, file_format)
-        return MeshRef(ref.uri, ref.scale, ref.file_format, _hollow(corners, scale), False), ""
+        return MeshRef(ref.uri, ref.scale, ref.file_format, _hollow(corners, scale)), ""

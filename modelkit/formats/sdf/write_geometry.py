@@ -91,10 +91,7 @@ class GeomWriter:
         for k, (ref, colour) in enumerate(parts):
             visual = sub(el, "visual", name=name if k == 0 else unique_name(f"{name}_{k}", used))
             add_pose(visual, offset @ geom.pose, relative_to)
-            mesh = sub(sub(visual, "geometry"), "mesh")
-            sub(mesh, "uri", ref.uri)
-            if any(abs(float(s) - 1.0) > 0.0 for s in ref.scale):
-                sub(mesh, "scale", fmt_vec(ref.scale))
+            _mesh_element(sub(visual, "geometry"), ref)
             if colour is not None and colour[3] < 1.0:
                 num(visual, "transparency", 1.0 - colour[3])
             if colour is not None:
@@ -127,10 +124,7 @@ class GeomWriter:
             found = self.ctx.meshes.mesh(g, mesh_name, target, geom.source, readable=MESH_READABLE)
             if found is None:
                 return False
-            mesh = sub(el, "mesh")
-            sub(mesh, "uri", found.uri)
-            if any(abs(float(s) - 1.0) > 0.0 for s in found.scale):
-                sub(mesh, "scale", fmt_vec(found.scale))
+            _mesh_element(el, found)
         else:  # pragma: no cover - the model has no other geometry
             return False
         return True
@@ -263,3 +257,10 @@ def _first(parent: Element, tag: str, value: float, after: str | None = None) ->
     previous = parent.find(after) if after is not None else None
     parent.insert(0 if previous is None else list(parent).index(previous) + 1, element)
 
+
+def _mesh_element(geometry: Element, ref: MeshRef) -> None:
+    """``<mesh>`` in ``geometry``: the file, and its scale when it is not 1."""
+    mesh = sub(geometry, "mesh")
+    sub(mesh, "uri", ref.uri)
+    if any(abs(float(s) - 1.0) > 0.0 for s in ref.scale):
+        sub(mesh, "scale", fmt_vec(ref.scale))

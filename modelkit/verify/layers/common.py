@@ -78,11 +78,12 @@ def zero_inertia(tensor: Array) -> bool:
 
 
 def engine_q(q: dict[str, float], eng: Loaded) -> dict[str, float]:
-    """A configuration keyed by the engine's (written) joint names; a ball joint's angles
-    (``NAME#x``..., ``BALL_KEYS``) follow the ball's written name."""
-    out: dict[str, float] = {}
-    for name, value in q.items():
-        base, mark, axis = name.rpartition("#")
-        ball = base and mark + axis in BALL_KEYS
-        out[f"{eng.joint(base)}#{axis}" if ball else eng.joint(name)] = value
-    return out
+    """A configuration keyed by the engine's (written) joint names (:func:`engine_dof`)."""
+    return {engine_dof(name, eng): value for name, value in q.items()}
+
+
+def engine_dof(name: str, eng: Loaded) -> str:
+    """A source degree of freedom's name in the engine: its joint's written name; a ball joint's
+    angles (``NAME#x``..., ``BALL_KEYS``) follow the ball's written name."""
+    base, mark, axis = name.rpartition("#")
+    return f"{eng.joint(base)}#{axis}" if base and mark + axis in BALL_KEYS else eng.joint(name)

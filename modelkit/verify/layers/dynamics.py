@@ -16,9 +16,9 @@ from typing import Any
 import numpy as np
 
 from modelkit.convert.compare import random_configuration
-from modelkit.model import BALL_KEYS, JointType, Robot
+from modelkit.model import JointType, Robot
 from modelkit.verify.engines.protocol import Check, EngineModel, Skip
-from modelkit.verify.layers.common import Loaded, Worst, engine_q
+from modelkit.verify.layers.common import Loaded, Worst, engine_dof, engine_q
 from modelkit.verify.layers.kinematics import ball_angles
 
 State = tuple[dict[str, float], dict[str, float]]
@@ -62,11 +62,6 @@ def layer3a(reference: EngineModel, eng: Loaded, samples: list[State],
         out.update({written[k]: v for k, v in values.items() if k in written})
         return out
 
-    def engine_dof(name: str) -> str:
-        if name in written:
-            return written[name]
-        base, mark, axis = name.rpartition("#")
-        return f"{eng.joint(base)}#{axis}" if base and mark + axis in BALL_KEYS else eng.joint(name)
 
     mass_matrix_of, bias_of = reference.mass_matrix, reference.bias
     engine_mass_matrix, engine_bias = eng.model.mass_matrix, eng.model.bias
@@ -78,7 +73,7 @@ def layer3a(reference: EngineModel, eng: Loaded, samples: list[State],
         engine_mass_matrix, engine_bias = model.mass_matrix_with_balls, model.bias_with_balls
         ref_dofs, eng_dofs = ref.dof_names_with_balls(), model.dof_names_with_balls()
     where = {name: i for i, name in enumerate(eng_dofs)}
-    order = [where.get(engine_dof(name), -1) for name in ref_dofs]
+    order = [where.get(written[name] if name in written else engine_dof(name, eng), -1) for name in ref_dofs]
     label = eng.label
     if -1 in order or len(eng_dofs) != len(ref_dofs):
         lost = [name for name, i in zip(ref_dofs, order, strict=True) if i < 0]
