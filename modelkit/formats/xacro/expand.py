@@ -54,6 +54,7 @@ from modelkit.formats.xacro.legacy import (
 )
 from modelkit.formats.xacro.origins import OriginMap, dom_elements
 from modelkit.formats.xacro.pretty import pretty_xml
+from modelkit.formats.xacro.text import evaluator as split_once_eval_text
 from modelkit.textio import UnreadableFile, decode_text, read_regular, real_path
 from modelkit.xmlsource import XmlDocument, read_xml
 
@@ -368,7 +369,7 @@ class _Run:
             for name in ("eval_all", "process_include", "grab_property", "grab_macro"):
                 put(xacro, name, self.tracked(getattr(xacro, name)))
             put(xacro, "handle_macro_call", self.tracked(xacro.handle_macro_call, call=True))
-            put(xacro, "eval_text", self.eval_text(xacro.eval_text))
+            put(xacro, "eval_text", self.eval_text(split_once_eval_text(xacro)))
             put(xacro, "check_attrs", self.check_attrs(xacro.check_attrs))
             put(xacro, "safe_eval", ExpressionGuard(xacro.XacroException).safe_eval)
             put(xacro, "load_yaml", self.load_yaml)

@@ -102,8 +102,16 @@ class ExpressionGuard:
     exception: Callable[[str], BaseException]  # xacro's XacroException, for xacro's own refusals
     work: int = 0
     max_work: int = MAX_WORK
+    _builtins: dict[str, Any] | None = field(default=None, init=False, repr=False, compare=False)
 
     def builtins(self) -> dict[str, Any]:
+        """The guard functions the rewritten code calls, made once per guard (expressions cannot reach
+        ``__builtins__``: dunder names are refused)."""
+        if self._builtins is None:
+            self._builtins = self._make_builtins()
+        return self._builtins
+
+    def _make_builtins(self) -> dict[str, Any]:
         return {
             "__mk_pow": self.pow,
             "__mk_mul": self.mul,
