@@ -7,9 +7,10 @@ Search order for ``package://NAME/REL`` (see docs/resources.md):
 3. each entry E of ``AMENT_PREFIX_PATH``: ``E/share/NAME/REL``;
 4. walking up from the model file: the first folder whose ``package.xml`` names NAME, or which holds
    ``NAME/package.xml``;
-5. when none of those finds the package: ``NAME/REL`` beside the model file, as PyBullet looks, or in
-   the first folder above it that has it (a package folder copied without its ``package.xml``, as in
-   robosuite's assets). That is reported (a warning, MK504): ROS tools and Gazebo will not find it.
+5. when none of those finds the package: ``NAME/REL`` (or a bare ``package://FILE``) beside the model
+   file, as PyBullet looks, or in the first folder above it that has it (a package folder copied
+   without its ``package.xml``, as in robosuite's assets). That is reported (a warning, MK504): ROS
+   tools and Gazebo will not find it.
 
 ``model://NAME/REL`` looks in the ``--resource-path`` folders, then ``GZ_SIM_RESOURCE_PATH``,
 ``IGN_GAZEBO_RESOURCE_PATH``, ``SDF_PATH`` and ``GAZEBO_MODEL_PATH`` (:data:`MODEL_PATH_VARIABLES`); an SDF
@@ -100,7 +101,19 @@ class Resolver:
     def _resolve_package(self, uri: str, rest: str, model_file: Path) -> Resolution:
         package, _, relative = rest.partition("/")
         root = self.find_package(package, model_file.parent)
-        beside = _without_package(model_file.parent, rest) if root is None and relative else None
+        # PyBullet strips the scheme and looks the rest up beside the file: ``package://wheel.obj`` too.
+        beside = _without_package(model_file.parent, rest) if root is None else None
+        if beside is not None and not relative:  # package://FILE: a file name where a package belongs
+            return Resolution(
+                uri,
+                beside,
+                "package",
+                fallback_code="MK504",
+                message=f'"{uri}" names no package, only a file; "{rest}" is read from the model\'s folder '
+                f"or one above it ({beside}), as PyBullet reads it, but ROS tools (RViz, "
+                "robot_state_publisher) and Gazebo will not find it",
+                hint=f'write the file\'s path relative to the model ("{rest}"), or package://PACKAGE/{rest}',
+            )
         if beside is not None:
             return Resolution(
                 uri,

@@ -430,6 +430,22 @@ def test_package_uri_found_beside_the_model_as_pybullet_looks(tmp_path: Path) ->
     assert [(d.code, d.severity.value) for d in validate(path).errors] == [("MK504", "error")]
 
 
+def test_bare_package_uri_of_a_file_beside_the_model_as_pybullet_looks(tmp_path: Path) -> None:
+    """``package://wheel.obj`` (Genesis's wheel assets): no package, only a file name, which PyBullet finds
+    beside the URDF and loads; without the file PyBullet refuses the URDF and so do we."""
+    (tmp_path / "wheel.stl").write_text(_TRIANGLE_STL)
+    path = tmp_path / "r.urdf"
+    path.write_text(_urdf(_part('<collision><geometry><mesh filename="package://wheel.stl"/></geometry></collision>')))
+    assert check_urdf_accepts(path)[0]
+    _pybullet_reads_it_and_we_warn(path, "MK504", "names no package, only a file")
+    (mesh,) = [g.geometry for link in validate(path).robots[0].links for g in link.collisions]
+    assert isinstance(mesh, Mesh) and mesh.path == str(tmp_path / "wheel.stl")
+    (tmp_path / "wheel.stl").unlink()
+    command = [sys.executable, "-c", _PYBULLET_LOADS, str(path)]
+    assert subprocess.run(command, capture_output=True, timeout=60).returncode != 0
+    assert [(d.code, d.severity.value) for d in validate(path).errors] == [("MK504", "error")]
+
+
 def _pybullet_reads_it_and_we_warn(path: Path, code: str, said: str) -> None:
     """PyBullet loads the file (live); modelkit reports no error and one ``code`` warning saying ``said``."""
     command = [sys.executable, "-c", _PYBULLET_LOADS, str(path)]
