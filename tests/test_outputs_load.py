@@ -291,3 +291,68 @@ def test_a_written_file_mujoco_refuses_is_an_error(tmp_path: Path, monkeypatch: 
     assert "error MK877" in output and "mesh volume is too small" in output, output
     with pytest.raises(ValueError, match="mesh volume is too small"):
         mujoco.MjModel.from_xml_path(str(out))
+
+
+TETRA_VERTICES = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\n"
+TETRA_FACES = ((1, 3, 2), (1, 2, 4), (1, 4, 3), (2, 3, 4))
+# How the corners of the first face and of the other three are written (v / vt / vn).
+FACE_ATTRIBUTE_CASES = {
+    "texture coordinates on some corners": ("{v}/1/1", "{v}//1", "texture coordinates", "warns"),
+    "normals on some corners": ("{v}/1/1", "{v}/1", "normals", "refuses"),
+}
+
+
+def _tetra_obj(first: str, rest: str) -> str:
+    lines = [" ".join(("f", *((first if i == 0 else rest).format(v=v) for v in face)))
+             for i, face in enumerate(TETRA_FACES)]
+    return TETRA_VERTICES + "\n".join(lines) + "\n"
+
+
+def _mujoco_load(path: Path) -> tuple[str, str]:
+    """MuJoCo's verdict on a model file, in a child process: its error, and what it printed (its
+    OBJ reader's warnings go to the process's stderr, not to Python)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, mujoco\ntry:\n    mujoco.MjModel.from_xml_path(sys.argv[1])\n"
+            "except ValueError as e:\n    print('REFUSED', e)\n")
+    done = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, timeout=60)
+    return done.stdout, done.stderr
+
+
+@pytest.mark.parametrize("case", list(FACE_ATTRIBUTE_CASES))
+def test_an_obj_whose_faces_mix_attributes_loads_without_a_warning(case: str, tmp_path: Path) -> None:
+    """pybullet_data's table_square/table.obj gives normals to some face corners and not to others, and
+    MuJoCo refuses it; a file that does the same with texture coordinates loads with a warning and no
+    texture coordinates. The MJCF writer writes the OBJ without what MuJoCo cannot take (MK804)."""
+    first, rest, left_out, verdict = FACE_ATTRIBUTE_CASES[case]
+    obj = _tetra_obj(first, rest)
+    (tmp_path / "m.obj").write_text(obj)
+    direct = tmp_path / "direct.xml"
+    direct.write_text(f'<mujoco><asset><mesh name="m" file="{tmp_path / "m.obj"}"/></asset>'
+                      '<worldbody><geom type="mesh" mesh="m"/></worldbody></mujoco>')
+    printed, warned = _mujoco_load(direct)  # the reader's behaviour this cleaning exists for
+    assert ("REFUSED" in printed) if verdict == "refuses" else ("WARNING" in warned and not printed)
+    source = tmp_path / "robot.urdf"
+    source.write_text(_urdf("m.obj", collision=True))
+    out = tmp_path / "out" / "robot.xml"
+    status, output = _convert(source, out)
+    assert status == 0, output
+    assert "MK804" in output and f"without its {left_out}" in output, output
+    assert _mujoco_load(out) == ("", "")  # loads, and prints nothing
+    written = (out.parent / "meshes" / "m.obj").read_text()
+    faces = [line for line in written.splitlines() if line.startswith("f ")]
+    assert len(faces) == 4 and [line.split()[1].split("/")[0] for line in faces] == ["1", "1", "1", "2"]
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert model.nmesh == 1 and model.mesh_facenum[0] == 4 and model.mesh_vertnum[0] == 4
+
+
+def test_an_obj_with_consistent_faces_keeps_its_normals_and_texture_coordinates(tmp_path: Path) -> None:
+    obj = _tetra_obj("{v}/1/1", "{v}/2/1")
+    (tmp_path / "m.obj").write_text(obj)
+    source = tmp_path / "robot.urdf"
+    source.write_text(_urdf("m.obj", collision=True))
+    out = tmp_path / "out" / "robot.xml"
+    status, output = _convert(source, out)
+    assert status == 0 and "MK804" not in output, output
+    assert (out.parent / "meshes" / "m.obj").read_text() == obj

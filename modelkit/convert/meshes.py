@@ -8,7 +8,7 @@ can be moved as a whole. What had to change on the way is a conversion note.
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -143,6 +143,9 @@ class Prepared:
     # all vertices in a plane (MuJoCo cannot build the convex hull it collides with): the thin box a
     # collision shape is written as (:func:`plate_of`); None for a mesh with volume
     plate: Plate | None = None
+    # an OBJ kept as OBJ but written without what MuJoCo's reader cannot take (:func:`obj_face_data`):
+    # what was left out and why; None when the bytes are the file's own
+    cleaned: str | None = None
 
 
 def _prepared(data: bytes, converted: str | None, corners: np.ndarray, scale: Vec3 | None) -> Prepared:
@@ -231,7 +234,60 @@ def as_binary_stl(data: bytes) -> Prepared | None:
     return ready if ready.converted is not None else None
 
 
+def obj_face_data(data: bytes) -> tuple[bytes, str | None]:
+    """An OBJ file's bytes as MuJoCo's OBJ reader takes them, and what was left out (None: unchanged).
+
+    MuJoCo needs a face's texture coordinate and normal on every corner of every face, or on none: a file
+    with ``vt`` lines and a corner without one loads with a warning and no texture coordinates at all; a
+    file with ``vn`` lines and a corner without one is refused ("mesh_facenormal normal index out of
+    bounds", measured with MuJoCo 4.0 on pybullet_data's ``table_square/table.obj``). Such a file is
+    written without the texture coordinates (MuJoCo would drop them) or without the normals (MuJoCo then
+    computes its own); the vertices and faces are the file's."""
+    has_vt = has_vn = vt_missing = vn_missing = False
+    for line in data.splitlines():
+        if line.startswith(b"vt "):
+            has_vt = True
+        elif line.startswith(b"vn "):
+            has_vn = True
+        elif line.startswith(b"f "):
+            for corner in line.split()[1:]:
+                parts = corner.split(b"/")
+                vt_missing = vt_missing or len(parts) < 2 or not parts[1]
+                vn_missing = vn_missing or len(parts) < 3 or not parts[2]
+    drop_vt, drop_vn = has_vt and vt_missing, has_vn and vn_missing
+    if not (drop_vt or drop_vn):
+        return data, None
+    out: list[bytes] = []
+    for line in data.splitlines(keepends=True):
+        if (drop_vt and line.startswith(b"vt ")) or (drop_vn and line.startswith(b"vn ")):
+            continue
+        if line.startswith(b"f "):
+            corners = []
+            for corner in line.split()[1:]:
+                vertex, texture, normal = ([*corner.split(b"/"), b"", b""])[:3]
+                texture = b"" if drop_vt else texture
+                normal = b"" if drop_vn else normal
+                corners.append(vertex + (b"/" + texture if texture or normal else b"")
+                               + (b"/" + normal if normal else b""))
+            line = b"f " + b" ".join(corners) + b"\n"
+        out.append(line)
+    left_out = []
+    if drop_vt:
+        left_out.append("its texture coordinates (some face corners have none: MuJoCo would drop them all, "
+                        "with a warning)")
+    if drop_vn:
+        left_out.append("its normals (some face corners have none: MuJoCo refuses such a file; it computes "
+                        "the normals itself)")
+    return b"".join(out), " and ".join(left_out)
+
+
 def _obj_for_mujoco(data: bytes, scale: Vec3 | None) -> Prepared:
+    data, cleaned = obj_face_data(data)
+    ready = _obj_whole_for_mujoco(data, scale)
+    return replace(ready, cleaned=cleaned) if cleaned and ready.converted is None else ready
+
+
+def _obj_whole_for_mujoco(data: bytes, scale: Vec3 | None) -> Prepared:
     """An OBJ file kept as is (with whether it is hollow or flat), unless MuJoCo's own OBJ reader reads
     fewer triangles than it holds (measured on files of several objects: example-robot-data's
     ``nub.obj`` gives 29 of 1,404, its laikago ``trunk.obj`` 5,368 of 22,246); then its triangles
@@ -592,6 +648,9 @@ class MeshExporter:
             if ready.plate is not None and collision:
                 return MeshRef("", scale, "box", plate=ready.plate), ""
             file_name = safe_file_name(path.name, "mesh")
+            if ready.cleaned is not None:
+                self.notes.note("MK804", f"mesh {path.name} written for MuJoCo without {ready.cleaned}",
+                                source, target)
             if ready.converted is not None:
                 file_name = f"{safe_file_name(converted_stem(path.stem, ext, 'stl'), 'mesh')}.stl"
                 why = "the only STL MuJoCo reads" if ext == "stl" else "which MuJoCo reads whole"
