@@ -956,9 +956,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK504",
         "package-not-found",
         "error",
-        "A `package://` URI names a package that cannot be found. A warning when `NAME/REL` lies beside the "
-        "model file, where PyBullet looks (it strips `package://`): the file is read, but ROS tools and "
-        "Gazebo will not find it.",
+        "A `package://` URI names a package that cannot be found. A warning when `NAME/REL` (or a bare "
+        "`package://FILE`) lies beside the model file, where PyBullet looks (it strips `package://`): the "
+        "file is read, but ROS tools and Gazebo will not find it.",
     ),
     CodeInfo("MK505", "path-variable-undefined", "error", "A `${VAR}` path variable is not defined."),
     CodeInfo("MK506", "resource-extension", "error", "A resource file type is not supported."),

@@ -340,3 +340,43 @@ def test_example_robot_data_mjcf_has_no_sub_nanometre_number(relative: str, tmp_
         other = next((b for b in back.links if b.name == names.get(link.name, link.name)), None)
         if other is not None and other.inertial is not None and other.inertial.mass == link.inertial.mass:
             assert np.allclose(other.inertial.inertia, link.inertial.inertia, rtol=0, atol=1e-9), link.name
+
+
+SINGLE_PRECISION_MJCF = """<mujoco model="m">
+  <asset><material name="paint" rgba="0.3 0.6 0.9 1" specular="0.35" shininess="0.7"/></asset>
+  <worldbody>
+    <light name="lamp" pos="0 0 2" diffuse="0.9 0.8 0.7" specular="0.2 0.2 0.2" attenuation="1 0.1 0.01"/>
+    <light name="plain" pos="0 0 3"/>
+    <body name="b" pos="0 0 1">
+      <freejoint/>
+      <geom type="box" size="0.1 0.1 0.1" rgba="0.8 0.6 0.4 1" mass="1"/>
+      <geom type="sphere" size="0.05" material="paint" mass="0.1" contype="0" conaffinity="0"/>
+      <site name="s" rgba="0.1 0.2 0.3 1"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+@pytest.mark.parametrize("target", TARGETS)
+def test_single_precision_values_keep_the_sources_decimals(target: str, tmp_path: Path) -> None:
+    """MuJoCo stores colours, lights and material terms in single precision: an MJCF source's ``0.8`` is
+    read back as the float32 nearest it, which was written ``0.800000011920929`` (671 attributes in the
+    MJCF written from Genesis's 26 MJCF files). Each is now the shortest decimal that is that float32."""
+    source = tmp_path / "m.xml"
+    source.write_text(SINGLE_PRECISION_MJCF)
+    out = tmp_path / "out" / f"m.{target}"
+    write(validate(source).robot, out)  # type: ignore[arg-type]
+    text = out.read_text()
+    numbers = [n for n in NUMBER.findall(text) if "." in n]
+    assert [n for n in numbers if DUST.search(n)] == []
+    if target == "xml":
+        assert 'rgba="0.8 0.6 0.4 1"' in text and 'diffuse="0.9 0.8 0.7"' in text
+        assert 'specular="0.2 0.2 0.2"' in text and 'attenuation="1 0.1 0.01"' in text
+        assert text.count("diffuse=") == 1  # the plain light's default colour is not written
+        model = mujoco.MjModel.from_xml_path(str(out))
+        original = mujoco.MjModel.from_xml_path(str(source))
+        assert np.array_equal(model.light_diffuse, original.light_diffuse)
+    elif target == "urdf":
+        assert '<color rgba="0.3 0.6 0.9 1"/>' in text  # the material's colour
+

@@ -12,6 +12,8 @@ turning them into robots imports no numpy.
 
 from __future__ import annotations
 
+import math
+import struct
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -27,6 +29,24 @@ def pose_of(pos: Any, quat: Any) -> Pose:
 
 def translation(vector: Any) -> Pose:
     return Pose(rot3.IDENTITY, rot3.vec3(vector))
+
+
+def single(value: Any) -> float:
+    """A number MuJoCo stores in single precision (colours, lights, material terms) as the shortest
+    decimal that is the same float32: the ``0.8`` a source wrote, not ``0.800000011920929``."""
+    x = float(value)
+    if not math.isfinite(x) or x == 0.0:
+        return x
+    stored = struct.pack("<f", x)
+    for digits in range(1, 10):
+        short = float(f"{x:.{digits}g}")
+        if struct.pack("<f", short) == stored:
+            return short
+    return x  # never reached: nine significant digits identify every float32
+
+
+def singles(values: Any) -> tuple[float, ...]:
+    return tuple(single(v) for v in values)
 
 
 @dataclass

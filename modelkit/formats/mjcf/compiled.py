@@ -26,6 +26,8 @@ from modelkit.formats.mjcf.bodies import (
     MjJoint,
     MjSite,
     pose_of,
+    single,
+    singles,
     translation,
 )
 from modelkit.spatial import Pose
@@ -135,14 +137,14 @@ class CompiledModel:
         m = self.m
         kind = enum_word(self.mj.mjtGeom(int(m.geom_type[g])), "mjGEOM_")
         pose = pose_of(m.geom_pos[g], m.geom_quat[g])
-        rgba = tuple(float(x) for x in m.geom_rgba[g])
+        rgba = singles(m.geom_rgba[g])
         material = None
         look: dict[str, Any] = {}
         matid = int(m.geom_matid[g])
         if matid >= 0:
             material = self.name("material", matid)
             if all_close(rgba, DEFAULT_RGBA):
-                rgba = tuple(float(x) for x in m.mat_rgba[matid])
+                rgba = singles(m.mat_rgba[matid])
             look = self._look(matid)
         geom = MjGeom(
             index=g,
@@ -171,9 +173,9 @@ class CompiledModel:
         m = self.m
         out: dict[str, Any] = {}
         for key, default in MATERIAL_DEFAULTS.items():
-            value = float(getattr(m, f"mat_{key}")[matid])
-            if abs(value - default) > 1e-6:  # stored as float32
-                out[key] = round(value, 6)
+            value = single(getattr(m, f"mat_{key}")[matid])
+            if value != single(default):
+                out[key] = value
         try:
             roles = m.mat_texid[matid]
             texture = int(roles[TEXTURE_RGB_ROLE]) if hasattr(roles, "__len__") else int(roles)
@@ -211,7 +213,7 @@ class CompiledModel:
         shown: dict[str, Any] = {}  # what MuJoCo shows of the site, when not its default
         if int(m.site_group[s]) != 0:
             shown["group"] = int(m.site_group[s])
-        rgba = [float(x) for x in m.site_rgba[s]]
+        rgba = list(singles(m.site_rgba[s]))
         if not all_close(tuple(rgba), SITE_RGBA, rtol=0.0, atol=1e-7):
             shown["rgba"] = rgba
         return MjSite(
@@ -243,15 +245,15 @@ class CompiledModel:
             pose = translation(m.light_pos[lt])
             params = {
                 "dir": [float(x) for x in m.light_dir[lt]],
-                "diffuse": [float(x) for x in m.light_diffuse[lt]],
+                "diffuse": list(singles(m.light_diffuse[lt])),
                 "type": enum_word(self.mj.mjtLightType(int(m.light_type[lt])), "mjLIGHT_"),
                 "castshadow": bool(m.light_castshadow[lt]),
                 "active": bool(m.light_active[lt]),
-                "attenuation": [float(x) for x in m.light_attenuation[lt]],
-                "cutoff": float(m.light_cutoff[lt]),
-                "exponent": float(m.light_exponent[lt]),
-                "ambient": [float(x) for x in m.light_ambient[lt]],
-                "specular": [float(x) for x in m.light_specular[lt]],
+                "attenuation": list(singles(m.light_attenuation[lt])),
+                "cutoff": single(m.light_cutoff[lt]),
+                "exponent": single(m.light_exponent[lt]),
+                "ambient": list(singles(m.light_ambient[lt])),
+                "specular": list(singles(m.light_specular[lt])),
             }
             params.update(self._tracking("light", lt))
             out.append((int(m.light_bodyid[lt]), "light", self.name("light", lt), pose, params))

@@ -25,7 +25,7 @@ from typing import Any
 
 from modelkit import rot3
 from modelkit.formats.devices import canonical_from_gl, horizontal_fov
-from modelkit.formats.mjcf.bodies import pose_of, translation
+from modelkit.formats.mjcf.bodies import pose_of, single, singles, translation
 from modelkit.formats.mjcf.build import Built, RobotBuilder
 from modelkit.formats.mjcf.compiled import enum_word
 from modelkit.model import Device, DeviceKind
@@ -101,27 +101,27 @@ class _Placer:
         body = int(m.light_bodyid[lt])
         light_type = enum_word(self.mj.mjtLightType(int(m.light_type[lt])), "mjLIGHT_")
         kind = LIGHT_KINDS.get(light_type, DeviceKind.OTHER)
-        constant, linear, quadratic = (float(x) for x in m.light_attenuation[lt])
+        constant, linear, quadratic = singles(m.light_attenuation[lt])
         canonical: dict[str, Any] = {
-            "color": tuple(float(x) for x in m.light_diffuse[lt]),
+            "color": singles(m.light_diffuse[lt]),
             "attenuation_constant": constant,
             "attenuation_linear": linear,
             "attenuation_quadratic": quadratic,
             "on": bool(m.light_active[lt]),
         }
         if float(m.light_intensity[lt]) > 0.0:
-            canonical["intensity"] = float(m.light_intensity[lt])
+            canonical["intensity"] = single(m.light_intensity[lt])
         if float(m.light_range[lt]) > 0.0:
-            canonical["range"] = float(m.light_range[lt])
+            canonical["range"] = single(m.light_range[lt])
         if kind is not DeviceKind.POINT_LIGHT:
             canonical["direction"] = tuple(float(x) for x in m.light_dir[lt])
         if kind is DeviceKind.SPOT_LIGHT:
-            canonical["spot_outer_angle"] = math.radians(float(m.light_cutoff[lt]))
-            canonical["spot_falloff"] = float(m.light_exponent[lt])
+            canonical["spot_outer_angle"] = math.radians(single(m.light_cutoff[lt]))
+            canonical["spot_falloff"] = single(m.light_exponent[lt])
         device = Device(
             f"light:{light_type}",
             self.name("light", lt),
-            params={"cutoff": float(m.light_cutoff[lt]), "exponent": float(m.light_exponent[lt])},
+            params={"cutoff": single(m.light_cutoff[lt]), "exponent": single(m.light_exponent[lt])},
             source=self.builder.loc.body(body),
             canonical=kind,
             canonical_params=canonical,

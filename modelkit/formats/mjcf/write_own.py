@@ -52,6 +52,7 @@ LIGHT_DEFAULTS: dict[str, Any] = {
     "type": "spot", "castshadow": True, "active": True, "attenuation": [1.0, 0.0, 0.0], "cutoff": 45.0,
     "exponent": 10.0, "ambient": [0.0, 0.0, 0.0], "specular": [0.3, 0.3, 0.3],
 }
+LIGHT_DIFFUSE = [0.7, 0.7, 0.7]  # MuJoCo's default light colour
 
 
 @dataclass
@@ -152,8 +153,9 @@ class OwnWriter:
     @staticmethod
     def _light(el: Element, item: dict[str, Any]) -> None:
         el.set("dir", fmt_vec([float(x) for x in item.get("dir", (0.0, 0.0, -1.0))]))
-        if item.get("diffuse") is not None:
-            el.set("diffuse", fmt_vec([float(x) for x in item["diffuse"]]))
+        diffuse = item.get("diffuse")
+        if diffuse is not None and [float(x) for x in diffuse] != LIGHT_DIFFUSE:
+            el.set("diffuse", fmt_vec([float(x) for x in diffuse]))
         for key, default in LIGHT_DEFAULTS.items():
             value = item.get(key)
             if value is None or value == default:
