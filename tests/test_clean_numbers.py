@@ -361,8 +361,8 @@ SINGLE_PRECISION_MJCF = """<mujoco model="m">
 @pytest.mark.parametrize("target", TARGETS)
 def test_single_precision_values_keep_the_sources_decimals(target: str, tmp_path: Path) -> None:
     """MuJoCo stores colours, lights and material terms in single precision: an MJCF source's ``0.8`` is
-    read back as the float32 nearest it, which was written ``0.800000011920929`` (671 attributes in the
-    MJCF written from Genesis's 26 MJCF files). Each is now the shortest decimal that is that float32."""
+    read back as the float32 nearest it, which was written ``0.800000011920929`` (774 attributes in the
+    MJCF written from 42 of Genesis's MJCF files). Each is now the shortest decimal that is that float32."""
     source = tmp_path / "m.xml"
     source.write_text(SINGLE_PRECISION_MJCF)
     out = tmp_path / "out" / f"m.{target}"
