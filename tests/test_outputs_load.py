@@ -210,15 +210,19 @@ def test_an_obj_of_several_objects_reaches_mujoco_whole(tmp_path: Path) -> None:
     assert model.nmesh == 1 and model.mesh_facenum[0] == 8
 
 
-def test_an_obj_of_one_object_is_copied_as_is(tmp_path: Path) -> None:
-    one = TWO_OBJECTS_OBJ.replace("o second\n", "")
-    (tmp_path / "one.obj").write_text(one)
+def _copied_as_is(obj: str, tmp_path: Path) -> None:
+    """An OBJ MuJoCo reads whole and without complaint is copied byte for byte, without a note."""
+    (tmp_path / "m.obj").write_text(obj)
     source = tmp_path / "robot.urdf"
-    source.write_text(_urdf("one.obj", collision=True))
+    source.write_text(_urdf("m.obj", collision=True))
     out = tmp_path / "out" / "robot.xml"
     status, output = _convert(source, out)
     assert status == 0 and "MK804" not in output, output
-    assert (out.parent / "meshes" / "one.obj").read_text() == one
+    assert (out.parent / "meshes" / "m.obj").read_text() == obj
+
+
+def test_an_obj_of_one_object_is_copied_as_is(tmp_path: Path) -> None:
+    _copied_as_is(TWO_OBJECTS_OBJ.replace("o second\n", ""), tmp_path)
 
 
 PYBULLET_SHAPES = """
@@ -348,11 +352,4 @@ def test_an_obj_whose_faces_mix_attributes_loads_without_a_warning(case: str, tm
 
 
 def test_an_obj_with_consistent_faces_keeps_its_normals_and_texture_coordinates(tmp_path: Path) -> None:
-    obj = _tetra_obj("{v}/1/1", "{v}/2/1")
-    (tmp_path / "m.obj").write_text(obj)
-    source = tmp_path / "robot.urdf"
-    source.write_text(_urdf("m.obj", collision=True))
-    out = tmp_path / "out" / "robot.xml"
-    status, output = _convert(source, out)
-    assert status == 0 and "MK804" not in output, output
-    assert (out.parent / "meshes" / "m.obj").read_text() == obj
+    _copied_as_is(_tetra_obj("{v}/1/1", "{v}/2/1"), tmp_path)
