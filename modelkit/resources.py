@@ -103,28 +103,22 @@ class Resolver:
         root = self.find_package(package, model_file.parent)
         # PyBullet strips the scheme and looks the rest up beside the file: ``package://wheel.obj`` too.
         beside = _without_package(model_file.parent, rest) if root is None else None
-        if beside is not None and not relative:  # package://FILE: a file name where a package belongs
-            return Resolution(
-                uri,
-                beside,
-                "package",
-                fallback_code="MK504",
-                message=f'"{uri}" names no package, only a file; "{rest}" is read from the model\'s folder '
-                f"or one above it ({beside}), as PyBullet reads it, but ROS tools (RViz, "
-                "robot_state_publisher) and Gazebo will not find it",
-                hint=f'write the file\'s path relative to the model ("{rest}"), or package://PACKAGE/{rest}',
-            )
         if beside is not None:
+            if relative:
+                what = f'package "{package}" of "{uri}" cannot be found on the package paths'
+                hint = (f"give the package's folder with --package-path {package}=DIR, or add a package.xml "
+                        f'naming "{package}"')
+            else:  # package://FILE: a file name where a package belongs
+                what = f'"{uri}" names no package, only a file'
+                hint = f'write the file\'s path relative to the model ("{rest}"), or package://PACKAGE/{rest}'
             return Resolution(
                 uri,
                 beside,
                 "package",
                 fallback_code="MK504",
-                message=f'package "{package}" of "{uri}" cannot be found on the package paths; "{rest}" is '
-                f"read from the model's folder or one above it ({beside}), as PyBullet reads it, but ROS "
-                "tools (RViz, robot_state_publisher) and Gazebo will not find it",
-                hint=f"give the package's folder with --package-path {package}=DIR, or add a package.xml "
-                f'naming "{package}"',
+                message=f'{what}; "{rest}" is read from the model\'s folder or one above it ({beside}), as '
+                "PyBullet reads it, but ROS tools (RViz, robot_state_publisher) and Gazebo will not find it",
+                hint=hint,
             )
         if root is None:
             return Resolution(

@@ -48,11 +48,11 @@ SHAPED = frozenset({"touch", "insidesite"})  # read their site's volume
 ONE_OBJECT = frozenset({"site", "joint", "tendon", "actuator", "body", "camera"})  # attribute = objtype
 ELEMENT = {"jointactfrc": "jointactuatorfrc", "tendonactfrc": "tendonactuatorfrc"}  # enum word → tag
 CAMERA_FOVY = 45.0  # MuJoCo's defaults, left out when equal
-LIGHT_DEFAULTS: dict[str, Any] = {
-    "type": "spot", "castshadow": True, "active": True, "attenuation": [1.0, 0.0, 0.0], "cutoff": 45.0,
-    "exponent": 10.0, "ambient": [0.0, 0.0, 0.0], "specular": [0.3, 0.3, 0.3],
+LIGHT_DEFAULTS: dict[str, Any] = {  # in the order written; MuJoCo's defaults are not written
+    "diffuse": [0.7, 0.7, 0.7], "type": "spot", "castshadow": True, "active": True,
+    "attenuation": [1.0, 0.0, 0.0], "cutoff": 45.0, "exponent": 10.0, "ambient": [0.0, 0.0, 0.0],
+    "specular": [0.3, 0.3, 0.3],
 }
-LIGHT_DIFFUSE = [0.7, 0.7, 0.7]  # MuJoCo's default light colour
 
 
 @dataclass
@@ -153,11 +153,10 @@ class OwnWriter:
     @staticmethod
     def _light(el: Element, item: dict[str, Any]) -> None:
         el.set("dir", fmt_vec([float(x) for x in item.get("dir", (0.0, 0.0, -1.0))]))
-        diffuse = item.get("diffuse")
-        if diffuse is not None and [float(x) for x in diffuse] != LIGHT_DIFFUSE:
-            el.set("diffuse", fmt_vec([float(x) for x in diffuse]))
         for key, default in LIGHT_DEFAULTS.items():
             value = item.get(key)
+            if isinstance(value, tuple):
+                value = list(value)
             if value is None or value == default:
                 continue
             if isinstance(value, bool):
