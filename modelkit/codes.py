@@ -385,7 +385,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK172",
         "mjcf-element-unsupported",
         "warning",
-        "An MJCF element the model cannot hold (tendon, non-joint equality, plane/hfield/sdf geom...).",
+        "An MJCF element the model cannot hold (tendon, non-joint equality, plane/hfield/sdf geom...); "
+        "tendons and tendon equalities are kept as data and written back to MJCF.",
     ),
     CodeInfo(
         "MK173",
@@ -1343,7 +1344,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "actuator-not-written",
         "warning",
         "A source actuator drives a joint the target cannot drive with one actuator (a fixed, ball or "
-        "planar joint, a mimic follower, a locked joint): it is left out.",
+        "planar joint, a mimic follower, a locked joint), or an MJCF actuator the model does not hold "
+        "(a tendon, site or body transmission, activation dynamics, another law) names an object the "
+        "MJCF output does not have, or is a plugin or delayed actuator: it is left out.",
     ),
     CodeInfo(
         "MK843",

@@ -197,20 +197,22 @@ TOUCH = """<mujoco model="t"><worldbody><camera name="fixed" pos="0 -2 1"/><site
     <site name="toe" pos="0 0 -0.1"/></body></worldbody>
   <tendon><spatial name="cord"><site site="toe"/><site site="top"/></spatial></tendon>
   <sensor><touch name="toe_touch" site="toe"/><subtreelinvel name="vel" body="a"/>
-    <tendonpos name="cord_length" tendon="cord"/></sensor>
+    <tendonpos name="cord_length" tendon="cord"/><user name="custom" dim="1" needstage="pos" datatype="real"/>
+  </sensor>
 </mujoco>"""
 
 
 def test_mjcf_to_mjcf_says_which_of_its_own_elements_it_does_not_write(tmp_path: Path) -> None:
     """Touch sensors, the sites they use and a world camera are not in the model's devices; MJCF to
     MJCF dropped them without a word (dm_control's hopper lost 3 sensors, 2 sites and 2 cameras).
-    They are now written back (formats/mjcf/write_own); a sensor of a tendon, which is not written,
-    is named."""
+    They are now written back (formats/mjcf/write_own), the tendon and its sensor too
+    (formats/mjcf/write_transmissions); a user sensor, which needs the program's callback, is named."""
     source = tmp_path / "t.xml"
     source.write_text(TOUCH)
     notes = convert([source], tmp_path / "m" / "t.xml").notes
     (sensors,) = [n for n in notes if n.code == "MK806" and "sensors" in n.message]
-    assert "1 of 3 MJCF sensors not written (cord_length)" in sensors.message
+    assert "1 of 4 MJCF sensors not written (custom)" in sensors.message
+    assert not [n for n in notes if "MJCF tendons" in n.message]
     others = [n for n in notes if "sites" in n.message or "cameras" in n.message]
     assert not any("not written" in n.message for n in others)
 

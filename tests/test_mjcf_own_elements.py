@@ -138,22 +138,25 @@ OWN = """<mujoco model="own">
     <tendonpos name="cable_length" tendon="cable"/>
     <subtreecom name="arm_com" body="arm"/>
     <clock name="time"/>
+    <user name="custom" dim="1" needstage="pos" datatype="real"/>
   </sensor>
 </mujoco>"""
 
 
 def test_each_kind_comes_back_and_only_what_names_a_missing_object_is_noted(tmp_path: Path) -> None:
-    """A sensor on a tendon (never written: MK172) stays named in the MK806 note; the others, the
-    sites (shape, colour and group kept), the world camera (its mode, target and fovy) and light are
-    written, and read the same."""
+    """A user sensor (it needs the program's callback: never written) stays named in the MK806 note;
+    the others, the tendon its sensor reads (between a world site and a body's), the sites (shape,
+    colour and group kept), the world camera (its mode, target and fovy) and light are written, and
+    read the same."""
     source = tmp_path / "own.xml"
     source.write_text(OWN)
     out = tmp_path / "m" / "own.xml"
     said = _convert(source, out)
     a, b = mujoco.MjModel.from_xml_path(str(source)), mujoco.MjModel.from_xml_path(str(out))
-    assert set(_sensors(b)) == set(_sensors(a)) - {"cable_length"}
+    assert set(_sensors(b)) == set(_sensors(a)) - {"custom"}
     notes = [line for line in said.splitlines() if "MK806" in line and "MJCF sensors" in line]
-    assert len(notes) == 1 and "1 of 8 MJCF sensors not written (cable_length)" in notes[0]
+    assert len(notes) == 1 and "1 of 9 MJCF sensors not written (custom)" in notes[0]
+    assert b.ntendon == 1 and "MJCF tendons" not in said
     assert not any(kind in said for kind in OWN_KINDS[1:])
     assert (b.nsite, b.ncam, b.nlight) == (a.nsite, a.ncam, a.nlight) == (3, 2, 1)
     tip_a = mujoco.mj_name2id(a, mujoco.mjtObj.mjOBJ_SITE, "tip")

@@ -169,3 +169,12 @@ class MjBody:
     inertial: MjInertial | None = None
     mocap: bool = False
     physics: dict[str, str] = field(default_factory=dict)  # gravcomp where not MuJoCo's default
+
+
+def plain(values: tuple[float, ...] | list[float]) -> str:
+    """Numbers as the shortest decimals that give them back (``0.015 1``), ``0`` for ±0."""
+    texts = []
+    for x in values:
+        text = "0" if x == 0.0 else repr(float(x))
+        texts.append(text[:-2] if text.endswith(".0") else text)
+    return " ".join(texts)

@@ -25,17 +25,23 @@ from modelkit.formats.mjcf.bodies import (
     MjInertial,
     MjJoint,
     MjSite,
+    plain,
     pose_of,
     single,
     singles,
     translation,
 )
+from modelkit.formats.mjcf.transmissions import SOLIMP, SOLREF, general_attributes, tendon_attributes
 from modelkit.spatial import Pose
 
 JOINT_KINDS = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
 DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)
 SITE_RGBA = (0.5, 0.5, 0.5, 1.0)  # MuJoCo's default site colour (as stored in float32)
 CAMERA_IPD = 0.068  # m: MuJoCo's default inter-pupillary distance of a camera
+EQUALITY_SOLVER_DEFAULTS: dict[str, tuple[str, str, tuple[float, ...]]] = {
+    "solref": ("eq", "solref", SOLREF),
+    "solimp": ("eq", "solimp", SOLIMP),
+}
 
 
 def all_close(a: tuple[float, ...], b: tuple[float, ...], rtol: float = 1e-5, atol: float = 1e-8) -> bool:
@@ -278,18 +284,20 @@ class CompiledModel:
             kind = enum_word(self.mj.mjtEq(int(m.eq_type[e])), "mjEQ_")
             objtype = enum_word(self.mj.mjtObj(int(m.eq_objtype[e])), "mjOBJ_")
             obj1, obj2 = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+            named = kind if kind in ("joint", "tendon") else objtype  # MuJoCo sets no objtype for these
             out.append(
                 {
                     "index": e,
                     "name": self.name("equality", e),
                     "type": kind,
                     "objtype": objtype,
-                    "obj1": self._object_name(objtype, obj1),
-                    "obj2": self._object_name(objtype, obj2),
+                    "obj1": self._object_name(named, obj1),
+                    "obj2": self._object_name(named, obj2),
                     "obj1id": obj1,
                     "obj2id": obj2,
                     "data": [float(x) for x in m.eq_data[e]],
                     "active": bool(m.eq_active0[e]),
+                    "solver": non_default(m, EQUALITY_SOLVER_DEFAULTS, {"eq": e}),
                 }
             )
         return out
@@ -316,10 +324,16 @@ class CompiledModel:
                 "gain": enum_word(self.mj.mjtGain(int(m.actuator_gaintype[a])), "mjGAIN_"),
                 "bias": enum_word(self.mj.mjtBias(int(m.actuator_biastype[a])), "mjBIAS_"),
             }
+            second = int(m.actuator_trnid[a][1])
+            if trn in ("site", "slidercrank") and second >= 0:  # the reference site, the slider site
+                entry["refsite" if trn == "site" else "slidersite"] = self._object_name("site", second)
             if bool(m.actuator_ctrllimited[a]):
                 entry["ctrlrange"] = [float(x) for x in m.actuator_ctrlrange[a]]
             if bool(m.actuator_forcelimited[a]):
                 entry["forcerange"] = [float(x) for x in m.actuator_forcerange[a]]
+            entry["general"], why = general_attributes(self.mj, m, a)
+            if why is not None:
+                entry["unwritable"] = why
             out.append(entry)
         return out
 
@@ -354,29 +368,35 @@ class CompiledModel:
             for w in range(start, start + count):
                 wtype = enum_word(self.mj.mjtWrap(int(m.wrap_type[w])), "mjWRAP_")
                 objtype = {"joint": "joint", "site": "site", "sphere": "geom", "cylinder": "geom"}.get(wtype)
-                wraps.append(
-                    {
-                        "type": wtype,
-                        "object": self._object_name(objtype, int(m.wrap_objid[w])) if objtype else None,
-                        "coef": float(m.wrap_prm[w]),
-                    }
-                )
+                wrap = {
+                    "type": wtype,
+                    "object": self._object_name(objtype, int(m.wrap_objid[w])) if objtype else None,
+                    "coef": float(m.wrap_prm[w]),
+                }
+                if objtype == "geom" and float(m.wrap_prm[w]) >= 0.0:  # the side site, by its id
+                    wrap["sidesite"] = self._object_name("site", int(m.wrap_prm[w]))
+                wraps.append(wrap)
             fixed = all(w["type"] == "joint" for w in wraps)
             out.append(
-                {"name": self.name("tendon", t), "kind": "fixed" if fixed else "spatial", "wraps": wraps}
+                {"name": self.name("tendon", t), "kind": "fixed" if fixed else "spatial", "wraps": wraps,
+                 "attributes": tendon_attributes(m, t, spatial=not fixed),
+                 "length0": float(m.tendon_length0[t])}
             )
         return out
 
     def keyframes(self) -> list[dict[str, Any]]:
         m = self.m
-        return [
-            {
+        out = []
+        for k in range(m.nkey):
+            key: dict[str, Any] = {
                 "name": self.name("key", k),
                 "time": float(m.key_time[k]),
                 "qpos": [float(x) for x in m.key_qpos[k]],
             }
-            for k in range(m.nkey)
-        ]
+            if m.nu:
+                key["ctrl"] = [float(x) for x in m.key_ctrl[k]]
+            out.append(key)
+        return out
 
 
 def mesh_path(model_dir: Path, meshdir: str, written: str) -> Path:
@@ -399,11 +419,11 @@ def contact_attributes(m: Any, g: int) -> dict[str, str]:
         raw = getattr(m, f"geom_{name}")[g]
         values = tuple(float(x) for x in (raw if hasattr(raw, "__len__") else (raw,)))
         if any(abs(a - b) > 1e-12 * max(1.0, abs(b)) for a, b in zip(values, default, strict=True)):
-            out[name] = str(int(values[0])) if name in INTEGER_CONTACT else _plain(values)
+            out[name] = str(int(values[0])) if name in INTEGER_CONTACT else plain(values)
     friction = tuple(float(x) for x in m.geom_friction[g])
     acting = 3 if int(m.geom_condim[g]) >= 6 else 2 if int(m.geom_condim[g]) >= 4 else 1
     if friction[acting:] != MUJOCO_FRICTION[acting:]:  # coefficients its condim leaves idle, which
-        out["friction"] = _plain(friction)  # still count when MuJoCo mixes it with a larger condim
+        out["friction"] = plain(friction)  # still count when MuJoCo mixes it with a larger condim
     out.update(fluid_attributes(m, g))
     return out
 
@@ -428,7 +448,7 @@ def fluid_attributes(m: Any, g: int) -> dict[str, str]:
     coefficients = tuple(float(x) for x in row[1:6])
     out = {"fluidshape": "ellipsoid"}
     if any(abs(a - b) > 1e-12 for a, b in zip(coefficients, FLUID_COEFFICIENTS, strict=True)):
-        out["fluidcoef"] = _plain(coefficients)
+        out["fluidcoef"] = plain(coefficients)
     return out
 
 
@@ -446,14 +466,5 @@ def non_default(m: Any, table: dict[str, tuple[str, str, tuple[float, ...]]],
         values = tuple(float(x) for x in (raw if hasattr(raw, "__len__") else (raw,)))
         if any(abs(a - b) > 1e-12 * max(1.0, abs(b)) for a, b in zip(values, default, strict=True)):
             flag = attribute == "actuatorgravcomp"
-            out[attribute] = ("true" if values[0] else "false") if flag else _plain(values)
+            out[attribute] = ("true" if values[0] else "false") if flag else plain(values)
     return out
-
-
-def _plain(values: tuple[float, ...]) -> str:
-    """Numbers as the shortest decimals that give them back (``0.015 1``), ``0`` for ±0."""
-    texts = []
-    for x in values:
-        text = "0" if x == 0.0 else repr(float(x))
-        texts.append(text[:-2] if text.endswith(".0") else text)
-    return " ".join(texts)

@@ -36,6 +36,7 @@ from modelkit.formats.mjcf.files import check_asset_files, check_sizes
 from modelkit.formats.mjcf.options import source_globals, source_options
 from modelkit.formats.mjcf.quiet import collected_warnings
 from modelkit.formats.mjcf.source import SourceIndex, TreeShape, locate, pair
+from modelkit.formats.mjcf.transmissions import transmission_sites
 from modelkit.formats.mjcf.uncompiled import SpecReader
 from modelkit.model import Joint, Robot
 from modelkit.xmlsource import read_xml
@@ -220,9 +221,13 @@ class _MjcfReader:
         for eq in equalities:
             if eq["type"] == "joint":
                 continue
-            objects = {"body": "bodies", "xbody": "bodies"}.get(eq["objtype"], f"{eq['objtype']}s")
-            what = f"{eq['type']} equality{quoted(eq['name'])} between {objects} "
-            what += f'"{eq["obj1"]}" and "{eq["obj2"] or "world"}"'
+            objtype = "tendon" if eq["type"] == "tendon" else eq["objtype"]
+            objects = {"body": "bodies", "xbody": "bodies"}.get(objtype, f"{objtype}s")
+            what = f"{eq['type']} equality{quoted(eq['name'])} "
+            if eq["obj2"] is None and objtype in ("tendon", "joint"):  # one object, held by a polynomial
+                what += f'on {objtype} "{eq["obj1"]}"'
+            else:
+                what += f'between {objects} "{eq["obj1"]}" and "{eq["obj2"] or "world"}"'
             self.sink.emit(
                 "MK172", f"{what}: the model cannot hold it (kept as data)", eq_where.get(eq["index"], top)
             )
@@ -231,16 +236,21 @@ class _MjcfReader:
             self.sink.emit(
                 "MK172",
                 f"{tendon['kind']} tendon{quoted(tendon['name'])}: the model cannot hold tendons "
-                "(kept as data)",
+                "(kept as data; MJCF output writes it back)",
                 where.get(i, top),
             )
 
     @staticmethod
     def _canonical_actuators(reader: CompiledModel, built: Built, kept: list[dict[str, Any]]) -> None:
-        """The actuators the model can hold, on the robot of their joint's body (:mod:`.actuators`)."""
+        """The actuators the model can hold, on the robot of their joint's body (:mod:`.actuators`); their
+        entries kept as data say so (``canonical``, with the model joint), for the writers that write the
+        others back or name them."""
         m = reader.m
         for a, j, actuator in read_actuators(reader.mj, m, built.joints):
             entry = kept[a] if a < len(kept) else {}
+            if entry:
+                entry["canonical"] = True
+                entry["joint"] = actuator.joint
             actuator.source_kind = entry.get("element", actuator.source_kind)
             robot = built.robot_of_body.get(int(m.jnt_bodyid[j]))
             if robot is not None:
@@ -410,10 +420,4 @@ def _used_sites(data: dict[str, list[dict[str, Any]]]) -> set[str]:
     for eq in data.get("mjcf_equalities", []):
         if eq.get("objtype") == "site":
             used.update(str(eq[key]) for key in ("obj1", "obj2") if eq.get(key))
-    for actuator in data.get("mjcf_actuators", []):
-        if actuator.get("transmission") in ("site", "slidercrank") and actuator.get("target"):
-            used.add(str(actuator["target"]))
-    for tendon in data.get("mjcf_tendons", []):
-        wraps = tendon.get("wraps", [])
-        used.update(str(w["object"]) for w in wraps if w.get("type") == "site" and w.get("object"))
-    return used
+    return used | transmission_sites(data.get("mjcf_actuators", []), data.get("mjcf_tendons", []))

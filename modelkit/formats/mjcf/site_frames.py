@@ -24,6 +24,7 @@ import numpy as np
 
 from modelkit.convert.names import unique_name
 from modelkit.convert.notes import NoteSink
+from modelkit.formats.mjcf.transmissions import transmission_sites
 from modelkit.model import Joint, JointType, Link, Robot
 from modelkit.spatial import Pose
 
@@ -40,11 +41,7 @@ def used_sites(robot: Robot) -> set[str]:
     for eq in extras.get("mjcf_equalities") or []:
         if eq.get("objtype") == "site":
             used.update(str(eq.get(key)) for key in ("obj1", "obj2"))
-    for actuator in extras.get("mjcf_actuators") or []:
-        if actuator.get("transmission") in ("site", "slidercrank"):
-            used.add(str(actuator.get("target")))
-    for tendon in extras.get("mjcf_tendons") or []:
-        used.update(str(w.get("object")) for w in tendon.get("wraps", []) if w.get("type") == "site")
+    used |= transmission_sites(extras.get("mjcf_actuators") or [], extras.get("mjcf_tendons") or [])
     for link in robot.links:
         used.update(str(d.params["site"]) for d in link.devices if "site" in d.params)
     used.update(str(s.get("name")) for s in extras.get(SITES) or [] if s.get("used"))  # the reader's mark

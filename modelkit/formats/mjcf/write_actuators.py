@@ -7,7 +7,8 @@
   Gains the source did not give come from :mod:`modelkit.convert.servo_gains` (MK840).
   An actuator on a joint that is not written as one hinge or slide (fixed, ball, planar, a mimic
   follower or a locked joint) is left out (MK842); a transmission reduction is folded into the joint
-  (MK843).
+  (MK843). An MJCF source's other actuators (tendon and site transmissions, activation dynamics,
+  other laws) are written back as ``<general>`` by :mod:`.write_transmissions`, in the source's order.
 * A source without actuators: every hinge and slide that is not a mimic follower or locked gets the
   ``--actuators`` kind, or none (MK841). ``auto`` (the default): a position servo on each joint with a
   range or in a leg (the model holds its ``home`` pose, as MuJoCo Menagerie's arms and legs do), a
@@ -56,6 +57,9 @@ class ActuatorWriter:
         self.section = section
         self.joint_names = joint_names
         self.ctrl: list[float] = []  # the home keyframe's ctrl, one per written actuator
+        self.elements: list[tuple[Actuator, Element]] = []  # the written actuators, as ``ctrl``
+        self.set_aside = False  # --source-actuators replace set the source's actuators aside
+        self.made_up = False  # the actuators are the --actuators choice, not the source's
         self.any_position = False
         self.servos = 0  # position and velocity actuators written
         self._loads: dict[str, JointLoad] | None = None
@@ -65,14 +69,17 @@ class ActuatorWriter:
         by_name: dict[str, Joint] = {}
         for each in self.robot.joints:
             by_name.setdefault(each.name, each)
-        replaced = self._replaced()
+        replaced = self.set_aside = self._replaced()
         planned: list[tuple[Actuator, Joint | None]] = [
             (a, by_name.get(a.joint)) for a in self.robot.actuators
             if not (replaced and a.source_kind != TRACK_ROLLER)
         ]
         # The track approximation's roller servos are the writer's, not the source's: the rest of a
-        # tracked robot is as silent as any other source (convert.tracks).
-        made_up = replaced or not any(a.source_kind != TRACK_ROLLER for a in self.robot.actuators)
+        # tracked robot is as silent as any other source (convert.tracks). An MJCF source's actuators
+        # the model does not hold are its own too: they are written back (write_transmissions).
+        made_up = self.made_up = replaced or not (
+            any(a.source_kind != TRACK_ROLLER for a in self.robot.actuators)
+            or self.robot.extras.get("mjcf_actuators"))
         chosen: list[Actuator] = []
         if made_up:
             taken = {a.joint for a, _ in planned}
@@ -101,10 +108,8 @@ class ActuatorWriter:
         movable = any(j.type in (JointType.REVOLUTE, JointType.PRISMATIC) for j in self.robot.joints)
         if replaced:
             self._said_replaced(written)
-        else:
-            self._uncanonical()
-            if made_up and movable:
-                self._said_choice(written)
+        elif made_up and movable:
+            self._said_choice(written)
         self._said_legs(on_joint)
 
     def _replaced(self) -> bool:
@@ -193,21 +198,6 @@ class ActuatorWriter:
         self.ctx.note("MK841", f"the source names no actuators: {what} written (--actuators {choice}{why})",
                       self.robot.source, "actuator")
 
-    def _uncanonical(self) -> None:
-        """MK842 for an MJCF source's actuators that the model could not hold (activation dynamics,
-        tendon or site transmissions, other gain and bias laws): they are not written."""
-        kept = self.robot.extras.get("mjcf_actuators") or []
-        canonical = sum(1 for a in self.robot.actuators if a.source_kind != TRACK_ROLLER)
-        left = len(kept) - canonical
-        if left > 0:
-            self.ctx.note(
-                "MK842",
-                f"{left} MJCF actuator(s) of the source left out: not a motor, position or velocity law on "
-                "one hinge or slide (activation dynamics, tendon or site transmission, another law)",
-                self.robot.source,
-                "actuator",
-            )
-
     def _constrained(self) -> set[str]:
         followers = {j.name for j in self.robot.joints if j.mimic is not None}
         return followers | {j.name for j in self.robot.joints if j.limits.lower == j.limits.upper}
@@ -233,6 +223,7 @@ class ActuatorWriter:
         where = actuator.source or joint.source
         el = sub(self.section, ELEMENTS[kind],
                  name=self.names.claim("actuator", name, where, f"actuator[{name}]"), joint=target)
+        self.elements.append((actuator, el))
         effort = joint.limits.effort
         limited = math.isfinite(effort) and effort > 0.0
         if actuator.gear != 1.0:

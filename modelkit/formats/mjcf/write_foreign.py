@@ -1,8 +1,9 @@
 """MJCF to MJCF: which of the source's own elements kept as data the output does not hold again.
 
-Sites, cameras, lights and sensors are written back by :mod:`.write_own`, which says which it could not
-write; keyframes other than ``home``, equalities other than joint couplings and world geoms are not
-written back, and count as written when an element of their kind has their name.
+Sites, cameras, lights and sensors are written back by :mod:`.write_own`, tendons by
+:mod:`.write_transmissions`; each says which it could not write. Keyframes other than ``home``,
+equalities other than joint couplings and world geoms are not written back, and count as written when
+an element of their kind has their name.
 
 Another format's data is noted by ``convert`` itself
 (:func:`modelkit.convert.extras_notes.note_foreign_extras`).
@@ -27,11 +28,16 @@ OWN_ELEMENTS = {  # an MJCF source's kept lists → the output elements that may
     "mjcf_keyframes": "key",
     "mjcf_equalities": "equality",
     "mjcf_world_geoms": "geom",
+    "mjcf_tendons": "tendon",
 }
+WRITTEN_BACK = frozenset(  # what write_own and write_transmissions write back when what it names is written
+    {"mjcf_sensors", "mjcf_sites", "mjcf_world_sites", "mjcf_cameras", "mjcf_lights", "mjcf_tendons"}
+)
 WHY = "only what the model holds (devices on links, frames, the home keyframe, mimic joints) is"
-WHY_WRITE_OWN = (  # the kinds write_own writes back
-    "the body each is on, or an object it names (a tendon, a body written at another frame...), is not in "
-    "the output (user, plugin, contact and tactile sensors are never written back)"
+WHY_WRITE_OWN = (  # the kinds write_own and write_transmissions write back
+    "the body each is on, or an object it names (a tendon, a joint not written as one hinge or slide, a body "
+    "written at another frame...), is not in the output (user, plugin, contact and tactile sensors are "
+    "never written back)"
 )
 
 
@@ -39,8 +45,8 @@ def note_unwritten_own(
     root: Element, robot: Robot, ctx: WriteContext, unwritten: dict[str, list[dict[str, Any]]] | None = None
 ) -> None:
     """MJCF to MJCF: what of the source's own elements kept as data (sensors, sites, cameras, lights,
-    keyframes, equalities, world geoms) the output does not hold again, by name; one note per kind
-    with the code and words the MJCF declaration gives (a tendon is reported by the reader, MK172).
+    keyframes, equalities, world geoms, tendons) the output does not hold again, by name; one note per
+    kind with the code and words the MJCF declaration gives.
 
     ``unwritten``: for the kinds :mod:`.write_own` writes back, what it could not write (an object a
     sensor names is missing...); the other kinds count as written when an element of their kind has
@@ -71,7 +77,7 @@ def note_unwritten_own(
         ctx.note(
             code,
             f"{len(lost)} of {len(kept)} {what} not written ({shown}{', ...' if len(lost) > 6 else ''}): "
-            + (WHY_WRITE_OWN if key in unwritten else WHY),
+            + (WHY_WRITE_OWN if key in unwritten and key in WRITTEN_BACK else WHY),
             robot.source,
             kind,
         )

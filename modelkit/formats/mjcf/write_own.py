@@ -12,7 +12,7 @@ source, they go back into the file (the sites of bodies are written with their b
 * world sites go into ``<worldbody>`` as the sites of bodies do;
 * each sensor that is not a device already written (an accelerometer, gyro, force/torque or
   rangefinder of a site) is written into ``<sensor>`` with its ``cutoff`` and ``noise`` when every
-  object it names (site, joint, body, actuator, camera, geom; tendons are never written) exists in
+  object it names (site, joint, body, actuator, camera, geom, tendon) exists in
   the output: under the name written for it, which may differ from the source's (MK800). A sensor
   whose reading depends on its site's shape (``touch``, ``insidesite``) is not moved to the site a
   device wrote (a small sphere of its own). A frame sensor of a body's frame (``xbody``) needs the
@@ -33,6 +33,7 @@ from modelkit.formats.mjcf.site_frames import site_pose
 from modelkit.formats.mjcf.write_bodies import BodyTree
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_names import NameTable
+from modelkit.formats.mjcf.write_refs import WrittenObjects
 from modelkit.formats.mjcf.write_xml import Element, set_pose, sub
 from modelkit.model import Robot
 from modelkit.spatial import Pose
@@ -68,8 +69,11 @@ class OwnWriter:
     sensor: Element
     unwritten: dict[str, list[dict[str, Any]]] = field(default_factory=dict)
 
-    def write(self) -> dict[str, list[dict[str, Any]]]:
-        """Write them; returns what could not be written, by ``extras`` key."""
+    def __post_init__(self) -> None:
+        self.refs = WrittenObjects(self.robot, self.names, self.tree, self.devices)
+
+    def write_places(self) -> dict[str, list[dict[str, Any]]]:
+        """Write the sites, cameras and lights; returns what could not be written, by ``extras`` key."""
         extras = self.robot.extras
         written = {id(s) for s in self.tree.written_sites}
         on_devices = set(self.devices.site_for)
@@ -83,11 +87,15 @@ class OwnWriter:
         for key in ("mjcf_cameras", "mjcf_lights"):
             kept = extras.get(key) or []
             self.unwritten[key] = [item for item in kept if not self._camera_or_light(key, item)]
-        sensors = extras.get("mjcf_sensors") or []
-        rank = {str(s["name"]): i for i, s in enumerate(sensors) if s.get("name")}  # the devices' too
-        self.unwritten["mjcf_sensors"] = [s for s in sensors if not self._sensor(s, rank)]
-        self._source_order(rank, len(sensors))
         return self.unwritten
+
+    def write_sensors(self) -> dict[str, list[dict[str, Any]]]:
+        """Write the sensors (after everything they may name); returns those that could not be."""
+        sensors = self.robot.extras.get("mjcf_sensors") or []
+        rank = {str(s["name"]): i for i, s in enumerate(sensors) if s.get("name")}  # the devices' too
+        unwritten = [s for s in sensors if not self._sensor(s, rank)]
+        self._source_order(rank, len(sensors))
+        return {"mjcf_sensors": unwritten}
 
     def _source_order(self, rank: dict[str, int], last: int) -> None:
         """The sensors in the source's order (MuJoCo lays out ``sensordata`` in it): the devices' are
@@ -105,7 +113,7 @@ class OwnWriter:
         kind = "camera" if key == "mjcf_cameras" else "light"
         target = None
         if item.get("target") is not None:
-            target = self._body(str(item["target"]))
+            target = self.refs.body(str(item["target"]))
             if target is None:
                 return False  # MuJoCo needs the target body of a targetbody mode
         link = item.get("link")
@@ -202,8 +210,8 @@ class OwnWriter:
         if kind in NOT_WRITTEN_SENSORS or obj is None:
             return None
         shaped = kind in SHAPED
-        name = self._object(objtype, str(obj), shaped and kind == "touch")
-        other = self._object(str(reftype), str(ref), shaped) if ref is not None else None
+        name = self.refs.object(objtype, str(obj), shaped and kind == "touch")
+        other = self.refs.object(str(reftype), str(ref), shaped) if ref is not None else None
         if name is None or (ref is not None and other is None):
             return None
         if kind in FRAME_SENSORS:
@@ -220,35 +228,3 @@ class OwnWriter:
         if objtype in ONE_OBJECT and ref is None:
             return {objtype: name}
         return None
-
-    def _object(self, objtype: str, name: str, shaped: bool) -> str | None:
-        """The written name of a source object the sensor names, or ``None``."""
-        if objtype == "site":
-            if name in self.devices.site_for:
-                return None if shaped else self.devices.site_for[name]
-            return self.names.written("site", name)
-        if objtype == "joint":
-            written = self.tree.joint_names.get(name, [])
-            return written[0] if len(written) == 1 else None
-        if objtype == "body":
-            return self._body(name)
-        if objtype == "xbody":  # the body's own frame: only where the body is written at it
-            return self._body(name) if self._at_source_frame(name) else None
-        if objtype == "geom":  # its collision and visual copies share its pose: the first will do
-            return self.names.written("geom", name, first=True)
-        if objtype in ("actuator", "camera"):
-            return self.names.written(objtype, name)
-        return None  # tendons and the rest are not written
-
-    def _at_source_frame(self, name: str) -> bool:
-        """Whether the body of link ``name`` is written at the MuJoCo body's frame: the link frame sits
-        in the written body where the reader found it in the source body (``mjcf_body_offset``; a chain
-        body is written back at its source frame, :mod:`.write_chains`)."""
-        link = self.robot.link(name)
-        if link is None:
-            return False
-        offset = [float(x) for x in link.extras.get("mjcf_body_offset") or (0.0, 0.0, 0.0)]
-        return (Pose(translation=offset).inverse() @ self.tree.frame(name)).is_identity()
-
-    def _body(self, link: str) -> str | None:
-        return self.tree.body_name.get(link) if link in self.tree.bodies else None

@@ -63,13 +63,14 @@ from modelkit.formats.mjcf.write_foreign import note_unwritten_own
 from modelkit.formats.mjcf.write_geoms import COLLISION, CONTACT_PRIORITY, GeomWriter, shared_stems
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_own import OwnWriter
+from modelkit.formats.mjcf.write_transmissions import TransmissionWriter
 from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, quat_wxyz, set_pose, sub
 from modelkit.model import WORLD_LINK, LoopConstraint, Robot
 from modelkit.spatial import Pose
 
 SECTIONS = (
-    "compiler", "option", "default", "asset", "worldbody", "contact", "equality", "actuator", "sensor",
-    "keyframe",
+    "compiler", "option", "default", "asset", "worldbody", "contact", "equality", "tendon", "actuator",
+    "sensor", "keyframe",
 )
 SERVO_INTEGRATOR = "implicitfast"  # with position/velocity servos: kv taken implicitly (as Menagerie's arms)
 HINGE_HALF_SPAN = 0.05  # m: the two connects of a hinge loop sit this far either side of the joint
@@ -88,6 +89,7 @@ class MjcfWriter:
         self.ctx = ctx
         self.names = NameTable(ctx)
         self._refusal_explained = False  # a note already says why MuJoCo refuses the file (MK872)
+        self.written_equalities: list[dict[str, Any]] = []  # an MJCF source's, written back
         self.root = etree.Element("mujoco", model=robot.name)
         self.sections = {tag: sub(self.root, tag) for tag in SECTIONS}
         compiler = self.sections["compiler"]
@@ -140,10 +142,10 @@ class MjcfWriter:
         for loop in self.robot.loops:
             self._loop(loop)
         self._actuators()
-        self._home()
         self.geoms.defaults(self.sections["default"], self.robot.name)
         self._surface_note()
         lost = self._own() if self.robot.source_format == "mjcf" else {}
+        self._home()
         note_unwritten_own(self.root, self.robot, self.ctx, lost)
         write_source_pairs(self.root, self.sections["contact"], self.robot, self.ctx)
         self._meshdir()
@@ -153,10 +155,20 @@ class MjcfWriter:
         return self._text()
 
     def _own(self) -> dict[str, list[dict[str, Any]]]:
-        """MJCF to MJCF: the source's own cameras, lights, world sites and sensors (:mod:`.write_own`)."""
+        """MJCF to MJCF: the source's own cameras, lights, world sites (:mod:`.write_own`), tendons and
+        other actuators (:mod:`.write_transmissions`), then its sensors, which may name any of them."""
         own = OwnWriter(self.robot, self.ctx, self.names, self.tree, self.devices, self.sections["worldbody"],
                         self.sections["sensor"])
-        return own.write()
+        lost = own.write_places()
+        sections = self.sections
+        transmissions = TransmissionWriter(self.robot, self.ctx, self.names, own.refs, sections["tendon"],
+                                           sections["equality"], self.actuators)
+        lost.update(transmissions.write())
+        lost.update(own.write_sensors())
+        written = {id(eq) for eq in self.written_equalities + transmissions.equalities}
+        lost["mjcf_equalities"] = [eq for eq in self.robot.extras.get("mjcf_equalities") or []
+                                   if id(eq) not in written]
+        return lost
 
     def _surface_note(self) -> None:
         """Once per file: how MuJoCo combines the source's shape frictions the geoms now hold."""
@@ -298,7 +310,9 @@ class MjcfWriter:
         in its order (joints in document order): a free joint gets its body's pose, a ball joint the
         identity, the other hinges and slides 0."""
         home = self.tree.home
-        ctrl = self.actuators.ctrl if self.actuators.any_position else []
+        ctrl = self.actuators.ctrl
+        if not self.actuators.any_position and not any(ctrl):  # zero is MuJoCo's own ctrl of a key
+            ctrl = []
         if not home and not ctrl:
             return
         qpos: list[float] = []
@@ -349,14 +363,26 @@ class MjcfWriter:
                     target,
                 )
                 continue
-            sub(
+            source = self._source_equality(joint.name, mimic.joint)
+            el = sub(
                 self.sections["equality"],
                 "joint",
-                name=self.names.claim("equality", f"{joint.name}_mimic"),
+                name=self.names.claim("equality", str((source or {}).get("name") or f"{joint.name}_mimic")),
                 joint1=follower[0],
                 joint2=leader[0],
                 polycoef=f"{fmt(mimic.offset)} {fmt(mimic.multiplier)} 0 0 0",
             )
+            for key, value in ((source or {}).get("solver") or {}).items():
+                el.set(key, str(value))
+
+    def _source_equality(self, follower: str, leader: str) -> dict[str, Any] | None:
+        """An MJCF source's joint equality the reader made this mimic of (its name and solver settings
+        are written back; it counts as written, :attr:`written_equalities`)."""
+        for eq in self.robot.extras.get("mjcf_equalities") or []:
+            if eq.get("type") == "joint" and (eq.get("obj1"), eq.get("obj2")) == (follower, leader):
+                self.written_equalities.append(eq)
+                return dict(eq)
+        return None
 
     def _loop(self, loop: LoopConstraint) -> None:
         target = f"equality/{loop.name}"
@@ -432,7 +458,10 @@ class MjcfWriter:
                                         self.tree.joint_names)
         self.actuators.write(self.tree.home)
         option = self.sections["option"]
-        if self.actuators.servos and option.get("integrator") is None:
+        # An MJCF source's own servos keep the integrator its author ran them with (MuJoCo's default
+        # Euler when it names none); the servos a writer makes, or another format's, get implicitfast
+        ours = self.robot.source_format != "mjcf" or self.actuators.made_up
+        if self.actuators.servos and option.get("integrator") is None and ours:
             option.set("integrator", SERVO_INTEGRATOR)
             self.ctx.note(
                 "MK825",

@@ -330,7 +330,7 @@ def _notes(robot: Robot, ctx: WriteContext) -> None:
             continue
         if key == "mjcf_actuators" and isinstance(value, list):
             # the canonical ones are written as transmissions: only the others are left out
-            value = value[len(robot.actuators):] if len(value) > len(robot.actuators) else []
+            value = [v for v in value if not (isinstance(v, dict) and v.get("canonical"))]
             if not value:
                 continue
         code, what = EXTRAS_DROPPED.get(key, ("MK808", f"extension data {key}"))

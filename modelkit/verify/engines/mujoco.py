@@ -73,6 +73,7 @@ _GEOMS = {
 
 _ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
 _DOF_WIDTH = {int(mujoco.mjtJoint.mjJNT_FREE): 6, int(mujoco.mjtJoint.mjJNT_BALL): 3}
+TENDON_PASSIVE = ("stiffness", "stiffnesspoly", "damping", "dampingpoly", "frictionloss", "armature")
 
 
 def _split_chains(path: Path, links: set[str]) -> str:
@@ -642,7 +643,9 @@ class MujocoSimulator:
                          "armature": ("as in the file" if armature
                                       else "zeroed (the URDF cannot hold it, MK820)"),
                          "passive_joint_terms": ("dof_damping, dof_frictionloss and jnt_stiffness zeroed"
-                                                 + ("" if armature else ", dof_armature zeroed")),
+                                                 + ("" if armature else ", dof_armature zeroed")
+                                                 + "; tendon stiffness, damping, friction loss and armature "
+                                                   "zeroed"),
                          "left_out": {k: dict(sorted(v.items())) for k, v in sorted(self.left_out.items())},
                          "inertials_replaced": {k: list(v) for k, v in sorted((inertials or {}).items())},
                          "torques": ("the PD law as affine actuators (gain kp, bias 0, -kp, -kd; the file's "
@@ -669,6 +672,18 @@ class MujocoSimulator:
         for values in fields.values():
             values[:] = 0.0
         m.jnt_stiffness[:] = 0.0
+        # An MJCF source's tendons are written back to MJCF only: their springs, damping, friction loss
+        # and armature act on the joints they couple, which the other engine's URDF has no tendon for
+        for quantity in TENDON_PASSIVE:
+            values = getattr(m, f"tendon_{quantity}", None)
+            if values is None:
+                continue
+            for t in range(m.ntendon):
+                value = float(np.max(np.abs(values[t])))
+                if value:
+                    name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_TENDON, t) or f"tendon {t}"
+                    left_out.setdefault(f"tendon {quantity}", {})[name] = value
+            values[...] = 0.0
         return left_out
 
     def dof_names(self) -> list[str]:
