@@ -13,8 +13,6 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
 
-import mujoco
-import numpy as np
 import pytest
 
 from modelkit.api import load, validate

@@ -257,7 +257,8 @@ def test_what_names_an_object_that_is_not_written_is_left_out_and_said(tmp_path:
     (tendons,) = [n for n in notes if n.code == "MK808" and "tendons" in n.message]
     assert "1 of 4 MJCF tendons not written (coupled)" in tendons.message
     (left,) = [n for n in notes if n.code == "MK842"]
-    assert left.message == 'MJCF actuator "filtered" left out: its tendon coupled is not written as the source has it'
+    assert left.message == ('MJCF actuator "filtered" left out: its tendon coupled is not written as the '
+                            "source has it")
     b = mujoco.MjModel.from_xml_path(str(out))
     assert b.nu == 5 and list(b.key_ctrl[0]) == [0.3, 0.5, 0.0, 0.0, 0.0]
 

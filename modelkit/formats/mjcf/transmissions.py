@@ -32,7 +32,8 @@ TENDON_DEFAULTS: dict[str, tuple[str, tuple[float, ...]]] = {  # attribute → c
 }
 TENDON_RGBA = (0.5, 0.5, 0.5, 1.0)
 LOOK = frozenset({"width", "rgba"})  # a spatial tendon's only
-ACTUATOR_PARAMETERS = {  # attribute → compiled field, MuJoCo's default (the values written: all)
+# attribute → compiled field, MuJoCo's default (the values written: all of them)
+ACTUATOR_PARAMETERS: dict[str, tuple[str, tuple[float, ...]]] = {
     "dynprm": ("dynprm", (1.0,)),
     "gainprm": ("gainprm", (1.0,)),
     "biasprm": ("biasprm", (0.0,)),
@@ -89,9 +90,9 @@ def tendon_attributes(m: Any, t: int, spatial: bool) -> dict[str, str]:
     if spring is not None and ("stiffness" in out or _differs(spring, (length0, length0))):
         out["springlength"] = plain(spring if spring[0] != spring[1] else spring[:1])
     for attribute, (field, default) in TENDON_DEFAULTS.items():
-        values = _row(m, f"tendon_{field}", t)
-        if values is not None and _differs(values, default) and (spatial or attribute not in LOOK):
-            out[attribute] = plain(values)
+        row = _row(m, f"tendon_{field}", t)
+        if row is not None and _differs(row, default) and (spatial or attribute not in LOOK):
+            out[attribute] = plain(row)
     rgba = tuple(singles(m.tendon_rgba[t]))
     if rgba != TENDON_RGBA and spatial:
         out["rgba"] = plain(rgba)
@@ -105,11 +106,11 @@ def general_attributes(mj: Any, m: Any, a: int) -> tuple[dict[str, str], str | N
     """Actuator ``a`` as the attributes of a ``<general>`` that compiles to it (its transmission
     apart), and why it cannot be written back (None: it can)."""
     out: dict[str, str] = {}
-    for attribute, enum, prefix, default in LAWS:
+    for attribute, enum, prefix, default_word in LAWS:
         value = getattr(mj, enum)(int(getattr(m, f"actuator_{attribute}")[a]))
         name = str(getattr(value, "name", value))
         word = name[len(prefix):].lower() if name.startswith(prefix) else name.lower()
-        if word != default:
+        if word != default_word:
             out[attribute] = word
     for attribute, (field, default) in ACTUATOR_PARAMETERS.items():
         values = _row(m, f"actuator_{field}", a) or ()

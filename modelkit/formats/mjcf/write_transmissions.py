@@ -156,7 +156,8 @@ class TransmissionWriter:
 
     def _generals(self) -> None:
         kept = self.robot.extras.get("mjcf_actuators") or []
-        home = next((k for k in self.robot.extras.get("mjcf_keyframes") or [] if k.get("name") == "home"), {})
+        keys = self.robot.extras.get("mjcf_keyframes") or []
+        home: dict[str, Any] = next((k for k in keys if k.get("name") == "home"), {})
         home_ctrl = [float(x) for x in home.get("ctrl") or []]
         section = self.actuators.section
         placed: list[Placed] = []
