@@ -228,3 +228,40 @@ def test_verify_finds_the_frames_among_the_sites_of_a_default_mjcf(tmp_path: Pat
     assert checks[("mujoco", "link-set")].error == 0.0, checks[("mujoco", "link-set")].detail
     assert checks[("mujoco", "joint-set")].error == 0.0
     assert report.failed == [], [c.detail for c in report.failed]
+
+
+EEF = """<mujoco model="hand">
+  <worldbody>
+    <body name="hand" quat="0.7071068 0.7071068 0 0">
+      <freejoint/>
+      <geom type="box" size="0.04 0.04 0.02" mass="0.5"/>
+      <body name="eef" pos="0 0 0.05" quat="0.707 0 -0.707 0">
+        <site name="grip_site" size="0.01" rgba="1 1 0 1" group="2"/>
+        <site name="ee_x" pos="0.1 0 0" quat="0.707105 0 0.707108 0" type="cylinder" size="0.005 0.1"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_the_sites_of_an_mjcf_frame_body_go_with_it(tmp_path: Path) -> None:
+    """robosuite's grippers hang their controller's sites (``grip_site``, ``ee_x``...) on ``eef``, a
+    massless body without a joint: a frame link, written as a site in ``hand``. Its sites were lost
+    with it (MK808 named them); they are now written in ``hand`` too, where MuJoCo puts them."""
+    source = tmp_path / "hand.xml"
+    source.write_text(EEF)
+    robot = read_model(source).robot
+    assert robot is not None and frame_links(robot) == ["eef"]
+    b, notes = _mjcf(robot, tmp_path / "m" / "hand.xml")
+    assert not [n for n in notes if n.code == "MK808"], [n.message for n in notes]
+    a = mujoco.MjModel.from_xml_string(EEF)
+    da, db = mujoco.MjData(a), mujoco.MjData(b)
+    mujoco.mj_forward(a, da)
+    mujoco.mj_forward(b, db)
+    for name in ("grip_site", "ee_x"):
+        i, j = (mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, name) for m in (a, b))
+        assert mujoco.mj_id2name(b, mujoco.mjtObj.mjOBJ_BODY, int(b.site_bodyid[j])) == "hand"
+        np.testing.assert_allclose(db.site_xpos[j], da.site_xpos[i], rtol=0.0, atol=1e-12)
+        np.testing.assert_allclose(db.site_xmat[j], da.site_xmat[i], rtol=0.0, atol=1e-12)
+        assert (b.site_type[j], b.site_group[j]) == (a.site_type[i], a.site_group[i])

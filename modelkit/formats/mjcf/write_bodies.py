@@ -28,7 +28,8 @@
 * Frame links (:func:`modelkit.convert.frames.frame_links`: massless, on fixed joints, carrying
   nothing) are ``<site name pos quat>``s in the nearest body above them, their poses composed up to it,
   written after that body's own contents in tree order (``WriteOptions.frame_sites``; one MK873 note
-  lists them). With ``frame_sites`` off they are bodies without ``<inertial>`` (MK816).
+  lists them); an MJCF source's sites on a frame link go with it, at their pose in it. With
+  ``frame_sites`` off they are bodies without ``<inertial>`` (MK816).
 * An MJCF source's sites (``mjcf_sites``) in the body of their link, at their pose, with their type,
   size, group and colour: every one of them from an MJCF source (the source's own sensors refer to
   them, :mod:`.write_own`), only those naming a frame from another (:mod:`.site_frames`).
@@ -428,6 +429,7 @@ class BodyTree:
                                 f"site[{site}]")
             set_pose(sub(el, "site", name=site), pose)
             self.sites[name] = (site, body_link)
+            self._kept_sites(el, name, pose)  # the frame's own sites (robosuite's grip_site on eef)
             stack.extend((j.child, pose @ j.origin) for j in reversed(self.children.get(name, [])))
 
     def _contents(self, el: Element, link: Link, name: str, static: bool) -> None:
