@@ -96,8 +96,10 @@ MIXED = """<mujoco model="mixed">
     <motor name="m_wrist" joint="wrist" gear="10" ctrlrange="-1 1"/>
     <general name="filtered" tendon="coupled" dyntype="filter" dynprm="0.05" gainprm="5" ctrlrange="-1 1"/>
     <general name="at_site" site="grip" refsite="anchor" gear="0 0 1 0 0 0" ctrlrange="-2 2"/>
+    <general name="crank" cranksite="tip" slidersite="anchor" cranklength="1.2" ctrlrange="-1 1"/>
+    <adhesion name="stick" body="c" ctrlrange="0 1" gain="5"/>
   </actuator>
-  <keyframe><key name="home" qpos="0.3 -0.2 0" ctrl="0.3 0.5 0 0 0.2 0"/></keyframe>
+  <keyframe><key name="home" qpos="0.3 -0.2 0" ctrl="0.3 0.5 0 0 0.2 0 0.1 0"/></keyframe>
 </mujoco>
 """
 
@@ -147,8 +149,8 @@ def test_the_menagerie_panda_gripper_keeps_its_tendon_actuator(tmp_path: Path) -
 
 def test_every_path_element_and_actuator_law_comes_back_in_the_source_order(tmp_path: Path) -> None:
     """Fixed and spatial tendons (sites, a wrapping cylinder with its side site, pulleys), a tendon
-    equality, a muscle, an integrated-velocity servo, a filtered general on a tendon and a site
-    transmission: the written file compiles to the same actuators in the same order, and the same
+    equality, a muscle, an integrated-velocity servo, a filtered general on a tendon, site, slider-crank
+    and body (adhesion) transmissions: the written file compiles to the same actuators in the same order, and the same
     tendons; run 0.5 s under the home controls it moves as the source."""
     source = tmp_path / "mixed.xml"
     source.write_text(MIXED)
@@ -157,7 +159,7 @@ def test_every_path_element_and_actuator_law_comes_back_in_the_source_order(tmp_
     assert not [n for n in notes if n.code in ("MK842", "MK808")], [n.message for n in notes]
     a, b = mujoco.MjModel.from_xml_string(MIXED), mujoco.MjModel.from_xml_path(str(out))
     names = [mujoco.mj_id2name(b, mujoco.mjtObj.mjOBJ_ACTUATOR, i) for i in range(b.nu)]
-    assert names == ["p_swing", "pull", "iv_elbow", "m_wrist", "filtered", "at_site"]
+    assert names == ["p_swing", "pull", "iv_elbow", "m_wrist", "filtered", "at_site", "crank", "stick"]
     for field in SAME:
         if field in ("gear", "gainprm"):  # the model's motor folds its gain into its gear: the same force
             continue
@@ -260,7 +262,7 @@ def test_what_names_an_object_that_is_not_written_is_left_out_and_said(tmp_path:
     assert left.message == ('MJCF actuator "filtered" left out: its tendon coupled is not written as the '
                             "source has it")
     b = mujoco.MjModel.from_xml_path(str(out))
-    assert b.nu == 5 and list(b.key_ctrl[0]) == [0.3, 0.5, 0.0, 0.0, 0.0]
+    assert b.nu == 7 and list(b.key_ctrl[0]) == [0.3, 0.5, 0.0, 0.0, 0.0, 0.1, 0.0]
 
 
 def test_set_aside_with_the_others(tmp_path: Path) -> None:
