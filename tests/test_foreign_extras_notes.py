@@ -370,3 +370,54 @@ def test_mjcf_size_visual_and_statistic_written_back(tmp_path: Path) -> None:
     assert written.stat.extent == 2.0
     notes = convert([source], tmp_path / "urdf" / "g.urdf").notes
     assert not [n for n in notes if "size" in n.message or "visual>" in n.message or "statistic" in n.message]
+
+
+KEPT = """<mujoco model="kept">
+  <worldbody>
+    <camera name="overview" pos="0 -3 1"/>
+    <light name="sun" pos="0 0 4" directional="true"/>
+    <body name="arm" pos="0 0 1">
+      <joint name="swing" axis="0 1 0" range="-2 2"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.5" size="0.05" mass="1"/>
+      <site name="imu" pos="0 0 -0.25"/>
+      <site name="tip" pos="0 0 -0.5"/>
+      <camera name="eye" pos="0 0 -0.5"/>
+      <body name="hand" pos="0 0 -0.5">
+        <joint name="wrist" axis="0 1 0" range="-1 1"/>
+        <geom type="sphere" size="0.05" mass="0.2"/>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <motor name="drive" joint="swing" gear="2"/>
+    <intvelocity name="turn" joint="wrist" kp="5" actrange="-1 1"/>
+  </actuator>
+  <sensor>
+    <accelerometer name="imu_acc" site="imu"/>
+    <jointvel name="swing_vel" joint="swing"/>
+    <touch name="tip_touch" site="tip"/>
+  </sensor>
+</mujoco>"""
+
+
+@pytest.mark.parametrize("target", ["sdf", "body", "urdf"])
+def test_mjcf_to_other_formats_names_what_the_model_does_not_carry(tmp_path: Path, target: str) -> None:
+    """SDF and ``.body`` left out, without a word, the MJCF actuators the model does not hold (here an
+    intvelocity servo), the sensors no device stands for, the world's camera and light and the sites
+    devices do not use; URDF said so. Every target now names that part, and only it: the motor (a
+    canonical actuator), the accelerometer (an IMU device) and the body's camera (a device) are written."""
+    source = tmp_path / "kept.xml"
+    source.write_text(KEPT)
+    notes = convert([source], tmp_path / "out" / f"kept.{target}").notes
+    said = {n.message.split(":")[0].split(" (")[0].lstrip("0123456789 ") + "|" + n.message for n in notes
+            if n.code in ("MK806", "MK808")}
+    by_kind = {key.split("|")[0]: key.split("|")[1] for key in said}
+    assert set(by_kind) == {"MJCF actuators", "MJCF sensors", "MJCF cameras", "MJCF lights",
+                            "MJCF sites"}, sorted(by_kind)
+    for kind, names in (("MJCF actuators", ["turn"]), ("MJCF sensors", ["swing_vel", "tip_touch"]),
+                        ("MJCF cameras", ["overview"]), ("MJCF lights", ["sun"]), ("MJCF sites", ["tip"])):
+        message = by_kind[kind]
+        if target == "urdf":  # the URDF writer counts
+            assert message.startswith(f"{len(names)} {kind}"), message
+        else:
+            assert f"({len(names)}: {', '.join(names)})" in message, message

@@ -63,7 +63,7 @@ def shown_extras(value: Any, records: bool = False) -> str:
 
 def _record(value: Any) -> bool:
     """A dict that is a reader's record of one element (not a kept XML block, plugin or data element)."""
-    return isinstance(value, dict) and not {"xml", "element"} & value.keys()
+    return isinstance(value, dict) and "xml" not in value and not {"element", "data"} <= value.keys()
 
 
 def _plain(value: Any) -> str:
@@ -92,6 +92,7 @@ def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
         EXTRAS_PARTLY_CARRIED,
         carried_by,
         declared,
+        declared_function,
         partly_carried_by,
     )
 
@@ -101,38 +102,35 @@ def note_foreign_extras(robot: Robot, target: str, notes: NoteSink) -> None:
     handled_joint = (output.handles_joint if output is not None else frozenset()) | carried
     found: list[tuple[str, str, str, Any, Any, str]] = []  # owner, code, words, value, source, target
     # a dict value's entries that say only the owner's default are no loss (EXTRAS_DEFAULTS)
+    partly = partly_carried_by(target)
     if output is None or not output.walks_extras:
         for key in sorted(robot.extras):
-            if key in EXTRAS_OWNER and key not in EXTRAS_PARTLY_CARRIED and key not in handled:
-                code, what = EXTRAS_DROPPED[key]
-                value = _without_defaults(robot.extras[key], EXTRAS_DEFAULTS.get(key))
-                found.append((EXTRAS_OWNER[key], code, what, value, robot.source, "robot"))
+            if key not in EXTRAS_OWNER or key in handled:
+                continue
+            if key in EXTRAS_PARTLY_CARRIED and key not in partly:
+                continue  # only a writer that walks extras can count what it carries of it
+            code, what = EXTRAS_DROPPED[key]
+            value = _without_defaults(robot.extras[key], EXTRAS_DEFAULTS.get(key))
+            if key in partly:  # what the target's writer carries of it is no loss
+                value = declared_function(partly[key])(value, robot)
+            found.append((EXTRAS_OWNER[key], code, what, value, robot.source, "robot"))
     elements: list[tuple[str, Any, dict[str, tuple[str, str, str]], frozenset[str]]] = [
         *(("link", link, EXTRAS_DROPPED_LINK, handled) for link in robot.links),
         *(("joint", joint, EXTRAS_DROPPED_JOINT, handled_joint) for joint in robot.joints),
     ]
-    partly = partly_carried_by(target)
     for kind, element, table, skip in elements:
         for key in sorted(element.extras):
             if key in table and key not in skip:
                 owner, code, what = table[key]
                 value = _without_defaults(element.extras[key], EXTRAS_DEFAULTS.get(key))
                 if key in partly:  # what the target's writer carries of it is no loss
-                    value = _function(partly[key])(value, element)
+                    value = declared_function(partly[key])(value, element)
                 found.append((owner, code, f"{kind} {element.name}: {what}", value,
                               element.source, f"{kind}[{element.name}]"))
     for owner, code, what, value, source, where in found:
         shown = shown_extras(value, records=where == "robot") if owner != target and value else ""
         if shown:
             notes.note(code, f"{what} ({shown}): no {target} equivalent; left out", source, where)
-
-
-def _function(path: str) -> Any:
-    """The function a declaration names as ``"module:function"``."""
-    import importlib
-
-    module, name = path.split(":")
-    return getattr(importlib.import_module(module), name)
 
 
 def _without_defaults(value: Any, defaults: dict[str, object] | None) -> Any:

@@ -8,6 +8,8 @@ one entry below (``tests/test_format_registry.py`` fails until it does).
 
 from __future__ import annotations
 
+from typing import Any
+
 from modelkit.formats.body import declare as body
 from modelkit.formats.declaration import FormatDeclaration
 from modelkit.formats.mjcf import declare as mjcf
@@ -75,3 +77,11 @@ def declared(name: str) -> FormatDeclaration:
         if d.name == name:
             return d
     raise KeyError(name)
+
+
+def declared_function(path: str) -> Any:
+    """The function a declaration names as ``"module:function"`` (imported on first use)."""
+    import importlib
+
+    module, name = path.split(":")
+    return getattr(importlib.import_module(module), name)

@@ -47,5 +47,13 @@ FORMAT = FormatDeclaration(
             ("mjcf_ball_range", "MK820", "the ball joint's cone limit (MJCF range, radians)"),
             ("mjcf_joint_physics", "MK820", "MJCF joint solver parameters"),
         ),
+        # the kept lists in part carried by the model's canonical actuators and devices: .carried gives
+        # what the other targets still leave out, for their notes
+        carried_to=tuple(
+            (key, ("urdf", "sdf", "body"), f"modelkit.formats.mjcf.carried:{left}")
+            for key, left in (("mjcf_actuators", "actuators_left"), ("mjcf_sensors", "sensors_left"),
+                              ("mjcf_cameras", "on_links_left"), ("mjcf_lights", "on_links_left"),
+                              ("mjcf_sites", "sites_left"))
+        ),
     ),
 )

@@ -35,6 +35,8 @@ from modelkit.formats.registry import (
     EXTRAS_QUIET,
     EXTRAS_QUIET_LINK,
     carried_by,
+    declared_function,
+    partly_carried_by,
 )
 from modelkit.formats.urdf.write_frames import frame_link, sensor_frames
 from modelkit.formats.urdf.write_gazebo import unnamed_shapes, write_extensions
@@ -321,18 +323,14 @@ def _notes(robot: Robot, ctx: WriteContext) -> None:
             loop.source,
             "robot",
         )
-    on_links = {(link.name, device.name) for link in robot.links for device in link.devices}
+    partly = partly_carried_by("urdf")
     for key, value in sorted(robot.extras.items()):
-        if key in ("mjcf_cameras", "mjcf_lights") and isinstance(value, list):
-            # those on a link are its devices too, written or noted with them: only the others count
-            value = [v for v in value if (v.get("link"), v.get("name")) not in on_links]
+        if key in partly:
+            # the part the model's own fields carry (an MJCF file's canonical actuators, written as
+            # transmissions; cameras, lights and sensors that are devices of links) is written with them
+            value = declared_function(partly[key])(value, robot)
         if key in SILENT_EXTRAS or not value:
             continue
-        if key == "mjcf_actuators" and isinstance(value, list):
-            # the canonical ones are written as transmissions: only the others are left out
-            value = [v for v in value if not (isinstance(v, dict) and v.get("canonical"))]
-            if not value:
-                continue
         code, what = EXTRAS_DROPPED.get(key, ("MK808", f"extension data {key}"))
         count = f"{len(value)} " if isinstance(value, list) else ""
         ctx.note(code, f"{count}{what}: URDF has no equivalent; left out", robot.source, "robot")

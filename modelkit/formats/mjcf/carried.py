@@ -1,0 +1,45 @@
+"""What of an MJCF source's kept lists the model's own fields carry to another target.
+
+``extras["mjcf_actuators"]``, ``mjcf_sensors``, ``mjcf_cameras``, ``mjcf_lights`` and ``mjcf_sites`` hold
+everything the file had; part of it is also in the model (canonical actuators, devices on links, frame
+sites made links), which the SDF and ``.body`` writers write. Each function gives, from a kept list and
+its robot, the part those targets still leave out, for ``convert``'s note (the MJCF declaration's
+``carried_to``; the URDF writer counts the same part itself).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from modelkit.model import Robot
+
+
+def actuators_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]]:
+    """The actuators the model does not hold as canonical actuators (tendon and site transmissions,
+    activation dynamics, other laws)."""
+    return [a for a in value if not (isinstance(a, dict) and a.get("canonical"))]
+
+
+def sensors_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]]:
+    """The sensors no device on a link stands for (an accelerometer, gyro, rangefinder or force/torque
+    pair of a site is one)."""
+    carried: set[str] = set()
+    for link in robot.links:
+        for device in link.devices:
+            carried.add(device.name)
+            pair = ("force_sensor", "torque_sensor")  # a force/torque device's two sensors
+            carried.update(str(device.params[k]) for k in pair if k in device.params)
+    return [s for s in value if not (isinstance(s, dict) and s.get("name") in carried)]
+
+
+def on_links_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]]:
+    """The cameras or lights that are not a device of their link (those of the world body)."""
+    on_links = {(link.name, device.name) for link in robot.links for device in link.devices}
+    return [v for v in value if not (isinstance(v, dict) and (v.get("link"), v.get("name")) in on_links)]
+
+
+def sites_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]]:
+    """The sites left once those naming frames became links (``convert`` takes them out of the list):
+    all but the sites of devices, which the device's pose carries."""
+    device_sites = {str(d.params["site"]) for link in robot.links for d in link.devices if "site" in d.params}
+    return [s for s in value if not (isinstance(s, dict) and s.get("name") in device_sites)]
