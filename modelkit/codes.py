@@ -1430,6 +1430,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "(`--source-actuators replace` gives them the `--actuators` choice: with `auto`, position servos).",
     ),
     CodeInfo(
+        "MK863",
+        "effort-motors-sag",
+        "warning",
+        "MJCF: joints outside a legged robot's legs that the source's effort actuators drive (URDF "
+        "`EffortJointInterface` transmissions: example-robot-data's Kinova arm) and that gravity turns at "
+        "home, written as `<motor>`s: at zero control the robot sags until a controller drives them "
+        "(`--source-actuators replace` gives them the `--actuators` choice: with `auto`, position servos).",
+    ),
+    CodeInfo(
         "MK858",
         "drive-plugin-written",
         "info",

@@ -150,8 +150,8 @@ def test_the_menagerie_panda_gripper_keeps_its_tendon_actuator(tmp_path: Path) -
 def test_every_path_element_and_actuator_law_comes_back_in_the_source_order(tmp_path: Path) -> None:
     """Fixed and spatial tendons (sites, a wrapping cylinder with its side site, pulleys), a tendon
     equality, a muscle, an integrated-velocity servo, a filtered general on a tendon, site, slider-crank
-    and body (adhesion) transmissions: the written file compiles to the same actuators in the same order, and the same
-    tendons; run 0.5 s under the home controls it moves as the source."""
+    and body (adhesion) transmissions: the written file compiles to the same actuators in the same order,
+    and the same tendons; run 0.5 s under the home controls it moves as the source."""
     source = tmp_path / "mixed.xml"
     source.write_text(MIXED)
     out = tmp_path / "m" / "mixed.xml"

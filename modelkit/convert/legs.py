@@ -47,7 +47,7 @@ def leg_joints(robot: Robot) -> frozenset[str]:
     out: set[str] = set()
     for first in legs:
         below = _below(children, by_name[first])
-        if any(_is_wheel(joint, links) for joint in below):
+        if any(is_wheel(joint, links) for joint in below):
             continue
         out.update(j.name for j in below if j.type in (JointType.REVOLUTE, JointType.PRISMATIC))
     return frozenset(out)
@@ -66,7 +66,7 @@ def _below(children: dict[str, list[Joint]], first: Joint) -> list[Joint]:
     return out
 
 
-def _is_wheel(joint: Joint, links: dict[str, Link]) -> bool:
+def is_wheel(joint: Joint, links: dict[str, Link]) -> bool:
     """A hinge without a range whose child's collision shapes (its visuals without any) are round
     about its axis."""
     if joint.type is not JointType.REVOLUTE:

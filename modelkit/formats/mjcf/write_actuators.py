@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.legs import leg_joints, resting_on
+from modelkit.convert.legs import is_wheel, leg_joints, resting_on
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.convert.servo_gains import (
     SERVO_BANDWIDTH_HZ,
@@ -40,12 +40,13 @@ from modelkit.convert.servo_gains import (
 from modelkit.convert.tracks import TRACK_ROLLER
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, sub
-from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Robot
+from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
 
 ELEMENTS = {ActuatorKind.EFFORT: "motor", ActuatorKind.POSITION: "position",
             ActuatorKind.VELOCITY: "velocity"}
 CHOICES = {"motor": ActuatorKind.EFFORT, "position": ActuatorKind.POSITION, "velocity": ActuatorKind.VELOCITY}
 ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # MK841 lists kinds in this order
+GRAVITY_FLOOR = 1e-9  # N·m or N: a gravity load at home below this is rounding (a vertical axis)
 
 
 class ActuatorWriter:
@@ -64,6 +65,7 @@ class ActuatorWriter:
         self.servos = 0  # position and velocity actuators written
         self._loads: dict[str, JointLoad] | None = None
         self._legs: frozenset[str] | None = None  # the joints in a legged robot's legs, found once
+        self._links: dict[str, Link] | None = None
 
     def write(self, home: dict[str, float]) -> None:
         by_name: dict[str, Joint] = {}
@@ -111,6 +113,7 @@ class ActuatorWriter:
         elif made_up and movable:
             self._said_choice(written)
         self._said_legs(on_joint)
+        self._said_sagging(on_joint, by_name)
 
     def _replaced(self) -> bool:
         """Whether ``--source-actuators replace`` sets the source's own actuators aside (it has some)."""
@@ -133,6 +136,26 @@ class ActuatorWriter:
         self.ctx.note("MK855", f"the source's {len(own) + max(unheld, 0)} actuator(s) ({', '.join(parts)}) "
                       f"set aside (--source-actuators replace); written instead: {what} "
                       f"(--actuators {self.ctx.options.actuators})", self.robot.source, "actuator")
+
+    def _said_sagging(self, on_joint: dict[str, Actuator], by_name: dict[str, Joint]) -> None:
+        """MK863: joints outside legs (MK857) that the source's effort actuators drive and gravity turns
+        at home (an arm's shoulder and elbow under URDF ``EffortJointInterface`` transmissions): at zero
+        control the robot sags until a controller drives them."""
+        if self._legs is None:
+            self._legs = leg_joints(self.robot)
+        sagging = [(name, self.load(by_name[name]).gravity) for name, actuator in on_joint.items()
+                   if actuator.kind is ActuatorKind.EFFORT and actuator.source_kind not in ("--actuators",
+                                                                                             TRACK_ROLLER)
+                   and name not in self._legs and name in by_name and self.sags(by_name[name])]
+        if not sagging:
+            return
+        shown = ", ".join(f"{name} {load:.3g}" for name, load in sagging[:4]) + (" ..." if len(sagging) > 4
+                                                                                 else "")
+        self.ctx.note("MK863", f"{len(sagging)} joint(s) with the source's effort actuators, written as "
+                      f"<motor>, carry a gravity load at home ({shown}; N·m, N for a slide): at zero control "
+                      "the robot sags until a controller drives them (--source-actuators replace gives them "
+                      "the --actuators choice: auto, position servos that hold the home keyframe)",
+                      self.robot.source, "actuator")
 
     def _said_legs(self, on_joint: dict[str, Actuator]) -> None:
         """MK857: the source's motors leave a legged robot's legs limp; MK856: its home pose, which the
@@ -166,10 +189,12 @@ class ActuatorWriter:
     def _chosen_kind(self, joint: Joint) -> ActuatorKind | None:
         """The ``--actuators`` kind of a joint the source does not actuate (None: no actuator).
 
-        ``auto``: a position servo on a joint with a finite range or in a leg (:mod:`modelkit.convert.legs`:
-        a URDF's ``continuous`` knee), so the written model holds its home pose as MuJoCo Menagerie's arms
+        ``auto``: a position servo on a joint with a finite range, in a leg (:mod:`modelkit.convert.legs`:
+        a URDF's ``continuous`` knee) or, on a welded base, that gravity turns at home (:meth:`sags`: an
+        arm's ``continuous`` wrist), so the written model holds its home pose as MuJoCo Menagerie's arms
         and legs do; a motor on any other joint without one (wheels, casters, endless spindles), whose
-        zero control leaves it free as the source has it."""
+        zero control leaves it free as the source has it. A mobile robot's joints without a range are its
+        wheels and casters (the lecture's smartcar has its wheels' masses off their axes: still motors)."""
         if joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
             return None
         choice = self.ctx.options.actuators
@@ -178,8 +203,20 @@ class ActuatorWriter:
             ranged = math.isfinite(lower) and math.isfinite(upper) and lower < upper
             if self._legs is None:
                 self._legs = leg_joints(self.robot)
-            return ActuatorKind.POSITION if ranged or joint.name in self._legs else ActuatorKind.EFFORT
+            welded = self.robot.root_joint is JointType.FIXED  # an arm; a mobile robot's are wheels, casters
+            held = ranged or joint.name in self._legs or (welded and self.sags(joint))
+            return ActuatorKind.POSITION if held else ActuatorKind.EFFORT
         return CHOICES.get(choice)
+
+    def sags(self, joint: Joint) -> bool:
+        """Whether gravity turns the joint at home: its gravity load there exceeds its Coulomb friction
+        (a wheel's, whose mass sits on its axis, and a vertical axis's are nil). A wheel never sags:
+        its load is the robot's, which the floor carries."""
+        if self._links is None:
+            self._links = {link.name: link for link in self.robot.links}
+        if is_wheel(joint, self._links):
+            return False
+        return self.load(joint).gravity > max(joint.friction, GRAVITY_FLOOR)
 
     def _said_choice(self, written: dict[ActuatorKind, int]) -> None:
         """MK841: the source names no actuators, what ``--actuators`` wrote instead."""
@@ -193,8 +230,9 @@ class ActuatorWriter:
                                 sorted(written.items(), key=lambda item: ORDER.index(item[0])))
         why = ""
         if choice == "auto":
-            why = ("; auto puts a position servo on each joint with a range or in a leg (the home keyframe "
-                   "holds) and a motor on each other joint without a range (zero control leaves it free)")
+            why = ("; auto puts a position servo on each joint with a range, in a leg or, on a welded base, "
+                   "that gravity turns at home (the home keyframe holds) and a motor on each other joint "
+                   "without a range (zero control leaves it free)")
         self.ctx.note("MK841", f"the source names no actuators: {what} written (--actuators {choice}{why})",
                       self.robot.source, "actuator")
 
