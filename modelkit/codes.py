@@ -426,6 +426,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "a checker, gradient or flat pattern) or a cube or skybox texture. Converted files keep the "
         "material's colour, specular, shininess and emission; a 2d texture from a PNG file is carried.",
     ),
+    CodeInfo(
+        "MK179",
+        "mjcf-tendon-actuator-on-joint",
+        "info",
+        "An MJCF actuator on a fixed tendon whose joints all follow one joint (a parallel gripper: MuJoCo "
+        "Menagerie's Panda) is read as the same actuator on that joint, with its gains, ranges and the "
+        "control mapped through the coupling (the message gives the mapping): URDF, SDF and `.body` "
+        "write it on the joint; MJCF writes the source's element back.",
+    ),
     # -- MK18x: .body values -----------------------------------------------------------------
     CodeInfo(
         "MK181",

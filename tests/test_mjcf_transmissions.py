@@ -16,10 +16,11 @@ import mujoco
 import numpy as np
 import pytest
 
-from modelkit.api import load
+from modelkit.api import load, validate
 from modelkit.convert.api import write
 from modelkit.convert.options import WriteOptions
 from modelkit.formats.mjcf.write_transmissions import rebased
+from modelkit.model import ActuatorKind
 
 GRIPPER = """<mujoco model="gripper">
   <compiler angle="radian"/>
@@ -291,3 +292,39 @@ def test_a_tendon_polynomial_is_rebased_on_the_written_lengths(
         before = sum(c * (x - shift2) ** i for i, c in enumerate(coefficients))  # l1 − l1₀
         after = sum(c * x**i for i, c in enumerate(new))  # l1 − l1₀'
         assert after == pytest.approx(before + shift1, abs=1e-12)
+
+
+def test_the_gripper_actuator_reaches_urdf_sdf_and_body_on_the_joint_its_fingers_follow(tmp_path: Path) -> None:
+    """URDF, SDF and ``.body`` have no tendons, and they lost the gripper's actuator (SDF and ``.body``
+    without a word). Its tendon's two joints follow one (``finger1`` mimics ``finger2``: the file's joint
+    equality), so the actuator is that joint's: a position servo kp = −b₁ (gear·k)² = 100, kv 10, whose
+    target is 0.04/255 of the control (MK179). Written on ``finger2`` in each target; the joint
+    coupling is a mimic there, so neither it nor the actuator is named as left out. Driven on ``finger2``
+    with the mapped target, the model settles where the source's tendon servo puts the fingers."""
+    source = tmp_path / "gripper.xml"
+    source.write_text(GRIPPER)
+    robot = load(source)
+    (on_joint,) = robot.actuators
+    assert (on_joint.joint, on_joint.kind, on_joint.kp, on_joint.kv) == ("finger2", ActuatorKind.POSITION, 100.0,
+                                                                         10.0)
+    assert on_joint.ctrl_range == pytest.approx((0.0, 0.04), abs=1e-12)
+    assert on_joint.force_range == (-100.0, 100.0)
+    (said,) = [d for d in validate(source).diagnostics if d.code == "MK179"]
+    assert "on joint finger2" in said.message and "0.000156863·u (0 to 0.04)" in said.message
+    for target in ("urdf", "sdf", "body"):
+        out = tmp_path / target / f"gripper.{target}"
+        notes = _write(source, out)
+        assert not [n for n in notes if n.code in ("MK842", "MK808") and "tendons" not in n.message], target
+        text = out.read_text()
+        expected = {"urdf": "hardware_interface/PositionJointInterface", "sdf": "<p_gain>100</p_gain>",
+                    "body": "actuation_mode: joint_displacement"}[target]
+        assert expected in text and "finger2" in text
+    a = mujoco.MjModel.from_xml_string(GRIPPER)
+    b = mujoco.MjModel.from_xml_string(GRIPPER.replace(
+        '<general name="grip" tendon="split" forcerange="-100 100" ctrlrange="0 255" gainprm="0.01568627451"\n'
+        '      biastype="affine" biasprm="0 -100 -10"/>',
+        '<position name="grip" joint="finger2" kp="100" kv="10" forcerange="-100 100"/>'))
+    for ctrl in (0.0, 100.0, 255.0):
+        da = _run(a, a.key_qpos[0], np.array([ctrl]), 2000)
+        db = _run(b, a.key_qpos[0], np.array([ctrl * 0.01568627451 / 100.0]), 2000)
+        np.testing.assert_allclose(db.qpos, da.qpos, rtol=0.0, atol=1e-9)  # measured 3e-13

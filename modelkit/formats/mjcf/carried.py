@@ -15,9 +15,9 @@ from modelkit.model import Robot
 
 
 def actuators_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]]:
-    """The actuators the model does not hold as canonical actuators (tendon and site transmissions,
-    activation dynamics, other laws)."""
-    return [a for a in value if not (isinstance(a, dict) and a.get("canonical"))]
+    """The actuators the model does not hold as canonical actuators (site transmissions, tendons whose
+    joints do not follow one joint, activation dynamics, other laws)."""
+    return [a for a in value if not (isinstance(a, dict) and (a.get("canonical") or a.get("as_joint")))]
 
 
 def sensors_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]]:
@@ -43,3 +43,11 @@ def sites_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]
     all but the sites of devices, which the device's pose carries."""
     device_sites = {str(d.params["site"]) for link in robot.links for d in link.devices if "site" in d.params}
     return [s for s in value if not (isinstance(s, dict) and s.get("name") in device_sites)]
+
+
+def equalities_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]]:
+    """The equalities that are not a joint coupling the model holds as a mimic (the joint follows the
+    other, as the reader made it of the equality)."""
+    followers = {(j.name, j.mimic.joint) for j in robot.joints if j.mimic is not None}
+    return [e for e in value if not (isinstance(e, dict) and e.get("type") == "joint"
+                                     and (e.get("obj1"), e.get("obj2")) in followers)]

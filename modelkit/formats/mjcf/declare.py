@@ -21,7 +21,7 @@ FORMAT = FormatDeclaration(
         quiet=frozenset({"mjcf_compiled", "mjcf_globals"}),
         quiet_link=frozenset({"mjcf_body_id", "mjcf_body_offset", "mjcf_intermediate_of"}),
         partly_carried=frozenset(
-            {"mjcf_actuators", "mjcf_sensors", "mjcf_cameras", "mjcf_lights", "mjcf_sites"}
+            {"mjcf_actuators", "mjcf_sensors", "mjcf_cameras", "mjcf_lights", "mjcf_sites", "mjcf_equalities"}
         ),
         dropped=(
             ("mjcf_actuators", "MK808", "MJCF actuators"),
@@ -53,7 +53,7 @@ FORMAT = FormatDeclaration(
             (key, ("urdf", "sdf", "body"), f"modelkit.formats.mjcf.carried:{left}")
             for key, left in (("mjcf_actuators", "actuators_left"), ("mjcf_sensors", "sensors_left"),
                               ("mjcf_cameras", "on_links_left"), ("mjcf_lights", "on_links_left"),
-                              ("mjcf_sites", "sites_left"))
+                              ("mjcf_sites", "sites_left"), ("mjcf_equalities", "equalities_left"))
         ),
     ),
 )

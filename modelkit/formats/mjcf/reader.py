@@ -26,7 +26,7 @@ from typing import Any
 from modelkit.diagnostics import DiagnosticSink, SourceLocation, sorted_diagnostics
 from modelkit.formats.common import ReadOptions, ReadResult
 from modelkit.formats.meshref import not_found
-from modelkit.formats.mjcf.actuators import read_actuators
+from modelkit.formats.mjcf.actuators import OnJoint, read_actuators, tendon_actuators
 from modelkit.formats.mjcf.bodies import MjBody, MjGeom
 from modelkit.formats.mjcf.build import Built, RobotBuilder, apply_joint_equalities, quoted
 from modelkit.formats.mjcf.compiled import CompiledModel, mesh_path
@@ -38,7 +38,7 @@ from modelkit.formats.mjcf.quiet import collected_warnings
 from modelkit.formats.mjcf.source import SourceIndex, TreeShape, locate, pair
 from modelkit.formats.mjcf.transmissions import transmission_sites
 from modelkit.formats.mjcf.uncompiled import SpecReader
-from modelkit.model import Joint, Robot
+from modelkit.model import Actuator, ActuatorKind, Joint, Robot
 from modelkit.xmlsource import read_xml
 
 MUJOCO_DEFAULT_NAME = "MuJoCo Model"
@@ -192,7 +192,7 @@ class _MjcfReader:
             "mjcf_world_sites": builder.sites(reader.world_sites(), 0),
         }
         self._tag_actuators(index, data["mjcf_actuators"])
-        self._canonical_actuators(reader, built, data["mjcf_actuators"])
+        self._canonical_actuators(reader, built, data["mjcf_actuators"], index)
         self._keep(reader, built, builder, bodies, data)
         if model.nflex:
             self.sink.emit(
@@ -240,21 +240,56 @@ class _MjcfReader:
                 where.get(i, top),
             )
 
-    @staticmethod
-    def _canonical_actuators(reader: CompiledModel, built: Built, kept: list[dict[str, Any]]) -> None:
-        """The actuators the model can hold, on the robot of their joint's body (:mod:`.actuators`); their
-        entries kept as data say so (``canonical``, with the model joint), for the writers that write the
-        others back or name them."""
+    def _canonical_actuators(self, reader: CompiledModel, built: Built, kept: list[dict[str, Any]],
+                             index: SourceIndex) -> None:
+        """The actuators the model can hold, on the robot of their joint's body, in the file's order
+        (:mod:`.actuators`); their entries kept as data say so (``canonical``, with the model joint), for
+        the writers that write the others back or name them. An actuator on a fixed tendon whose joints
+        follow one joint is also read as one on that joint (MK179; its entry says ``as_joint``): the MJCF
+        writer writes the source's element back, the other targets the joint's actuator."""
         m = reader.m
+        found: list[tuple[int, int, Actuator]] = []
         for a, j, actuator in read_actuators(reader.mj, m, built.joints):
             entry = kept[a] if a < len(kept) else {}
             if entry:
                 entry["canonical"] = True
                 entry["joint"] = actuator.joint
             actuator.source_kind = entry.get("element", actuator.source_kind)
+            found.append((a, j, actuator))
+        index_of = {joint.name: j for j, joint in built.joints.items()}
+        where = self._item_locations(index, "actuator", [e.get("name") for e in kept])
+        for on in tendon_actuators(reader.mj, m, built.joints):
+            actuator = on.actuator
+            if on.actuator_id < len(kept):
+                kept[on.actuator_id]["as_joint"] = actuator.joint
+            found.append((on.actuator_id, index_of[actuator.joint], actuator))
+            self._said_on_joint(on, where.get(on.actuator_id, index.top().loc()))
+        for _, j, actuator in sorted(found, key=lambda item: item[0]):
             robot = built.robot_of_body.get(int(m.jnt_bodyid[j]))
             if robot is not None:
                 robot.actuators.append(actuator)
+
+    def _said_on_joint(self, on: OnJoint, where: SourceLocation) -> None:
+        """MK179: an actuator on a fixed tendon read as one on the joint the tendon's joints follow."""
+        a = on.actuator
+        name = f' "{a.name}"' if a.name else ""
+        what = {ActuatorKind.EFFORT: f"an effort actuator of gear {a.gear:.6g}",
+                ActuatorKind.POSITION: f"a position servo (kp {a.kp:.6g}, kv {a.kv:.6g})",
+                ActuatorKind.VELOCITY: f"a velocity servo (kv {a.kv:.6g})"}[a.kind]
+        control = ""
+        if a.kind is not ActuatorKind.EFFORT and (on.scale != 1.0 or on.offset != 0.0):
+            target = "target" if a.kind is ActuatorKind.POSITION else "target velocity"
+            control = f"; its control u sets the joint's {target} {on.scale:.6g}·u"
+            control += f" {'+' if on.offset >= 0 else '−'} {abs(on.offset):.6g}" if on.offset else ""
+            if a.ctrl_range is not None:
+                control += f" ({a.ctrl_range[0]:.6g} to {a.ctrl_range[1]:.6g})"
+        self.sink.emit(
+            "MK179",
+            f'MJCF actuator{name} on fixed tendon "{on.tendon}" is read as {what} on joint {a.joint}, which '
+            f"every joint of the tendon follows{control}: URDF, SDF and .body get that actuator, MJCF the "
+            "source's",
+            where,
+        )
 
     def _tag_actuators(self, index: SourceIndex, actuators: list[dict[str, Any]]) -> None:
         """Add the written element (``motor``, ``position``...) to each actuator when it is known."""

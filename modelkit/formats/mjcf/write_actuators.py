@@ -38,6 +38,7 @@ from modelkit.convert.servo_gains import (
     velocity_gain,
 )
 from modelkit.convert.tracks import TRACK_ROLLER
+from modelkit.formats.mjcf.actuators import TENDON_SOURCE
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, sub
 from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
@@ -72,9 +73,11 @@ class ActuatorWriter:
         for each in self.robot.joints:
             by_name.setdefault(each.name, each)
         replaced = self.set_aside = self._replaced()
+        # an MJCF source's actuator on a fixed tendon, also read as one on the joint the tendon's joints
+        # follow, is written back as it was (write_transmissions), not on the joint
         planned: list[tuple[Actuator, Joint | None]] = [
             (a, by_name.get(a.joint)) for a in self.robot.actuators
-            if not (replaced and a.source_kind != TRACK_ROLLER)
+            if not (replaced and a.source_kind != TRACK_ROLLER) and a.source_kind != TENDON_SOURCE
         ]
         # The track approximation's roller servos are the writer's, not the source's: the rest of a
         # tracked robot is as silent as any other source (convert.tracks). An MJCF source's actuators
