@@ -30,12 +30,6 @@ EXCEPTIONS: dict[tuple[str, str], str] = {
         "copied by the SDF writer)",
     ("formats/urdf/write_gazebo.py", "sdf_plugins"): "an SDF model's plugins are written as <gazebo> blocks",
     ("formats/urdf/writer.py", "sdf_plugins"): "the same: written, so no MK808 note",
-    ("formats/urdf/writer.py", "mjcf_actuators"):
-        "the MJCF reader keeps every actuator, also those Robot.actuators holds: the note counts only "
-        "the others (keeping only those would change the reader's MK175 counts)",
-    ("formats/urdf/writer.py", "mjcf_cameras"):
-        "the MJCF reader keeps every camera, also those on links (devices): only the others are noted",
-    ("formats/urdf/writer.py", "mjcf_lights"): "the same, for lights",
     ("formats/body/writer.py", "sdf_world_joint"):
         "a model fixed without a world joint is a static SDF model: its free links are written fixed",
     ("formats/body/writer.py", "gazebo"): "URDF extension blocks are noted as not carried over",
