@@ -178,3 +178,21 @@ def plain(values: tuple[float, ...] | list[float]) -> str:
         text = "0" if x == 0.0 else repr(float(x))
         texts.append(text[:-2] if text.endswith(".0") else text)
     return " ".join(texts)
+
+
+def non_default(m: Any, table: dict[str, tuple[str, str, tuple[float, ...]]],
+                index: dict[str, int]) -> dict[str, str]:
+    """The attributes of ``table`` (MJCF attribute → the compiled array's row kind and field, MuJoCo's
+    default) whose compiled value differs from the default, as MJCF attribute text; ``index`` gives the
+    row per kind (``jnt``, ``dof``, ``body``). An array the loaded library lacks is skipped."""
+    out: dict[str, str] = {}
+    for attribute, (row, name, default) in table.items():
+        try:
+            raw = getattr(m, f"{row}_{name}")[index[row]]
+        except AttributeError:
+            continue
+        values = tuple(float(x) for x in (raw if hasattr(raw, "__len__") else (raw,)))
+        if any(abs(a - b) > 1e-12 * max(1.0, abs(b)) for a, b in zip(values, default, strict=True)):
+            flag = attribute == "actuatorgravcomp"
+            out[attribute] = ("true" if values[0] else "false") if flag else plain(values)
+    return out

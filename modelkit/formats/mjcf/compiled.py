@@ -25,6 +25,7 @@ from modelkit.formats.mjcf.bodies import (
     MjInertial,
     MjJoint,
     MjSite,
+    non_default,
     plain,
     pose_of,
     single,
@@ -449,22 +450,4 @@ def fluid_attributes(m: Any, g: int) -> dict[str, str]:
     out = {"fluidshape": "ellipsoid"}
     if any(abs(a - b) > 1e-12 for a, b in zip(coefficients, FLUID_COEFFICIENTS, strict=True)):
         out["fluidcoef"] = plain(coefficients)
-    return out
-
-
-def non_default(m: Any, table: dict[str, tuple[str, str, tuple[float, ...]]],
-                index: dict[str, int]) -> dict[str, str]:
-    """The attributes of ``table`` (MJCF attribute → the compiled array's row kind and field, MuJoCo's
-    default) whose compiled value differs from the default, as MJCF attribute text; ``index`` gives the
-    row per kind (``jnt``, ``dof``, ``body``). An array the loaded library lacks is skipped."""
-    out: dict[str, str] = {}
-    for attribute, (row, name, default) in table.items():
-        try:
-            raw = getattr(m, f"{row}_{name}")[index[row]]
-        except AttributeError:
-            continue
-        values = tuple(float(x) for x in (raw if hasattr(raw, "__len__") else (raw,)))
-        if any(abs(a - b) > 1e-12 * max(1.0, abs(b)) for a, b in zip(values, default, strict=True)):
-            flag = attribute == "actuatorgravcomp"
-            out[attribute] = ("true" if values[0] else "false") if flag else plain(values)
     return out

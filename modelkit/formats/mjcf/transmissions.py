@@ -15,20 +15,20 @@ from __future__ import annotations
 
 from typing import Any
 
-from modelkit.formats.mjcf.bodies import plain, singles
+from modelkit.formats.mjcf.bodies import non_default, plain, singles
 
 SOLREF = (0.02, 1.0)
 SOLIMP = (0.9, 0.95, 0.001, 0.5, 2.0)
-TENDON_DEFAULTS: dict[str, tuple[str, tuple[float, ...]]] = {  # attribute → compiled field, default
-    "width": ("width", (0.003,)),
-    "margin": ("margin", (0.0,)),
-    "frictionloss": ("frictionloss", (0.0,)),
-    "armature": ("armature", (0.0,)),
-    "springyield": ("springyield", (0.0,)),
-    "solreflimit": ("solref_lim", SOLREF),
-    "solimplimit": ("solimp_lim", SOLIMP),
-    "solreffriction": ("solref_fri", SOLREF),
-    "solimpfriction": ("solimp_fri", SOLIMP),
+TENDON_DEFAULTS: dict[str, tuple[str, str, tuple[float, ...]]] = {  # attribute → compiled field, default
+    "width": ("tendon", "width", (0.003,)),
+    "margin": ("tendon", "margin", (0.0,)),
+    "frictionloss": ("tendon", "frictionloss", (0.0,)),
+    "armature": ("tendon", "armature", (0.0,)),
+    "springyield": ("tendon", "springyield", (0.0,)),
+    "solreflimit": ("tendon", "solref_lim", SOLREF),
+    "solimplimit": ("tendon", "solimp_lim", SOLIMP),
+    "solreffriction": ("tendon", "solref_fri", SOLREF),
+    "solimpfriction": ("tendon", "solimp_fri", SOLIMP),
 }
 TENDON_RGBA = (0.5, 0.5, 0.5, 1.0)
 LOOK = frozenset({"width", "rgba"})  # a spatial tendon's only
@@ -89,10 +89,8 @@ def tendon_attributes(m: Any, t: int, spatial: bool) -> dict[str, str]:
     # its body's pose) moves: written as a length whenever a spring uses it
     if spring is not None and ("stiffness" in out or _differs(spring, (length0, length0))):
         out["springlength"] = plain(spring if spring[0] != spring[1] else spring[:1])
-    for attribute, (field, default) in TENDON_DEFAULTS.items():
-        row = _row(m, f"tendon_{field}", t)
-        if row is not None and _differs(row, default) and (spatial or attribute not in LOOK):
-            out[attribute] = plain(row)
+    out.update((k, v) for k, v in non_default(m, TENDON_DEFAULTS, {"tendon": t}).items()
+               if spatial or k not in LOOK)
     rgba = tuple(singles(m.tendon_rgba[t]))
     if rgba != TENDON_RGBA and spatial:
         out["rgba"] = plain(rgba)
