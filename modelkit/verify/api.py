@@ -683,6 +683,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                 last = {chain.joint: chain.joints[2] for chain in chains}
                 report.checks.extend(_guarded(3, eng, lambda eng=eng, ref=ref, st=held_state, last=last,
                                               wb=with_balls: dynamics.layer3a(ref, eng, st, last, wb)))
+                report.engines[eng.label] = dict(eng.model.settings)  # a route layer 3a chose, said
                 if dropped:
                     report.skips.append(Skip(3, eng.label, (
                         f"joint armature (rotor inertia) of {', '.join(with_armature)} cannot be written in "

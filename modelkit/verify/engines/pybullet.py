@@ -26,6 +26,7 @@ the child link frame with the child's inertial orientation.
 from __future__ import annotations
 
 import math
+import re
 import sys
 from pathlib import Path
 from typing import Any
@@ -83,6 +84,21 @@ def invalid_inertia_note(link: str, moments: tuple[float, float, float]) -> str:
 
 class PyBulletError(EngineError):
     """PyBullet refused a file, failed a request, crashed or timed out."""
+
+
+REFUSED_TENSOR = re.compile(r"invalid inertia tensor (?:for )?body (\d+) (I\(\d,\d\)!=I\(\d,\d\))\. "
+                            r"I\(\d,\d\)-I\(\d,\d\)= ?([-+0-9.eE]+)")
+"""What PyBullet's inverse-dynamics library (btInverseDynamics, behind ``calculateMassMatrix`` and
+``calculateInverseDynamics``) prints when a link's tensor, as it composed it about the link frame
+from the importer's principal moments and rotation, is not symmetric to 5 machine epsilons
+(``kIsZero``, an absolute bound of 1.1e-15 kg·m²): the rounding of a heavy link's rotated tensor
+passes it (ros-industrial's KUKA KR210, rtb-data: 1.4e-14 on a ~100 kg·m² tensor). The file is sound;
+stepping never checks it."""
+
+FORWARD_STEP = 1.0
+"""s: the one ``stepSimulation`` that reads PyBullet's forward accelerations when its inverse dynamics
+refuses (``Engine.accelerations`` in the worker): a long step keeps (dq' − dq) / step well above the
+rounding of dq (the velocity clamp and limits are off for it)."""
 
 
 def quat_xyzw_matrix(q: tuple[float, ...] | list[float]) -> Array:
@@ -300,15 +316,59 @@ class PyBulletModel:
         return {name: to_root @ pose for name, pose in world.items() if self._robots(name)}
 
     def mass_matrix(self, q: dict[str, float]) -> Array:
-        m = self._worker.request("mass_matrix", timeout=self.timeout, q=self._q_vector(q))
-        return np.asarray(m, dtype=float).reshape(len(self._dofs), len(self._dofs))
+        if not self._through_stepping():
+            try:
+                m = self._worker.request("mass_matrix", timeout=self.timeout, q=self._q_vector(q))
+                return np.asarray(m, dtype=float).reshape(len(self._dofs), len(self._dofs))
+            except PyBulletError as exc:
+                self._step_instead(exc)
+        return self._stepped_mass_matrix(self._q_vector(q))
 
     def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
         """Gravity + Coriolis/centrifugal: inverse dynamics at zero acceleration."""
         n = len(self._dofs)
-        tau = self._worker.request("inverse_dynamics", timeout=self.timeout, q=self._q_vector(q),
-                                   dq=self._q_vector(dq), ddq=[0.0] * n)
-        return np.asarray(tau, dtype=float)
+        if not self._through_stepping():
+            try:
+                tau = self._worker.request("inverse_dynamics", timeout=self.timeout, q=self._q_vector(q),
+                                           dq=self._q_vector(dq), ddq=[0.0] * n)
+                return np.asarray(tau, dtype=float)
+            except PyBulletError as exc:
+                self._step_instead(exc)
+        # qdd0 = M⁻¹ (0 − b): b = −M qdd0, with M from the same forward dynamics.
+        position, velocity = self._q_vector(q), self._q_vector(dq)
+        free = self._worker.request("accelerations", timeout=self.timeout, q=position, dq=velocity,
+                                    torques=[[0.0] * n], gravity=True, step=FORWARD_STEP)
+        return -self._stepped_mass_matrix(position) @ np.asarray(free[0], dtype=float)
+
+    def _through_stepping(self) -> bool:
+        return "dynamics_path" in self.settings
+
+    def _step_instead(self, exc: PyBulletError) -> None:
+        """After PyBullet's inverse dynamics refused a tensor it composed itself (``REFUSED_TENSOR``),
+        the mass matrix and bias come from its forward dynamics, said in ``settings``; any other
+        failure is the engine's finding and propagates."""
+        found = REFUSED_TENSOR.search(str(exc))
+        if found is None:
+            raise exc
+        body, which, off = found.groups()
+        # btInverseDynamics numbers the base 0 and link i of PyBullet i + 1, as ``_links`` does
+        link = self._links[int(body)] if int(body) < len(self._links) else f"body {body}"
+        self.settings["dynamics_path"] = (
+            f"mass matrix and bias from PyBullet's forward dynamics (one {FORWARD_STEP:g} s stepSimulation "
+            f"per column, gravity and velocity off, M = (its accelerations)⁻¹; b = −M·qdd at zero torque): "
+            f"its "
+            f"inverse-dynamics library (calculateMassMatrix, calculateInverseDynamics) refused the tensor "
+            f"it composed for {link} ({which}, off by {float(off):.3g} kg·m², its fixed bound 1.1e-15: "
+            "the rounding of a heavy link's rotated tensor, not the file)")
+
+    def _stepped_mass_matrix(self, q: list[float]) -> Array:
+        n = len(self._dofs)
+        unit = np.eye(n).tolist()
+        columns = self._worker.request("accelerations", timeout=self.timeout, q=q, dq=[0.0] * n,
+                                       torques=unit, gravity=False, step=FORWARD_STEP)
+        inverse = np.asarray(columns, dtype=float).T
+        m = np.linalg.inv(inverse)
+        return 0.5 * (m + m.T)
 
     # ---- Simulator ----------------------------------------------------------------------------
 

@@ -60,10 +60,12 @@ class Engine:
         self.body = -1
         self.movable: list[int] = []
         self.n_joints = 0
+        self.gravity = 0.0
 
     def load(self, path: str, gravity: float, dt: float) -> dict[str, Any]:
         p = self.p
         self.client = p.connect(p.DIRECT)
+        self.gravity = gravity
         p.setGravity(0.0, 0.0, gravity, physicsClientId=self.client)
         p.setTimeStep(dt, physicsClientId=self.client)
         flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER
@@ -163,6 +165,39 @@ class Engine:
                 raise RuntimeError("calculateInverseDynamics returned None")
             return []
         return list(tau)
+
+    def accelerations(self, q: list[float], dq: list[float], torques: list[list[float]], gravity: bool,
+                      step: float) -> list[list[float]]:
+        """PyBullet's forward dynamics: per torque vector, the joint accelerations from (q, dq) under
+        it, read as (dq' − dq) / ``step`` after one ``stepSimulation`` of ``step`` seconds (btMultiBody
+        updates the velocities with the accelerations of the start state before the positions, so
+        this is its articulated-body solution at the start, exactly). Gravity on or off; joint limits
+        made inert first (a long step would otherwise meet a limit inside it) and the velocity clamp
+        lifted for the step (back to ``limits_off``'s afterwards, with the time step).
+
+        For the mass matrix and bias of a model whose tensors PyBullet's inverse-dynamics library
+        refuses (``calculateMassMatrix``, ``calculateInverseDynamics``), which stepping never checks."""
+        p, body, client, idx = self.p, self.body, self.client, list(self.movable)
+        before = p.getPhysicsEngineParameters(physicsClientId=client)["fixedTimeStep"]
+        self.limits_off()
+        p.changeDynamics(body, -1, maxJointVelocity=1e30, physicsClientId=client)  # a light link's dq'
+        p.setTimeStep(step, physicsClientId=client)
+        p.setGravity(0.0, 0.0, self.gravity if gravity else 0.0, physicsClientId=client)
+        out = []
+        try:
+            for tau in torques:
+                self._set_q(q, dq)
+                p.setJointMotorControlArray(body, idx, p.TORQUE_CONTROL, forces=list(tau),
+                                            physicsClientId=client)
+                p.stepSimulation(physicsClientId=client)
+                after = p.getJointStates(body, idx, physicsClientId=client)
+                out.append([(s[1] - v) / step for s, v in zip(after, dq, strict=True)])
+        finally:
+            p.setGravity(0.0, 0.0, self.gravity, physicsClientId=client)
+            p.setTimeStep(before, physicsClientId=client)
+            p.changeDynamics(body, -1, maxJointVelocity=1e4, physicsClientId=client)  # limits_off's clamp
+            self._set_q(q, dq)
+        return out
 
     def _reset(self, dt: float) -> None:
         n = len(self.movable)

@@ -116,6 +116,9 @@ def layer3a(reference: EngineModel, eng: Loaded, samples: list[State],
                 "at rest)")
         checks = [dataclasses.replace(c, detail=f"{c.detail}; {said}" if c.detail != what else said)
                   for c in checks]
+    path = eng.model.settings.get("dynamics_path")
+    if path:  # the engine took another documented route to the same numbers: say which
+        checks = [dataclasses.replace(c, detail=f"{c.detail}; {path}") for c in checks]
     return checks
 
 
