@@ -356,8 +356,7 @@ class PyBulletModel:
         self.settings["dynamics_path"] = (
             f"mass matrix and bias from PyBullet's forward dynamics (one {FORWARD_STEP:g} s stepSimulation "
             f"per column, gravity and velocity off, M = (its accelerations)⁻¹; b = −M·qdd at zero torque): "
-            f"its "
-            f"inverse-dynamics library (calculateMassMatrix, calculateInverseDynamics) refused the tensor "
+            "its inverse-dynamics library (calculateMassMatrix, calculateInverseDynamics) refused the tensor "
             f"it composed for {link} ({which}, off by {float(off):.3g} kg·m², its fixed bound 1.1e-15: "
             "the rounding of a heavy link's rotated tensor, not the file)")
 
