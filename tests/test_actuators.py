@@ -289,6 +289,26 @@ def test_ur5_holds_home_under_its_own_position_actuators(tmp_path: Path) -> None
     assert error < HOLD_TOLERANCE, f"UR5 moved {error * 1e3:.3f} mm"
 
 
+def test_a_kinematic_only_arm_holds_home_with_the_mass_it_is_written_with(tmp_path: Path) -> None:
+    """An arm without one <inertial> (rtb-data's ABB IRB 140) is written with 1e-6 kg per moving body
+    (MK816); its servos' gains are made for that mass, not for none (it hung 3.8 mm off home)."""
+    source = tmp_path / "bare.urdf"
+    reach_out = {2: 0.28, 5: 1.49}  # the forearm reaches out: gravity turns the shoulder and elbow
+    joints = "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
+        f'<origin xyz="{reach_out.get(i, 0)} 0 {1.4 if i in (2, 3) else 0.05}"/>'
+        f'<axis xyz="0 {1 if i in (2, 3, 5) else 0} {0 if i in (2, 3, 5) else 1}"/>'
+        '<limit lower="-2" upper="2" effort="100" velocity="2"/></joint>'
+        for i in range(1, 7))
+    links = "".join(f'<link name="l{i}"/>' for i in range(7))
+    source.write_text(f'<robot name="bare">{links}{joints}</robot>')
+    out, notes = convert(load(source), tmp_path)
+    assert sum(n.code == "MK816" for n in notes) >= 6
+    count, error = hold_error(out)
+    assert count == 6
+    assert error < HOLD_TOLERANCE, f"moved {error * 1e3:.3f} mm"
+
+
 def test_panda_holds_its_reference_pose(tmp_path: Path) -> None:
     """Panda (example-robot-data) has no transmissions: the default ``--actuators auto`` gives one position
     servo per joint with a range (7 arm joints and finger 1; finger 2 mimics it); home = the SRDF's

@@ -455,7 +455,7 @@ class MjcfWriter:
 
     def _actuators(self) -> None:
         self.actuators = ActuatorWriter(self.robot, self.ctx, self.names, self.sections["actuator"],
-                                        self.tree.joint_names)
+                                        self.tree.joint_names, self.tree.lifted)
         self.actuators.write(self.tree.home)
         option = self.sections["option"]
         # An MJCF source's own servos keep the integrator its author ran them with (MuJoCo's default
