@@ -450,3 +450,25 @@ def test_pybullet_with_its_flag_excludes_parent_and_child(tmp_path: Path) -> Non
     finally:
         pybullet.disconnect(client)
     assert found == {"off": set(), "on": {(1, -1)}}  # c (link 1) with a (the base), never b with a or c
+
+
+def test_gains_are_made_for_the_masses_the_sdf_holds(tmp_path: Path) -> None:
+    """A kinematic-only arm is written with 1e-6 kg per massless link (MK816); its joint controllers'
+    gains are made for that mass, as the MJCF's are, not for none (the massless floor, 1e-6 kg·m²)."""
+    links = "".join(f'<link name="l{i}"/>' for i in range(4))
+    joints = "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
+        f'<origin xyz="{0.5 if i > 1 else 0} 0 0.1"/><axis xyz="0 1 0"/>'
+        '<limit lower="-2" upper="2" effort="10" velocity="2"/></joint>' for i in range(1, 4))
+    transmissions = "".join(
+        f'<transmission name="t{i}"><type>transmission_interface/SimpleTransmission</type>'
+        f'<joint name="j{i}"><hardwareInterface>hardware_interface/PositionJointInterface</hardwareInterface>'
+        '</joint></transmission>' for i in range(1, 4))
+    text = f'<robot name="bare">{links}{joints}{transmissions}</robot>'
+    source = load(_write_text(tmp_path, "bare.urdf", text))
+    out = tmp_path / "out" / "bare.sdf"
+    write(source, out)
+    shoulder = float(_by_joint(out)["j1"].findtext("p_gain") or 0)
+    # j1 carries two 1e-6 kg links 0.5 m and 1 m out: 1.5e-5 N·m of gravity at 1 m reach, held within
+    # SAG_PER_JOINT (1e-4 m) by kp ≥ τ·R / 1e-4 = 0.147 (or the 80 Hz ceiling on 1.25e-6 kg·m²: 0.316)
+    assert 0.145 < shoulder <= 0.317, shoulder  # without the written masses: the floor's 0.0355

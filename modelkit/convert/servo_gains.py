@@ -27,6 +27,7 @@ A subtree without mass gets ``MIN_INERTIA`` so that every gain is positive.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -34,7 +35,7 @@ import numpy as np
 
 from modelkit.convert.legs import carried_loads
 from modelkit.convert.wheel_loads import carried_inertias
-from modelkit.model import Joint, JointType, Link, Robot
+from modelkit.model import Inertial, Joint, JointType, Link, Robot
 from modelkit.spatial import Pose
 
 SERVO_BANDWIDTH_HZ = 30.0
@@ -54,6 +55,26 @@ class JointLoad:
     gravity: float = 0.0
     reach: float = 0.0
     pushed: float = 0.0  # of ``inertia``: a drive wheel's share of the robot it pushes (wheel_loads)
+
+
+def with_written_masses(robot: Robot, lifted: frozenset[str], mass: float, inertia: float) -> Robot:
+    """``robot`` with the mass a writer gives each massless link of ``lifted`` (``mass`` kg at the link
+    origin, ``inertia`` kg·m² per axis: MK816), so that gains are made for the file's masses: a
+    kinematic-only arm (rtb-data's ABB IRB 140) held its home 3.8 mm off under gains made for no mass.
+    ``robot`` itself when nothing was lifted."""
+    if not lifted:
+        return robot
+    links = []
+    for link in robot.links:
+        if link.name in lifted:
+            before = link.inertial
+            had = before is not None and before.mass > 0.0
+            com = before.com if before is not None and had else (0.0, 0.0, 0.0)
+            tensor = np.asarray(before.inertia, dtype=float) if before is not None else np.zeros((3, 3))
+            total = (before.mass if before is not None and had else 0.0) + mass
+            link = dataclasses.replace(link, inertial=Inertial(total, com, tensor + inertia * np.eye(3)))
+        links.append(link)
+    return dataclasses.replace(robot, links=links)
 
 
 def home_position(joint: Joint) -> float:

@@ -36,10 +36,12 @@ from modelkit.convert.servo_gains import (
     natural_frequency_for,
     position_gains,
     velocity_gain,
+    with_written_masses,
 )
 from modelkit.convert.tracks import TRACK_ROLLER
 from modelkit.formats.mjcf.actuators import TENDON_SOURCE
-from modelkit.formats.mjcf.write_bodies import with_written_masses
+from modelkit.formats.mjcf.write_bodies import MIN_INERTIA as BODY_MIN_INERTIA
+from modelkit.formats.mjcf.write_bodies import MIN_MASS
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, sub
 from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
@@ -257,7 +259,8 @@ class ActuatorWriter:
 
     def load(self, joint: Joint) -> JointLoad:
         if self._loads is None:
-            self._loads = joint_loads(with_written_masses(self.robot, self.lifted))
+            self._loads = joint_loads(with_written_masses(self.robot, self.lifted, MIN_MASS,
+                                                          BODY_MIN_INERTIA))
         return self._loads.get(joint.name, JointLoad(0.0))
 
     def _one(self, actuator: Actuator, joint: Joint, target: str, home_q: float) -> None:

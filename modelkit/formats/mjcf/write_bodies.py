@@ -37,7 +37,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import math
 from dataclasses import dataclass, field
@@ -158,25 +157,6 @@ def mujoco_valid_inertia(tensor: np.ndarray) -> tuple[np.ndarray, tuple[float, f
     delta = (need - a - b) / 2.0
     fixed: np.ndarray = vectors @ np.diag([a + delta, b + delta, c]) @ vectors.T
     return fixed, (a, b, c), delta
-
-
-def with_written_masses(robot: Robot, lifted: frozenset[str]) -> Robot:
-    """``robot`` with the mass the body writer gives each link of ``lifted`` (``MIN_MASS`` kg at the
-    link origin, ``MIN_INERTIA`` kg·m² per axis: MK816), for what is computed from the written file's
-    masses (the servo gains: a kinematic-only arm held its home 3.8 mm off under gains made for no
-    mass, ABB IRB 140 of rtb-data). ``robot`` itself when nothing was lifted."""
-    if not lifted:
-        return robot
-    links = []
-    for link in robot.links:
-        if link.name in lifted:
-            before = link.inertial
-            mass = (before.mass if before is not None else 0.0) + MIN_MASS
-            com = before.com if before is not None and before.mass > 0.0 else (0.0, 0.0, 0.0)
-            tensor = (np.asarray(before.inertia, dtype=float) if before is not None else np.zeros((3, 3)))
-            link = dataclasses.replace(link, inertial=Inertial(mass, com, tensor + MIN_INERTIA * np.eye(3)))
-        links.append(link)
-    return dataclasses.replace(robot, links=links)
 
 
 @dataclass

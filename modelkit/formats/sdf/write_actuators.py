@@ -75,8 +75,11 @@ class ActuatorWriter:
     """Writes the plugins into ``model``; ``joints`` maps source joint names to written revolute or
     prismatic joints (anything else cannot carry one of these systems)."""
 
-    def __init__(self, robot: Robot, ctx: WriteContext, family: str, joints: dict[str, str]) -> None:
+    def __init__(self, robot: Robot, ctx: WriteContext, family: str, joints: dict[str, str],
+                 as_written: Robot | None = None) -> None:
         self.robot = robot
+        # the robot with the masses the file holds (a massless link's tiny one, MK816): the gains' model
+        self.as_written = as_written or robot
         self.ctx = ctx
         self.family = family
         self.joints = joints
@@ -198,5 +201,5 @@ class ActuatorWriter:
 
     def _load(self, joint: str) -> JointLoad:
         if self._loads is None:
-            self._loads = joint_loads(self.robot)
+            self._loads = joint_loads(self.as_written)
         return self._loads.get(joint, JointLoad(0.0))

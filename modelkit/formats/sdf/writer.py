@@ -42,6 +42,7 @@ from modelkit.convert.friction import floor_friction
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.joint_springs import note_spring_dropped
 from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_vec
+from modelkit.convert.servo_gains import with_written_masses
 from modelkit.formats.sdf.gz_inertia import libsdformat_accepts
 from modelkit.formats.sdf.kept import JOINT_KEY, LIMIT_KEY, MODEL_KEY, write_back
 from modelkit.formats.sdf.write_actuators import ActuatorWriter
@@ -133,6 +134,7 @@ class _ModelWriter:
         self.ctx = ctx
         self.version = parse_version(ctx.options.sdf_version)
         self.frames_ok = self.version >= (1, 7)
+        self.lifted: set[str] = set()  # massless links written with TINY_MASS (MK816): the gains carry it
         self.names = Names(ctx)
         self.geoms = GeomWriter(ctx, self.version, robot.source_format)
         self.devices = DeviceWriter(
@@ -374,6 +376,7 @@ class _ModelWriter:
                 f"link[{name}]/inertial",
             )
             num(inertial_el, "mass", TINY_MASS)
+            self.lifted.add(link.name)
             tensor = sub(inertial_el, "inertia")
             for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"):
                 num(tensor, key, TINY_INERTIA if key in ("ixx", "iyy", "izz") else 0.0)
@@ -661,7 +664,8 @@ class _ModelWriter:
                 "model/plugin",
             )
         else:
-            ActuatorWriter(robot, ctx, family, self.axis_joints).write(model)
+            as_written = with_written_masses(robot, frozenset(self.lifted), TINY_MASS, TINY_INERTIA)
+            ActuatorWriter(robot, ctx, family, self.axis_joints, as_written).write(model)
         if ctx.options.drive_plugin:
             self._drive_plugin(model)
         for plugin in robot.extras.get("sdf_plugins", []):
