@@ -59,3 +59,22 @@ def test_the_shared_actuator_name_is_said_and_written_apart(tmp_path: Path) -> N
     assert text.count('<actuator name="motor3">') == 1 and '<actuator name="motor3_joint4">' in text
     assert _drake_loads(out) is None
     assert subprocess.run(["check_urdf", str(out)], capture_output=True).returncode == 0
+
+
+def test_a_transmission_of_a_joint_the_robot_lacks_is_left_out(tmp_path: Path) -> None:
+    """example-robot-data's TALOS left arm keeps the transmission of ``arm_left_1_joint``, a joint cut off
+    with the rest of the robot: check_urdf loads it, Drake refuses it ("Transmission specifies joint ...
+    which does not exist"). validate says so (MK139); convert leaves that one transmission out (MK808),
+    so Drake loads the written file, and keeps the others."""
+    ghost = JOINT.format(j="gone", p="a", c="b", m="motor9").split("  <transmission", 1)[1]
+    source = tmp_path / "cut.urdf"
+    source.write_text(SOURCE.replace("</robot>", "  <transmission" + ghost + "</robot>")
+                      .replace('name="motor3"', 'name="motor4"', 1))
+    assert "MK139" in {d.code for d in validate(source).diagnostics}
+    assert _drake_loads(source) is not None  # the source itself is refused
+    out = tmp_path / "out" / "cut.urdf"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "MK808" in result.output and '"gone_trans" left out' in result.output
+    assert _drake_loads(out) is None
+    assert out.read_text().count("<transmission") == 2

@@ -262,10 +262,22 @@ def _transmissions(robot_el: Element, robot: Robot, names: NameTable, ctx: Write
                 "transmission",
             )
             continue
+        missing = [str(joint.get("name", "")) for joint in block.iter("joint")
+                   if joint.get("name") not in names.joint_map]
+        if missing:  # the source's own fault (validate's MK139); Drake refuses the whole file over it
+            source = entry.get("source")
+            ctx.note(
+                "MK808",
+                f'<transmission> "{block.get("name", "")}" left out: it drives joint(s) '
+                f'{", ".join(repr(m) for m in missing)}, which the robot does not have (validate: MK139); '
+                "Drake refuses a URDF whose transmission names no joint",
+                source if isinstance(source, SourceLocation) else None,
+                "transmission",
+            )
+            continue
         joints = []
         for joint_el in block.iter("joint"):
-            if joint_el.get("name") in names.joint_map:
-                joint_el.set("name", names.joint(joint_el.get("name", "")))
+            joint_el.set("name", names.joint(joint_el.get("name", "")))
             joints.append(joint_el.get("name", ""))
         for motor in block.iter("actuator"):
             wanted = motor.get("name")
