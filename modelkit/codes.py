@@ -249,7 +249,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK139",
         "urdf-transmission-joint-unknown",
         "warning",
-        "A `<transmission>` drives a joint that does not exist.",
+        "A `<transmission>` drives a joint that does not exist. Reference: check_urdf and PyBullet load the "
+        "file, Drake refuses it; `convert` to URDF leaves that transmission out (MK808).",
     ),
     CodeInfo(
         "MK140",
