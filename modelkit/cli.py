@@ -94,6 +94,20 @@ def reading_options(fn: F) -> F:
             help="Contact-materials file (default: Choreonoid's share/default/materials.yaml).",
         ),
         click.option(
+            "--srdf",
+            type=click.Path(dir_okay=False, path_type=Path),
+            default=None,
+            help="MoveIt's SRDF of the robot: its <group_state> gives the home pose (the MJCF home "
+            "keyframe and servo targets, .body initial angles; MK147).",
+        ),
+        click.option(
+            "--home",
+            metavar="STATE",
+            default=None,
+            help="The SRDF <group_state> to use as the home pose [default: the first of home, ready, "
+            "default, standing, half_sitting the SRDF holds, else its only state].",
+        ),
+        click.option(
             "--vrml-extrusion",
             is_flag=True,
             help="Build Extrusions as VRML97 intends instead of reproducing Choreonoid's quirks.",
@@ -154,8 +168,12 @@ def _read_options(kwargs: dict[str, Any], check_resources: bool, xacro_args: dic
         path_variables=_pairs(kwargs["path_variables"], "--path-variable"),
         resource_paths=list(kwargs.get("resource_paths") or ()),
     )
+    if kwargs.get("home") is not None and kwargs.get("srdf") is None:
+        raise click.BadParameter("--home names an SRDF state: give the SRDF with --srdf", param_hint="--home")
     return ReadOptions(
         resolver=resolver,
+        srdf=kwargs.get("srdf"),
+        home=kwargs.get("home"),
         xacro_args=xacro_args,
         legacy_xacro=kwargs["legacy_xacro"],
         materials_path=kwargs["materials"],

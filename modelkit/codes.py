@@ -308,6 +308,30 @@ _TABLE: tuple[CodeInfo, ...] = (
         "urdfdom silently makes the colour black (0 0 0 1) and loads the robot, PyBullet uses its default "
         "colour; MuJoCo refuses the file (an error under `--target mjcf`).",
     ),
+    # SRDF beside a URDF (--srdf, --home): modelkit/formats/srdf.py
+    CodeInfo(
+        "MK147",
+        "srdf-home-state",
+        "info",
+        "The home pose comes from an SRDF `<group_state>` (`--srdf`, `--home`; without `--home` the first of "
+        "`home`, `ready`, `default`, `standing`, `half_sitting`, else the SRDF's only state), or none is "
+        "found and the home stays q = 0.",
+    ),
+    CodeInfo(
+        "MK148",
+        "srdf-state-missing",
+        "error",
+        "`--home` names a `<group_state>` the SRDF does not hold (the message lists those it holds), or the "
+        "file given with `--srdf` is not an SRDF (its top element is not `<robot>`).",
+    ),
+    CodeInfo(
+        "MK149",
+        "srdf-joint-value-unusable",
+        "warning",
+        "A `<group_state>` joint the robot does not move (no such joint, or a fixed one), or whose value is "
+        "not a number, is not used; a value outside the joint's range is used, and the writers put it at "
+        "the nearer bound.",
+    ),
     # -- MK15x/MK16x: SDF -------------------------------------------------------------------
     # (sdf section)
     CodeInfo("MK150", "sdf-version-missing", "error", "`<sdf>` has no `version` attribute."),

@@ -31,6 +31,8 @@ CONVERTIBLE_ERRORS = frozenset({"MK211", "MK313", "MK500", "MK501", "MK502", "MK
 UNREADABLE = frozenset({"MK001", "MK002"})
 COMPOUND_SUFFIXES = (".urdf.xacro", ".xacro", ".urdf", ".body", ".sdf", ".world", ".mjcf", ".xml")
 
+HOME_FROM_SRDF = frozenset({"MK147", "MK149"})  # reading infos a convert user needs to see
+
 
 @dataclass
 class ConversionResult:
@@ -210,6 +212,10 @@ def convert(
         plan.opened |= {f.identity for f in checked.opened}
         blocking = [d for d in checked.errors if d.code not in CONVERTIBLE_ERRORS]
         result.diagnostics.extend(d for d in checked.diagnostics if d.severity is not Severity.INFO)
+        # which SRDF state became the home pose (an info of the read) is said with the conversion's notes
+        result.notes.extend(ConversionNote(d.code, d.severity, d.message, d.location, None)
+                            for d in checked.diagnostics
+                            if d.code in HOME_FROM_SRDF and d.severity is Severity.INFO)
         if any(d.code in UNREADABLE for d in checked.diagnostics):
             result.status = 2
             continue

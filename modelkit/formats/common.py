@@ -37,6 +37,8 @@ class ReadOptions:
     max_links: int = DEFAULT_MAX_LINKS
     xacro_args: dict[str, str] = field(default_factory=dict)
     legacy_xacro: bool | None = None
+    srdf: Path | None = None  # MoveIt's SRDF beside the model: its group_state gives the home pose
+    home: str | None = None  # the group_state to use (None: home, ready or default; modelkit.formats.srdf)
 
 
 @dataclass

@@ -46,6 +46,13 @@ def read_model(
     ``ReadResult.opened`` lists every regular file the read opened (see :func:`modelkit.textio.recording`)."""
     with recording() as opened:
         result = _read_model(path, options, fmt, display)
+        if options is not None and options.srdf is not None and result.robot is not None:
+            from modelkit.diagnostics import DiagnosticSink
+            from modelkit.formats.srdf import apply_home
+
+            sink = DiagnosticSink()
+            apply_home(result.robot, options.srdf, options.home, sink, options.max_bytes)
+            result.diagnostics.extend(sink.items)
     result.opened = _unique(opened)
     return result
 
