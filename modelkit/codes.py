@@ -203,6 +203,15 @@ _TABLE: tuple[CodeInfo, ...] = (
     # -- MK13x/MK14x: URDF ------------------------------------------------------------------
     # (urdf section)
     CodeInfo(
+        "MK125",
+        "urdf-limit-range-missing",
+        "warning",
+        "A revolute or prismatic joint's `<limit>` gives neither `lower` nor `upper`. The URDF spec and "
+        "urdfdom read 0 and 0, a locked joint (ROS, MoveIt and modelkit's model: `convert` to MJCF holds it "
+        "with an equality, MK820); MuJoCo's and PyBullet's URDF import leave the joint free (measured). "
+        "Give both, or make the joint `continuous`.",
+    ),
+    CodeInfo(
         "MK130",
         "urdf-version-unsupported",
         "error",

@@ -197,8 +197,10 @@ JOINTS = robot_of(f"""
 def test_joint_fields(tmp_path: Path) -> None:
     robot, diags = read(tmp_path, JOINTS)
     assert robot is not None
-    # the one finding besides the URDF 1.2 attributes: the axis "0 0 2" is not a unit vector
-    assert [d.split(" ", 2)[:2] for d in diags if not d.startswith("MK142")] == [["MK306", "13:11"]]
+    # the findings besides the URDF 1.2 attributes: the axis "0 0 2" is not a unit vector, and the slide's
+    # <limit> gives no range (read as urdfdom does, 0 and 0; MuJoCo and PyBullet leave it free: MK125)
+    assert [d.split(" ", 2)[:2] for d in diags if not d.startswith("MK142")] == [["MK306", "13:11"],
+                                                                                  ["MK125", "26:5"]]
     joints = {j.name: j for j in robot.joints}
     rev = joints["rev"]
     assert rev.type is JointType.REVOLUTE and (rev.parent, rev.child) == ("a", "b")
@@ -248,7 +250,8 @@ def test_version_1_2_declared_quietly(tmp_path: Path) -> None:
     text = JOINTS.replace('<robot name="r">', '<robot name="r" version="1.2">')
     robot, diags = read(tmp_path, text)
     assert robot is not None and robot.extras["urdf_version"] == "1.2"
-    assert [d.split(" ", 2)[:2] for d in diags] == [["MK306", "13:11"]]  # the axis "0 0 2", nothing else
+    # the axis "0 0 2" and the slide's limit without a range (MK125), no MK142
+    assert [d.split(" ", 2)[:2] for d in diags] == [["MK306", "13:11"], ["MK125", "26:5"]]
 
 
 def test_newer_feature_without_version_is_reported_once_each(tmp_path: Path) -> None:

@@ -138,6 +138,14 @@ def _limit(ctx: Context, element: Element, joint: Joint, word: str | None, label
     joint.sources["limit"] = ctx.loc(limit_el)
     joint.sources["range"] = ctx.loc(limit_el, "lower" if limit_el.get("lower") is not None else "upper")
     what = f"limit of {label}"
+    if word in NEEDS_LIMIT and limit_el.get("lower") is None and limit_el.get("upper") is None:
+        ctx.emit(
+            "MK125",
+            f"<limit> of {label} gives neither `lower` nor `upper`: urdfdom reads 0 and 0, a locked joint "
+            "(ROS, MoveIt and modelkit), while MuJoCo's and PyBullet's URDF import leave it free",
+            ctx.loc(limit_el),
+            hint='give lower="..." upper="...", or make the joint "continuous" if it turns without end',
+        )
     lower = number(ctx, limit_el, "lower", what, default=0.0)
     upper = number(ctx, limit_el, "upper", what, default=0.0)
     missing = [k for k in ("effort", "velocity") if limit_el.get(k) is None]
