@@ -207,9 +207,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "urdf-limit-range-missing",
         "warning",
         "A revolute or prismatic joint's `<limit>` gives neither `lower` nor `upper`. The URDF spec and "
-        "urdfdom read 0 and 0, a locked joint (ROS, MoveIt and modelkit's model: `convert` to MJCF holds it "
-        "with an equality, MK820); MuJoCo's and PyBullet's URDF import leave the joint free (measured). "
-        "Give both, or make the joint `continuous`.",
+        "urdfdom read 0 and 0, a locked joint for ROS and MoveIt; MuJoCo's, PyBullet's and Drake's URDF "
+        "import leave the joint free (measured), and so does modelkit: `convert` writes it free (MJCF, SDF) "
+        "or as it was (URDF). Give both, or make the joint `continuous`.",
     ),
     CodeInfo(
         "MK130",

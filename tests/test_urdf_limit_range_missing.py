@@ -1,7 +1,9 @@
 """MK125: a revolute or prismatic joint whose ``<limit>`` gives neither ``lower`` nor ``upper``. urdfdom
-reads 0 and 0 (a locked joint, as modelkit's model does), while MuJoCo's and PyBullet's own URDF import
-leave the joint free: the engines themselves are the oracle here. Genesis's ANYmal C gives all twelve
-leg joints such a limit; example-robot-data's Centauro and quadruped four each."""
+reads 0 and 0 (a locked joint for ROS and MoveIt), while MuJoCo's, PyBullet's and Drake's own URDF
+import leave the joint free: the engines themselves are the oracle here, and modelkit reads it as they
+do. The URDF writer writes such a limit back as it was; the MJCF's hinge is free, not locked by an
+equality (it was: Genesis's ANYmal C, whose twelve leg joints all have such a limit, got locked legs
+and no actuator; example-robot-data's Centauro and quadruped have four each)."""
 
 from __future__ import annotations
 
@@ -32,7 +34,7 @@ def test_a_limit_without_a_range_is_said(tmp_path: Path) -> None:
     found = [d for d in validate(_file(tmp_path)).diagnostics if d.code == "MK125"]
     assert len(found) == 1 and found[0].location is not None and found[0].location.line == 6
     robot = validate(_file(tmp_path)).robots[0]
-    assert (robot.joints[0].limits.lower, robot.joints[0].limits.upper) == (0.0, 0.0)  # urdfdom's reading
+    assert not robot.joints[0].limits.position_limited  # the simulators' reading, not urdfdom's 0 and 0
     assert [d for d in validate(_file(tmp_path, "prismatic")).diagnostics if d.code == "MK125"]
 
 
@@ -64,3 +66,35 @@ def test_the_engines_leave_such_a_joint_free(tmp_path: Path) -> None:
         assert abs(pybullet.getJointState(body, 0, physicsClientId=client)[0]) > 0.1
     finally:
         pybullet.disconnect(physicsClientId=client)
+
+
+def test_written_back_as_it_was_and_free_in_the_mjcf(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+    from lxml import etree
+
+    from modelkit.cli import main
+
+    source = _file(tmp_path)
+    for suffix in ("urdf", "xml"):
+        out = tmp_path / "out" / f"r.{suffix}"
+        result = CliRunner().invoke(main, ["convert", str(source), "-o", str(out)])
+        assert result.exit_code == 0, result.output
+    joint = etree.parse(str(tmp_path / "out" / "r.urdf")).find("joint")
+    assert joint is not None and joint.get("type") == "revolute"
+    limit = joint.find("limit")
+    assert limit is not None and limit.get("lower") is None and limit.get("upper") is None
+    mjcf = etree.parse(str(tmp_path / "out" / "r.xml"))
+    hinge = mjcf.find(".//joint[@name='j']")
+    assert hinge is not None and hinge.get("range") is None
+    assert mjcf.find("equality") is None  # not held by a joint equality
+
+
+def test_verify_passes_in_every_engine(tmp_path: Path) -> None:
+    """MuJoCo, PyBullet, Drake (URDF and SDF) and yourdfpy (no bound given: none) all agree with the
+    model's reading."""
+    from modelkit.verify.api import verify
+
+    report = verify(_file(tmp_path), tmp_path / "out", replay=False, driven=False)
+    assert not report.errors, report.errors
+    assert [c for c in report.checks if not c.passed] == []
+    assert {c.engine for c in report.checks if c.quantity == "limits"} >= {"mujoco", "pybullet", "yourdfpy"}

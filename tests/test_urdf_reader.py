@@ -198,7 +198,7 @@ def test_joint_fields(tmp_path: Path) -> None:
     robot, diags = read(tmp_path, JOINTS)
     assert robot is not None
     # the findings besides the URDF 1.2 attributes: the axis "0 0 2" is not a unit vector, and the slide's
-    # <limit> gives no range (read as urdfdom does, 0 and 0; MuJoCo and PyBullet leave it free: MK125)
+    # <limit> gives no range (MK125: urdfdom reads 0 and 0; MuJoCo, PyBullet and Drake leave it free)
     assert [d.split(" ", 2)[:2] for d in diags if not d.startswith("MK142")] == [["MK306", "13:11"],
                                                                                   ["MK125", "26:5"]]
     joints = {j.name: j for j in robot.joints}
@@ -226,7 +226,8 @@ def test_joint_fields(tmp_path: Path) -> None:
         0.5,
     )
     pris = joints["pris"]
-    assert pris.type is JointType.PRISMATIC and (pris.limits.lower, pris.limits.upper) == (0.0, 0.0)
+    # its <limit> gives no range: unlimited, as MuJoCo, PyBullet and Drake read it (urdfdom: 0 and 0; MK125)
+    assert pris.type is JointType.PRISMATIC and not pris.limits.position_limited
     assert joints["float"].type is JointType.FLOATING and joints["plane"].type is JointType.PLANAR
     assert robot.root == "a" and robot.root_joint is None
 

@@ -138,14 +138,17 @@ def _limit(ctx: Context, element: Element, joint: Joint, word: str | None, label
     joint.sources["limit"] = ctx.loc(limit_el)
     joint.sources["range"] = ctx.loc(limit_el, "lower" if limit_el.get("lower") is not None else "upper")
     what = f"limit of {label}"
-    if word in NEEDS_LIMIT and limit_el.get("lower") is None and limit_el.get("upper") is None:
+    range_unset = word in NEEDS_LIMIT and limit_el.get("lower") is None and limit_el.get("upper") is None
+    if range_unset:
         ctx.emit(
             "MK125",
             f"<limit> of {label} gives neither `lower` nor `upper`: urdfdom reads 0 and 0, a locked joint "
-            "(ROS, MoveIt and modelkit), while MuJoCo's and PyBullet's URDF import leave it free",
+            "for urdfdom's users (ROS, MoveIt), while MuJoCo's, PyBullet's and Drake's URDF import leave it "
+            "free, as modelkit reads it",
             ctx.loc(limit_el),
             hint='give lower="..." upper="...", or make the joint "continuous" if it turns without end',
         )
+        joint.extras["urdf_range_unset"] = True  # written back the same way (write_joints)
     lower = number(ctx, limit_el, "lower", what, default=0.0)
     upper = number(ctx, limit_el, "upper", what, default=0.0)
     missing = [k for k in ("effort", "velocity") if limit_el.get(k) is None]
@@ -158,7 +161,7 @@ def _limit(ctx: Context, element: Element, joint: Joint, word: str | None, label
     effort = number(ctx, limit_el, "effort", what)
     velocity = number(ctx, limit_el, "velocity", what)
     limits = JointLimits()
-    if word in NEEDS_LIMIT:
+    if word in NEEDS_LIMIT and not range_unset:  # else unlimited, as the simulators read it (MK125)
         limits.lower = lower if lower is not None else 0.0
         limits.upper = upper if upper is not None else 0.0
     for key, value in (("effort", effort), ("velocity", velocity)):

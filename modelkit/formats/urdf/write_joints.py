@@ -151,8 +151,11 @@ def joint_elements(
     el = etree.Element("joint", name=name)
     dropped: list[str] = []
     limited = joint.limits.position_limited
+    # a URDF source's <limit> without lower and upper (MK125) is written the same way: free in the
+    # simulators that read it so, locked at 0 where urdfdom's reading rules, as the source is
+    range_unset = bool(joint.extras.get("urdf_range_unset")) and not limited
     if joint.type is JointType.REVOLUTE:
-        word = "revolute" if limited else "continuous"
+        word = "revolute" if limited or range_unset else "continuous"
     else:
         word = URDF_TYPE[joint.type]
     el.set("type", word)
@@ -162,7 +165,7 @@ def joint_elements(
     if word in ("revolute", "continuous", "prismatic", "planar"):
         etree.SubElement(el, "axis", xyz=_axis(joint))
     if word in ("revolute", "prismatic"):
-        _limit_element(el, joint, name, ctx, True, dropped)
+        _limit_element(el, joint, name, ctx, not range_unset, dropped)
     elif word == "continuous" and (
         math.isfinite(joint.limits.effort)
         or math.isfinite(joint.limits.velocity)

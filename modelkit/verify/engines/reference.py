@@ -222,7 +222,8 @@ class YourdfpyKinematics(_KinematicsOnly):
             jtype = {"continuous": "revolute"}.get(joint.type, joint.type)
             moving = jtype in ("revolute", "prismatic")
             lower, upper = -math.inf, math.inf
-            if moving and joint.type != "continuous" and joint.limit is not None:
+            given = joint.limit is not None and (joint.limit.lower, joint.limit.upper) != (None, None)
+            if moving and joint.type != "continuous" and given:  # neither given: no bound (MK125)
                 lower = float(joint.limit.lower) if joint.limit.lower is not None else 0.0
                 upper = float(joint.limit.upper) if joint.limit.upper is not None else 0.0
             facts.joints[joint.name] = JointFacts(jtype, joint.parent, joint.child,
