@@ -36,12 +36,9 @@ from modelkit.convert.servo_gains import (
     natural_frequency_for,
     position_gains,
     velocity_gain,
-    with_written_masses,
 )
 from modelkit.convert.tracks import TRACK_ROLLER
 from modelkit.formats.mjcf.actuators import TENDON_SOURCE
-from modelkit.formats.mjcf.write_bodies import MIN_INERTIA as BODY_MIN_INERTIA
-from modelkit.formats.mjcf.write_bodies import MIN_MASS
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, sub
 from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
@@ -55,9 +52,10 @@ GRAVITY_FLOOR = 1e-9  # N·m or N: a gravity load at home below this is rounding
 
 class ActuatorWriter:
     def __init__(self, robot: Robot, ctx: WriteContext, names: NameTable, section: Element,
-                 joint_names: dict[str, list[str]], lifted: set[str] | None = None) -> None:
+                 joint_names: dict[str, list[str]], as_written: Robot | None = None) -> None:
         self.robot = robot
-        self.lifted = frozenset(lifted or ())  # links the body writer gave MIN_MASS: the gains carry it too
+        # the robot with the masses the file holds (a massless link's MIN_MASS, MK816): the gains' model
+        self.as_written = as_written or robot
         self.ctx = ctx
         self.names = names
         self.section = section
@@ -259,8 +257,7 @@ class ActuatorWriter:
 
     def load(self, joint: Joint) -> JointLoad:
         if self._loads is None:
-            self._loads = joint_loads(with_written_masses(self.robot, self.lifted, MIN_MASS,
-                                                          BODY_MIN_INERTIA))
+            self._loads = joint_loads(self.as_written)
         return self._loads.get(joint.name, JointLoad(0.0))
 
     def _one(self, actuator: Actuator, joint: Joint, target: str, home_q: float) -> None:

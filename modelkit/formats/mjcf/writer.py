@@ -54,9 +54,10 @@ from modelkit.convert.friction import floor_friction
 from modelkit.convert.meshes import MESH_FOLDER
 from modelkit.convert.numbers import fmt, fmt_text, fmt_vec
 from modelkit.convert.self_contact import touching_pairs
+from modelkit.convert.servo_gains import with_written_masses
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.formats.mjcf.write_actuators import ActuatorWriter
-from modelkit.formats.mjcf.write_bodies import BodyTree
+from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, MIN_MASS, BodyTree
 from modelkit.formats.mjcf.write_contact_pairs import write_source_pairs
 from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_foreign import note_unwritten_own
@@ -454,8 +455,9 @@ class MjcfWriter:
         return name
 
     def _actuators(self) -> None:
+        as_written = with_written_masses(self.robot, frozenset(self.tree.lifted), MIN_MASS, MIN_INERTIA)
         self.actuators = ActuatorWriter(self.robot, self.ctx, self.names, self.sections["actuator"],
-                                        self.tree.joint_names, self.tree.lifted)
+                                        self.tree.joint_names, as_written)
         self.actuators.write(self.tree.home)
         option = self.sections["option"]
         # An MJCF source's own servos keep the integrator its author ran them with (MuJoCo's default
