@@ -499,12 +499,15 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
               help="MJCF: the actuator of every hinge and slide joint when the source has no actuators; "
                    "auto: a position servo on each joint with a range or in a leg (the model holds its home "
                    "pose), a motor on each other (wheels: torque-driven). Servos get gains from each joint's "
-                   "reflected inertia (MK840, MK841). A source's own actuators are written unless "
-                   "--source-actuators replace.")
-@click.option("--source-actuators", type=click.Choice(SOURCE_ACTUATORS), default="keep", show_default=True,
-              help="MJCF: keep the source's own actuators, or replace them with the --actuators choice on "
-                   "every joint (MK855), e.g. position servos for a legged robot whose URDF names effort "
-                   "interfaces (its legs are limp under motors at zero control, MK857).")
+                   "reflected inertia (MK840, MK841). A source's own actuators are written as "
+                   "--source-actuators says.")
+@click.option("--source-actuators", type=click.Choice(SOURCE_ACTUATORS), default="auto", show_default=True,
+              help="MJCF: what becomes of the source's own actuators. auto: written as they are, except ROS "
+                   "effort interfaces (URDF transmissions, ros2_control), which get the --actuators choice "
+                   "(position servos on an arm's and a leg's joints, MK864), since a ROS controller closes "
+                   "its own loop over them; keep: all written as they are (effort interfaces as <motor>s, "
+                   "limp at zero control: MK857, MK863); replace: all set aside for the --actuators choice "
+                   "(MK855).")
 @reading_options
 def convert(
     words: tuple[str, ...],

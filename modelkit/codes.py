@@ -1470,7 +1470,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MJCF: the source names effort actuators on a legged robot's leg joints (URDF "
         "`EffortJointInterface` transmissions: Unitree's Go1 and A1, HyQ, B1), written as `<motor>`s: at "
         "zero control the legs are limp and the robot lies down on a floor until a controller drives them "
-        "(`--source-actuators replace` gives them the `--actuators` choice: with `auto`, position servos).",
+        "(`--source-actuators replace` gives them the `--actuators` choice, and so does the default, "
+        "`auto`, for ROS effort interfaces: MK864).",
     ),
     CodeInfo(
         "MK863",
@@ -1479,7 +1480,20 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MJCF: joints outside a legged robot's legs that the source's effort actuators drive (URDF "
         "`EffortJointInterface` transmissions: example-robot-data's Kinova arm) and that gravity turns at "
         "home, written as `<motor>`s: at zero control the robot sags until a controller drives them "
-        "(`--source-actuators replace` gives them the `--actuators` choice: with `auto`, position servos).",
+        "(`--source-actuators replace` gives them the `--actuators` choice, and so does the default, "
+        "`auto`, for ROS effort interfaces: MK864).",
+    ),
+    CodeInfo(
+        "MK864",
+        "ros-effort-interfaces-servoed",
+        "info",
+        "MJCF: the source names ROS effort interfaces (URDF `EffortJointInterface` transmissions, "
+        "ros2_control `effort` command interfaces) on joints that `--actuators` gives a servo (with `auto`: "
+        "an arm's or a leg's joints, not wheels), and `--source-actuators auto` (the default) writes those "
+        "servos instead of `<motor>`s: an effort interface says how a ROS controller commands the joint (its "
+        "position or trajectory controller closes a PID over it), and at zero control a `<motor>` leaves an "
+        "arm sagging and legs limp. The effort limit, or the interface's `min`/`max`, is the servo's "
+        "`forcerange`; `--source-actuators keep` writes the `<motor>`s (MK857, MK863).",
     ),
     CodeInfo(
         "MK858",

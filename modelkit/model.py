@@ -349,7 +349,10 @@ class Actuator:
     ``rotor_inertia`` the motor rotor's inertia before the reduction (kg·m²; the joint's armature
     already holds reduction² · rotor inertia where the reader knew both). ``source_kind`` names what the
     source wrote (``PositionJointInterface``, ``ros2_control position``, ``jointDisplacement``,
-    ``position``, ``general``...).
+    ``position``, ``general``...). ``ros_interface``: the source names a ROS control hardware interface
+    (a URDF ``<transmission>`` or ``<ros2_control>`` command interface), which says how a ROS controller
+    commands the joint, not what the joint does at zero control (a ROS effort interface is usually under
+    a position or trajectory controller's PID).
     """
 
     joint: str
@@ -364,6 +367,7 @@ class Actuator:
     rotor_inertia: float = 0.0
     source_kind: str = ""
     source: SourceLocation | None = None
+    ros_interface: bool = False
 
 
 @dataclass(eq=False)

@@ -45,10 +45,13 @@ def hold_error(path: Path) -> tuple[int, float]:
     return int(m.nu), worst
 
 
-def convert(robot: Robot, folder: Path, actuators: str | None = None) -> tuple[Path, list]:
-    """``robot`` written to MJCF in ``folder``, with ``--actuators`` default unless ``actuators``."""
+def convert(robot: Robot, folder: Path, actuators: str | None = None,
+            source_actuators: str | None = None) -> tuple[Path, list]:
+    """``robot`` written to MJCF in ``folder``, with ``--actuators`` and ``--source-actuators`` default
+    unless given."""
     out = folder / f"{robot.name or 'model'}.xml"
-    options = WriteOptions() if actuators is None else WriteOptions(actuators=actuators)
+    chosen = {"actuators": actuators, "source_actuators": source_actuators}
+    options = WriteOptions(**{key: value for key, value in chosen.items() if value is not None})
     notes = write(robot, out, options=options, force=True)
     return out, notes
 
@@ -173,11 +176,32 @@ def test_urdf_transmissions_and_ros2_control_become_actuators(tmp_path: Path) ->
     assert (got["j1"].kind, got["j1"].reduction, got["j1"].name) == (ActuatorKind.EFFORT, 50.0, "m1")
     assert got["j2"].kind is ActuatorKind.VELOCITY  # the old PR2 form: the interface in <actuator>
     assert (got["j3"].kind, got["j3"].ctrl_range) == (ActuatorKind.POSITION, (-0.5, 0.5))  # the first one
-    out, notes = convert(load(path), tmp_path / "out")
+    out, notes = convert(load(path), tmp_path / "keep", source_actuators="keep")
     tags = {el.get("joint"): el.tag for el in actuator_elements(out)}
     assert tags == {"j1": "motor", "j2": "velocity", "j3": "position"}
     codes = sorted(n.code for n in notes if n.code.startswith("MK84"))
     assert codes == ["MK840", "MK840", "MK843"]  # j2's kv and j3's kp/kv made up; j1's reduction folded
+
+
+def test_a_ros_effort_interface_on_a_ranged_joint_is_written_as_a_servo(tmp_path: Path) -> None:
+    """By default (``--source-actuators auto``) j1's ``EffortJointInterface`` gets the ``--actuators``
+    choice, a position servo on a joint with a range, bounded by the joint's effort limit, and MK864 says
+    so; the velocity and position interfaces are written as they are."""
+    path = tmp_path / "two.urdf"
+    path.write_text(URDF)
+    out, notes = convert(load(path), tmp_path / "auto")
+    written = {el.get("joint"): el for el in actuator_elements(out)}
+    assert {joint: el.tag for joint, el in written.items()} == {"j1": "position", "j2": "velocity",
+                                                              "j3": "position"}
+    assert written["j1"].get("forcerange") == "-10 10" and written["j1"].get("ctrlrange") == "-1 1"
+    assert written["j3"].get("ctrlrange") == "-0.5 0.5"  # the source's own position interface, as it was
+    (said,) = [n for n in notes if n.code == "MK864"]
+    assert said.message.startswith("1 joint(s) (j1) whose source names ROS effort interfaces")
+    assert "written as 1 <position> (--actuators auto)" in said.message
+    # --actuators motor is the source's kind: the source's motor is written, with its reduction
+    out, notes = convert(load(path), tmp_path / "motor", actuators="motor")
+    assert {el.get("joint"): el.tag for el in actuator_elements(out)}["j1"] == "motor"
+    assert "MK864" not in {n.code for n in notes} and "MK843" in {n.code for n in notes}
 
 
 def test_body_actuation_mode_becomes_an_actuator(tmp_path: Path) -> None:
@@ -369,34 +393,47 @@ def test_pa10_holds_home(tmp_path: Path) -> None:
     assert error < HOLD_TOLERANCE, f"PA10 moved {error * 1e3:.3f} mm"
 
 
-# Every fixed-base arm of example-robot-data whose URDF names no actuators or position ones, with the
-# joints the default writes a servo for (the PR2 and Tiago carry continuous joints or wheels; Baxter,
-# Kinova and Z1 name effort interfaces: their motors are the source's answer).
+# Every fixed-base arm of example-robot-data whose default MJCF is all position servos, with their count
+# (the PR2 and Tiago carry continuous joints or wheels; Baxter names actuators for its grippers only;
+# the Kinova arm's vertical joint 1 and wrist roll keep motors: its own test below).
 KINOVA = "kinova_description/robots/kinova.urdf"  # Jaco: continuous joints 1, 4, 6; effort transmissions
 
 
-def test_an_arm_with_effort_interfaces_says_it_sags_and_holds_given_servos(tmp_path: Path) -> None:
-    """example-robot-data's Kinova arm names ``EffortJointInterface`` transmissions: written as the
-    source's motors, it falls at zero control (255 mm in 2 s), and MK863 says so with the joints gravity
-    turns. With ``--source-actuators replace`` the ``auto`` choice gives a position servo to every ranged
-    joint and, the base being welded, to the continuous ones gravity turns at home (joint 4: they got
-    motors, and the arm still fell 257 mm); the vertical joint 1 and the wrist roll keep motors."""
+SAGGING_KINOVA_JOINTS = ("j2s6s200_joint_2", "j2s6s200_joint_3", "j2s6s200_joint_4", "j2s6s200_joint_5")
+
+
+@pytest.mark.parametrize("source_actuators", ["auto", "replace"])
+def test_an_arm_with_effort_interfaces_holds_home_on_servos(tmp_path: Path, source_actuators: str) -> None:
+    """example-robot-data's Kinova arm names ``EffortJointInterface`` transmissions. By default
+    (``--source-actuators auto``) and with ``replace``, the ``--actuators auto`` choice gives a position
+    servo to every ranged joint and, the base being welded, to the continuous ones gravity turns at home
+    (joint 4: with a motor there the arm still fell 257 mm); the vertical joint 1 and the wrist roll keep
+    motors. The arm holds home within 1 mm; MK864 (auto) names the four servoed joints."""
     robot = load(example_robot(KINOVA))
-    out, notes = convert(robot, tmp_path / "keep")
-    (sags,) = [n for n in notes if n.code == "MK863"]
-    assert sags.message.startswith("4 joint(s) with the source's effort actuators")
-    for joint in ("j2s6s200_joint_2", "j2s6s200_joint_3", "j2s6s200_joint_4", "j2s6s200_joint_5"):
-        assert joint in sags.message
-    count, error = hold_error(out)
-    assert count == 6 and error > 0.1  # the source's motors: the arm falls
-    replaced = tmp_path / "replace" / out.name
-    write(robot, replaced, options=WriteOptions(source_actuators="replace"), force=True)
-    kinds = {el.get("joint"): el.tag for el in actuator_elements(replaced)}
+    out, notes = convert(robot, tmp_path, source_actuators=source_actuators)
+    kinds = {el.get("joint"): el.tag for el in actuator_elements(out)}
     assert kinds == {"j2s6s200_joint_1": "motor", "j2s6s200_joint_2": "position",
                      "j2s6s200_joint_3": "position", "j2s6s200_joint_4": "position",
                      "j2s6s200_joint_5": "position", "j2s6s200_joint_6": "motor"}
-    count, error = hold_error(replaced)
-    assert error < HOLD_TOLERANCE, f"moved {error * 1e3:.3f} mm"
+    assert "MK863" not in {n.code for n in notes}
+    if source_actuators == "auto":
+        (said,) = [n for n in notes if n.code == "MK864"]
+        assert all(joint in said.message for joint in SAGGING_KINOVA_JOINTS)
+    count, error = hold_error(out)
+    assert count == 6 and error < HOLD_TOLERANCE, f"moved {error * 1e3:.3f} mm"
+
+
+def test_an_arm_whose_effort_interfaces_are_kept_as_motors_says_it_sags(tmp_path: Path) -> None:
+    """``--source-actuators keep``: the Kinova's effort interfaces written as the source's motors, it
+    falls at zero control (255 mm in 2 s), and MK863 says so with the joints gravity turns."""
+    robot = load(example_robot(KINOVA))
+    out, notes = convert(robot, tmp_path, source_actuators="keep")
+    (sags,) = [n for n in notes if n.code == "MK863"]
+    assert sags.message.startswith("4 joint(s) with the source's effort actuators")
+    assert all(joint in sags.message for joint in SAGGING_KINOVA_JOINTS)
+    assert {el.tag for el in actuator_elements(out)} == {"motor"}
+    count, error = hold_error(out)
+    assert count == 6 and error > 0.1  # the source's motors: the arm falls
 
 
 EXAMPLE_ARMS = {
@@ -408,6 +445,7 @@ EXAMPLE_ARMS = {
     "panda_description/urdf/panda.urdf": 8,
     "talos_data/robots/talos_left_arm.urdf": 7,
     "finger_edu_description/robots/finger_edu.urdf": 3,
+    "z1_description/urdf/z1.urdf": 6,  # effort transmissions, servoed by --source-actuators auto (MK864)
 }
 
 
@@ -607,20 +645,22 @@ def test_a_home_that_lies_on_the_body_is_said(tmp_path: Path) -> None:
 
 
 def test_source_motors_on_legs_are_said(tmp_path: Path) -> None:
-    """HyQ's URDF names an EffortJointInterface on each of its 12 leg joints: written as motors (the
-    source's answer), so MK857 says the legs are limp at zero control."""
+    """HyQ's URDF names an EffortJointInterface on each of its 12 leg joints: under
+    ``--source-actuators keep`` written as motors (the source's kind), so MK857 says the legs are limp at
+    zero control."""
     robot = load(example_robot("hyq_description/robots/hyq_no_sensors.urdf"))
-    out, notes = convert(robot, tmp_path)
+    out, notes = convert(robot, tmp_path, source_actuators="keep")
     assert {el.tag for el in actuator_elements(out)} == {"motor"}
     (said,) = [n for n in notes if n.code == "MK857"]
     assert said.message.startswith("12 of the 12 leg joints")
     assert not [n for n in notes if n.code == "MK856"]
 
 
-# Legged robots whose URDFs name an EffortJointInterface on every leg joint (MK857 above): the user who
-# wants them to stand in MuJoCo asks ``--source-actuators replace`` and gets ``--actuators auto``'s
-# position servos. Measured: Go1 sank 6.4 mm and tilted 0.016 rad in 3 s, B1 4.8 mm and 0.006, HyQ
-# 9.2 mm and 0.004; with the source's motors (the default) each lies down.
+# Legged robots whose URDFs name an EffortJointInterface on every leg joint (MK857 above): by default
+# (``--source-actuators auto``: ROS effort interfaces get the ``--actuators`` choice, MK864) and with
+# ``--source-actuators replace`` they get ``--actuators auto``'s position servos and stand in MuJoCo.
+# Measured: Go1 sank 6.4 mm and tilted 0.016 rad in 3 s, B1 4.8 mm and 0.006, HyQ 9.2 mm and 0.004; with
+# the source's motors (``--source-actuators keep``) each lies down.
 EFFORT_LEGGED = ("go1_description/urdf/go1.urdf", "b1_description/urdf/b1.urdf",
                  "hyq_description/robots/hyq_no_sensors.urdf")
 
@@ -650,10 +690,25 @@ def test_source_motors_replaced_by_servos_stand(tmp_path: Path, relative: str) -
     assert sag < STAND_SAG and tilt < STAND_TILT, f"{relative}: sank {sag * 1e3:.1f} mm, tilted {tilt:.3f}"
 
 
-def test_source_motors_kept_by_default_leave_the_legs_limp(tmp_path: Path) -> None:
-    """The contrast: the default keeps HyQ's motors (MK857), and at zero control it does not stand."""
+@pytest.mark.parametrize("relative", EFFORT_LEGGED)
+def test_ros_effort_legs_are_servoed_by_default_and_stand(tmp_path: Path, relative: str) -> None:
+    """``convert go1.urdf -o go1.xml`` with the default options: the source's 12 ROS effort interfaces
+    get position servos (MK864 says so), MK857 is not said, and the written file stands at home on a
+    plain floor."""
     out = tmp_path / "m.xml"
-    said = _convert_cli(example_robot(EFFORT_LEGGED[2]), out)
+    said = _convert_cli(example_robot(relative), out)
+    assert [el.tag for el in actuator_elements(out)] == ["position"] * 12
+    assert "MK864 12 joint(s)" in said and "written as 12 <position> (--actuators auto)" in said
+    assert "MK857" not in said and "MK855" not in said
+    sag, tilt = stand_on_a_plain_floor(out)
+    assert sag < STAND_SAG and tilt < STAND_TILT, f"{relative}: sank {sag * 1e3:.1f} mm, tilted {tilt:.3f}"
+
+
+def test_source_motors_kept_leave_the_legs_limp(tmp_path: Path) -> None:
+    """The contrast: ``--source-actuators keep`` writes HyQ's motors (MK857), and at zero control it does
+    not stand."""
+    out = tmp_path / "m.xml"
+    said = _convert_cli(example_robot(EFFORT_LEGGED[2]), out, "--source-actuators", "keep")
     assert {el.tag for el in actuator_elements(out)} == {"motor"} and "MK857" in said
     assert "--source-actuators replace" in said
     sag, tilt = stand_on_a_plain_floor(out)

@@ -130,7 +130,7 @@ def test_kinova_stands_clear_of_its_floor_at_its_srdf_state(tmp_path: Path) -> N
     urdf = example_robot("kinova_description/robots/kinova.urdf")
     srdf = example_robot("kinova_description/srdf/kinova.srdf")
     package = f"example-robot-data={urdf.parents[3]}"
-    common = ["--package-path", package, "--source-actuators", "replace"]
+    common = ["--package-path", package]  # the default options: its effort interfaces servoed (MK864)
     with_state, without = tmp_path / "a" / "kinova.xml", tmp_path / "b" / "kinova.xml"
     result = CliRunner().invoke(main, ["convert", str(urdf), "--srdf", str(srdf), *common,
                                        "-o", str(with_state)])

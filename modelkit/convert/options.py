@@ -41,9 +41,10 @@ class WriteOptions:
     # actuators are written as they are unless ``source_actuators`` replaces them (docs/convert.md,
     # "Actuators")
     actuators: str = "auto"
-    # MJCF: the source's own actuators: keep (default: written as they are) | replace (set aside, MK855:
-    # every joint gets the ``actuators`` choice, as for a source without any)
-    source_actuators: str = "keep"
+    # MJCF: the source's own actuators: auto (default: written as they are, except ROS effort interfaces
+    # on joints the ``actuators`` choice servos, MK864) | keep (all written as they are) | replace (set
+    # aside, MK855: every joint gets the ``actuators`` choice, as for a source without any)
+    source_actuators: str = "auto"
     # MJCF: massless frame links (modelkit/convert/frames.py) as <site>s in the body they hang on, as
     # MuJoCo Menagerie writes them (MK873); False writes them as empty bodies
     frame_sites: bool = True

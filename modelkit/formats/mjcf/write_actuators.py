@@ -47,6 +47,7 @@ ELEMENTS = {ActuatorKind.EFFORT: "motor", ActuatorKind.POSITION: "position",
             ActuatorKind.VELOCITY: "velocity"}
 CHOICES = {"motor": ActuatorKind.EFFORT, "position": ActuatorKind.POSITION, "velocity": ActuatorKind.VELOCITY}
 ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # MK841 lists kinds in this order
+SERVOED = "ROS effort interface, servoed"  # source_kind of a servo --source-actuators auto put there
 GRAVITY_FLOOR = 1e-9  # N·m or N: a gravity load at home below this is rounding (a vertical axis)
 
 
@@ -75,10 +76,11 @@ class ActuatorWriter:
         for each in self.robot.joints:
             by_name.setdefault(each.name, each)
         replaced = self.set_aside = self._replaced()
+        servoed = {} if replaced else self._servoed_interfaces(by_name)
         # an MJCF source's actuator on a fixed tendon, also read as one on the joint the tendon's joints
         # follow, is written back as it was (write_transmissions), not on the joint
         planned: list[tuple[Actuator, Joint | None]] = [
-            (a, by_name.get(a.joint)) for a in self.robot.actuators
+            (servoed.get(id(a), a), by_name.get(a.joint)) for a in self.robot.actuators
             if not (replaced and a.source_kind != TRACK_ROLLER) and a.source_kind != TENDON_SOURCE
         ]
         # The track approximation's roller servos are the writer's, not the source's: the rest of a
@@ -117,6 +119,8 @@ class ActuatorWriter:
             self._said_replaced(written)
         elif made_up and movable:
             self._said_choice(written)
+        if servoed:
+            self._said_servoed(list(servoed.values()))
         self._said_legs(on_joint)
         self._said_sagging(on_joint, by_name)
 
@@ -125,6 +129,52 @@ class ActuatorWriter:
         own = any(a.source_kind != TRACK_ROLLER for a in self.robot.actuators)
         return self.ctx.options.source_actuators == "replace" and (
             own or bool(self.robot.extras.get("mjcf_actuators")))
+
+    def _servoed_interfaces(self, by_name: dict[str, Joint]) -> dict[int, Actuator]:
+        """``--source-actuators auto``: the source's ROS effort interfaces (URDF ``EffortJointInterface``
+        transmissions, ros2_control ``effort`` command interfaces) on joints to which the ``--actuators``
+        choice gives a servo, keyed by the id of the source's actuator they replace.
+
+        A ROS effort interface says how a controller commands the joint (ros2_control's trajectory and
+        position controllers close a PID over it), not that the joint is free at zero control; as
+        ``<motor>``s the arm sags and the legs are limp until the user writes that controller. The servo
+        keeps what the source says of the joint: the effort limit, or the interface's own ``min``/``max``,
+        as its force range."""
+        if self.ctx.options.source_actuators != "auto":
+            return {}
+        out: dict[int, Actuator] = {}
+        constrained = self._constrained()  # a mimic follower or a locked joint carries no actuator (MK842)
+        for actuator in self.robot.actuators:
+            joint = by_name.get(actuator.joint)
+            if not actuator.ros_interface or actuator.kind is not ActuatorKind.EFFORT or joint is None \
+                    or joint.name in constrained:
+                continue
+            kind = self._chosen_kind(joint)
+            if kind is None or kind is ActuatorKind.EFFORT:
+                continue  # --actuators motor or none, a wheel, or not a hinge or slide: the source's motor
+            force = actuator.force_range
+            if force is None and actuator.ctrl_range is not None:
+                low, high = actuator.ctrl_range
+                force = (low * abs(actuator.gear), high * abs(actuator.gear))
+            out[id(actuator)] = Actuator(joint=joint.name, kind=kind, force_range=force,
+                                         source_kind=SERVOED, source=actuator.source)
+        return out
+
+    def _said_servoed(self, servoed: list[Actuator]) -> None:
+        """MK864: the source's ROS effort interfaces written as the ``--actuators`` choice."""
+        kinds: dict[ActuatorKind, int] = {}
+        for actuator in servoed:
+            kinds[actuator.kind] = kinds.get(actuator.kind, 0) + 1
+        what = " and ".join(f"{count} <{ELEMENTS[kind]}>" for kind, count in
+                            sorted(kinds.items(), key=lambda item: ORDER.index(item[0])))
+        names = [a.joint for a in servoed]
+        shown = ", ".join(names[:4]) + (" ..." if len(names) > 4 else "")
+        self.ctx.note("MK864", f"{len(servoed)} joint(s) ({shown}) whose source names ROS effort "
+                      f"interfaces (URDF transmissions, ros2_control) written as {what} (--actuators "
+                      f"{self.ctx.options.actuators}), not <motor>s: a ROS controller closes its own loop "
+                      "over an effort interface, and at zero control a <motor> leaves the robot sagging "
+                      "until one drives it (--source-actuators keep writes the <motor>s)", self.robot.source,
+                      "actuator")
 
     def _said_replaced(self, written: dict[ActuatorKind, int]) -> None:
         """MK855: the source's actuators set aside by ``--source-actuators replace``, and what was written."""
@@ -159,7 +209,8 @@ class ActuatorWriter:
         self.ctx.note("MK863", f"{len(sagging)} joint(s) with the source's effort actuators, written as "
                       f"<motor>, carry a gravity load at home ({shown}; N·m, N for a slide): at zero control "
                       "the robot sags until a controller drives them (--source-actuators replace gives them "
-                      "the --actuators choice: auto, position servos that hold the home keyframe)",
+                      "the --actuators choice: auto, position servos that hold the home keyframe; the "
+                      "default --source-actuators auto does so for ROS effort interfaces)",
                       self.robot.source, "actuator")
 
     def _said_legs(self, on_joint: dict[str, Actuator]) -> None:
@@ -177,7 +228,8 @@ class ActuatorWriter:
             self.ctx.note("MK857", f"{len(limp)} of the {len(legs)} leg joints ({shown}) have the source's "
                           "effort actuators, written as <motor>: at zero control those legs are limp and the "
                           "robot lies down on a floor until a controller drives them (--source-actuators "
-                          "replace gives them the --actuators choice: auto, position servos)",
+                          "replace gives them the --actuators choice: auto, position servos; the default "
+                          "--source-actuators auto does so for ROS effort interfaces)",
                           self.robot.source, "actuator")
         held = [name for name in legs if name in on_joint and on_joint[name].kind is ActuatorKind.POSITION]
         if not held:
@@ -324,6 +376,13 @@ class ActuatorWriter:
                 self._made_up(actuator, joint, target, load, f"kv {fmt(kv)}", natural_frequency())
             el.set("kv", fmt(kv))
 
+    @staticmethod
+    def _whose(actuator: Actuator) -> str:
+        """What the gains were missing from, as MK840 says it."""
+        if actuator.source_kind == SERVOED:
+            return "the source's effort interface"
+        return f"the source{' ' + actuator.source_kind if actuator.source_kind else ''}"
+
     def _made_up(self, actuator: Actuator, joint: Joint, target: str, load: JointLoad, gains: str,
                  wn: float) -> None:
         unit = "kg" if joint.type is JointType.PRISMATIC else "kg·m²"
@@ -342,8 +401,7 @@ class ActuatorWriter:
             f"{fmt(load.inertia)} {unit} at home"
             + (f" (with {fmt(load.pushed)} {unit}, its share of the robot it pushes as a drive wheel)"
                if load.pushed else "")
-            + f" and {why} "
-            f"(the source{' ' + actuator.source_kind if actuator.source_kind else ''} gives no gains)",
+            + f" and {why} ({self._whose(actuator)} gives no gains)",
             actuator.source or joint.source,
             f"actuator[{target}]",
         )

@@ -76,6 +76,7 @@ def _transmission(ctx: Context, element: Element, joints: set[str], found: dict[
             reduction=reduction if reduction else 1.0,
             source_kind=(written or "").strip(),
             source=ctx.loc(joint_el),
+            ros_interface=True,
         )
 
 
@@ -126,6 +127,7 @@ def _ros2_control(ctx: Context, element: Element, joints: set[str], found: dict[
             actuator: Actuator = found.get(name) or Actuator(joint=name)
             actuator.kind = kind
             actuator.source_kind = f"ros2_control {kind.value}"
+            actuator.ros_interface = True
             actuator.source = ctx.loc(command)
             params = {p.get("name"): parse_number((p.text or "").strip())
                       for p in ctx.children(command, "param")}
