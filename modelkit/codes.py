@@ -1496,6 +1496,19 @@ _TABLE: tuple[CodeInfo, ...] = (
         "`forcerange`; `--source-actuators keep` writes the `<motor>`s (MK857, MK863).",
     ),
     CodeInfo(
+        "MK865",
+        "home-below-base",
+        "warning",
+        "MJCF: the robot's base is welded and, at the `home` keyframe (the source's initial positions, "
+        "else its zero pose put into range), the collision shapes of moving links reach more than 1 mm "
+        "below the lowest point of the base's collision shapes: on a table or floor there, where an arm "
+        "is mounted, they start inside it, and MuJoCo pushes the robot out at the first step "
+        "(example-robot-data's Kinova arm: 45 mm; a UR5's zero pose: its wrist, 41 mm). A robot whose "
+        "moving links' centre of mass is not above that point hangs from its base and is not judged. The "
+        "note names the links and depths; the source's initial positions or MoveIt's SRDF (`--srdf`, "
+        "`--home`) give a home pose clear of it.",
+    ),
+    CodeInfo(
         "MK858",
         "drive-plugin-written",
         "info",

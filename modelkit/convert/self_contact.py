@@ -17,7 +17,8 @@ the core install (``mujoco-core``); when they cannot be imported or the compiler
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 from typing import Any
 
 
@@ -32,10 +33,22 @@ class Touching:
 
 
 @dataclass(frozen=True)
+class BelowBase:
+    """A moving body of a welded robot whose collision shapes reach below the robot's base at rest."""
+
+    body: str
+    depth: float  # m below the base's lowest point (its collision shapes', else its frame's)
+
+
+@dataclass(frozen=True)
 class Checked:
     pairs: list[Touching]
     failure: str | None = None  # why nothing was checked
     refused: bool = False  # the failure is MuJoCo's compiler refusing the file
+    below: list[BelowBase] = field(default_factory=list)  # a welded robot's bodies under its base
+
+
+BELOW_TOLERANCE = 1e-3  # m: what a collision shape may reach below the base before it is said (MK865)
 
 
 def touching_pairs(xml: bytes, assets: dict[str, bytes]) -> Checked:
@@ -86,4 +99,69 @@ def _touching(mujoco: Any, xml: bytes, assets: dict[str, bytes]) -> Checked:
         Touching(name(b1), name(b2), depth, " and ".join(s for s, _ in states if s in labels))
         for (b1, b2), (depth, labels) in sorted(found.items())
     ]
-    return Checked(pairs)
+    below = [BelowBase(name(body), depth) for body, depth in _below_base(mujoco, model, data)]
+    return Checked(pairs, below=below)
+
+
+def _below_base(mujoco: Any, model: Any, data: Any) -> list[tuple[int, float]]:
+    """A welded robot's moving bodies whose collision shapes reach more than :data:`BELOW_TOLERANCE`
+    below its base, in the state ``data`` holds (the last one :func:`_touching` applied).
+
+    The base is every body welded to the world; the plane it stands on is the lowest point of its
+    collision shapes (a base without any, such as a virtual frame, says nothing). A table or floor
+    under the robot is there: a shape below it starts inside it, and MuJoCo pushes the arm out at the
+    first step. A robot whose moving links' centre of mass is not above that plane hangs from its base
+    (mounted from above or from the side: TriFinger's finger, a humanoid's arm, a drone's) and is not
+    judged; nor is a robot with a free joint, which stands nowhere yet."""
+    import numpy as np
+
+    if any(int(t) == int(mujoco.mjtJoint.mjJNT_FREE) for t in model.jnt_type):
+        return []
+    welded = [int(b) for b in range(1, model.nbody) if int(model.body_weldid[b]) == 0]
+    if not welded or len(welded) == model.nbody - 1:
+        return []
+    lowest: dict[int, float] = {}
+    for g in range(model.ngeom):
+        if not (model.geom_contype[g] or model.geom_conaffinity[g]):
+            continue
+        low = _lowest_point(mujoco, np, model, data, g)
+        if low is not None:
+            body = int(model.geom_bodyid[g])
+            lowest[body] = min(lowest.get(body, math.inf), low)
+    base = [lowest[b] for b in welded if b in lowest]
+    if not base:
+        return []  # a base without collision shapes (a virtual frame): where it stands is not known
+    plane = min(base)
+    moving = [b for b in range(1, model.nbody) if int(model.body_weldid[b]) != 0]
+    mass = float(sum(model.body_mass[b] for b in moving))
+    if mass > 0.0 and sum(float(model.body_mass[b] * data.xipos[b][2]) for b in moving) / mass <= plane:
+        return []  # the robot hangs from its base (a finger under its frame, an arm on a shoulder, a drone's)
+    return [(body, plane - low) for body, low in sorted(lowest.items())
+            if int(model.body_weldid[body]) != 0 and plane - low > BELOW_TOLERANCE]
+
+
+def _lowest_point(mujoco: Any, np: Any, model: Any, data: Any, g: int) -> float | None:
+    """The lowest world height of geom ``g``'s surface (None for a plane, an hfield or an SDF)."""
+    kind = int(model.geom_type[g])
+    types = mujoco.mjtGeom
+    size = model.geom_size[g]
+    z = float(data.geom_xpos[g][2])
+    rz = np.asarray(data.geom_xmat[g]).reshape(3, 3)[2]  # the geom's axes' world heights
+    if kind == int(types.mjGEOM_SPHERE):
+        return z - float(size[0])
+    if kind == int(types.mjGEOM_CAPSULE):
+        return z - abs(float(rz[2])) * float(size[1]) - float(size[0])
+    if kind == int(types.mjGEOM_CYLINDER):
+        axial = abs(float(rz[2]))
+        return z - axial * float(size[1]) - math.sqrt(max(0.0, 1.0 - axial * axial)) * float(size[0])
+    if kind == int(types.mjGEOM_BOX):
+        return z - float(np.abs(rz) @ np.asarray(size))
+    if kind == int(types.mjGEOM_ELLIPSOID):
+        return z - float(np.linalg.norm(rz * np.asarray(size)))
+    if kind == int(types.mjGEOM_MESH):
+        mesh = int(model.geom_dataid[g])
+        start, count = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
+        if count == 0:
+            return None
+        return z + float((np.asarray(model.mesh_vert[start:start + count]) @ rz).min())
+    return None

@@ -53,7 +53,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.meshes import MESH_FOLDER
 from modelkit.convert.numbers import fmt, fmt_text, fmt_vec
-from modelkit.convert.self_contact import touching_pairs
+from modelkit.convert.self_contact import BelowBase, touching_pairs
 from modelkit.convert.servo_gains import with_written_masses
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.formats.mjcf.write_actuators import ActuatorWriter
@@ -219,6 +219,7 @@ class MjcfWriter:
                               "is written, but it does not load in MuJoCo", self.robot.source, "mujoco")
             return
         links = {el.get("name"): link for link, el in self.tree.bodies.items()}
+        self._below_base(checked.below, links)
         for pair in checked.pairs:
             sub(self.sections["contact"], "exclude", body1=pair.body1, body2=pair.body2)
             link = self.robot.link(links.get(pair.body2) or "")
@@ -232,6 +233,24 @@ class MjcfWriter:
                 link.source if link is not None else self.robot.source,
                 f"contact/exclude[{pair.body1},{pair.body2}]",
             )
+
+    def _below_base(self, below: list[BelowBase], links: dict[str | None, str]) -> None:
+        """MK865: a welded robot whose home pose puts moving collision shapes below its base."""
+        if not below:
+            return
+        deepest = max(below, key=lambda each: each.depth)
+        shown = ", ".join(f"{each.body} {each.depth * 1000.0:.0f} mm" for each in below[:4])
+        link = self.robot.link(links.get(deepest.body) or "")
+        self.ctx.note(
+            "MK865",
+            f"at home the collision shapes of {len(below)} moving bod(ies) reach below the welded base's "
+            f"lowest point ({shown}{' ...' if len(below) > 4 else ''}): on a table or floor there, "
+            "where an arm is mounted, they start inside it, and MuJoCo pushes the robot out at the first "
+            "step; a home pose clear of it comes from the source's initial positions, or from MoveIt's "
+            "SRDF (--srdf FILE, --home STATE)",
+            link.source if link is not None else self.robot.source,
+            "keyframe",
+        )
 
     def _assets(self) -> dict[str, bytes]:
         """The staged files as MuJoCo resolves the model's references (``meshes/link0.stl``)."""
