@@ -198,6 +198,17 @@ def test_a_ros_effort_interface_on_a_ranged_joint_is_written_as_a_servo(tmp_path
     (said,) = [n for n in notes if n.code == "MK864"]
     assert said.message.startswith("1 joint(s) (j1) whose source names ROS effort interfaces")
     assert "written as 1 <position> (--actuators auto)" in said.message
+    # a ros2_control effort command interface is a ROS effort interface too: its min/max bound the servo
+    path.write_text(URDF.replace('<command_interface name="position"><param name="min">-0.5</param>',
+                                 '<command_interface name="effort"><param name="min">-7</param>')
+                    .replace('<param name="max">0.5</param>', '<param name="max">7</param>'))
+    out, notes = convert(load(path), tmp_path / "ros2_control")
+    written = {el.get("joint"): el for el in actuator_elements(out)}
+    assert written["j3"].tag == "position" and written["j3"].get("forcerange") == "-7 7"
+    assert written["j3"].get("ctrlrange") == "-1 1"  # the joint's range: the servo's control is a position
+    (said,) = [n for n in notes if n.code == "MK864"]
+    assert said.message.startswith("2 joint(s) (j1, j3)")
+    path.write_text(URDF)
     # --actuators motor is the source's kind: the source's motor is written, with its reduction
     out, notes = convert(load(path), tmp_path / "motor", actuators="motor")
     assert {el.get("joint"): el.tag for el in actuator_elements(out)}["j1"] == "motor"

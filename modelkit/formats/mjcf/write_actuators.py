@@ -9,6 +9,10 @@
   follower or a locked joint) is left out (MK842); a transmission reduction is folded into the joint
   (MK843). An MJCF source's other actuators (tendon and site transmissions, activation dynamics,
   other laws) are written back as ``<general>`` by :mod:`.write_transmissions`, in the source's order.
+* ``--source-actuators``: ``auto`` (the default) writes the source's actuators but its ROS effort
+  interfaces (URDF ``EffortJointInterface`` transmissions, ros2_control ``effort``), which get the
+  ``--actuators`` choice where it gives a servo (MK864); ``keep`` writes them all; ``replace`` sets them
+  all aside, as for a source without any (MK855).
 * A source without actuators: every hinge and slide that is not a mimic follower or locked gets the
   ``--actuators`` kind, or none (MK841). ``auto`` (the default): a position servo on each joint with a
   range or in a leg (the model holds its ``home`` pose, as MuJoCo Menagerie's arms and legs do), a
