@@ -2,23 +2,17 @@
 
 On a table or floor the base stands on, such a pose starts inside it and MuJoCo pushes the arm out at
 the first step. The test arms are a base box (its bottom at z = 0) and one link on a hinge whose
-capsule hangs down or stands up at q = 0; the Kinova arm of example-robot-data has the fault in its
-zero pose and not in its SRDF's ``arm_up``.
+capsule hangs down or stands up at q = 0. The Kinova arm of example-robot-data, which has the fault
+in its zero pose and not in its SRDF's ``arm_up``, is in ``tests/test_srdf_home.py``.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import mujoco
-import pytest
-from click.testing import CliRunner
-
 from modelkit.api import load
-from modelkit.cli import main
 from modelkit.convert.api import write
 from modelkit.convert.options import WriteOptions
-from tests.conftest import example_robot
 
 INERTIAL = ('<inertial><mass value="1"/>'
             '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>')
@@ -72,29 +66,3 @@ def test_a_robot_hanging_from_its_base_is_not_judged(tmp_path: Path) -> None:
 
 def test_a_floating_robot_is_not_judged(tmp_path: Path) -> None:
     assert not [n for n in _notes(tmp_path, -0.2, base="floating") if n.code == "MK865"]
-
-
-@pytest.mark.parametrize("with_srdf", [False, True])
-def test_the_kinova_zero_pose_is_said_and_its_srdf_pose_is_not(tmp_path: Path, with_srdf: bool) -> None:
-    urdf = example_robot("kinova_description/robots/kinova.urdf")
-    srdf = example_robot("kinova_description/srdf/kinova.srdf")
-    out = tmp_path / "kinova.xml"
-    extra = ["--srdf", str(srdf)] if with_srdf else []
-    result = CliRunner().invoke(main, ["convert", str(urdf), "--package-path",
-                                       f"example-robot-data={urdf.parents[3]}", *extra, "-o", str(out)])
-    assert result.exit_code == 0, result.output
-    said = [line for line in result.output.splitlines() if "MK865" in line]
-    if with_srdf:
-        assert not said
-        return
-    (line,) = said
-    assert "j2s6s200_link_2 45 mm" in line and "j2s6s200_link_3 45 mm" in line
-    # the written file itself: on a plane at the base's bottom (z = 0), MuJoCo finds the links inside it
-    spec = mujoco.MjSpec.from_file(str(out))
-    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[2, 2, 0.1])
-    model = spec.compile()
-    data = mujoco.MjData(model)
-    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
-    mujoco.mj_forward(model, data)
-    depth = max(-data.contact[i].dist for i in range(data.ncon))
-    assert 0.040 < depth < 0.050

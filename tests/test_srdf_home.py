@@ -135,8 +135,13 @@ def test_kinova_stands_clear_of_its_floor_at_its_srdf_state(tmp_path: Path) -> N
     result = CliRunner().invoke(main, ["convert", str(urdf), "--srdf", str(srdf), *common,
                                        "-o", str(with_state)])
     assert result.exit_code == 0, result.output
-    assert 'SRDF group_state "arm_up"' in result.output
-    assert CliRunner().invoke(main, ["convert", str(urdf), *common, "-o", str(without)]).exit_code == 0
+    assert 'SRDF group_state "arm_up"' in result.output and "MK865" not in result.output
+    zero = CliRunner().invoke(main, ["convert", str(urdf), *common, "-o", str(without)])
+    assert zero.exit_code == 0
     deepest, moved = _floor_and_hold(with_state)
     assert deepest == 0.0 and moved < 1e-3, (deepest, moved)
-    assert _floor_and_hold(without)[0] > 0.04  # the zero pose put into range: 45 mm into the floor
+    deepest = _floor_and_hold(without)[0]
+    assert 0.04 < deepest < 0.05  # the zero pose put into range: 45 mm into the floor
+    # ... which convert says (MK865), with the same depth
+    (said,) = [line for line in zero.output.splitlines() if "MK865" in line]
+    assert "j2s6s200_link_2 45 mm" in said and "j2s6s200_link_3 45 mm" in said
