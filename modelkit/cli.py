@@ -98,7 +98,8 @@ def reading_options(fn: F) -> F:
             type=click.Path(dir_okay=False, path_type=Path),
             default=None,
             help="MoveIt's SRDF of the robot: its <group_state> gives the home pose (the MJCF home "
-            "keyframe and servo targets, .body initial angles; MK147).",
+            "keyframe and servo targets, .body initial angles; MK147), its <disable_collisions> pairs the "
+            "MJCF's <contact><exclude> (MK866).",
         ),
         click.option(
             "--home",

@@ -334,6 +334,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "file given with `--srdf` is not an SRDF (its top element is not `<robot>`).",
     ),
     CodeInfo(
+        "MK126",
+        "srdf-pair-unusable",
+        "warning",
+        "`--srdf`: `<disable_collisions>` pairs that name a link the robot does not have (an SRDF written "
+        "for another variant of the robot) are not used; one warning counts them and names the first.",
+    ),
+    CodeInfo(
         "MK149",
         "srdf-joint-value-unusable",
         "warning",
@@ -1507,6 +1514,24 @@ _TABLE: tuple[CodeInfo, ...] = (
         "moving links' centre of mass is not above that point hangs from its base and is not judged. The "
         "note names the links and depths; the source's initial positions or MoveIt's SRDF (`--srdf`, "
         "`--home`) give a home pose clear of it.",
+    ),
+    CodeInfo(
+        "MK866",
+        "srdf-exclusions-written",
+        "info",
+        "MJCF: the SRDF's `<disable_collisions>` pairs (`--srdf`) written as `<contact><exclude>` between "
+        "the bodies that hold the two links; the note counts them by the SRDF's reasons (Adjacent, Default, "
+        "Never...) and those not written: MuJoCo already ignores a body and its parent and two links in "
+        "one body, a repeated pair is written once, and a pair with the world body or a merged link is "
+        "left out.",
+    ),
+    CodeInfo(
+        "MK867",
+        "srdf-exclusions-not-written",
+        "info",
+        "URDF, SDF, `.body`: the SRDF's `<disable_collisions>` pairs (`--srdf`) are not written: these "
+        "formats have no exclusion of one link pair (SDF and URDF self-collision flags are per link or "
+        "model); the SRDF itself still holds them for MoveIt.",
     ),
     CodeInfo(
         "MK858",

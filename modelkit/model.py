@@ -371,6 +371,18 @@ class Actuator:
 
 
 @dataclass(eq=False)
+class CollisionExclusion:
+    """Two links whose collisions with each other the source disables (MoveIt's SRDF
+    ``<disable_collisions link1 link2 reason>``: adjacent, colliding at the default pose, always or never
+    in collision over the sampled workspace). ``reason`` is the source's word for why."""
+
+    link1: str
+    link2: str
+    reason: str = ""
+    source: SourceLocation | None = None
+
+
+@dataclass(eq=False)
 class LoopConstraint:
     """A closed-loop joint between two links of the tree (Choreonoid ``extra_joints``)."""
 
@@ -422,6 +434,7 @@ class Robot:
     root_joint_source: SourceLocation | None = None
     free_link_poses: dict[str, Pose] = field(default_factory=dict)
     self_collide: bool | None = None  # the model-wide flag (SDF <model><self_collide>), see Link's
+    collision_exclusions: list[CollisionExclusion] = field(default_factory=list)  # link pairs (SRDF)
     materials_file: Path | None = None
     extras: dict[str, Any] = field(default_factory=dict)  # one format's own data, kept as is
 

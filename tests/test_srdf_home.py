@@ -145,3 +145,46 @@ def test_kinova_stands_clear_of_its_floor_at_its_srdf_state(tmp_path: Path) -> N
     # ... which convert says (MK865), with the same depth
     (said,) = [line for line in zero.output.splitlines() if "MK865" in line]
     assert "j2s6s200_link_2 45 mm" in said and "j2s6s200_link_3 45 mm" in said
+
+
+# -- <disable_collisions>: the pairs MoveIt's setup assistant disabled -----------------------------------
+
+EXCLUSIONS = """<?xml version="1.0"?>
+<robot name="arm">
+  <disable_collisions link1="base" link2="upper" reason="Adjacent"/>
+  <disable_collisions link1="base" link2="finger_a" reason="Never"/>
+  <disable_collisions link1="finger_a" link2="base" reason="Never"/>
+  <disable_collisions link1="finger_a" link2="finger_b" reason="Default"/>
+  <disable_collisions link1="upper" link2="ghost" reason="Never"/>
+</robot>
+"""
+
+
+def test_disabled_pairs_become_mujoco_exclusions(tmp_path: Path) -> None:
+    """Written: base-finger_a (Never, once though listed twice) and the fingers (Default). Not written:
+    base-upper, a body and its parent, which MuJoCo already ignores. The pair naming a link the robot
+    lacks is a warning (MK126). MuJoCo compiles the two exclusions."""
+    urdf, srdf = _files(tmp_path, EXCLUSIONS)
+    out = tmp_path / "out" / "arm.xml"
+    result = CliRunner().invoke(main, ["convert", str(urdf), "--srdf", str(srdf), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "warning MK126 1 disable_collisions pair(s) name a link the robot lacks" in result.output
+    assert ("MK866 2 of the SRDF's 4 disabled collision pair(s) written as <contact><exclude> (Default 1, "
+            "Never 1); not written: 1 between a body and its parent (MuJoCo ignores those); 1 repeated"
+            in result.output)
+    model = mujoco.MjModel.from_xml_path(str(out))
+    pairs = set()
+    for i in range(model.nexclude):
+        signature = int(model.exclude_signature[i])
+        first, second = signature >> 16, signature & 0xFFFF
+        pairs.add(frozenset((model.body(first).name, model.body(second).name)))
+    assert pairs == {frozenset(("base", "finger_a")), frozenset(("finger_a", "finger_b"))}
+
+
+def test_disabled_pairs_are_said_not_written_in_urdf(tmp_path: Path) -> None:
+    urdf, srdf = _files(tmp_path, EXCLUSIONS)
+    out = tmp_path / "out" / "arm.urdf"
+    result = CliRunner().invoke(main, ["convert", str(urdf), "--srdf", str(srdf), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    said = "MK867 the SRDF's 4 disabled collision pair(s) are not written: urdf has no exclusion"
+    assert said in result.output

@@ -79,6 +79,10 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
 
     _check_mass_properties(robot)
     note_foreign_extras(robot, target.name, notes)
+    if robot.collision_exclusions and target.name != "mjcf":
+        notes.note("MK867", f"the SRDF's {len(robot.collision_exclusions)} disabled collision pair(s) are "
+                   f"not written: {target.name} has no exclusion of one link pair (MJCF's <contact><exclude> "
+                   "has)", robot.collision_exclusions[0].source, "collision")
     out = copy.deepcopy(robot)
     settle_base(out, options.base, notes)
     if not target.tracks_native:

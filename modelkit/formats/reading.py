@@ -48,10 +48,10 @@ def read_model(
         result = _read_model(path, options, fmt, display)
         if options is not None and options.srdf is not None and result.robot is not None:
             from modelkit.diagnostics import DiagnosticSink
-            from modelkit.formats.srdf import apply_home
+            from modelkit.formats.srdf import apply_srdf
 
             sink = DiagnosticSink()
-            apply_home(result.robot, options.srdf, options.home, sink, options.max_bytes)
+            apply_srdf(result.robot, options.srdf, options.home, sink, options.max_bytes)
             result.diagnostics.extend(sink.items)
     result.opened = _unique(opened)
     return result

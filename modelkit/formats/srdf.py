@@ -14,7 +14,9 @@ still outside the joint's range (the writers clamp it) are warnings (MK149); a `
 file does not hold is an error (MK148) naming those it holds; the state used, or that none was found,
 is an info (MK147).
 
-Only ``<group_state>`` is read; ``<disable_collisions>``, groups and end effectors are not used.
+``<disable_collisions link1 link2 reason>`` pairs become the robot's collision exclusions (the MJCF
+writer excludes them, MK866; the other targets have no per-pair exclusion and say so); a pair naming
+a link the robot lacks is not used (MK126, a warning). Groups and end effectors are not used.
 """
 
 from __future__ import annotations
@@ -22,9 +24,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
-from modelkit.model import JointType, Robot
+from modelkit.model import CollisionExclusion, JointType, Robot
 from modelkit.xmlsource import parse_number, read_xml
 
 PREFERRED_STATES = ("home", "ready", "default", "standing", "half_sitting")
@@ -42,9 +45,16 @@ class JointState:
     groups: list[str] = field(default_factory=list)
 
 
-def read_states(path: Path, sink: DiagnosticSink, max_bytes: int) -> dict[str, JointState] | None:
-    """The ``<group_state>``s of the SRDF at ``path`` by name (None when the file cannot be read or
-    parsed: said in ``sink``)."""
+@dataclass
+class SrdfFile:
+    """What modelkit uses of an SRDF: its named joint states and its disabled collision pairs."""
+
+    states: dict[str, JointState]
+    exclusions: list[CollisionExclusion]
+
+
+def read_srdf(path: Path, sink: DiagnosticSink, max_bytes: int) -> SrdfFile | None:
+    """The SRDF at ``path`` (None when the file cannot be read or parsed: said in ``sink``)."""
     doc = read_xml(path, sink, max_bytes)
     if doc is None:
         return None
@@ -52,6 +62,14 @@ def read_states(path: Path, sink: DiagnosticSink, max_bytes: int) -> dict[str, J
         sink.emit("MK148", f"an SRDF has a <robot> top element; this file's is <{doc.root.tag}>",
                   doc.loc(doc.root))
         return None
+    exclusions = [CollisionExclusion(element.get("link1", ""), element.get("link2", ""),
+                                     element.get("reason", ""), doc.loc(element))
+                  for element in doc.root.iter("disable_collisions")]
+    return SrdfFile(_states(doc, sink), exclusions)
+
+
+def _states(doc: Any, sink: DiagnosticSink) -> dict[str, JointState]:
+    """The ``<group_state>``s by name."""
     states: dict[str, JointState] = {}
     for element in doc.root.iter("group_state"):
         name = element.get("name", "")
@@ -80,12 +98,37 @@ def chosen_state(states: dict[str, JointState], wanted: str | None) -> JointStat
     return preferred
 
 
-def apply_home(robot: Robot, srdf: Path, wanted: str | None, sink: DiagnosticSink, max_bytes: int) -> None:
-    """Set ``robot``'s joint initial positions from the SRDF state chosen (see the module docstring)."""
-    states = read_states(srdf, sink, max_bytes)
-    if states is None:
+def apply_srdf(robot: Robot, srdf: Path, wanted: str | None, sink: DiagnosticSink, max_bytes: int) -> None:
+    """Set ``robot``'s joint initial positions from the SRDF state chosen and its collision exclusions
+    from the disabled pairs (see the module docstring)."""
+    read = read_srdf(srdf, sink, max_bytes)
+    if read is None:
         return
-    shown = str(srdf)
+    _apply_exclusions(robot, read.exclusions, sink)
+    _apply_home(robot, read.states, str(srdf), wanted, sink)
+
+
+def _apply_exclusions(robot: Robot, exclusions: list[CollisionExclusion], sink: DiagnosticSink) -> None:
+    """The pairs whose links the robot has become its collision exclusions; the others are said once
+    (an SRDF written for another variant of the robot names links this one lacks)."""
+    links = {link.name for link in robot.links}
+    unused: list[tuple[CollisionExclusion, str]] = []
+    for pair in exclusions:
+        unknown = next((name for name in (pair.link1, pair.link2) if name not in links), None)
+        if unknown is not None:
+            unused.append((pair, unknown))
+        elif pair.link1 != pair.link2:
+            robot.collision_exclusions.append(pair)
+    if unused:
+        shown = ", ".join(f"{pair.link1!r}-{pair.link2!r} ({name!r})" for pair, name in unused[:3])
+        more = " ..." if len(unused) > 3 else ""
+        sink.emit("MK126", f"{len(unused)} disable_collisions pair(s) name a link the robot lacks and are "
+                  f"not used: {shown}{more}", unused[0][0].source or SourceLocation(""),
+                  severity=Severity.WARNING)
+
+
+def _apply_home(robot: Robot, states: dict[str, JointState], shown: str, wanted: str | None,
+                sink: DiagnosticSink) -> None:
     state = chosen_state(states, wanted)
     held = ", ".join(f'"{name}"' for name in states) or "none"
     if state is None:

@@ -60,6 +60,7 @@ from modelkit.formats.mjcf.write_actuators import ActuatorWriter
 from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, MIN_MASS, BodyTree
 from modelkit.formats.mjcf.write_contact_pairs import write_source_pairs
 from modelkit.formats.mjcf.write_devices import DeviceWriter
+from modelkit.formats.mjcf.write_exclusions import write_exclusions
 from modelkit.formats.mjcf.write_foreign import note_unwritten_own
 from modelkit.formats.mjcf.write_geoms import COLLISION, CONTACT_PRIORITY, GeomWriter, shared_stems
 from modelkit.formats.mjcf.write_names import NameTable
@@ -149,6 +150,7 @@ class MjcfWriter:
         self._home()
         note_unwritten_own(self.root, self.robot, self.ctx, lost)
         write_source_pairs(self.root, self.sections["contact"], self.robot, self.ctx)
+        write_exclusions(self.robot, self.tree, self.sections["contact"], self.ctx)
         self._meshdir()
         if any(el.get("euler") is not None for el in self.root.iter()):
             self.sections["compiler"].set("eulerseq", EULER_SEQUENCE)  # set_pose's euler: URDF's rpy
