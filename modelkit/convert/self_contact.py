@@ -21,6 +21,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 
 @dataclass(frozen=True)
 class Touching:
@@ -37,7 +39,7 @@ class BelowBase:
     """A moving body of a welded robot whose collision shapes reach below the robot's base at rest."""
 
     body: str
-    depth: float  # m below the base's lowest point (its collision shapes', else its frame's)
+    depth: float  # m below the lowest point of the base's collision shapes
 
 
 @dataclass(frozen=True)
@@ -113,8 +115,6 @@ def _below_base(mujoco: Any, model: Any, data: Any) -> list[tuple[int, float]]:
     first step. A robot whose moving links' centre of mass is not above that plane hangs from its base
     (mounted from above or from the side: TriFinger's finger, a humanoid's arm, a drone's) and is not
     judged; nor is a robot with a free joint, which stands nowhere yet."""
-    import numpy as np
-
     if any(int(t) == int(mujoco.mjtJoint.mjJNT_FREE) for t in model.jnt_type):
         return []
     welded = [int(b) for b in range(1, model.nbody) if int(model.body_weldid[b]) == 0]
@@ -124,7 +124,7 @@ def _below_base(mujoco: Any, model: Any, data: Any) -> list[tuple[int, float]]:
     for g in range(model.ngeom):
         if not (model.geom_contype[g] or model.geom_conaffinity[g]):
             continue
-        low = _lowest_point(mujoco, np, model, data, g)
+        low = _lowest_point(mujoco, model, data, g)
         if low is not None:
             body = int(model.geom_bodyid[g])
             lowest[body] = min(lowest.get(body, math.inf), low)
@@ -140,7 +140,7 @@ def _below_base(mujoco: Any, model: Any, data: Any) -> list[tuple[int, float]]:
             if int(model.body_weldid[body]) != 0 and plane - low > BELOW_TOLERANCE]
 
 
-def _lowest_point(mujoco: Any, np: Any, model: Any, data: Any, g: int) -> float | None:
+def _lowest_point(mujoco: Any, model: Any, data: Any, g: int) -> float | None:
     """The lowest world height of geom ``g``'s surface (None for a plane, an hfield or an SDF)."""
     kind = int(model.geom_type[g])
     types = mujoco.mjtGeom
