@@ -79,7 +79,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
 
     _check_mass_properties(robot)
     note_foreign_extras(robot, target.name, notes)
-    if robot.collision_exclusions and target.name != "mjcf":
+    if robot.collision_exclusions and not target.pair_exclusions_native:
         notes.note("MK867", f"the SRDF's {len(robot.collision_exclusions)} disabled collision pair(s) are "
                    f"not written: {target.name} has no exclusion of one link pair (MJCF's <contact><exclude> "
                    "has)", robot.collision_exclusions[0].source, "collision")

@@ -36,6 +36,7 @@ class TargetInfo:
     auto_wheel: str = "cylinder"  # the wheel collision `--wheel-collision auto` writes
     sites_native: bool = False  # the target holds MJCF sites itself (else they become frame links)
     frames_native: bool = False  # the target holds SDF <frame>s itself (else they become frame links)
+    pair_exclusions_native: bool = False  # the target excludes one link pair's contacts (else MK867)
 
 
 def _target(declaration: FormatDeclaration) -> TargetInfo:
@@ -43,7 +44,8 @@ def _target(declaration: FormatDeclaration) -> TargetInfo:
     if out is None:
         raise ValueError(f"format {declaration.name} declares no output")
     return TargetInfo(declaration.name, out.suffix, out.suffixes, out.writer, out.tracks_native,
-                      out.auto_wheel, out.sites_native, out.frames_native)
+                      out.auto_wheel, out.sites_native, out.frames_native,
+                      out.pair_exclusions_native)
 
 
 TARGETS: tuple[TargetInfo, ...] = tuple(_target(d) for d in WRITTEN)

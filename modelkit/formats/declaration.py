@@ -21,6 +21,7 @@ class OutputDeclaration(NamedTuple):
     auto_wheel: str = "cylinder"  # the wheel collision `--wheel-collision auto` writes: cylinder or sphere
     sites_native: bool = False  # the format holds MJCF sites (named frames on a body) itself
     frames_native: bool = False  # the format holds SDF <frame>s (named poses on a link) itself
+    pair_exclusions_native: bool = False  # the format excludes one link pair's contacts (SRDF pairs)
     handles: frozenset[str] = frozenset()  # other formats' robot/link extras keys its writer notes itself
     handles_joint: frozenset[str] = frozenset()  # the same for joint extras keys
     walks_extras: bool = False  # its writer notes every other format's robot extras key itself

@@ -14,6 +14,7 @@ FORMAT = FormatDeclaration(
         suffixes=(".xml", ".mjcf"),
         auto_wheel="sphere",  # MuJoCo: a cylinder rolling on a plane gets odd contacts
         sites_native=True,
+        pair_exclusions_native=True,  # <contact><exclude>
     ),
     extras=ExtrasDeclaration(
         # mjcf_globals: <size>, <visual>, <statistic>: MuJoCo's memory, viewer and camera extent, nothing
