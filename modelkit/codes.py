@@ -1534,6 +1534,18 @@ _TABLE: tuple[CodeInfo, ...] = (
         "model); the SRDF itself still holds them for MoveIt.",
     ),
     CodeInfo(
+        "MK868",
+        "servo-below-gravity",
+        "warning",
+        "MJCF: a position servo's force limit (the joint's effort limit, or the source actuator's force "
+        "range, times its gear) is below the gravity load the joint holds at home, less its Coulomb "
+        "friction (a leg's joint with its leg's share of the robot's weight standing): the servo saturates "
+        "and the robot sags off its home pose whatever its gains, as in any engine that applies the "
+        "limit (example-robot-data's PR2: its shoulders need 52 N·m against 30; the real arm has a "
+        "counterbalance spring its URDF does not describe). The note names the joints, their loads and "
+        "limits; a larger effort limit, or MuJoCo's body `gravcomp`, holds the pose.",
+    ),
+    CodeInfo(
         "MK858",
         "drive-plugin-written",
         "info",

@@ -9,7 +9,10 @@ joint below the root's rigid body with two or more moving joints in a row below 
 q = 0), in a robot with four or more such limbs whose root floats (as settled for the output: a welded
 test rig of 30 chains has no legs), that carries no wheel: no hinge in it without a range
 whose child's shapes are round about its axis (a wheeled leg's wheel, a caster's wheel; a cart with
-four casters has four limbs of two joints, and its swivels stay free).
+four casters has four limbs of two joints, and its swivels stay free). When four or more of those
+limbs reach the ground at q = 0 (as ``--base auto`` finds feet), only they are legs: the Z1 arm folded
+on a B1's back and the Kinova arm on an ANYmal carry none of the robot's weight. With fewer (a model
+whose front legs point forward at q = 0, pybullet_data's Y-up Laikago) every such limb stays a leg.
 
 :func:`resting_on` says what a legged robot rests on at its home pose: the links whose shapes reach
 the lowest level (within 2 % of the robot's height, at least 1 mm, as ``--base auto`` judges it) that
@@ -31,6 +34,7 @@ import numpy as np
 
 from modelkit.convert.base import LIMBS, _limbs, _moving_above, _points_up, _round_about, vertical_spans
 from modelkit.model import Joint, JointType, Link, Robot
+from modelkit.spatial import Pose
 
 
 def leg_joints(robot: Robot) -> frozenset[str]:
@@ -43,6 +47,9 @@ def leg_joints(robot: Robot) -> frozenset[str]:
         return frozenset()
     children = robot.children_of()
     by_name = {joint.name: joint for joint in robot.joints}
+    grounded = _grounded(robot, poses, children, [by_name[first] for first in legs])
+    if len(grounded) >= LIMBS:
+        legs = grounded  # an arm folded on a quadruped's back, or raised beside it: not a leg
     links = {link.name: link for link in robot.links}
     out: set[str] = set()
     for first in legs:
@@ -51,6 +58,20 @@ def leg_joints(robot: Robot) -> frozenset[str]:
             continue
         out.update(j.name for j in below if j.type in (JointType.REVOLUTE, JointType.PRISMATIC))
     return frozenset(out)
+
+
+def _grounded(robot: Robot, poses: dict[str, Pose], children: dict[str, list[Joint]],
+              firsts: list[Joint]) -> list[str]:
+    """The limbs (by first joint) with a link that touches the ground at q = 0, as ``--base auto`` finds
+    feet: within 2 % of the robot's height (at least 1 mm) of its lowest shape."""
+    lows = vertical_spans(robot, poses)
+    if not lows:
+        return []
+    ground = min(low for low, _ in lows.values())
+    tolerance = max(1e-3, 0.02 * (max(high for _, high in lows.values()) - ground))
+    return [first.name for first in firsts
+            if any(j.child in lows and lows[j.child][0] - ground <= tolerance
+                   for j in _below(children, first))]
 
 
 def _below(children: dict[str, list[Joint]], first: Joint) -> list[Joint]:

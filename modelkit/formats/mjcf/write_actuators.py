@@ -74,6 +74,7 @@ class ActuatorWriter:
         self._loads: dict[str, JointLoad] | None = None
         self._legs: frozenset[str] | None = None  # the joints in a legged robot's legs, found once
         self._links: dict[str, Link] | None = None
+        self._holding: dict[str, float] = {}  # joint → the most its position servo gives it (N·m or N)
 
     def write(self, home: dict[str, float]) -> None:
         by_name: dict[str, Joint] = {}
@@ -127,6 +128,7 @@ class ActuatorWriter:
             self._said_servoed(list(servoed.values()))
         self._said_legs(on_joint)
         self._said_sagging(on_joint, by_name)
+        self._said_overloaded(by_name)
 
     def _replaced(self) -> bool:
         """Whether ``--source-actuators replace`` sets the source's own actuators aside (it has some)."""
@@ -216,6 +218,37 @@ class ActuatorWriter:
                       "the --actuators choice: auto, position servos that hold the home keyframe; the "
                       "default --source-actuators auto does so for ROS effort interfaces)",
                       self.robot.source, "actuator")
+
+    def _said_overloaded(self, by_name: dict[str, Joint]) -> None:
+        """MK868: position servos whose force limit (the source's effort limit, or its actuator's force
+        range) is below the gravity load they hold at home (a leg's with its share of the robot's
+        weight), less the joint's Coulomb friction: the servo saturates and the robot sags off its home
+        pose, whatever the gains (the PR2's shoulders: 52 N·m against 30; the real arm has a counterbalance
+        spring its URDF does not describe)."""
+        if self._legs is None:
+            self._legs = leg_joints(self.robot)
+        if self._links is None:
+            self._links = {link.name: link for link in self.robot.links}
+        over: list[tuple[str, float, float]] = []
+        for name, most in self._holding.items():
+            joint = by_name[name]
+            if is_wheel(joint, self._links):
+                continue  # a wheel's load is the robot's, which the floor carries
+            gravity = self.load(joint).gravity
+            if gravity > GRAVITY_FLOOR and gravity - joint.friction > most * (1.0 + 1e-9):
+                over.append((name, gravity, most))
+        if not over:
+            return
+        over.sort(key=lambda each: each[2] - each[1])
+        shown = ", ".join(f"{name} {need:.3g} > {most:.3g}" for name, need, most in over[:4])
+        legs = sum(1 for name, _, _ in over if name in self._legs)
+        share = f"; {legs} in legs, with the leg's share of the robot's weight standing" if legs else ""
+        where = by_name[over[0][0]].source or self.robot.source
+        self.ctx.note("MK868", f"{len(over)} joint(s) whose position servo's force limit is below the "
+                      f"gravity load it holds at home ({shown}; N·m, N for a slide{share}): the servo "
+                      "saturates and the robot sags off its home pose in any engine that applies the "
+                      "limit; a counterbalance the source does not describe, a larger effort limit or "
+                      "MuJoCo's body gravcomp holds it", where, "actuator")
 
     def _said_legs(self, on_joint: dict[str, Actuator]) -> None:
         """MK857: the source's motors leave a legged robot's legs limp; MK856: its home pose, which the
@@ -351,6 +384,10 @@ class ActuatorWriter:
             force = (-effort, effort)
         if force is not None:
             el.set("forcerange", fmt_vec(list(force)))
+        if kind is ActuatorKind.POSITION and (force is not None or limited):
+            # the joint gets gear × the actuator's force, clamped by its actuatorfrcrange (±effort)
+            most = max(abs(force[0]), abs(force[1])) * abs(actuator.gear) if force is not None else math.inf
+            self._holding[joint.name] = min(most, effort if limited else math.inf)
         if actuator.reduction != 1.0:
             self.ctx.note(
                 "MK843",
