@@ -408,6 +408,33 @@ def test_xml_declaration_as_tinyxml2_reads_it(tmp_path: Path, head: str, line: i
     assert [d.code for d in validate(path).errors] == ["MK020"]  # a real malformation stays an error
 
 
+def test_an_undeclared_namespace_prefix_in_a_urdf_is_a_warning_as_tinyxml2_reads_it(tmp_path: Path) -> None:
+    """airo-models' UR3e/UR5e URDFs carry Drake's ``drake:acceleration`` and
+    ``<drake:collision_filter_group>`` without declaring ``xmlns:drake``: urdfdom reads them (TinyXML2
+    ignores namespaces), lxml refuses the document. The robot is read, the warning points at the
+    first use, and converting it writes a file MuJoCo loads."""
+    path = tmp_path / "r.urdf"
+    limit = '\n    <limit effort="1" velocity="1" drake:acceleration="2"/>'
+    group = ('  <drake:collision_filter_group name="g"><drake:member link="arm"/>'
+             '</drake:collision_filter_group>\n')
+    text = _TRIANGLE_URDF.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/>' + limit)
+    path.write_text(text.replace("</robot>", group + "</robot>"))
+    assert check_urdf_accepts(path)[0]
+    v = validate(path)
+    assert v.errors == []
+    (d,) = [d for d in v.diagnostics if d.code == "MK020"]
+    assert d.severity.value == "warning" and "drake:" in d.message and 'xmlns:drake="http' in (d.hint or "")
+    assert d.location is not None and (d.location.line, d.location.col) == (8, 36)  # drake:acceleration
+    assert [r.name for r in v.robots] == ["r"] and len(v.robots[0].links) == 2
+    mujoco = pytest.importorskip("mujoco")
+    from modelkit.convert.api import write
+
+    write(v.robots[0], tmp_path / "out" / "r.xml", force=True)
+    assert mujoco.MjModel.from_xml_path(str(tmp_path / "out" / "r.xml")).joint("j").type == 3  # a hinge
+    path.write_text(path.read_text().replace("</robot>", "<bad></robot>"))
+    assert [d.code for d in validate(path).errors] == ["MK020"]  # a real malformation stays an error
+
+
 def test_package_uri_found_beside_the_model_as_pybullet_looks(tmp_path: Path) -> None:
     """``package://NAME/REL`` with no package NAME anywhere: PyBullet reads NAME/REL beside the file."""
     (tmp_path / "arm_description" / "meshes").mkdir(parents=True)

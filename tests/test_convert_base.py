@@ -242,3 +242,64 @@ def test_our_urdf_of_a_robot_on_a_caster_floats_again(tmp_path: Path) -> None:
     assert "MK825" in result.output  # the wheels' <option> and stiff contact
     model = mujoco.MjModel.from_xml_path(str(mjcf))
     assert model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE
+
+
+def _tree_urdf(root: str, joints: list[tuple[str, str, str]]) -> str:
+    """A URDF of boxes: each (parent, child, joint origin xyz) a revolute joint about y; every link a
+    1 kg box 5 cm wide around its frame, a foot (``*_foot``) a flat sole 20 × 10 × 3 cm."""
+    inertial = ('<inertial><mass value="1"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" '
+                'iyz="0"/></inertial>')
+    def box(name: str) -> str:
+        size = "0.2 0.1 0.03" if name.endswith("_foot") else "0.05 0.05 0.05"
+        return f'<collision><geometry><box size="{size}"/></geometry></collision>'
+
+    names = [root] + [child for _, child, _ in joints]
+    links = [f'<link name="{name}">{inertial}{box(name)}</link>' for name in names]
+    moving = [f'<joint name="{child}_joint" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+              f'<origin xyz="{xyz}"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="100" '
+              'velocity="1"/></joint>' for parent, child, xyz in joints]
+    return f'<robot name="r">{"".join(links)}{"".join(moving)}</robot>'
+
+
+def _limb(parent: str, names: list[str], first: str, step: str) -> list[tuple[str, str, str]]:
+    """A chain of joints from ``parent``: the first at ``first``, each next one ``step`` below."""
+    chain, above = [], parent
+    for i, name in enumerate(names):
+        chain.append((above, name, first if i == 0 else step))
+        above = name
+    return chain
+
+
+def test_a_biped_rooted_at_its_torso_stands_on_legs_below_a_waist(tmp_path: Path) -> None:
+    """OpenLoong (fourier-robot-descriptions' ``qinglong.urdf``) hangs its legs from three waist joints
+    below its torso, the root: the legs part below the root's frame with more joints each than the
+    waist has, so the robot floats. Before, the feet rule wanted the legs to part at the root itself,
+    and the humanoid was welded in the air by its torso."""
+    waist = _limb("torso", ["waist_pitch", "waist_roll", "pelvis"], "0 0 -0.05", "0 0 -0.05")
+    legs = [joint for side, y in (("l", "0.1"), ("r", "-0.1"))
+            for joint in _limb("pelvis", [f"{side}_hip", f"{side}_knee", f"{side}_ankle", f"{side}_foot"],
+                               f"0 {y} -0.05", "0 0 -0.3")]
+    arms = [joint for side, y in (("la", "0.2"), ("ra", "-0.2"))
+            for joint in _limb("torso", [f"{side}_shoulder", f"{side}_elbow", f"{side}_wrist"],
+                               f"0 {y} 0.1", "0 0 -0.25")]
+    path = tmp_path / "biped.urdf"
+    path.write_text(_tree_urdf("torso", waist + legs + arms))
+    robot = validate(path).robot
+    assert robot is not None
+    decision = decide(robot)
+    assert decision.kind is JointType.FLOATING, decision.reason
+    assert 'feet "l_foot", "r_foot"' in decision.reason
+    # the same legs parting above the torso's frame (a waist that rises first) are not taken for legs
+    raised = [("torso", "waist_pitch", "0 0 0.3"), *waist[1:]]
+    path.write_text(_tree_urdf("torso", raised + legs + arms))
+    robot = validate(path).robot
+    assert robot is not None and decide(robot).kind is JointType.FIXED
+
+def test_an_upper_body_whose_arms_hang_below_its_pelvis_stays_welded() -> None:
+    """Alex (example-robot-data): its arms part after three spine joints, at shoulders 0.43 m above the
+    pelvis (the root), and reach lower than the pelvis: hands, not feet."""
+    source = example_robot("alex_description/urdf/alex_nub_hands.urdf")
+    robot = validate(source).robot
+    assert robot is not None
+    decision = decide(robot)
+    assert decision.kind is JointType.FIXED, decision.reason

@@ -17,8 +17,10 @@ with a fixed joint, or no ``world`` link; .body: ``jointType: fixed|free``).
     differential-drive robots: the tutorial's robot written to URDF came back welded);
   - otherwise a robot whose root's own rigid body (the root and what is fixed to it) touches the
     lowest level rests on its base: welded (arms, fixtures);
-  - legs: at least two branches (from different first moving joints below the root) whose shapes
-    touch the lowest level through two or more moving joints: floating;
+  - legs: at least two branches whose shapes touch the lowest level through two or more moving
+    joints each, parting from each other with at least two moving joints on each side (two legs from
+    the root; or from a waist, each then with at least as many joints as the waist and starting below
+    the root's frame): floating;
   - legs that do not reach the ground at q = 0 (folded or sideways, as some quadrupeds are modelled):
     four or more limbs of two or more moving joints in a row hanging from the root's rigid body (four
     legs, or two legs and two arms; an arm has one, a dual-arm torso two or three): floating. A limb
@@ -196,7 +198,10 @@ def decide(robot: Robot) -> BaseDecision:
     if any(not moving for moving in above.values()):
         return _by_limbs(limbs, "the root's own body rests on the ground (an arm or a fixture"
                          + (f"; {raised} limb(s) point up, as a hand's fingers do" if raised else "") + ")")
-    feet = _feet(above)
+    root_z = float(poses[robot.root].translation[2]) if robot.root in poses else 0.0
+    below_root = {j.name for j in robot.joints
+                  if j.child in poses and float(poses[j.child].translation[2]) < root_z}
+    feet = _feet(above, below_root)
     if len(feet) >= 2:
         shown = ", ".join(f'"{name}"' for name in feet[:6])
         return BaseDecision(JointType.FLOATING, f"it stands on {len(feet)} legs (feet {shown} touch the "
@@ -326,11 +331,30 @@ def _moving_above(parent_joint: dict[str, Joint], name: str) -> list[Joint]:
     return moving
 
 
-def _feet(above: dict[str, list[Joint]]) -> list[str]:
-    """One touching link per branch (named by its first moving joint below the root) that reaches the
-    ground through ≥ 2 moving joints."""
-    by_branch: dict[str, str] = {}
-    for name, moving in above.items():
-        if len(moving) >= 2:
-            by_branch.setdefault(moving[-1].name, name)
-    return [by_branch[key] for key in sorted(by_branch)]
+def _feet(above: dict[str, list[Joint]], below_root: set[str]) -> list[str]:
+    """One touching link per leg among those that reach the ground through ≥ 2 moving joints (in the order
+    of the legs' first joints, then of link names). Two such links are on different legs where their
+    paths from the root part with at least two moving joints on each side; where the paths share
+    joints (legs from a waist), each side must have at least as many as they share and start below
+    the root's frame (``below_root``: the moving joints whose frames are lower). OpenLoong's
+    torso-rooted humanoid parts so (3 waist joints, then 6 in each leg, hips 0.17 m below the torso's
+    frame); a foot's heel and toe do not (one joint apart), nor an arm's two fingers (7 arm joints
+    shared), nor Alex's arms hanging beside its pelvis (their shoulders 0.43 m above it)."""
+    paths = {name: [j.name for j in reversed(moving)] for name, moving in above.items() if len(moving) >= 2}
+    feet: list[str] = []
+    for name in sorted(paths, key=lambda each: (paths[each][0], each)):
+        path = paths[name]
+        if all(_apart(path, paths[other], below_root) for other in feet):
+            feet.append(name)
+    return feet
+
+
+def _apart(one: list[str], two: list[str], below_root: set[str]) -> bool:
+    """Whether two root-first paths of moving joints are on different legs (:func:`_feet`)."""
+    shared = 0
+    while shared < min(len(one), len(two)) and one[shared] == two[shared]:
+        shared += 1
+    rest = min(len(one), len(two)) - shared
+    if shared == 0:
+        return rest >= 2
+    return rest >= max(2, shared) and one[shared] in below_root and two[shared] in below_root

@@ -2,9 +2,8 @@
 
 SDF files often use namespaced custom elements (``<gz:...>``, ``<ignition:...>``) without
 declaring the prefix: libsdformat's XML parser (tinyxml2) ignores namespaces, lxml refuses the
-document. When that is the only problem, the undeclared prefixes are declared on the root element
-(at the end of its start tag, so line numbers and the columns of every other line are unchanged)
-and the document is parsed again.
+document. When that is the only problem the prefixes are declared (:mod:`modelkit.xml_prefixes`),
+silently: every SDF consumer reads the file through libsdformat.
 """
 
 from __future__ import annotations
@@ -15,8 +14,8 @@ from pathlib import Path
 
 from modelkit.diagnostics import DiagnosticSink, Severity
 from modelkit.formats.sdf.values import Values, local_name
-from modelkit.textio import UnreadableFile, read_regular
-from modelkit.xmlsource import XmlDocument, mask_markup, parse_xml_bytes, read_xml, tag_end
+from modelkit.xml_prefixes import read_declaring_prefixes
+from modelkit.xmlsource import XmlDocument
 
 MIN_VERSION = (1, 2)
 MAX_VERSION = (1, 12)
@@ -25,9 +24,6 @@ SUPPORTED = "1.2-1.12"
 # only world <physics> elements move, so modelkit reads them with the semantics of 1.4.
 OLDEST_SEMANTICS = (1, 4)
 _VERSION = re.compile(r"\s*(\d+)\.(\d+)\s*")
-_PREFIXED = re.compile(r"(?:<|\s)([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*")
-_DECLARED = re.compile(r"xmlns:([A-Za-z_][\w.-]*)\s*=")
-_ENCODING = re.compile(r"<\?xml[^>]*encoding\s*=\s*[\"']([^\"']+)", re.IGNORECASE)
 
 
 @dataclass
@@ -66,7 +62,7 @@ def load_document(path: Path, display: str, sink: DiagnosticSink, max_bytes: int
     An unsupported or missing version is reported, and reading goes on with the nearest version
     modelkit knows, so that the rest of the file is still checked.
     """
-    doc = _read(path, display, sink, max_bytes)
+    doc = read_declaring_prefixes(path, display, sink, max_bytes).doc
     if doc is None:
         return None
     root = doc.root
@@ -102,50 +98,3 @@ def load_document(path: Path, display: str, sink: DiagnosticSink, max_bytes: int
             severity=Severity.INFO,
         )
     return SdfDocument(doc, path, max(version, OLDEST_SEMANTICS), values)
-
-
-def _read(path: Path, display: str, sink: DiagnosticSink, max_bytes: int) -> XmlDocument | None:
-    first = DiagnosticSink()
-    doc = read_xml(path, first, max_bytes, display)
-    if doc is not None:
-        sink.extend(first.items)
-        return doc
-    if not any(d.code == "MK020" and "Namespace prefix" in d.message for d in first.items):
-        sink.extend(first.items)
-        return None
-    try:
-        text = read_regular(path, max_bytes).decode("utf-8")
-    except (UnreadableFile, UnicodeDecodeError):
-        sink.extend(first.items)
-        return None
-    declared = _declare_prefixes(text)
-    if declared is None:
-        sink.extend(first.items)
-        return None
-    second = DiagnosticSink()
-    doc = parse_xml_bytes(declared.encode("utf-8"), display, second, path)
-    sink.extend(second.items)
-    return doc
-
-
-def _declare_prefixes(text: str) -> str | None:
-    """``text`` with every undeclared namespace prefix declared on the root element."""
-    encoding = _ENCODING.search(text)
-    if encoding and encoding.group(1).lower().replace("_", "-") not in ("utf-8", "utf8"):
-        return None
-    masked = mask_markup(text)
-    start = masked.find("<")
-    while start >= 0 and masked[start + 1 : start + 2] in ("!", "?", ""):
-        start = masked.find("<", start + 1)
-    if start < 0:
-        return None
-    end = tag_end(masked, start)
-    if end >= len(masked):
-        return None
-    prefixes = {m.group(1) for m in _PREFIXED.finditer(masked)} - {"xml", "xmlns", "http", "https"}
-    prefixes -= set(_DECLARED.findall(masked))
-    if not prefixes:
-        return None
-    insert = "".join(f' xmlns:{p}="urn:modelkit:undeclared:{p}"' for p in sorted(prefixes))
-    at = end - 1 if masked[end - 1] == "/" else end
-    return text[:at] + insert + text[at:]

@@ -28,17 +28,38 @@ from modelkit.formats.urdf.schema import check_structure
 from modelkit.formats.urdf.values import VERSIONS, Context
 from modelkit.limits import too_many_links
 from modelkit.model import WORLD_LINK, Joint, JointType, Link, Robot
-from modelkit.xmlsource import XmlDocument, location_at, read_xml
+from modelkit.xml_prefixes import Declared, read_declaring_prefixes
+from modelkit.xmlsource import XmlDocument, location_at
+
+# the URIs the tools that own these prefixes declare
+_KNOWN_NAMESPACES = {"drake": "http://drake.mit.edu", "xacro": "http://www.ros.org/wiki/xacro"}
 
 
 def read_urdf(path: Path, options: ReadOptions, display: str) -> ReadResult:
     """Read a URDF file into a :class:`Robot` (None when the file is not a readable URDF)."""
     sink = DiagnosticSink()
-    doc = read_xml(path, sink, options.max_bytes, display, keep_blank_text=False)  # never written back
+    read = read_declaring_prefixes(path, display, sink, options.max_bytes, keep_blank_text=False)
+    doc = read.doc  # never written back: whitespace between elements is dropped
+    _said_prefixes(read, sink)
     robot = None
     if doc is not None:
         robot = read_urdf_document(doc, options, sink, path.parent, path)
     return ReadResult(robot, sorted_diagnostics(sink.items))
+
+
+def _said_prefixes(read: Declared, sink: DiagnosticSink) -> None:
+    """MK020 (a warning): the file uses namespace prefixes it does not declare (airo-models' URDFs and
+    their Drake extensions); TinyXML2's readers take it, xacro and lxml refuse it."""
+    if not read.prefixes or read.first_use is None:
+        return
+    shown = ", ".join(f"{p}:" for p in read.prefixes)
+    first = read.prefixes[0]
+    sink.emit("MK020", f"namespace prefix(es) {shown} used without an xmlns declaration: urdfdom "
+              "(check_urdf, robot_state_publisher), PyBullet, MuJoCo, Drake and libsdformat (TinyXML2) "
+              "ignore namespaces and read the file; namespace-aware XML parsers refuse it (xacro: "
+              "\"unbound prefix\"; lxml, so urdf_parser_py; yourdfpy retries and reads it)", read.first_use,
+              hint=f'declare it on <robot>, e.g. xmlns:{first}="{_KNOWN_NAMESPACES.get(first, "...")}"',
+              severity=Severity.WARNING)
 
 
 def read_urdf_document(
