@@ -246,11 +246,13 @@ def test_our_urdf_of_a_robot_on_a_caster_floats_again(tmp_path: Path) -> None:
 
 def _tree_urdf(root: str, joints: list[tuple[str, str, str]]) -> str:
     """A URDF of boxes: each (parent, child, joint origin xyz) a revolute joint about y; every link a
-    1 kg box 5 cm wide around its frame, a foot (``*_foot``) a flat sole 20 × 10 × 3 cm."""
+    1 kg box 5 cm wide around its frame, a foot (``*_foot``) a flat sole 20 × 10 × 3 cm, a ``palm``
+    10 × 8 × 6 cm."""
     inertial = ('<inertial><mass value="1"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" '
                 'iyz="0"/></inertial>')
     def box(name: str) -> str:
         size = "0.2 0.1 0.03" if name.endswith("_foot") else "0.05 0.05 0.05"
+        size = "0.1 0.08 0.06" if name == "palm" else size
         return f'<collision><geometry><box size="{size}"/></geometry></collision>'
 
     names = [root] + [child for _, child, _ in joints]
@@ -303,3 +305,21 @@ def test_an_upper_body_whose_arms_hang_below_its_pelvis_stays_welded() -> None:
     assert robot is not None
     decision = decide(robot)
     assert decision.kind is JointType.FIXED, decision.reason
+
+
+def test_a_hand_whose_fingers_point_sideways_is_welded_not_legged(tmp_path: Path) -> None:
+    """fourier-robot-descriptions' and Inspire's hands are modelled with the fingers level with the palm
+    at q = 0: five limbs of two or more joints that do not point up, which the limbs rule took for
+    legs (floated, "a legged robot"). Legs start around the body's centre of mass, a hand's fingers
+    at one end of the palm: welded. A quadruped with its legs sideways (vision60) still floats."""
+    fingers = [joint for i, y in enumerate(("-0.03", "-0.015", "0", "0.015", "0.03"))
+               for joint in _limb("palm", [f"f{i}_a", f"f{i}_b", f"f{i}_c"], f"0.06 {y} 0", "0.04 0 0")]
+    path = tmp_path / "hand.urdf"
+    path.write_text(_tree_urdf("palm", fingers))
+    robot = validate(path).robot
+    assert robot is not None
+    decision = decide(robot)
+    assert decision.kind is JointType.FIXED, decision.reason
+    assert "5 limbs" in decision.reason and "one end of its body" in decision.reason
+    quadruped = validate(VISION60).robot
+    assert quadruped is not None and decide(quadruped).kind is JointType.FLOATING

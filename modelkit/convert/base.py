@@ -23,9 +23,11 @@ with a fixed joint, or no ``world`` link; .body: ``jointType: fixed|free``).
     the root's frame): floating;
   - legs that do not reach the ground at q = 0 (folded or sideways, as some quadrupeds are modelled):
     four or more limbs of two or more moving joints in a row hanging from the root's rigid body (four
-    legs, or two legs and two arms; an arm has one, a dual-arm torso two or three): floating. A limb
-    that points up at q = 0 (its links rise above its first joint by more than half its reach, as a
-    hand's fingers do) is not a leg: a hand on its palm is welded, not floated;
+    legs, or two legs and two arms; an arm has one, a dual-arm torso two or three) that start around
+    the body's centre of mass: floating. A limb that points up at q = 0 (its links rise above its
+    first joint by more than half its reach, as a hand's fingers do) is not a leg: a hand on its palm
+    is welded, not floated; so is a hand whose fingers lie level with the palm (they start at one end
+    of it);
   - a robot without moving joints (an object: a cube, a mug) floats, as URDF's convention has it;
   - a robot without mass is welded (it cannot float in a simulator); one without any shape floats
     (nothing to judge by: URDF's own convention, so a URDF round trip keeps a floating root).
@@ -196,7 +198,7 @@ def decide(robot: Robot) -> BaseDecision:
         return BaseDecision(JointType.FLOATING, f"it drives on wheels (joint(s) {shown}: a round shape "
                             f"on a horizontal axis touching the ground{caster})")
     if any(not moving for moving in above.values()):
-        return _by_limbs(limbs, "the root's own body rests on the ground (an arm or a fixture"
+        return _by_limbs(robot, poses, limbs, "the root's own body rests on the ground (an arm or a fixture"
                          + (f"; {raised} limb(s) point up, as a hand's fingers do" if raised else "") + ")")
     root_z = float(poses[robot.root].translation[2]) if robot.root in poses else 0.0
     below_root = {j.name for j in robot.joints
@@ -206,16 +208,53 @@ def decide(robot: Robot) -> BaseDecision:
         shown = ", ".join(f'"{name}"' for name in feet[:6])
         return BaseDecision(JointType.FLOATING, f"it stands on {len(feet)} legs (feet {shown} touch the "
                             "ground, the root's body does not)")
-    return _by_limbs(limbs, "no wheels or legs touch the ground (an arm or a fixture)")
+    return _by_limbs(robot, poses, limbs, "no wheels or legs touch the ground (an arm or a fixture)")
 
 
-def _by_limbs(limbs: list[str], otherwise: str) -> BaseDecision:
-    """Legs that do not reach the ground at q = 0 (folded, or sideways): four or more limbs."""
-    if len(limbs) >= LIMBS:
-        shown = ", ".join(f'"{name}"' for name in limbs[:6])
-        return BaseDecision(JointType.FLOATING, f"it has {len(limbs)} limbs of two or more moving joints "
-                            f"each from its body (first joints {shown}): a legged robot")
-    return BaseDecision(JointType.FIXED, otherwise)
+def _by_limbs(robot: Robot, poses: dict[str, Pose], limbs: list[str], otherwise: str) -> BaseDecision:
+    """Legs that do not reach the ground at q = 0 (folded, or sideways): four or more limbs that start
+    around the body's centre of mass (:func:`_around_body`); a hand's fingers start at one end of it."""
+    if len(limbs) < LIMBS:
+        return BaseDecision(JointType.FIXED, otherwise)
+    shown = ", ".join(f'"{name}"' for name in limbs[:6])
+    if not _around_body(robot, poses, limbs):
+        return BaseDecision(JointType.FIXED, f"its {len(limbs)} limbs of two or more moving joints (first "
+                            f"joints {shown}) start at one end of its body, as a hand's fingers do, not "
+                            "around its centre of mass as legs do (an arm's end or a fixture)")
+    return BaseDecision(JointType.FLOATING, f"it has {len(limbs)} limbs of two or more moving joints "
+                        f"each from its body (first joints {shown}): a legged robot")
+
+
+LIMBS_AROUND = 0.25  # of their spread: how far the limbs' first joints' centroid may be from the body's COM
+
+
+def _around_body(robot: Robot, poses: dict[str, Pose], limbs: list[str]) -> bool:
+    """Whether the limbs' first joints lie around the root body's centre of mass (the root and what is
+    fixed to it; the root's frame when that body has no mass): their centroid within
+    :data:`LIMBS_AROUND` of their spread from it. A quadruped's hips: 0.00 (vision60, Spirit 40 with
+    legs sideways or folded); the fingers of fourier-robot-descriptions' and Inspire's hands: 0.49 to
+    2.5 (hands modelled pointing sideways, whose fingers do not point up at q = 0)."""
+    by_name = {joint.name: joint for joint in robot.joints}
+    firsts = np.array([poses[by_name[name].child].translation for name in limbs
+                       if by_name[name].child in poses])
+    if len(firsts) == 0 or robot.root not in poses:
+        return True
+    children = robot.children_of()
+    links = {link.name: link for link in robot.links}
+    body, mass, moment = [robot.root], 0.0, np.zeros(3)
+    while body:
+        name = body.pop()
+        link = links.get(name)
+        if link is not None and link.inertial is not None and name in poses and link.inertial.mass > 0.0:
+            pose = poses[name]
+            com = np.asarray(pose.rotation) @ np.asarray(link.inertial.com) + np.asarray(pose.translation)
+            mass += float(link.inertial.mass)
+            moment += float(link.inertial.mass) * com
+        body.extend(joint.child for joint in children.get(name, []) if not joint.type.moves)
+    centre = moment / mass if mass > 0.0 else np.asarray(poses[robot.root].translation, dtype=float)
+    centroid = firsts.mean(axis=0)
+    spread = float(np.max(np.linalg.norm(firsts - centroid, axis=1)))
+    return spread <= 0.0 or float(np.linalg.norm(centroid - centre)) <= LIMBS_AROUND * spread
 
 
 def _limbs(robot: Robot) -> list[str]:
