@@ -213,3 +213,44 @@ def test_a_corpus_gripper_pybullet_refuses_by_rounding_verifies(tmp_path: Path) 
     assert replay.error < 1e-12, replay.detail
     said = [s.reason for s in report.skips if s.engine == "pybullet" and "by rounding" in s.reason]
     assert said and "Finger1_knuckle" in said[0] and "validate finds no fault" in said[0]
+
+
+# ARMAR-4's right shoulder (armar 1.1.0 on PyPI): ixx 0 beside iyy 0.0575 and izz 0.0195, singular and
+# off the triangle bound at once; and its ankles' collision spheres of radius 0.
+ARMAR_LIKE = """<?xml version="1.0"?>
+<robot name="armar_like">
+  <link name="base"><inertial><mass value="2"/><inertia ixx="0.02" iyy="0.02" izz="0.02" ixy="0" ixz="0"
+    iyz="0"/></inertial>
+    <collision><geometry><sphere radius="0.00"/></geometry></collision>
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <link name="sho3"><inertial><origin xyz="0 -0.0575318 0.0134998"/><mass value="0.51"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0.0575321" iyz="0" izz="0.0195"/></inertial></link>
+  <joint name="world_mount" type="fixed"><parent link="world"/><child link="base"/></joint>
+  <link name="world"/>
+  <joint name="sho3_joint" type="revolute"><parent link="base"/><child link="sho3"/><axis xyz="0 0 1"/>
+    <origin xyz="0 0 0.2" rpy="0.3 0.2 0"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+</robot>
+"""
+
+
+def test_a_tensor_singular_and_off_the_triangle_and_a_radius_0_sphere_are_source_findings(
+        tmp_path: Path) -> None:
+    """The MJCF writer adds 1e-9 per axis (singular) and then raises the two smaller moments (a + b ≥
+    c), both MK870; layer 1 expected only the first and failed ARMAR-4 at 0.33 (and its mass matrix
+    and bias by 7e-3). The sphere of radius 0 (validate's MK416), which MuJoCo refuses and the writer
+    leaves out (MK871), failed MuJoCo's shape-set. Both are now the source's findings, said."""
+    path = tmp_path / "armar_like.urdf"
+    path.write_text(ARMAR_LIKE)
+    report = verify(path, engines=("mujoco", "pybullet", "pinocchio"), configurations=3, samples=3,
+                    driven=False)
+    assert not report.errors
+    assert [c for c in report.checks if not c.passed] == [], [c for c in report.checks if not c.passed]
+    (inertia,) = [c for c in report.checks if c.engine == "mujoco" and c.quantity == "inertia"]
+    assert inertia.error < 1e-12
+    (said,) = [s for s in report.skips if s.engine == "mujoco" and "MK302" in s.reason]
+    assert "sho3" in said.reason and "a + b = c" in said.reason
+    (shape,) = [s for s in report.skips if s.engine == "mujoco" and "MK416" in s.reason]
+    assert "base" in shape.reason and "MK871" in shape.reason
+    (shape_set,) = [c for c in report.checks if c.engine == "mujoco" and c.quantity == "shape-set"]
+    assert shape_set.error == 0.0
+    assert not [s for s in report.skips if s.engine == "pybullet" and "MK416" in s.reason]  # a point there

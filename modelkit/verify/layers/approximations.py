@@ -177,10 +177,14 @@ def zero_inertias(fmt: str, notes: Iterable[ConversionNote], renames: Renames, s
 
     back = _source_names(renames)
     lifted: set[str] = set()
+    balanced: set[str] = set()  # then raised to satisfy the triangle inequality too (ARMAR-4's armr_sho3)
     for note in notes:
         match = re.fullmatch(r"body\[(.+)\]/inertial", note.target or "")
-        if fmt == "mjcf" and note.code == "MK870" and "singular" in note.message and match:
-            lifted.add(back.get(match[1], match[1]))
+        if fmt == "mjcf" and note.code == "MK870" and match:
+            if "singular" in note.message:
+                lifted.add(back.get(match[1], match[1]))
+            elif "violate a + b" in note.message:
+                balanced.add(back.get(match[1], match[1]))
     out: dict[str, Approximated] = {}
     with length_scale(length_scale_of(source)):
         for link in source.links:
@@ -195,13 +199,17 @@ def zero_inertias(fmt: str, notes: Iterable[ConversionNote], renames: Renames, s
                 continue
             held = clean_inertia(tensor, float(link.inertial.mass))
             if link.name in lifted:
-                from modelkit.formats.mjcf.write_bodies import MIN_INERTIA
+                from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, mujoco_valid_inertia
 
                 held = held + MIN_INERTIA * np.eye(3)
+                if link.name in balanced:
+                    held = np.asarray(mujoco_valid_inertia(held)[0], dtype=float)
             if np.array_equal(held, tensor):
                 continue
             by = ("the MJCF writer, writing the dust as 0 and adding 1e-9 kg·m² per axis (MK870)"
                   if link.name in lifted else "the writer, printing the dust as 0 (clean numbers)")
+            if link.name in lifted and link.name in balanced:
+                by += ", then raising the two smaller principal moments to a + b = c (MK870)"
             out[link.name] = Approximated(link.name, float(link.inertial.mass), 0.0, code, by,
                                           tuple(float(v) for v in held.ravel()))
     return out

@@ -17,8 +17,11 @@ the links, naming the source link:
 
 A primitive the engine's file format cannot hold (a cone anywhere; capsule and ellipsoid in URDF)
 is written as a mesh by every writer (with a note): it is expected as a mesh of scale 1 at the same
-pose. A source mesh whose file is missing is left out (the writers drop it, MK805). Engines that
-report no shapes (Pinocchio, yourdfpy, Drake) get a Skip saying so, and so does a missing mesh.
+pose. A source mesh whose file is missing is left out (the writers drop it, MK805), and so is, for
+MuJoCo, a primitive with a size that is not positive (validate's MK416: a sphere of radius 0, which
+MuJoCo refuses and the MJCF writer leaves out, MK871; PyBullet collides with a point there, so it is
+compared there). Engines that report no shapes (Pinocchio, yourdfpy, Drake) get a Skip saying so,
+and so do the shapes left out.
 """
 
 from __future__ import annotations
@@ -43,6 +46,8 @@ MESHED: dict[str, tuple[str, ...]] = {
 }
 DEFAULT_MESHED = ("capsule", "cone", "ellipsoid")
 MISSING = "missing-mesh"  # a source mesh whose file is not there: no writer can write it (MK805)
+# engines whose file cannot hold a primitive with a size that is not positive (the writer leaves it out)
+REFUSE_DEGENERATE = ("mujoco",)
 _BOX_TURNS = [np.diag(d) for d in ((1.0, 1.0, 1.0), (1.0, -1.0, -1.0), (-1.0, 1.0, -1.0), (-1.0, -1.0, 1.0))]
 
 
@@ -87,6 +92,16 @@ def expected(shape: ShapeFacts, meshed: tuple[str, ...]) -> ShapeFacts:
     return shape
 
 
+def _degenerate(shape: ShapeFacts) -> bool:
+    """A primitive with a size that is not positive (a sphere of radius 0: validate's MK416)."""
+    size = np.asarray(shape.size, dtype=float)
+    return shape.type not in ("mesh", MISSING) and size.size > 0 and bool(np.any(size <= 0.0))
+
+
+def _refused(shape: ShapeFacts, engine: str) -> bool:
+    return engine in REFUSE_DEGENERATE and _degenerate(shape)
+
+
 def _pair_cost(a: ShapeFacts, b: ShapeFacts) -> tuple[float, float, float]:
     position = float(np.linalg.norm(a.pose.translation - b.pose.translation))
     rotation = rotation_error(a.type, a.pose.rotation, b.pose.rotation)
@@ -117,7 +132,7 @@ def compare(source: StaticFacts, facts: StaticFacts, eng: Loaded) -> list[Check]
         got = facts.shapes.get(eng.link(link))
         if got is None:
             continue  # a missing link: the link-set check reports it
-        want = [expected(s, meshed) for s in source_shapes if s.type != MISSING]
+        want = [expected(s, meshed) for s in source_shapes if s.type != MISSING and not _refused(s, label)]
         unmatched = 0
         for kind in sorted({s.type for s in want} | {s.type for s in got}):
             a = [s for s in want if s.type == kind]
@@ -170,9 +185,17 @@ def skips(source: StaticFacts, eng: Loaded) -> list[Skip]:
         why = " (it is built from the source model itself)" if eng.label == "pinocchio" else ""
         return [Skip(1, eng.label, f"{eng.label} reports no collision shapes{why}: shape-set, shape-size and "
                                    "shape-pose not compared for it")]
+    out = []
     missing = [link for link, shapes in source.shapes.items() for s in shapes if s.type == MISSING]
-    if not missing:
-        return []
-    return [Skip(1, eng.label, f"{len(missing)} collision mesh(es) of the source not compared: the file is "
-                               f"missing, so no writer could write it (MK805); links: "
-                               f"{', '.join(sorted(set(missing)))}")]
+    if missing:
+        out.append(Skip(1, eng.label, f"{len(missing)} collision mesh(es) of the source not compared: the "
+                                      "file is missing, so no writer could write it (MK805); links: "
+                                      f"{', '.join(sorted(set(missing)))}"))
+    refused = [link for link, shapes in source.shapes.items() for s in shapes if _refused(s, eng.label)]
+    if refused:
+        links = ", ".join(sorted(set(refused)))
+        out.append(Skip(1, eng.label, f"source finding MK416: {len(refused)} collision primitive(s) of the "
+                                      f"source with a size that is not positive (links: {links}), which "
+                                      f"{eng.label} refuses and the writer leaves out (MK871): not compared, "
+                                      "not a conversion fault"))
+    return out
