@@ -6,6 +6,7 @@ zero tensor and says so with the code."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -78,13 +79,19 @@ def test_drake_is_held_to_a_replacement_only_where_drake_refuses(tmp_path: Path)
     assert set(approximations.refused_inertias("pybullet", "urdf", robot)) == {"link_puller", "bad"}
 
 
-def test_pybullet_refusing_the_source_inertia_is_no_conversion_fail(tmp_path: Path) -> None:
-    path = tmp_path / "go1_like.urdf"
-    path.write_text(GO1_LIKE)
+def _passes(path: Path, text: str) -> Any:
+    """verify's report on ``text`` written at ``path`` (MuJoCo, PyBullet, Pinocchio; no driving),
+    asserted free of errors and failed checks."""
+    path.write_text(text)
     report = verify(path, engines=("mujoco", "pybullet", "pinocchio"), configurations=3, samples=3,
                     driven=False)
     assert not report.errors
     assert [c for c in report.checks if not c.passed] == [], [c for c in report.checks if not c.passed]
+    return report
+
+
+def test_pybullet_refusing_the_source_inertia_is_no_conversion_fail(tmp_path: Path) -> None:
+    report = _passes(tmp_path / "go1_like.urdf", GO1_LIKE)
     inertia = [c for c in report.checks if c.engine == "pybullet" and c.quantity == "inertia"]
     assert len(inertia) == 1 and inertia[0].error == 0.0
     (entry,) = [s for s in report.skips if s.engine == "pybullet" and "source finding MK302" in s.reason]
@@ -239,12 +246,7 @@ def test_a_tensor_singular_and_off_the_triangle_and_a_radius_0_sphere_are_source
     c), both MK870; layer 1 expected only the first and failed ARMAR-4 at 0.33 (and its mass matrix
     and bias by 7e-3). The sphere of radius 0 (validate's MK416), which MuJoCo refuses and the writer
     leaves out (MK871), failed MuJoCo's shape-set. Both are now the source's findings, said."""
-    path = tmp_path / "armar_like.urdf"
-    path.write_text(ARMAR_LIKE)
-    report = verify(path, engines=("mujoco", "pybullet", "pinocchio"), configurations=3, samples=3,
-                    driven=False)
-    assert not report.errors
-    assert [c for c in report.checks if not c.passed] == [], [c for c in report.checks if not c.passed]
+    report = _passes(tmp_path / "armar_like.urdf", ARMAR_LIKE)
     (inertia,) = [c for c in report.checks if c.engine == "mujoco" and c.quantity == "inertia"]
     assert inertia.error < 1e-12
     (said,) = [s for s in report.skips if s.engine == "mujoco" and "MK302" in s.reason]
