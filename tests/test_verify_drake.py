@@ -209,10 +209,19 @@ def test_unknown_root_and_bad_file_raise_clear_errors(tmp_path: Path) -> None:
 
 
 def test_parser_warnings_are_kept(tmp_path: Path) -> None:
-    """Drake only warns about an invalid inertia (a negative mass); the warning is kept for the report."""
+    """Drake only warns about an invalid inertia (a negative mass); the warning is kept for the report,
+    and not printed: verify on Hello Robot's Stretch put 19 "WARNING:drake:" lines on the terminal."""
     odd = tmp_path / "odd.sdf"
     odd.write_text('<sdf version="1.9"><model name="m"><link name="a"><inertial><mass>-1</mass>'
                    "</inertial></link></model></sdf>")
     model = engine_drake.load(odd, {}, root="a")
     assert any("invalid inertia" in w for w in model.warnings)
     assert model.settings["parser_warnings"] == model.warnings
+    # in a process of its own, as the CLI runs it (pytest captures Python's logging itself)
+    import subprocess
+    import sys
+
+    code = ("from pathlib import Path; from modelkit.verify.engines import drake; "
+            f"print(len(drake.load(Path({str(odd)!r}), {{}}, root='a').warnings))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert run.stdout.strip() != "0" and "invalid inertia" not in run.stderr, run.stderr

@@ -169,12 +169,20 @@ def _parse(plant: MultibodyPlant, path: Path) -> tuple[list[ModelInstanceIndex],
     logger = logging.getLogger("drake")
     collect = _Collect()
     logger.addHandler(collect)
+    # kept for the report, not printed: pydrake's own handler would put each on the terminal
+    propagate, logger.propagate = logger.propagate, False
+    own = [h for h in logger.handlers if h is not collect]
+    for handler in own:
+        logger.removeHandler(handler)
     try:
         instances = Parser(plant).AddModels(file_name=path)
     except Exception as exc:  # Drake raises RuntimeError with the parser's message
         raise DrakeLoadError(f"{path.name}: Drake could not parse the file: {exc}") from exc
     finally:
         logger.removeHandler(collect)
+        for handler in own:
+            logger.addHandler(handler)
+        logger.propagate = propagate
     return list(instances), collect.messages
 
 
