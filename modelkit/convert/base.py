@@ -61,6 +61,27 @@ class BaseDecision:
 
 
 
+def touching_ground(lows: dict[str, tuple[float, float]]) -> set[str]:
+    """The links (of :func:`vertical_spans`) whose shapes reach the lowest level: within 2 % of the
+    robot's height, at least 1 mm."""
+    if not lows:
+        return set()
+    ground = min(low for low, _ in lows.values())
+    tolerance = max(1e-3, 0.02 * (max(high for _, high in lows.values()) - ground))
+    return {name for name, (low, _) in lows.items() if low - ground <= tolerance}
+
+
+def root_body(robot: Robot) -> list[str]:
+    """The root's rigid body: the root link and every link hanging from it by fixed joints."""
+    children = robot.children_of()
+    body, stack = [], [robot.root or ""]
+    while stack:
+        name = stack.pop()
+        body.append(name)
+        stack.extend(joint.child for joint in children.get(name, []) if not joint.type.moves)
+    return body
+
+
 def vertical_spans(robot: Robot, poses: dict[str, Pose]) -> dict[str, tuple[float, float]]:
     """Link name → the lowest and highest world height of its collision shapes (its visuals when the
     robot has no collision shape at all), at ``poses``; links without shapes or pose are absent."""
@@ -182,10 +203,7 @@ def decide(robot: Robot) -> BaseDecision:
     if not lows:
         return BaseDecision(JointType.FLOATING, "it has no shape to judge by, so URDF's own convention "
                             "(a root that does not hang from `world` floats)")
-    ground = min(low for low, _ in lows.values())
-    height = max(high for _, high in lows.values()) - ground
-    tolerance = max(1e-3, 0.02 * height)
-    touching = {name for name, (low, _) in lows.items() if low - ground <= tolerance}
+    touching = touching_ground(lows)
     parent_joint = {joint.child: joint for joint in robot.joints}
     above = {name: _moving_above(parent_joint, name) for name in sorted(touching)}
     # Wheels first: a differential-drive robot's caster is often a shape of the root's own body that
@@ -239,18 +257,15 @@ def _around_body(robot: Robot, poses: dict[str, Pose], limbs: list[str]) -> bool
                        if by_name[name].child in poses])
     if len(firsts) == 0 or robot.root not in poses:
         return True
-    children = robot.children_of()
     links = {link.name: link for link in robot.links}
-    body, mass, moment = [robot.root], 0.0, np.zeros(3)
-    while body:
-        name = body.pop()
+    mass, moment = 0.0, np.zeros(3)
+    for name in root_body(robot):
         link = links.get(name)
         if link is not None and link.inertial is not None and name in poses and link.inertial.mass > 0.0:
             pose = poses[name]
             com = np.asarray(pose.rotation) @ np.asarray(link.inertial.com) + np.asarray(pose.translation)
             mass += float(link.inertial.mass)
             moment += float(link.inertial.mass) * com
-        body.extend(joint.child for joint in children.get(name, []) if not joint.type.moves)
     centre = moment / mass if mass > 0.0 else np.asarray(poses[robot.root].translation, dtype=float)
     centroid = firsts.mean(axis=0)
     spread = float(np.max(np.linalg.norm(firsts - centroid, axis=1)))
@@ -260,14 +275,7 @@ def _around_body(robot: Robot, poses: dict[str, Pose], limbs: list[str]) -> bool
 def _limbs(robot: Robot) -> list[str]:
     """The first moving joints below the root's rigid body whose subtree holds ≥ 2 moving joints in a row."""
     children = robot.children_of()
-    body = [robot.root or ""]
-    starts: list[Joint] = []
-    while body:  # the root's rigid body: the root and what hangs from it by fixed joints
-        for joint in children.get(body.pop(), []):
-            if joint.type.moves:
-                starts.append(joint)
-            else:
-                body.append(joint.child)
+    starts = [joint for name in root_body(robot) for joint in children.get(name, []) if joint.type.moves]
     return sorted(joint.name for joint in starts if _depth(children, joint.child) >= 1)
 
 

@@ -32,7 +32,15 @@ import math
 
 import numpy as np
 
-from modelkit.convert.base import LIMBS, _limbs, _moving_above, _points_up, _round_about, vertical_spans
+from modelkit.convert.base import (
+    LIMBS,
+    _limbs,
+    _moving_above,
+    _points_up,
+    _round_about,
+    touching_ground,
+    vertical_spans,
+)
 from modelkit.model import Joint, JointType, Link, Robot
 from modelkit.spatial import Pose
 
@@ -64,14 +72,8 @@ def _grounded(robot: Robot, poses: dict[str, Pose], children: dict[str, list[Joi
               firsts: list[Joint]) -> list[str]:
     """The limbs (by first joint) with a link that touches the ground at q = 0, as ``--base auto`` finds
     feet: within 2 % of the robot's height (at least 1 mm) of its lowest shape."""
-    lows = vertical_spans(robot, poses)
-    if not lows:
-        return []
-    ground = min(low for low, _ in lows.values())
-    tolerance = max(1e-3, 0.02 * (max(high for _, high in lows.values()) - ground))
-    return [first.name for first in firsts
-            if any(j.child in lows and lows[j.child][0] - ground <= tolerance
-                   for j in _below(children, first))]
+    touching = touching_ground(vertical_spans(robot, poses))
+    return [first.name for first in firsts if any(j.child in touching for j in _below(children, first))]
 
 
 def _below(children: dict[str, list[Joint]], first: Joint) -> list[Joint]:
@@ -147,11 +149,6 @@ def resting_on(robot: Robot, home: dict[str, float]) -> list[str]:
     if not leg_joints(robot):
         return []
     poses = robot.world_poses(home)
-    lows = vertical_spans(robot, poses)
-    if not lows:
-        return []
-    ground = min(low for low, _ in lows.values())
-    tolerance = max(1e-3, 0.02 * (max(high for _, high in lows.values()) - ground))
     parent_joint = {joint.child: joint for joint in robot.joints}
-    return sorted(name for name, (low, _) in lows.items()
-                  if low - ground <= tolerance and len(_moving_above(parent_joint, name)) < 2)
+    return sorted(name for name in touching_ground(vertical_spans(robot, poses))
+                  if len(_moving_above(parent_joint, name)) < 2)
