@@ -84,6 +84,64 @@ def test_find_drive_refuses_what_is_not_a_two_sided_robot(tmp_path: Path) -> Non
         find_drive(_robot("primitive"), Scenario(profiles=(), left="Left", right="RightWheel"))
 
 
+def _mesh_wheels(robot: Robot, folder: Path) -> None:
+    """The wheels' cylinders replaced by STL files of the same cylinders, held by path only (as a URDF
+    reader leaves a mesh: Hello Robot's Stretch)."""
+    import trimesh
+
+    from modelkit.model import Cylinder, Mesh
+
+    for link in robot.links:
+        for geom in link.collisions:
+            if link.name in ("LeftWheel", "RightWheel") and isinstance(geom.geometry, Cylinder):
+                stl = folder / f"{link.name}.stl"
+                trimesh.creation.cylinder(radius=geom.geometry.radius, height=geom.geometry.length,
+                                          sections=64).export(stl)
+                geom.geometry = Mesh(uri=stl.name, path=str(stl))
+
+
+def test_mesh_wheels_read_from_their_files_and_a_law_too_weak_for_them(tmp_path: Path) -> None:
+    """A wheel whose collision is a mesh file was not found (its vertices were never read), so layer
+    4 skipped Stretch as "not a two-wheeled robot". Found now, a wheel whose joint damping and friction
+    the seed's law (kd 0.5) cannot overcome (Stretch: 21.75 N·m·s, 10.48 N·m) is said as such."""
+    from modelkit.verify.drive.vehicle import drivable
+
+    robot = _robot("primitive")
+    _mesh_wheels(robot, tmp_path)
+    scenario = default_scenario()
+    drive = find_drive(robot, scenario)
+    assert (drive.left, drive.right) == ("LeftWheel", "RightWheel")
+    assert drive.radius == pytest.approx(0.076, abs=1e-7)  # STL holds float32
+    assert drive.half_axle == pytest.approx(0.145, abs=1e-7)
+    assert drivable(robot, drive, scenario) is None
+    for joint in robot.joints:
+        if joint.name in ("LeftWheel", "RightWheel"):
+            joint.damping, joint.friction = 21.75, 10.48
+    why = drivable(robot, drive, scenario)
+    assert why is not None and "cannot drive wheel joint LeftWheel" in why and "0% of the" in why
+    assert drivable(robot, drive, dataclasses.replace(scenario, kd=5000.0)) is None  # a scenario's kd
+
+
+def test_wheels_on_steering_joints_are_not_a_differential_drive() -> None:
+    """Dexmate's Vega turns its two drive wheels on steering joints: driving them as a differential
+    drive with the steering free graded a robot that cannot go straight (every layer 4 row failed)."""
+    from modelkit.model import Inertial, Joint, JointType, Link
+    from modelkit.spatial import Pose
+
+    robot = _robot("primitive")
+    for joint in list(robot.joints):
+        if joint.name in ("LeftWheel", "RightWheel"):
+            steer = f"{joint.name}Steer"
+            robot.links.append(Link(steer, Inertial(0.1, np.zeros(3), np.eye(3) * 1e-4)))
+            robot.joints.append(Joint(f"{steer}Joint", JointType.REVOLUTE, joint.parent, steer, joint.origin,
+                                      np.array([0.0, 0.0, 1.0])))
+            joint.parent, joint.origin = steer, Pose()
+    with pytest.raises(ValueError, match="not a differential drive: the wheel joint"):
+        find_drive(robot, default_scenario())
+    named = find_drive(robot, Scenario(profiles=(), left="LeftWheel", right="RightWheel"))
+    assert (named.left, named.right) == ("LeftWheel", "RightWheel")  # the user may still name them
+
+
 def test_the_scenario_may_name_the_joints_and_the_radius() -> None:
     scenario = Scenario(
         profiles=(),

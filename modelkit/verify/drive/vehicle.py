@@ -5,10 +5,13 @@ sentence saying why the model is not a two-sided wheeled or tracked robot (layer
 Skip). Everything is measured in the root link's frame at q = 0:
 
 * **wheels**: the two unlimited revolute joints whose child link has a round collision (a cylinder
-  whose axis lies along the joint axis, a sphere, or a mesh whose extent around the axis is round),
-  axes parallel to the root's Y, one on each side (mirrored in Y). Left is the one at +Y. The radius
-  comes from the collision (cylinder or sphere radius, half the mesh's extent across the axis); the
-  half axle width b is half the distance between the two collision centres along Y. ``signs``: +1
+  whose axis lies along the joint axis, a sphere, or a mesh whose extent around the axis is round,
+  read from its file when the model holds only the path: Hello Robot's Stretch), axes parallel to
+  the root's Y, hanging from the root's rigid body (not from a steering joint or a leg), one on each
+  side (mirrored in Y); :func:`drivable` then says when the scenario's wheel law cannot turn them.
+  Left is the one at +Y. The radius comes from the collision (cylinder or sphere radius, half the
+  mesh's extent across the axis); the half axle width b is half the distance between the two
+  collision centres along Y. ``signs``: +1
   when the joint axis points along +Y (a positive rotation then rolls the wheel forward, towards +X),
   −1 when it points along −Y. The scenario may name the joints and give the radius and b instead.
 * **tracks** (Choreonoid's ``PSEUDO_CONTINUOUS_TRACK`` joints): the two track joints, one on each
@@ -102,8 +105,9 @@ def _round(geom: Geom, axis: np.ndarray) -> tuple[float, np.ndarray] | None:
     if isinstance(g, Cylinder):
         along = geom.pose.rotation @ np.array([0.0, 0.0, 1.0])
         return (float(g.radius), centre) if _parallel(along, axis) else None
-    if isinstance(g, Mesh) and g.data is not None and len(g.data.vertices):
-        points = (geom.pose.rotation @ (np.asarray(g.data.vertices) * np.asarray(g.scale)).T).T + centre
+    vertices = _mesh_vertices(g) if isinstance(g, Mesh) else None
+    if isinstance(g, Mesh) and vertices is not None and len(vertices):
+        points = (geom.pose.rotation @ (vertices * np.asarray(g.scale)).T).T + centre
         # two directions across the axis
         helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
         u = np.cross(axis, helper)
@@ -115,6 +119,67 @@ def _round(geom: Geom, axis: np.ndarray) -> tuple[float, np.ndarray] | None:
             return None
         mid = 0.5 * (points.max(axis=0) + points.min(axis=0))
         return 0.25 * (span_u + span_w), mid
+    return None
+
+
+def _mesh_vertices(mesh: Mesh) -> np.ndarray | None:
+    """The mesh's vertices (metres, the file's frame), from memory or read from its file (Hello Robot
+    Stretch's wheels are STL files); None when it has none or the file does not load."""
+    if mesh.data is not None:
+        return np.asarray(mesh.data.vertices, dtype=float)
+    if mesh.path is None:
+        return None
+    from pathlib import Path
+
+    from modelkit.geometry.meshfiles import MeshLoadError, load_mesh
+
+    try:
+        return np.asarray(load_mesh(Path(mesh.path), mesh.fragment).mesh.vertices, dtype=float)
+    except (MeshLoadError, OSError):
+        return None
+
+
+def _root_body(robot: Robot) -> set[str]:
+    """The root link and every link fixed to it (the rigid body a differential drive's wheels hang
+    from)."""
+    children: dict[str, list[Joint]] = {}
+    for joint in robot.joints:
+        children.setdefault(joint.parent, []).append(joint)
+    body, stack = set(), [robot.root or ""]
+    while stack:
+        name = stack.pop()
+        if name in body:
+            continue
+        body.add(name)
+        stack.extend(j.child for j in children.get(name, []) if j.type is JointType.FIXED)
+    return body
+
+
+def drivable(robot: Robot, drive: Drive, scenario: Scenario) -> str | None:
+    """Why the scenario's wheel law cannot drive these wheels (None when it can): ``u = kd (dq* − dq)``
+    against the wheel joints' damping c and Coulomb friction f settles at ``dq = (kd dq* − f) / (kd +
+    c)``; below half the target speed at the scenario's fastest wheel target, the driven comparison
+    would grade a robot that barely moves. Hello Robot's Stretch: c 21.75 N·m·s, f 10.48 N·m against
+    the seed's kd 0.5 (its wheels do not turn)."""
+    if drive.kind != "wheels" or scenario.controller not in (None, "drive"):
+        return None
+    joints = {j.name: j for j in robot.joints}
+    fastest = max((max(abs(c.v - c.w * drive.half_axle), abs(c.v + c.w * drive.half_axle)) / drive.radius
+                   for profile in scenario.profiles if profile.graded for c in profile.commands), default=0.0)
+    if fastest <= 0.0:
+        return None
+    kd = scenario.kd
+    for name in (drive.left, drive.right):
+        joint = joints.get(name)
+        if joint is None:
+            continue
+        c, f = max(joint.damping, 0.0), max(joint.friction, 0.0)
+        settled = (kd * fastest - f) / (kd + c)
+        if settled < 0.5 * fastest:
+            return (f"the drive law u = kd (dq* - dq), kd {kd:g}, cannot drive wheel joint {name}: against "
+                    f"its damping {c:g} N·m·s and friction {f:g} N·m it settles at "
+                    f"{max(settled, 0.0) / fastest:.0%} of the {fastest:.3g} rad/s target (give a scenario "
+                    "kd for this robot)")
     return None
 
 
@@ -155,11 +220,18 @@ def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
         what = ", ".join(j.name for j, _, _ in found) or "none"
         raise ValueError(
             "not a two-wheeled differential-drive robot: layer 4 needs exactly two unlimited revolute joints "
-            f"about the root's Y axis whose links have a round collision (found: {what}); name them in the "
-            "scenario (robot.left, robot.right) if the model has them"
+            f"about the root's Y axis whose links have a round collision (found: {what}); "
+            "name them in the scenario (robot.left, robot.right) if the model has them"
         )
     if len(found) != 2:
         raise ValueError("the scenario's wheel joints have no round collision shape: give robot.wheel_radius")
+    steered = [j.name for j, _, _ in found if j.parent not in _root_body(robot)]
+    if named[0] is None and steered:
+        raise ValueError(
+            f"not a differential drive: the wheel joint(s) {', '.join(steered)} hang from a moving joint (a "
+            "steering joint or a leg), not from the root's body; name the wheels in the scenario "
+            "(robot.left, robot.right) to drive them anyway"
+        )
     if named[0] is None:
         found.sort(key=lambda f: -float(f[2][1]))  # left (+Y) first
     (left, r_left, c_left), (right, r_right, c_right) = found
