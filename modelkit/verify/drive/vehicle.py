@@ -11,9 +11,9 @@ Skip). Everything is measured in the root link's frame at q = 0:
   side (mirrored in Y); :func:`drivable` then says when the scenario's wheel law cannot turn them.
   Left is the one at +Y. The radius comes from the collision (cylinder or sphere radius, half the
   mesh's extent across the axis); the half axle width b is half the distance between the two
-  collision centres along Y. ``signs``: +1
-  when the joint axis points along +Y (a positive rotation then rolls the wheel forward, towards +X),
-  −1 when it points along −Y. The scenario may name the joints and give the radius and b instead.
+  collision centres along Y. ``signs``: +1 when the joint axis points along +Y (a positive rotation
+  then rolls the wheel forward, towards +X), −1 when it points along −Y. The scenario may name the
+  joints and give the radius and b instead.
 * **tracks** (Choreonoid's ``PSEUDO_CONTINUOUS_TRACK`` joints): the two track joints, one on each
   side; ``rollers`` and ``roller_radius`` come from the track approximation every writer makes
   (``prepared.extras["tracks"]``, see :mod:`modelkit.convert.tracks`); ``track_offset_y`` is the
