@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from modelkit.convert.notes import NoteSink
-from modelkit.convert.tracks import extent
+from modelkit.geometry.extents import extent
 from modelkit.model import WORLD_LINK, Cylinder, Geom, Joint, JointType, Robot, Sphere
 from modelkit.spatial import Pose
 

@@ -57,31 +57,24 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from modelkit.convert.names import unique_name
 from modelkit.convert.notes import NoteSink
+from modelkit.geometry.extents import extent
 from modelkit.model import (
     Actuator,
     ActuatorKind,
-    Box,
-    Capsule,
-    Cone,
     Cylinder,
-    Ellipsoid,
     Geom,
-    Geometry,
     Inertial,
     Joint,
     JointLimits,
     JointType,
     Link,
-    Mesh,
     Mimic,
     Robot,
-    Sphere,
 )
 from modelkit.spatial import (
     Mat3,
@@ -153,70 +146,6 @@ class TrackShape:
     @property
     def width(self) -> float:
         return self.width_range[1] - self.width_range[0]
-
-
-# ---- geometry: support functions ---------------------------------------------------------------
-
-
-def _mesh_vertices(mesh: Mesh) -> np.ndarray | None:
-    """The mesh's vertices in its geom frame (scale applied), loading the file when needed."""
-    if mesh.data is not None:
-        vertices = np.asarray(mesh.data.vertices, dtype=float)
-    elif mesh.path:
-        from modelkit.geometry.meshfiles import MeshLoadError, MeshMetadata, load_mesh
-
-        meta = mesh.source_params.get("metadata")
-        metadata = (MeshMetadata(meta.get("length_unit"), meta.get("upper_axis"))
-                    if isinstance(meta, dict) and meta else None)
-        try:
-            loaded = load_mesh(Path(mesh.path), mesh.fragment, metadata)
-            vertices = np.asarray(loaded.mesh.vertices, dtype=float)
-        except MeshLoadError:
-            return None
-    else:
-        return None
-    if vertices.size == 0:
-        return None
-    return vertices.reshape(-1, 3) * np.asarray(mesh.scale, dtype=float)
-
-
-def support(geometry: Geometry, direction: Vec3) -> float | None:
-    """max over the shape of ``direction · p`` (p in the geom frame); None for an unreadable mesh."""
-    d = np.asarray(direction, dtype=float)
-    lateral = math.hypot(float(d[0]), float(d[1]))
-    if isinstance(geometry, Box):
-        return float(np.abs(d) @ (0.5 * np.asarray(geometry.size, dtype=float)))
-    if isinstance(geometry, Sphere):
-        return float(geometry.radius * np.linalg.norm(d))
-    if isinstance(geometry, Cylinder):
-        return geometry.radius * lateral + 0.5 * geometry.length * abs(float(d[2]))
-    if isinstance(geometry, Capsule):
-        return 0.5 * geometry.length * abs(float(d[2])) + geometry.radius * float(np.linalg.norm(d))
-    if isinstance(geometry, Cone):  # apex at +length/2, base circle at -length/2
-        half = 0.5 * geometry.length
-        return max(half * float(d[2]), -half * float(d[2]) + geometry.radius * lateral)
-    if isinstance(geometry, Ellipsoid):
-        return float(np.linalg.norm(np.asarray(geometry.radii, dtype=float) * d))
-    vertices = _mesh_vertices(geometry)
-    return None if vertices is None else float(np.max(vertices @ d))
-
-
-def extent(geoms: list[Geom], direction: Vec3) -> tuple[float, float] | None:
-    """(min, max) of ``direction · p`` over the shapes, p in the link frame; None without any."""
-    lows: list[float] = []
-    highs: list[float] = []
-    for geom in geoms:
-        rotation, offset = geom.pose.rotation, geom.pose.translation
-        hi = support(geom.geometry, rotation.T @ direction)
-        lo = support(geom.geometry, rotation.T @ -direction)
-        if hi is None or lo is None:
-            continue
-        base = float(direction @ offset)
-        highs.append(base + hi)
-        lows.append(base - lo)
-    if not highs:
-        return None
-    return min(lows), max(highs)
 
 
 def _unit(v: Vec3) -> Vec3:

@@ -1,8 +1,10 @@
 """Wheel collisions: which links are wheels, and the collision shape a target gets for them.
 
 A **wheel** is the child link of a revolute joint (unlimited, not a mimic follower, not a track
-roller ``convert.tracks`` wrote) that has a cylinder collision coaxial with the joint axis (or a
-sphere centred on it: the wheels of this module's own URDF and MJCF outputs), the axis
+roller ``convert.tracks`` wrote) that has a cylinder collision coaxial with the joint axis, a
+collision mesh round about it (``geometry.extents.round_about``: the tutorial's
+``mobile_robot_mesh.body``, Hello Robot's Stretch), or a sphere centred on it (the wheels of this
+module's own URDF and MJCF outputs), the axis
 horizontal at q = 0 (perpendicular to the root's Z), and the cylinder's lowest point on the lowest
 level of the robot's collision shapes (within :data:`GROUND_LEVEL` of it). A tilt head, a roller of a
 track or a wheel of a robot welded to the world (fixed root) is not a wheel.
@@ -19,9 +21,13 @@ only when the wheel meets something sideways. ``--wheel-collision``:
 * ``auto`` (default): a sphere for MJCF and URDF (the formats MuJoCo and PyBullet load), the
   cylinder kept for SDF and ``.body`` (Gazebo's and Choreonoid's cylinder contacts roll);
 * ``cylinder``: the source's cylinder, every target;
-* ``sphere``: a sphere of the wheel radius at the cylinder's centre;
-* ``ellipsoid``: an ellipsoid of radii (r, r, half width) in the cylinder's frame (round in the
-  rolling plane, as thin as the wheel across it).
+* ``sphere``: a sphere of the wheel radius at the cylinder's (mesh's) centre;
+* ``ellipsoid``: an ellipsoid of radii (r, r, half width) in the cylinder's frame (for a mesh, a
+  frame whose z is the joint axis): round in the rolling plane, as thin as the wheel across it.
+
+A mesh wheel's radius is half its mean reach across the axis and its width its reach along it; its
+visual stays the mesh. MuJoCo and PyBullet collide with a mesh's convex hull, a polygonal cylinder
+with the cylinder's edge contacts.
 
 Every replaced shape gets an MK826 note; the wheels found are recorded in
 ``robot.extras["wheels"]`` (link → joint) for the writers' simulator options (MK825).
@@ -29,12 +35,16 @@ Every replaced shape gets an MK826 note; the wheels found are recorded in
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from pathlib import Path
+
 import numpy as np
 
 from modelkit.convert.choices import WHEEL_COLLISIONS
 from modelkit.convert.notes import NoteSink
 from modelkit.convert.registry import TARGETS
-from modelkit.model import Cylinder, Ellipsoid, Geom, JointType, Robot, Sphere
+from modelkit.geometry.extents import ROUNDNESS, Round, across, extent, round_about
+from modelkit.model import Cylinder, Ellipsoid, Geom, JointType, Mesh, Robot, Sphere
 from modelkit.spatial import Pose
 
 WHEELS_KEY = "wheels"
@@ -62,8 +72,6 @@ def resolve(choice: str, target: str) -> str:
 
 def link_lows(robot: Robot, poses: dict[str, Pose]) -> dict[str, float]:
     """Link → the lowest world z of its collision shapes at ``poses`` (links without any left out)."""
-    from modelkit.convert.tracks import extent
-
     lows: dict[str, float] = {}
     for link in robot.links:
         pose = poses.get(link.name)
@@ -81,8 +89,19 @@ def _lowest(robot: Robot, poses: dict[str, Pose]) -> float | None:
     return min(lows.values()) if lows else None
 
 
-def find_wheels(robot: Robot) -> dict[str, tuple[str, int]]:
-    """Wheel link → (its joint, the index of its wheel cylinder among the link's collisions)."""
+@dataclass(frozen=True)
+class Wheel:
+    """A wheel found: its joint, which of its link's collisions rolls, and that shape's roundness
+    about the joint axis (link frame)."""
+
+    joint: str
+    index: int
+    round: Round
+    axis: np.ndarray  # unit, link frame
+
+
+def find_wheels(robot: Robot) -> dict[str, Wheel]:
+    """Wheel link → its :class:`Wheel`."""
     if robot.root is None or robot.root_joint is JointType.FIXED:
         return {}
     poses = robot.world_poses()
@@ -97,7 +116,7 @@ def find_wheels(robot: Robot) -> dict[str, tuple[str, int]]:
                 rollers.update(record.get("roller_links", []))
     links = {link.name: link for link in robot.links}
     z = np.array([0.0, 0.0, 1.0])
-    out: dict[str, tuple[str, int]] = {}
+    out: dict[str, Wheel] = {}
     for joint in robot.joints:
         link = links.get(joint.child)
         pose = poses.get(joint.child)
@@ -110,40 +129,43 @@ def find_wheels(robot: Robot) -> dict[str, tuple[str, int]]:
         axis = axis / float(np.linalg.norm(axis))
         if abs(float((pose.rotation @ axis) @ z)) > HORIZONTAL:
             continue
-        best: tuple[float, int] | None = None
+        best: Wheel | None = None
         for i, geom in enumerate(link.collisions):
-            g = geom.geometry
-            if not isinstance(g, Cylinder | Sphere) or g.radius <= 0.0:
+            shape = round_about(geom, axis, PARALLEL)
+            if shape is None or shape.radius <= 0.0:
                 continue
-            if isinstance(g, Cylinder):
-                along = geom.pose.rotation @ z
-                if abs(1.0 - abs(float(along @ axis))) > PARALLEL:
-                    continue
-            else:  # a sphere wheel (our own URDF and MJCF outputs): its centre on the axis
-                centre_local = np.asarray(geom.pose.translation, dtype=float)
-                off_axis = centre_local - float(centre_local @ axis) * axis
-                if float(np.linalg.norm(off_axis)) > ON_AXIS:
-                    continue
-            centre = pose.rotation @ geom.pose.translation + pose.translation
-            bottom = float(centre[2]) - g.radius
-            if abs(bottom - floor) > GROUND_LEVEL:
+            off_axis = shape.centre - float(shape.centre @ axis) * axis
+            if not isinstance(geom.geometry, Cylinder) and float(np.linalg.norm(off_axis)) > max(
+                    ON_AXIS, ROUNDNESS * shape.radius):
+                continue  # a sphere or mesh wheel turns about its centre
+            reach = extent([geom], pose.rotation.T @ z)
+            if reach is None or abs(float(pose.translation[2]) + reach[0] - floor) > GROUND_LEVEL:
                 continue
-            if best is None or g.radius > best[0]:
-                best = (g.radius, i)
+            if best is None or shape.radius > best.round.radius:
+                best = Wheel(joint.name, i, shape, axis)
         if best is not None:
-            out[link.name] = (joint.name, best[1])
+            out[link.name] = best
     return out
 
 
-def wheel_proxy(geom: Geom, cylinder: Cylinder, shape: str) -> tuple[Geom, str]:
-    """The ``shape`` ("sphere" or "ellipsoid") written for a wheel's collision cylinder, and its words."""
+def wheel_proxy(geom: Geom, wheel: Wheel, shape: str) -> tuple[Geom, str]:
+    """The ``shape`` ("sphere" or "ellipsoid") written for a wheel's collision cylinder or round mesh,
+    and its words."""
+    radius, centre = wheel.round.radius, wheel.round.centre
     if shape == "sphere":
-        new = Geom(Sphere(cylinder.radius), Pose(translation=geom.pose.translation.copy()),
+        new = Geom(Sphere(radius), Pose(translation=np.array(centre, dtype=float)),
                    name=geom.name, material=geom.material, source=geom.source)
-        return new, f"a sphere of radius {cylinder.radius:g} m at the cylinder's centre"
-    radii = (cylinder.radius, cylinder.radius, 0.5 * cylinder.length)
-    new = Geom(Ellipsoid(radii), geom.pose, name=geom.name, material=geom.material, source=geom.source)
-    return new, f"an ellipsoid of radii ({radii[0]:g}, {radii[1]:g}, {radii[2]:g}) m in the cylinder's frame"
+        where = "the cylinder's centre" if isinstance(geom.geometry, Cylinder) else "the mesh's centre"
+        return new, f"a sphere of radius {radius:g} m at {where}"
+    radii = (radius, radius, 0.5 * wheel.round.width)
+    if isinstance(geom.geometry, Cylinder):
+        frame, words = geom.pose, "the cylinder's frame"
+    else:  # the ellipsoid's z along the wheel's axis, at the mesh's centre
+        u, w = across(wheel.axis)
+        frame = Pose(np.column_stack([u, w, wheel.axis]), np.array(centre, dtype=float))
+        words = "a frame whose z is the wheel's axis, at the mesh's centre"
+    new = Geom(Ellipsoid(radii), frame, name=geom.name, material=geom.material, source=geom.source)
+    return new, f"an ellipsoid of radii ({radii[0]:g}, {radii[1]:g}, {radii[2]:g}) m in {words}"
 
 
 def approximate_wheels(robot: Robot, choice: str, target: str, notes: NoteSink) -> None:
@@ -152,26 +174,39 @@ def approximate_wheels(robot: Robot, choice: str, target: str, notes: NoteSink) 
     wheels = find_wheels(robot)
     if not wheels:
         return
-    robot.extras[WHEELS_KEY] = {link: joint for link, (joint, _) in sorted(wheels.items())}
+    robot.extras[WHEELS_KEY] = {link: wheel.joint for link, wheel in sorted(wheels.items())}
     shape = resolve(choice, target)
     if shape == "cylinder":
         return
     links = {link.name: link for link in robot.links}
-    for name, (joint, index) in sorted(wheels.items()):
+    for name, wheel in sorted(wheels.items()):
         link = links[name]
-        geom = link.collisions[index]
+        geom = link.collisions[wheel.index]
         g = geom.geometry
-        if not isinstance(g, Cylinder):  # already a sphere: nothing to replace
+        if isinstance(g, Cylinder):
+            was = f"its collision cylinder (radius {g.radius:g} m, width {g.length:g} m)"
+        elif isinstance(g, Mesh):
+            was = (f"its collision mesh {mesh_name(g)} (round about the joint axis: radius "
+                   f"{wheel.round.radius:.6g} m, width {wheel.round.width:.6g} m)")
+        else:  # already a sphere: nothing to replace
             continue
-        link.collisions[index], what = wheel_proxy(geom, g, shape)
+        link.collisions[wheel.index], what = wheel_proxy(geom, wheel, shape)
         notes.note(
             "MK826",
-            f"wheel {name} (joint {joint}): its collision cylinder (radius {g.radius:g} m, width "
-            f"{g.length:g} m) "
+            f"wheel {name} (joint {wheel.joint}): {was} "
             f"is written as {what} (--wheel-collision {choice}"
             + (f", {shape} for this target" if choice == "auto" else "")
-            + "): MuJoCo and PyBullet give a cylinder rolling on a plane different contacts, a sphere "
-            "touches the floor at one point under the hub in both; --wheel-collision cylinder keeps it",
+            + "): MuJoCo and PyBullet give a cylinder or a mesh's convex hull rolling on a plane different "
+            "contacts, a sphere touches the floor at one point under the hub in both; --wheel-collision "
+            "cylinder keeps the source's shape",
             geom.source or link.source,
-            f"link[{name}]/collision[{index}]",
+            f"link[{name}]/collision[{wheel.index}]",
         )
+
+
+def mesh_name(mesh: Mesh) -> str:
+    """The mesh's file name (with its fragment), or "(inline)" for a mesh held only in memory."""
+    if not mesh.path:
+        return "(inline)"
+    name = Path(mesh.path).name
+    return f"{name}#{mesh.fragment}" if mesh.fragment else name

@@ -8,7 +8,8 @@ Skip). Everything is measured in the root link's frame at q = 0:
   whose axis lies along the joint axis, a sphere, or a mesh whose extent around the axis is round,
   read from its file when the model holds only the path: Hello Robot's Stretch), axes parallel to
   the root's Y, hanging from the root's rigid body (not from a steering joint or a leg), one on each
-  side (mirrored in Y); :func:`drivable` then says when the scenario's wheel law cannot turn them.
+  side (mirrored in Y); :func:`supported` then says when nothing but the wheels reaches the floor
+  (the robot would tip over) and :func:`drivable` when the scenario's wheel law cannot turn them.
   Left is the one at +Y. The radius comes from the collision (cylinder or sphere radius, half the
   mesh's extent across the axis); the half axle width b is half the distance between the two
   collision centres along Y. ``signs``: +1 when the joint axis points along +Y (a positive rotation
@@ -30,7 +31,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from modelkit.model import Cylinder, Geom, Joint, JointType, Link, Mesh, Robot, Sphere
+from modelkit.convert.base import root_body, touching_ground, vertical_spans
+from modelkit.geometry.extents import ROUNDNESS, mesh_vertices, round_about
+from modelkit.model import Geom, Joint, JointType, Link, Mesh, Robot
 from modelkit.spatial import Pose
 from modelkit.verify.drive import Drive, Scenario
 
@@ -98,61 +101,39 @@ def wheel_shape(link: Link, axis_local: np.ndarray) -> tuple[float, np.ndarray] 
 
 
 def _round(geom: Geom, axis: np.ndarray) -> tuple[float, np.ndarray] | None:
-    g = geom.geometry
-    centre = np.asarray(geom.pose.translation, dtype=float)
-    if isinstance(g, Sphere):
-        return float(g.radius), centre
-    if isinstance(g, Cylinder):
-        along = geom.pose.rotation @ np.array([0.0, 0.0, 1.0])
-        return (float(g.radius), centre) if _parallel(along, axis) else None
-    vertices = _mesh_vertices(g) if isinstance(g, Mesh) else None
-    if isinstance(g, Mesh) and vertices is not None and len(vertices):
-        points = (geom.pose.rotation @ (vertices * np.asarray(g.scale)).T).T + centre
-        # two directions across the axis
-        helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
-        u = np.cross(axis, helper)
-        u /= np.linalg.norm(u)
-        w = np.cross(axis, u)
-        span_u = float(np.ptp(points @ u))
-        span_w = float(np.ptp(points @ w))
-        if span_u <= 0.0 or abs(span_u - span_w) > 0.02 * max(span_u, span_w):
-            return None
-        mid = 0.5 * (points.max(axis=0) + points.min(axis=0))
-        return 0.25 * (span_u + span_w), mid
-    return None
+    found = round_about(geom, axis, PARALLEL)
+    return None if found is None else (found.radius, found.centre)
 
 
-def _mesh_vertices(mesh: Mesh) -> np.ndarray | None:
-    """The mesh's vertices (metres, the file's frame), from memory or read from its file (Hello Robot
-    Stretch's wheels are STL files); None when it has none or the file does not load."""
-    if mesh.data is not None:
-        return np.asarray(mesh.data.vertices, dtype=float)
-    if mesh.path is None:
+def supported(robot: Robot, drive: Drive) -> str | None:
+    """Why the wheeled robot cannot stand for a drive (None when it can): at q = 0 a shape other than
+    the two wheels (and what hangs from them) must reach the floor with them (``base.touching_ground``:
+    a caster, a skid), or the robot tips over on its axle and the driven comparison would grade its
+    fall. The tutorial's ``mobile_robot_mesh.body`` and ``mobile_robot_sensors.urdf`` name a chassis
+    mesh that is not shipped: they stand on their wheels alone."""
+    if drive.kind != "wheels":
         return None
-    from pathlib import Path
-
-    from modelkit.geometry.meshfiles import MeshLoadError, load_mesh
-
-    try:
-        return np.asarray(load_mesh(Path(mesh.path), mesh.fragment).mesh.vertices, dtype=float)
-    except (MeshLoadError, OSError):
+    spans = vertical_spans(robot, robot.world_poses())
+    wheels = _subtree(robot, set(drive.wheel_links))
+    if touching_ground(spans) - wheels:
         return None
+    unread = sorted({link.name for link in robot.links for geom in link.collisions
+                     if isinstance(geom.geometry, Mesh) and mesh_vertices(geom.geometry) is None})
+    why = (f" (the collision mesh of {', '.join(unread)} cannot be read)" if unread else "")
+    return (f"the robot stands on its two wheels alone: no collision shape but the wheels reaches the floor "
+            f"at q = 0{why}, so it tips over on its axle and a driven comparison would grade its fall")
 
 
-def _root_body(robot: Robot) -> set[str]:
-    """The root link and every link fixed to it (the rigid body a differential drive's wheels hang
-    from)."""
-    children: dict[str, list[Joint]] = {}
-    for joint in robot.joints:
-        children.setdefault(joint.parent, []).append(joint)
-    body, stack = set(), [robot.root or ""]
+def _subtree(robot: Robot, links: set[str]) -> set[str]:
+    """``links`` and every link hanging from them."""
+    children = robot.children_of()
+    out, stack = set(), list(links)
     while stack:
         name = stack.pop()
-        if name in body:
-            continue
-        body.add(name)
-        stack.extend(j.child for j in children.get(name, []) if j.type is JointType.FIXED)
-    return body
+        if name not in out:
+            out.add(name)
+            stack.extend(joint.child for joint in children.get(name, []))
+    return out
 
 
 def drivable(robot: Robot, drive: Drive, scenario: Scenario) -> str | None:
@@ -205,6 +186,7 @@ def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
             and j.mimic is None
         ]
     found: list[tuple[Joint, float, np.ndarray]] = []  # joint, radius, centre in the root frame
+    unround: list[str] = []  # candidates whose collision is not round about their axis
     for j in candidates:
         axis_root = _axis_in_root(j, frames)
         frame = frames[j.child]
@@ -212,12 +194,17 @@ def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
         shape = wheel_shape(links[j.child], local) if j.child in links else None
         if shape is None:
             if scenario.wheel_radius is None or named[0] is None:
+                unround.append(j.name)
                 continue
             shape = (scenario.wheel_radius, np.zeros(3))
         centre = frame.rotation @ shape[1] + frame.translation
         found.append((j, shape[0], centre))
     if named[0] is None and len(found) != 2:
         what = ", ".join(j.name for j, _, _ in found) or "none"
+        if unround:
+            what += (f"; {', '.join(unround)} turn(s) about Y, but no collision shape of its link is round "
+                     f"about the axis: a cylinder, a sphere or a mesh whose reach across the axis varies by "
+                     f"less than {ROUNDNESS:.0%}")
         raise ValueError(
             "not a two-wheeled differential-drive robot: layer 4 needs exactly two unlimited revolute joints "
             f"about the root's Y axis whose links have a round collision (found: {what}); "
@@ -225,7 +212,8 @@ def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
         )
     if len(found) != 2:
         raise ValueError("the scenario's wheel joints have no round collision shape: give robot.wheel_radius")
-    steered = [j.name for j, _, _ in found if j.parent not in _root_body(robot)]
+    body = root_body(robot)
+    steered = [j.name for j, _, _ in found if j.parent not in body]
     if named[0] is None and steered:
         raise ValueError(
             f"not a differential drive: the wheel joint(s) {', '.join(steered)} hang from a moving joint (a "

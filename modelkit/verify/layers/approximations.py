@@ -638,36 +638,42 @@ def chains_skip(engine: str, chains: list[BallChain]) -> Skip | None:
 
 @dataclass(frozen=True)
 class WheelProxy:
-    """``convert``'s wheel collision (MK826) held by an engine in place of the source's cylinders."""
+    """``convert``'s wheel collision (MK826) held by an engine in place of the source's cylinders or
+    round meshes."""
 
     shape: str  # "sphere" or "ellipsoid" (--wheel-collision)
     links: tuple[str, ...]  # source names
+    replaced: str = "cylinder"  # what the source holds: "cylinder", "round mesh" or both, in words
 
 
 def wheel_proxies(source: Robot, engine_shapes: Mapping[str, Sequence[Any]],
                   written: Callable[[str], str]) -> WheelProxy | None:
     """The wheel collision an engine holds for every wheel of ``source`` (the model as read, its root
-    not welded) whose collision is a cylinder there, when it is one of ``convert``'s choices for it
-    (``--wheel-collision auto`` writes spheres for MJCF and URDF, MK826). Found from the engine's own
-    shapes: a file given with ``--mjcf/--urdf`` carries no notes, and is usually ``convert``'s default."""
+    not welded) whose collision is a cylinder or a round mesh there, when it is one of ``convert``'s
+    choices for it (``--wheel-collision auto`` writes spheres for MJCF and URDF, MK826). Found from the
+    engine's own shapes: a file given with ``--mjcf/--urdf`` carries no notes, and is usually
+    ``convert``'s default."""
     from modelkit.convert.wheels import find_wheels
 
-    wheels = {link: index for link, (_, index) in find_wheels(source).items()
-              if isinstance(_collision(source, link, index), Cylinder)}
+    wheels = {link: wheel.index for link, wheel in find_wheels(source).items()
+              if isinstance(_collision(source, link, wheel.index), Cylinder | Mesh)}
     held = set()
     for link in sorted(wheels):
         kinds = {shape.type for shape in engine_shapes.get(written(link), [])}
         proxy = [kind for kind in ("sphere", "ellipsoid") if kind in kinds]
-        if "cylinder" in kinds or len(proxy) != 1:
+        if "cylinder" in kinds or "mesh" in kinds or len(proxy) != 1:
             return None
         held.add(proxy[0])
     if len(held) != 1:
         return None
-    return WheelProxy(held.pop(), tuple(sorted(wheels)))
+    kinds = {"cylinder" if isinstance(_collision(source, link, index), Cylinder) else "round mesh"
+             for link, index in wheels.items()}
+    return WheelProxy(held.pop(), tuple(sorted(wheels)), " or ".join(sorted(kinds)))
 
 
 def applied_wheels(robot: Robot, source: Robot, proxy: WheelProxy) -> Robot:
-    """``robot`` (the reference) with the wheels' cylinders of ``source`` replaced by ``proxy``'s shape,
+    """``robot`` (the reference) with the wheels' cylinders and round meshes of ``source`` replaced by
+    ``proxy``'s shape,
     as ``convert`` writes them."""
     from modelkit.convert.wheels import find_wheels, wheel_proxy
 
@@ -676,10 +682,10 @@ def applied_wheels(robot: Robot, source: Robot, proxy: WheelProxy) -> Robot:
     for link in out.links:
         if link.name not in proxy.links or link.name not in wheels:
             continue
-        index = wheels[link.name][1]
+        index = wheels[link.name].index
         geom = link.collisions[index]
-        if isinstance(geom.geometry, Cylinder):
-            link.collisions[index] = wheel_proxy(geom, geom.geometry, proxy.shape)[0]
+        if isinstance(geom.geometry, Cylinder | Mesh):
+            link.collisions[index] = wheel_proxy(geom, wheels[link.name], proxy.shape)[0]
     return out
 
 
@@ -738,7 +744,8 @@ def wheels_skip(engine: str, proxy: WheelProxy | None) -> Skip | None:
     if proxy is None:
         return None
     return Skip(1, engine, "approximation: the file holds convert's wheel collision (MK826, "
-                           f"--wheel-collision): a {proxy.shape} in place of the source's cylinder on "
+                           f"--wheel-collision): a {proxy.shape} in place of the source's {proxy.replaced} "
+                           "on "
                            f"{', '.join(proxy.links)}; layer 1 compares its shapes with those")
 
 
