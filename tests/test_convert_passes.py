@@ -16,7 +16,8 @@ from modelkit.convert.merge import merge_fixed_joints
 from modelkit.convert.notes import NoteSink
 from modelkit.convert.options import WriteOptions
 from modelkit.convert.registry import target_info
-from modelkit.convert.tracks import approximate_tracks, assembly_mass_properties, support
+from modelkit.convert.tracks import approximate_tracks, assembly_mass_properties
+from modelkit.geometry.extents import support
 from modelkit.model import (
     Box,
     Capsule,
