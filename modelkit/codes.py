@@ -1546,6 +1546,16 @@ _TABLE: tuple[CodeInfo, ...] = (
         "limits; a larger effort limit, or MuJoCo's body `gravcomp`, holds the pose.",
     ),
     CodeInfo(
+        "MK869",
+        "mimic-coupling-stiffened",
+        "info",
+        "MJCF: the source's mimic joints (rigid couplings in URDF, SDF and `.body`) are written as MuJoCo "
+        "joint equalities with a 5 ms time constant (`solref=\"0.005 1\"`, as MuJoCo Menagerie's "
+        "Robotiq 2F-85 couples its drivers) instead of MuJoCo's default 20 ms, under which a follower "
+        "lags its servoed leader (a Robotiq 2F-85 commanded from home to mid-range: 0.25 rad apart; "
+        "0.076 rad with it). An MJCF source's own equalities keep their settings.",
+    ),
+    CodeInfo(
         "MK858",
         "drive-plugin-written",
         "info",
