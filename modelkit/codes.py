@@ -826,6 +826,16 @@ _TABLE: tuple[CodeInfo, ...] = (
         "drops it and no output repeats it.",
     ),
     CodeInfo(
+        "MK326",
+        "mimic-range-mismatch",
+        "warning",
+        "A mimic carries its follower past the follower's position range somewhere in the leader's range "
+        "(Fourier's Inspire hand: the thumb's leader ranges over [−0.1, 0.6] rad, its followers at ×1.6 "
+        "and ×2.4 from 0). A simulator that holds the coupling (MuJoCo's joint equality, Gazebo's mimic) "
+        "then has the follower's limit and the coupling fight there. The hint gives the leader's range the "
+        "coupling allows.",
+    ),
+    CodeInfo(
         "MK340",
         "sdf-joint-type-unsupported",
         "warning",

@@ -6,6 +6,7 @@ URDF loader, PyBullet) so a user knows why a file that passes ``check_urdf`` sti
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from pathlib import PurePosixPath
 
@@ -76,6 +77,68 @@ def mimic_targets(robot: Robot) -> Iterator[Diagnostic]:
             )
         elif _mimic_loop(joint, by_name):
             yield diag("MK321", f'joint "{joint.name}" is part of a loop of mimic joints', where)
+
+
+MIMIC_RANGE_SLACK = 1e-6
+"""rad or m: how far a mimic may carry its follower past the follower's range over the leader's range
+before MK326 says so (ranges are often written to 6 digits)."""
+
+
+@rule("mimic-range", "MK326")
+def mimic_range(robot: Robot) -> Iterator[Diagnostic]:
+    """A mimic keeps its follower inside the follower's range over the whole of the leader's range.
+
+    When it does not, a simulator holding the coupling (MuJoCo's joint equality, Gazebo's mimic) has
+    the follower's limit and the coupling fight wherever the leader may go: Fourier's Inspire hand's
+    thumb leader ranges over [−0.1, 0.6] rad, its followers at ×1.6 and ×2.4 from 0, and in MuJoCo its
+    thumb shook 0.8 rad off its mimic at rest under a stiff coupling."""
+    by_name: dict[str, Joint] = {}
+    for joint in robot.joints:
+        by_name.setdefault(joint.name, joint)
+    for joint in robot.joints:
+        mimic = joint.mimic
+        leader = by_name.get(mimic.joint) if mimic is not None else None
+        if mimic is None or leader is None or leader is joint or joint.type not in ONE_DOF \
+                or leader.type not in ONE_DOF:
+            continue
+        low, high = leader.limits.lower, leader.limits.upper
+        own_low, own_high = joint.limits.lower, joint.limits.upper
+        finite = all(math.isfinite(x) for x in (low, high, own_low, own_high))
+        if not finite or low > high or own_low > own_high:
+            continue
+        ends = sorted((mimic.multiplier * low + mimic.offset, mimic.multiplier * high + mimic.offset))
+        past = max(own_low - ends[0], ends[1] - own_high)
+        if past <= MIMIC_RANGE_SLACK:
+            continue
+        reachable = _leader_range_within(mimic.multiplier, mimic.offset, (low, high), (own_low, own_high))
+        if reachable is None:
+            hint = ("no position of the leader keeps the follower in its range: check the mimic's multiplier "
+                    "(its sign) and offset")
+        elif reachable[1] - reachable[0] <= MIMIC_RANGE_SLACK:
+            hint = (f"only the leader at {reachable[0]:.6g} keeps the follower in its range: check the "
+                    "mimic's multiplier (its sign) and offset")
+        else:
+            hint = (f"the coupling allows the leader [{reachable[0]:.6g}, {reachable[1]:.6g}]: narrow its "
+                    "range to that, or widen the follower's")
+        yield diag(
+            "MK326",
+            f'joint "{joint.name}" mimics "{leader.name}" ({mimic.multiplier:.6g} × q + {mimic.offset:.6g}): '
+            f"over the leader's range [{low:.6g}, {high:.6g}] it would reach [{ends[0]:.6g}, {ends[1]:.6g}], "
+            f"past its own range [{own_low:.6g}, {own_high:.6g}] by {past:.3g}; a simulator holding the "
+            "coupling makes it fight the limit there",
+            mimic.source or joint.loc("mimic"),
+            hint=hint,
+        )
+
+
+def _leader_range_within(multiplier: float, offset: float, leader: tuple[float, float],
+                         follower: tuple[float, float]) -> tuple[float, float] | None:
+    """The part of the leader's range whose image stays in the follower's (None: none)."""
+    if multiplier == 0.0:
+        return leader if follower[0] <= offset <= follower[1] else None
+    bounds = sorted(((follower[0] - offset) / multiplier, (follower[1] - offset) / multiplier))
+    low, high = max(leader[0], bounds[0]), min(leader[1], bounds[1])
+    return (low + 0.0, high + 0.0) if low <= high else None  # + 0.0: no "-0"
 
 
 def _mimic_loop(start: Joint, by_name: dict[str, Joint]) -> bool:
