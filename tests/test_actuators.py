@@ -234,7 +234,7 @@ def test_body_actuation_mode_becomes_an_actuator(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(("choice", "tags"), [("motor", ["motor"]), ("velocity", ["velocity"]),
                                               ("position", ["position"]), ("none", []),
-                                              ("auto", ["motor"])])  # the pendulum's joint has no range
+                                              ("auto", ["position"])])  # welded: every joint holds
 def test_actuators_option_decides_for_a_source_without_any(tmp_path: Path, choice: str,
                                                            tags: list[str]) -> None:
     path = tmp_path / "pendulum.body"
@@ -244,7 +244,8 @@ def test_actuators_option_decides_for_a_source_without_any(tmp_path: Path, choic
     out, notes = convert(robot, tmp_path / "out", choice)
     assert [el.tag for el in actuator_elements(out)] == tags
     assert [n.code for n in notes if n.code == "MK841"] == ["MK841"]
-    assert len([n for n in notes if n.code == "MK840"]) == (1 if choice in ("position", "velocity") else 0)
+    assert len([n for n in notes if n.code == "MK840"]) == (1 if choice in ("position", "velocity", "auto")
+                                                           else 0)
     m = mujoco.MjModel.from_xml_path(str(out))
     assert m.nu == len(tags)
 
@@ -417,21 +418,37 @@ SAGGING_KINOVA_JOINTS = ("j2s6s200_joint_2", "j2s6s200_joint_3", "j2s6s200_joint
 def test_an_arm_with_effort_interfaces_holds_home_on_servos(tmp_path: Path, source_actuators: str) -> None:
     """example-robot-data's Kinova arm names ``EffortJointInterface`` transmissions. By default
     (``--source-actuators auto``) and with ``replace``, the ``--actuators auto`` choice gives a position
-    servo to every ranged joint and, the base being welded, to the continuous ones gravity turns at home
-    (joint 4: with a motor there the arm still fell 257 mm); the vertical joint 1 and the wrist roll keep
-    motors. The arm holds home within 1 mm; MK864 (auto) names the four servoed joints."""
+    servo to every joint, the base being welded: the continuous ones too, as Menagerie's Kinova Gen3 has
+    them (joint 4: with a motor there the arm fell 257 mm; the vertical joint 1, a motor, turned 0.0136 rad
+    while joint 2 moved 0.5 rad). The arm holds home within 1 mm; MK864 (auto) names the servoed joints."""
     robot = load(example_robot(KINOVA))
     out, notes = convert(robot, tmp_path, source_actuators=source_actuators)
     kinds = {el.get("joint"): el.tag for el in actuator_elements(out)}
-    assert kinds == {"j2s6s200_joint_1": "motor", "j2s6s200_joint_2": "position",
-                     "j2s6s200_joint_3": "position", "j2s6s200_joint_4": "position",
-                     "j2s6s200_joint_5": "position", "j2s6s200_joint_6": "motor"}
+    assert kinds == {f"j2s6s200_joint_{i}": "position" for i in range(1, 7)}
     assert "MK863" not in {n.code for n in notes}
     if source_actuators == "auto":
         (said,) = [n for n in notes if n.code == "MK864"]
-        assert all(joint in said.message for joint in SAGGING_KINOVA_JOINTS)
+        assert said.message.startswith("6 joint(s) (j2s6s200_joint_1, j2s6s200_joint_2, j2s6s200_joint_3, "
+                                       "j2s6s200_joint_4 ...)")
     count, error = hold_error(out)
     assert count == 6 and error < HOLD_TOLERANCE, f"moved {error * 1e3:.3f} mm"
+
+
+def test_an_arms_other_joints_hold_while_one_moves(tmp_path: Path) -> None:
+    """The Kinova's joint 2 commanded 0.5 rad from home: its vertical joint 1 and wrist roll 6, servoed
+    now, stay put (as motors, free at zero control, joint 1 turned 0.0136 rad under the reaction)."""
+    out, _ = convert(load(example_robot(KINOVA)), tmp_path)
+    m = mujoco.MjModel.from_xml_path(str(out))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    home = d.qpos.copy()
+    d.ctrl[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "j2s6s200_joint_2")] = home[1] + 0.5
+    worst = 0.0
+    for _ in range(3000):
+        mujoco.mj_step(m, d)
+        worst = max(worst, abs(d.qpos[0] - home[0]), abs(d.qpos[5] - home[5]))
+    assert d.qpos[1] - home[1] == pytest.approx(0.5, abs=2e-3)
+    assert worst < 1e-3, worst
 
 
 def test_an_arm_whose_effort_interfaces_are_kept_as_motors_says_it_sags(tmp_path: Path) -> None:

@@ -284,11 +284,14 @@ class ActuatorWriter:
         """The ``--actuators`` kind of a joint the source does not actuate (None: no actuator).
 
         ``auto``: a position servo on a joint with a finite range, in a leg (:mod:`modelkit.convert.legs`:
-        a URDF's ``continuous`` knee) or, on a welded base, that gravity turns at home (:meth:`sags`: an
-        arm's ``continuous`` wrist), so the written model holds its home pose as MuJoCo Menagerie's arms
-        and legs do; a motor on any other joint without one (wheels, casters, endless spindles), whose
-        zero control leaves it free as the source has it. A mobile robot's joints without a range are its
-        wheels and casters (the lecture's smartcar has its wheels' masses off their axes: still motors)."""
+        a URDF's ``continuous`` knee) or on a welded base (an arm's ``continuous`` joints: Menagerie's
+        Kinova Gen3 servos its four), so the written model holds its home pose as MuJoCo Menagerie's
+        arms and legs do; on a free base, a motor on any other joint without one (wheels, casters,
+        endless spindles), whose zero control leaves it free as the source has it. A mobile robot's
+        joints without a range are its wheels and casters (the lecture's smartcar has its wheels' masses
+        off their axes: still motors). Before, a welded arm's unranged joints that gravity does not turn
+        (example-robot-data's Kinova: joint 1, vertical, and joint 6) were motors: free at zero control,
+        joint 1 turned 0.0136 rad while joint 2 moved 0.5 rad."""
         if joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
             return None
         choice = self.ctx.options.actuators
@@ -298,7 +301,7 @@ class ActuatorWriter:
             if self._legs is None:
                 self._legs = leg_joints(self.robot)
             welded = self.robot.root_joint is JointType.FIXED  # an arm; a mobile robot's are wheels, casters
-            held = ranged or joint.name in self._legs or (welded and self.sags(joint))
+            held = ranged or joint.name in self._legs or welded
             return ActuatorKind.POSITION if held else ActuatorKind.EFFORT
         return CHOICES.get(choice)
 
@@ -324,8 +327,8 @@ class ActuatorWriter:
                                 sorted(written.items(), key=lambda item: ORDER.index(item[0])))
         why = ""
         if choice == "auto":
-            why = ("; auto puts a position servo on each joint with a range, in a leg or, on a welded base, "
-                   "that gravity turns at home (the home keyframe holds) and a motor on each other joint "
+            why = ("; auto puts a position servo on each joint with a range, in a leg or on a welded base "
+                   "(the home keyframe holds) and a motor on each other joint "
                    "without a range (zero control leaves it free)")
         self.ctx.note("MK841", f"the source names no actuators: {what} written (--actuators {choice}{why})",
                       self.robot.source, "actuator")
