@@ -1347,6 +1347,17 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MuJoCo and PyBullet roll alike on a floor.",
     ),
     CodeInfo(
+        "MK827",
+        "unactuated-load-bearing-servoed",
+        "info",
+        "MJCF: the source names actuators for some joints but leaves load-bearing ones without (a leg's "
+        "joints; on a welded base, joints gravity turns at home): with `--source-actuators auto` (the "
+        "default) those get the `--actuators` choice where it is a servo, so the robot holds its home "
+        "keyframe (example-robot-data's ANYmal-Kinova names the arm's transmissions only; its unactuated "
+        "legs folded it onto the floor, 451 mm in 2 s). Other unactuated joints stay passive; "
+        "`--source-actuators keep` leaves them all without.",
+    ),
+    CodeInfo(
         "MK830",
         "base-decided",
         "info",

@@ -809,3 +809,21 @@ def test_spirit40_given_a_stance_holds_it_with_its_legs_share_of_the_weight(tmp_
     assert held < 0.05 and worst < 0.15 and sag < STAND_SAG, (
         f"joints {held:.3f} rad off at the end ({worst:.3f} at worst), base sank {sag * 1e3:.1f} mm"
     )
+
+
+def test_a_sources_unactuated_legs_get_servos_so_the_robot_stands(tmp_path: Path) -> None:
+    """example-robot-data's ANYmal-Kinova names transmissions for the arm only. Its twelve leg joints had
+    no actuator, and on a plain floor the robot folded (451 mm in 2 s): by default they now get the
+    ``--actuators`` choice, position servos (MK827), and it stands; ``keep`` leaves them without."""
+    robot = load(example_robot("anymal_b_simple_description/robots/anymal-kinova.urdf"))
+    out, notes = convert(robot, tmp_path / "auto")
+    (said,) = [n for n in notes if n.code == "MK827"]
+    assert said.message.startswith("12 joint(s) (LF_HAA, LF_HFE, LF_KFE, RF_HAA ...; 12 in legs)")
+    kinds = {el.get("joint"): el.tag for el in actuator_elements(out)}
+    assert all(kinds.get(f"{leg}_{part}") == "position" for leg in ("LF", "RF", "LH", "RH")
+               for part in ("HAA", "HFE", "KFE"))
+    sag, tilt = stand_on_a_plain_floor(out)
+    assert sag < STAND_SAG and tilt < STAND_TILT, f"sank {sag * 1e3:.1f} mm, tilted {tilt:.3f}"
+    kept, notes = convert(robot, tmp_path / "keep", source_actuators="keep")
+    assert "MK827" not in {n.code for n in notes}
+    assert not any(el.get("joint", "").endswith("_KFE") for el in actuator_elements(kept))

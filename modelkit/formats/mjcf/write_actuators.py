@@ -52,6 +52,7 @@ ELEMENTS = {ActuatorKind.EFFORT: "motor", ActuatorKind.POSITION: "position",
 CHOICES = {"motor": ActuatorKind.EFFORT, "position": ActuatorKind.POSITION, "velocity": ActuatorKind.VELOCITY}
 ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # MK841 lists kinds in this order
 SERVOED = "ROS effort interface, servoed"  # source_kind of a servo --source-actuators auto put there
+FILLED = "unactuated, load-bearing"  # source_kind of a servo on a joint the source left without (MK827)
 GRAVITY_FLOOR = 1e-9  # N·m or N: a gravity load at home below this is rounding (a vertical axis)
 
 
@@ -95,14 +96,17 @@ class ActuatorWriter:
             any(a.source_kind != TRACK_ROLLER for a in self.robot.actuators)
             or self.robot.extras.get("mjcf_actuators"))
         chosen: list[Actuator] = []
+        taken = {a.joint for a, _ in planned}
         if made_up:
-            taken = {a.joint for a, _ in planned}
             for free in self.robot.joints:
                 kind = self._chosen_kind(free)
                 if kind is not None and free.name not in taken:
                     chosen.append(Actuator(joint=free.name, kind=kind, source_kind="--actuators",
                                            source=free.source))
             planned += [(a, by_name.get(a.joint)) for a in chosen]
+        else:
+            filled = self._load_bearing_unactuated(taken)
+            planned += [(a, by_name.get(a.joint)) for a in filled]
         skipped = self._constrained()
         written: dict[ActuatorKind, int] = {}
         on_joint: dict[str, Actuator] = {}  # source joint name → the actuator written on it
@@ -110,7 +114,7 @@ class ActuatorWriter:
             target = self.joint_names.get(actuator.joint)
             reason = self._unwritable(joint, target, skipped)
             if reason is not None:
-                if actuator.source_kind != "--actuators":
+                if actuator.source_kind not in ("--actuators", FILLED):
                     self.ctx.note("MK842", f"actuator on joint {actuator.joint} left out: {reason}",
                                   actuator.source, "actuator")
                 continue
@@ -129,6 +133,43 @@ class ActuatorWriter:
         self._said_legs(on_joint)
         self._said_sagging(on_joint, by_name)
         self._said_overloaded(by_name)
+
+    def _load_bearing_unactuated(self, taken: set[str]) -> list[Actuator]:
+        """``--source-actuators auto``: the ``--actuators`` choice, where it gives a servo, on the joints
+        that a source naming actuators for others leaves without one and that carry the robot: a leg's
+        joints, and on a welded base the joints gravity turns at home (MK827). example-robot-data's
+        ANYmal-Kinova names the arm's transmissions only: its twelve leg joints had no actuator and the
+        robot folded onto the floor (451 mm in 2 s). Other unactuated joints (a free wheel, a passive
+        linkage) stay passive, as the source has them."""
+        if self.ctx.options.source_actuators != "auto" or self.robot.source_format == "mjcf":
+            return []
+        if self._legs is None:
+            self._legs = leg_joints(self.robot)
+        welded = self.robot.root_joint is JointType.FIXED
+        constrained = self._constrained()
+        out: list[Actuator] = []
+        for joint in self.robot.joints:
+            if joint.name in taken or joint.name in constrained or \
+                    joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
+                continue
+            if joint.name not in self._legs and not (welded and self.sags(joint)):
+                continue
+            kind = self._chosen_kind(joint)
+            if kind is ActuatorKind.POSITION or kind is ActuatorKind.VELOCITY:
+                out.append(Actuator(joint=joint.name, kind=kind, source_kind=FILLED, source=joint.source))
+        if out:
+            names = [a.joint for a in out]
+            shown = ", ".join(names[:4]) + (" ..." if len(names) > 4 else "")
+            legs = sum(1 for name in names if name in self._legs)
+            what = f"{legs} in legs" if legs == len(names) else (
+                f"{legs} in legs, {len(names) - legs} that gravity turns at home" if legs else
+                "that gravity turns at home")
+            self.ctx.note("MK827", f"{len(out)} joint(s) ({shown}; {what}) that the source leaves without "
+                          "an actuator while it names others get the --actuators choice "
+                          f"({self.ctx.options.actuators}: <{ELEMENTS[out[0].kind]}>), so that the robot "
+                          "holds its home keyframe (unactuated, they fold at zero control); "
+                          "--source-actuators keep leaves them without", self.robot.source, "actuator")
+        return out
 
     def _replaced(self) -> bool:
         """Whether ``--source-actuators replace`` sets the source's own actuators aside (it has some)."""
@@ -425,6 +466,8 @@ class ActuatorWriter:
         """What the gains were missing from, as MK840 says it."""
         if actuator.source_kind == SERVOED:
             return "the source's effort interface"
+        if actuator.source_kind == FILLED:
+            return "the source, which names no actuator for this joint,"
         return f"the source{' ' + actuator.source_kind if actuator.source_kind else ''}"
 
     def _made_up(self, actuator: Actuator, joint: Joint, target: str, load: JointLoad, gains: str,

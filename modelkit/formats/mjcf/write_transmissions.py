@@ -29,14 +29,14 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.convert.tracks import TRACK_ROLLER
 from modelkit.diagnostics import SourceLocation
-from modelkit.formats.mjcf.write_actuators import SERVOED, ActuatorWriter
+from modelkit.formats.mjcf.write_actuators import FILLED, SERVOED, ActuatorWriter
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_refs import WrittenObjects
 from modelkit.formats.mjcf.write_xml import Element, sub
 from modelkit.model import Robot
 
 WRAPPING = ("sphere", "cylinder")  # the geom types a spatial tendon wraps around
-MADE_UP = ("--actuators", TRACK_ROLLER, SERVOED)  # written actuators that are not the source's
+MADE_UP = ("--actuators", TRACK_ROLLER, SERVOED, FILLED)  # written actuators that are not the source's
 Placed = tuple[float, int, Element, float]  # source rank, order written, element, home ctrl
 
 
