@@ -76,3 +76,17 @@ def test_an_mjcf_source_keeps_its_own_equalities(tmp_path: Path) -> None:
     result = CliRunner().invoke(main, ["convert", str(tmp_path / "out.urdf"), "-o", str(back)])
     assert result.exit_code == 0, result.output
     assert 'polycoef="0 2 0 0 0" solref="0.005 1"' in back.read_text()  # a URDF mimic
+
+
+def test_track_rollers_keep_mujocos_default_coupling(tmp_path: Path) -> None:
+    """The track approximation's rollers mimic roller 0; its skid-steer tolerances (docs/verify.md)
+    were measured with MuJoCo's default coupling, which they keep."""
+    from tests.conftest import TUTORIAL
+
+    target = tmp_path / "tracks.xml"
+    source = TUTORIAL / "mobile_robot_tracks.body"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(target)])
+    assert result.exit_code == 0, result.output
+    xml = target.read_text()
+    assert "<equality>" in xml and "_mimic" in xml and "solref=\"0.005 1\"" not in xml
+    assert "MK869" not in result.output

@@ -183,7 +183,7 @@ def _commit_under_signal(tmp_path: Path, sig: int, model: str = "robot.xml") -> 
     out.mkdir(exist_ok=True)
     proc = subprocess.Popen(cli("convert", str(source), "-o", str(out / model), "--force"), env=env(),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    deadline = time.monotonic() + 30
+    deadline = time.monotonic() + 120  # staging 400 meshes takes seconds, more on a loaded machine
     while time.monotonic() < deadline and proc.poll() is None:
         if (out / "meshes").is_dir() and any((out / "meshes").iterdir()):
             break
@@ -208,7 +208,7 @@ def test_kill_9_mid_commit_leaves_no_model_without_meshes_and_the_next_run_clean
     assert code == -signal.SIGKILL
     _model_has_its_meshes(out, "a.xml")
     staging = [n for n in os.listdir(out) if n.startswith(STAGING_PREFIX)]
-    placed = len(list((out / "meshes").iterdir()))
+    placed = len(list((out / "meshes").iterdir())) if (out / "meshes").is_dir() else 0
     print(f"killed with {placed} of 400 meshes in place, model there: {(out / 'a.xml').exists()}")
     assert staging and 0 < placed < 400, "the kill did not come in the middle of the commit"
     again = subprocess.run(cli("convert", str(tmp_path / "in" / "robot.urdf"), "-o", str(out / "a.xml"),

@@ -76,12 +76,13 @@ SECTIONS = (
 )
 SERVO_INTEGRATOR = "implicitfast"  # with position/velocity servos: kv taken implicitly (as Menagerie's arms)
 MIMIC_SOLREF = "0.005 1"
-"""A mimic's joint equality: time constant 5 ms (MuJoCo Menagerie's Robotiq 2F-85 couples its drivers so;
-MuJoCo's default 20 ms lets a follower lag its servoed leader). Measured, a gripper's servos held at home
-2 s then stepped to mid-range: the worst mimic violation fell from 0.25 to 0.076 rad (airo's Robotiq
-2F-85), 0.28 to 0.073 (pybullet_data's xArm gripper), 0.33 to 0.18 (PR2), 2.5 to 1.0 (Fourier's
-Inspire hand); held at home, 0.036 to 0.0078 rad (Inspire). At least 2 time steps at every step the
-writer sets (1 or 2 ms)."""
+"""A mimic's joint equality (not a track approximation's rollers, whose skid-steer tolerances were
+measured with MuJoCo's default coupling: docs/verify.md): time constant 5 ms (MuJoCo Menagerie's
+Robotiq 2F-85 couples its drivers so; MuJoCo's default 20 ms lets a follower lag its servoed leader).
+Measured, a gripper's servos held at home 2 s then stepped to mid-range: the worst mimic violation fell
+from 0.25 to 0.076 rad (airo's Robotiq 2F-85), 0.28 to 0.073 (pybullet_data's xArm gripper), 0.33 to
+0.18 (PR2), 2.5 to 1.0 (Fourier's Inspire hand); held at home, 0.036 to 0.0078 rad (Inspire). At least
+2 time steps at every step the writer sets (1 or 2 ms)."""
 HINGE_HALF_SPAN = 0.05  # m: the two connects of a hinge loop sit this far either side of the joint
 # MuJoCo's XML parser (TinyXML2, 500 levels) reads at most this many nested <body> elements inside
 # <mujoco><worldbody> (measured with MuJoCo 3.x and 4.0: 496 load, 497 are refused).
@@ -382,6 +383,7 @@ class MjcfWriter:
 
     def _mimics(self) -> None:
         written = set(self.tree.scalar_joints)
+        rollers = track_rollers(self.robot)
         for joint in self.robot.joints:
             mimic = joint.mimic
             if mimic is None:
@@ -415,7 +417,7 @@ class MjcfWriter:
             solver = (source or {}).get("solver") or {}
             for key, value in solver.items():
                 el.set(key, str(value))
-            if source is None:  # a mimic of URDF, SDF or .body: rigid there, a stiff soft constraint here
+            if source is None and joint.name not in rollers:  # rigid in the source: stiff here
                 el.set("solref", MIMIC_SOLREF)
                 self.stiff_mimics += 1
 
@@ -517,3 +519,12 @@ class MjcfWriter:
                 self.robot.source,
                 "option",
             )
+
+
+def track_rollers(robot: Robot) -> set[str]:
+    """The joints of the track approximation's rollers (``convert.tracks``: rollers i > 0 mimic roller 0)."""
+    tracks = robot.extras.get("tracks")
+    if not isinstance(tracks, dict):
+        return set()
+    return {name for record in tracks.values() if isinstance(record, dict)
+            for name in record.get("rollers", [])}
