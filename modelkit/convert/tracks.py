@@ -355,6 +355,16 @@ def _message(joint: Joint, link: Link, shape: TrackShape, rollers: list[str], sp
     return "; ".join(parts)
 
 
+def roller_names(robot: Robot, key: str) -> set[str]:
+    """The names the track approximation recorded under ``key`` for every track: ``"rollers"`` (joints)
+    or ``"roller_links"`` (links); empty without tracks."""
+    tracks = robot.extras.get(TRACKS_KEY)
+    if not isinstance(tracks, dict):
+        return set()
+    return {str(name) for record in tracks.values() if isinstance(record, dict)
+            for name in record.get(key, [])}
+
+
 def track_impratio(robot: Robot) -> float | None:
     """The MJCF ``<option impratio>`` the robot's tracks ask for (the smallest), None without tracks."""
     records = robot.extras.get(TRACKS_KEY)

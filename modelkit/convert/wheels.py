@@ -108,12 +108,9 @@ def find_wheels(robot: Robot) -> dict[str, Wheel]:
     floor = _lowest(robot, poses)
     if floor is None:
         return {}
-    rollers: set[str] = set()
-    tracks = robot.extras.get("tracks")
-    if isinstance(tracks, dict):
-        for record in tracks.values():
-            if isinstance(record, dict):
-                rollers.update(record.get("roller_links", []))
+    from modelkit.convert.tracks import roller_names
+
+    rollers = roller_names(robot, "roller_links")
     links = {link.name: link for link in robot.links}
     z = np.array([0.0, 0.0, 1.0])
     out: dict[str, Wheel] = {}

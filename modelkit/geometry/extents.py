@@ -9,6 +9,7 @@ wheel. A mesh held only by its path is read from its file (Hello Robot's Stretch
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -27,26 +28,49 @@ MICRON_DIGITS = 6
 vertices (7 digits), and the shape written from them (a wheel's sphere) is an approximation anyway."""
 
 
+_READ: weakref.WeakKeyDictionary[Mesh, tuple[tuple[object, ...], np.ndarray | None]] = \
+    weakref.WeakKeyDictionary()
+"""A file mesh's vertices as read, per model object and what it was read from: the rules ask for the
+same mesh's reach in several directions (``extent`` asks twice per direction), and each ask parsed the
+file again."""
+
+
 def mesh_vertices(mesh: Mesh) -> np.ndarray | None:
     """The mesh's vertices in its geom frame (scale applied), loading the file when needed."""
     if mesh.data is not None:
-        vertices = np.asarray(mesh.data.vertices, dtype=float)
+        vertices: np.ndarray | None = np.asarray(mesh.data.vertices, dtype=float)
     elif mesh.path:
-        from modelkit.geometry.meshfiles import MeshLoadError, MeshMetadata, load_mesh
-
-        meta = mesh.source_params.get("metadata")
-        metadata = (MeshMetadata(meta.get("length_unit"), meta.get("upper_axis"))
-                    if isinstance(meta, dict) and meta else None)
-        try:
-            loaded = load_mesh(Path(mesh.path), mesh.fragment, metadata)
-            vertices = np.asarray(loaded.mesh.vertices, dtype=float)
-        except (MeshLoadError, OSError):
-            return None
+        vertices = _file_vertices(mesh)
     else:
         return None
-    if vertices.size == 0:
+    if vertices is None or vertices.size == 0:
         return None
     return vertices.reshape(-1, 3) * np.asarray(mesh.scale, dtype=float)
+
+
+def _file_vertices(mesh: Mesh) -> np.ndarray | None:
+    """The vertices of the mesh's file (None when it does not load), read once per mesh object."""
+    from modelkit.geometry.meshfiles import MeshLoadError, MeshMetadata, load_mesh
+
+    meta = mesh.source_params.get("metadata")
+    metadata = (MeshMetadata(meta.get("length_unit"), meta.get("upper_axis"))
+                if isinstance(meta, dict) and meta else None)
+    try:
+        stat = Path(str(mesh.path)).stat()
+    except OSError:
+        return None
+    # a rewritten file (another modification time or size) is read again
+    key = (mesh.path, mesh.fragment, metadata, stat.st_mtime_ns, stat.st_size)
+    kept = _READ.get(mesh)
+    if kept is not None and kept[0] == key:
+        return kept[1]
+    try:
+        vertices: np.ndarray | None = np.asarray(
+            load_mesh(Path(str(mesh.path)), mesh.fragment, metadata).mesh.vertices, dtype=float)
+    except (MeshLoadError, OSError):
+        vertices = None
+    _READ[mesh] = (key, vertices)
+    return vertices
 
 
 def support(geometry: Geometry, direction: Vec3) -> float | None:

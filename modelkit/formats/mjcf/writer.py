@@ -56,6 +56,7 @@ from modelkit.convert.numbers import fmt, fmt_text, fmt_vec
 from modelkit.convert.self_contact import BelowBase, touching_pairs
 from modelkit.convert.servo_gains import with_written_masses
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
+from modelkit.convert.tracks import roller_names
 from modelkit.formats.mjcf.write_actuators import ActuatorWriter
 from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, MIN_MASS, BodyTree
 from modelkit.formats.mjcf.write_contact_pairs import write_source_pairs
@@ -383,7 +384,7 @@ class MjcfWriter:
 
     def _mimics(self) -> None:
         written = set(self.tree.scalar_joints)
-        rollers = track_rollers(self.robot)
+        rollers = roller_names(self.robot, "rollers")  # they keep MuJoCo's default coupling
         for joint in self.robot.joints:
             mimic = joint.mimic
             if mimic is None:
@@ -520,11 +521,3 @@ class MjcfWriter:
                 "option",
             )
 
-
-def track_rollers(robot: Robot) -> set[str]:
-    """The joints of the track approximation's rollers (``convert.tracks``: rollers i > 0 mimic roller 0)."""
-    tracks = robot.extras.get("tracks")
-    if not isinstance(tracks, dict):
-        return set()
-    return {name for record in tracks.values() if isinstance(record, dict)
-            for name in record.get("rollers", [])}

@@ -31,6 +31,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from modelkit.checks.masses import subtree
 from modelkit.convert.base import root_body, touching_ground, vertical_spans
 from modelkit.geometry.extents import ROUNDNESS, mesh_vertices, round_about
 from modelkit.model import Geom, Joint, JointType, Link, Mesh, Robot
@@ -114,7 +115,8 @@ def supported(robot: Robot, drive: Drive) -> str | None:
     if drive.kind != "wheels":
         return None
     spans = vertical_spans(robot, robot.world_poses())
-    wheels = _subtree(robot, set(drive.wheel_links))
+    children = robot.children_of()
+    wheels = {name for link in drive.wheel_links for name in subtree(children, link)}
     if touching_ground(spans) - wheels:
         return None
     unread = sorted({link.name for link in robot.links for geom in link.collisions
@@ -122,18 +124,6 @@ def supported(robot: Robot, drive: Drive) -> str | None:
     why = (f" (the collision mesh of {', '.join(unread)} cannot be read)" if unread else "")
     return (f"the robot stands on its two wheels alone: no collision shape but the wheels reaches the floor "
             f"at q = 0{why}, so it tips over on its axle and a driven comparison would grade its fall")
-
-
-def _subtree(robot: Robot, links: set[str]) -> set[str]:
-    """``links`` and every link hanging from them."""
-    children = robot.children_of()
-    out, stack = set(), list(links)
-    while stack:
-        name = stack.pop()
-        if name not in out:
-            out.add(name)
-            stack.extend(joint.child for joint in children.get(name, []))
-    return out
 
 
 def drivable(robot: Robot, drive: Drive, scenario: Scenario) -> str | None:

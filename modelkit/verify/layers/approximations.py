@@ -655,8 +655,8 @@ def wheel_proxies(source: Robot, engine_shapes: Mapping[str, Sequence[Any]],
     ``convert``'s default."""
     from modelkit.convert.wheels import find_wheels
 
-    wheels = {link: wheel.index for link, wheel in find_wheels(source).items()
-              if isinstance(_collision(source, link, wheel.index), Cylinder | Mesh)}
+    shapes = {link: _collision(source, link, wheel.index) for link, wheel in find_wheels(source).items()}
+    wheels = {link: shape for link, shape in shapes.items() if isinstance(shape, Cylinder | Mesh)}
     held = set()
     for link in sorted(wheels):
         kinds = {shape.type for shape in engine_shapes.get(written(link), [])}
@@ -666,8 +666,7 @@ def wheel_proxies(source: Robot, engine_shapes: Mapping[str, Sequence[Any]],
         held.add(proxy[0])
     if len(held) != 1:
         return None
-    kinds = {"cylinder" if isinstance(_collision(source, link, index), Cylinder) else "round mesh"
-             for link, index in wheels.items()}
+    kinds = {"cylinder" if isinstance(shape, Cylinder) else "round mesh" for shape in wheels.values()}
     return WheelProxy(held.pop(), tuple(sorted(wheels)), " or ".join(sorted(kinds)))
 
 
