@@ -108,6 +108,14 @@ GOOD = {
     "exponents_and_signs": "v 1e5 1E-5 -.5e+3\nv +1. 0 0\nv 0 1 0\nf 1 2 3\n",
     "latin1_comment": "# caf\xe9\n" + V4 + "f 1 2 3\n",
     "no_final_newline": V4 + "f 1 2 3",
+    # the shape-based paths and their fall-backs to reading every number
+    "meshlab_interleaved_rows": "vn 0 0 1\nv 0 0 0\nvn 0 0 1\nv 1 0 0\nvn 0 0 1\nv 0 1 0\n"
+    + "vt 0 0\nvt 1 0\nvt 0 1\nf 1/1/1 2/2/2 3/3/3\nvt 1 1\nvt 0 1\nvt 1 0\nf 3/4/3 2/5/2 1/6/1\n",
+    "blanks_around_face_lines": V4 + "f 1 2 3 \nf  2 4 3\nf\t1 3 4\n",
+    "comment_among_face_lines": V4 + "f 1 2 3\n# caf\xe9\nf 2 4 3\n",
+    "leading_zeros_past_eighteen_digits": V4 + "f 0000000000000000000001 2 3\n",
+    "long_mantissa": "v 0." + "0" * 120 + "1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    "two_digit_exponents": "v 1e-05 2E+10 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
 }
 
 # refused by load_mesh: the fast check must refuse them with the same message
@@ -133,6 +141,10 @@ BAD = {
     "faces_without_vertices": "f 1 2 3\n",
     "faces_with_two_vertices": V4 + "f 1 2\nf 2 3\n",
     "face_line_with_tab": V4 + "f\t1 2 3\n",
+    "second_kind_malformed": V4 + "vn 0 0 1..\nf 1//1 2//1 3//1\n",
+    "overflow_in_a_long_mantissa": "v 9" + "9" * 400 + " 0 0\n" + V4 + "f 1 2 3\n",
+    "interleaved_face_past_last_vertex": "vn 0 0 1\nv 0 0 0\nvn 0 0 1\nv 1 0 0\nvn 0 0 1\nv 0 1 0\n"
+    + "vt 0 0\nf 1/1/1 2/1/2 3/1/3\nvt 1 1\nf 3/2/3 2/2/2 4/2/1\n",
 }
 
 # the fast check leaves these to load_mesh
@@ -142,6 +154,7 @@ UNDECIDED_CASES = {
     "plus_sign_index": V4 + "f +1 2 3\n",
     "mixed_token_forms": V4 + VT + "f 1/1 2 3\n",
     "huge_index": V4 + "f 1 2 99999999999999999999\n",
+    "non_ascii_in_face_line": V4 + "f 1 2 3 \xe9\n",
 }
 
 

@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cached_property
 from itertools import pairwise
 
 __all__ = ["UNDECIDED", "obj_problem"]
@@ -43,6 +45,19 @@ _NOT_FACE_CHAR = re.compile(r"[^0-9/\- \t]")
 # numpy's message when np.fromstring meets something that is not a number
 _NUMPY_UNMATCHED = "string or file could not be read to its end due to unmatched data"
 _INT_LIMIT = 2**62  # larger indices: numpy's int64 reading might wrap or saturate
+_INT_DIGITS = 18  # a run of at most this many digits is below _INT_LIMIT
+
+# The fast paths below judge numbers by their shape: every digit read as 0 ("-12.5e3" is "-00.0e0"). Whether
+# Python (and so numpy, for these characters) reads a token as a number depends on its shape alone, and a
+# file written by one exporter has a handful of shapes among its millions of numbers.
+_DIGITS_TO_ZERO = bytes.maketrans(b"123456789", b"000000000")
+_DECIMAL_BYTES = b"0123456789eE+-. \t"
+_FACE_BYTES = b"0123456789/- \t\n"
+_ODD_ASCII_SPACE = "\r\x0b\x0c\x1c\x1d\x1e\x1f"
+# trimesh's rows: the rest of the line after each "\n<kind> " (its split and first-line comprehension)
+_ROWS = {k: re.compile(f"\n{k} ([^\n]*)") for k in ("v", "vt", "vn")}
+# trimesh's face lines: the rest of each line starting with "f" (its re.split("^f") and first line)
+_FACE_LINE = re.compile("^f([^\n]*)", re.MULTILINE)
 
 
 class _Undecided(Exception):
@@ -62,9 +77,21 @@ class _Vertices:
 
 @dataclass
 class _Chunk:
-    faces: list[int]  # vertex indices, row-major, ``width`` per face (trimesh's 0-based, negatives kept)
     width: int  # vertices per face
     masked_to_max: bool  # the vertex mask is arange(max + 1) (texture or normal indices present)
+    count: int  # vertex references
+    low: int  # the smallest and largest of them (trimesh's 0-based, negatives kept)
+    high: int
+    read_faces: Callable[[], list[int]] = field(repr=False)
+
+    @cached_property
+    def faces(self) -> list[int]:
+        """The vertex indices, row-major, ``width`` per face; read only when the bounds cannot decide."""
+        return self.read_faces()
+
+
+def _chunk_of(faces: list[int], width: int, masked_to_max: bool) -> _Chunk:
+    return _Chunk(width, masked_to_max, len(faces), min(faces), max(faces), lambda: faces)
 
 
 def obj_problem(data: bytes, name: str) -> str | None:
@@ -80,7 +107,7 @@ def obj_problem(data: bytes, name: str) -> str | None:
         return f"MK501\t{name} contains NUL bytes: not a text OBJ file"
     # trimesh: leading/trailing newline, \r\n -> \n, backslash continuations merged
     text = "\n{}\n".format(text.strip().replace("\r\n", "\n")).replace("\\\n", "")
-    if _ODD_SPACE.search(text):
+    if any(c in text for c in _ODD_ASCII_SPACE) if text.isascii() else _ODD_SPACE.search(text):
         return UNDECIDED
     try:
         verts, has_normals = _vertices(text)
@@ -108,14 +135,17 @@ def _vertices(text: str) -> tuple[_Vertices | None, bool]:
         raise _Undecided
     start = min(s for s in starts.values() if s >= 0)
     chunk = text[start : max(ends)].replace("+e", "e").replace("-e", "e")
+    lines = _zeroed_lines(chunk) if chunk.isascii() else None
     verts: _Vertices | None = None
     for k, s in starts.items():
         if s < 0:
             continue
-        rows = [i.split("\n", 1)[0] for i in chunk.split(f"\n{k} ")[1:]]
-        if not rows:
-            raise _Undecided
-        table = _number_rows(rows)
+        table = _rows_by_shape(lines, k, chunk) if lines is not None else None
+        if table is None:
+            rows = _ROWS[k].findall(chunk)
+            if not rows:
+                raise _Undecided
+            table = _number_rows(rows)
         if k == "v":
             verts = table
     return verts, starts["vn"] >= 0
@@ -133,6 +163,7 @@ def _number_rows(rows: list[str]) -> _Vertices:
     """Rows of numbers as trimesh reads them: one ``np.fromstring`` of all rows, reshaped to
     (rows, numbers of the first row) when the count fits, else row by row clipped to the shortest."""
     joined = " ".join(rows)
+    per_row = len(rows[0].split())
     tokens = joined.split()
     try:
         if _NOT_DECIMAL_CHAR.search(joined) and not all(_NUMBER_TOKEN.fullmatch(t) for t in tokens):
@@ -143,7 +174,6 @@ def _number_rows(rows: list[str]) -> _Vertices:
         if any(not _NAN_INF_START.match(t) for t in odd):
             raise _Malformed from None  # numpy's np.fromstring stops at it (numpy >= 2: ValueError)
         raise _Undecided from None
-    per_row = len(rows[0].split())
     if len(values) == len(rows) * per_row:
         columns = min(per_row, 3)
         bad: int | None = None
@@ -159,6 +189,37 @@ def _number_rows(rows: list[str]) -> _Vertices:
     columns = min(count, 3)
     bad = next((r for r, t in enumerate(lines) if not all(map(math.isfinite, _floats(t[:columns])))), None)
     return _Vertices(len(lines), columns, bad)
+
+
+def _zeroed_lines(text: str) -> set[bytes]:
+    """The distinct lines of an ASCII ``text`` with every digit written as 0."""
+    return set(text.encode("ascii").translate(_DIGITS_TO_ZERO).split(b"\n"))
+
+
+def _rows_by_shape(lines: set[bytes], kind: str, chunk: str) -> _Vertices | None:
+    """trimesh's table of the ``kind`` rows of ``chunk``, judged from the shapes of its lines alone when
+    every row holds as many plain decimal numbers, each surely finite; None otherwise (the caller then
+    reads every number). A number that is no number is :class:`_Malformed` whatever its digits."""
+    prefix = f"{kind} ".encode()
+    rows = [line[len(prefix) :] for line in lines if line.startswith(prefix)]
+    if not rows or any(row.translate(None, _DECIMAL_BYTES) for row in rows):
+        return None
+    tokens = [row.split() for row in rows]
+    numbers = set().union(*tokens)
+    for number in numbers:
+        try:
+            float(number)
+        except ValueError:
+            raise _Malformed from None  # numpy's np.fromstring stops at it (numpy >= 2: ValueError)
+    if len({len(t) for t in tokens}) != 1 or not all(map(_surely_finite, numbers)):
+        return None
+    return _Vertices(chunk.count(f"\n{kind} "), min(len(tokens[0]), 3), None)
+
+
+def _surely_finite(shape: bytes) -> bool:
+    """A number of this shape is finite whatever its digits (below 1e100 times 1e99)."""
+    mantissa, _, exponent = shape.lower().partition(b"e")
+    return len(mantissa) <= 100 and len(exponent.lstrip(b"+-")) <= 2
 
 
 # ---- faces (trimesh.exchange.obj._preprocess_faces and load_obj) --------------------------------
@@ -184,7 +245,7 @@ def _face_chunks(text: str) -> list[str]:
     return chunks
 
 
-def _ints(text: str) -> list[int]:
+def _ints(text: bytes) -> list[int]:
     try:
         values = list(map(int, text.split()))
     except ValueError:
@@ -197,23 +258,76 @@ def _ints(text: str) -> list[int]:
 def _chunk(chunk: str, has_normals: bool) -> _Chunk:
     """The vertex indices of one face chunk, read as trimesh does (vectorised when every face line has
     the same number of integers, else line by line with quads and polygons fanned into triangles)."""
-    face_lines = [i.split("\n", 1)[0].strip() for i in re.split("^f", chunk, flags=re.MULTILINE)[1:]]
-    if _NOT_FACE_CHAR.search(" ".join(face_lines)):
-        raise _Undecided
-    columns = [len(f.replace("/", " ").split()) for f in face_lines]
-    if all(c == columns[0] for c in columns):
-        return _vectorised(face_lines, columns[0], has_normals)
-    return _per_line(face_lines, has_normals)
+    block = _face_block(chunk)
+    if block.translate(None, _FACE_BYTES):
+        raise _Undecided  # a character that is not a digit, slash, minus or blank
+    shapes = _line_shapes(block)
+    if shapes is None:  # long digit runs: every index is read
+        face_lines = block.split(b"\n")
+        columns = [len(f.replace(b"/", b" ").split()) for f in face_lines]
+        if all(c == columns[0] for c in columns):
+            return _vectorised(block, columns[0], has_normals, check_ints=True)
+        return _per_line(face_lines, has_normals)
+    counts = {len(s.replace(b"/", b" ").split()) for s in shapes}
+    if len(counts) != 1:
+        return _per_line(block.split(b"\n"), has_normals)
+    if any(t not in (b"0", b"-0") for s in shapes for t in s.replace(b"/", b" ").split()):
+        raise _Undecided  # a token that is not a plain integer (numpy and int() may differ)
+    return _vectorised(block, counts.pop(), has_normals, check_ints=False)
 
 
-def _vectorised(face_lines: list[str], columns: int, has_normals: bool) -> _Chunk:
-    sample = face_lines[0]
-    values = _ints(" ".join(face_lines).replace("/", " "))
+def _face_block(chunk: str) -> bytes:
+    """The rest of every line that starts with ``f``, stripped (trimesh's ``re.split("^f")`` and first
+    line), one per line; :class:`_Undecided` when one of them is not ASCII."""
+    if not chunk.isascii():
+        lines = [line.strip() for line in _FACE_LINE.findall(chunk)]
+        if not all(line.isascii() for line in lines):
+            raise _Undecided
+        return "\n".join(lines).encode("ascii")
+    pieces = (b"\n" + chunk.encode("ascii")).split(b"\nf")[1:]
+    return _stripped_lines(b"\n".join([piece.split(b"\n", 1)[0] for piece in pieces]))
+
+
+def _stripped_lines(block: bytes) -> bytes:
+    """``block`` with each line stripped of blanks at both ends."""
+    if (block.startswith(b" ") and block.count(b"\n ") == block.count(b"\n") and b"  " not in block
+            and b" \n" not in block and not block.endswith(b" ") and b"\t" not in block):
+        return block[1:].replace(b"\n ", b"\n")  # one blank at the start of every line, none at the end
+    return b"\n".join([line.strip() for line in block.split(b"\n")])
+
+
+def _line_shapes(block: bytes) -> set[bytes] | None:
+    """The distinct face lines of ``block`` with every run of digits written as one 0; None when a run is
+    longer than :data:`_INT_DIGITS` (the indices are then read one by one)."""
+    data = block.translate(_DIGITS_TO_ZERO)
+    if b"0" * (_INT_DIGITS + 1) in data:
+        return None
+    return {_one_zero_per_run(line) for line in set(data.split(b"\n"))}
+
+
+def _one_zero_per_run(line: bytes) -> bytes:
+    while b"00" in line:
+        line = line.replace(b"00", b"0")
+    return line
+
+
+def _vectorised(block: bytes, columns: int, has_normals: bool, check_ints: bool) -> _Chunk:
+    """One face chunk whose lines all hold ``columns`` integers; ``check_ints`` when the tokens' shapes
+    were not checked (every value is then read and bounded)."""
+    sample = block.split(b"\n", 1)[0].decode("ascii")
+    joined = block.replace(b"/", b" ")
+    if check_ints:
+        _ints(joined)
     group_count = len(sample.strip().split())
     if columns == 0 or group_count == 0 or columns % group_count:
         raise _Undecided  # numpy errors or trimesh's slicing of mixed token forms
     per_ref = columns // group_count
-    faces = [x - 1 if x > 0 else x for x in values[::per_ref]]
+    references = joined.split()[::per_ref]
+    distinct = list(map(int, set(references)))
+
+    def read_faces() -> list[int]:
+        return [_zero_based(int(t)) for t in references]
+
     tex = norm = False
     if per_ref == 2:
         count = "".join(i.strip("/") for i in sample.split()).count("/")
@@ -223,10 +337,17 @@ def _vectorised(face_lines: list[str], columns: int, has_normals: bool) -> _Chun
             tex = True
     elif per_ref == 3:  # a/b/c
         tex = norm = True
-    return _Chunk(faces, group_count, tex or (norm and has_normals))
+    # _zero_based keeps the order of indices: the bounds are those of the raw ones, shifted
+    return _Chunk(group_count, tex or (norm and has_normals), len(references), _zero_based(min(distinct)),
+                  _zero_based(max(distinct)), read_faces)
 
 
-def _per_line(face_lines: list[str], has_normals: bool) -> _Chunk:
+def _zero_based(index: int) -> int:
+    """trimesh's index: 1-based positive indices shifted to 0-based, relative (negative) ones kept."""
+    return index - 1 if index > 0 else index
+
+
+def _per_line(face_lines: list[bytes], has_normals: bool) -> _Chunk:
     v: list[int] = []
     n_vt = n_vn = 0
     for line in face_lines:
@@ -239,7 +360,7 @@ def _per_line(face_lines: list[str], has_normals: bool) -> _Chunk:
         elif k > 4:
             split = [t for i in range(k - 2) for t in (split[0], split[i + 1], split[i + 2])]
         for token in split:
-            parts = token.split("/")
+            parts = token.split(b"/")
             try:
                 v.append(int(parts[0]))
             except ValueError:
@@ -252,10 +373,10 @@ def _per_line(face_lines: list[str], has_normals: bool) -> _Chunk:
         raise _Undecided  # no faces: trimesh fails in numpy (max of an empty array)
     tex = n_vt == len(v)
     norm = n_vn == len(v)
-    return _Chunk([x - 1 if x > 0 else x for x in v], 3, tex or (norm and has_normals))
+    return _chunk_of([_zero_based(x) for x in v], 3, tex or (norm and has_normals))
 
 
-def _is_int(token: str) -> bool:
+def _is_int(token: bytes) -> bool:
     try:
         int(token)
     except ValueError:
@@ -272,12 +393,13 @@ def _verdict(verts: _Vertices, chunks: list[_Chunk], name: str) -> str | None:
     n = verts.rows
     used_rows: list[int] = []  # vertex rows each chunk keeps
     for c in chunks:
-        lo, hi = min(c.faces), max(c.faces)
+        lo, hi = c.low, c.high
         if c.masked_to_max:  # unmerge_faces(maintain_faces=True): mask arange(max + 1)
             if hi < -1:
                 raise _Undecided  # numpy: negative dimensions
-            first3 = [x for i, x in enumerate(c.faces) if i % c.width < 3] if c.width > 3 else c.faces
-            if min(first3) < -(hi + 1) or hi + 1 > n:
+            if lo < -(hi + 1) and c.width > 3:  # only the first three of a polygon's corners count
+                lo = min(x for i, x in enumerate(c.faces) if i % c.width < 3)
+            if lo < -(hi + 1) or hi + 1 > n:
                 return f"MK501\t{name}: a face refers to a vertex that does not exist"
             used_rows.append(hi + 1)
         else:  # mask of all vertices; indices remapped into [0, n)
@@ -298,14 +420,18 @@ def _verdict(verts: _Vertices, chunks: list[_Chunk], name: str) -> str | None:
     n_triangles = 0
     out_of_range = False
     for (c, _), nv in zip(pieces, sizes, strict=True):
-        faces = c.faces if c.masked_to_max else [x + n if x < 0 else x for x in c.faces]
+        low, high = _remapped_bounds(c, n)
         if c.width == 3:
-            n_triangles += len(faces) // 3
-            if min(faces) < 0 or max(faces) + offset >= total:
+            n_triangles += c.count // 3
+            if low < 0 or high + offset >= total:
                 out_of_range = True
         elif c.width > 3:  # polygons with an index outside the vertices are skipped
             w = c.width
-            kept = sum(1 for i in range(0, len(faces), w) if all(0 <= x < nv for x in faces[i : i + w]))
+            if low >= 0 and high < nv:
+                kept = (c.count + w - 1) // w
+            else:
+                faces = _remapped(c, n)
+                kept = sum(1 for i in range(0, len(faces), w) if all(0 <= x < nv for x in faces[i : i + w]))
             n_triangles += kept * (w - 2)
         offset += nv
     if out_of_range:
@@ -315,3 +441,17 @@ def _verdict(verts: _Vertices, chunks: list[_Chunk], name: str) -> str | None:
     if verts.first_bad_row is not None and verts.first_bad_row < max(used_rows):
         return f"MK501\t{name} has non-finite vertex coordinates (NaN or infinity)"
     return None
+
+
+def _remapped(c: _Chunk, n: int) -> list[int]:
+    """The chunk's vertex indices as trimesh uses them: relative ones counted from the end of the ``n``
+    vertices unless the vertex mask is arange(max + 1)."""
+    return c.faces if c.masked_to_max else [x + n if x < 0 else x for x in c.faces]
+
+
+def _remapped_bounds(c: _Chunk, n: int) -> tuple[int, int]:
+    """The smallest and largest of :func:`_remapped`, from the chunk's bounds when no index is relative."""
+    if c.masked_to_max or c.low >= 0:
+        return c.low, c.high
+    faces = _remapped(c, n)
+    return min(faces), max(faces)
