@@ -277,23 +277,16 @@ def _chunk(chunk: str, has_normals: bool) -> _Chunk:
 
 
 def _face_block(chunk: str) -> bytes:
-    """The rest of every line that starts with ``f``, stripped (trimesh's ``re.split("^f")`` and first
-    line), one per line; :class:`_Undecided` when one of them is not ASCII."""
+    """The rest of every line that starts with ``f`` (trimesh's ``re.split("^f")`` and first line), one per
+    line; :class:`_Undecided` when one of them is not ASCII. trimesh strips each line; blanks at the ends
+    change nothing here, since every use of these lines splits them at blanks."""
     if not chunk.isascii():
         lines = [line.strip() for line in _FACE_LINE.findall(chunk)]
         if not all(line.isascii() for line in lines):
             raise _Undecided
         return "\n".join(lines).encode("ascii")
     pieces = (b"\n" + chunk.encode("ascii")).split(b"\nf")[1:]
-    return _stripped_lines(b"\n".join([piece.split(b"\n", 1)[0] for piece in pieces]))
-
-
-def _stripped_lines(block: bytes) -> bytes:
-    """``block`` with each line stripped of blanks at both ends."""
-    if (block.startswith(b" ") and block.count(b"\n ") == block.count(b"\n") and b"  " not in block
-            and b" \n" not in block and not block.endswith(b" ") and b"\t" not in block):
-        return block[1:].replace(b"\n ", b"\n")  # one blank at the start of every line, none at the end
-    return b"\n".join([line.strip() for line in block.split(b"\n")])
+    return b"\n".join([piece.split(b"\n", 1)[0] for piece in pieces])
 
 
 def _line_shapes(block: bytes) -> set[bytes] | None:
