@@ -1,12 +1,14 @@
 """`modelkit validate` of real robots with large meshes: without the mesh-check cache, on its first
 run (cold, the cache filled), and on the next runs (warm, the outcomes read back).
 
-    python bench/bench_mesh_cache.py [--repeat N] [--json FILE] [FILE ...]
+    python bench/bench_mesh_cache.py [--repeat N] [--json FILE] [--source DIR] [FILE ...]
 
 Default files: example-robot-data's slowest to validate (tens of MB of COLLADA text, many meshes).
 Each figure is the median wall time of N fresh processes (after one warm-up of the interpreter's
 bytecode), taking turns; "cold" empties the cache before each run. The printed output of the three
 modes must be the same bytes (checked, reported). Reports, never fails: exit 0 whatever the figures.
+``--source DIR`` runs the modelkit package found in DIR (a worktree of another commit) instead of the
+installed one, so two commits can be measured the same way, taking turns.
 """
 
 from __future__ import annotations
@@ -41,9 +43,19 @@ DEFAULT = ("b1_description/urdf/b1-z1.urdf", "b1_description/urdf/b1.urdf", "go1
            "romeo_description/urdf/romeo.urdf", "alex_description/urdf/alex_psyonic_hands.urdf")
 
 
-def run(path: Path, cache: str, env: dict[str, str]) -> tuple[float, str]:
+def command(source: Path | None) -> list[str]:
+    """The modelkit command: the installed one, or the package in ``source`` ahead of it on sys.path."""
+    if source is None:
+        return [str(MODELKIT)]
+    code = (f"import sys; sys.path.insert(0, {str(source.resolve())!r}); import modelkit.cli as cli; "
+            f"assert cli.__file__.startswith({str(source.resolve())!r}), cli.__file__; "
+            "sys.argv[0] = 'modelkit'; cli.main()")
+    return [sys.executable, "-c", code]
+
+
+def run(path: Path, cache: str, env: dict[str, str], modelkit: list[str]) -> tuple[float, str]:
     start = time.perf_counter()
-    done = subprocess.run([str(MODELKIT), "validate", str(path)], capture_output=True, text=True, check=False,
+    done = subprocess.run([*modelkit, "validate", str(path)], capture_output=True, text=True, check=False,
                           env={**env, "MODELKIT_CACHE_DIR": cache})
     wall = time.perf_counter() - start
     return wall, hashlib.sha256((done.stdout + str(done.returncode)).encode()).hexdigest()
@@ -54,7 +66,9 @@ def main() -> None:
     parser.add_argument("files", nargs="*", type=Path)
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--json", type=Path)
+    parser.add_argument("--source", type=Path, help="a folder holding another commit's modelkit package")
     args = parser.parse_args()
+    modelkit = command(args.source)
     root = robots()
     files = args.files or [root / f for f in DEFAULT]
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
@@ -64,18 +78,18 @@ def main() -> None:
         env["PYTHONPYCACHEPREFIX"] = str(Path(tmp) / "pyc")
         cache = str(Path(tmp) / "cache")
         for path in files:
-            run(path, "off", env)  # bytecode compiled once
+            run(path, "off", env, modelkit)  # bytecode compiled once
             times: dict[str, list[float]] = {"off": [], "cold": [], "warm": []}
             outputs: set[str] = set()
             for _ in range(args.repeat):
-                wall, out = run(path, "off", env)
+                wall, out = run(path, "off", env, modelkit)
                 times["off"].append(wall)
                 outputs.add(out)
                 shutil.rmtree(cache, ignore_errors=True)
-                wall, out = run(path, cache, env)
+                wall, out = run(path, cache, env, modelkit)
                 times["cold"].append(wall)
                 outputs.add(out)
-                wall, out = run(path, cache, env)
+                wall, out = run(path, cache, env, modelkit)
                 times["warm"].append(wall)
                 outputs.add(out)
             row = {"file": path.name, **{f"{k}_median_s": statistics.median(v) for k, v in times.items()},
