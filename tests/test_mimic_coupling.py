@@ -90,3 +90,51 @@ def test_track_rollers_keep_mujocos_default_coupling(tmp_path: Path) -> None:
     xml = target.read_text()
     assert "<equality>" in xml and "_mimic" in xml and "solref=\"0.005 1\"" not in xml
     assert "MK869" not in result.output
+
+
+GRIPPER_STARTED_OPEN = """<robot name="gripper">
+  <link name="palm"/>
+  <link name="driver"><inertial><origin xyz="0 0 0.03"/><mass value="0.05"/>
+    <inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="mirror"><inertial><origin xyz="0 0 0.03"/><mass value="0.05"/>
+    <inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="tip"><inertial><origin xyz="0 0 0.02"/><mass value="0.02"/>
+    <inertia ixx="1e-6" iyy="1e-6" izz="1e-6" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="finger" type="revolute"><parent link="palm"/><child link="driver"/><axis xyz="1 0 0"/>
+    <limit lower="0" upper="0.8" effort="5" velocity="2"/></joint>
+  <joint name="finger_mirror" type="revolute"><parent link="palm"/><child link="mirror"/>
+    <origin xyz="0 0.05 0"/><axis xyz="1 0 0"/><limit lower="-0.8" upper="0" effort="5" velocity="2"/>
+    <mimic joint="finger" multiplier="-1"/></joint>
+  <joint name="finger_tip" type="revolute"><parent link="driver"/><child link="tip"/>
+    <origin xyz="0 0 0.06"/><axis xyz="1 0 0"/><limit lower="0" upper="1" effort="5" velocity="2"/>
+    <mimic joint="finger_mirror" multiplier="-0.5" offset="0.1"/></joint>
+  <ros2_control name="hw" type="system">
+    <joint name="finger"><command_interface name="position"/>
+      <state_interface name="position"><param name="initial_value">0.4</param></state_interface></joint>
+  </ros2_control>
+</robot>
+"""
+
+
+def test_the_home_keyframe_puts_followers_where_their_mimics_do(tmp_path: Path) -> None:
+    """A source that starts a gripper's leader open (ros2_control's ``initial_value``, as TIAGo Pro's does)
+    and names no position for its followers: the ``home`` keyframe puts each follower, through a chain of
+    two mimics, at its leader's image, so nothing snaps at the first step (before: the followers sat at 0
+    and jumped to the leader's 0.15–0.19 rad on TIAGo Pro)."""
+    source = tmp_path / "gripper.urdf"
+    source.write_text(GRIPPER_STARTED_OPEN)
+    out = tmp_path / "gripper.xml"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    m = mujoco.MjModel.from_xml_path(str(out))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home"))
+    names = ("finger", "finger_mirror", "finger_tip")
+    home = {name: float(d.qpos[m.joint(name).qposadr[0]]) for name in names}
+    assert home == pytest.approx({"finger": 0.4, "finger_mirror": -0.4, "finger_tip": 0.3}, abs=1e-12)
+    mujoco.mj_forward(m, d)
+    assert float(np.max(np.abs(d.efc_pos[d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY]))) < 1e-12
+    for _ in range(round(0.2 / m.opt.timestep)):
+        mujoco.mj_step(m, d)
+    moved = {name: abs(float(d.qpos[m.joint(name).qposadr[0]]) - home[name]) for name in home}
+    assert max(moved.values()) < 0.01, moved

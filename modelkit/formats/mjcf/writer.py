@@ -385,6 +385,7 @@ class MjcfWriter:
     def _mimics(self) -> None:
         written = set(self.tree.scalar_joints)
         rollers = roller_names(self.robot, "rollers")  # they keep MuJoCo's default coupling
+        couplings: list[tuple[str, str, float, float]] = []  # follower, leader, multiplier, offset
         for joint in self.robot.joints:
             mimic = joint.mimic
             if mimic is None:
@@ -421,6 +422,24 @@ class MjcfWriter:
             if source is None and joint.name not in rollers:  # rigid in the source: stiff here
                 el.set("solref", MIMIC_SOLREF)
                 self.stiff_mimics += 1
+            couplings.append((follower[0], leader[0], mimic.multiplier, mimic.offset))
+        self._home_coupled(couplings)
+
+    def _home_coupled(self, couplings: list[tuple[str, str, float, float]]) -> None:
+        """Each mimic follower's home at its leader's image (offset + multiplier × the leader's home), so
+        that the ``home`` keyframe satisfies the equalities: TIAGo Pro's ros2_control starts its gripper's
+        leader at 0.15 rad and names no position for the followers, which then snapped 0.15–0.19 rad at
+        the first step. A chain (a follower of a follower) settles in as many passes as it is long."""
+        home = self.tree.home
+        for _ in range(len(couplings)):
+            changed = False
+            for follower, leader, multiplier, offset in couplings:
+                value = offset + multiplier * home.get(leader, 0.0)
+                if home.get(follower, 0.0) != value:
+                    home[follower] = value
+                    changed = True
+            if not changed:
+                break
 
     def _source_equality(self, follower: str, leader: str) -> dict[str, Any] | None:
         """An MJCF source's joint equality the reader made this mimic of (its name and solver settings
