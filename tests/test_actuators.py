@@ -827,3 +827,101 @@ def test_a_sources_unactuated_legs_get_servos_so_the_robot_stands(tmp_path: Path
     kept, notes = convert(robot, tmp_path / "keep", source_actuators="keep")
     assert "MK827" not in {n.code for n in notes}
     assert not any(el.get("joint", "").endswith("_KFE") for el in actuator_elements(kept))
+
+
+# -- a free base's unactuated joints off the ground (MK827) and ROS interfaces listed after a state one ----
+
+def test_a_joint_state_interface_listed_first_does_not_hide_the_command_interface(tmp_path: Path) -> None:
+    """PAL's TIAGo lists ``JointStateInterface`` before ``PositionJointInterface`` for its head and wrist
+    joints. The first interface that commands the joint gives the actuator; before, those joints had
+    none and the head nodded 0.115 rad in 2 s."""
+    path = tmp_path / "two.urdf"
+    path.write_text(URDF.replace(
+        "<hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>",
+        "<hardwareInterface>hardware_interface/JointStateInterface</hardwareInterface>"
+        "<hardwareInterface>hardware_interface/PositionJointInterface</hardwareInterface>"
+        "<hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>"))
+    got = {a.joint: a for a in load(path).actuators}
+    assert got["j1"].kind is ActuatorKind.POSITION
+    assert got["j1"].source_kind == "hardware_interface/PositionJointInterface"
+    path.write_text(URDF.replace("hardware_interface/EffortJointInterface",
+                                 "hardware_interface/JointStateInterface"))
+    assert "j1" not in {a.joint for a in load(path).actuators}  # a state interface alone commands nothing
+
+
+CART_WITH_ARM = FOUR_CASTERS.replace('''<joint name="swivel0" type="continuous"><parent link="base"/>''',
+                                     '''<link name="strut"><inertial><mass value="0.2"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="suspension" type="prismatic"><parent link="base"/><child link="strut"/>
+    <origin xyz="0.25 0.15 -0.1"/><axis xyz="0 0 1"/><limit lower="-0.02" upper="0.02" effort="500"
+    velocity="1"/></joint>
+  <joint name="swivel0" type="continuous"><parent link="strut"/>''').replace(
+    '<origin xyz="0.25 0.15 -0.1"/><axis xyz="0 0 1"/></joint>',
+    '<origin xyz="0 0 0"/><axis xyz="0 0 1"/></joint>', 1).replace("</robot>", '''
+  <link name="upper_arm"><inertial><origin xyz="0.2 0 0"/><mass value="2"/>
+    <inertia ixx="0.002" iyy="0.03" izz="0.03" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="0.2 0 0"/><geometry><box size="0.4 0.05 0.05"/></geometry></collision></link>
+  <link name="head"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper_arm"/>
+    <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/><limit lower="-1.5" upper="1.5" effort="40" velocity="2"/>
+  </joint>
+  <joint name="head_pan" type="revolute"><parent link="base"/><child link="head"/>
+    <origin xyz="0 0 0.5"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="5" velocity="2"/></joint>
+  <transmission name="drive"><type>transmission_interface/SimpleTransmission</type>
+    <joint name="spin1"><hardwareInterface>hardware_interface/VelocityJointInterface</hardwareInterface>
+    </joint><actuator name="drive_motor"/></transmission>
+</robot>''')
+
+
+def test_a_free_bases_unactuated_joints_off_the_ground_get_servos(tmp_path: Path) -> None:
+    """A cart whose source actuates one wheel: the arm's shoulder, which gravity turns and below which
+    nothing reaches the ground, gets the ``--actuators`` choice (MK827) and holds; the sprung strut above
+    a caster (gravity turns it too, but its wheel is on the ground), the vertical head pan, the swivels
+    and the other wheels stay passive, as the source has them."""
+    from modelkit.convert.base import decide
+
+    path = tmp_path / "cart.urdf"
+    path.write_text(CART_WITH_ARM)
+    robot = load(path)
+    robot.root_joint = decide(robot).kind
+    assert robot.root_joint is JointType.FLOATING
+    out, notes = convert(robot, tmp_path / "auto")
+    tags = {el.get("joint"): el.tag for el in actuator_elements(out)}
+    assert tags == {"spin1": "velocity", "shoulder": "position"}
+    (said,) = [n for n in notes if n.code == "MK827"]
+    assert said.message.startswith("1 joint(s) (shoulder; that gravity turns at home)")
+    m, d = _home_on_a_plain_floor(out)
+    shoulder = m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "shoulder")]
+    for _ in range(round(HOLD_SECONDS / m.opt.timestep)):
+        mujoco.mj_step(m, d)
+    assert abs(float(d.qpos[shoulder])) < 0.01, f"the shoulder turned {float(d.qpos[shoulder]):.3f} rad"
+    kept, notes = convert(robot, tmp_path / "keep", source_actuators="keep")
+    assert {el.get("joint") for el in actuator_elements(kept)} == {"spin1"}
+    assert "MK827" not in {n.code for n in notes}
+
+
+TIAGO = "tiago_description/robots/tiago.urdf"
+
+
+def test_tiago_holds_its_head_and_hand_on_a_plain_floor(tmp_path: Path) -> None:
+    """example-robot-data's TIAGo (a free base on wheels and casters): its head and wrist transmissions
+    list ``JointStateInterface`` first, and its hand's 27 coupled finger joints have no transmission.
+    Converted with the defaults and dropped on a plain floor, no hinge or slide turns 0.02 rad in 2 s
+    (before: the head's tilt 0.115 rad, the fingers 0.1)."""
+    robot = load(example_robot(TIAGO))
+    out, notes = convert(robot, tmp_path / "tiago")
+    acted = {el.get("joint") for el in actuator_elements(out)}
+    assert {"head_1_joint", "head_2_joint", "arm_5_joint"} <= acted
+    (said,) = [n for n in notes if n.code == "MK827"]
+    assert said.message.startswith("27 joint(s) (hand_thumb_abd_joint")
+    m, d = _home_on_a_plain_floor(out)
+    start = d.qpos.copy()
+    for _ in range(round(HOLD_SECONDS / m.opt.timestep)):
+        mujoco.mj_step(m, d)
+    one_dof = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
+    turned = {m.joint(j).name: abs(float(d.qpos[m.jnt_qposadr[j]] - start[m.jnt_qposadr[j]]))
+              for j in range(m.njnt) if int(m.jnt_type[j]) in one_dof
+              and not m.joint(j).name.startswith(("wheel", "caster"))}
+    worst = max(turned, key=turned.__getitem__)
+    assert turned[worst] < 0.02, f"{worst} turned {turned[worst]:.3f} rad"

@@ -68,6 +68,19 @@ def leg_joints(robot: Robot) -> frozenset[str]:
     return frozenset(out)
 
 
+def off_ground_joints(robot: Robot) -> frozenset[str]:
+    """On a free base, the names of the joints with nothing below them that reaches the ground at q = 0
+    (as ``--base auto`` finds feet and wheels): a mobile manipulator's arm, head and hands, which carry
+    none of the robot's weight. A passive suspension, a caster and a leg have a link on the ground below
+    them. Empty on a welded base (nothing of it stands on a floor)."""
+    if robot.root_joint is not JointType.FLOATING:
+        return frozenset()
+    touching = touching_ground(vertical_spans(robot, robot.world_poses()))
+    children = robot.children_of()
+    return frozenset(joint.name for joint in robot.joints
+                     if not any(j.child in touching for j in _below(children, joint)))
+
+
 def _grounded(robot: Robot, poses: dict[str, Pose], children: dict[str, list[Joint]],
               firsts: list[Joint]) -> list[str]:
     """The limbs (by first joint) with a link that touches the ground at q = 0, as ``--base auto`` finds

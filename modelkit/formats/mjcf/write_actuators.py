@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 
 from modelkit.convert.context import WriteContext
-from modelkit.convert.legs import is_wheel, leg_joints, resting_on
+from modelkit.convert.legs import is_wheel, leg_joints, off_ground_joints, resting_on
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.convert.servo_gains import (
     SERVO_BANDWIDTH_HZ,
@@ -137,22 +137,26 @@ class ActuatorWriter:
     def _load_bearing_unactuated(self, taken: set[str]) -> list[Actuator]:
         """``--source-actuators auto``: the ``--actuators`` choice, where it gives a servo, on the joints
         that a source naming actuators for others leaves without one and that carry the robot: a leg's
-        joints, and on a welded base the joints gravity turns at home (MK827). example-robot-data's
-        ANYmal-Kinova names the arm's transmissions only: its twelve leg joints had no actuator and the
-        robot folded onto the floor (451 mm in 2 s). Other unactuated joints (a free wheel, a passive
-        linkage) stay passive, as the source has them."""
+        joints, and the joints gravity turns at home on a welded base or, on a free base, off the ground
+        (MK827). example-robot-data's ANYmal-Kinova names the arm's transmissions only: its twelve leg
+        joints had no actuator and the robot folded onto the floor (451 mm in 2 s); its TIAGo names none
+        for the 27 joints of its hand's coupled fingers, which drooped 0.1 rad in 2 s. Other unactuated joints (a free wheel, a
+        passive suspension or linkage with the ground below it, a vertical axis) stay passive, as the
+        source has them."""
         if self.ctx.options.source_actuators != "auto" or self.robot.source_format == "mjcf":
             return []
         if self._legs is None:
             self._legs = leg_joints(self.robot)
         welded = self.robot.root_joint is JointType.FIXED
+        off_ground = off_ground_joints(self.robot)
         constrained = self._constrained()
         out: list[Actuator] = []
         for joint in self.robot.joints:
             if joint.name in taken or joint.name in constrained or \
                     joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
                 continue
-            if joint.name not in self._legs and not (welded and self.sags(joint)):
+            held = welded or joint.name in off_ground
+            if joint.name not in self._legs and not (held and self.sags(joint)):
                 continue
             kind = self._chosen_kind(joint)
             if kind is ActuatorKind.POSITION or kind is ActuatorKind.VELOCITY:

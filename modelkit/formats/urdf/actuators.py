@@ -1,7 +1,8 @@
 """URDF ``<transmission>`` and ``<ros2_control>`` as the model's canonical actuators.
 
 * ``<transmission>``: each ``<joint>`` with a ``<hardwareInterface>`` (in the joint, or in the
-  ``<actuator>`` as the old PR2 form writes it) naming a position, velocity or effort interface
+  ``<actuator>`` as the old PR2 form writes it; the first of several that commands the joint, not
+  ``JointStateInterface``) naming a position, velocity or effort interface
   (``hardware_interface/PositionJointInterface``, ``...VelocityJointInterface``,
   ``...EffortJointInterface``, or ROS 2's bare ``position``...) gets one actuator; the first
   ``<actuator>``'s ``<mechanicalReduction>`` is its reduction.
@@ -65,7 +66,7 @@ def _transmission(ctx: Context, element: Element, joints: set[str], found: dict[
         name = joint_el.get("name")
         if name is None or name not in joints or name in found:
             continue
-        written = _text(ctx, joint_el, "hardwareInterface") or _text(ctx, first, "hardwareInterface")
+        written = _command_interface(ctx, joint_el) or _command_interface(ctx, first)
         kind = interface_kind(written)
         if kind is None:
             continue
@@ -78,6 +79,16 @@ def _transmission(ctx: Context, element: Element, joints: set[str], found: dict[
             source=ctx.loc(joint_el),
             ros_interface=True,
         )
+
+
+def _command_interface(ctx: Context, element: Element | None) -> str | None:
+    """The first ``<hardwareInterface>`` of ``element`` that commands the joint (position, velocity,
+    effort). A joint may list several; ``JointStateInterface`` only reports its state: PAL's TIAGo lists
+    it first for its head and wrist joints, then ``PositionJointInterface``."""
+    for child in ctx.children(element, "hardwareInterface") if element is not None else []:
+        if interface_kind(child.text) is not None:
+            return child.text
+    return None
 
 
 def _same_motor(ctx: Context, element: Element, motors: dict[str, str]) -> None:
