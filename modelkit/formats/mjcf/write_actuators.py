@@ -140,9 +140,9 @@ class ActuatorWriter:
         joints, and the joints gravity turns at home on a welded base or, on a free base, off the ground
         (MK827). example-robot-data's ANYmal-Kinova names the arm's transmissions only: its twelve leg
         joints had no actuator and the robot folded onto the floor (451 mm in 2 s); its TIAGo names none
-        for the 27 joints of its hand's coupled fingers, which drooped 0.1 rad in 2 s. Other unactuated joints (a free wheel, a
-        passive suspension or linkage with the ground below it, a vertical axis) stay passive, as the
-        source has them."""
+        for the 27 joints of its hand's coupled fingers, which drooped 0.1 rad in 2 s. Other unactuated
+        joints (a free wheel, a passive suspension or linkage with the ground below it, a vertical axis)
+        stay passive, as the source has them."""
         if self.ctx.options.source_actuators != "auto" or self.robot.source_format == "mjcf":
             return []
         if self._legs is None:
