@@ -13,6 +13,12 @@ vectorised or per-line reading of the face lines, the vertex masks (all vertices
 largest index when there are texture coordinates or normals), and in the end the checks of ``_load_obj``
 and ``_finish`` in their order. The messages are the ones ``load_mesh`` gives.
 
+Most of a file is numbers, and reading each one in Python costs more than the rest. Where the text is
+ASCII, the rows and face lines are first judged by their shapes (every digit read as 0; a file has a
+handful of distinct shapes among its hundreds of thousands of lines): each shape is read once, and the
+faces keep only their smallest and largest vertex index unless those cannot decide. What the shapes
+cannot settle (rows of different lengths, long digit runs, large exponents) is read number by number.
+
 Whatever it cannot decide exactly and cheaply (a number numpy and Python might read differently, an
 unusual white-space character, a face token that is not ``a``, ``a/b``, ``a//c`` or ``a/b/c`` with plain
 integers, an error whose text comes from numpy) gives :data:`UNDECIDED`: the caller then loads the file.
@@ -40,8 +46,6 @@ _NOT_DECIMAL_CHAR = re.compile(r"[^0-9eE+\-. \t]")
 _NUMBER_TOKEN = re.compile(r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf|infinity)", re.IGNORECASE)
 # a token that is not a number and does not start like numpy's NaN/infinity spellings ("nan(...)")
 _NAN_INF_START = re.compile(r"[+-]?(?:nan|inf)", re.IGNORECASE)
-# face lines made only of these characters: integers, slashes, blanks
-_NOT_FACE_CHAR = re.compile(r"[^0-9/\- \t]")
 # numpy's message when np.fromstring meets something that is not a number
 _NUMPY_UNMATCHED = "string or file could not be read to its end due to unmatched data"
 _INT_LIMIT = 2**62  # larger indices: numpy's int64 reading might wrap or saturate
@@ -52,7 +56,7 @@ _INT_DIGITS = 18  # a run of at most this many digits is below _INT_LIMIT
 # file written by one exporter has a handful of shapes among its millions of numbers.
 _DIGITS_TO_ZERO = bytes.maketrans(b"123456789", b"000000000")
 _DECIMAL_BYTES = b"0123456789eE+-. \t"
-_FACE_BYTES = b"0123456789/- \t\n"
+_FACE_BYTES = b"0123456789/- \t\n"  # face lines made only of these: integers, slashes, blanks
 _ODD_ASCII_SPACE = "\r\x0b\x0c\x1c\x1d\x1e\x1f"
 # trimesh's rows: the rest of the line after each "\n<kind> " (its split and first-line comprehension)
 _ROWS = {k: re.compile(f"\n{k} ([^\n]*)") for k in ("v", "vt", "vn")}
