@@ -71,6 +71,7 @@ from pydrake.multibody.tree import (
 
 from modelkit.model import BALL_KEYS, Robot
 from modelkit.spatial import Pose, axis_angle
+from modelkit.verify.engines import ball_law
 from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, StaticFacts
 
 Renames = dict[str, dict[str, str]]
@@ -395,6 +396,44 @@ class DrakeModel:
         coriolis = np.array(self.plant.CalcBiasTerm(self.context), dtype=float)
         gravity = np.array(self.plant.CalcGravityGeneralizedForces(self.context), dtype=float)
         return (coriolis - gravity)[self._indices()]
+
+    def dof_names_with_balls(self) -> list[str]:
+        """The hinge and slide degrees of freedom, then each ball joint's three (``NAME#x``...)."""
+        return [*self.dof_names(), *(ball.name() + key for ball in self._balls for key in BALL_KEYS)]
+
+    def _chain_map(self, q: dict[str, float]) -> Array:
+        """T (nv × the names of :meth:`dof_names_with_balls`): v = T·rates. A ``BallRpyJoint``'s
+        velocities are the child frame's angular velocity in the parent frame, expressed in the parent:
+        ω_F = R·J·(ȧ, ḃ, ċ), R = Rx(a)·Ry(b)·Rz(c) the ball's orientation and J the chain's Jacobian in the
+        child's frame (``ball_law.chain_jacobian``)."""
+        names = self.dof_names_with_balls()
+        out = np.zeros((self.plant.num_velocities(), len(names)))
+        for column, joint in enumerate(self._dofs):
+            out[joint.velocity_start(), column] = 1.0
+        column = len(self._dofs)
+        for ball in self._balls:
+            a, b, c = (q.get(ball.name() + key, 0.0) for key in BALL_KEYS)
+            turn = axis_angle(np.eye(3)[0], a) @ axis_angle(np.eye(3)[1], b) @ axis_angle(np.eye(3)[2], c)
+            jacobian = np.array(ball_law.chain_jacobian(b, c), dtype=float).reshape(3, 3)
+            start = ball.velocity_start()
+            out[start:start + 3, column:column + 3] = turn @ jacobian
+            column += 3
+        return out
+
+    def mass_matrix_with_balls(self, q: dict[str, float]) -> Array:
+        """Tᵀ·M·T (:meth:`_chain_map`): the mass matrix in the chain's coordinates, a ball's three
+        angles included, comparable with the Pinocchio reference's pieces."""
+        self._set(q)
+        full = np.array(self.plant.CalcMassMatrix(self.context), dtype=float)
+        t = self._chain_map(q)
+        return np.asarray(t.T @ full @ t)
+
+    def bias_with_balls(self, q: dict[str, float], dq: dict[str, float]) -> Array:
+        """Tᵀ·bias, a ball at rest (its chain rates 0, so T's derivative adds nothing)."""
+        self._set(q, dq)
+        coriolis = np.array(self.plant.CalcBiasTerm(self.context), dtype=float)
+        gravity = np.array(self.plant.CalcGravityGeneralizedForces(self.context), dtype=float)
+        return np.asarray(self._chain_map(q).T @ (coriolis - gravity))
 
     def close(self) -> None:
         return None
