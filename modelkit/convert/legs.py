@@ -75,10 +75,14 @@ def off_ground_joints(robot: Robot) -> frozenset[str]:
     them. Empty on a welded base (nothing of it stands on a floor)."""
     if robot.root_joint is not JointType.FLOATING:
         return frozenset()
-    touching = touching_ground(vertical_spans(robot, robot.world_poses()))
-    children = robot.children_of()
-    return frozenset(joint.name for joint in robot.joints
-                     if not any(j.child in touching for j in _below(children, joint)))
+    parent = {joint.child: joint.parent for joint in robot.joints}
+    grounded: set[str] = set()  # links with a link on the ground at or below them
+    for touching in touching_ground(vertical_spans(robot, robot.world_poses())):
+        link: str | None = touching
+        while link is not None and link not in grounded:  # each link is marked once: linear in the tree
+            grounded.add(link)
+            link = parent.get(link)
+    return frozenset(joint.name for joint in robot.joints if joint.child not in grounded)
 
 
 def _grounded(robot: Robot, poses: dict[str, Pose], children: dict[str, list[Joint]],

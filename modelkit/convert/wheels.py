@@ -43,6 +43,7 @@ import numpy as np
 from modelkit.convert.choices import WHEEL_COLLISIONS
 from modelkit.convert.notes import NoteSink
 from modelkit.convert.registry import TARGETS
+from modelkit.convert.tracks import roller_names
 from modelkit.geometry.extents import ROUNDNESS, Round, across, extent, round_about
 from modelkit.model import Cylinder, Ellipsoid, Geom, JointType, Mesh, Robot, Sphere
 from modelkit.spatial import Pose
@@ -108,8 +109,6 @@ def find_wheels(robot: Robot) -> dict[str, Wheel]:
     floor = _lowest(robot, poses)
     if floor is None:
         return {}
-    from modelkit.convert.tracks import roller_names
-
     rollers = roller_names(robot, "roller_links")
     links = {link.name: link for link in robot.links}
     z = np.array([0.0, 0.0, 1.0])

@@ -429,17 +429,27 @@ class MjcfWriter:
         """Each mimic follower's home at its leader's image (offset + multiplier × the leader's home), so
         that the ``home`` keyframe satisfies the equalities: TIAGo Pro's ros2_control starts its gripper's
         leader at 0.15 rad and names no position for the followers, which then snapped 0.15–0.19 rad at
-        the first step. A chain (a follower of a follower) settles in as many passes as it is long."""
+        the first step. Along a chain (a follower of a follower) each follower is placed after its
+        leader, once; a loop of mimics keeps the homes it has."""
         home = self.tree.home
-        for _ in range(len(couplings)):
-            changed = False
-            for follower, leader, multiplier, offset in couplings:
+        leader_of = {follower: (leader, multiplier, offset)
+                     for follower, leader, multiplier, offset in couplings}
+        placed: set[str] = set()
+        for start in leader_of:
+            chain = []  # from ``start`` up to the first joint that follows nothing (or a loop)
+            joint = start
+            while joint in leader_of and joint not in placed and joint not in chain:
+                chain.append(joint)
+                joint = leader_of[joint][0]
+            if joint in chain:  # a loop of mimics
+                placed.update(chain)
+                continue
+            for follower in reversed(chain):
+                leader, multiplier, offset = leader_of[follower]
                 value = offset + multiplier * home.get(leader, 0.0)
                 if home.get(follower, 0.0) != value:
                     home[follower] = value
-                    changed = True
-            if not changed:
-                break
+                placed.add(follower)
 
     def _source_equality(self, follower: str, leader: str) -> dict[str, Any] | None:
         """An MJCF source's joint equality the reader made this mimic of (its name and solver settings
@@ -539,4 +549,3 @@ class MjcfWriter:
                 self.robot.source,
                 "option",
             )
-

@@ -70,7 +70,7 @@ from pydrake.multibody.tree import (
 )
 
 from modelkit.model import BALL_KEYS, Robot
-from modelkit.spatial import Pose, axis_angle
+from modelkit.spatial import Pose
 from modelkit.verify.engines import ball_law
 from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, StaticFacts
 
@@ -365,11 +365,8 @@ class DrakeModel:
             if dq is not None:
                 velocities[joint.velocity_start()] = dq.get(joint.name(), 0.0)
         for ball in self._balls:  # R = Rx·Ry·Rz from the three angles (BALL_KEYS) as Drake's rpy
-            turn = np.eye(3)
-            for key, unit in zip(BALL_KEYS, np.eye(3), strict=True):
-                turn = turn @ axis_angle(unit, q.get(ball.name() + key, 0.0))
             start = ball.position_start()
-            positions[start:start + 3] = RollPitchYaw(RotationMatrix(turn)).vector()
+            positions[start:start + 3] = RollPitchYaw(RotationMatrix(_ball_turn(ball, q))).vector()
         plant.SetPositions(context, _vec(positions))
         plant.SetVelocities(context, _vec(velocities))
 
@@ -412,11 +409,10 @@ class DrakeModel:
             out[joint.velocity_start(), column] = 1.0
         column = len(self._dofs)
         for ball in self._balls:
-            a, b, c = (q.get(ball.name() + key, 0.0) for key in BALL_KEYS)
-            turn = axis_angle(np.eye(3)[0], a) @ axis_angle(np.eye(3)[1], b) @ axis_angle(np.eye(3)[2], c)
+            _, b, c = (q.get(ball.name() + key, 0.0) for key in BALL_KEYS)
             jacobian = np.array(ball_law.chain_jacobian(b, c), dtype=float).reshape(3, 3)
             start = ball.velocity_start()
-            out[start:start + 3, column:column + 3] = turn @ jacobian
+            out[start:start + 3, column:column + 3] = _ball_turn(ball, q) @ jacobian
             column += 3
         return out
 
@@ -437,6 +433,12 @@ class DrakeModel:
 
     def close(self) -> None:
         return None
+
+
+def _ball_turn(ball: BallRpyJoint, q: dict[str, float]) -> Array:
+    """The ball's orientation R = Rx(a)·Ry(b)·Rz(c) from its three angles (``BALL_KEYS``)."""
+    angles = (q.get(ball.name() + key, 0.0) for key in BALL_KEYS)
+    return np.array(ball_law.chain_matrix(*angles), dtype=float).reshape(3, 3)
 
 
 def load(model: Path | Robot, renames: Renames, *, root: str) -> DrakeModel:
