@@ -1723,8 +1723,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK877",
         "mjcf-refused-by-mujoco",
         "error",
-        "MuJoCo's compiler refuses the written MJCF (compiled while converting) for a reason no other note "
-        "explains; the file is written, the note quotes MuJoCo, and convert exits 1.",
+        "MuJoCo's compiler refuses the written MJCF (compiled while converting), or the compiled model stops "
+        "at its first step (too many collision shapes overlapping at once for MuJoCo's memory), for a "
+        "reason no other note explains; the file is written, the note quotes MuJoCo, and convert exits 1.",
     ),
     CodeInfo(
         "MK878",

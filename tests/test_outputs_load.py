@@ -297,6 +297,35 @@ def test_a_written_file_mujoco_refuses_is_an_error(tmp_path: Path, monkeypatch: 
         mujoco.MjModel.from_xml_path(str(out))
 
 
+
+def _star_of_boxes(links: int) -> str:
+    """A root with ``links - 1`` children, every one a 0.05 m box at the same place."""
+    box = '<collision><geometry><box size="0.05 0.05 0.1"/></geometry></collision>'
+    inertial = ('<inertial><mass value="0.5"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" '
+                'izz="0.0005"/></inertial>')
+    out = ['<robot name="star">']
+    out += [f'<link name="l{i}">{inertial}{box}</link>' for i in range(links)]
+    out += [f'<joint name="j{i}" type="revolute"><parent link="l0"/><child link="l{i}"/>'
+            '<origin xyz="0 0 0.1"/><axis xyz="0 1 0"/>'
+            '<limit lower="-1" upper="1" effort="10" velocity="2"/></joint>'
+            for i in range(1, links)]
+    return "\n".join([*out, "</robot>"])
+
+
+def test_a_written_file_mujoco_cannot_step_is_an_error(tmp_path: Path) -> None:
+    """400 boxes at one place: 80,000 pairs in contact overflow MuJoCo's memory at the first step.
+    Finding the contacts at rest raised mujoco.FatalError out of convert (a traceback); now MK877
+    says what a user of the file meets, and convert exits 1."""
+    source = tmp_path / "star.urdf"
+    source.write_text(_star_of_boxes(400))
+    out = tmp_path / "out" / "star.xml"
+    status, output = _convert(source, out)
+    assert status == 1, output
+    assert "Traceback" not in output and "error MK877" in output and "out of memory" in output, output
+    model = mujoco.MjModel.from_xml_path(str(out))
+    with pytest.raises(mujoco.FatalError, match="out of memory"):  # what the note tells the user
+        mujoco.mj_step(model, mujoco.MjData(model))
+
 TETRA_VERTICES = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\n"
 TETRA_FACES = ((1, 3, 2), (1, 2, 4), (1, 4, 3), (2, 3, 4))
 # How the corners of the first face and of the other three are written (v / vt / vn).

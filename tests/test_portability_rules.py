@@ -63,6 +63,26 @@ def test_mimic_loop() -> None:
     assert len(_codes(robot, "MK321")) == 2
 
 
+
+def test_mimic_loop_names_only_the_joints_on_it() -> None:
+    """A joint whose mimics lead into a loop is not on it; a 10,000-joint loop is found whole (in one pass
+    over the leaders: a walk per joint took 23 s on 5,000); a joint whose name an earlier one holds is
+    judged by its own mimic."""
+    count = 10_000
+    names = [chr(ord("a") + i % 26) + str(i) for i in range(count + 1)]
+    joints = [_joint(f"j{i}", names[i], names[i + 1]) for i in range(count)]
+    for i in range(1, count):
+        joints[i].mimic = Mimic(f"j{i + 1 if i + 1 < count else 1}")  # j1 .. j9999 loop; j0 leads nowhere
+    joints[0].mimic = Mimic("j5")  # into the loop, not on it
+    robot = Robot("r", [_link(n) for n in names], joints, root=names[0], source_format="urdf")
+    looped = _codes(robot, "MK321")
+    assert len(looped) == count - 1 and not any('"j0"' in m for m in looped)
+    twin = _joint("j0", "x", "y")  # a second "j0", mimicking j1, which never leads back to a "j0"
+    twin.mimic = Mimic("j1")
+    robot.joints.append(twin)
+    robot.links += [_link("x"), _link("y")]
+    assert len(_codes(robot, "MK321")) == count - 1
+
 def test_massless_links_dropped_like_libsdformat() -> None:
     links = [_link("base"), _link("frame", None), _link("arm", None), _link("hand"), _link("tool", 0.0)]
     joints = [

@@ -53,6 +53,7 @@ def mimic_targets(robot: Robot) -> Iterator[Diagnostic]:
     by_name: dict[str, Joint] = {}
     for joint in robot.joints:
         by_name.setdefault(joint.name, joint)
+    looped = _on_mimic_loops(by_name)
     for joint in robot.joints:
         mimic = joint.mimic
         if mimic is None:
@@ -75,7 +76,7 @@ def mimic_targets(robot: Robot) -> Iterator[Diagnostic]:
                 "revolute, continuous and prismatic joints can be followed",
                 where,
             )
-        elif _mimic_loop(joint, by_name):
+        elif (joint.name in looped) if by_name[joint.name] is joint else _mimic_loop(joint, by_name):
             yield diag("MK321", f'joint "{joint.name}" is part of a loop of mimic joints', where)
 
 
@@ -141,7 +142,28 @@ def _leader_range_within(multiplier: float, offset: float, leader: tuple[float, 
     return (low + 0.0, high + 0.0) if low <= high else None  # + 0.0: no "-0"
 
 
+def _on_mimic_loops(by_name: dict[str, Joint]) -> set[str]:
+    """The names of the joints on a loop of mimic joints (each joint follows the next), found in one pass
+    over the leader-of map: each name is walked from once, so a chain of 10,000 mimics is linear."""
+    looped: set[str] = set()
+    done: set[str] = set()
+    for start in by_name:
+        path: dict[str, None] = {}  # the names walked from ``start`` (ordered)
+        name: str | None = start
+        while name is not None and name not in done and name not in path:
+            path[name] = None
+            mimic = by_name[name].mimic
+            name = mimic.joint if mimic is not None and mimic.joint in by_name else None
+        if name is not None and name in path:  # the walk closed on itself: the names from there loop
+            walked = list(path)
+            looped.update(walked[walked.index(name):])
+        done.update(path)
+    return looped
+
+
 def _mimic_loop(start: Joint, by_name: dict[str, Joint]) -> bool:
+    """Whether following the mimics from ``start`` comes back to its name (for a joint whose name an
+    earlier joint holds, which :func:`_on_mimic_loops` does not see)."""
     seen = {start.name}
     current: Joint | None = start
     while current is not None and current.mimic is not None:

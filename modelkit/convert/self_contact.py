@@ -46,7 +46,7 @@ class BelowBase:
 class Checked:
     pairs: list[Touching]
     failure: str | None = None  # why nothing was checked
-    refused: bool = False  # the failure is MuJoCo's compiler refusing the file
+    unusable: str | None = None  # the failure is one a user of the file meets too: what MuJoCo does
     below: list[BelowBase] = field(default_factory=list)  # a welded robot's bodies under its base
 
 
@@ -72,7 +72,9 @@ def _touching(mujoco: Any, xml: bytes, assets: dict[str, bytes]) -> Checked:
     try:
         model = mujoco.MjModel.from_xml_string(xml.decode("utf-8"), assets)
     except Exception as exc:  # MuJoCo raises ValueError with its compiler's message
-        return Checked([], f"MuJoCo did not compile the written file ({' '.join(str(exc).split())})", True)
+        said = " ".join(str(exc).split())
+        return Checked([], f"MuJoCo did not compile the written file ({said})",
+                       f"MuJoCo refuses the written file ({said}): the file is written, but it does not load")
     data = mujoco.MjData(model)
     found: dict[tuple[int, int], tuple[float, set[str]]] = {}
     home = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "home")
@@ -84,7 +86,14 @@ def _touching(mujoco: Any, xml: bytes, assets: dict[str, bytes]) -> Checked:
             mujoco.mj_resetData(model, data)
         else:
             mujoco.mj_resetDataKeyframe(model, data, key)
-        mujoco.mj_forward(model, data)
+        try:
+            mujoco.mj_forward(model, data)
+        except mujoco.FatalError as exc:  # its arena overflows: too many geoms overlap at once
+            said = " ".join(str(exc).splitlines()[0].split())
+            return Checked([], f"MuJoCo stopped while finding the contacts at {label} ({said})",
+                           f"MuJoCo loads the written file but stops at its first step at {label} ({said}): "
+                           f"{model.nbody - 1} bodies whose collision shapes overlap too many at once "
+                           "for its memory")
         for i in range(data.ncon):
             contact = data.contact[i]
             b1, b2 = (int(model.geom_bodyid[contact.geom[0]]), int(model.geom_bodyid[contact.geom[1]]))

@@ -236,9 +236,8 @@ class MjcfWriter:
         if checked.failure is not None:
             self.ctx.note("MK833", f"self-contact at rest not checked: {checked.failure}", self.robot.source,
                           "contact")
-            if checked.refused and not self._refusal_explained:
-                self.ctx.note("MK877", f"{checked.failure.replace('did not compile', 'refuses')}: the file "
-                              "is written, but it does not load in MuJoCo", self.robot.source, "mujoco")
+            if checked.unusable is not None and not self._refusal_explained:
+                self.ctx.note("MK877", checked.unusable, self.robot.source, "mujoco")
             return
         links = {el.get("name"): link for link, el in self.tree.bodies.items()}
         self._below_base(checked.below, links)
