@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from modelkit.convert.moving_paths import MovingPaths
 from modelkit.convert.notes import NoteSink
 from modelkit.geometry.extents import extent
 from modelkit.model import WORLD_LINK, Cylinder, Geom, Joint, JointType, Robot, Sphere
@@ -196,7 +197,8 @@ def decide(robot: Robot) -> BaseDecision:
                             "convention (a root that does not hang from `world` floats)")
     poses = robot.world_poses()
     every_limb = _limbs(robot)
-    limbs = [name for name in every_limb if not _points_up(robot, poses, name)]
+    raised_limbs = _raised(robot, poses, every_limb)
+    limbs = [name for name in every_limb if name not in raised_limbs]
     raised = len(every_limb) - len(limbs)
     use_collisions = any(link.collisions for link in robot.links)
     lows = vertical_spans(robot, poses)
@@ -204,24 +206,23 @@ def decide(robot: Robot) -> BaseDecision:
         return BaseDecision(JointType.FLOATING, "it has no shape to judge by, so URDF's own convention "
                             "(a root that does not hang from `world` floats)")
     touching = touching_ground(lows)
-    parent_joint = {joint.child: joint for joint in robot.joints}
-    above = {name: _moving_above(parent_joint, name) for name in sorted(touching)}
+    paths = MovingPaths(robot)
+    on_base = any(paths.length(name) == 0 for name in touching)  # the root's rigid body touches
     # Wheels first: a differential-drive robot's caster is often a shape of the root's own body that
     # touches the ground (a fixed ball or skid), and the robot still drives.
     wheels = _wheels(robot, poses, touching, use_collisions)
     if len(wheels) >= 2:
         shown = ", ".join(f'"{j.name}"' for j in wheels[:4]) + (" ..." if len(wheels) > 4 else "")
-        caster = (" beside a caster of the root's own body" if any(not moving for moving in above.values())
-                  else "")
+        caster = " beside a caster of the root's own body" if on_base else ""
         return BaseDecision(JointType.FLOATING, f"it drives on wheels (joint(s) {shown}: a round shape "
                             f"on a horizontal axis touching the ground{caster})")
-    if any(not moving for moving in above.values()):
+    if on_base:
         return _by_limbs(robot, poses, limbs, "the root's own body rests on the ground (an arm or a fixture"
                          + (f"; {raised} limb(s) point up, as a hand's fingers do" if raised else "") + ")")
     root_z = float(poses[robot.root].translation[2]) if robot.root in poses else 0.0
     below_root = {j.name for j in robot.joints
                   if j.child in poses and float(poses[j.child].translation[2]) < root_z}
-    feet = _feet(above, below_root)
+    feet = _feet(paths, sorted(touching), below_root)
     if len(feet) >= 2:
         shown = ", ".join(f'"{name}"' for name in feet[:6])
         return BaseDecision(JointType.FLOATING, f"it stands on {len(feet)} legs (feet {shown} touch the "
@@ -279,11 +280,16 @@ def _limbs(robot: Robot) -> list[str]:
     return sorted(joint.name for joint in starts if _depth(children, joint.child) >= 1)
 
 
-def _points_up(robot: Robot, poses: dict[str, Pose], first_joint: str) -> bool:
-    """Whether the limb below ``first_joint`` rises at q = 0: the highest of its link frames is above the
-    joint's frame by more than half the farthest one's distance from it (a hand's raised finger)."""
+def _raised(robot: Robot, poses: dict[str, Pose], first_joints: list[str]) -> set[str]:
+    """The limbs (by first joint) that rise at q = 0: the highest of the limb's link frames is above the
+    first joint's frame by more than half the farthest one's distance from it (a hand's raised finger)."""
     children = robot.children_of()
-    joint = next(j for j in robot.joints if j.name == first_joint)
+    by_name = {joint.name: joint for joint in robot.joints}
+    return {name for name in first_joints if name in by_name and _points_up(children, poses, by_name[name])}
+
+
+def _points_up(children: dict[str, list[Joint]], poses: dict[str, Pose], joint: Joint) -> bool:
+    """Whether the limb below ``joint`` rises at q = 0 (:func:`_raised`)."""
     start = poses.get(joint.child)
     if start is None:
         return False
@@ -364,21 +370,7 @@ def _round_about(geom: Geom, axis: np.ndarray) -> bool:
                 and max(abs(c) for c in centres) <= 0.1 * radius)
 
 
-def _moving_above(parent_joint: dict[str, Joint], name: str) -> list[Joint]:
-    """The moving joints from the link up to the root, nearest first."""
-    moving: list[Joint] = []
-    current = name
-    seen: set[str] = set()
-    while current in parent_joint and current not in seen:
-        seen.add(current)
-        joint = parent_joint[current]
-        if joint.type.moves:
-            moving.append(joint)
-        current = joint.parent
-    return moving
-
-
-def _feet(above: dict[str, list[Joint]], below_root: set[str]) -> list[str]:
+def _feet(paths: MovingPaths, touching: list[str], below_root: set[str]) -> list[str]:
     """One touching link per leg among those that reach the ground through ≥ 2 moving joints (in the order
     of the legs' first joints, then of link names). Two such links are on different legs where their
     paths from the root part with at least two moving joints on each side; where the paths share
@@ -386,22 +378,27 @@ def _feet(above: dict[str, list[Joint]], below_root: set[str]) -> list[str]:
     the root's frame (``below_root``: the moving joints whose frames are lower). OpenLoong's
     torso-rooted humanoid parts so (3 waist joints, then 6 in each leg, hips 0.17 m below the torso's
     frame); a foot's heel and toe do not (one joint apart), nor an arm's two fingers (7 arm joints
-    shared), nor Alex's arms hanging beside its pelvis (their shoulders 0.43 m above it)."""
-    paths = {name: [j.name for j in reversed(moving)] for name, moving in above.items() if len(moving) >= 2}
+    shared), nor Alex's arms hanging beside its pelvis (their shoulders 0.43 m above it).
+
+    Paths with different first joints share nothing and each has ≥ 2 joints: they are always apart, so a
+    link is compared only with the feet found under its own first joint."""
+    candidates = [name for name in touching if paths.length(name) >= 2]
+    first = {name: paths.at(name, 0) for name in candidates}
     feet: list[str] = []
-    for name in sorted(paths, key=lambda each: (paths[each][0], each)):
-        path = paths[name]
-        if all(_apart(path, paths[other], below_root) for other in feet):
+    under: dict[str, list[str]] = {}  # first joint → the feet found below it
+    for name in sorted(candidates, key=lambda each: (first[each], each)):
+        siblings = under.setdefault(first[name], [])
+        if all(_apart(paths, name, other, below_root) for other in siblings):
+            siblings.append(name)
             feet.append(name)
     return feet
 
 
-def _apart(one: list[str], two: list[str], below_root: set[str]) -> bool:
-    """Whether two root-first paths of moving joints are on different legs (:func:`_feet`)."""
-    shared = 0
-    while shared < min(len(one), len(two)) and one[shared] == two[shared]:
-        shared += 1
-    rest = min(len(one), len(two)) - shared
+def _apart(paths: MovingPaths, one: str, two: str, below_root: set[str]) -> bool:
+    """Whether two touching links' paths of moving joints are on different legs (:func:`_feet`)."""
+    shared = paths.shared(one, two)
+    rest = min(paths.length(one), paths.length(two)) - shared
     if shared == 0:
         return rest >= 2
-    return rest >= max(2, shared) and one[shared] in below_root and two[shared] in below_root
+    return (rest >= max(2, shared) and paths.at(one, shared) in below_root
+            and paths.at(two, shared) in below_root)

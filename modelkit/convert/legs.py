@@ -35,12 +35,12 @@ import numpy as np
 from modelkit.convert.base import (
     LIMBS,
     _limbs,
-    _moving_above,
-    _points_up,
+    _raised,
     _round_about,
     touching_ground,
     vertical_spans,
 )
+from modelkit.convert.moving_paths import MovingPaths
 from modelkit.model import Joint, JointType, Link, Robot
 from modelkit.spatial import Pose
 
@@ -50,7 +50,9 @@ def leg_joints(robot: Robot) -> frozenset[str]:
     if robot.root_joint is not JointType.FLOATING:
         return frozenset()
     poses = robot.world_poses()
-    legs = [name for name in _limbs(robot) if not _points_up(robot, poses, name)]
+    limbs = _limbs(robot)
+    raised = _raised(robot, poses, limbs)
+    legs = [name for name in limbs if name not in raised]
     if len(legs) < LIMBS:
         return frozenset()
     children = robot.children_of()
@@ -166,6 +168,5 @@ def resting_on(robot: Robot, home: dict[str, float]) -> list[str]:
     if not leg_joints(robot):
         return []
     poses = robot.world_poses(home)
-    parent_joint = {joint.child: joint for joint in robot.joints}
-    return sorted(name for name in touching_ground(vertical_spans(robot, poses))
-                  if len(_moving_above(parent_joint, name)) < 2)
+    paths = MovingPaths(robot)
+    return sorted(name for name in touching_ground(vertical_spans(robot, poses)) if paths.length(name) < 2)
