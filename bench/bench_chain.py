@@ -1,6 +1,7 @@
 """How `modelkit verify`, `convert` and `validate` grow with a serial chain's length (issue 18 §2).
 
-    python bench/bench_chain.py [--verify 100,200,400,1000] [--convert 1000,10000] [--json FILE]
+    python bench/bench_chain.py [--verify 100,200,400,1000] [--convert 1000,10000] [--shapes 5000,10000]
+                                [--json FILE]
 
 Every run is a fresh `modelkit` process on a chain generated in a temporary folder
 (``tests/chain_support.py``: every link with an inertial and a box visual; revolute and continuous
@@ -8,6 +9,10 @@ joints about y, alternately limited). For each run: the wall time, the peak RSS 
 (``wait4``), and the peak of the whole process tree's RSS summed (sampled from ``/proc`` every 50 ms:
 verify's PyBullet worker and picture processes count). verify runs with ``-j 1 -o DIR`` (its report and
 pictures written), every default engine; its own per-phase times ("wall time: ...") are kept.
+
+Two more shapes of URDF chain, for ``validate`` and ``convert`` to MJCF (``--shapes``): one lying on
+the floor (each joint 0.1 m along x: every link touches the ground, so convert's base decision looks at
+each), and one whose every joint mimics the one before (validate's mimic-loop rule follows each chain).
 
 The columns per link (ms/link, MB/link) are flat when the growth is linear. A benchmark reports, it
 never fails: exit 0 whatever the figures.
@@ -99,12 +104,15 @@ def main() -> int:
     parser.add_argument("--verify", default="100,200,400,1000", help="chain lengths for verify ('' for none)")
     parser.add_argument("--convert", default="1000,10000", help="chain lengths for convert ('' for none)")
     parser.add_argument("--inputs", default="urdf,body", help="input formats for convert")
+    parser.add_argument("--shapes", default="5000,10000",
+                        help="lengths of the lying and mimic chains (validate, convert to MJCF; '' for none)")
     parser.add_argument("--json", type=Path, help="also write the figures here")
     args = parser.parse_args()
     sizes = [int(x) for x in args.verify.split(",") if x]
     converts = [int(x) for x in args.convert.split(",") if x]
-    results: dict[str, Any] = {"machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
-                                           "load": os.getloadavg()}, "verify": {}, "convert": {}}
+    shaped = [int(x) for x in args.shapes.split(",") if x]
+    machine = {"python": platform.python_version(), "cpus": os.cpu_count(), "load": os.getloadavg()}
+    results: dict[str, Any] = {"machine": machine, "verify": {}, "convert": {}, "shapes": {}}
     with tempfile.TemporaryDirectory(prefix="bench-chain-") as tmp:
         folder = Path(tmp)
         print(f"{'command':<24}{'links':>6}{'s':>9}{'ms/link':>9}{'max MB':>9}{'tree MB':>9}{'MB/link':>9}"
@@ -128,6 +136,17 @@ def main() -> int:
                           f"{1000 * r['seconds'] / n:>9.2f}{r['max_rss_mb']:>9.0f}{r['tree_rss_mb']:>9.0f}"
                           f"{r['tree_rss_mb'] / n:>9.3f}  exit {r['exit']}"
                           f"{' TRACEBACK' if r['traceback'] else ''}", flush=True)
+        for shape in ("lying", "mimic"):  # convert's base decision; validate's mimic loops (issue 18 §2)
+            for n in shaped:
+                path = chain_support.write(folder, "urdf", n, shape=shape)
+                for command in ("validate", "convert"):
+                    out = ["-q", "-o", str(folder / f"out_{shape}_{n}"), "--to", "mjcf"]
+                    r = run([command, str(path), *(out if command == "convert" else [])], folder)
+                    results["shapes"][f"{command} {shape}:{n}"] = r
+                    label = f"{command} {shape}"
+                    print(f"{label:<24}{n:>6}{r['seconds']:>9.2f}{1000 * r['seconds'] / n:>9.2f}"
+                          f"{r['max_rss_mb']:>9.0f}{r['tree_rss_mb']:>9.0f}{r['tree_rss_mb'] / n:>9.3f}  "
+                          f"exit {r['exit']}{' TRACEBACK' if r['traceback'] else ''}", flush=True)
     if args.json:
         args.json.write_text(json.dumps(results, indent=1, sort_keys=True) + "\n")
     return 0

@@ -1359,6 +1359,16 @@ _TABLE: tuple[CodeInfo, ...] = (
         "`--source-actuators keep` leaves them all without.",
     ),
     CodeInfo(
+        "MK828",
+        "mimic-leader-ctrlrange-narrowed",
+        "info",
+        "MJCF: a mimic leader's position servo gets as `ctrlrange` only the part of its joint's range that "
+        "keeps each follower inside the follower's own range (validate's MK326): commanded past it, the "
+        "follower's limit and the coupling fight (Fourier's Inspire hand's thumb followers parted 1.0 rad "
+        "from their mimic). The joint's range is kept; a follower no position keeps in range narrows "
+        "nothing.",
+    ),
+    CodeInfo(
         "MK830",
         "base-decided",
         "info",
@@ -1394,6 +1404,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "SDF (and URDF for Gazebo) cannot exclude a pair of links from colliding, only flag links or the "
         "whole model (`<self_collide>`): the written flags follow the MJCF output's policy as far as they "
         "can (docs/convert.md, \"Self-collision\"), and the note says what each simulator then does.",
+    ),
+    CodeInfo(
+        "MK835",
+        "coupled-joint-armature",
+        "info",
+        "MJCF: each joint a mimic couples (leader and follower) gets an armature of at least its own inertia "
+        "at home where the source gives less, as the leader's motor and linkage give it; without one, "
+        "MuJoCo's soft joint equality on light fingers never settled (Fourier's Inspire thumb swung 1.0 "
+        "rad about its mimic, dexmate's f5d6 hand 1.7 rad). An MJCF source's own armatures are kept.",
     ),
     CodeInfo(
         "MK840",

@@ -22,7 +22,9 @@ def _parents(links: int, branches: int) -> list[int]:
     return [0 if (i - 1) % per == 0 else i - 1 for i in range(1, links)]
 
 
-def urdf(links: int, branches: int = 1, xacro: bool = False) -> str:
+def urdf(links: int, branches: int = 1, xacro: bool = False, shape: str = "upright") -> str:
+    """``shape``: "upright" (each joint 0.1 m above its parent), "lying" (0.1 m along x: every link on
+    the floor, as for convert's base decision), "mimic" (upright, each joint mimicking the one before)."""
     head = '<robot name="chain"'
     out = [head + (' xmlns:xacro="http://www.ros.org/wiki/xacro">' if xacro else ">")]
     if xacro:
@@ -37,9 +39,11 @@ def urdf(links: int, branches: int = 1, xacro: bool = False) -> str:
     for i, parent in enumerate(_parents(links, branches), start=1):
         kind = "revolute" if i % 2 else "continuous"
         limit = '<limit lower="-1.5" upper="1.5" effort="10" velocity="2"/>' if i % 2 else ""
+        xyz = f"{step} 0 0" if shape == "lying" else f"0 0 {step}"
+        mimic = f'<mimic joint="joint{i - 1}"/>' if shape == "mimic" and i > 1 else ""
         out.append(
             f'<joint name="joint{i}" type="{kind}"><parent link="link{parent}"/><child link="link{i}"/>'
-            f'<origin xyz="0 0 {step}" rpy="0 0 0.1"/><axis xyz="0 1 0"/>{limit}</joint>'
+            f'<origin xyz="{xyz}" rpy="0 0 0.1"/><axis xyz="0 1 0"/>{limit}{mimic}</joint>'
         )
     out.append("</robot>")
     return "\n".join(out) + "\n"
@@ -116,8 +120,13 @@ def mjcf(links: int, branches: int = 1) -> str:
     return "\n".join(out) + "\n"
 
 
-def write(folder: Path, fmt: str, links: int, branches: int = 1) -> Path:
-    """Write the chain (or ``branches`` chains from one root) as ``fmt`` in ``folder``."""
+def write(folder: Path, fmt: str, links: int, branches: int = 1, shape: str = "upright") -> Path:
+    """Write the chain (or ``branches`` chains from one root) as ``fmt`` in ``folder``; ``shape`` as for
+    :func:`urdf` (URDF only)."""
+    if shape != "upright":
+        path = folder / f"chain{links}_{shape}.urdf"
+        path.write_text(urdf(links, branches, shape=shape))
+        return path
     text = {
         "urdf": lambda: urdf(links, branches),
         "xacro": lambda: urdf(links, branches, xacro=True),

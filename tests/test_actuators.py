@@ -516,7 +516,8 @@ def test_mjcf_actuators_reach_urdf_and_body_as_their_kinds(tmp_path: Path) -> No
 
 def test_reflected_inertias_equal_mujocos_mass_matrix(tmp_path: Path) -> None:
     """The gain rule's inertia of every Panda joint (summed once per subtree, bottom up, with a
-    parallel-axis shift) is the diagonal of MuJoCo's own joint-space mass matrix at home."""
+    parallel-axis shift) is the diagonal of MuJoCo's own joint-space mass matrix at home, less the
+    armature the file gives the fingers' mimic coupling (MK835; the source has none)."""
     from modelkit.convert.servo_gains import joint_loads
 
     robot = load(example_robot("panda_description/urdf/panda.urdf"))
@@ -531,7 +532,9 @@ def test_reflected_inertias_equal_mujocos_mass_matrix(tmp_path: Path) -> None:
     for j in range(m.njnt):
         name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
         dof = m.jnt_dofadr[j]
-        assert loads[name].inertia == pytest.approx(full[dof, dof], rel=1e-9), name
+        assert loads[name].inertia == pytest.approx(full[dof, dof] - m.dof_armature[dof], rel=1e-9), name
+    assert {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(m.njnt)
+            if m.dof_armature[m.jnt_dofadr[j]]} == {"panda_finger_joint1", "panda_finger_joint2"}
 
 
 # Legged robots of example-robot-data whose URDF names no actuators: each gets a free base and a position

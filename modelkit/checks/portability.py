@@ -13,6 +13,7 @@ from pathlib import PurePosixPath
 from modelkit.checks.masses import lumped_masses, subtree
 from modelkit.checks.registry import rule
 from modelkit.diagnostics import Diagnostic, diag, did_you_mean
+from modelkit.mimic_range import MIMIC_RANGE_SLACK, leader_range_within
 from modelkit.model import WORLD_LINK, Geom, Joint, JointType, Link, Robot
 
 URDF_FORMATS = frozenset({"urdf", "xacro"})
@@ -80,11 +81,6 @@ def mimic_targets(robot: Robot) -> Iterator[Diagnostic]:
             yield diag("MK321", f'joint "{joint.name}" is part of a loop of mimic joints', where)
 
 
-MIMIC_RANGE_SLACK = 1e-6
-"""rad or m: how far a mimic may carry its follower past the follower's range over the leader's range
-before MK326 says so (ranges are often written to 6 digits)."""
-
-
 @rule("mimic-range", "MK326")
 def mimic_range(robot: Robot) -> Iterator[Diagnostic]:
     """A mimic keeps its follower inside the follower's range over the whole of the leader's range.
@@ -111,7 +107,7 @@ def mimic_range(robot: Robot) -> Iterator[Diagnostic]:
         past = max(own_low - ends[0], ends[1] - own_high)
         if past <= MIMIC_RANGE_SLACK:
             continue
-        reachable = _leader_range_within(mimic.multiplier, mimic.offset, (low, high), (own_low, own_high))
+        reachable = leader_range_within(mimic.multiplier, mimic.offset, (low, high), (own_low, own_high))
         if reachable is None:
             hint = ("no position of the leader keeps the follower in its range: check the mimic's multiplier "
                     "(its sign) and offset")
@@ -130,16 +126,6 @@ def mimic_range(robot: Robot) -> Iterator[Diagnostic]:
             mimic.source or joint.loc("mimic"),
             hint=hint,
         )
-
-
-def _leader_range_within(multiplier: float, offset: float, leader: tuple[float, float],
-                         follower: tuple[float, float]) -> tuple[float, float] | None:
-    """The part of the leader's range whose image stays in the follower's (None: none)."""
-    if multiplier == 0.0:
-        return leader if follower[0] <= offset <= follower[1] else None
-    bounds = sorted(((follower[0] - offset) / multiplier, (follower[1] - offset) / multiplier))
-    low, high = max(leader[0], bounds[0]), min(leader[1], bounds[1])
-    return (low + 0.0, high + 0.0) if low <= high else None  # + 0.0: no "-0"
 
 
 def _on_mimic_loops(by_name: dict[str, Joint]) -> set[str]:

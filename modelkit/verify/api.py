@@ -526,7 +526,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
     """Layers 1–3 on the welded model; returns the source model as read and the MJCF and URDF the user
     gave, as the engines loaded them, with their renames (None when nothing ran)."""
     from modelkit.verify.engines.reference import SourceModel, dof_joints, source_static
-    from modelkit.verify.layers import approximations, dynamics, kinematics, shapes, static
+    from modelkit.verify.layers import approximations, coupled_armature, dynamics, kinematics, shapes, static
 
     t0 = time.perf_counter()
     try:
@@ -573,6 +573,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
     # A URDF engine reading convert's default file holds its sensors as links on fixed joints (MK847):
     # layers 1-3 compare it with the source holding them (``models``), the report says so.
     models: dict[str, Robot] = {}
+    floors: dict[str, dict[str, float]] = {}  # engine → coupled joint → the MJCF's armature (MK835)
     for eng in loaded:
         kind = INPUTS.get(eng.label, "robot")
         notes = written.get(kind, [])
@@ -587,6 +588,12 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         frames_entry = approximations.frames_skip(eng.label, frames)
         if frames_entry is not None:
             report.skips.append(frames_entry)
+        if kind == "mjcf":  # the MJCF writer's armature on mimic-coupled joints (MK835)
+            floors[eng.label] = coupled_armature.written(files[kind], reference, maps[kind])
+            models[eng.label] = coupled_armature.applied(models[eng.label], floors[eng.label])
+            floors_entry = coupled_armature.skip(eng.label, floors[eng.label])
+            if floors_entry is not None:
+                report.skips.append(floors_entry)
     approx = _approximations(models, loaded, files, maps, written, report)
     # A URDF engine holds each ball joint as the writer's chain of three joints (MK813): layer 1
     # compares it with the source holding those chains, layer 2 turns the chain, the report says so.
@@ -695,10 +702,12 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                         "without it")))
             except NotImplementedError:
                 report.skips.append(dynamics.no_dynamics(eng))
+        for label, armature in sorted(floors.items()):
+            report.checks.extend(coupled_armature.rule_checks(label, reference, armature, pin_ref))
     t5 = time.perf_counter()
     if replay:
         _replay(reference, files, maps, loaded, report, approx, models.get("pybullet"),
-                chains_of.get("pybullet", []))
+                chains_of.get("pybullet", []), sorted(floors.get("mujoco", {})))
     t6 = time.perf_counter()
     for eng in loaded:
         messages = list(getattr(eng.model, "runtime_warnings", []))
@@ -881,10 +890,11 @@ def _without_armature(robot: Robot) -> Any:
 
 def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], loaded: list[Any],
             report: VerifyReport, approx: dict[str, Any] | None = None, held: Robot | None = None,
-            chains: Sequence[Any] = ()) -> None:
+            chains: Sequence[Any] = (), coupled: Sequence[str] = ()) -> None:
     """Layer 3b through the replay module (MuJoCo against PyBullet), when it is there; ``held``: the
     source as PyBullet's file holds it (its sensor frames), where PyBullet's approximated links hang;
-    ``chains``: the ball joints as PyBullet's file holds them (MK813)."""
+    ``chains``: the ball joints as PyBullet's file holds them (MK813); ``coupled``: the joints the MJCF
+    gives an armature the source does not (MK835)."""
     names = [e.label for e in loaded if e.label in ("mujoco", "pybullet")]
     if len(names) < 2:
         report.skips.append(Skip(3, "mujoco+pybullet", "layer 3b (replay) needs both MuJoCo and PyBullet "
@@ -899,7 +909,7 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
     sims = []
     # Armature (rotor inertia) reaches the MJCF but not the URDF PyBullet reads (MK820): the replay
     # runs both without it, as layer 3a compares PyBullet with a reference without it.
-    with_armature = [j.name for j in reference.joints if j.armature != 0.0]
+    with_armature = [j.name for j in reference.joints if j.armature != 0.0 or j.name in coupled]
     # PyBullet's documented mass approximations (its 1 kg for a URDF link without <inertial>, MK816)
     # are given to MuJoCo for the replay, so that both integrate the same robot (listed in the report).
     pb_approx = (approx or {}).get("pybullet", {})

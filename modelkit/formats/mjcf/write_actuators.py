@@ -45,6 +45,7 @@ from modelkit.convert.tracks import TRACK_ROLLER
 from modelkit.formats.mjcf.actuators import TENDON_SOURCE
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, sub
+from modelkit.mimic_range import MIMIC_RANGE_SLACK, leader_range_within
 from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
 
 ELEMENTS = {ActuatorKind.EFFORT: "motor", ActuatorKind.POSITION: "position",
@@ -76,6 +77,7 @@ class ActuatorWriter:
         self._legs: frozenset[str] | None = None  # the joints in a legged robot's legs, found once
         self._links: dict[str, Link] | None = None
         self._holding: dict[str, float] = {}  # joint → the most its position servo gives it (N·m or N)
+        self._followers: dict[str, list[Joint]] | None = None  # leader → its mimic followers, found once
 
     def write(self, home: dict[str, float]) -> None:
         by_name: dict[str, Joint] = {}
@@ -421,7 +423,7 @@ class ActuatorWriter:
             ctrl = actuator.ctrl_range
             if ctrl is None and kind is ActuatorKind.POSITION and joint.limits.lower < joint.limits.upper \
                     and math.isfinite(joint.limits.lower) and math.isfinite(joint.limits.upper):
-                ctrl = (joint.limits.lower, joint.limits.upper)
+                ctrl = self._kept_by_followers(joint, (joint.limits.lower, joint.limits.upper), name)
             if ctrl is not None:
                 el.set("ctrlrange", fmt_vec(list(ctrl)))
             self.ctrl.append(home_q if kind is ActuatorKind.POSITION else 0.0)
@@ -445,6 +447,40 @@ class ActuatorWriter:
                 actuator.source or joint.source,
                 f"actuator[{name}]",
             )
+
+    def _kept_by_followers(self, joint: Joint, ctrl: tuple[float, float], name: str) -> tuple[float, float]:
+        """A leader's servo range narrowed to the positions that keep every follower inside its own range
+        (MK828): commanded past them, the follower's limit and the coupling fight (validate's MK326).
+        A follower no position keeps in range (the source's fault, MK326's hint) narrows nothing, nor
+        does one kept at a single position."""
+        if self._followers is None:
+            self._followers = {}
+            for each in self.robot.joints:
+                if each.mimic is not None and each.type in (JointType.REVOLUTE, JointType.PRISMATIC):
+                    self._followers.setdefault(each.mimic.joint, []).append(each)
+        narrowed, by = ctrl, []
+        for follower in self._followers.get(joint.name, []):
+            mimic, own = follower.mimic, (follower.limits.lower, follower.limits.upper)
+            if mimic is None or not (math.isfinite(own[0]) and math.isfinite(own[1]) and own[0] <= own[1]):
+                continue
+            alone = leader_range_within(mimic.multiplier, mimic.offset, ctrl, own)
+            kept = leader_range_within(mimic.multiplier, mimic.offset, narrowed, own)
+            if alone is None or kept is None or kept[1] - kept[0] <= MIMIC_RANGE_SLACK:
+                continue
+            if alone[0] - ctrl[0] > MIMIC_RANGE_SLACK or ctrl[1] - alone[1] > MIMIC_RANGE_SLACK:
+                by.append(follower.name)
+            narrowed = kept
+        if narrowed[0] - ctrl[0] > MIMIC_RANGE_SLACK or ctrl[1] - narrowed[1] > MIMIC_RANGE_SLACK:
+            self.ctx.note(
+                "MK828",
+                f"actuator on joint {joint.name}: ctrlrange {fmt_vec(list(narrowed))}, not the joint's range "
+                f"{fmt_vec(list(ctrl))}: its mimic follower(s) {', '.join(by)} leave their own ranges beyond "
+                "it, where their limits would fight the coupling (the joint's range is kept)",
+                joint.source,
+                f"actuator[{name}]",
+            )
+            return narrowed
+        return ctrl
 
     def _gains(self, el: Element, actuator: Actuator, joint: Joint, target: str) -> None:
         kp, kv = actuator.kp, actuator.kv

@@ -57,6 +57,7 @@ from modelkit.convert.self_contact import BelowBase, touching_pairs
 from modelkit.convert.servo_gains import with_written_masses
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.convert.tracks import roller_names
+from modelkit.formats.mjcf.coupling_armature import floor_coupled_armature
 from modelkit.formats.mjcf.write_actuators import ActuatorWriter
 from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, MIN_MASS, BodyTree
 from modelkit.formats.mjcf.write_contact_pairs import write_source_pairs
@@ -138,6 +139,7 @@ class MjcfWriter:
             )
 
     def write(self) -> bytes:
+        floor_coupled_armature(self.robot, self.ctx)  # before the joints and the servo gains are written
         self.tree.write(self.sections["worldbody"])
         self._frame_note()
         self._depth()
