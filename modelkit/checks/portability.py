@@ -13,7 +13,7 @@ from pathlib import PurePosixPath
 from modelkit.checks.masses import lumped_masses, subtree
 from modelkit.checks.registry import rule
 from modelkit.diagnostics import Diagnostic, diag, did_you_mean
-from modelkit.mimic_range import MIMIC_RANGE_SLACK, leader_range_within
+from modelkit.mimics import MIMIC_RANGE_SLACK, leader_range_within
 from modelkit.model import WORLD_LINK, Geom, Joint, JointType, Link, Robot
 
 URDF_FORMATS = frozenset({"urdf", "xacro"})

@@ -22,7 +22,8 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.numbers import fmt
 from modelkit.convert.servo_gains import joint_loads
 from modelkit.convert.tracks import roller_names
-from modelkit.model import Joint, JointType, Robot
+from modelkit.mimics import coupled_joints
+from modelkit.model import Robot
 
 COUPLED_ARMATURE = 1.0
 """The armature each coupled joint gets at least, as a multiple of its own inertia at home. Measured on
@@ -31,26 +32,14 @@ violation one second after a command went from 1.0 rad (Inspire) and 1.7 rad (f5
 0.5 left the transients twice as large, and followers alone or leaders alone half as good
 (docs/convert.md, "Mimic joints in MuJoCo")."""
 
-SLIDERS = (JointType.REVOLUTE, JointType.PRISMATIC)
-
 
 def floor_coupled_armature(robot: Robot, ctx: WriteContext) -> None:
     """Raise the armature of every joint a mimic couples to :data:`COUPLED_ARMATURE` × its own inertia
     at home, in place (the writer's own copy of the model), with one MK835 note listing them."""
     if robot.source_format == "mjcf":
         return
-    by_name: dict[str, Joint] = {}
-    for joint in robot.joints:
-        by_name.setdefault(joint.name, joint)
     rollers = roller_names(robot, "rollers")
-    coupled: dict[str, Joint] = {}
-    for joint in robot.joints:
-        leader = by_name.get(joint.mimic.joint) if joint.mimic is not None else None
-        if leader is None or leader is joint or joint.name in rollers or joint.type not in SLIDERS \
-                or leader.type not in SLIDERS:
-            continue
-        coupled.setdefault(joint.name, joint)
-        coupled.setdefault(leader.name, leader)
+    coupled = {name: joint for name, joint in coupled_joints(robot).items() if name not in rollers}
     if not coupled:
         return
     loads = joint_loads(robot)

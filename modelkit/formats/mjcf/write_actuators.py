@@ -45,7 +45,7 @@ from modelkit.convert.tracks import TRACK_ROLLER
 from modelkit.formats.mjcf.actuators import TENDON_SOURCE
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, sub
-from modelkit.mimic_range import MIMIC_RANGE_SLACK, leader_range_within
+from modelkit.mimics import MIMIC_RANGE_SLACK, leader_range_within
 from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
 
 ELEMENTS = {ActuatorKind.EFFORT: "motor", ActuatorKind.POSITION: "position",

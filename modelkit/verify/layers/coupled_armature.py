@@ -23,29 +23,18 @@ from typing import Any
 
 from lxml import etree
 
-from modelkit.model import JointType, Robot
+from modelkit.mimics import SLIDERS, coupled_joints
+from modelkit.model import Robot
 from modelkit.verify.engines.protocol import Check, Skip
 
 Renames = dict[str, dict[str, str]]
-SLIDERS = (JointType.REVOLUTE, JointType.PRISMATIC)
 RULE_TOLERANCE = 1e-9  # relative: the written armature against the joint's own inertia at home
-
-
-def coupled_joints(source: Robot) -> set[str]:
-    """The source's hinges and slides that a mimic couples, leaders and followers."""
-    by_name = {joint.name: joint for joint in source.joints}
-    out: set[str] = set()
-    for joint in source.joints:
-        leader = by_name.get(joint.mimic.joint) if joint.mimic is not None else None
-        if leader is not None and leader is not joint and joint.type in SLIDERS and leader.type in SLIDERS:
-            out.update((joint.name, leader.name))
-    return out
 
 
 def written(mjcf: Path, source: Robot, renames: Renames) -> dict[str, float]:
     """Source joint name → the armature the MJCF file gives it, for the coupled joints whose armature
     there is above the source's."""
-    coupled = coupled_joints(source)
+    coupled = set(coupled_joints(source))
     if not coupled or source.source_format == "mjcf":
         return {}
     back = {name: src for src, name in renames.get("joint", {}).items()}
