@@ -593,6 +593,31 @@ def test_example_legged_robots_stand_at_home(tmp_path: Path, relative: str) -> N
     assert sag < STAND_SAG and tilt < STAND_TILT, f"{relative}: sank {sag * 1e3:.1f} mm, tilted {tilt:.3f}"
 
 
+
+def test_a_biped_whose_arms_hang_from_a_waist_stands(tmp_path: Path) -> None:
+    """example-robot-data's Unitree G1: two legs and a waist from its pelvis, its arms on the torso, so
+    fewer than four limbs start at the root and it was not taken for legged (leg_joints): its ankles got
+    gains for the foot's own inertia (30 Hz), softer than the robot tipping over them, and it fell on
+    its back (the base 0.70 m down in 3 s). Now its legs are its two limbs on the ground, their servos
+    hold at least TIPPING_MARGIN times the tipping stiffness of their share of the robot, and it stands."""
+    from modelkit.convert.legs import leg_joints
+    from modelkit.convert.servo_gains import TIPPING_MARGIN, joint_loads
+
+    robot = load(example_robot("g1_description/urdf/g1_29dof_rev_1_0.urdf"))
+    out, _ = convert(robot, tmp_path)
+    free = load(example_robot("g1_description/urdf/g1_29dof_rev_1_0.urdf"))
+    free.root_joint = JointType.FLOATING
+    legs = leg_joints(free)
+    assert {"left_ankle_pitch_joint", "right_knee_joint", "left_hip_roll_joint"} <= legs
+    assert not any("shoulder" in name or "waist" in name for name in legs)
+    loads = joint_loads(free)
+    m = mujoco.MjModel.from_xml_path(str(out))
+    ankle = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "left_ankle_pitch_joint")
+    tipping = loads["left_ankle_pitch_joint"].tipping
+    assert tipping > 50.0 and m.actuator_gainprm[ankle][0] >= TIPPING_MARGIN * tipping * (1 - 1e-9)
+    sag, tilt = stand_on_a_plain_floor(out)
+    assert sag < STAND_SAG and tilt < STAND_TILT, f"sank {sag * 1e3:.1f} mm, tilted {tilt:.3f}"
+
 # pybullet_data's quadrupeds whose URDFs declare leg joints ``continuous`` (no range) and name no
 # actuators: Laikago (toes, Z up) all twelve, Aliengo its four thighs. ``--actuators auto`` used to give
 # each such joint a motor (as for a wheel), and at zero control the robot folded to the floor (Laikago

@@ -44,22 +44,30 @@ from modelkit.convert.moving_paths import MovingPaths
 from modelkit.model import Joint, JointType, Link, Robot
 from modelkit.spatial import Pose
 
+BIPED = 2  # limbs standing on the ground that make a free-base robot legged when it has fewer than LIMBS
+
 
 def leg_joints(robot: Robot) -> frozenset[str]:
-    """The names of the hinges and slides in the legs of a legged robot (empty for any other robot)."""
+    """The names of the hinges and slides in the legs of a legged robot (empty for any other robot): a
+    free base with :data:`LIMBS` limbs or more (the base decision's), or with :data:`BIPED` limbs that
+    touch the ground (a humanoid whose arms hang from a waist, not from the root's body)."""
     if robot.root_joint is not JointType.FLOATING:
         return frozenset()
     poses = robot.world_poses()
     limbs = _limbs(robot)
     raised = _raised(robot, poses, limbs)
     legs = [name for name in limbs if name not in raised]
-    if len(legs) < LIMBS:
+    if len(legs) < BIPED:
         return frozenset()
     children = robot.children_of()
     by_name = {joint.name: joint for joint in robot.joints}
     grounded = _grounded(robot, poses, children, [by_name[first] for first in legs])
     if len(grounded) >= LIMBS:
         legs = grounded  # an arm folded on a quadruped's back, or raised beside it: not a leg
+    elif len(legs) < LIMBS:
+        if len(grounded) < BIPED:
+            return frozenset()
+        legs = grounded  # a biped whose arms hang from a waist (Fourier's GR1T1: 2 legs and a waist)
     links = {link.name: link for link in robot.links}
     out: set[str] = set()
     for first in legs:
@@ -125,9 +133,17 @@ def is_wheel(joint: Joint, links: dict[str, Link]) -> bool:
     return any(_round_about(geom, axis / norm) for geom in geoms)
 
 
-def carried_loads(robot: Robot, home: dict[str, float]) -> dict[str, tuple[float, float]]:
+def carried_loads(robot: Robot, home: dict[str, float]) -> dict[str, tuple[float, float, float]]:
     """Leg joint name → (the torque, or force, that the robot's weight shared by its legs puts on it at
-    ``home`` through the leg's foot; the distance from the joint to the foot). Empty without legs."""
+    ``home`` through the leg's foot; the distance from the joint to the foot; the tipping stiffness of
+    that share about the joint, N·m/rad). Empty without legs.
+
+    The tipping stiffness: a hinge that tilts by δ carries the robot's centre of mass, a height ``h``
+    above it, sideways by ``h δ``, so gravity turns it further by ``(M / n) g h δ`` (an inverted
+    pendulum on the leg's share ``M / n``), times ``1 − (a·z)²`` for an axis ``a`` off the horizontal
+    (a yaw joint tips nothing). A servo softer than that lets the robot fall: Fourier's GR1T1 (53 kg,
+    centre of mass 0.79 m above its ankles) needs 205 N·m/rad at each ankle and its ankles got 228 from
+    the bandwidth rule alone; it tipped over backwards in 2 s."""
     legs = leg_joints(robot)
     if not legs:
         return {}
@@ -137,7 +153,8 @@ def carried_loads(robot: Robot, home: dict[str, float]) -> dict[str, tuple[float
     firsts = [name for name in _limbs(robot) if name in legs]
     mass = robot.total_mass()
     share = np.array([0.0, 0.0, mass * 9.81 / len(firsts)])  # the floor's push on each foot
-    out: dict[str, tuple[float, float]] = {}
+    height = _centre_of_mass_height(robot, poses)
+    out: dict[str, tuple[float, float, float]] = {}
     for first in firsts:
         below = [j for j in _below(children, by_name[first]) if j.child in poses]
         if not below:
@@ -155,10 +172,27 @@ def carried_loads(robot: Robot, home: dict[str, float]) -> dict[str, tuple[float
             axis /= norm
             lever = foot - np.asarray(frame.translation, dtype=float)
             if joint.type is JointType.PRISMATIC:
-                out[joint.name] = (abs(float(axis @ share)), 1.0)
+                out[joint.name] = (abs(float(axis @ share)), 1.0, 0.0)
             else:
-                out[joint.name] = (abs(float(axis @ np.cross(lever, share))), float(np.linalg.norm(lever)))
+                above = max(0.0, height - float(frame.translation[2]))
+                tipping = float(share[2]) * above * (1.0 - float(axis[2]) ** 2)
+                out[joint.name] = (abs(float(axis @ np.cross(lever, share))), float(np.linalg.norm(lever)),
+                                   tipping)
     return out
+
+
+def _centre_of_mass_height(robot: Robot, poses: dict[str, Pose]) -> float:
+    """The height of the robot's centre of mass in the pose ``poses`` (0 without mass)."""
+    mass = moment = 0.0
+    for link in robot.links:
+        inertial = link.inertial
+        if inertial is None or inertial.mass <= 0.0 or link.name not in poses:
+            continue
+        pose = poses[link.name]
+        com = np.asarray(pose.rotation, dtype=float) @ np.asarray(inertial.com, dtype=float)
+        mass += float(inertial.mass)
+        moment += float(inertial.mass) * float(com[2] + pose.translation[2])
+    return moment / mass if mass > 0.0 else 0.0
 
 
 def resting_on(robot: Robot, home: dict[str, float]) -> list[str]:

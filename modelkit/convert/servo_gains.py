@@ -19,7 +19,9 @@ after 2 s at 30 Hz alone) hold as well as big ones. The raised servo's frequency
 taken with gravity along the root's −Z (an arm standing upright on its base, as fixed bases are).
 A joint in a leg of a legged robot also carries its share of the robot's weight through its foot
 (:func:`modelkit.convert.legs.carried_loads`): that torque is added to ``τ_g``, and ``R`` is at least
-the distance to the foot, so a leg's servos hold the robot standing at home as an arm's hold the arm.
+the distance to the foot, so a leg's servos hold the robot standing at home as an arm's hold the arm;
+and its kp is at least :data:`TIPPING_MARGIN` times the stiffness with which the robot's share above it
+tips over it (an inverted pendulum: ``(M / n) g h``), so a biped's ankles hold it upright.
 A drive wheel also carries its share of the robot it pushes, ``(M / n) r²`` about its axis
 (:mod:`modelkit.convert.wheel_loads`), so a wheel's velocity servo tracks with the robot on it.
 A subtree without mass gets ``MIN_INERTIA`` so that every gain is positive.
@@ -43,6 +45,8 @@ MAX_BANDWIDTH_HZ = 80.0  # the ceiling of a servo raised against gravity (ωn·d
 SAG_PER_JOINT = 1e-4  # m: the largest move of a subtree's farthest point a servo's gravity sag may cause
 DAMPING_RATIO = 1.0
 MIN_INERTIA = 1e-6  # kg·m² or kg: the floor of a massless subtree's reflected inertia
+TIPPING_MARGIN = 4.0  # a leg servo's kp over the tipping stiffness it holds (legs.carried_loads)
+TIPPING_BANDWIDTH_HZ = 150.0  # its ceiling: ωn·dt = 1.9 at a 2 ms step, under the explicit limit of 2
 GRAVITY = np.array([0.0, 0.0, -9.81])  # m/s², in the root's frame
 
 
@@ -55,6 +59,7 @@ class JointLoad:
     gravity: float = 0.0
     reach: float = 0.0
     pushed: float = 0.0  # of ``inertia``: a drive wheel's share of the robot it pushes (wheel_loads)
+    tipping: float = 0.0  # N·m/rad: a leg joint's share of the robot tipping over it (legs.carried_loads)
 
 
 def with_written_masses(robot: Robot, lifted: frozenset[str], mass: float, inertia: float) -> Robot:
@@ -108,14 +113,15 @@ def joint_loads(robot: Robot) -> dict[str, JointLoad]:
         total = sums.get(joint.child)
         load = JointLoad(0.0) if total is None else _load_about(joint, poses[joint.child], total)
         out[joint.name] = JointLoad(load.inertia + joint.armature, load.gravity, load.reach)
-    for name, (torque, lever) in carried_loads(robot, home).items():
+    for name, (torque, lever, tipping) in carried_loads(robot, home).items():
         if name in out:
             own = out[name]
-            out[name] = JointLoad(own.inertia, own.gravity + torque, max(own.reach, lever))
+            out[name] = dataclasses.replace(own, gravity=own.gravity + torque, reach=max(own.reach, lever),
+                                            tipping=tipping)
     for name, inertia in carried_inertias(robot).items():
         if name in out:
             own = out[name]
-            out[name] = JointLoad(own.inertia + inertia, own.gravity, own.reach, inertia)
+            out[name] = dataclasses.replace(own, inertia=own.inertia + inertia, pushed=inertia)
     return out
 
 
@@ -212,6 +218,9 @@ def natural_frequency_for(load: JointLoad) -> float:
     if load.gravity > 0.0 and load.reach > 0.0:
         needed = math.sqrt(load.gravity * load.reach / SAG_PER_JOINT / i)
         wn = min(max(wn, needed), 2.0 * math.pi * MAX_BANDWIDTH_HZ)
+    if load.tipping > 0.0:  # a leg's servo holds the robot up: kp at least TIPPING_MARGIN × its tipping
+        needed = math.sqrt(TIPPING_MARGIN * load.tipping / i)
+        wn = max(wn, min(needed, 2.0 * math.pi * TIPPING_BANDWIDTH_HZ))
     return wn
 
 
