@@ -34,6 +34,7 @@ import numpy as np
 
 from modelkit.convert.base import (
     LIMBS,
+    _feet,
     _limbs,
     _raised,
     _round_about,
@@ -48,34 +49,67 @@ BIPED = 2  # limbs standing on the ground that make a free-base robot legged whe
 
 
 def leg_joints(robot: Robot) -> frozenset[str]:
-    """The names of the hinges and slides in the legs of a legged robot (empty for any other robot): a
-    free base with :data:`LIMBS` limbs or more (the base decision's), or with :data:`BIPED` limbs that
-    touch the ground (a humanoid whose arms hang from a waist, not from the root's body)."""
-    if robot.root_joint is not JointType.FLOATING:
-        return frozenset()
-    poses = robot.world_poses()
-    limbs = _limbs(robot)
-    raised = _raised(robot, poses, limbs)
-    legs = [name for name in limbs if name not in raised]
-    if len(legs) < BIPED:
+    """The names of the hinges and slides in the legs of a legged robot (empty for any other robot)."""
+    firsts = leg_starts(robot)
+    if not firsts:
         return frozenset()
     children = robot.children_of()
     by_name = {joint.name: joint for joint in robot.joints}
-    grounded = _grounded(robot, poses, children, [by_name[first] for first in legs])
-    if len(grounded) >= LIMBS:
-        legs = grounded  # an arm folded on a quadruped's back, or raised beside it: not a leg
-    elif len(legs) < LIMBS:
-        if len(grounded) < BIPED:
-            return frozenset()
-        legs = grounded  # a biped whose arms hang from a waist (Fourier's GR1T1: 2 legs and a waist)
     links = {link.name: link for link in robot.links}
     out: set[str] = set()
-    for first in legs:
+    for first in firsts:
         below = _below(children, by_name[first])
         if any(is_wheel(joint, links) for joint in below):
             continue
         out.update(j.name for j in below if j.type in (JointType.REVOLUTE, JointType.PRISMATIC))
     return frozenset(out)
+
+
+def leg_starts(robot: Robot) -> list[str]:
+    """The first joints of a legged robot's legs (empty for any other robot), on a free base:
+
+    * :data:`LIMBS` limbs or more from the root's body (the base decision's), those on the ground when
+      that leaves :data:`LIMBS` (an arm folded on a quadruped's back is not a leg);
+    * else :data:`BIPED` limbs from the root's body on the ground (a humanoid whose arms hang from a
+      waist: Fourier's GR1T1);
+    * else the feet ``--base auto`` finds below a waist (a humanoid rooted at its torso: Fourier's
+      Qinglong), each leg starting at the first moving joint its foot shares with no other foot."""
+    if robot.root_joint is not JointType.FLOATING:
+        return []
+    poses = robot.world_poses()
+    limbs = _limbs(robot)
+    raised = _raised(robot, poses, limbs)
+    legs = [name for name in limbs if name not in raised]
+    children = robot.children_of()
+    by_name = {joint.name: joint for joint in robot.joints}
+    grounded = _grounded(robot, poses, children, [by_name[first] for first in legs])
+    if len(grounded) >= LIMBS:
+        return grounded
+    if len(legs) >= LIMBS:
+        return legs
+    if len(grounded) >= BIPED:
+        return grounded
+    return _legs_from_a_waist(robot, poses)
+
+
+def _legs_from_a_waist(robot: Robot, poses: dict[str, Pose]) -> list[str]:
+    """The legs' first joints below a waist, from the feet ``--base auto`` finds (:func:`base._feet`)."""
+    lows = vertical_spans(robot, poses)
+    if robot.root not in poses or not lows:
+        return []
+    paths = MovingPaths(robot)
+    root_z = float(poses[robot.root].translation[2])
+    below_root = {j.name for j in robot.joints
+                  if j.child in poses and float(poses[j.child].translation[2]) < root_z}
+    feet = _feet(paths, sorted(touching_ground(lows)), below_root)
+    if len(feet) < BIPED:
+        return []
+    firsts = []
+    for foot in feet:
+        shared = max(paths.shared(foot, other) for other in feet if other != foot)
+        if shared < paths.length(foot):
+            firsts.append(paths.at(foot, shared))
+    return sorted(set(firsts))
 
 
 def off_ground_joints(robot: Robot) -> frozenset[str]:
@@ -145,12 +179,12 @@ def carried_loads(robot: Robot, home: dict[str, float]) -> dict[str, tuple[float
     centre of mass 0.79 m above its ankles) needs 205 N·m/rad at each ankle and its ankles got 228 from
     the bandwidth rule alone; it tipped over backwards in 2 s."""
     legs = leg_joints(robot)
-    if not legs:
+    firsts = [name for name in leg_starts(robot) if name in legs]  # not a wheel's limb
+    if not firsts:
         return {}
     poses = robot.world_poses(home)
     children = robot.children_of()
     by_name = {joint.name: joint for joint in robot.joints}
-    firsts = [name for name in _limbs(robot) if name in legs]
     mass = robot.total_mass()
     share = np.array([0.0, 0.0, mass * 9.81 / len(firsts)])  # the floor's push on each foot
     height = _centre_of_mass_height(robot, poses)
