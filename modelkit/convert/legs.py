@@ -50,7 +50,11 @@ BIPED = 2  # limbs standing on the ground that make a free-base robot legged whe
 
 def leg_joints(robot: Robot) -> frozenset[str]:
     """The names of the hinges and slides in the legs of a legged robot (empty for any other robot)."""
-    firsts = leg_starts(robot)
+    return _joints_of(robot, leg_starts(robot))
+
+
+def _joints_of(robot: Robot, firsts: list[str]) -> frozenset[str]:
+    """The hinges and slides of the legs starting at ``firsts``, but a limb holding a wheel."""
     if not firsts:
         return frozenset()
     children = robot.children_of()
@@ -178,8 +182,9 @@ def carried_loads(robot: Robot, home: dict[str, float]) -> dict[str, tuple[float
     (a yaw joint tips nothing). A servo softer than that lets the robot fall: Fourier's GR1T1 (53 kg,
     centre of mass 0.79 m above its ankles) needs 205 N·m/rad at each ankle and its ankles got 228 from
     the bandwidth rule alone; it tipped over backwards in 2 s."""
-    legs = leg_joints(robot)
-    firsts = [name for name in leg_starts(robot) if name in legs]  # not a wheel's limb
+    starts = leg_starts(robot)
+    legs = _joints_of(robot, starts)
+    firsts = [name for name in starts if name in legs]  # not a wheel's limb
     if not firsts:
         return {}
     poses = robot.world_poses(home)
