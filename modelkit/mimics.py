@@ -2,6 +2,7 @@
 
 * :func:`leader_range_within`: the part of a leader's range that keeps its follower inside the
   follower's own range: validate's MK326 hint, and the MJCF writer's leader ``ctrlrange`` (MK828);
+* :func:`followers_by_leader`: each leader's hinge and slide followers: the MJCF writer's ``ctrlrange``;
 * :func:`coupled_joints`: the hinges and slides a mimic couples, leaders and followers: the MJCF
   writer's armature floor (MK835), and verify's reading of it.
 """
@@ -25,6 +26,15 @@ def leader_range_within(multiplier: float, offset: float, leader: tuple[float, f
     bounds = sorted(((follower[0] - offset) / multiplier, (follower[1] - offset) / multiplier))
     low, high = max(leader[0], bounds[0]), min(leader[1], bounds[1])
     return (low + 0.0, high + 0.0) if low <= high else None  # + 0.0: no "-0"
+
+
+def followers_by_leader(robot: Robot) -> dict[str, list[Joint]]:
+    """Leader name → the hinges and slides that mimic it, in document order."""
+    out: dict[str, list[Joint]] = {}
+    for joint in robot.joints:
+        if joint.mimic is not None and joint.type in SLIDERS:
+            out.setdefault(joint.mimic.joint, []).append(joint)
+    return out
 
 
 def coupled_joints(robot: Robot) -> dict[str, Joint]:

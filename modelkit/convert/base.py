@@ -219,10 +219,7 @@ def decide(robot: Robot) -> BaseDecision:
     if on_base:
         return _by_limbs(robot, poses, limbs, "the root's own body rests on the ground (an arm or a fixture"
                          + (f"; {raised} limb(s) point up, as a hand's fingers do" if raised else "") + ")")
-    root_z = float(poses[robot.root].translation[2]) if robot.root in poses else 0.0
-    below_root = {j.name for j in robot.joints
-                  if j.child in poses and float(poses[j.child].translation[2]) < root_z}
-    feet = _feet(paths, sorted(touching), below_root)
+    feet = _feet(paths, sorted(touching), _below_root(robot, poses))
     if len(feet) >= 2:
         shown = ", ".join(f'"{name}"' for name in feet[:6])
         return BaseDecision(JointType.FLOATING, f"it stands on {len(feet)} legs (feet {shown} touch the "
@@ -368,6 +365,13 @@ def _round_about(geom: Geom, axis: np.ndarray) -> bool:
     radius = max(widths) / 2
     return bool(radius > 0.0 and min(widths) >= 0.9 * max(widths)
                 and max(abs(c) for c in centres) <= 0.1 * radius)
+
+
+def _below_root(robot: Robot, poses: dict[str, Pose]) -> set[str]:
+    """The moving and fixed joints whose frames are lower than the root's at q = 0 (:func:`_feet`)."""
+    root_z = float(poses[robot.root].translation[2]) if robot.root in poses else 0.0
+    return {j.name for j in robot.joints
+            if j.child in poses and float(poses[j.child].translation[2]) < root_z}
 
 
 def _feet(paths: MovingPaths, touching: list[str], below_root: set[str]) -> list[str]:

@@ -34,6 +34,7 @@ import numpy as np
 
 from modelkit.convert.base import (
     LIMBS,
+    _below_root,
     _feet,
     _limbs,
     _raised,
@@ -102,10 +103,7 @@ def _legs_from_a_waist(robot: Robot, poses: dict[str, Pose]) -> list[str]:
     if robot.root not in poses or not lows:
         return []
     paths = MovingPaths(robot)
-    root_z = float(poses[robot.root].translation[2])
-    below_root = {j.name for j in robot.joints
-                  if j.child in poses and float(poses[j.child].translation[2]) < root_z}
-    feet = _feet(paths, sorted(touching_ground(lows)), below_root)
+    feet = _feet(paths, sorted(touching_ground(lows)), _below_root(robot, poses))
     if len(feet) < BIPED:
         return []
     firsts = []

@@ -45,7 +45,7 @@ from modelkit.convert.tracks import TRACK_ROLLER
 from modelkit.formats.mjcf.actuators import TENDON_SOURCE
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_xml import Element, sub
-from modelkit.mimics import MIMIC_RANGE_SLACK, leader_range_within
+from modelkit.mimics import MIMIC_RANGE_SLACK, followers_by_leader, leader_range_within
 from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
 
 ELEMENTS = {ActuatorKind.EFFORT: "motor", ActuatorKind.POSITION: "position",
@@ -454,10 +454,7 @@ class ActuatorWriter:
         A follower no position keeps in range (the source's fault, MK326's hint) narrows nothing, nor
         does one kept at a single position."""
         if self._followers is None:
-            self._followers = {}
-            for each in self.robot.joints:
-                if each.mimic is not None and each.type in (JointType.REVOLUTE, JointType.PRISMATIC):
-                    self._followers.setdefault(each.mimic.joint, []).append(each)
+            self._followers = followers_by_leader(self.robot)
         narrowed, by = ctrl, []
         for follower in self._followers.get(joint.name, []):
             mimic, own = follower.mimic, (follower.limits.lower, follower.limits.upper)
