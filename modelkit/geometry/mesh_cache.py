@@ -8,7 +8,8 @@ or "CODE\\tmessage") and the corners of its triangles (the rules' mesh extent). 
 in-process cache is, by the resolved path, modification time (ns), size, the fragment, the size limit
 and the file's name as given (its suffix picks the parser), and also by modelkit's version,
 :data:`SCHEMA` and the modification times of the mesh-checking modules (meshfiles, dae_sources,
-objcheck, vrml): a changed mesh file, a new modelkit or an edited checker never reads an old outcome.
+objcheck, glbcheck, vrml): a changed mesh file, a new modelkit or an edited checker never reads an old
+outcome.
 
 Who: the ``validate`` command (and the pre-commit hook, which runs it) turns it on with :func:`enable`;
 ``convert``, ``verify``, ``tree`` and the library write nothing outside their outputs (they parse a
@@ -56,10 +57,10 @@ def folder() -> Path | None:
 def _checker_stamp() -> str:
     """The schema, modelkit's version and the modification times of the modules a mesh check runs."""
     from modelkit import __version__
-    from modelkit.geometry import dae_sources, meshfiles, objcheck, vrml
+    from modelkit.geometry import dae_sources, glbcheck, meshfiles, objcheck, vrml
 
     stamps = []
-    for module in (meshfiles, dae_sources, objcheck, vrml):
+    for module in (meshfiles, dae_sources, objcheck, glbcheck, vrml):
         try:
             stamps.append(str(os.stat(str(module.__file__)).st_mtime_ns))
         except (OSError, TypeError):

@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from modelkit.geometry import mesh_cache
+from modelkit.geometry.glbcheck import glb_verdict
 from modelkit.geometry.objcheck import UNDECIDED, obj_problem
 from modelkit.model import TriangleMeshData
 from modelkit.textio import DEFAULT_MAX_BYTES, UnreadableFile, read_regular
@@ -245,7 +246,10 @@ def mesh_problem(
             return outcome
     corners = None
     try:
-        outcome = _fast_obj_problem(Path(path), fragment, metadata, max_bytes)
+        outcome, fast_corners = _fast_problem(Path(path), fragment, metadata, max_bytes)
+        if fast_corners is not None and kept and key is not None:
+            corners = fast_corners
+            _BOUNDS[(str(path), fragment)] = (key[1], key[2], corners)
         if outcome == UNDECIDED:
             # the mesh libraries' own warnings (trimesh's texture statistics on an all-transparent image)
             # are neither a finding nor something to print on stderr
@@ -264,13 +268,19 @@ def mesh_problem(
     return outcome
 
 
-def _fast_obj_problem(path: Path, fragment: str | None, metadata: MeshMetadata | None,
-                      max_bytes: int) -> str | None:
-    """:func:`mesh_problem`'s verdict on a plain OBJ file (no fragment, no metadata) without trimesh
-    (``objcheck``); the ``UNDECIDED`` sentinel for anything else or when the fast check cannot tell."""
-    if fragment is not None or metadata is not None or path.suffix.lower() != ".obj":
-        return UNDECIDED
-    return obj_problem(_read_mesh_bytes(path, max_bytes), path.name)
+def _fast_problem(path: Path, fragment: str | None, metadata: MeshMetadata | None,
+                  max_bytes: int) -> tuple[str | None, Corners | None]:
+    """:func:`mesh_problem`'s verdict on a plain OBJ or ``.glb`` file (no fragment, no metadata) without
+    trimesh (``objcheck``, ``glbcheck``), with the corners of the triangles when the check gives them; the
+    ``UNDECIDED`` sentinel for anything else or when the fast check cannot tell."""
+    suffix = path.suffix.lower()
+    if fragment is not None or metadata is not None or suffix not in (".obj", ".glb"):
+        return UNDECIDED, None
+    data = _read_mesh_bytes(path, max_bytes)
+    if suffix == ".obj":
+        return obj_problem(data, path.name), None
+    verdict = glb_verdict(data)
+    return (UNDECIDED, None) if verdict.problem is not None else (None, verdict.corners)
 
 
 def clear_mesh_cache() -> None:
