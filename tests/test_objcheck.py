@@ -15,11 +15,12 @@ import textwrap
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from modelkit.geometry import meshfiles
 from modelkit.geometry.meshfiles import MeshLoadError, MeshMetadata, load_mesh, mesh_problem
-from modelkit.geometry.objcheck import UNDECIDED, obj_problem
+from modelkit.geometry.objcheck import UNDECIDED, obj_problem, obj_verdict
 
 from .conftest import example_robot_data
 
@@ -30,13 +31,23 @@ EXAMPLE_ROBOT_DATA = example_robot_data()
 
 def reference(path: Path) -> str | None:
     """The verdict of the full loader, as mesh_problem gave it before the fast path."""
+    return reference_and_corners(path)[0]
+
+
+def reference_and_corners(path: Path) -> tuple[str | None, np.ndarray | None]:
+    """The full loader's verdict and, for a file that loads, the corners of its vertices (low, high)."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            load_mesh(path)
+            vertices = load_mesh(path).mesh.vertices
     except MeshLoadError as exc:
-        return f"{exc.code}\t{exc}"
-    return None
+        return f"{exc.code}\t{exc}", None
+    return None, np.array([vertices.min(axis=0), vertices.max(axis=0)])
+
+
+def same_corners(fast: tuple[object, object] | None, full: np.ndarray | None) -> bool:
+    """The fast check's corners are the full loader's, to the bit."""
+    return fast is not None and full is not None and np.array_equal(np.array(fast), full)
 
 
 def _pybullet_data() -> Path | None:
@@ -70,10 +81,12 @@ def test_same_verdict_as_load_mesh_on_real_files(root: str) -> None:
         pytest.skip(f"no .obj files under {ROOTS[root]}")
     differ = []
     for path in files:
-        fast = obj_problem(path.read_bytes(), path.name)
-        full = reference(path)
+        fast, fast_corners = obj_verdict(path.read_bytes(), path.name)
+        full, full_corners = reference_and_corners(path)
         if fast != full:  # UNDECIDED counts as a difference for real files
             differ.append(f"{path}: fast {fast!r}, load_mesh {full!r}")
+        elif full is None and not same_corners(fast_corners, full_corners):  # real files: always corners
+            differ.append(f"{path}: fast corners {fast_corners}, load_mesh {full_corners}")
     assert differ == [], f"{len(differ)} of {len(files)} files differ:\n" + "\n".join(differ[:20])
 
 
@@ -166,9 +179,27 @@ def _write(tmp_path: Path, text: str) -> Path:
 
 @pytest.mark.parametrize("text", list(GOOD.values()), ids=list(GOOD))
 def test_accepts_what_load_mesh_loads(text: str, tmp_path: Path) -> None:
+    """... with the corners of the vertices the loader keeps (not the NaN row past the last textured
+    vertex, not the colour columns)."""
     path = _write(tmp_path, text)
+    full, corners = reference_and_corners(path)
+    assert full is None
+    fast, fast_corners = obj_verdict(path.read_bytes(), path.name)
+    assert fast is None and same_corners(fast_corners, corners), (fast_corners, corners)
+
+
+def test_rows_of_different_lengths_give_no_corners(tmp_path: Path) -> None:
+    """trimesh clips such rows to the shortest: the fast check gives the verdict, and no corners."""
+    path = _write(tmp_path, "v 0 0 0\nv 1 0 0 1\nv 0 1 0\nf 1 2 3\n")
     assert reference(path) is None
-    assert obj_problem(path.read_bytes(), path.name) is None
+    assert obj_verdict(path.read_bytes(), path.name) == (None, None)
+
+
+def test_mesh_problem_keeps_the_corners_of_a_plain_obj(tmp_path: Path) -> None:
+    path = _write(tmp_path, GOOD["vertex_colours_and_w"])
+    meshfiles.clear_mesh_cache()
+    assert mesh_problem(path) is None
+    assert meshfiles.known_bounds(path) == ((0.0, 0.0, 0.0), (1.0, 1.0, 0.0))
 
 
 @pytest.mark.parametrize("text", list(BAD.values()), ids=list(BAD))

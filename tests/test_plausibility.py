@@ -9,8 +9,10 @@ from pathlib import Path
 import pytest
 
 from modelkit.api import validate
+from modelkit.formats.common import ReadOptions
+from modelkit.resources import Resolver
 
-from .conftest import CORPUS, SAMPLES
+from .conftest import CORPUS, SAMPLES, example_robot_data
 
 NEW_CODES = {"MK306", "MK316", "MK418", "MK419"}
 SMARTCAR = SAMPLES / "smartcar" / "urdf" / "myrobot.urdf.xacro"
@@ -208,6 +210,33 @@ def test_a_mesh_validate_loaded_counts_with_its_extent(tmp_path: Path) -> None:
     far = _urdf(tmp_path, visual=mesh, collision_origin='<origin xyz="0.5 0 0"/>')
     ((_, message),) = _found(far, "MK418")
     assert "the visuals at 0 0 0; sizes (half-diagonals) 0.07141 and 0.1428 m" in message
+
+
+def test_plain_obj_and_glb_meshes_count_with_their_extent(tmp_path: Path) -> None:
+    """The fast checks of OBJ and ``.glb`` files (no trimesh) give the rules the meshes' corners too."""
+    import trimesh
+
+    box = trimesh.creation.box(extents=(0.1, 0.1, 0.02))
+    (tmp_path / "wheel.obj").write_text(trimesh.exchange.obj.export_obj(box, include_normals=False))
+    (tmp_path / "wheel.glb").write_bytes(trimesh.Scene(box).export(file_type="glb"))
+    for name in ("wheel.obj", "wheel.glb"):
+        mesh = f'<mesh filename="{name}" scale="2 2 2"/>'
+        ((_, message),) = _found(_urdf(tmp_path, visual=mesh, collision=mesh, wheel_inertia=1.0), "MK316")
+        assert "22.1 times the 0.1428 m" in message, name
+
+
+def test_a_collision_origin_holding_an_rpy_is_far_from_its_obj_visual() -> None:
+    """example-robot-data's Alex with nub hands: each nub's collision origin is ``xyz="0 1.57 0"`` (the
+    visual's ``rpy`` typed into ``xyz``); its OBJ mesh lies 1.47 m beside the visual."""
+    robots = example_robot_data()
+    if robots is None:
+        pytest.skip("example-robot-data is not installed")
+    path = robots / "alex_description" / "urdf" / "alex_nub_hands.urdf"
+    options = ReadOptions(resolver=Resolver(environ={"AMENT_PREFIX_PATH": str(robots.parents[2])}))
+    found = [d for d in validate(path, options).diagnostics if d.code == "MK418"]
+    links = sorted(d.message.split(":")[0] for d in found)
+    assert links == ['link "leftNub"', 'link "rightNub"']
+    assert all("1.47 m away" in d.message and "centred at 0.035 1.57 0" in d.message for d in found)
 
 
 # ---- MK306 axis not a unit vector ------------------------------------------------------------------------

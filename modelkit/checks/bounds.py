@@ -2,8 +2,9 @@
 
 A primitive's box is exact for its pose (a rotated box's box is the smallest axis-aligned box around it).
 A mesh counts when its triangles are in memory (generated geometry) or when the reader has already
-loaded its file to check it (:func:`modelkit.geometry.meshfiles.known_bounds`): validate never loads a
-mesh a second time for this, and a mesh it did not load (a plain OBJ, a file with unit metadata) has no box.
+checked its file (:func:`modelkit.geometry.meshfiles.known_bounds`; the fast OBJ and glTF checks give the
+corners too): validate never loads a mesh a second time for this, and a mesh it did not check (a file
+with unit metadata) has no box.
 """
 
 from __future__ import annotations

@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from modelkit.geometry import mesh_cache
 from modelkit.geometry.glbcheck import glb_verdict
-from modelkit.geometry.objcheck import UNDECIDED, obj_problem
+from modelkit.geometry.objcheck import UNDECIDED, obj_verdict
 from modelkit.model import TriangleMeshData
 from modelkit.textio import DEFAULT_MAX_BYTES, UnreadableFile, read_regular
 
@@ -278,7 +278,7 @@ def _fast_problem(path: Path, fragment: str | None, metadata: MeshMetadata | Non
         return UNDECIDED, None
     data = _read_mesh_bytes(path, max_bytes)
     if suffix == ".obj":
-        return obj_problem(data, path.name), None
+        return obj_verdict(data, path.name)
     verdict = glb_verdict(data)
     return (UNDECIDED, None) if verdict.problem is not None else (None, verdict.corners)
 
@@ -291,8 +291,8 @@ def clear_mesh_cache() -> None:
 
 Corners = tuple[tuple[float, float, float], tuple[float, float, float]]
 # (path as given, fragment) -> (mtime_ns, size, the lowest and highest corner of the triangles) of a mesh that
-# :func:`mesh_problem` loaded without metadata: the validation rules use a mesh's extent without loading it
-# again (a plain OBJ judged by ``objcheck`` has none).
+# :func:`mesh_problem` loaded, or judged with ``objcheck``/``glbcheck``, without metadata: the validation
+# rules use a mesh's extent without loading it again.
 _BOUNDS: dict[tuple[str, str | None], tuple[int, int, Corners]] = {}
 
 

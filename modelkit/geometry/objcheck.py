@@ -28,12 +28,13 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
 from itertools import pairwise
 
-__all__ = ["UNDECIDED", "obj_problem"]
+__all__ = ["UNDECIDED", "obj_problem", "obj_verdict"]
 
 #: Returned by :func:`obj_problem` when only the full loader can tell.
 UNDECIDED = "UNDECIDED\tthe fast OBJ check cannot decide; load the file"
@@ -77,6 +78,7 @@ class _Vertices:
     rows: int  # rows of trimesh's vertex array
     columns: int  # its columns after trimesh keeps at most three
     first_bad_row: int | None  # first row with a NaN/infinite coordinate among those columns
+    text: str = ""  # the text trimesh finds the rows in (its chunk of v/vt/vn lines)
 
 
 @dataclass
@@ -98,31 +100,42 @@ def _chunk_of(faces: list[int], width: int, masked_to_max: bool) -> _Chunk:
     return _Chunk(width, masked_to_max, len(faces), min(faces), max(faces), lambda: faces)
 
 
+Corners = tuple[tuple[float, float, float], tuple[float, float, float]]
+
+
 def obj_problem(data: bytes, name: str) -> str | None:
     """None when ``load_mesh`` loads an OBJ file with these bytes (no fragment, no metadata), else
     ``"MK501\\t<message>"`` with the message of its :class:`MeshLoadError`, or :data:`UNDECIDED`."""
+    return obj_verdict(data, name)[0]
+
+
+def obj_verdict(data: bytes, name: str) -> tuple[str | None, Corners | None]:
+    """:func:`obj_problem`, and for a file that loads the lowest and highest corner of the vertices
+    ``load_mesh`` keeps (None when they cannot be had cheaply: rows of different lengths, fewer than three
+    columns)."""
     if not data.strip():
-        return f"MK501\t{name} is empty"
+        return f"MK501\t{name} is empty", None
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
         text = data.decode("latin-1")
     if "\x00" in text:
-        return f"MK501\t{name} contains NUL bytes: not a text OBJ file"
+        return f"MK501\t{name} contains NUL bytes: not a text OBJ file", None
     # trimesh: leading/trailing newline, \r\n -> \n, backslash continuations merged
     text = "\n{}\n".format(text.strip().replace("\r\n", "\n")).replace("\\\n", "")
     if any(c in text for c in _ODD_ASCII_SPACE) if text.isascii() else _ODD_SPACE.search(text):
-        return UNDECIDED
+        return UNDECIDED, None
     try:
         verts, has_normals = _vertices(text)
         if verts is None:  # trimesh returns no geometry
-            return f"MK501\t{name} contains no faces: not a usable OBJ file"
+            return f"MK501\t{name} contains no faces: not a usable OBJ file", None
         chunks = [_chunk(c, has_normals) for c in _face_chunks(text)]
-        return _verdict(verts, chunks, name)
+        problem, kept_rows = _verdict(verts, chunks, name)
     except _Malformed:
-        return f"MK501\t{name}: malformed OBJ ({_NUMPY_UNMATCHED})"
+        return f"MK501\t{name}: malformed OBJ ({_NUMPY_UNMATCHED})", None
     except _Undecided:
-        return UNDECIDED
+        return UNDECIDED, None
+    return problem, (_corners(verts, kept_rows) if problem is None else None)
 
 
 # ---- vertices (trimesh.exchange.obj._parse_vertices) ------------------------------------------
@@ -152,6 +165,7 @@ def _vertices(text: str) -> tuple[_Vertices | None, bool]:
             table = _number_rows(rows)
         if k == "v":
             verts = table
+            verts.text = chunk
     return verts, starts["vn"] >= 0
 
 
@@ -384,9 +398,10 @@ def _is_int(token: bytes) -> bool:
 # ---- the checks of load_obj, _load_obj and _finish, in their order ---------------------------------
 
 
-def _verdict(verts: _Vertices, chunks: list[_Chunk], name: str) -> str | None:
+def _verdict(verts: _Vertices, chunks: list[_Chunk], name: str) -> tuple[str | None, int]:
+    """The verdict, and how many vertex rows (from the first) the loaded mesh keeps."""
     if not chunks:  # trimesh returns a point cloud
-        return f"MK501\t{name} contains no faces: not a usable OBJ file"
+        return f"MK501\t{name} contains no faces: not a usable OBJ file", 0
     n = verts.rows
     used_rows: list[int] = []  # vertex rows each chunk keeps
     for c in chunks:
@@ -397,11 +412,11 @@ def _verdict(verts: _Vertices, chunks: list[_Chunk], name: str) -> str | None:
             if lo < -(hi + 1) and c.width > 3:  # only the first three of a polygon's corners count
                 lo = min(x for i, x in enumerate(c.faces) if i % c.width < 3)
             if lo < -(hi + 1) or hi + 1 > n:
-                return f"MK501\t{name}: a face refers to a vertex that does not exist"
+                return f"MK501\t{name}: a face refers to a vertex that does not exist", 0
             used_rows.append(hi + 1)
         else:  # mask of all vertices; indices remapped into [0, n)
             if lo < -n or hi > n - 1:
-                return f"MK501\t{name}: a face refers to a vertex that does not exist"
+                return f"MK501\t{name}: a face refers to a vertex that does not exist", 0
             used_rows.append(n)
     # meshfiles._load_obj: trimesh's chunks come out in reverse order; each is reshaped to (-1, 3)
     pieces = list(reversed(list(zip(chunks, used_rows, strict=True))))
@@ -410,7 +425,7 @@ def _verdict(verts: _Vertices, chunks: list[_Chunk], name: str) -> str | None:
         size = rows * verts.columns
         if size % 3:
             return (f"MK501\tcannot load {name}: ValueError: "
-                    f"cannot reshape array of size {size} into shape (3)")
+                    f"cannot reshape array of size {size} into shape (3)"), 0
         sizes.append(size // 3)
     total = sum(sizes)
     offset = 0
@@ -432,12 +447,35 @@ def _verdict(verts: _Vertices, chunks: list[_Chunk], name: str) -> str | None:
             n_triangles += kept * (w - 2)
         offset += nv
     if out_of_range:
-        return f"MK501\t{name}: face index out of range"
+        return f"MK501\t{name}: face index out of range", 0
     if n_triangles == 0:
-        return f"MK501\t{name} contains no triangles"
+        return f"MK501\t{name} contains no triangles", 0
     if verts.first_bad_row is not None and verts.first_bad_row < max(used_rows):
-        return f"MK501\t{name} has non-finite vertex coordinates (NaN or infinity)"
-    return None
+        return f"MK501\t{name} has non-finite vertex coordinates (NaN or infinity)", 0
+    return None, max(used_rows)
+
+
+def _corners(verts: _Vertices, kept_rows: int) -> Corners | None:
+    """The lowest and highest corner of the first ``kept_rows`` vertex rows, read as trimesh reads them
+    (one ``np.fromstring`` of every ``v`` row); None unless every row holds as many numbers, at least
+    three (the loader then reshapes or clips the rows, and only it can tell)."""
+    import numpy as np
+
+    rows = _ROWS["v"].findall(verts.text)
+    per_row = len(rows[0].split()) if rows else 0
+    if per_row < 3 or kept_rows < 1:
+        return None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            values = np.fromstring(" ".join(rows), sep=" ")  # the reader trimesh uses for these rows
+    except ValueError:
+        return None
+    if values.size != len(rows) * per_row:
+        return None
+    kept = values.reshape(len(rows), per_row)[:kept_rows, :3]
+    low, high = kept.min(axis=0), kept.max(axis=0)
+    return (float(low[0]), float(low[1]), float(low[2])), (float(high[0]), float(high[1]), float(high[2]))
 
 
 def _remapped(c: _Chunk, n: int) -> list[int]:
