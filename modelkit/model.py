@@ -501,7 +501,7 @@ class Robot:
                 if joint.child in poses:
                     continue
                 q = positions.get(joint.name, 0.0)
-                motion = Pose()
+                motion: Pose | None = None  # the joint at rest: the child sits at the joint's origin
                 axis = np.asarray(joint.axis, dtype=float)
                 if joint.type is JointType.REVOLUTE and q != 0.0 and np.linalg.norm(axis) > 0:
                     motion = Pose(axis_angle(axis, q), np.zeros(3))
@@ -514,6 +514,7 @@ class Robot:
                         if angle != 0.0:
                             rotation = rotation @ axis_angle(unit, angle)
                     motion = Pose(rotation, np.zeros(3))
-                poses[joint.child] = poses[parent] @ joint.origin @ motion
+                placed = poses[parent] @ joint.origin
+                poses[joint.child] = placed if motion is None else placed @ motion
                 stack.append(joint.child)
         return poses

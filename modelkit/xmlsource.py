@@ -165,7 +165,8 @@ class XmlDocument:
 class LazyLocation(SourceLocation):
     """A :class:`SourceLocation` in an :class:`XmlDocument` whose line and column are computed when first
     read. It equals, hashes, orders, prints and pickles as the plain location it stands for (a pickle or a
-    copy is that plain location), so no consumer can tell the two apart.
+    shallow copy is that plain location; a deep copy shares it, as any location), so no consumer can tell
+    the two apart.
 
     The document stays alive as long as the location does; it must not change after the location is
     taken (readers only read)."""

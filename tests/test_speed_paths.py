@@ -1,7 +1,7 @@
 """The fast paths of issue 9 §3 give exactly what the slow ones gave.
 
 * :class:`modelkit.xmlsource.LazyLocation`: a location found when first read equals, hashes, orders,
-  prints, copies and pickles as the plain location found at once;
+  prints, copies and pickles as the plain location found at once (a deep copy shares it, unresolved);
 * the xacro deep clone (:class:`modelkit.formats.xacro.origins._Cloner`) makes the same tree as
   minidom's ``cloneNode(deep=True)``;
 * ``xacro.substitution_args`` is imported without PyYAML, and PyYAML still works for it when needed;
@@ -69,8 +69,13 @@ def test_lazy_locations_equal_eager_ones() -> None:
         assert (lazy.file, lazy.line, lazy.col) == (eager.file, eager.line, eager.col)
         assert lazy == eager and eager == lazy and hash(lazy) == hash(eager)
         assert str(lazy) == str(eager) and repr(lazy) == repr(eager)
-        for other in (pickle.loads(pickle.dumps(lazy)), copy.copy(lazy), copy.deepcopy(lazy)):
+        for other in (pickle.loads(pickle.dumps(lazy)), copy.copy(lazy)):
             assert type(other) is SourceLocation and other == eager
+        # a location never changes: a deep copy (convert copies the model it writes) shares it unresolved
+        fresh = doc.loc(element, attribute)
+        assert copy.deepcopy(fresh) is fresh and "_pending" in fresh.__dict__
+        assert copy.deepcopy(fresh) == eager
+        assert copy.deepcopy(eager) is eager
         assert dataclasses.astuple(lazy) == dataclasses.astuple(eager)
         assert dataclasses.replace(lazy, line=99) == SourceLocation(eager.file, 99, eager.col)
         text_lazy, text_eager = doc.text_loc(element), doc.find_text_loc(element)
