@@ -17,7 +17,6 @@ import random
 import struct
 import subprocess
 import sys
-import warnings
 from pathlib import Path
 from typing import Any
 
@@ -26,7 +25,8 @@ import pytest
 
 from modelkit.geometry import glbcheck, meshfiles
 from modelkit.geometry.glbcheck import UNDECIDED, glb_verdict
-from modelkit.geometry.meshfiles import MeshLoadError, load_mesh, mesh_problem
+from modelkit.geometry.meshfiles import mesh_problem
+from tests.test_objcheck import reference_and_corners as full_load
 
 BOX = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-2.0, 2.0) for z in (-3.0, 3.0)], dtype="<f4") * 0.01
 BOX_FACES = np.array([0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1, 2, 3, 7, 2, 7, 6, 0, 2, 6,
@@ -100,17 +100,6 @@ def glb(header: dict[str, Any], binary: bytes) -> bytes:
     total = 12 + 8 + len(text) + 8 + len(binary)
     return (struct.pack("<III", 0x46546C67, 2, total) + struct.pack("<II", len(text), 0x4E4F534A) + text
             + struct.pack("<II", len(binary), 0x004E4942) + binary)
-
-
-def full_load(path: Path) -> tuple[str | None, np.ndarray | None]:
-    """The full loader's verdict and corners (low row, high row)."""
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            vertices = load_mesh(path).mesh.vertices
-    except MeshLoadError as exc:
-        return f"{exc.code}\t{exc}", None
-    return None, np.array([vertices.min(axis=0), vertices.max(axis=0)])
 
 
 def agrees(path: Path) -> bool:
