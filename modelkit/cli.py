@@ -497,7 +497,8 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
               help="Weld the root to the world or let it float; auto keeps the source's answer and, where "
                    "it has none (URDF), floats robots with wheels or legs and welds the others.")
 @click.option("--actuators", type=click.Choice(ACTUATOR_CHOICES), default="auto", show_default=True,
-              help="MJCF: the actuator of every hinge and slide joint when the source has no actuators; "
+              help="MJCF and SDF (gz-sim joint controllers): the actuator of every hinge and slide joint "
+                   "when the source has no actuators; "
                    "auto: a position servo on each joint with a range or in a leg (the model holds its home "
                    "pose), a motor on each other (wheels: torque-driven). Servos get gains from each joint's "
                    "reflected inertia (MK840, MK841). A source's own actuators are written as "

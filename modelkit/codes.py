@@ -1428,7 +1428,10 @@ _TABLE: tuple[CodeInfo, ...] = (
         "actuators-chosen",
         "info",
         "The source says nothing about actuation: every hinge and slide joint that is not a mimic follower "
-        "gets the actuator `--actuators` names (motor by default), or none with `--actuators none`.",
+        "or locked gets the actuator `--actuators` names (`auto` by default: a position servo on a joint "
+        "with a range, in a leg or on a welded base, a motor on the others), as an MJCF actuator or, in "
+        "SDF, a gz-sim joint controller (not on the wheels a DiffDrive system drives); none with "
+        "`--actuators none`.",
     ),
     CodeInfo(
         "MK842",

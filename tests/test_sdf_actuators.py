@@ -269,6 +269,96 @@ def test_gazebo_classic_leaves_the_systems_out(tmp_path: Path) -> None:
     assert any("3 actuator(s)" in m and "Gazebo classic" in m for m in _codes(notes, "MK808"))
 
 
+# -- a source without actuators: the --actuators choice, as for MJCF ----------------------------------
+
+BARE_ARM = """<?xml version="1.0"?>
+<robot name="bare">
+  <link name="base"><inertial><mass value="2"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="upper"><inertial><origin xyz="0 0 0.15"/><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="fore"><inertial><origin xyz="0 0 0.15"/><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="finger"><inertial><mass value="0.1"/>
+    <inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="twin"><inertial><mass value="0.1"/>
+    <inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
+    <origin xyz="0 0 0.05"/><axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="50" velocity="1"/></joint>
+  <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/>
+    <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/><limit lower="0.5" upper="2" effort="30" velocity="1"/></joint>
+  <joint name="grip" type="prismatic"><parent link="fore"/><child link="finger"/>
+    <origin xyz="0 0 0.3"/><axis xyz="1 0 0"/><limit lower="0" upper="0.04" effort="20" velocity="1"/></joint>
+  <joint name="grip_twin" type="prismatic"><parent link="fore"/><child link="twin"/>
+    <origin xyz="0 0 0.3"/><axis xyz="-1 0 0"/><limit lower="0" upper="0.04" effort="20" velocity="1"/>
+    <mimic joint="grip"/></joint>
+</robot>
+"""
+
+
+def test_a_source_without_actuators_gets_the_choice_as_gz_sim_systems(tmp_path: Path,
+                                                                     sdf_oracle: Path) -> None:  # noqa: F811
+    """A URDF arm without transmissions → SDF: --actuators auto puts a JointPositionController on every
+    joint of the welded arm but the mimic follower, with the MJCF rule's gains and, where the home pose
+    is not 0 (the elbow's range starts at 0.5), gz-sim's ``initial_position``; libsdformat accepts the
+    file, and it reads back as position actuators on the same joints. The gains are the ones the MJCF
+    output gets for the same joints (but for a mimic's leader, whose MJCF servo also moves the coupling
+    armature MuJoCo needs, MK835)."""
+    source = load(_write_text(tmp_path, "bare.urdf", BARE_ARM))
+    out = tmp_path / "out" / "bare.sdf"
+    notes = write(source, out)
+    assert not oracle_has_errors(sdf_oracle, out)
+    plugins = _by_joint(out)
+    assert {j: p.get("name") for j, p in plugins.items()} == {
+        name: "gz::sim::systems::JointPositionController" for name in ("shoulder", "elbow", "grip")}
+    assert plugins["elbow"].findtext("initial_position") == "0.5"
+    assert plugins["shoulder"].findtext("initial_position") is None  # home 0: gz-sim's default
+    assert (plugins["elbow"].findtext("cmd_max"), plugins["elbow"].findtext("cmd_min")) == ("30", "-30")
+    (chosen,) = _codes(notes, "MK841")
+    assert "3 JointPositionController system(s)" in chosen and "--actuators auto" in chosen
+    assert len(_codes(notes, "MK840")) == 1
+    assert _kinds(load(out)) == {name: ActuatorKind.POSITION for name in ("shoulder", "elbow", "grip")}
+    mjcf = tmp_path / "mjcf" / "bare.xml"
+    write(source, mjcf)
+    servos = {el.get("joint"): el for el in ET.parse(mjcf).getroot().iter("position")}
+    for name in ("shoulder", "elbow"):  # grip leads a mimic: MuJoCo's coupling armature raises its gains
+        got = float(plugins[name].findtext("p_gain") or 0)
+        assert got == pytest.approx(float(servos[name].get("kp") or 0), rel=1e-6), name
+
+
+@pytest.mark.parametrize(("choice", "system"), [("motor", "ApplyJointForce"), ("velocity", "JointController"),
+                                                ("none", None)])
+def test_the_actuators_option_chooses_the_systems(tmp_path: Path, choice: str, system: str | None) -> None:
+    source = load(_write_text(tmp_path, "bare.urdf", BARE_ARM))
+    out = tmp_path / "out" / "bare.sdf"
+    notes = write(source, out, options=WriteOptions(actuators=choice))
+    plugins = _by_joint(out)
+    if system is None:
+        assert plugins == {} and _codes(notes, "MK841") == []
+        return
+    assert {p.get("name") for p in plugins.values()} == {f"gz::sim::systems::{system}"}
+    assert sorted(plugins) == ["elbow", "grip", "shoulder"]
+
+
+def test_wheels_the_drive_system_drives_get_no_controller(tmp_path: Path) -> None:
+    """The tutorial's pan-tilt robot → SDF: its wheels are the DiffDrive system's (MK858); the pan and
+    tilt joints, without a range on a free base, get ApplyJointForce (zero force leaves them free), as
+    the MJCF gets <motor>s; Gazebo classic gets none."""
+    tutorial = Path(__file__).resolve().parents[1] / "samples" / "choreonoid_ros2_mobile_robot_tutorial"
+    source = load(tutorial / "model" / "mobile_robot_pantilt.body")
+    out = tmp_path / "sim" / "robot.sdf"
+    notes = write(source, out)
+    plugins = _by_joint(out)
+    assert {j: p.get("name") for j, p in plugins.items()} == {
+        "PanJoint": "gz::sim::systems::ApplyJointForce", "TiltJoint": "gz::sim::systems::ApplyJointForce"}
+    assert any(p.get("name") == "gz::sim::systems::DiffDrive" for p in _plugins(out))
+    (chosen,) = _codes(notes, "MK841")
+    assert "the wheels LeftWheel, RightWheel are the DiffDrive system's" in chosen
+    classic = tmp_path / "classic" / "robot.sdf"
+    write(source, classic, options=WriteOptions(gazebo="classic"))
+    assert _by_joint(classic) == {}
+
+
 # -- self-collision --------------------------------------------------------------------------------
 
 

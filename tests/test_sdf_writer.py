@@ -461,7 +461,12 @@ def test_initial_position_is_dropped_with_a_note(tmp_path: Path, version: str) -
     robot = arm()
     robot.joints[0].initial_position = 0.25
     notes = write(robot, tmp_path / "a.sdf", version)
-    assert etree.parse(str(tmp_path / "a.sdf")).find(".//initial_position") is None
+    tree = etree.parse(str(tmp_path / "a.sdf"))
+    assert tree.find(".//joint//initial_position") is None
+    # the position controller --actuators auto gives the welded arm's elbow starts there (gz-sim's parameter)
+    (plugin,) = [p for p in tree.iterfind(".//plugin") if p.findtext("joint_name") == "elbow_joint"]
+    assert plugin.get("name") == "gz::sim::systems::JointPositionController"
+    assert plugin.findtext("initial_position") == "0.25"
     (note,) = [n for n in notes if n.code == "MK820" and "initial position" in n.message]
     assert 'joint "elbow"' in note.message and "0.25" in note.message
     assert note.target == "joint[elbow_joint]/axis"

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 
+from modelkit.convert.actuator_choice import CHOSEN, chosen_kind, constrained_joints
 from modelkit.convert.context import WriteContext
 from modelkit.convert.legs import is_wheel, leg_joints, off_ground_joints, resting_on
 from modelkit.convert.numbers import fmt, fmt_vec
@@ -50,7 +51,6 @@ from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
 
 ELEMENTS = {ActuatorKind.EFFORT: "motor", ActuatorKind.POSITION: "position",
             ActuatorKind.VELOCITY: "velocity"}
-CHOICES = {"motor": ActuatorKind.EFFORT, "position": ActuatorKind.POSITION, "velocity": ActuatorKind.VELOCITY}
 ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # MK841 lists kinds in this order
 SERVOED = "ROS effort interface, servoed"  # source_kind of a servo --source-actuators auto put there
 FILLED = "unactuated, load-bearing"  # source_kind of a servo on a joint the source left without (MK827)
@@ -103,7 +103,7 @@ class ActuatorWriter:
             for free in self.robot.joints:
                 kind = self._chosen_kind(free)
                 if kind is not None and free.name not in taken:
-                    chosen.append(Actuator(joint=free.name, kind=kind, source_kind="--actuators",
+                    chosen.append(Actuator(joint=free.name, kind=kind, source_kind=CHOSEN,
                                            source=free.source))
             planned += [(a, by_name.get(a.joint)) for a in chosen]
         else:
@@ -116,14 +116,14 @@ class ActuatorWriter:
             target = self.joint_names.get(actuator.joint)
             reason = self._unwritable(joint, target, skipped)
             if reason is not None:
-                if actuator.source_kind not in ("--actuators", FILLED):
+                if actuator.source_kind not in (CHOSEN, FILLED):
                     self.ctx.note("MK842", f"actuator on joint {actuator.joint} left out: {reason}",
                                   actuator.source, "actuator")
                 continue
             assert joint is not None and target is not None
             self._one(actuator, joint, target[0], home.get(target[0], 0.0))
             on_joint.setdefault(joint.name, actuator)
-            if actuator.source_kind == "--actuators":
+            if actuator.source_kind == CHOSEN:
                 written[actuator.kind] = written.get(actuator.kind, 0) + 1
         movable = any(j.type in (JointType.REVOLUTE, JointType.PRISMATIC) for j in self.robot.joints)
         if replaced:
@@ -252,7 +252,7 @@ class ActuatorWriter:
         if self._legs is None:
             self._legs = leg_joints(self.robot)
         sagging = [(name, self.load(by_name[name]).gravity) for name, actuator in on_joint.items()
-                   if actuator.kind is ActuatorKind.EFFORT and actuator.source_kind not in ("--actuators",
+                   if actuator.kind is ActuatorKind.EFFORT and actuator.source_kind not in (CHOSEN,
                                                                                              TRACK_ROLLER)
                    and name not in self._legs and name in by_name and self.sags(by_name[name])]
         if not sagging:
@@ -306,7 +306,7 @@ class ActuatorWriter:
         if not legs:
             return
         limp = [name for name in legs if name in on_joint and on_joint[name].kind is ActuatorKind.EFFORT
-                and on_joint[name].source_kind != "--actuators"]
+                and on_joint[name].source_kind != CHOSEN]
         if limp:
             shown = ", ".join(limp[:4]) + (" ..." if len(limp) > 4 else "")
             self.ctx.note("MK857", f"{len(limp)} of the {len(legs)} leg joints ({shown}) have the source's "
@@ -328,29 +328,11 @@ class ActuatorWriter:
                           "it lying down", self.robot.source, "keyframe")
 
     def _chosen_kind(self, joint: Joint) -> ActuatorKind | None:
-        """The ``--actuators`` kind of a joint the source does not actuate (None: no actuator).
-
-        ``auto``: a position servo on a joint with a finite range, in a leg (:mod:`modelkit.convert.legs`:
-        a URDF's ``continuous`` knee) or on a welded base (an arm's ``continuous`` joints: Menagerie's
-        Kinova Gen3 servos its four), so the written model holds its home pose as MuJoCo Menagerie's
-        arms and legs do; on a free base, a motor on any other joint without one (wheels, casters,
-        endless spindles), whose zero control leaves it free as the source has it. A mobile robot's
-        joints without a range are its wheels and casters (the lecture's smartcar has its wheels' masses
-        off their axes: still motors). Before, a welded arm's unranged joints that gravity does not turn
-        (example-robot-data's Kinova: joint 1, vertical, and joint 6) were motors: free at zero control,
-        joint 1 turned 0.0136 rad while joint 2 moved 0.5 rad."""
-        if joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
-            return None
-        choice = self.ctx.options.actuators
-        if choice == "auto":
-            lower, upper = joint.limits.lower, joint.limits.upper
-            ranged = math.isfinite(lower) and math.isfinite(upper) and lower < upper
-            if self._legs is None:
-                self._legs = leg_joints(self.robot)
-            welded = self.robot.root_joint is JointType.FIXED  # an arm; a mobile robot's are wheels, casters
-            held = ranged or joint.name in self._legs or welded
-            return ActuatorKind.POSITION if held else ActuatorKind.EFFORT
-        return CHOICES.get(choice)
+        """The ``--actuators`` kind of a joint the source does not actuate (None: no actuator):
+        :func:`modelkit.convert.actuator_choice.chosen_kind`."""
+        if self._legs is None:
+            self._legs = leg_joints(self.robot)
+        return chosen_kind(joint, self.robot, self.ctx.options.actuators, self._legs)
 
     def sags(self, joint: Joint) -> bool:
         """Whether gravity turns the joint at home: its gravity load there exceeds its Coulomb friction
@@ -381,8 +363,7 @@ class ActuatorWriter:
                       self.robot.source, "actuator")
 
     def _constrained(self) -> set[str]:
-        followers = {j.name for j in self.robot.joints if j.mimic is not None}
-        return followers | {j.name for j in self.robot.joints if j.limits.lower == j.limits.upper}
+        return constrained_joints(self.robot)
 
     @staticmethod
     def _unwritable(joint: Joint | None, target: list[str] | None, skipped: set[str]) -> str | None:

@@ -25,6 +25,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from modelkit.convert.actuator_choice import CHOSEN
 from modelkit.convert.context import WriteContext
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.convert.tracks import TRACK_ROLLER
@@ -36,7 +37,7 @@ from modelkit.formats.mjcf.write_xml import Element, sub
 from modelkit.model import Robot
 
 WRAPPING = ("sphere", "cylinder")  # the geom types a spatial tendon wraps around
-MADE_UP = ("--actuators", TRACK_ROLLER, SERVOED, FILLED)  # written actuators that are not the source's
+MADE_UP = (CHOSEN, TRACK_ROLLER, SERVOED, FILLED)  # written actuators that are not the source's
 Placed = tuple[float, int, Element, float]  # source rank, order written, element, home ctrl
 
 

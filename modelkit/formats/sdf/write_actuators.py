@@ -27,11 +27,15 @@ from typing import Any
 
 from lxml.etree import _Element as Element
 
+from modelkit.convert.actuator_choice import CHOSEN, chosen_kind, constrained_joints
 from modelkit.convert.context import WriteContext
+from modelkit.convert.drive_plugin import find_drive
+from modelkit.convert.legs import leg_joints
 from modelkit.convert.numbers import fmt
 from modelkit.convert.servo_gains import (
     SERVO_BANDWIDTH_HZ,
     JointLoad,
+    home_position,
     joint_loads,
     position_gains,
     velocity_gain,
@@ -50,6 +54,7 @@ SYSTEM_FOR = {
     ActuatorKind.VELOCITY: "JointController",
     ActuatorKind.EFFORT: "ApplyJointForce",
 }
+_ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # MK841 lists kinds so
 NOT_COPIED = frozenset({"joint_name"})  # the source plugin's children the writer always writes itself
 
 
@@ -89,7 +94,7 @@ class ActuatorWriter:
     def write(self, model: Element) -> int:
         robot = self.robot
         if not robot.actuators:
-            return 0
+            return self._chosen(model)
         if self.family == "classic":
             self.ctx.note(
                 "MK808",
@@ -115,6 +120,11 @@ class ActuatorWriter:
                 continue
             self._one(model, actuator, joint, target, made_up, lost)
             written += 1
+        self._said(made_up, lost)
+        return written
+
+    def _said(self, made_up: list[str], lost: list[str]) -> None:
+        """MK840: the gains the rule gave; MK844: what the systems cannot hold."""
         if made_up:
             self.ctx.note(
                 "MK840",
@@ -122,7 +132,7 @@ class ActuatorWriter:
                 f"{fmt(SERVO_BANDWIDTH_HZ)} Hz critically damped loop on each joint's reflected inertia at "
                 "home, raised where gravity at home would make it sag (docs/convert.md): "
                 + "; ".join(made_up),
-                robot.source,
+                self.robot.source,
                 "model/plugin",
             )
         if lost:
@@ -130,15 +140,58 @@ class ActuatorWriter:
                 "MK844",
                 f"{len(lost)} actuator(s) written as gz-sim systems without what those systems cannot hold: "
                 + "; ".join(lost),
-                robot.source,
+                self.robot.source,
                 "model/plugin",
             )
-        return written
+
+    def _chosen(self, model: Element) -> int:
+        """The source names no actuators: the ``--actuators`` choice (:mod:`modelkit.convert.actuator_choice`,
+        the MJCF writer's rule) on every hinge and slide written as a revolute or prismatic joint that is
+        not a mimic follower, locked, or a wheel the differential-drive system drives (MK858); a position
+        controller starts at the joint's home position (``initial_position``). Gazebo classic has no
+        such systems: nothing is written there."""
+        choice = self.ctx.options.actuators
+        if self.family == "classic" or choice == "none":
+            return 0
+        robot = self.robot
+        driven: set[str] = set()
+        if self.ctx.options.drive_plugin:
+            drive, _ = find_drive(robot, "sdf", self.family)
+            driven = set(drive.left + drive.right) if drive is not None else set()
+        skipped = constrained_joints(robot) | driven
+        legs = leg_joints(robot) if choice == "auto" else frozenset()
+        made_up: list[str] = []
+        lost: list[str] = []
+        written: dict[ActuatorKind, int] = {}
+        for joint in robot.joints:
+            target = self.joints.get(joint.name)
+            kind = chosen_kind(joint, robot, choice, legs)
+            if target is None or kind is None or joint.name in skipped:
+                continue
+            actuator = Actuator(joint=joint.name, kind=kind, source_kind=CHOSEN, source=joint.source)
+            plugin = self._one(model, actuator, joint, target, made_up, lost)
+            home = home_position(joint)
+            if kind is ActuatorKind.POSITION and home != 0.0:
+                num(plugin, "initial_position", home)
+            written[kind] = written.get(kind, 0) + 1
+        if not written:
+            return 0
+        what = " and ".join(f"{count} {SYSTEM_FOR[kind]}" for kind, count in
+                            sorted(written.items(), key=lambda item: _ORDER.index(item[0])))
+        why = ("; auto puts a position controller on each joint with a range, in a leg or on a welded base "
+               "(the home pose holds) and a force system on each other joint without a range (zero force "
+               "leaves it free)") if choice == "auto" else ""
+        wheels = f"; the wheels {', '.join(sorted(driven))} are the DiffDrive system's" if driven else ""
+        self.ctx.note("MK841", f"the source names no actuators: {what} system(s) written (--actuators "
+                      f"{choice}{why}{wheels}; --actuators none leaves them out)", robot.source,
+                      "model/plugin")
+        self._said(made_up, lost)
+        return sum(written.values())
 
     # -- one actuator -------------------------------------------------------------------------------
 
     def _one(self, model: Element, actuator: Actuator, joint: Joint, target: str, made_up: list[str],
-             lost: list[str]) -> None:
+             lost: list[str]) -> Element:
         source = self.sources.get(actuator.joint) if from_sdf_plugin(actuator) else None
         verbatim = parse_fragment(str(source.get("xml", ""))) if source is not None else None
         system = SYSTEM_FOR[actuator.kind]
@@ -157,6 +210,7 @@ class ActuatorWriter:
             if isinstance(extra.tag, str) and extra.tag not in written:
                 extra.tail = None
                 el.append(extra)
+        return el
 
     def _parameters(self, el: Element, actuator: Actuator, joint: Joint, target: str,
                     made_up: list[str]) -> set[str]:

@@ -1,0 +1,45 @@
+"""The ``--actuators`` choice: which actuator a joint gets when the source names none.
+
+One rule for every target that writes actuators (MJCF ``<actuator>``, SDF gz-sim joint controllers), so
+that a robot converted to either holds the same pose under the same kinds of actuators.
+
+``auto``: a position servo on a joint with a finite range, in a leg (:mod:`modelkit.convert.legs`: a
+URDF's ``continuous`` knee) or on a welded base (an arm's ``continuous`` joints: Menagerie's Kinova Gen3
+servos its four), so the written model holds its home pose as MuJoCo Menagerie's arms and legs do; on a
+free base, a motor on any other joint without one (wheels, casters, endless spindles), whose zero control
+leaves it free as the source has it. A mobile robot's joints without a range are its wheels and casters
+(the lecture's smartcar has its wheels' masses off their axes: still motors). Before, a welded arm's
+unranged joints that gravity does not turn (example-robot-data's Kinova: joint 1, vertical, and joint 6)
+were motors: free at zero control, joint 1 turned 0.0136 rad while joint 2 moved 0.5 rad.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Set
+
+from modelkit.model import ActuatorKind, Joint, JointType, Robot
+
+CHOICES = {"motor": ActuatorKind.EFFORT, "position": ActuatorKind.POSITION, "velocity": ActuatorKind.VELOCITY}
+CHOSEN = "--actuators"  # an Actuator's source_kind when the --actuators choice put it there
+
+
+def chosen_kind(joint: Joint, robot: Robot, choice: str, legs: Set[str]) -> ActuatorKind | None:
+    """The ``choice`` kind for a joint the source does not actuate (None: no actuator); ``legs`` are the
+    joints of the robot's legs (:func:`modelkit.convert.legs.leg_joints`)."""
+    if joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
+        return None
+    if choice == "auto":
+        lower, upper = joint.limits.lower, joint.limits.upper
+        ranged = math.isfinite(lower) and math.isfinite(upper) and lower < upper
+        welded = robot.root_joint is JointType.FIXED  # an arm; a mobile robot's are wheels, casters
+        held = ranged or joint.name in legs or welded
+        return ActuatorKind.POSITION if held else ActuatorKind.EFFORT
+    return CHOICES.get(choice)
+
+
+def constrained_joints(robot: Robot) -> set[str]:
+    """The joints that carry no actuator of their own: mimic followers (their leader's drives them) and
+    locked joints (a range of one value)."""
+    followers = {j.name for j in robot.joints if j.mimic is not None}
+    return followers | {j.name for j in robot.joints if j.limits.lower == j.limits.upper}
