@@ -504,7 +504,8 @@ def _tree(file: Path, xacro_words: tuple[str, ...], order: str, output_format: s
                    "reflected inertia (MK840, MK841). A source's own actuators are written as "
                    "--source-actuators says.")
 @click.option("--source-actuators", type=click.Choice(SOURCE_ACTUATORS), default="auto", show_default=True,
-              help="MJCF: what becomes of the source's own actuators. auto: written as they are, except ROS "
+              help="MJCF and SDF: what becomes of the source's own actuators. auto: written as they are, "
+                   "except ROS "
                    "effort interfaces (URDF transmissions, ros2_control), which get the --actuators choice "
                    "(position servos on an arm's and a leg's joints, MK864), since a ROS controller closes "
                    "its own loop over them; keep: all written as they are (effort interfaces as <motor>s, "

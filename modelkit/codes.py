@@ -1538,7 +1538,7 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK864",
         "ros-effort-interfaces-servoed",
         "info",
-        "MJCF: the source names ROS effort interfaces (URDF `EffortJointInterface` transmissions, "
+        "MJCF and SDF: the source names ROS effort interfaces (URDF `EffortJointInterface` transmissions, "
         "ros2_control `effort` command interfaces) on joints that `--actuators` gives a servo (with `auto`: "
         "an arm's or a leg's joints, not wheels), and `--source-actuators auto` (the default) writes those "
         "servos instead of `<motor>`s: an effort interface says how a ROS controller commands the joint (its "

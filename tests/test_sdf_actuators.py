@@ -198,10 +198,11 @@ def test_a_plugin_for_several_joints_is_one_actuator_each(tmp_path: Path) -> Non
 def test_urdf_actuators_become_gz_sim_systems(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
     """URDF transmissions and ros2_control → SDF: effort → ApplyJointForce, velocity → JointController
     in force mode, position → JointPositionController; gains made up by the MJCF writer's rule (MK840),
-    clamps = the effort limits; read back as the same kinds; libsdformat and Drake load it."""
+    clamps = the effort limits; read back as the same kinds; libsdformat and Drake load it. With
+    ``--source-actuators keep``: the default makes the ROS effort interface a servo (the next test)."""
     source = load(_write_text(tmp_path, "two.urdf", URDF))
     out = tmp_path / "out" / "two.sdf"
-    notes = write(source, out)
+    notes = write(source, out, options=WriteOptions(source_actuators="keep"))
     assert not oracle_has_errors(sdf_oracle, out)
     plugins = _by_joint(out)
     assert {j: p.get("name") for j, p in plugins.items()} == {
@@ -222,6 +223,42 @@ def test_urdf_actuators_become_gz_sim_systems(tmp_path: Path, sdf_oracle: Path) 
     assert _drake_loads(out) == 4  # --base auto welds the arm: the world joint and three
     transmissions = [m for m in _codes(notes, "MK808") if "<transmission>" in m]
     assert transmissions and all("written as gz-sim joint controllers" in m for m in transmissions)
+
+
+def test_ros_effort_interfaces_become_position_controllers(tmp_path: Path) -> None:
+    """``--source-actuators auto`` (the default), as in MJCF (MK864): a URDF's ROS effort interface on a
+    joint the ``--actuators`` choice servos is written as a JointPositionController, keeping the effort
+    limit as its clamp. example-robot-data's Kinova (6 EffortJointInterface transmissions) held by
+    nothing in gz-sim before (ApplyJointForce at zero force); a servo each now."""
+    source = load(_write_text(tmp_path, "two.urdf", URDF))
+    out = tmp_path / "out" / "two.sdf"
+    notes = write(source, out)
+    plugins = _by_joint(out)
+    assert plugins["j1"].get("name") == "gz::sim::systems::JointPositionController"
+    (said,) = _codes(notes, "MK864")
+    assert "1 joint(s) (j1)" in said and "1 JointPositionController" in said
+    kinova = load(example_robot("kinova_description/robots/kinova.urdf"))
+    out = tmp_path / "kinova" / "kinova.sdf"
+    write(kinova, out)
+    assert {p.get("name") for p in _by_joint(out).values()} == {"gz::sim::systems::JointPositionController"}
+    assert len(_by_joint(out)) == 6
+    kept = tmp_path / "kept" / "kinova.sdf"
+    write(kinova, kept, options=WriteOptions(source_actuators="keep"))
+    assert {p.get("name") for p in _by_joint(kept).values()} == {"gz::sim::systems::ApplyJointForce"}
+
+
+def test_replace_sets_the_sources_controllers_aside(tmp_path: Path) -> None:
+    """``--source-actuators replace``: the SDF arm's five controllers are set aside (MK855) and every
+    joint gets the ``--actuators`` choice: on the welded arm, position controllers with the rule's
+    gains, none of the source's topics or gains kept."""
+    source = load(_write_text(tmp_path, "arm.sdf", ARM))
+    out = tmp_path / "out" / "arm.sdf"
+    notes = write(source, out, options=WriteOptions(source_actuators="replace"))
+    plugins = _by_joint(out)
+    assert {p.get("name") for p in plugins.values()} == {"gz::sim::systems::JointPositionController"}
+    assert sorted(plugins) == ["elbow", "push", "shoulder", "slide", "spin"]
+    assert plugins["shoulder"].findtext("topic") is None and plugins["shoulder"].findtext("p_gain") != "300"
+    assert len(_codes(notes, "MK855")) == 1 and "actuators set aside" in _codes(notes, "MK841")[0]
 
 
 def test_body_actuation_mode_reaches_sdf(tmp_path: Path) -> None:

@@ -18,10 +18,11 @@ from __future__ import annotations
 import math
 from collections.abc import Set
 
-from modelkit.model import ActuatorKind, Joint, JointType, Robot
+from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Robot
 
 CHOICES = {"motor": ActuatorKind.EFFORT, "position": ActuatorKind.POSITION, "velocity": ActuatorKind.VELOCITY}
 CHOSEN = "--actuators"  # an Actuator's source_kind when the --actuators choice put it there
+SERVOED = "ROS effort interface, servoed"  # source_kind of a servo --source-actuators auto put there
 
 
 def chosen_kind(joint: Joint, robot: Robot, choice: str, legs: Set[str]) -> ActuatorKind | None:
@@ -43,3 +44,38 @@ def constrained_joints(robot: Robot) -> set[str]:
     locked joints (a range of one value)."""
     followers = {j.name for j in robot.joints if j.mimic is not None}
     return followers | {j.name for j in robot.joints if j.limits.lower == j.limits.upper}
+
+
+def servoed_interfaces(robot: Robot, choice: str, source_actuators: str,
+                       legs: Set[str]) -> dict[int, Actuator]:
+    """``--source-actuators auto``: the source's ROS effort interfaces (URDF ``EffortJointInterface``
+    transmissions, ros2_control ``effort`` command interfaces) on joints to which the ``--actuators``
+    choice gives a servo, keyed by the id of the source's actuator they replace.
+
+    A ROS effort interface says how a controller commands the joint (ros2_control's trajectory and
+    position controllers close a PID over it), not that the joint is free at zero control; as motors
+    the arm sags and the legs are limp until the user writes that controller. The servo keeps what the
+    source says of the joint: the effort limit, or the interface's own ``min``/``max``, as its force
+    range."""
+    if source_actuators != "auto":
+        return {}
+    by_name: dict[str, Joint] = {}
+    for each in robot.joints:
+        by_name.setdefault(each.name, each)
+    out: dict[int, Actuator] = {}
+    constrained = constrained_joints(robot)  # a mimic follower or a locked joint carries no actuator
+    for actuator in robot.actuators:
+        joint = by_name.get(actuator.joint)
+        if not actuator.ros_interface or actuator.kind is not ActuatorKind.EFFORT or joint is None \
+                or joint.name in constrained:
+            continue
+        kind = chosen_kind(joint, robot, choice, legs)
+        if kind is None or kind is ActuatorKind.EFFORT:
+            continue  # --actuators motor or none, a wheel, or not a hinge or slide: the source's motor
+        force = actuator.force_range
+        if force is None and actuator.ctrl_range is not None:
+            low, high = actuator.ctrl_range
+            force = (low * abs(actuator.gear), high * abs(actuator.gear))
+        out[id(actuator)] = Actuator(joint=joint.name, kind=kind, force_range=force,
+                                     source_kind=SERVOED, source=actuator.source)
+    return out

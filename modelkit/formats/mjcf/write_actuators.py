@@ -28,7 +28,13 @@ from __future__ import annotations
 
 import math
 
-from modelkit.convert.actuator_choice import CHOSEN, chosen_kind, constrained_joints
+from modelkit.convert.actuator_choice import (
+    CHOSEN,
+    SERVOED,
+    chosen_kind,
+    constrained_joints,
+    servoed_interfaces,
+)
 from modelkit.convert.context import WriteContext
 from modelkit.convert.legs import is_wheel, leg_joints, off_ground_joints, resting_on
 from modelkit.convert.numbers import fmt, fmt_vec
@@ -52,7 +58,6 @@ from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
 ELEMENTS = {ActuatorKind.EFFORT: "motor", ActuatorKind.POSITION: "position",
             ActuatorKind.VELOCITY: "velocity"}
 ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # MK841 lists kinds in this order
-SERVOED = "ROS effort interface, servoed"  # source_kind of a servo --source-actuators auto put there
 FILLED = "unactuated, load-bearing"  # source_kind of a servo on a joint the source left without (MK827)
 GRAVITY_FLOOR = 1e-9  # N·m or N: a gravity load at home below this is rounding (a vertical axis)
 
@@ -84,7 +89,7 @@ class ActuatorWriter:
         for each in self.robot.joints:
             by_name.setdefault(each.name, each)
         replaced = self.set_aside = self._replaced()
-        servoed = {} if replaced else self._servoed_interfaces(by_name)
+        servoed = {} if replaced else self._servoed_interfaces()
         # an MJCF source's actuator on a fixed tendon, also read as one on the joint the tendon's joints
         # follow, is written back as it was (write_transmissions), not on the joint
         planned: list[tuple[Actuator, Joint | None]] = [
@@ -183,35 +188,12 @@ class ActuatorWriter:
         return self.ctx.options.source_actuators == "replace" and (
             own or bool(self.robot.extras.get("mjcf_actuators")))
 
-    def _servoed_interfaces(self, by_name: dict[str, Joint]) -> dict[int, Actuator]:
-        """``--source-actuators auto``: the source's ROS effort interfaces (URDF ``EffortJointInterface``
-        transmissions, ros2_control ``effort`` command interfaces) on joints to which the ``--actuators``
-        choice gives a servo, keyed by the id of the source's actuator they replace.
-
-        A ROS effort interface says how a controller commands the joint (ros2_control's trajectory and
-        position controllers close a PID over it), not that the joint is free at zero control; as
-        ``<motor>``s the arm sags and the legs are limp until the user writes that controller. The servo
-        keeps what the source says of the joint: the effort limit, or the interface's own ``min``/``max``,
-        as its force range."""
-        if self.ctx.options.source_actuators != "auto":
-            return {}
-        out: dict[int, Actuator] = {}
-        constrained = self._constrained()  # a mimic follower or a locked joint carries no actuator (MK842)
-        for actuator in self.robot.actuators:
-            joint = by_name.get(actuator.joint)
-            if not actuator.ros_interface or actuator.kind is not ActuatorKind.EFFORT or joint is None \
-                    or joint.name in constrained:
-                continue
-            kind = self._chosen_kind(joint)
-            if kind is None or kind is ActuatorKind.EFFORT:
-                continue  # --actuators motor or none, a wheel, or not a hinge or slide: the source's motor
-            force = actuator.force_range
-            if force is None and actuator.ctrl_range is not None:
-                low, high = actuator.ctrl_range
-                force = (low * abs(actuator.gear), high * abs(actuator.gear))
-            out[id(actuator)] = Actuator(joint=joint.name, kind=kind, force_range=force,
-                                         source_kind=SERVOED, source=actuator.source)
-        return out
+    def _servoed_interfaces(self) -> dict[int, Actuator]:
+        """:func:`modelkit.convert.actuator_choice.servoed_interfaces` (MK864)."""
+        if self._legs is None:
+            self._legs = leg_joints(self.robot)
+        return servoed_interfaces(self.robot, self.ctx.options.actuators, self.ctx.options.source_actuators,
+                                  self._legs)
 
     def _said_servoed(self, servoed: list[Actuator]) -> None:
         """MK864: the source's ROS effort interfaces written as the ``--actuators`` choice."""

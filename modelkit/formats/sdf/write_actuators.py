@@ -27,7 +27,7 @@ from typing import Any
 
 from lxml.etree import _Element as Element
 
-from modelkit.convert.actuator_choice import CHOSEN, chosen_kind, constrained_joints
+from modelkit.convert.actuator_choice import CHOSEN, chosen_kind, constrained_joints, servoed_interfaces
 from modelkit.convert.context import WriteContext
 from modelkit.convert.drive_plugin import find_drive
 from modelkit.convert.legs import leg_joints
@@ -105,13 +105,20 @@ class ActuatorWriter:
                 "model",
             )
             return 0
+        if self.ctx.options.source_actuators == "replace":
+            self.ctx.note("MK855", f"the source's {len(robot.actuators)} actuator(s) set aside "
+                          "(--source-actuators replace); the --actuators choice is written instead",
+                          robot.source, "model/plugin")
+            return self._chosen(model)
         by_name: dict[str, Joint] = {}
         for each in robot.joints:
             by_name.setdefault(each.name, each)
         written = 0
         made_up: list[str] = []
         lost: list[str] = []
-        for actuator in robot.actuators:
+        servoed = self._servoed()
+        for source_actuator in robot.actuators:
+            actuator = servoed.get(id(source_actuator), source_actuator)
             target = self.joints.get(actuator.joint)
             joint = by_name.get(actuator.joint)
             if target is None or joint is None:
@@ -120,8 +127,35 @@ class ActuatorWriter:
                 continue
             self._one(model, actuator, joint, target, made_up, lost)
             written += 1
+        self._said_servoed(list(servoed.values()))
         self._said(made_up, lost)
         return written
+
+    def _servoed(self) -> dict[int, Actuator]:
+        """``--source-actuators auto``: the source's ROS effort interfaces that the ``--actuators`` choice
+        makes servos, as in MJCF (:func:`modelkit.convert.actuator_choice.servoed_interfaces`)."""
+        robot, options = self.robot, self.ctx.options
+        if not any(a.ros_interface and a.kind is ActuatorKind.EFFORT for a in robot.actuators):
+            return {}
+        legs = leg_joints(robot) if options.actuators == "auto" else frozenset()
+        return servoed_interfaces(robot, options.actuators, options.source_actuators, legs)
+
+    def _said_servoed(self, servoed: list[Actuator]) -> None:
+        """MK864: the source's ROS effort interfaces written as position or velocity controllers."""
+        if not servoed:
+            return
+        kinds: dict[ActuatorKind, int] = {}
+        for actuator in servoed:
+            kinds[actuator.kind] = kinds.get(actuator.kind, 0) + 1
+        what = " and ".join(f"{count} {SYSTEM_FOR[kind]}" for kind, count in
+                            sorted(kinds.items(), key=lambda item: _ORDER.index(item[0])))
+        names = [a.joint for a in servoed]
+        shown = ", ".join(names[:4]) + (" ..." if len(names) > 4 else "")
+        self.ctx.note("MK864", f"{len(servoed)} joint(s) ({shown}) whose source names ROS effort interfaces "
+                      f"(URDF transmissions, ros2_control) written as {what} (--actuators "
+                      f"{self.ctx.options.actuators}), not ApplyJointForce: a ROS controller closes its own "
+                      "loop over an effort interface, and at zero force the robot sags until one drives it "
+                      "(--source-actuators keep writes ApplyJointForce)", self.robot.source, "model/plugin")
 
     def _said(self, made_up: list[str], lost: list[str]) -> None:
         """MK840: the gains the rule gave; MK844: what the systems cannot hold."""
@@ -145,11 +179,12 @@ class ActuatorWriter:
             )
 
     def _chosen(self, model: Element) -> int:
-        """The source names no actuators: the ``--actuators`` choice (:mod:`modelkit.convert.actuator_choice`,
-        the MJCF writer's rule) on every hinge and slide written as a revolute or prismatic joint that is
-        not a mimic follower, locked, or a wheel the differential-drive system drives (MK858); a position
-        controller starts at the joint's home position (``initial_position``). Gazebo classic has no
-        such systems: nothing is written there."""
+        """The source names no actuators, or ``--source-actuators replace`` set them aside: the
+        ``--actuators`` choice (:mod:`modelkit.convert.actuator_choice`, the MJCF writer's rule) on every
+        hinge and slide written as a revolute or prismatic joint that is not a mimic follower, locked, or a
+        wheel the differential-drive system drives (MK858); a position controller starts at the joint's
+        home position (``initial_position``). Gazebo classic has no such systems: nothing is written
+        there."""
         choice = self.ctx.options.actuators
         if self.family == "classic" or choice == "none":
             return 0
@@ -182,7 +217,8 @@ class ActuatorWriter:
                "(the home pose holds) and a force system on each other joint without a range (zero force "
                "leaves it free)") if choice == "auto" else ""
         wheels = f"; the wheels {', '.join(sorted(driven))} are the DiffDrive system's" if driven else ""
-        self.ctx.note("MK841", f"the source names no actuators: {what} system(s) written (--actuators "
+        whose = "the source's actuators set aside" if robot.actuators else "the source names no actuators"
+        self.ctx.note("MK841", f"{whose}: {what} system(s) written (--actuators "
                       f"{choice}{why}{wheels}; --actuators none leaves them out)", robot.source,
                       "model/plugin")
         self._said(made_up, lost)
