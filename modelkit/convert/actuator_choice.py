@@ -16,13 +16,14 @@ were motors: free at zero control, joint 1 turned 0.0136 rad while joint 2 moved
 from __future__ import annotations
 
 import math
-from collections.abc import Set
+from collections.abc import Callable, Iterable, Set
 
 from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Robot
 
 CHOICES = {"motor": ActuatorKind.EFFORT, "position": ActuatorKind.POSITION, "velocity": ActuatorKind.VELOCITY}
 CHOSEN = "--actuators"  # an Actuator's source_kind when the --actuators choice put it there
 SERVOED = "ROS effort interface, servoed"  # source_kind of a servo --source-actuators auto put there
+ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # notes list kinds in this order
 
 
 def chosen_kind(joint: Joint, robot: Robot, choice: str, legs: Set[str]) -> ActuatorKind | None:
@@ -79,3 +80,12 @@ def servoed_interfaces(robot: Robot, choice: str, source_actuators: str,
         out[id(actuator)] = Actuator(joint=joint.name, kind=kind, force_range=force,
                                      source_kind=SERVOED, source=actuator.source)
     return out
+
+
+def counted(kinds: Iterable[ActuatorKind], label: Callable[[ActuatorKind], str]) -> str:
+    """The kinds counted for a note, in :data:`ORDER`: ``"3 <position> and 1 <motor>"`` (``label`` names
+    a kind as the target writes it)."""
+    counts: dict[ActuatorKind, int] = {}
+    for kind in kinds:
+        counts[kind] = counts.get(kind, 0) + 1
+    return " and ".join(f"{counts[kind]} {label(kind)}" for kind in ORDER if kind in counts)

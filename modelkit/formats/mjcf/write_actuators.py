@@ -33,6 +33,7 @@ from modelkit.convert.actuator_choice import (
     SERVOED,
     chosen_kind,
     constrained_joints,
+    counted,
     servoed_interfaces,
 )
 from modelkit.convert.context import WriteContext
@@ -57,7 +58,6 @@ from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
 
 ELEMENTS = {ActuatorKind.EFFORT: "motor", ActuatorKind.POSITION: "position",
             ActuatorKind.VELOCITY: "velocity"}
-ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # MK841 lists kinds in this order
 FILLED = "unactuated, load-bearing"  # source_kind of a servo on a joint the source left without (MK827)
 GRAVITY_FLOOR = 1e-9  # N·m or N: a gravity load at home below this is rounding (a vertical axis)
 
@@ -197,11 +197,7 @@ class ActuatorWriter:
 
     def _said_servoed(self, servoed: list[Actuator]) -> None:
         """MK864: the source's ROS effort interfaces written as the ``--actuators`` choice."""
-        kinds: dict[ActuatorKind, int] = {}
-        for actuator in servoed:
-            kinds[actuator.kind] = kinds.get(actuator.kind, 0) + 1
-        what = " and ".join(f"{count} <{ELEMENTS[kind]}>" for kind, count in
-                            sorted(kinds.items(), key=lambda item: ORDER.index(item[0])))
+        what = counted((a.kind for a in servoed), lambda kind: f"<{ELEMENTS[kind]}>")
         names = [a.joint for a in servoed]
         shown = ", ".join(names[:4]) + (" ..." if len(names) > 4 else "")
         self.ctx.note("MK864", f"{len(servoed)} joint(s) ({shown}) whose source names ROS effort "
@@ -221,8 +217,7 @@ class ActuatorWriter:
         parts = [f"{count} {kind}" for kind, count in sorted(kinds.items())]
         if unheld > 0:
             parts.append(f"{unheld} other MJCF")
-        what = " and ".join(f"{count} <{ELEMENTS[kind]}>" for kind, count in
-                            sorted(written.items(), key=lambda item: ORDER.index(item[0]))) or "none"
+        what = counted(_each(written), lambda kind: f"<{ELEMENTS[kind]}>") or "none"
         self.ctx.note("MK855", f"the source's {len(own) + max(unheld, 0)} actuator(s) ({', '.join(parts)}) "
                       f"set aside (--source-actuators replace); written instead: {what} "
                       f"(--actuators {self.ctx.options.actuators})", self.robot.source, "actuator")
@@ -334,8 +329,7 @@ class ActuatorWriter:
         elif not written:
             what = "no actuators (no hinge or slide that is free to drive)"
         else:
-            what = " and ".join(f"{count} <{ELEMENTS[kind]}> actuator(s)" for kind, count in
-                                sorted(written.items(), key=lambda item: ORDER.index(item[0])))
+            what = counted(_each(written), lambda kind: f"<{ELEMENTS[kind]}> actuator(s)")
         why = ""
         if choice == "auto":
             why = ("; auto puts a position servo on each joint with a range, in a leg or on a welded base "
@@ -492,3 +486,8 @@ class ActuatorWriter:
             actuator.source or joint.source,
             f"actuator[{target}]",
         )
+
+
+def _each(counts: dict[ActuatorKind, int]) -> list[ActuatorKind]:
+    """A count of kinds as the kinds, one per actuator (for :func:`counted`)."""
+    return [kind for kind, count in counts.items() for _ in range(count)]

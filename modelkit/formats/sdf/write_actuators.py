@@ -27,7 +27,13 @@ from typing import Any
 
 from lxml.etree import _Element as Element
 
-from modelkit.convert.actuator_choice import CHOSEN, chosen_kind, constrained_joints, servoed_interfaces
+from modelkit.convert.actuator_choice import (
+    CHOSEN,
+    chosen_kind,
+    constrained_joints,
+    counted,
+    servoed_interfaces,
+)
 from modelkit.convert.context import WriteContext
 from modelkit.convert.drive_plugin import find_drive
 from modelkit.convert.legs import leg_joints
@@ -54,7 +60,6 @@ SYSTEM_FOR = {
     ActuatorKind.VELOCITY: "JointController",
     ActuatorKind.EFFORT: "ApplyJointForce",
 }
-_ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # MK841 lists kinds so
 NOT_COPIED = frozenset({"joint_name"})  # the source plugin's children the writer always writes itself
 
 
@@ -144,11 +149,7 @@ class ActuatorWriter:
         """MK864: the source's ROS effort interfaces written as position or velocity controllers."""
         if not servoed:
             return
-        kinds: dict[ActuatorKind, int] = {}
-        for actuator in servoed:
-            kinds[actuator.kind] = kinds.get(actuator.kind, 0) + 1
-        what = " and ".join(f"{count} {SYSTEM_FOR[kind]}" for kind, count in
-                            sorted(kinds.items(), key=lambda item: _ORDER.index(item[0])))
+        what = counted((a.kind for a in servoed), SYSTEM_FOR.__getitem__)
         names = [a.joint for a in servoed]
         shown = ", ".join(names[:4]) + (" ..." if len(names) > 4 else "")
         self.ctx.note("MK864", f"{len(servoed)} joint(s) ({shown}) whose source names ROS effort interfaces "
@@ -197,7 +198,7 @@ class ActuatorWriter:
         legs = leg_joints(robot) if choice == "auto" else frozenset()
         made_up: list[str] = []
         lost: list[str] = []
-        written: dict[ActuatorKind, int] = {}
+        written: list[ActuatorKind] = []
         for joint in robot.joints:
             target = self.joints.get(joint.name)
             kind = chosen_kind(joint, robot, choice, legs)
@@ -208,11 +209,10 @@ class ActuatorWriter:
             home = home_position(joint)
             if kind is ActuatorKind.POSITION and home != 0.0:
                 num(plugin, "initial_position", home)
-            written[kind] = written.get(kind, 0) + 1
+            written.append(kind)
         if not written:
             return 0
-        what = " and ".join(f"{count} {SYSTEM_FOR[kind]}" for kind, count in
-                            sorted(written.items(), key=lambda item: _ORDER.index(item[0])))
+        what = counted(written, SYSTEM_FOR.__getitem__)
         why = ("; auto puts a position controller on each joint with a range, in a leg or on a welded base "
                "(the home pose holds) and a force system on each other joint without a range (zero force "
                "leaves it free)") if choice == "auto" else ""
@@ -222,7 +222,7 @@ class ActuatorWriter:
                       f"{choice}{why}{wheels}; --actuators none leaves them out)", robot.source,
                       "model/plugin")
         self._said(made_up, lost)
-        return sum(written.values())
+        return len(written)
 
     # -- one actuator -------------------------------------------------------------------------------
 
