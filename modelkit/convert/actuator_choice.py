@@ -89,3 +89,17 @@ def counted(kinds: Iterable[ActuatorKind], label: Callable[[ActuatorKind], str])
     for kind in kinds:
         counts[kind] = counts.get(kind, 0) + 1
     return " and ".join(f"{counts[kind]} {label(kind)}" for kind in ORDER if kind in counts)
+
+
+def servoed_message(servoed: list[Actuator], choice: str, label: Callable[[ActuatorKind], str], motors: str,
+                    at_zero: str, kept: str) -> str:
+    """MK864's text: the source's ROS effort interfaces written as servos, in a target's words (``motors``
+    what they are not written as, ``at_zero`` what such a motor does at zero command, ``kept`` what
+    ``--source-actuators keep`` writes)."""
+    names = [a.joint for a in servoed]
+    shown = ", ".join(names[:4]) + (" ..." if len(names) > 4 else "")
+    what = counted((a.kind for a in servoed), label)
+    return (f"{len(servoed)} joint(s) ({shown}) whose source names ROS effort interfaces (URDF "
+            f"transmissions, ros2_control) written as {what} (--actuators {choice}), not {motors}: a ROS "
+            f"controller closes its own loop over an effort interface, and {at_zero} (--source-actuators "
+            f"keep writes {kept})")

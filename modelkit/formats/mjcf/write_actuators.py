@@ -35,6 +35,7 @@ from modelkit.convert.actuator_choice import (
     constrained_joints,
     counted,
     servoed_interfaces,
+    servoed_message,
 )
 from modelkit.convert.context import WriteContext
 from modelkit.convert.legs import is_wheel, leg_joints, off_ground_joints, resting_on
@@ -197,15 +198,10 @@ class ActuatorWriter:
 
     def _said_servoed(self, servoed: list[Actuator]) -> None:
         """MK864: the source's ROS effort interfaces written as the ``--actuators`` choice."""
-        what = counted((a.kind for a in servoed), lambda kind: f"<{ELEMENTS[kind]}>")
-        names = [a.joint for a in servoed]
-        shown = ", ".join(names[:4]) + (" ..." if len(names) > 4 else "")
-        self.ctx.note("MK864", f"{len(servoed)} joint(s) ({shown}) whose source names ROS effort "
-                      f"interfaces (URDF transmissions, ros2_control) written as {what} (--actuators "
-                      f"{self.ctx.options.actuators}), not <motor>s: a ROS controller closes its own loop "
-                      "over an effort interface, and at zero control a <motor> leaves the robot sagging "
-                      "until one drives it (--source-actuators keep writes the <motor>s)", self.robot.source,
-                      "actuator")
+        message = servoed_message(servoed, self.ctx.options.actuators, lambda kind: f"<{ELEMENTS[kind]}>",
+                                  "<motor>s", "at zero control a <motor> leaves the robot sagging until one "
+                                  "drives it", "the <motor>s")
+        self.ctx.note("MK864", message, self.robot.source, "actuator")
 
     def _said_replaced(self, written: dict[ActuatorKind, int]) -> None:
         """MK855: the source's actuators set aside by ``--source-actuators replace``, and what was written."""

@@ -33,6 +33,7 @@ from modelkit.convert.actuator_choice import (
     constrained_joints,
     counted,
     servoed_interfaces,
+    servoed_message,
 )
 from modelkit.convert.context import WriteContext
 from modelkit.convert.drive_plugin import find_drive
@@ -149,14 +150,10 @@ class ActuatorWriter:
         """MK864: the source's ROS effort interfaces written as position or velocity controllers."""
         if not servoed:
             return
-        what = counted((a.kind for a in servoed), SYSTEM_FOR.__getitem__)
-        names = [a.joint for a in servoed]
-        shown = ", ".join(names[:4]) + (" ..." if len(names) > 4 else "")
-        self.ctx.note("MK864", f"{len(servoed)} joint(s) ({shown}) whose source names ROS effort interfaces "
-                      f"(URDF transmissions, ros2_control) written as {what} (--actuators "
-                      f"{self.ctx.options.actuators}), not ApplyJointForce: a ROS controller closes its own "
-                      "loop over an effort interface, and at zero force the robot sags until one drives it "
-                      "(--source-actuators keep writes ApplyJointForce)", self.robot.source, "model/plugin")
+        message = servoed_message(servoed, self.ctx.options.actuators, SYSTEM_FOR.__getitem__,
+                                  "ApplyJointForce", "at zero force the robot sags until one drives it",
+                                  "ApplyJointForce")
+        self.ctx.note("MK864", message, self.robot.source, "model/plugin")
 
     def _said(self, made_up: list[str], lost: list[str]) -> None:
         """MK840: the gains the rule gave; MK844: what the systems cannot hold."""
