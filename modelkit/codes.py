@@ -1350,9 +1350,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK827",
         "unactuated-load-bearing-servoed",
         "info",
-        "MJCF: the source names actuators for some joints but leaves load-bearing ones without (a leg's "
-        "joints; joints gravity turns at home, on a welded base or, on a free base, with nothing on the "
-        "ground below them): with `--source-actuators auto` (the "
+        "MJCF and SDF: the source names actuators for some joints but leaves load-bearing ones without "
+        "(a leg's joints; joints gravity turns at home, on a welded base or, on a free base, with nothing "
+        "on the ground below them): with `--source-actuators auto` (the "
         "default) those get the `--actuators` choice where it is a servo, so the robot holds its home "
         "keyframe (example-robot-data's ANYmal-Kinova names the arm's transmissions only; its unactuated "
         "legs folded it onto the floor, 451 mm in 2 s). Other unactuated joints stay passive; "

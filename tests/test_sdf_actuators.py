@@ -247,6 +247,24 @@ def test_ros_effort_interfaces_become_position_controllers(tmp_path: Path) -> No
     assert {p.get("name") for p in _by_joint(kept).values()} == {"gz::sim::systems::ApplyJointForce"}
 
 
+def test_load_bearing_joints_the_source_leaves_unactuated_get_controllers(tmp_path: Path) -> None:
+    """example-robot-data's ANYmal-Kinova names the arm's 6 transmissions only: as in MJCF (MK827), its
+    12 leg joints get JointPositionControllers in SDF (they had none: the robot folded onto the floor),
+    and the arm's effort interfaces are servos too (MK864)."""
+    source = load(example_robot("anymal_b_simple_description/robots/anymal-kinova.urdf"))
+    out = tmp_path / "out" / "anymal-kinova.sdf"
+    notes = write(source, out)
+    plugins = _by_joint(out)
+    assert {p.get("name") for p in plugins.values()} == {"gz::sim::systems::JointPositionController"}
+    legs = {f"{leg}_{joint}" for leg in ("LF", "RF", "LH", "RH") for joint in ("HAA", "HFE", "KFE")}
+    assert legs < set(plugins) and len(plugins) == 18
+    (filled,) = _codes(notes, "MK827")
+    assert "12 joint(s)" in filled and "12 in legs" in filled and "JointPositionController" in filled
+    kept = tmp_path / "kept" / "anymal-kinova.sdf"
+    write(source, kept, options=WriteOptions(source_actuators="keep"))
+    assert not legs & set(_by_joint(kept))
+
+
 def test_replace_sets_the_sources_controllers_aside(tmp_path: Path) -> None:
     """``--source-actuators replace``: the SDF arm's five controllers are set aside (MK855) and every
     joint gets the ``--actuators`` choice: on the welded arm, position controllers with the rule's

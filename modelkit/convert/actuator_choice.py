@@ -18,11 +18,15 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Set
 
-from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Robot
+from modelkit.convert.legs import is_wheel, off_ground_joints
+from modelkit.convert.servo_gains import JointLoad
+from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
 
 CHOICES = {"motor": ActuatorKind.EFFORT, "position": ActuatorKind.POSITION, "velocity": ActuatorKind.VELOCITY}
 CHOSEN = "--actuators"  # an Actuator's source_kind when the --actuators choice put it there
 SERVOED = "ROS effort interface, servoed"  # source_kind of a servo --source-actuators auto put there
+FILLED = "unactuated, load-bearing"  # source_kind of a servo on a joint the source left without (MK827)
+GRAVITY_FLOOR = 1e-9  # N·m or N: a gravity load at home below this is rounding (a vertical axis)
 ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # notes list kinds in this order
 
 
@@ -103,3 +107,53 @@ def servoed_message(servoed: list[Actuator], choice: str, label: Callable[[Actua
             f"transmissions, ros2_control) written as {what} (--actuators {choice}), not {motors}: a ROS "
             f"controller closes its own loop over an effort interface, and {at_zero} (--source-actuators "
             f"keep writes {kept})")
+
+
+def load_bearing_unactuated(robot: Robot, taken: Set[str], choice: str, legs: Set[str],
+                            sags: Callable[[Joint], bool]) -> list[Actuator]:
+    """``--source-actuators auto``: the ``--actuators`` choice, where it gives a servo, on the joints
+    that a source naming actuators for others leaves without one (not in ``taken``) and that carry the
+    robot: a leg's joints, and the joints gravity turns at home (``sags``) on a welded base or, on a free
+    base, off the ground (MK827). example-robot-data's ANYmal-Kinova names the arm's transmissions only:
+    its twelve leg joints had no actuator and the robot folded onto the floor (451 mm in 2 s); its TIAGo
+    names none for the 27 joints of its hand's coupled fingers, which drooped 0.1 rad in 2 s. Other
+    unactuated joints (a free wheel, a passive suspension or linkage with the ground below it, a vertical
+    axis) stay passive, as the source has them."""
+    welded = robot.root_joint is JointType.FIXED
+    off_ground = off_ground_joints(robot)
+    constrained = constrained_joints(robot)
+    out: list[Actuator] = []
+    for joint in robot.joints:
+        if joint.name in taken or joint.name in constrained or \
+                joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
+            continue
+        held = welded or joint.name in off_ground
+        if joint.name not in legs and not (held and sags(joint)):
+            continue
+        kind = chosen_kind(joint, robot, choice, legs)
+        if kind is ActuatorKind.POSITION or kind is ActuatorKind.VELOCITY:
+            out.append(Actuator(joint=joint.name, kind=kind, source_kind=FILLED, source=joint.source))
+    return out
+
+
+def filled_message(filled: list[Actuator], legs: Set[str], choice: str, written_as: str, holds: str) -> str:
+    """MK827's text: the servos :func:`load_bearing_unactuated` adds, in a target's words (``written_as``
+    the element or system, ``holds`` what the robot then holds)."""
+    names = [a.joint for a in filled]
+    shown = ", ".join(names[:4]) + (" ..." if len(names) > 4 else "")
+    in_legs = sum(1 for name in names if name in legs)
+    what = f"{in_legs} in legs" if in_legs == len(names) else (
+        f"{in_legs} in legs, {len(names) - in_legs} that gravity turns at home" if in_legs else
+        "that gravity turns at home")
+    return (f"{len(filled)} joint(s) ({shown}; {what}) that the source leaves without an actuator while it "
+            f"names others get the --actuators choice ({choice}: {written_as}), so that the robot holds "
+            f"{holds} (unactuated, they fold at zero control); --source-actuators keep leaves them without")
+
+
+def sags_at_home(joint: Joint, load: JointLoad, links: dict[str, Link]) -> bool:
+    """Whether gravity turns the joint at home: its gravity load there (``load``) exceeds its Coulomb
+    friction (a wheel's, whose mass sits on its axis, and a vertical axis's are nil). A wheel never
+    sags: its load is the robot's, which the floor carries."""
+    if is_wheel(joint, links):
+        return False
+    return load.gravity > max(joint.friction, GRAVITY_FLOOR)

@@ -30,15 +30,20 @@ import math
 
 from modelkit.convert.actuator_choice import (
     CHOSEN,
+    FILLED,
+    GRAVITY_FLOOR,
     SERVOED,
     chosen_kind,
     constrained_joints,
     counted,
+    filled_message,
+    load_bearing_unactuated,
+    sags_at_home,
     servoed_interfaces,
     servoed_message,
 )
 from modelkit.convert.context import WriteContext
-from modelkit.convert.legs import is_wheel, leg_joints, off_ground_joints, resting_on
+from modelkit.convert.legs import is_wheel, leg_joints, resting_on
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.convert.servo_gains import (
     SERVO_BANDWIDTH_HZ,
@@ -59,8 +64,6 @@ from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
 
 ELEMENTS = {ActuatorKind.EFFORT: "motor", ActuatorKind.POSITION: "position",
             ActuatorKind.VELOCITY: "velocity"}
-FILLED = "unactuated, load-bearing"  # source_kind of a servo on a joint the source left without (MK827)
-GRAVITY_FLOOR = 1e-9  # N·m or N: a gravity load at home below this is rounding (a vertical axis)
 
 
 class ActuatorWriter:
@@ -143,44 +146,18 @@ class ActuatorWriter:
         self._said_overloaded(by_name)
 
     def _load_bearing_unactuated(self, taken: set[str]) -> list[Actuator]:
-        """``--source-actuators auto``: the ``--actuators`` choice, where it gives a servo, on the joints
-        that a source naming actuators for others leaves without one and that carry the robot: a leg's
-        joints, and the joints gravity turns at home on a welded base or, on a free base, off the ground
-        (MK827). example-robot-data's ANYmal-Kinova names the arm's transmissions only: its twelve leg
-        joints had no actuator and the robot folded onto the floor (451 mm in 2 s); its TIAGo names none
-        for the 27 joints of its hand's coupled fingers, which drooped 0.1 rad in 2 s. Other unactuated
-        joints (a free wheel, a passive suspension or linkage with the ground below it, a vertical axis)
-        stay passive, as the source has them."""
+        """:func:`modelkit.convert.actuator_choice.load_bearing_unactuated` (MK827); not for an MJCF source,
+        whose actuators the model may not all hold."""
         if self.ctx.options.source_actuators != "auto" or self.robot.source_format == "mjcf":
             return []
         if self._legs is None:
             self._legs = leg_joints(self.robot)
-        welded = self.robot.root_joint is JointType.FIXED
-        off_ground = off_ground_joints(self.robot)
-        constrained = self._constrained()
-        out: list[Actuator] = []
-        for joint in self.robot.joints:
-            if joint.name in taken or joint.name in constrained or \
-                    joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
-                continue
-            held = welded or joint.name in off_ground
-            if joint.name not in self._legs and not (held and self.sags(joint)):
-                continue
-            kind = self._chosen_kind(joint)
-            if kind is ActuatorKind.POSITION or kind is ActuatorKind.VELOCITY:
-                out.append(Actuator(joint=joint.name, kind=kind, source_kind=FILLED, source=joint.source))
+        choice = self.ctx.options.actuators
+        out = load_bearing_unactuated(self.robot, taken, choice, self._legs, self.sags)
         if out:
-            names = [a.joint for a in out]
-            shown = ", ".join(names[:4]) + (" ..." if len(names) > 4 else "")
-            legs = sum(1 for name in names if name in self._legs)
-            what = f"{legs} in legs" if legs == len(names) else (
-                f"{legs} in legs, {len(names) - legs} that gravity turns at home" if legs else
-                "that gravity turns at home")
-            self.ctx.note("MK827", f"{len(out)} joint(s) ({shown}; {what}) that the source leaves without "
-                          "an actuator while it names others get the --actuators choice "
-                          f"({self.ctx.options.actuators}: <{ELEMENTS[out[0].kind]}>), so that the robot "
-                          "holds its home keyframe (unactuated, they fold at zero control); "
-                          "--source-actuators keep leaves them without", self.robot.source, "actuator")
+            message = filled_message(out, self._legs, choice, f"<{ELEMENTS[out[0].kind]}>",
+                                     "its home keyframe")
+            self.ctx.note("MK827", message, self.robot.source, "actuator")
         return out
 
     def _replaced(self) -> bool:
@@ -313,9 +290,7 @@ class ActuatorWriter:
         its load is the robot's, which the floor carries."""
         if self._links is None:
             self._links = {link.name: link for link in self.robot.links}
-        if is_wheel(joint, self._links):
-            return False
-        return self.load(joint).gravity > max(joint.friction, GRAVITY_FLOOR)
+        return sags_at_home(joint, self.load(joint), self._links)
 
     def _said_choice(self, written: dict[ActuatorKind, int]) -> None:
         """MK841: the source names no actuators, what ``--actuators`` wrote instead."""

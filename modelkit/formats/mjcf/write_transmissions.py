@@ -25,12 +25,12 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from modelkit.convert.actuator_choice import CHOSEN, SERVOED
+from modelkit.convert.actuator_choice import CHOSEN, FILLED, SERVOED
 from modelkit.convert.context import WriteContext
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.convert.tracks import TRACK_ROLLER
 from modelkit.diagnostics import SourceLocation
-from modelkit.formats.mjcf.write_actuators import FILLED, ActuatorWriter
+from modelkit.formats.mjcf.write_actuators import ActuatorWriter
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_refs import WrittenObjects
 from modelkit.formats.mjcf.write_xml import Element, sub

@@ -32,6 +32,9 @@ from modelkit.convert.actuator_choice import (
     chosen_kind,
     constrained_joints,
     counted,
+    filled_message,
+    load_bearing_unactuated,
+    sags_at_home,
     servoed_interfaces,
     servoed_message,
 )
@@ -133,9 +136,32 @@ class ActuatorWriter:
                 continue
             self._one(model, actuator, joint, target, made_up, lost)
             written += 1
+        for actuator in self._load_bearing_unactuated():
+            joint = by_name[actuator.joint]
+            target = self.joints.get(joint.name)
+            if target is not None:
+                self._one(model, actuator, joint, target, made_up, lost)
+                written += 1
         self._said_servoed(list(servoed.values()))
         self._said(made_up, lost)
         return written
+
+    def _load_bearing_unactuated(self) -> list[Actuator]:
+        """``--source-actuators auto``: servos on the load-bearing joints a source naming actuators for
+        others leaves without one, as in MJCF (MK827, :func:`modelkit.convert.actuator_choice.
+        load_bearing_unactuated`); not for an MJCF source, whose actuators the model may not all hold."""
+        robot, options = self.robot, self.ctx.options
+        if options.source_actuators != "auto" or robot.source_format == "mjcf":
+            return []
+        legs = leg_joints(robot)
+        links = {link.name: link for link in robot.links}
+        taken = {a.joint for a in robot.actuators}
+        out = load_bearing_unactuated(robot, taken, options.actuators, legs,
+                                      lambda joint: sags_at_home(joint, self._load(joint.name), links))
+        if out:
+            message = filled_message(out, legs, options.actuators, SYSTEM_FOR[out[0].kind], "its home pose")
+            self.ctx.note("MK827", message, robot.source, "model/plugin")
+        return out
 
     def _servoed(self) -> dict[int, Actuator]:
         """``--source-actuators auto``: the source's ROS effort interfaces that the ``--actuators`` choice
