@@ -16,7 +16,8 @@ were motors: free at zero control, joint 1 turned 0.0136 rad while joint 2 moved
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable, Set
+from collections import Counter
+from collections.abc import Callable, Mapping, Set
 
 from modelkit.convert.legs import is_wheel, off_ground_joints
 from modelkit.convert.servo_gains import JointLoad
@@ -42,6 +43,16 @@ def chosen_kind(joint: Joint, robot: Robot, choice: str, legs: Set[str]) -> Actu
         held = ranged or joint.name in legs or welded
         return ActuatorKind.POSITION if held else ActuatorKind.EFFORT
     return CHOICES.get(choice)
+
+
+def chosen_actuators(robot: Robot, choice: str, legs: Set[str], skip: Set[str]) -> list[Actuator]:
+    """The ``choice`` actuator (:func:`chosen_kind`) of every joint not in ``skip`` that gets one."""
+    out: list[Actuator] = []
+    for joint in robot.joints:
+        kind = None if joint.name in skip else chosen_kind(joint, robot, choice, legs)
+        if kind is not None:
+            out.append(Actuator(joint=joint.name, kind=kind, source_kind=CHOSEN, source=joint.source))
+    return out
 
 
 def constrained_joints(robot: Robot) -> set[str]:
@@ -86,13 +97,10 @@ def servoed_interfaces(robot: Robot, choice: str, source_actuators: str,
     return out
 
 
-def counted(kinds: Iterable[ActuatorKind], label: Callable[[ActuatorKind], str]) -> str:
-    """The kinds counted for a note, in :data:`ORDER`: ``"3 <position> and 1 <motor>"`` (``label`` names
-    a kind as the target writes it)."""
-    counts: dict[ActuatorKind, int] = {}
-    for kind in kinds:
-        counts[kind] = counts.get(kind, 0) + 1
-    return " and ".join(f"{counts[kind]} {label(kind)}" for kind in ORDER if kind in counts)
+def counted(counts: Mapping[ActuatorKind, int], label: Callable[[ActuatorKind], str]) -> str:
+    """Actuators counted by kind for a note, in :data:`ORDER`: ``"3 <position> and 1 <motor>"``
+    (``label`` names a kind as the target writes it)."""
+    return " and ".join(f"{counts[kind]} {label(kind)}" for kind in ORDER if counts.get(kind))
 
 
 def servoed_message(servoed: list[Actuator], choice: str, label: Callable[[ActuatorKind], str], motors: str,
@@ -102,7 +110,7 @@ def servoed_message(servoed: list[Actuator], choice: str, label: Callable[[Actua
     ``--source-actuators keep`` writes)."""
     names = [a.joint for a in servoed]
     shown = ", ".join(names[:4]) + (" ..." if len(names) > 4 else "")
-    what = counted((a.kind for a in servoed), label)
+    what = counted(Counter(a.kind for a in servoed), label)
     return (f"{len(servoed)} joint(s) ({shown}) whose source names ROS effort interfaces (URDF "
             f"transmissions, ros2_control) written as {what} (--actuators {choice}), not {motors}: a ROS "
             f"controller closes its own loop over an effort interface, and {at_zero} (--source-actuators "

@@ -162,7 +162,7 @@ def _accessors(header: dict[str, Any], binary: bytes,
         size = (count - 1) * step + row
         raw = np.frombuffer(binary, dtype=np.uint8, count=size, offset=view_start + offset)
         rows = np.lib.stride_tricks.as_strided(raw, (count, row), (step, 1))
-        out.append((component, kind, np.ascontiguousarray(rows).view(dtype).reshape(count, width)))
+        out.append((component, kind, rows.view(dtype)))  # a view of the bytes: (count, width), no copy
     return out
 
 

@@ -106,13 +106,13 @@ Corners = tuple[tuple[float, float, float], tuple[float, float, float]]
 def obj_problem(data: bytes, name: str) -> str | None:
     """None when ``load_mesh`` loads an OBJ file with these bytes (no fragment, no metadata), else
     ``"MK501\\t<message>"`` with the message of its :class:`MeshLoadError`, or :data:`UNDECIDED`."""
-    return obj_verdict(data, name)[0]
+    return obj_verdict(data, name, corners=False)[0]
 
 
-def obj_verdict(data: bytes, name: str) -> tuple[str | None, Corners | None]:
-    """:func:`obj_problem`, and for a file that loads the lowest and highest corner of the vertices
-    ``load_mesh`` keeps (None when they cannot be had cheaply: rows of different lengths, fewer than three
-    columns)."""
+def obj_verdict(data: bytes, name: str, corners: bool = True) -> tuple[str | None, Corners | None]:
+    """:func:`obj_problem`, and with ``corners``, for a file that loads, the lowest and highest corner of
+    the vertices ``load_mesh`` keeps (None when they cannot be had cheaply: rows of different lengths,
+    fewer than three columns)."""
     if not data.strip():
         return f"MK501\t{name} is empty", None
     try:
@@ -135,7 +135,7 @@ def obj_verdict(data: bytes, name: str) -> tuple[str | None, Corners | None]:
         return f"MK501\t{name}: malformed OBJ ({_NUMPY_UNMATCHED})", None
     except _Undecided:
         return UNDECIDED, None
-    return problem, (_corners(verts, kept_rows) if problem is None else None)
+    return problem, (_corners(verts, kept_rows) if problem is None and corners else None)
 
 
 # ---- vertices (trimesh.exchange.obj._parse_vertices) ------------------------------------------

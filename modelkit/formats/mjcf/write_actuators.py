@@ -33,6 +33,7 @@ from modelkit.convert.actuator_choice import (
     FILLED,
     GRAVITY_FLOOR,
     SERVOED,
+    chosen_actuators,
     chosen_kind,
     constrained_joints,
     counted,
@@ -106,14 +107,9 @@ class ActuatorWriter:
         made_up = self.made_up = replaced or not (
             any(a.source_kind != TRACK_ROLLER for a in self.robot.actuators)
             or self.robot.extras.get("mjcf_actuators"))
-        chosen: list[Actuator] = []
         taken = {a.joint for a, _ in planned}
         if made_up:
-            for free in self.robot.joints:
-                kind = self._chosen_kind(free)
-                if kind is not None and free.name not in taken:
-                    chosen.append(Actuator(joint=free.name, kind=kind, source_kind=CHOSEN,
-                                           source=free.source))
+            chosen = chosen_actuators(self.robot, self.ctx.options.actuators, self._leg_joints(), taken)
             planned += [(a, by_name.get(a.joint)) for a in chosen]
         else:
             filled = self._load_bearing_unactuated(taken)
@@ -150,12 +146,10 @@ class ActuatorWriter:
         whose actuators the model may not all hold."""
         if self.ctx.options.source_actuators != "auto" or self.robot.source_format == "mjcf":
             return []
-        if self._legs is None:
-            self._legs = leg_joints(self.robot)
         choice = self.ctx.options.actuators
-        out = load_bearing_unactuated(self.robot, taken, choice, self._legs, self.sags)
+        out = load_bearing_unactuated(self.robot, taken, choice, self._leg_joints(), self.sags)
         if out:
-            message = filled_message(out, self._legs, choice, f"<{ELEMENTS[out[0].kind]}>",
+            message = filled_message(out, self._leg_joints(), choice, f"<{ELEMENTS[out[0].kind]}>",
                                      "its home keyframe")
             self.ctx.note("MK827", message, self.robot.source, "actuator")
         return out
@@ -168,10 +162,8 @@ class ActuatorWriter:
 
     def _servoed_interfaces(self) -> dict[int, Actuator]:
         """:func:`modelkit.convert.actuator_choice.servoed_interfaces` (MK864)."""
-        if self._legs is None:
-            self._legs = leg_joints(self.robot)
         return servoed_interfaces(self.robot, self.ctx.options.actuators, self.ctx.options.source_actuators,
-                                  self._legs)
+                                  self._leg_joints())
 
     def _said_servoed(self, servoed: list[Actuator]) -> None:
         """MK864: the source's ROS effort interfaces written as the ``--actuators`` choice."""
@@ -190,7 +182,7 @@ class ActuatorWriter:
         parts = [f"{count} {kind}" for kind, count in sorted(kinds.items())]
         if unheld > 0:
             parts.append(f"{unheld} other MJCF")
-        what = counted(_each(written), lambda kind: f"<{ELEMENTS[kind]}>") or "none"
+        what = counted(written, lambda kind: f"<{ELEMENTS[kind]}>") or "none"
         self.ctx.note("MK855", f"the source's {len(own) + max(unheld, 0)} actuator(s) ({', '.join(parts)}) "
                       f"set aside (--source-actuators replace); written instead: {what} "
                       f"(--actuators {self.ctx.options.actuators})", self.robot.source, "actuator")
@@ -199,12 +191,10 @@ class ActuatorWriter:
         """MK863: joints outside legs (MK857) that the source's effort actuators drive and gravity turns
         at home (an arm's shoulder and elbow under URDF ``EffortJointInterface`` transmissions): at zero
         control the robot sags until a controller drives them."""
-        if self._legs is None:
-            self._legs = leg_joints(self.robot)
         sagging = [(name, self.load(by_name[name]).gravity) for name, actuator in on_joint.items()
                    if actuator.kind is ActuatorKind.EFFORT and actuator.source_kind not in (CHOSEN,
                                                                                              TRACK_ROLLER)
-                   and name not in self._legs and name in by_name and self.sags(by_name[name])]
+                   and name not in self._leg_joints() and name in by_name and self.sags(by_name[name])]
         if not sagging:
             return
         shown = ", ".join(f"{name} {load:.3g}" for name, load in sagging[:4]) + (" ..." if len(sagging) > 4
@@ -222,8 +212,6 @@ class ActuatorWriter:
         weight), less the joint's Coulomb friction: the servo saturates and the robot sags off its home
         pose, whatever the gains (the PR2's shoulders: 52 N·m against 30; the real arm has a counterbalance
         spring its URDF does not describe)."""
-        if self._legs is None:
-            self._legs = leg_joints(self.robot)
         if self._links is None:
             self._links = {link.name: link for link in self.robot.links}
         over: list[tuple[str, float, float]] = []
@@ -238,7 +226,7 @@ class ActuatorWriter:
             return
         over.sort(key=lambda each: each[2] - each[1])
         shown = ", ".join(f"{name} {need:.3g} > {most:.3g}" for name, need, most in over[:4])
-        legs = sum(1 for name, _, _ in over if name in self._legs)
+        legs = sum(1 for name, _, _ in over if name in self._leg_joints())
         share = f"; {legs} in legs, with the leg's share of the robot's weight standing" if legs else ""
         where = by_name[over[0][0]].source or self.robot.source
         self.ctx.note("MK868", f"{len(over)} joint(s) whose position servo's force limit is below the "
@@ -250,9 +238,7 @@ class ActuatorWriter:
     def _said_legs(self, on_joint: dict[str, Actuator]) -> None:
         """MK857: the source's motors leave a legged robot's legs limp; MK856: its home pose, which the
         servos hold, lies on the body, not the feet (convert.legs)."""
-        if self._legs is None:
-            self._legs = leg_joints(self.robot)
-        legs = sorted(self._legs)
+        legs = sorted(self._leg_joints())
         if not legs:
             return
         limp = [name for name in legs if name in on_joint and on_joint[name].kind is ActuatorKind.EFFORT
@@ -277,12 +263,16 @@ class ActuatorWriter:
                           "URDF can give them as ros2_control initial_value), so on a floor its servos hold "
                           "it lying down", self.robot.source, "keyframe")
 
+    def _leg_joints(self) -> frozenset[str]:
+        """The joints of the robot's legs (:func:`modelkit.convert.legs.leg_joints`), found once."""
+        if self._legs is None:
+            self._legs = leg_joints(self.robot)
+        return self._legs
+
     def _chosen_kind(self, joint: Joint) -> ActuatorKind | None:
         """The ``--actuators`` kind of a joint the source does not actuate (None: no actuator):
         :func:`modelkit.convert.actuator_choice.chosen_kind`."""
-        if self._legs is None:
-            self._legs = leg_joints(self.robot)
-        return chosen_kind(joint, self.robot, self.ctx.options.actuators, self._legs)
+        return chosen_kind(joint, self.robot, self.ctx.options.actuators, self._leg_joints())
 
     def sags(self, joint: Joint) -> bool:
         """Whether gravity turns the joint at home: its gravity load there exceeds its Coulomb friction
@@ -300,7 +290,7 @@ class ActuatorWriter:
         elif not written:
             what = "no actuators (no hinge or slide that is free to drive)"
         else:
-            what = counted(_each(written), lambda kind: f"<{ELEMENTS[kind]}> actuator(s)")
+            what = counted(written, lambda kind: f"<{ELEMENTS[kind]}> actuator(s)")
         why = ""
         if choice == "auto":
             why = ("; auto puts a position servo on each joint with a range, in a leg or on a welded base "
@@ -442,9 +432,8 @@ class ActuatorWriter:
         why = f"a {fmt(SERVO_BANDWIDTH_HZ)} Hz critically damped servo"
         if hz > SERVO_BANDWIDTH_HZ * (1.0 + 1e-9):
             force = "N" if joint.type is JointType.PRISMATIC else "N·m"
-            if self._legs is None:
-                self._legs = leg_joints(self.robot)
-            share = " (with its leg's share of the robot's weight)" if joint.name in self._legs else ""
+            in_leg = joint.name in self._leg_joints()
+            share = " (with its leg's share of the robot's weight)" if in_leg else ""
             why = (f"a critically damped servo raised to {hz:.1f} Hz against the gravity load "
                    f"{load.gravity:.3g} {force}{share} at home (docs/convert.md)")
         self.ctx.note(
@@ -458,7 +447,3 @@ class ActuatorWriter:
             f"actuator[{target}]",
         )
 
-
-def _each(counts: dict[ActuatorKind, int]) -> list[ActuatorKind]:
-    """A count of kinds as the kinds, one per actuator (for :func:`counted`)."""
-    return [kind for kind, count in counts.items() for _ in range(count)]

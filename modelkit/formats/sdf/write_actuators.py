@@ -23,13 +23,13 @@ Gazebo classic (``--gazebo classic``), which has no such systems, actuators are 
 from __future__ import annotations
 
 import math
+from collections import Counter
 from typing import Any
 
 from lxml.etree import _Element as Element
 
 from modelkit.convert.actuator_choice import (
-    CHOSEN,
-    chosen_kind,
+    chosen_actuators,
     constrained_joints,
     counted,
     filled_message,
@@ -99,11 +99,15 @@ class ActuatorWriter:
         self.joints = joints
         self.sources = source_plugins(robot)
         self._loads: dict[str, JointLoad] | None = None
+        self._legs: frozenset[str] | None = None  # the joints in a legged robot's legs, found once
 
     def write(self, model: Element) -> int:
         robot = self.robot
+        by_name: dict[str, Joint] = {}
+        for each in robot.joints:
+            by_name.setdefault(each.name, each)
         if not robot.actuators:
-            return self._chosen(model)
+            return self._chosen(model, by_name)
         if self.family == "classic":
             self.ctx.note(
                 "MK808",
@@ -118,10 +122,7 @@ class ActuatorWriter:
             self.ctx.note("MK855", f"the source's {len(robot.actuators)} actuator(s) set aside "
                           "(--source-actuators replace); the --actuators choice is written instead",
                           robot.source, "model/plugin")
-            return self._chosen(model)
-        by_name: dict[str, Joint] = {}
-        for each in robot.joints:
-            by_name.setdefault(each.name, each)
+            return self._chosen(model, by_name)
         written = 0
         made_up: list[str] = []
         lost: list[str] = []
@@ -153,7 +154,7 @@ class ActuatorWriter:
         robot, options = self.robot, self.ctx.options
         if options.source_actuators != "auto" or robot.source_format == "mjcf":
             return []
-        legs = leg_joints(robot)
+        legs = self._leg_joints()
         links = {link.name: link for link in robot.links}
         taken = {a.joint for a in robot.actuators}
         out = load_bearing_unactuated(robot, taken, options.actuators, legs,
@@ -169,8 +170,13 @@ class ActuatorWriter:
         robot, options = self.robot, self.ctx.options
         if not any(a.ros_interface and a.kind is ActuatorKind.EFFORT for a in robot.actuators):
             return {}
-        legs = leg_joints(robot) if options.actuators == "auto" else frozenset()
-        return servoed_interfaces(robot, options.actuators, options.source_actuators, legs)
+        return servoed_interfaces(robot, options.actuators, options.source_actuators, self._leg_joints())
+
+    def _leg_joints(self) -> frozenset[str]:
+        """The joints of the robot's legs (:func:`modelkit.convert.legs.leg_joints`), found once."""
+        if self._legs is None:
+            self._legs = leg_joints(self.robot)
+        return self._legs
 
     def _said_servoed(self, servoed: list[Actuator]) -> None:
         """MK864: the source's ROS effort interfaces written as position or velocity controllers."""
@@ -202,7 +208,7 @@ class ActuatorWriter:
                 "model/plugin",
             )
 
-    def _chosen(self, model: Element) -> int:
+    def _chosen(self, model: Element, by_name: dict[str, Joint]) -> int:
         """The source names no actuators, or ``--source-actuators replace`` set them aside: the
         ``--actuators`` choice (:mod:`modelkit.convert.actuator_choice`, the MJCF writer's rule) on every
         hinge and slide written as a revolute or prismatic joint that is not a mimic follower, locked, or a
@@ -217,22 +223,19 @@ class ActuatorWriter:
         if self.ctx.options.drive_plugin:
             drive, _ = find_drive(robot, "sdf", self.family)
             driven = set(drive.left + drive.right) if drive is not None else set()
-        skipped = constrained_joints(robot) | driven
-        legs = leg_joints(robot) if choice == "auto" else frozenset()
         made_up: list[str] = []
         lost: list[str] = []
-        written: list[ActuatorKind] = []
-        for joint in robot.joints:
-            target = self.joints.get(joint.name)
-            kind = chosen_kind(joint, robot, choice, legs)
-            if target is None or kind is None or joint.name in skipped:
-                continue
-            actuator = Actuator(joint=joint.name, kind=kind, source_kind=CHOSEN, source=joint.source)
+        written: Counter[ActuatorKind] = Counter()
+        skipped = constrained_joints(robot) | driven
+        for actuator in chosen_actuators(robot, choice, self._leg_joints(), skipped):
+            joint, target = by_name[actuator.joint], self.joints.get(actuator.joint)
+            if target is None:
+                continue  # not written as a revolute or prismatic joint
             plugin = self._one(model, actuator, joint, target, made_up, lost)
             home = home_position(joint)
-            if kind is ActuatorKind.POSITION and home != 0.0:
+            if actuator.kind is ActuatorKind.POSITION and home != 0.0:
                 num(plugin, "initial_position", home)
-            written.append(kind)
+            written[actuator.kind] += 1
         if not written:
             return 0
         what = counted(written, SYSTEM_FOR.__getitem__)
@@ -245,7 +248,7 @@ class ActuatorWriter:
                       f"{choice}{why}{wheels}; --actuators none leaves them out)", robot.source,
                       "model/plugin")
         self._said(made_up, lost)
-        return len(written)
+        return sum(written.values())
 
     # -- one actuator -------------------------------------------------------------------------------
 
