@@ -1784,6 +1784,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "none.",
     ),
     CodeInfo(
+        "MK882",
+        "home-key-rests-on-floor",
+        "info",
+        "MJCF: the `home` keyframe puts a free robot's base at the height where its lowest collision shape "
+        "at home rests on z = 0, the floor a user adds (a URDF's root is at the origin, so its feet or "
+        "wheels would start inside that floor); the body's own `pos` stays the source's root pose.",
+    ),
+    CodeInfo(
         "MK890",
         "output-exists",
         "error",

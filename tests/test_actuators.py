@@ -555,20 +555,19 @@ STAND_SECONDS, STAND_SAG, STAND_TILT = 3.0, 0.015, 0.05  # s, m, rad
 
 
 def _home_on_a_plain_floor(path: Path) -> tuple[Any, Any]:
-    """The written MJCF as a user loads it: a default plane added, reset to the ``home`` keyframe and
-    lifted until no contact is deeper than 0.1 mm."""
+    """The written MJCF as a user loads it: a default plane added and reset to the ``home`` keyframe,
+    nothing else. The key stands the robot on z = 0 (MK882): no contact with the floor deeper than 1 µm."""
     spec = mujoco.MjSpec.from_file(str(path))
-    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0])
+    spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0])
     m = spec.compile()
     d = mujoco.MjData(m)
     mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home"))
-    for _ in range(100):
-        mujoco.mj_forward(m, d)
-        depth = min([c.dist for c in d.contact[:d.ncon]] or [0.0])
-        if depth >= -1e-4:
-            break
-        d.qpos[2] -= depth
+    mujoco.mj_forward(m, d)
+    floor = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "floor")
+    depth = min([c.dist for c in d.contact[:d.ncon] if floor in tuple(c.geom)] or [0.0])
+    assert depth >= -1e-6, f"{path.name}: at home the robot starts {-depth * 1e3:.3f} mm inside the floor"
     return m, d
+
 
 def stand_on_a_plain_floor(path: Path) -> tuple[float, float]:
     """The written MJCF with only a default-contact plane added, reset to ``home``, lowered onto the

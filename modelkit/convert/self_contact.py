@@ -43,11 +43,21 @@ class BelowBase:
 
 
 @dataclass(frozen=True)
+class Lowest:
+    """Where a free robot's collision shapes reach lowest at rest (the state :func:`touching_pairs`
+    applied): the world height and the body whose shape reaches it."""
+
+    height: float
+    body: str
+
+
+@dataclass(frozen=True)
 class Checked:
     pairs: list[Touching]
     failure: str | None = None  # why nothing was checked
     unusable: str | None = None  # the failure is one a user of the file meets too: what MuJoCo does
     below: list[BelowBase] = field(default_factory=list)  # a welded robot's bodies under its base
+    lowest: Lowest | None = None  # a robot whose root body is free: its lowest collision shape at rest
 
 
 BELOW_TOLERANCE = 1e-3  # m: what a collision shape may reach below the base before it is said (MK865)
@@ -111,7 +121,30 @@ def _touching(mujoco: Any, xml: bytes, assets: dict[str, bytes]) -> Checked:
         for (b1, b2), (depth, labels) in sorted(found.items())
     ]
     below = [BelowBase(name(body), depth) for body, depth in _below_base(mujoco, model, data)]
-    return Checked(pairs, below=below)
+    lowest = _free_root_lowest(mujoco, model, data)
+    return Checked(pairs, below=below,
+                   lowest=Lowest(lowest[0], name(lowest[1])) if lowest is not None else None)
+
+
+def _free_root_lowest(mujoco: Any, model: Any, data: Any) -> tuple[float, int] | None:
+    """When the first joint is a free joint on a body of the world (the robot's root, as the MJCF
+    writer puts it), the lowest point of the collision shapes of that body's tree in the state ``data``
+    holds, and the body whose shape reaches it; None when that tree has no collision shape with a
+    lowest point."""
+    if model.njnt == 0 or int(model.jnt_type[0]) != int(mujoco.mjtJoint.mjJNT_FREE):
+        return None
+    root = int(model.jnt_bodyid[0])
+    if int(model.body_parentid[root]) != 0:
+        return None
+    found: tuple[float, int] | None = None
+    for g in range(model.ngeom):
+        body = int(model.geom_bodyid[g])
+        if int(model.body_rootid[body]) != root or not (model.geom_contype[g] or model.geom_conaffinity[g]):
+            continue
+        low = _lowest_point(mujoco, model, data, g)
+        if low is not None and (found is None or low < found[0]):
+            found = (low, body)
+    return found
 
 
 def _below_base(mujoco: Any, model: Any, data: Any) -> list[tuple[int, float]]:

@@ -52,7 +52,7 @@ from lxml import etree
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.meshes import MESH_FOLDER
-from modelkit.convert.numbers import fmt, fmt_text, fmt_vec
+from modelkit.convert.numbers import fmt, fmt_text
 from modelkit.convert.self_contact import BelowBase, touching_pairs
 from modelkit.convert.servo_gains import with_written_masses
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
@@ -65,10 +65,11 @@ from modelkit.formats.mjcf.write_devices import DeviceWriter
 from modelkit.formats.mjcf.write_exclusions import write_exclusions
 from modelkit.formats.mjcf.write_foreign import note_unwritten_own
 from modelkit.formats.mjcf.write_geoms import COLLISION, CONTACT_PRIORITY, GeomWriter, shared_stems
+from modelkit.formats.mjcf.write_home import HomeKey
 from modelkit.formats.mjcf.write_names import NameTable
 from modelkit.formats.mjcf.write_own import OwnWriter
 from modelkit.formats.mjcf.write_transmissions import TransmissionWriter
-from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, quat_wxyz, set_pose, sub
+from modelkit.formats.mjcf.write_xml import EULER_SEQUENCE, Element, indent, set_pose, sub
 from modelkit.model import WORLD_LINK, LoopConstraint, Robot
 from modelkit.spatial import Pose
 
@@ -116,6 +117,8 @@ class MjcfWriter:
                                 if robot.source is not None and robot.source.file else None)
         self.devices = DeviceWriter(ctx, self.names, self.sections["sensor"])
         self.tree = BodyTree(robot, ctx, self.names, self.geoms, self.devices)
+        self.home_key = HomeKey(robot, ctx, self.sections["keyframe"], self.sections["worldbody"],
+                                self.tree.body_pose)
         options, why = mujoco_options(robot)  # wheels or tracks (convert.simulator says why)
         for key, value in options.items():
             self.sections["option"].set(key, value)
@@ -243,6 +246,7 @@ class MjcfWriter:
             return
         links = {el.get("name"): link for link, el in self.tree.bodies.items()}
         self._below_base(checked.below, links)
+        self.home_key.rest_on_floor(checked.lowest)
         for pair in checked.pairs:
             sub(self.sections["contact"], "exclude", body1=pair.body1, body2=pair.body2)
             link = self.robot.link(links.get(pair.body2) or "")
@@ -349,29 +353,8 @@ class MjcfWriter:
     # -- joints across the tree ----------------------------------------------------------------
 
     def _home(self) -> None:
-        """Initial joint positions as the ``home`` keyframe. MuJoCo wants every qpos value of a key,
-        in its order (joints in document order): a free joint gets its body's pose, a ball joint the
-        identity, the other hinges and slides 0."""
-        home = self.tree.home
-        ctrl = self.actuators.ctrl
-        if not self.actuators.any_position and not any(ctrl):  # zero is MuJoCo's own ctrl of a key
-            ctrl = []
-        if not home and not ctrl:
-            return
-        qpos: list[float] = []
-        for el in self.sections["worldbody"].iter("joint", "freejoint"):
-            kind = "free" if el.tag == "freejoint" else el.get("type", "hinge")
-            if kind == "free":
-                parent = el.getparent()
-                pose = self.tree.body_pose.get(parent, Pose()) if parent is not None else Pose()
-                qpos.extend([*np.asarray(pose.translation, dtype=float), *quat_wxyz(pose.rotation)])
-            elif kind == "ball":
-                qpos.extend([1.0, 0.0, 0.0, 0.0])
-            else:
-                qpos.append(home.get(el.get("name", ""), 0.0))
-        key = sub(self.sections["keyframe"], "key", name="home", qpos=fmt_vec(np.asarray(qpos)))
-        if ctrl:
-            key.set("ctrl", fmt_vec(np.asarray(ctrl)))
+        """The ``home`` keyframe (:mod:`.write_home`): initial positions and the servos' targets."""
+        self.home_key.write(self.tree.home, self.actuators.ctrl, self.actuators.any_position)
 
     def _joint_ids(self) -> None:
         ids = [j for j in self.robot.joints if j.joint_id is not None]
