@@ -3,10 +3,11 @@
 For each legged robot found here (pybullet_data's and example-robot-data's), as a user would:
 ``modelkit convert ROBOT -o out/ROBOT.xml`` (defaults: a floating base, position servos with the
 documented gain rule, a ``home`` keyframe), then the written MJCF loaded through ``MjSpec`` with one
-default-contact ``<geom type="plane">`` added, reset to ``home`` (``ctrl`` = the home positions), the
-base lifted until no contact is deeper than 0.1 mm, and 2 s of MuJoCo with that ``ctrl``.
+default-contact ``<geom type="plane">`` added, reset to ``home`` (``ctrl`` = the home positions; the
+key stands the base on the floor, MK882), and 2 s of MuJoCo with that ``ctrl``.
 
-Printed per robot: the actuators written (count and kinds), the mass, how far the base dropped
+Printed per robot: the actuators written (count and kinds), the mass, the lowest collision shape's
+height above the floor at the key (negative: inside it), how far the base dropped
 (start minus end height) and tilted, the largest joint error from home over the run, the largest
 share of the run any one actuator spent at its force limit, and the joint that spent it.
 
@@ -73,6 +74,7 @@ class Stand:
     robot: str
     actuators: str
     mass: float
+    start_gap: float  # m, the lowest collision geom above the floor at the home key (negative: inside)
     drop: float  # m, base height at the start minus at the end
     tilt: float  # rad, the base's rotation from upright at the end
     joint_error: float  # rad, the largest |q - q_home| over the run
@@ -90,25 +92,21 @@ def convert(source: Path, folder: Path) -> Path:
     return out
 
 
-def place_on_floor(m: mujoco.MjModel, d: mujoco.MjData, floor: int) -> None:
-    """Move the free base up or down until the lowest collision geom touches the floor (its distance
-    to the floor within 0.01 mm): the floor's margin is raised while the contacts are found, so that
-    a robot above the floor sees it too."""
+def floor_gap(m: mujoco.MjModel, d: mujoco.MjData, floor: int) -> float:
+    """How far the lowest collision geom is above the floor (negative: inside it) in the state ``d``
+    holds: the floor's margin is raised while the contacts are found, so that a robot above the floor
+    sees it too. Nothing is moved: the written ``home`` key places the base (MK882)."""
     margin = float(m.geom_margin[floor])
     m.geom_margin[floor] = 10.0
     try:
-        for _ in range(100):
-            mujoco.mj_forward(m, d)
-            gaps = [c.dist for c in d.contact[:d.ncon] if floor in (c.geom1, c.geom2)]
-            if not gaps:
-                raise ValueError("no collision geom within 10 m of the floor")
-            gap = min(gaps)
-            if abs(gap) < 1e-5:
-                break
-            d.qpos[2] -= gap
+        mujoco.mj_forward(m, d)
+        gaps = [c.dist for c in d.contact[:d.ncon] if floor in (c.geom1, c.geom2)]
+        if not gaps:
+            raise ValueError("no collision geom within 10 m of the floor")
+        return float(min(gaps))
     finally:
         m.geom_margin[floor] = margin
-    mujoco.mj_forward(m, d)
+        mujoco.mj_forward(m, d)
 
 
 def stand(xml: Path, seconds: float) -> tuple[mujoco.MjModel, dict[str, float]]:
@@ -120,7 +118,7 @@ def stand(xml: Path, seconds: float) -> tuple[mujoco.MjModel, dict[str, float]]:
     mujoco.mj_resetDataKeyframe(m, d, key)
     if m.jnt_type[0] != mujoco.mjtJoint.mjJNT_FREE:
         raise ValueError("the base is not free")
-    place_on_floor(m, d, floor.id)
+    gap = floor_gap(m, d, floor.id)
     home = d.qpos.copy()
     start = float(d.qpos[2])
     moving = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
@@ -141,8 +139,8 @@ def stand(xml: Path, seconds: float) -> tuple[mujoco.MjModel, dict[str, float]]:
     share = at_limit / steps if m.nu else np.zeros(1)
     a = int(np.argmax(share)) if m.nu and share.max() > 0.0 else -1  # the joint named only when it sat
     jname = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.actuator_trnid[a, 0])) if a >= 0 else ""
-    return m, {"drop": start - float(d.qpos[2]), "tilt": 2.0 * math.acos(w), "joint_error": worst,
-               "saturated": float(share.max()), "saturated_joint": jname or ""}
+    return m, {"start_gap": gap, "drop": start - float(d.qpos[2]), "tilt": 2.0 * math.acos(w),
+               "joint_error": worst, "saturated": float(share.max()), "saturated_joint": jname or ""}
 
 
 def kinds(xml: Path) -> str:
@@ -176,19 +174,19 @@ def main(argv: list[str] | None = None) -> int:
                 xml = convert(source, folder)
                 m, r = stand(xml, args.seconds)
             except Exception as exc:  # a robot that does not convert or load is reported, not fatal
-                rows.append(Stand(name, "", 0.0, math.nan, math.nan, math.nan, math.nan, "",
+                rows.append(Stand(name, "", 0.0, math.nan, math.nan, math.nan, math.nan, math.nan, "",
                                   f"{type(exc).__name__}: {str(exc).splitlines()[0][:90]}"))
                 continue
             mass = float(m.body_subtreemass[1]) if m.nbody > 1 else 0.0
             rows.append(Stand(name, kinds(xml), mass, **r))
-    print(f"{'robot':34} {'actuators':22} {'mass':>7} {'drop mm':>9} {'tilt':>7} {'q err':>7} "
+    print(f"{'robot':34} {'actuators':22} {'mass':>7} {'gap mm':>7} {'drop mm':>9} {'tilt':>7} {'q err':>7} "
           f"{'at limit':>8}  joint")
     for s in rows:
         if s.note:
             print(f"{s.robot:34} {s.note}")
             continue
-        print(f"{s.robot:34} {s.actuators:22} {s.mass:7.2f} {s.drop * 1e3:9.1f} {s.tilt:7.3f} "
-              f"{s.joint_error:7.3f} {s.saturated:8.0%}  {s.saturated_joint}")
+        print(f"{s.robot:34} {s.actuators:22} {s.mass:7.2f} {s.start_gap * 1e3:7.3f} {s.drop * 1e3:9.1f} "
+              f"{s.tilt:7.3f} {s.joint_error:7.3f} {s.saturated:8.0%}  {s.saturated_joint}")
     if args.json:
         args.json.write_text(json.dumps([asdict(s) for s in rows], indent=1, sort_keys=True) + "\n")
     return 0
