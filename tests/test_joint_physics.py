@@ -59,7 +59,10 @@ def test_mjcf_writes_every_field_and_reads_them_back(tmp_path: Path) -> None:
     assert key >= 0
     qpos = model.key_qpos[key]
     assert qpos[model.jnt_qposadr[hinge]] == 0.4 and qpos[model.jnt_qposadr[slide]] == 0.0
-    assert list(qpos[:7]) == [0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0]  # the free joint at the root's pose
+    # the free base where its lowest collision shape (the base's box, 0.05 below its frame) rests on z = 0
+    # (MK882); the body itself stays at the root's pose, 1 m up
+    assert list(qpos[:7]) == [0.0, 0.0, 0.05, 1.0, 0.0, 0.0, 0.0]
+    assert list(model.qpos0[:3]) == [0.0, 0.0, 1.0]
     assert not [n for n in notes if n.code == "MK820" and "initial position" in n.message]
     velocity = [n for n in notes if n.code == "MK820" and "velocity limit" in n.message]
     assert len(velocity) == 2  # MJCF joints have no velocity limit: said, not silently dropped
@@ -82,9 +85,11 @@ def test_home_keyframe_puts_the_arm_at_its_initial_position(tmp_path: Path) -> N
 
 
 def test_no_keyframe_without_initial_positions(tmp_path: Path) -> None:
-    """Motors and q = 0: nothing for a key to hold (position servos get one for their controls)."""
+    """Motors, q = 0 and a base resting on z = 0: nothing for a key to hold (position servos get one
+    for their controls; a free base off the floor, one that stands it there)."""
     robot = _robot()
     _joint(robot, "hinge").initial_position = 0.0
+    robot.root_pose = Pose(np.eye(3), np.array([0.0, 0.0, 0.05]))
     out = tmp_path / "m.xml"
     write(robot, out, options=WriteOptions(actuators="motor"))
     assert b"keyframe" not in out.read_bytes()

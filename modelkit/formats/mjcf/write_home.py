@@ -73,7 +73,7 @@ class HomeKey:
     def rest_on_floor(self, lowest: Lowest | None) -> None:
         """The free root's height in the key such that its lowest collision shape at home rests on
         z = 0 (MK882)."""
-        if not self.free_root or lowest is None:
+        if not self.free_root or lowest is None or not math.isfinite(lowest.height):
             return
         if abs(lowest.height) <= (HEIGHT_STEP if self.key is not None else REST_TOLERANCE):
             return  # it rests on z = 0 already
