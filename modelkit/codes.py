@@ -1554,8 +1554,10 @@ _TABLE: tuple[CodeInfo, ...] = (
         "else its zero pose put into range), the collision shapes of moving links reach more than 1 mm "
         "below the lowest point of the base's collision shapes: on a table or floor there, where an arm "
         "is mounted, they start inside it, and MuJoCo pushes the robot out at the first step "
-        "(example-robot-data's Kinova arm: 45 mm; a UR5's zero pose: its wrist, 41 mm). A robot whose "
-        "moving links' centre of mass is not above that point hangs from its base and is not judged. The "
+        "(example-robot-data's Kinova arm: 45 mm; a UR5's zero pose: its wrist, 41 mm). Only a standing "
+        "arm is judged: its moving links start as one chain of 3 or more joints, longer than any branch "
+        "after it (a gripper's fingers); a hand, a gripper or an upper body is held by a wrist or a torso, "
+        "and a robot whose moving links' centre of mass is not above that point hangs from its base. The "
         "note names the links and depths; the source's initial positions or MoveIt's SRDF (`--srdf`, "
         "`--home`) give a home pose clear of it.",
     ),

@@ -60,6 +60,7 @@ class Checked:
     lowest: Lowest | None = None  # a robot whose root body is free: its lowest collision shape at rest
 
 
+STANDING_ARM_JOINTS = 3  # a welded robot is judged for MK865 when its moving part starts as such a chain
 BELOW_TOLERANCE = 1e-3  # m: what a collision shape may reach below the base before it is said (MK865)
 
 
@@ -156,7 +157,13 @@ def _below_base(mujoco: Any, model: Any, data: Any) -> list[tuple[int, float]]:
     under the robot is there: a shape below it starts inside it, and MuJoCo pushes the arm out at the
     first step. A robot whose moving links' centre of mass is not above that plane hangs from its base
     (mounted from above or from the side: TriFinger's finger, a humanoid's arm, a drone's) and is not
-    judged; nor is a robot with a free joint, which stands nowhere yet."""
+    judged. Only a standing arm is: one chain of at least :data:`STANDING_ARM_JOINTS` moving joints
+    from the base before it branches, longer than any branch after it (UR5, Panda, Kinova with the
+    fingers of their grippers). A hand
+    (example-robot-data's Allegro), a gripper (PR2's, Choreonoid's Robotiq 2F-85), an upper body whose
+    arms branch at a waist (Alex) or a one-motor test rig (pybullet_data's Minitaur motor) is held by
+    a wrist, a torso or a frame, not a table, and its fingers or arms reach past that mount's plane
+    as they are built to. Nor is a robot with a free joint, which stands nowhere yet."""
     if any(int(t) == int(mujoco.mjtJoint.mjJNT_FREE) for t in model.jnt_type):
         return []
     welded = [int(b) for b in range(1, model.nbody) if int(model.body_weldid[b]) == 0]
@@ -175,11 +182,49 @@ def _below_base(mujoco: Any, model: Any, data: Any) -> list[tuple[int, float]]:
         return []  # a base without collision shapes (a virtual frame): where it stands is not known
     plane = min(base)
     moving = [b for b in range(1, model.nbody) if int(model.body_weldid[b]) != 0]
+    if _arm_joints(model, moving) < STANDING_ARM_JOINTS:
+        return []  # fingers, a gripper's jaws, an upper body's arms, a test rig's motor
     mass = float(sum(model.body_mass[b] for b in moving))
     if mass > 0.0 and sum(float(model.body_mass[b] * data.xipos[b][2]) for b in moving) / mass <= plane:
         return []  # the robot hangs from its base (a finger under its frame, an arm on a shoulder, a drone's)
     return [(body, plane - low) for body, low in sorted(lowest.items())
             if int(model.body_weldid[body]) != 0 and plane - low > BELOW_TOLERANCE]
+
+
+def _arm_joints(model: Any, moving: list[int]) -> int:
+    """The moving joints of the chain the robot's moving bodies start with, up to its first branch;
+    0 when several chains start from the base, or when a branch holds as many joints in a row as that
+    chain (the arms above a humanoid's waist; a gripper's fingers at an arm's end hold fewer)."""
+    children: dict[int, list[int]] = {}
+    for body in moving:
+        children.setdefault(int(model.body_parentid[body]), []).append(body)
+    starts = [b for b in moving if int(model.body_weldid[int(model.body_parentid[b])]) == 0]
+    if len(starts) != 1:
+        return 0
+    count, body = 0, starts[0]
+    while True:
+        count += int(model.body_jntnum[body])
+        below = children.get(body, [])
+        if len(below) != 1:
+            break
+        body = below[0]
+    if any(_longest_chain(model, children, branch) >= count for branch in children.get(body, [])):
+        return 0
+    return count
+
+
+def _longest_chain(model: Any, children: dict[int, list[int]], top: int) -> int:
+    """The most moving joints on one path down from body ``top`` (itself included)."""
+    longest: dict[int, int] = {}
+    order, stack = [], [top]
+    while stack:  # bodies in depth-first order; then each body after its children
+        body = stack.pop()
+        order.append(body)
+        stack.extend(children.get(body, []))
+    for body in reversed(order):
+        below = [longest[c] for c in children.get(body, [])]
+        longest[body] = int(model.body_jntnum[body]) + max(below, default=0)
+    return longest[top]
 
 
 def _lowest_point(mujoco: Any, model: Any, data: Any, g: int) -> float | None:
