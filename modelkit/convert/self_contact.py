@@ -13,6 +13,9 @@ collision detection: every contact there is
 between two of the robot's own bodies, since the file holds no floor. MuJoCo's Python bindings come with
 the core install (``mujoco-core``); when they cannot be imported or the compiler refuses the file,
 :func:`touching_pairs` says why and the writer notes that nothing was checked (MK833).
+
+The same pass gives two more facts of the file at rest: a welded standing arm's links below its base
+(MK865) and a free robot's lowest collision shape, where the ``home`` key rests it on the floor (MK882).
 """
 
 from __future__ import annotations

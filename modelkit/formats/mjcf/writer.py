@@ -35,6 +35,8 @@ body pairs touching at rest. The style is MuJoCo Menagerie's (docs/convert.md, "
   MK806/MK808 note (:mod:`.write_foreign`).
 * Massless frame links (a tool flange, a TCP, an optical frame) are ``<site>``s in the body they hang
   on (:mod:`.write_bodies`, MK873), unless ``WriteOptions.frame_sites`` is off.
+* The ``home`` keyframe (:mod:`.write_home`): initial positions, servo targets, and a free robot's
+  base at the height where it rests on z = 0 (MK882), found in the same MuJoCo pass as self-contact.
 * Self-collision follows MuJoCo's defaults (parent–child and welded pairs never collide), and any
   other body pair whose collision shapes MuJoCo finds touching at the ``home`` keyframe (q = 0 without one)
   gets ``<contact><exclude>`` (MK832; :mod:`modelkit.convert.self_contact` compiles the file; MK833
