@@ -380,3 +380,61 @@ def test_single_precision_values_keep_the_sources_decimals(target: str, tmp_path
     elif target == "urdf":
         assert '<color rgba="0.3 0.6 0.9 1"/>' in text  # the material's colour
 
+
+
+def test_small_values_lose_the_dust_of_larger_ones() -> None:
+    """A small value computed from larger ones keeps their arithmetic's tail: iCub's (icub-models)
+    ``1.38999999999695e-5`` m, a difference of two positions near 0.1 m, is 3e-17 m from ``1.39e-5``:
+    2e-12 of the value (over fmt's 1e-12), but far below 1e-12 of the robot's size. A position is
+    written with that size as its scale, a tensor's entry with its largest entry's; a value whose
+    digits are real (a third, a 4 µrad rotation) keeps them."""
+    from modelkit.convert.numbers import fmt_inertia, fmt_length, fmt_position, fmt_tensor
+
+    assert fmt(1.38999999999695e-5) == "1.38999999999695e-5"  # fmt alone knows no scale
+    assert fmt_length(1.38999999999695e-5) == "1.39e-5"
+    assert fmt_position([-0.0009363, 1.38999999999695e-5, 8.09999999998312e-6]) == "-0.0009363 1.39e-5 8.1e-6"
+    assert fmt_length(1 / 3 * 1e-5) == "3.33333333333333e-6"  # a value, not a decimal with a dusty tail
+    with length_scale(1e-3):  # on a millimetre robot 3e-17 m is 3e-14 of its size: still dust
+        assert fmt_length(1.38999999999695e-5) == "1.39e-5"
+    with length_scale(1e-6):  # on a micrometre one it is 3e-11 of it: kept
+        assert fmt_length(1.38999999999695e-5) == "1.38999999999695e-5"
+    tensor = np.array([[3.03891e-4, 7.12496000000835e-8, 3.3401e-6],
+                       [7.12496000000835e-8, 4.6914e-4, -4.76597e-8],
+                       [3.3401e-6, -4.76597e-8, 2.77108e-4]])
+    assert fmt_inertia(tensor[0, 1], tensor) == "7.12496e-8"
+    assert fmt(tensor[0, 1]) == "7.12496000000835e-8"
+    assert fmt_tensor([0.0100000187393413, 0.0100000000323507], np.eye(3) * 0.01) == (
+        "0.0100000187393413 0.0100000000323507")  # 3e-9 of the tensor: a real difference of moments
+
+
+ICUB_LIKE = """<robot name="dusty">
+  <link name="base"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+  <link name="hip"><inertial><origin xyz="-0.0009315 8.09999999998312e-6 -0.044809"/><mass value="0.413242"/>
+    <inertia ixx="0.000303891" ixy="7.12496000000835e-8" ixz="3.3401e-6" iyy="0.00046914" iyz="-4.76597e-8"
+             izz="0.000277108"/></inertial></link>
+  <joint name="hip" type="revolute"><parent link="base"/><child link="hip"/>
+    <origin xyz="-0.0009363 1.38999999999695e-5 -0.0743"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+</robot>
+"""
+
+
+@pytest.mark.parametrize("target", ["xml", "urdf", "sdf", "body"])
+def test_every_writer_drops_the_dust_of_small_values(target: str, tmp_path: Path) -> None:
+    """The numbers above, as a URDF holds them after another tool's arithmetic: every target writes the
+    short decimals, and reads back equal to 1e-9."""
+    source = tmp_path / "dusty.urdf"
+    source.write_text(ICUB_LIKE)
+    robot = validate(source).robot
+    assert robot is not None
+    out = tmp_path / target / f"robot.{target}"
+    notes = write(robot, out)
+    text = out.read_text()
+    for dusty in ("1.38999999999695", "8.09999999998312", "7.12496000000835"):
+        assert dusty not in text, (target, dusty)
+    assert "1.39e-5" in text or "1.39e-05" in text
+    back = validate(out).robot
+    assert back is not None
+    assert compare_poses(robot, back, renames(notes, "link"), tol=1e-9) == []

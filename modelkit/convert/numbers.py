@@ -38,33 +38,39 @@ _LENGTH_SCALE: contextvars.ContextVar[float] = contextvars.ContextVar("length_sc
 _EXACT_ROTATION_VALUES = (0.0, 1.0, 0.5, math.sqrt(0.5))
 
 
-def fmt(value: float) -> str:
+def fmt(value: float, dust: float = 0.0) -> str:
     """One number: the shortest decimal that is ``x`` up to dust (see :func:`_short`), else at most
-    15 significant digits; integers without ``.0``."""
+    15 significant digits; integers without ``.0``. ``dust`` is an absolute size the caller knows to be
+    no measurement for this quantity (1e-12 of the model's size for a position: :func:`fmt_position`;
+    1e-12 of a tensor's largest entry for its entries: :func:`fmt_tensor`)."""
     x = float(value)
     if not math.isfinite(x):
         raise ValueError(f"cannot write a non-finite number ({x})")
     if x == 0.0:
         return "0"
-    text = _short(x) or repr(x)
+    text = _short(x, dust) or repr(x)
     fifteen = f"{x:.15g}"
     if len(fifteen) < len(text) and math.isfinite(float(fifteen)):  # near DBL_MAX, rounding overflows
         text = fifteen
     return _tidy(text)
 
 
-def _short(x: float) -> str | None:
+def _short(x: float, dust: float = 0.0) -> str | None:
     """The shortest decimal of at most 14 digits that differs from ``x`` by dust: at most 1e-12
-    relative, and at least 10⁴ times less than its own last digit (``0.0615250000000001`` →
-    ``0.061525``; ``1/3`` stays ``0.333333333333333``, which is not a decimal with a dusty tail)."""
+    relative (or ``dust``, when larger), and at least 10⁴ times less than its own last digit
+    (``0.0615250000000001`` → ``0.061525``; ``1/3`` stays ``0.333333333333333``, which is not a decimal
+    with a dusty tail). With ``dust`` a small value keeps no tail of the arithmetic on larger ones
+    (iCub's ``1.38999999999695e-5`` m, a difference of two positions near 0.1 m: 3e-17 m off
+    ``1.39e-5``, which is 2e-12 of the value but far below 1e-12 m)."""
     exponent = math.floor(math.log10(abs(x)))
+    tolerance = max(SNAP * abs(x), dust)
     for digits in range(1, 15):
         short = f"{x:.{digits}g}"
         y = float(short)
         if not math.isfinite(y):
             continue
         error = abs(y - x)
-        if error <= SNAP * abs(x) and error * 1e4 <= 10.0 ** (exponent - digits + 1):
+        if error <= tolerance and error * 1e4 <= 10.0 ** (exponent - digits + 1):
             return f"{y:.15g}"  # the same decimal, laid out as before (1000000, not 1e+06)
     return None
 
@@ -105,9 +111,30 @@ def fmt_vec(values: Iterable[float] | np.ndarray) -> str:
 
 def fmt_position(values: Iterable[float] | np.ndarray) -> str:
     """A point in metres (a centre of mass, a joint anchor, a light): each coordinate cleaned by
-    :func:`clean_length`, so a CAD export's ``2.9948e-14`` on a half-metre arm is written as 0."""
+    :func:`clean_length`, so a CAD export's ``2.9948e-14`` on a half-metre arm is written as 0, and
+    written by :func:`fmt_length`."""
     vector = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel()
-    return fmt_vec([clean_length(float(v)) for v in vector])
+    return " ".join(fmt_length(clean_length(float(v))) for v in vector)
+
+
+def fmt_length(value: float) -> str:
+    """A length in metres: :func:`fmt` with 1e-12 of the model's length scale as dust."""
+    return fmt(value, SNAP * _LENGTH_SCALE.get())
+
+
+def fmt_tensor(values: Iterable[float] | np.ndarray, tensor: np.ndarray) -> str:
+    """Entries of an inertia tensor (moments, products): :func:`fmt` with 1e-12 of the tensor's largest
+    entry as dust (iCub's product ``7.12496000000835e-8`` beside moments of 3e-4 kg·m² is
+    ``7.12496e-8``), the scale :func:`clean_inertia` and ``verify`` judge a tensor by."""
+    return " ".join(fmt_inertia(v, tensor) for v in np.asarray(
+        list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel())
+
+
+def fmt_inertia(value: float, tensor: np.ndarray) -> str:
+    """One entry of ``tensor``, as :func:`fmt_tensor` writes it."""
+    t = np.asarray(tensor, dtype=float)
+    own = float(np.max(np.abs(t))) if t.size else 0.0
+    return fmt(value, SNAP * own if math.isfinite(own) else 0.0)
 
 
 def fmt_rpy(rotation: np.ndarray) -> str:

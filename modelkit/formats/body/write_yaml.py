@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from modelkit.convert.numbers import clean, fmt
+from modelkit.convert.numbers import clean, fmt, fmt_inertia, fmt_length
 from modelkit.spatial import Mat3
 
 NUM_TAG = "tag:modelkit,2024:number"
@@ -51,6 +51,20 @@ def nums(values: Iterable[float] | np.ndarray, tidy: bool = False) -> Flow:
     """A flow list of numbers; ``tidy`` sets arithmetic dust below 1e-15 to 0 (poses and axes)."""
     flat = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel()
     return Flow(num(clean(float(x)) if tidy else float(x)) for x in flat)
+
+
+def lengths(values: Iterable[float] | np.ndarray) -> Flow:
+    """A flow list of lengths in metres: dust below 1e-15 set to 0, each written by ``fmt_length`` (a
+    shorter decimal within 1e-12 of the model's size, where the rest is arithmetic dust)."""
+    flat = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel()
+    return Flow(Num(fmt_length(clean(float(x)))) for x in flat)
+
+
+def tensor(values: np.ndarray) -> Flow:
+    """The 9 entries of an inertia tensor, each written by ``fmt_inertia`` (dust relative to the
+    tensor's largest entry)."""
+    t = np.asarray(values, dtype=float)
+    return Flow(Num(fmt_inertia(float(x), t)) for x in t.ravel())
 
 
 def deg(radians: float) -> Num:
@@ -101,7 +115,7 @@ def put_pose(node: dict[str, Any], rotation: Mat3, translation: np.ndarray) -> N
     """``translation`` / ``rotation`` keys of a node, each omitted when it is the identity."""
     t = np.asarray(translation, dtype=float)
     if np.any(t != 0.0):
-        node["translation"] = nums(t, tidy=True)
+        node["translation"] = lengths(t)
     r = rotation_value(rotation)
     if r is not None:
         node["rotation"] = r

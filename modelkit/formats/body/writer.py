@@ -42,7 +42,18 @@ from modelkit.convert.joint_springs import note_spring_dropped
 from modelkit.convert.names import unique_name
 from modelkit.formats.body.write_devices import device_node
 from modelkit.formats.body.write_shapes import link_elements
-from modelkit.formats.body.write_yaml import Flow, Num, deg, dump, num, nums, put_pose, rotation_value
+from modelkit.formats.body.write_yaml import (
+    Flow,
+    Num,
+    deg,
+    dump,
+    lengths,
+    num,
+    nums,
+    put_pose,
+    rotation_value,
+    tensor,
+)
 from modelkit.model import WORLD_LINK, Inertial, Joint, JointType, Link, Robot
 
 JOINT_WORDS = {
@@ -346,8 +357,8 @@ def _inertial(inertial: Inertial | None, node: dict[str, Any]) -> None:
                 node["center_of_mass"] = nums(com)
         return
     node["mass"] = num(inertial.mass)
-    node["center_of_mass"] = nums(com)
-    node["inertia"] = nums(inertia.ravel())
+    node["center_of_mass"] = lengths(com)
+    node["inertia"] = tensor(inertia)
 
 
 def _extra_joints(robot: Robot, names: _Names, ctx: WriteContext) -> list[dict[str, Any]]:

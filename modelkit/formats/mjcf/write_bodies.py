@@ -46,7 +46,7 @@ import numpy as np
 
 from modelkit.convert.context import WriteContext
 from modelkit.convert.frames import frame_links
-from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_position, fmt_vec
+from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_position, fmt_tensor, fmt_vec
 from modelkit.convert.servo_gains import home_position
 from modelkit.formats.mjcf.site_frames import named_frames, own_sites, site_pose
 from modelkit.formats.mjcf.write_chains import Chain, ChainFinder, shifted
@@ -657,11 +657,11 @@ class BodyTree:
         if principal is not None:
             moments, axes = principal
             el.set("quat", fmt_vec(quat_wxyz(axes)))
-            el.set("diaginertia", fmt_vec(moments))
+            el.set("diaginertia", fmt_tensor(moments, tensor))
         elif any(v != 0.0 for v in off):
-            el.set("fullinertia", fmt_vec([tensor[0, 0], tensor[1, 1], tensor[2, 2], *off]))
+            el.set("fullinertia", fmt_tensor([tensor[0, 0], tensor[1, 1], tensor[2, 2], *off], tensor))
         else:
-            el.set("diaginertia", fmt_vec([tensor[0, 0], tensor[1, 1], tensor[2, 2]]))
+            el.set("diaginertia", fmt_tensor([tensor[0, 0], tensor[1, 1], tensor[2, 2]], tensor))
 
     def _triangle(self, tensor: np.ndarray, link: Link, target: str) -> np.ndarray:
         """The tensor, or MuJoCo's nearest acceptable one (:func:`mujoco_valid_inertia`), noted."""

@@ -41,7 +41,7 @@ from modelkit.convert.drive_plugin import planned_drive, plugin_elements
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.gazebo import gazebo_family
 from modelkit.convert.joint_springs import note_spring_dropped
-from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_vec
+from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_inertia, fmt_vec
 from modelkit.convert.servo_gains import with_written_masses
 from modelkit.formats.sdf.gz_inertia import libsdformat_accepts
 from modelkit.formats.sdf.kept import JOINT_KEY, LIMIT_KEY, MODEL_KEY, write_back
@@ -401,7 +401,7 @@ class _ModelWriter:
             ("iyz", (1, 2)),
             ("izz", (2, 2)),
         ):
-            num(tensor, key, 0.5 * (m[i, j] + m[j, i]) if i != j else m[i, j])
+            sub(tensor, key, fmt_inertia(0.5 * (m[i, j] + m[j, i]) if i != j else m[i, j], m))
 
     def _valid_inertia(self, link: Link, name: str, m: Mat3) -> Mat3:
         """``m``, or libsdformat's nearest acceptable tensor (:func:`sdformat_valid_inertia`), noted."""

@@ -18,7 +18,7 @@ from lxml.etree import _Element as Element
 from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import PairFriction, describe, link_surface
 from modelkit.convert.meshes import MeshRef
-from modelkit.convert.numbers import clean_inertia, fmt, fmt_position, fmt_rpy, fmt_vec
+from modelkit.convert.numbers import clean_inertia, fmt, fmt_inertia, fmt_position, fmt_rpy, fmt_vec
 from modelkit.diagnostics import SourceLocation
 from modelkit.formats.urdf.links import PYBULLET_LATERAL_DEFAULT
 from modelkit.formats.urdf.massless import TINY_INERTIA, TINY_MASS
@@ -103,12 +103,12 @@ def inertial_element(parent: Element, link: Link, ctx: WriteContext, target: str
     etree.SubElement(
         el,
         "inertia",
-        ixx=fmt(i[0, 0]),
-        ixy=fmt(i[0, 1]),
-        ixz=fmt(i[0, 2]),
-        iyy=fmt(i[1, 1]),
-        iyz=fmt(i[1, 2]),
-        izz=fmt(i[2, 2]),
+        ixx=fmt_inertia(i[0, 0], i),
+        ixy=fmt_inertia(i[0, 1], i),
+        ixz=fmt_inertia(i[0, 2], i),
+        iyy=fmt_inertia(i[1, 1], i),
+        iyz=fmt_inertia(i[1, 2], i),
+        izz=fmt_inertia(i[2, 2], i),
     )
 
 
