@@ -3,7 +3,11 @@
 ``fmt(x)`` prints the shortest decimal that is ``x`` up to arithmetic dust (within 1e-12 relative,
 and 10⁴ below the decimal's last digit): a number a person wrote comes back as written, and the
 dust goes (``0.0615250000000001`` → ``0.061525``, ``1.0000000000000002`` → ``1``); other values
-get at most 15 significant digits. A read-back differs from the model by at most 1e-12 relative.
+get at most 15 significant digits. A read-back differs from the model by at most 1e-12 relative,
+or 1e-12 of the quantity's scale where a writer gives one: a position's is the model's size
+(:func:`fmt_length`, :func:`fmt_position`), a tensor entry's the tensor's largest entry
+(:func:`fmt_inertia`, :func:`fmt_tensor`), so that a small value computed from larger ones loses
+their dust too.
 
 Near-zero values are a question of scale, which ``fmt`` cannot know (``6.123233995736766e-17``
 is dust in a position, a real value in an inertia of a milligram part). Writers settle it where
