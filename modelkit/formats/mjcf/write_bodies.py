@@ -619,11 +619,12 @@ class BodyTree:
         if moving:
             group_mass, moments = self._weld_group(link)
             if group_mass < SINGULAR:
+                kept = bool(np.any(tensor != 0.0))  # a tensor the source gives without mass is kept
                 self.ctx.note(
                     "MK816",
                     f"link {link.name} moves but has no mass (nor anything welded to it); "
                     f"MuJoCo refuses that, so it gets {fmt(MIN_MASS)} kg and {fmt(MIN_INERTIA)} kg·m² "
-                    "on each axis",
+                    "on each axis" + (" added to the inertia tensor its source gives it" if kept else ""),
                     link.loc("mass"),
                     target,
                 )
@@ -632,13 +633,20 @@ class BodyTree:
                 tensor = tensor + MIN_INERTIA * np.eye(3)
             elif float(np.min(moments)) < (SINGULAR_DIAGONAL if _diagonal(tensor) or _principal_form(tensor)
                                            else SINGULAR_FULL):
+                # a massless frame over welded links with mass but no inertia carries the fix itself
+                # (icub-models' iCub: a free base_link over root_link's 4.72 kg with a zero tensor)
+                frame = mass <= 0.0
                 self.ctx.note(
                     "MK870",
                     f"link {link.name} moves but its inertia (with what is welded to it) is "
-                    f"singular; MuJoCo refuses that, so {fmt(MIN_INERTIA)} kg·m² is added on each axis",
+                    f"singular; MuJoCo refuses that, so {fmt(MIN_INERTIA)} kg·m² is added on each axis"
+                    + (f" (with {fmt(MIN_MASS)} kg, since the link itself has no mass)" if frame else ""),
                     link.loc("inertia"),
                     target,
                 )
+                if frame:
+                    mass, com = MIN_MASS, np.zeros(3)
+                    self.lifted.add(link.name)
                 tensor = tensor + MIN_INERTIA * np.eye(3)
         if mass > 0.0:
             tensor = self._triangle(tensor, link, target)

@@ -77,12 +77,18 @@ def _source_names(renames: Renames) -> dict[str, str]:
     return {written: source for source, written in renames.get("link", {}).items()}
 
 
-def from_notes(fmt: str, notes: Iterable[ConversionNote], renames: Renames) -> dict[str, Approximated]:
-    """The writer's own tiny-mass approximations (MK816) in the written ``fmt`` file."""
+def from_notes(fmt: str, notes: Iterable[ConversionNote], renames: Renames, source: Robot | None = None
+               ) -> dict[str, Approximated]:
+    """The writer's own tiny-mass approximations (MK816) in the written ``fmt`` file. The MJCF writer
+    keeps a tensor the source gives a massless link (icub-models' iCub: ``torso_2``, 0 kg with 2e-3
+    kg·m²) and adds its own to it: the link then holds that sum (``tensor``), with ``MIN_MASS`` at its
+    origin."""
     back = _source_names(renames)
+    links = {link.name: link for link in source.links} if source is not None else {}
     out: dict[str, Approximated] = {}
     for note in notes:
-        if note.code != "MK816" or not note.target:
+        # MK870 of a frame: the MJCF writer's lift of a massless link over welded links without inertia
+        if not note.target or (note.code != "MK816" and not (fmt == "mjcf" and note.code == "MK870")):
             continue
         if fmt == "sdf":
             from modelkit.formats.sdf.writer import TINY_INERTIA, TINY_MASS
@@ -102,9 +108,16 @@ def from_notes(fmt: str, notes: Iterable[ConversionNote], renames: Renames) -> d
             from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, MIN_MASS
 
             match = re.fullmatch(r"body\[(.+)\]/inertial", note.target)
-            if match and "moves but has no mass" in note.message:
+            if match and ("moves but has no mass" in note.message
+                          or (note.code == "MK870" and "the link itself has no mass" in note.message)):
                 name = back.get(match[1], match[1])
-                out[name] = Approximated(name, MIN_MASS, MIN_INERTIA, note.code, "the MJCF writer")
+                link = links.get(name)
+                own = (np.asarray(link.inertial.inertia, dtype=float)
+                       if link is not None and link.inertial is not None else np.zeros((3, 3)))
+                tensor = None
+                if np.any(own != 0.0):
+                    tensor = tuple(float(v) for v in (own + MIN_INERTIA * np.eye(3)).ravel())
+                out[name] = Approximated(name, MIN_MASS, MIN_INERTIA, note.code, "the MJCF writer", tensor)
     return out
 
 
@@ -359,7 +372,7 @@ def for_engine(engine: str, fmt: str, notes: Iterable[ConversionNote], file: Pat
     """What ``engine`` (reading the written ``fmt`` file) holds instead of no mass, or instead of a
     source inertia it refuses (:func:`refused_inertias`), by source link."""
     notes = list(notes)
-    out = from_notes(fmt, notes, renames)
+    out = from_notes(fmt, notes, renames, source)
     out.update(lifted_inertias(fmt, notes, renames, source))
     out.update(zero_inertias(fmt, notes, renames, source))
     if fmt == "urdf":
@@ -377,7 +390,10 @@ def applied(robot: Robot, approx: dict[str, Approximated]) -> Robot:
     out = copy.deepcopy(robot)
     for link in out.links:
         a = approx.get(link.name)
-        if a is not None and a.tensor is not None and link.inertial is not None:
+        own_tensor = a is not None and a.code in ("MK816", "MK870")  # a massless link's own, kept
+        if a is not None and a.tensor is not None and link.inertial is not None and own_tensor:
+            link.inertial = Inertial(a.mass, np.zeros(3), np.asarray(a.tensor, dtype=float).reshape(3, 3))
+        elif a is not None and a.tensor is not None and link.inertial is not None:
             link.inertial = Inertial(link.inertial.mass, np.asarray(link.inertial.com, dtype=float),
                                      np.asarray(a.tensor, dtype=float).reshape(3, 3))
         elif a is not None:
@@ -404,6 +420,10 @@ def skip(engine: str, approx: dict[str, Approximated]) -> Skip | None:
             continue
         if a.tensor is None:
             groups.setdefault((a.by, a.code, a.mass, a.inertia), []).append(a.link)
+            continue
+        if a.code in ("MK816", "MK870"):
+            lifts.append(f"{a.by} gives {a.link}, massless in the source, {a.mass:g} kg and adds "
+                         f"{a.inertia:g} kg·m² per axis to the inertia tensor the source gives it ({a.code})")
             continue
         lifted = np.linalg.eigvalsh(np.asarray(a.tensor).reshape(3, 3))
         lifts.append(f"{a.by} lifts the inertia of {a.link}, whose principal moments violate the triangle "
