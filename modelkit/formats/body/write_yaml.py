@@ -57,14 +57,14 @@ def lengths(values: Iterable[float] | np.ndarray) -> Flow:
     """A flow list of lengths in metres: dust below 1e-15 set to 0, each written by ``fmt_length`` (a
     shorter decimal within 1e-12 of the model's size, where the rest is arithmetic dust)."""
     flat = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel()
-    return Flow(Num(fmt_length(clean(float(x)))) for x in flat)
+    return Flow(Num(fmt_length(clean(float(x)))) if math.isfinite(x) else num(x) for x in flat)
 
 
 def tensor(values: np.ndarray) -> Flow:
     """The 9 entries of an inertia tensor, each written by ``fmt_inertia`` (dust relative to the
     tensor's largest entry)."""
     t = np.asarray(values, dtype=float)
-    return Flow(Num(fmt_inertia(float(x), t)) for x in t.ravel())
+    return Flow(Num(fmt_inertia(float(x), t)) if math.isfinite(x) else num(x) for x in t.ravel())
 
 
 def deg(radians: float) -> Num:
