@@ -323,3 +323,40 @@ def test_a_hand_whose_fingers_point_sideways_is_welded_not_legged(tmp_path: Path
     assert "5 limbs" in decision.reason and "one end of its body" in decision.reason
     quadruped = validate(VISION60).robot
     assert quadruped is not None and decide(quadruped).kind is JointType.FLOATING
+
+
+DISCS = """<robot name="discs">
+  <link name="body"><inertial><mass value="2"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="0 0 0.2"/><geometry><box size="0.3 0.2 0.05"/></geometry></collision></link>
+  SIDES
+</robot>"""
+SIDE = """<link name="disc_{s}"><inertial><mass value="0.2"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin rpy="1.5708 0 0"/><geometry><cylinder radius="0.1" length="0.03"/></geometry>
+    </collision></link>
+  <joint name="disc_{s}" type="{kind}"><parent link="body"/><child link="disc_{s}"/>
+    <origin xyz="0 {y} 0.1"/><axis xyz="0 1 0"/>{limit}</joint>"""
+
+
+@pytest.mark.parametrize(("kind", "floats"), [("continuous", True), ("revolute", False)])
+def test_a_wheel_turns_without_end(tmp_path: Path, kind: str, floats: bool) -> None:
+    """Two discs on horizontal axes touching the ground float the robot as wheels only when their joints
+    have no range: a round link on a limited hinge (icub-models' and example-robot-data's iCub: the ankle
+    below the pitch joint) is no wheel, as the writers' wheel rules already had it."""
+    limit = '<limit lower="-0.7" upper="0.4" effort="10" velocity="1"/>' if kind == "revolute" else ""
+    sides = "\n  ".join(SIDE.format(s=s, y=y, kind=kind, limit=limit) for s, y in (("l", 0.15), ("r", -0.15)))
+    path = tmp_path / "discs.urdf"
+    path.write_text(DISCS.replace("SIDES", sides))
+    robot = validate(path).robot
+    assert robot is not None
+    decision = decide(robot)
+    assert (decision.kind is JointType.FLOATING) is floats
+    assert ("drives on wheels" in decision.reason) is floats
+
+
+def test_icub_stands_on_legs_not_wheels() -> None:
+    robot = validate(example_robot("icub_description/robots/icub_reduced.urdf")).robot
+    assert robot is not None
+    decision = decide(robot)
+    assert decision.kind is JointType.FLOATING and "legs" in decision.reason, decision.reason

@@ -10,7 +10,8 @@ with a fixed joint, or no ``world`` link; .body: ``jointType: fixed|free``).
 * Where the source is silent (a URDF without ``world``: ``Robot.root_joint is None``), ``--base`` decides;
   ``auto`` floats a robot that moves itself and welds the others (MK830 says which and why):
 
-  - wheels: at least two revolute joints with a horizontal axis whose child's shapes touch the lowest
+  - wheels: at least two revolute joints without a range (a wheel turns without end: iCub's ankle,
+    round about its pitch axis, is no wheel) with a horizontal axis whose child's shapes touch the lowest
     level with a round section about that axis (a cylinder or sphere on the axis, or any shape whose
     extents across the axis are equal within 10 % and centred on it): floating, also when a shape of
     the root's own body touches too (a caster ball or skid fixed to the base, as on most
@@ -327,8 +328,9 @@ def _wheels(robot: Robot, poses: dict[str, Pose], touching: set[str], use_collis
     out: list[Joint] = []
     links = {link.name: link for link in robot.links}
     for joint in robot.joints:
-        if joint.type is not JointType.REVOLUTE or joint.child not in touching or joint.child not in poses:
-            continue
+        if (joint.type is not JointType.REVOLUTE or joint.limits.position_limited
+                or joint.child not in touching or joint.child not in poses):
+            continue  # a wheel turns without end, as the writers' wheels (convert.wheels, legs.is_wheel) do
         link = links[joint.child]
         axis = np.asarray(joint.axis, dtype=float)
         norm = float(np.linalg.norm(axis))
