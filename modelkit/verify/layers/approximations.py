@@ -71,6 +71,9 @@ class Approximated:
     # the engine itself refused the source's tensor and holds its own repair (refused_inertias), as
     # opposed to holding what the writer wrote
     refused_by_engine: bool = False
+    # a link massless in the source whose own tensor the writer kept (``tensor``), with ``mass`` kg at
+    # its origin (from_notes: the MJCF writer's MK816), as opposed to a lifted tensor (mass, COM kept)
+    massless: bool = False
 
 
 def _source_names(renames: Renames) -> dict[str, str]:
@@ -117,7 +120,8 @@ def from_notes(fmt: str, notes: Iterable[ConversionNote], renames: Renames, sour
                 tensor = None
                 if np.any(own != 0.0):
                     tensor = tuple(float(v) for v in (own + MIN_INERTIA * np.eye(3)).ravel())
-                out[name] = Approximated(name, MIN_MASS, MIN_INERTIA, note.code, "the MJCF writer", tensor)
+                out[name] = Approximated(name, MIN_MASS, MIN_INERTIA, note.code, "the MJCF writer", tensor,
+                                         massless=tensor is not None)
     return out
 
 
@@ -390,8 +394,7 @@ def applied(robot: Robot, approx: dict[str, Approximated]) -> Robot:
     out = copy.deepcopy(robot)
     for link in out.links:
         a = approx.get(link.name)
-        own_tensor = a is not None and a.code in ("MK816", "MK870")  # a massless link's own, kept
-        if a is not None and a.tensor is not None and link.inertial is not None and own_tensor:
+        if a is not None and a.tensor is not None and a.massless:
             link.inertial = Inertial(a.mass, np.zeros(3), np.asarray(a.tensor, dtype=float).reshape(3, 3))
         elif a is not None and a.tensor is not None and link.inertial is not None:
             link.inertial = Inertial(link.inertial.mass, np.asarray(link.inertial.com, dtype=float),
@@ -421,7 +424,7 @@ def skip(engine: str, approx: dict[str, Approximated]) -> Skip | None:
         if a.tensor is None:
             groups.setdefault((a.by, a.code, a.mass, a.inertia), []).append(a.link)
             continue
-        if a.code in ("MK816", "MK870"):
+        if a.massless:
             lifts.append(f"{a.by} gives {a.link}, massless in the source, {a.mass:g} kg and adds "
                          f"{a.inertia:g} kg·m² per axis to the inertia tensor the source gives it ({a.code})")
             continue
