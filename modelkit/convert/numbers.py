@@ -130,15 +130,21 @@ def fmt_tensor(values: Iterable[float] | np.ndarray, tensor: np.ndarray) -> str:
     """Entries of an inertia tensor (moments, products): :func:`fmt` with 1e-12 of the tensor's largest
     entry as dust (iCub's product ``7.12496000000835e-8`` beside moments of 3e-4 kg·m² is
     ``7.12496e-8``), the scale :func:`clean_inertia` and ``verify`` judge a tensor by."""
-    return " ".join(fmt_inertia(v, tensor) for v in np.asarray(
+    dust = _tensor_dust(tensor)
+    return " ".join(fmt(v, dust) for v in np.asarray(
         list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel())
 
 
 def fmt_inertia(value: float, tensor: np.ndarray) -> str:
     """One entry of ``tensor``, as :func:`fmt_tensor` writes it."""
+    return fmt(value, _tensor_dust(tensor))
+
+
+def _tensor_dust(tensor: np.ndarray) -> float:
+    """1e-12 (:data:`SNAP`) of the tensor's largest entry; 0 for an empty or non-finite tensor."""
     t = np.asarray(tensor, dtype=float)
     own = float(np.max(np.abs(t))) if t.size else 0.0
-    return fmt(value, SNAP * own if math.isfinite(own) else 0.0)
+    return SNAP * own if math.isfinite(own) else 0.0
 
 
 def fmt_rpy(rotation: np.ndarray) -> str:

@@ -124,36 +124,44 @@ def _touching(mujoco: Any, xml: bytes, assets: dict[str, bytes]) -> Checked:
         Touching(name(b1), name(b2), depth, " and ".join(s for s, _ in states if s in labels))
         for (b1, b2), (depth, labels) in sorted(found.items())
     ]
-    below = [BelowBase(name(body), depth) for body, depth in _below_base(mujoco, model, data)]
-    lowest = _free_root_lowest(mujoco, model, data)
+    lows = _lowest_by_body(mujoco, model, data)
+    below = [BelowBase(name(body), depth) for body, depth in _below_base(mujoco, model, data, lows)]
+    lowest = _free_root_lowest(mujoco, model, lows)
     return Checked(pairs, below=below,
                    lowest=Lowest(lowest[0], name(lowest[1])) if lowest is not None else None)
 
 
-def _free_root_lowest(mujoco: Any, model: Any, data: Any) -> tuple[float, int] | None:
+def _lowest_by_body(mujoco: Any, model: Any, data: Any) -> dict[int, float]:
+    """Body → the lowest world height of its collision shapes in the state ``data`` holds (bodies
+    without a collision shape that has a lowest point are left out)."""
+    lowest: dict[int, float] = {}
+    for g in range(model.ngeom):
+        if not (model.geom_contype[g] or model.geom_conaffinity[g]):
+            continue
+        low = _lowest_point(mujoco, model, data, g)
+        if low is not None:
+            body = int(model.geom_bodyid[g])
+            lowest[body] = min(lowest.get(body, math.inf), low)
+    return lowest
+
+
+def _free_root_lowest(mujoco: Any, model: Any, lows: dict[int, float]) -> tuple[float, int] | None:
     """When the first joint is a free joint on a body of the world (the robot's root, as the MJCF
-    writer puts it), the lowest point of the collision shapes of that body's tree in the state ``data``
-    holds, and the body whose shape reaches it; None when that tree has no collision shape with a
-    lowest point."""
+    writer puts it), the lowest point of the collision shapes of that body's tree (``lows``:
+    :func:`_lowest_by_body`), and the body whose shape reaches it; None when that tree has none."""
     if model.njnt == 0 or int(model.jnt_type[0]) != int(mujoco.mjtJoint.mjJNT_FREE):
         return None
     root = int(model.jnt_bodyid[0])
     if int(model.body_parentid[root]) != 0:
         return None
-    found: tuple[float, int] | None = None
-    for g in range(model.ngeom):
-        body = int(model.geom_bodyid[g])
-        if int(model.body_rootid[body]) != root or not (model.geom_contype[g] or model.geom_conaffinity[g]):
-            continue
-        low = _lowest_point(mujoco, model, data, g)
-        if low is not None and (found is None or low < found[0]):
-            found = (low, body)
-    return found
+    tree = [(low, body) for body, low in lows.items() if int(model.body_rootid[body]) == root]
+    return min(tree) if tree else None
 
 
-def _below_base(mujoco: Any, model: Any, data: Any) -> list[tuple[int, float]]:
+def _below_base(mujoco: Any, model: Any, data: Any, lowest: dict[int, float]) -> list[tuple[int, float]]:
     """A welded robot's moving bodies whose collision shapes reach more than :data:`BELOW_TOLERANCE`
-    below its base, in the state ``data`` holds (the last one :func:`_touching` applied).
+    below its base, in the state ``data`` holds (the last one :func:`_touching` applied; ``lowest``:
+    :func:`_lowest_by_body` there).
 
     The base is every body welded to the world; the plane it stands on is the lowest point of its
     collision shapes (a base without any, such as a virtual frame, says nothing). A table or floor
@@ -172,14 +180,6 @@ def _below_base(mujoco: Any, model: Any, data: Any) -> list[tuple[int, float]]:
     welded = [int(b) for b in range(1, model.nbody) if int(model.body_weldid[b]) == 0]
     if not welded or len(welded) == model.nbody - 1:
         return []
-    lowest: dict[int, float] = {}
-    for g in range(model.ngeom):
-        if not (model.geom_contype[g] or model.geom_conaffinity[g]):
-            continue
-        low = _lowest_point(mujoco, model, data, g)
-        if low is not None:
-            body = int(model.geom_bodyid[g])
-            lowest[body] = min(lowest.get(body, math.inf), low)
     base = [lowest[b] for b in welded if b in lowest]
     if not base:
         return []  # a base without collision shapes (a virtual frame): where it stands is not known
