@@ -669,6 +669,8 @@ class MeshExporter:
         stem = converted_stem(part_stem, ext, written)
         if mujoco:
             ref, why = self._mujoco_triangles(loaded.mesh, stem, scale, f"mesh {uri}", collision)
+        elif not len(loaded.mesh.faces):  # an empty STL or OBJ: PyBullet says so, RViz shows nothing
+            return None, f"mesh {uri}{part} holds no triangles"
         else:
             ref, why = self.triangles(loaded.mesh, stem, scale), ""
         if ref is not None:

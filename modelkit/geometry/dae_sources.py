@@ -1,4 +1,5 @@
-"""COLLADA loading that decodes only the numbers the mesh checks read: the vertex positions.
+"""COLLADA loading that decodes only the numbers the mesh checks read (the vertex positions), and that
+keeps a geometry whose material binding is broken.
 
 pycollada decodes every ``<float_array>`` of a ``<mesh>`` when it loads a document: positions, and
 normals, texture coordinates and colours, which nothing in modelkit reads (the checks and the STL
@@ -10,6 +11,13 @@ normals), instead of the decoded numbers. Its length is what pycollada would hav
 index checks refuse the same primitives (a truncated normal array, indexed past its end). Only a
 number that is not a number is no longer refused there: Assimp, which Choreonoid, RViz and Gazebo
 read COLLADA with, reads such a text without complaint too (``fast_atoreal_move``).
+
+pycollada drops a whole ``<instance_geometry>`` when one ``<instance_material>`` names a material the
+document lacks (``DaeBrokenRefError``, which the loader is told to ignore): example-robot-data's
+ANYmal B foot, whose carbon-fibre material lost its effect, then has no triangles at all, and the
+converter wrote an empty STL. Assimp keeps the geometry with its default material. Inside
+:func:`materials_optional`, such a binding is kept with no material (no colour), and its target is
+listed for the loader's notes.
 """
 
 from __future__ import annotations
@@ -21,7 +29,8 @@ from typing import Any
 
 import numpy as np
 
-_PATCH = threading.Lock()  # pycollada's loader is a class attribute: one document at a time
+# pycollada's loaders are class attributes: one document at a time (a re-entrant lock: the patches nest)
+_PATCH = threading.RLock()
 
 
 def _positions(mesh: Any, collada: Any) -> set[str]:
@@ -75,3 +84,29 @@ def positions_only() -> Iterator[None]:
             yield
         finally:
             dae.FloatSource.load = staticmethod(original)
+
+
+@contextmanager
+def materials_optional(missing: list[str]) -> Iterator[None]:
+    """Inside the block, an ``<instance_material>`` whose target the document lacks is bound to no
+    material instead of dropping its ``<instance_geometry>``; each such target is appended to
+    ``missing``."""
+    from collada import scene
+
+    original = scene.MaterialNode.load
+
+    def load(collada: Any, node: Any) -> Any:
+        target = node.get("target") or ""
+        if target.startswith("#") and collada.materials.get(target[1:]) is None:
+            missing.append(target)
+            inputs = [(n.get("semantic"), n.get("input_semantic"), n.get("input_set"))
+                      for n in node.findall(collada.tag("bind_vertex_input"))]
+            return scene.MaterialNode(node.get("symbol"), None, inputs, xmlnode=node)
+        return original(collada, node)
+
+    with _PATCH:
+        scene.MaterialNode.load = staticmethod(load)
+        try:
+            yield
+        finally:
+            scene.MaterialNode.load = staticmethod(original)

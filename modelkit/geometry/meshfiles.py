@@ -1029,10 +1029,13 @@ def _load_dae(data: bytes, name: str, fragment: str | None, metadata: MeshMetada
     import collada
     from collada.common import DaeBrokenRefError, DaeError, DaeUnsupportedError
 
-    from modelkit.geometry.dae_sources import positions_only
+    from modelkit.geometry.dae_sources import materials_optional, positions_only
 
+    unbound: list[str] = []
     try:
-        with positions_only():  # normals and texture coordinates are not decoded: nothing reads them
+        # normals and texture coordinates are not decoded (nothing reads them); a geometry bound to a
+        # material the file lacks is kept without a colour, as Assimp keeps it
+        with positions_only(), materials_optional(unbound):
             dae = collada.Collada(io.BytesIO(data), ignore=[DaeUnsupportedError, DaeBrokenRefError])
     except DaeError as e:
         msg = str(getattr(e, "msg", "") or e)
@@ -1073,6 +1076,10 @@ def _load_dae(data: bytes, name: str, fragment: str | None, metadata: MeshMetada
             f"COLLADA up_axis {shown} ignored, as Choreonoid does (RViz and Gazebo also ignore it; "
             "viewers that honour it show this mesh rotated)"
         )
+    if unbound:
+        shown = ", ".join(sorted(set(unbound))[:3]) + (" ..." if len(set(unbound)) > 3 else "")
+        notes.append(f"material(s) {shown} not in the file: the triangles bound to them are kept without "
+                     "a colour, as Assimp (RViz, Gazebo, Choreonoid) keeps them")
     if dae.errors:
         shown_errors = "; ".join(str(getattr(e, "msg", e)) for e in dae.errors[:3])
         more = f" (+{len(dae.errors) - 3} more)" if len(dae.errors) > 3 else ""
