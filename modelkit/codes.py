@@ -1794,6 +1794,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "wheels would start inside that floor); the body's own `pos` stays the source's root pose.",
     ),
     CodeInfo(
+        "MK883",
+        "soft-floor-contact",
+        "warning",
+        "MJCF: a free robot stands at home on a body so light that MuJoCo's default contact gives way under "
+        "the robot's weight: MuJoCo softens a contact by the inverse mass it moves, and the robot's mass "
+        "times the body's `body_invweight0` is above 400 (the robots measured standing reach 178; "
+        "icub-models' iCubLisboa01, 10 g feet, 926, sinks 33 mm and falls). The source's masses are kept.",
+    ),
+    CodeInfo(
         "MK890",
         "output-exists",
         "error",

@@ -14,8 +14,19 @@ between two of the robot's own bodies, since the file holds no floor. MuJoCo's P
 the core install (``mujoco-core``); when they cannot be imported or the compiler refuses the file,
 :func:`touching_pairs` says why and the writer notes that nothing was checked (MK833).
 
-The same pass gives two more facts of the file at rest: a welded standing arm's links below its base
-(MK865) and a free robot's lowest collision shape, where the ``home`` key rests it on the floor (MK882).
+The same pass gives three more facts of the file at rest: a welded standing arm's links below its base
+(MK865), a free robot's lowest collision shape, where the ``home`` key rests it on the floor (MK882),
+and how soft MuJoCo makes the floor's contact on the bodies it stands on (MK883).
+
+MuJoCo softens a contact in proportion to the inverse mass the contact moves (its constraint
+regularisation is ``(1 − d) / d`` times the diagonal of the inverse inertia in contact space, which
+the compiler estimates per body as ``body_invweight0``). So under a robot's weight a body sinks in
+proportion to the robot's mass times that body's ``body_invweight0``: a dimensionless *load ratio*,
+1 for a rigid block resting on the floor. Measured with MuJoCo's default contact on the 128 free
+robots of example-robot-data, pybullet_data, the shared corpus and icub-models 3.2.0 reset to
+``home`` on a plain floor (docs/convert.md): every robot that stands has a ratio of at most 178
+(HyQ's feet, 10 mm of sink; quadrupeds 40 to 180, humanoids 7 to 33); icub-models' iCubLisboa01,
+whose source gives each foot 10 g, has 926: its feet sink 33 mm and it falls within 2 s.
 """
 
 from __future__ import annotations
@@ -46,12 +57,25 @@ class BelowBase:
 
 
 @dataclass(frozen=True)
+class SoftSupport:
+    """A body a free robot stands on at rest whose floor contact MuJoCo makes soft: the robot's mass
+    times the body's ``body_invweight0`` (translation) is above :data:`SOFT_LOAD_RATIO`."""
+
+    body: str
+    mass: float  # kg: the body's own
+    robot_mass: float  # kg
+    ratio: float  # the load ratio
+
+
+@dataclass(frozen=True)
 class Lowest:
     """Where a free robot's collision shapes reach lowest at rest (the state :func:`touching_pairs`
-    applied): the world height and the body whose shape reaches it."""
+    applied): the world height and the body whose shape reaches it; and the bodies at that level
+    (within :data:`SUPPORT_LEVEL`) whose contact with a default floor is too soft to carry the robot."""
 
     height: float
     body: str
+    soft: list[SoftSupport] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -65,6 +89,12 @@ class Checked:
 
 STANDING_ARM_JOINTS = 3  # a welded robot is judged for MK865 when its moving part starts as such a chain
 BELOW_TOLERANCE = 1e-3  # m: what a collision shape may reach below the base before it is said (MK865)
+SUPPORT_LEVEL = 1e-3  # m: a body whose collision shapes reach this close to the lowest point stands there
+SOFT_LOAD_RATIO = 400.0
+"""MK883: the load ratio above which a support body's contact is said to be too soft: more than twice the
+largest of the robots measured standing (178), less than half of the one that falls (926)."""
+DEFAULT_SOLREF = (0.02, 1.0)
+DEFAULT_SOLIMP = (0.9, 0.95, 0.001, 0.5, 2.0)
 
 
 def touching_pairs(xml: bytes, assets: dict[str, bytes]) -> Checked:
@@ -127,8 +157,12 @@ def _touching(mujoco: Any, xml: bytes, assets: dict[str, bytes]) -> Checked:
     lows = _lowest_by_body(mujoco, model, data)
     below = [BelowBase(name(body), depth) for body, depth in _below_base(mujoco, model, data, lows)]
     lowest = _free_root_lowest(mujoco, model, lows)
-    return Checked(pairs, below=below,
-                   lowest=Lowest(lowest[0], name(lowest[1])) if lowest is not None else None)
+    rest = None
+    if lowest is not None:
+        soft = [SoftSupport(name(body), float(model.body_mass[body]), mass, ratio)
+                for body, mass, ratio in _soft_supports(model, lows, lowest[0])]
+        rest = Lowest(lowest[0], name(lowest[1]), soft)
+    return Checked(pairs, below=below, lowest=rest)
 
 
 def _lowest_by_body(mujoco: Any, model: Any, data: Any) -> dict[int, float]:
@@ -156,6 +190,30 @@ def _free_root_lowest(mujoco: Any, model: Any, lows: dict[int, float]) -> tuple[
         return None
     tree = [(low, body) for body, low in lows.items() if int(model.body_rootid[body]) == root]
     return min(tree) if tree else None
+
+
+def _soft_supports(model: Any, lows: dict[int, float], floor: float) -> list[tuple[int, float, float]]:
+    """(body, robot mass, load ratio) of each body of the free root's tree whose collision shapes reach
+    within :data:`SUPPORT_LEVEL` of ``floor`` and whose load ratio is above :data:`SOFT_LOAD_RATIO`, in
+    body order. Only bodies whose collision geoms all keep MuJoCo's default ``solref`` and ``solimp``
+    are judged: the ratios were measured with them (a wheeled robot's stiff contact, an MJCF source's
+    own values, change how far a body sinks)."""
+    root = int(model.jnt_bodyid[0])
+    mass = float(model.body_subtreemass[root])
+    out: list[tuple[int, float, float]] = []
+    for body, low in sorted(lows.items()):
+        if int(model.body_rootid[body]) != root or low - floor > SUPPORT_LEVEL:
+            continue
+        geoms = [g for g in range(int(model.body_geomadr[body]), int(model.body_geomadr[body])
+                                  + int(model.body_geomnum[body]))
+                 if model.geom_contype[g] or model.geom_conaffinity[g]]
+        if not all(np.allclose(model.geom_solref[g], DEFAULT_SOLREF)
+                   and np.allclose(model.geom_solimp[g], DEFAULT_SOLIMP) for g in geoms):
+            continue
+        ratio = mass * float(model.body_invweight0[body][0])
+        if ratio > SOFT_LOAD_RATIO:
+            out.append((body, mass, ratio))
+    return out
 
 
 def _below_base(mujoco: Any, model: Any, data: Any, lowest: dict[int, float]) -> list[tuple[int, float]]:

@@ -55,7 +55,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.friction import floor_friction
 from modelkit.convert.meshes import MESH_FOLDER
 from modelkit.convert.numbers import fmt, fmt_text
-from modelkit.convert.self_contact import BelowBase, touching_pairs
+from modelkit.convert.self_contact import SOFT_LOAD_RATIO, BelowBase, Lowest, touching_pairs
 from modelkit.convert.servo_gains import with_written_masses
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.convert.tracks import roller_names
@@ -249,6 +249,7 @@ class MjcfWriter:
         links = {el.get("name"): link for link, el in self.tree.bodies.items()}
         self._below_base(checked.below, links)
         self.home_key.rest_on_floor(checked.lowest)
+        self._soft_support(checked.lowest, links)
         for pair in checked.pairs:
             sub(self.sections["contact"], "exclude", body1=pair.body1, body2=pair.body2)
             link = self.robot.link(links.get(pair.body2) or "")
@@ -279,6 +280,27 @@ class MjcfWriter:
             "SRDF (--srdf FILE, --home STATE)",
             link.source if link is not None else self.robot.source,
             "keyframe",
+        )
+
+    def _soft_support(self, lowest: Lowest | None, links: dict[str | None, str]) -> None:
+        """MK883: a free robot stands at home on bodies so light that MuJoCo's contact gives way."""
+        if lowest is None or not lowest.soft:
+            return
+        first = max(lowest.soft, key=lambda each: each.ratio)
+        shown = " and ".join(f"{each.body} ({fmt(round(each.mass, 6))} kg, load ratio {each.ratio:.0f})"
+                             for each in lowest.soft)
+        link = self.robot.link(links.get(first.body) or "")
+        self.ctx.note(
+            "MK883",
+            f"the robot ({first.robot_mass:.4g} kg) stands at home on {shown}: MuJoCo softens a contact "
+            "by the inverse mass it moves, and this load ratio (the robot's mass times the body's "
+            f"body_invweight0) is above {SOFT_LOAD_RATIO:.0f}, where the robots measured standing on a "
+            "default floor reach 178 at most (HyQ's feet, 10 mm deep); with MuJoCo's default contact the "
+            "robot sinks into the floor and may fall (icub-models' iCubLisboa01, 10 g feet, load ratio "
+            "926: 33 mm, falls within 2 s). The source's masses are kept; a body as heavy as the "
+            "hardware's, or a stiffer solimp on its collision geoms (0.99 0.999), holds the robot",
+            link.source if link is not None else self.robot.source,
+            f"body[{first.body}]",
         )
 
     def _assets(self) -> dict[str, bytes]:
