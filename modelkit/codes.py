@@ -1803,6 +1803,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "icub-models' iCubLisboa01, 10 g feet, 926, sinks 33 mm and falls). The source's masses are kept.",
     ),
     CodeInfo(
+        "MK884",
+        "spawn-height",
+        "info",
+        "URDF, SDF, `.body`: a free robot's lowest collision shape at q = 0 is not on the ground where the "
+        "file (or a spawn at z = 0) puts its root; the note gives the root frame's height at which it "
+        "stands on z = 0, and how the target's tools take it (Gazebo's and PyBullet's spawn height, an SDF "
+        "model pose). MJCF's `home` key does this in the file (MK882).",
+    ),
+    CodeInfo(
         "MK890",
         "output-exists",
         "error",

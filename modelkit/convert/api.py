@@ -72,6 +72,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     never changed."""
     from modelkit.convert.base import settle_base
     from modelkit.convert.merge import merge_fixed_joints
+    from modelkit.convert.spawn import note_spawn_height
     from modelkit.convert.tracks import approximate_tracks
     from modelkit.convert.wheels import approximate_wheels
     from modelkit.formats.mjcf.site_frames import sites_as_links
@@ -88,6 +89,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     if not target.tracks_native:
         approximate_tracks(out, notes)
     approximate_wheels(out, options.wheel_collision, target.name, notes)
+    note_spawn_height(out, target, notes)
     if options.frame_sites and not target.sites_native:
         sites_as_links(out, notes)
     if not target.frames_native:

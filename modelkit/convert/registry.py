@@ -37,6 +37,8 @@ class TargetInfo:
     sites_native: bool = False  # the target holds MJCF sites itself (else they become frame links)
     frames_native: bool = False  # the target holds SDF <frame>s itself (else they become frame links)
     pair_exclusions_native: bool = False  # the target excludes one link pair's contacts (else MK867)
+    spawn: str = ""  # how a user stands a free robot on the ground, "{z}" its height (MK884); "": itself
+    places_root: bool = False  # the file places the root at the model's root pose
 
 
 def _target(declaration: FormatDeclaration) -> TargetInfo:
@@ -45,7 +47,7 @@ def _target(declaration: FormatDeclaration) -> TargetInfo:
         raise ValueError(f"format {declaration.name} declares no output")
     return TargetInfo(declaration.name, out.suffix, out.suffixes, out.writer, out.tracks_native,
                       out.auto_wheel, out.sites_native, out.frames_native,
-                      out.pair_exclusions_native)
+                      out.pair_exclusions_native, out.spawn, out.places_root)
 
 
 TARGETS: tuple[TargetInfo, ...] = tuple(_target(d) for d in WRITTEN)

@@ -25,6 +25,10 @@ class OutputDeclaration(NamedTuple):
     handles: frozenset[str] = frozenset()  # other formats' robot/link extras keys its writer notes itself
     handles_joint: frozenset[str] = frozenset()  # the same for joint extras keys
     walks_extras: bool = False  # its writer notes every other format's robot extras key itself
+    # how a user stands a free robot of this format on the ground, "{z}" the root frame's height (MK884);
+    # empty: the format does it itself (MJCF's home key, MK882)
+    spawn: str = ""
+    places_root: bool = False  # the file places the root at the model's root pose (else the user spawns it)
 
 
 class ExtrasDeclaration(NamedTuple):

@@ -13,6 +13,9 @@ FORMAT = FormatDeclaration(
         suffixes=(".body",),
         tracks_native=True,  # Choreonoid simulates pseudo continuous tracks (AISTSimulator)
         handles=frozenset({"gazebo", "mujoco"}),  # noted with the URDF's other blocks (_plugin_notes)
+        spawn=("the root link's `translation` z = {z}, or that height for the body item in a Choreonoid "
+               "project"),
+        places_root=True,  # the root link's translation/rotation is the root pose
     ),
     extras=ExtrasDeclaration(
         quiet_link=frozenset({"is_continuous_track"}),

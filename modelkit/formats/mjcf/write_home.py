@@ -27,12 +27,10 @@ import numpy as np
 from modelkit.convert.context import WriteContext
 from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.convert.self_contact import Lowest
+from modelkit.convert.spawn import HEIGHT_STEP, REST_TOLERANCE, rest_height
 from modelkit.formats.mjcf.write_xml import Element, quat_wxyz, sub
 from modelkit.model import Robot
 from modelkit.spatial import Pose
-
-REST_TOLERANCE = 1e-4  # m: a free robot this close to resting on z = 0 at q = 0 gets no key for it
-HEIGHT_STEP = 1e-6  # m: the key's base height is rounded up to this
 
 
 class HomeKey:
@@ -78,7 +76,7 @@ class HomeKey:
         if abs(lowest.height) <= (HEIGHT_STEP if self.key is not None else REST_TOLERANCE):
             return  # it rests on z = 0 already
         source = self.qpos[2]
-        self.qpos[2] = math.ceil(round((source - lowest.height) / HEIGHT_STEP, 3)) * HEIGHT_STEP
+        self.qpos[2] = rest_height(source - lowest.height)
         self._element()
         depth = fmt(round(abs(lowest.height) * 1000.0, 1))
         where = f"{depth} mm {'below' if lowest.height < 0 else 'above'} it"

@@ -15,6 +15,9 @@ FORMAT = FormatDeclaration(
         frames_native=True,
         handles=frozenset({"gazebo"}),  # a URDF's <gazebo> blocks: written or noted (write_self_collide)
         handles_joint=frozenset({"gazebo"}),  # a URDF joint's: written as libsdformat does, or noted
+        spawn=("a model <pose> (or an <include>'s <pose> in a world) at z = {z}, or ros_gz_sim's "
+               "`create -z {z}`"),
+        places_root=True,  # the model <pose> is the root pose
     ),
     extras=ExtrasDeclaration(
         quiet=frozenset({"sdf_canonical_link", "sdf_version", "sdf_model_pose", "sdf_world_joint"}),

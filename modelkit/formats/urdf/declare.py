@@ -14,6 +14,8 @@ FORMAT = FormatDeclaration(
         suffixes=(".urdf",),
         auto_wheel="sphere",  # PyBullet loads URDF: a cylinder rolling on a plane gets odd contacts there
         walks_extras=True,
+        spawn=("ros_gz_sim's `create -z {z}` (Gazebo), gazebo_ros's `spawn_entity.py -z {z}` (Gazebo "
+               "classic), `loadURDF(..., basePosition=[0, 0, {z}])` (PyBullet)"),
     ),
     extras=ExtrasDeclaration(
         # the version is bookkeeping; the named materials, transmissions and <ros2_control> are kept for
