@@ -1812,6 +1812,23 @@ _TABLE: tuple[CodeInfo, ...] = (
         "model pose). MJCF's `home` key does this in the file (MK882).",
     ),
     CodeInfo(
+        "MK885",
+        "wheel-not-round",
+        "warning",
+        "A free robot's wheel (a joint turning without end on a horizontal axis, its link on the ground) "
+        "collides as a shape whose reach from the axis changes as it turns by more than 10 % (Hello Robot "
+        "Stretch: a box around a round wheel, 50.8 to 71.8 mm): rolling lifts the robot and drops it, in "
+        "every simulator. Nothing is changed.",
+    ),
+    CodeInfo(
+        "MK886",
+        "chassis-on-ground",
+        "warning",
+        "A free wheeled robot's chassis (the root link's collision shapes other than spheres) reaches the "
+        "ground its wheels stand on at q = 0: on a floor it rests there beside them and drags as they "
+        "turn, in every simulator. Nothing is changed.",
+    ),
+    CodeInfo(
         "MK890",
         "output-exists",
         "error",

@@ -72,6 +72,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     never changed."""
     from modelkit.convert.base import settle_base
     from modelkit.convert.merge import merge_fixed_joints
+    from modelkit.convert.rolling import note_rolling_faults
     from modelkit.convert.spawn import note_spawn_height
     from modelkit.convert.tracks import approximate_tracks
     from modelkit.convert.wheels import approximate_wheels
@@ -86,6 +87,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
                    "has)", robot.collision_exclusions[0].source, "collision")
     out = copy.deepcopy(robot)
     settle_base(out, options.base, notes)
+    note_rolling_faults(out, notes)
     if not target.tracks_native:
         approximate_tracks(out, notes)
     approximate_wheels(out, options.wheel_collision, target.name, notes)
