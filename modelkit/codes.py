@@ -1806,8 +1806,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK884",
         "spawn-height",
         "info",
-        "URDF, SDF, `.body`: a free robot's lowest collision shape at q = 0 is not on the ground where the "
-        "file (or a spawn at z = 0) puts its root; the note gives the root frame's height at which it "
+        "URDF, SDF, `.body`: a free robot's lowest collision shape at q = 0 starts inside the ground where "
+        "the file (or a spawn at z = 0) puts its root; the note gives the root frame's height at which it "
         "stands on z = 0, and how the target's tools take it (Gazebo's and PyBullet's spawn height, an SDF "
         "model pose). MJCF's `home` key does this in the file (MK882).",
     ),

@@ -33,7 +33,9 @@ def rest_height(height: float) -> float:
 
 def note_spawn_height(robot: Robot, target: TargetInfo, notes: NoteSink) -> None:
     """MK884 for a free robot of a target without a ``home`` key whose lowest collision shape at q = 0
-    is not on z = 0 where the written file (or a spawn at 0) puts its root."""
+    starts more than :data:`REST_TOLERANCE` inside the ground where the written file (or a spawn at 0)
+    puts its root: the simulator throws it out. A robot that starts above the ground drops onto it and
+    is not told."""
     from modelkit.convert.numbers import fmt
     from modelkit.convert.wheels import link_lows
 
@@ -46,10 +48,9 @@ def note_spawn_height(robot: Robot, target: TargetInfo, notes: NoteSink) -> None
     root_z = float(robot.root_pose.translation[2])
     placed = root_z if target.places_root else 0.0  # where the root frame starts without the user
     height = rest_height(root_z - low)  # the root frame's height at which the lowest shape touches z = 0
-    if abs(placed - height) <= REST_TOLERANCE:
-        return
-    gap = (placed - height) * 1000.0
-    where = f"{fmt(round(abs(gap), 1))} mm {'above' if gap > 0 else 'inside'} the ground"
+    if placed >= height - REST_TOLERANCE:
+        return  # on the ground, or above it: the robot drops onto it (SR1's .body root, 5 mm)
+    where = f"{fmt(round((height - placed) * 1000.0, 1))} mm inside the ground"
     start = (f"where the file puts its root (z = {fmt(round(placed, 6))} m)" if target.places_root
              else "when spawned at z = 0")
     link = robot.link(body)
