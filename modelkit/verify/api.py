@@ -500,7 +500,8 @@ def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence
         report.skips.append(Skip(4, "all", f"layer 4 (driven scenarios) not run: {exc}"))
         return
     chosen = chosen or scenarios.default_scenario(drive.kind, bool(drive.pan or drive.tilt))
-    why = vehicle.supported(robot, drive) or vehicle.drivable(robot, drive, chosen)
+    why = (vehicle.supported(robot, drive) or vehicle.drivable(robot, drive, chosen)
+           or vehicle.caster_drag(robot, drive))
     if why is not None:
         report.skips.append(Skip(4, "all", f"layer 4 (driven scenarios) not run: {why}"))
         return

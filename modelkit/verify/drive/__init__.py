@@ -151,6 +151,7 @@ class Drive:
     rollers: dict[str, tuple[str, ...]] = field(default_factory=dict)
     roller_radius: float = 0.0
     track_offset_y: float = 0.0
+    casters: tuple[str, ...] = ()  # caster wheel joints (round, about Y, on a swivel): not driven
 
     def as_dict(self) -> dict[str, Any]:
         """Plain data (for the report and for an engine's child process)."""
@@ -160,6 +161,7 @@ class Drive:
             "pan": self.pan, "tilt": self.tilt,
             "rollers": {k: list(v) for k, v in sorted(self.rollers.items())},
             "roller_radius": self.roller_radius, "track_offset_y": self.track_offset_y,
+            "casters": list(self.casters),
         }
 
     @staticmethod
@@ -172,6 +174,7 @@ class Drive:
             rollers={k: tuple(v) for k, v in data.get("rollers", {}).items()},
             roller_radius=float(data.get("roller_radius", 0.0)),
             track_offset_y=float(data.get("track_offset_y", 0.0)),
+            casters=tuple(data.get("casters", ())),
         )
 
 

@@ -8,8 +8,11 @@ Skip). Everything is measured in the root link's frame at q = 0:
   whose axis lies along the joint axis, a sphere, or a mesh whose extent around the axis is round,
   read from its file when the model holds only the path: Hello Robot's Stretch), axes parallel to
   the root's Y, hanging from the root's rigid body (not from a steering joint or a leg), one on each
-  side (mirrored in Y); :func:`supported` then says when nothing but the wheels reaches the floor
-  (the robot would tip over) and :func:`drivable` when the scenario's wheel law cannot turn them.
+  side (mirrored in Y); caster wheels (round, about Y at q = 0, but hanging from a swivel joint, as
+  TIAGo's four) are left out when more than two are found; :func:`supported` then says when nothing
+  but the wheels reaches the floor (the robot would tip over), :func:`drivable` when the scenario's
+  wheel law cannot turn them, and :func:`caster_drag` when casters slide with friction (the no-slip
+  reference has none).
   Left is the one at +Y. The radius comes from the collision (cylinder or sphere radius, half the
   mesh's extent across the axis); the half axle width b is half the distance between the two
   collision centres along Y. ``signs``: +1 when the joint axis points along +Y (a positive rotation
@@ -70,6 +73,7 @@ def find_drive(robot: Robot, scenario: Scenario, prepared: Robot | None = None) 
         rollers=drive.rollers,
         roller_radius=drive.roller_radius,
         track_offset_y=drive.track_offset_y,
+        casters=drive.casters,
     )
 
 
@@ -83,6 +87,31 @@ def _axis_in_root(joint: Joint, frames: dict[str, Pose]) -> np.ndarray:
     if norm == 0.0:
         return axis
     return np.asarray(frames[joint.child].rotation @ (axis / norm))
+
+
+def _joints_above(robot: Robot, joint: Joint, body: set[str] | list[str]) -> list[Joint]:
+    """The moving joints between the root's rigid body and ``joint``'s parent link, lowest first."""
+    parent_of = {j.child: j for j in robot.joints}
+    out: list[Joint] = []
+    link = joint.parent
+    while link not in body and link in parent_of and len(out) <= len(robot.joints):
+        above = parent_of[link]
+        if above.type.moves:
+            out.append(above)
+        link = above.parent
+    return out
+
+
+def _turned_above(robot: Robot, joint: Joint, body: set[str] | list[str]) -> bool:
+    """Whether a joint that turns (not a suspension's slide) lies between the root's body and ``joint``."""
+    return any(j.type is not JointType.PRISMATIC for j in _joints_above(robot, joint, body))
+
+
+def _swivels(robot: Robot, joint: Joint, body: set[str] | list[str], frames: dict[str, Pose]) -> bool:
+    """A caster wheel: it hangs from a joint turning without end about the vertical (TIAGo's four)."""
+    return any(j.type is JointType.REVOLUTE and not j.limits.position_limited
+               and _parallel(_axis_in_root(j, frames), (0.0, 0.0, 1.0))
+               for j in _joints_above(robot, joint, body))
 
 
 def _parallel(a: np.ndarray, b: np.ndarray | Sequence[float]) -> bool:
@@ -154,6 +183,37 @@ def drivable(robot: Robot, drive: Drive, scenario: Scenario) -> str | None:
     return None
 
 
+def caster_drag(robot: Robot, drive: Drive) -> str | None:
+    """Why the no-slip reference cannot stand for a robot on swivel casters (None when it can): the
+    reference has no casters, and a caster whose contact slides with friction while it swivels drags
+    the robot and loads its wheels differently under the drive law. Measured on example-robot-data's
+    TIAGo dual (four casters, the source's friction 0.1): MuJoCo's heading ended 55 mrad of 5 rad from
+    the reference on the spin; with the casters' friction set to 0 in the source, 0.45 mrad. Casters
+    whose every collision shape has a friction of 0 are driven and graded."""
+    if not drive.casters:
+        return None
+    joints = {j.name: j for j in robot.joints}
+    links = {link.name: link for link in robot.links}
+    sliding: dict[str, str] = {}
+    for name in drive.casters:
+        joint = joints.get(name)
+        link = links.get(joint.child) if joint is not None else None
+        if link is None:
+            continue
+        found = {("the engine's default" if g.friction is None else f"{g.friction.sliding:g}")
+                 for g in link.collisions if g.friction is None or g.friction.sliding != 0.0}
+        if found:
+            sliding[name] = " and ".join(sorted(found))
+    if not sliding:
+        return None
+    shown = ", ".join(f"{name} ({mu})" for name, mu in sorted(sliding.items()))
+    return (f"the robot stands on {len(drive.casters)} swivel caster(s) whose contact slides with friction "
+            f"while they swivel ({shown}), and the rigid no-slip reference has no casters: their drag "
+            "turns the wheels differently under the drive law, so a driven comparison would grade the "
+            "reference's omission (example-robot-data's TIAGo dual: MuJoCo's heading 55 mrad from the "
+            "reference after a 5 rad spin; 0.45 mrad with frictionless casters)")
+
+
 def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
     links = {link.name: link for link in robot.links}
     joints = {j.name: j for j in robot.joints}
@@ -189,8 +249,15 @@ def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
             shape = (scenario.wheel_radius, np.zeros(3))
         centre = frame.rotation @ shape[1] + frame.translation
         found.append((j, shape[0], centre))
+    body = root_body(robot)
+    casters: list[str] = []
+    if named[0] is None and len(found) > 2:  # caster wheels swivel about a vertical joint
+        casters = [j.name for j, _, _ in found if _swivels(robot, j, body, frames)]
+        found = [f for f in found if f[0].name not in casters]
     if named[0] is None and len(found) != 2:
         what = ", ".join(j.name for j, _, _ in found) or "none"
+        if casters:
+            what += f"; caster wheels, which hang from a moving joint, left out: {', '.join(casters)}"
         if unround:
             what += (f"; {', '.join(unround)} turn(s) about Y, but no collision shape of its link is round "
                      f"about the axis: a cylinder, a sphere or a mesh whose reach across the axis varies by "
@@ -202,13 +269,12 @@ def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
         )
     if len(found) != 2:
         raise ValueError("the scenario's wheel joints have no round collision shape: give robot.wheel_radius")
-    body = root_body(robot)
-    steered = [j.name for j, _, _ in found if j.parent not in body]
+    steered = [j.name for j, _, _ in found if _turned_above(robot, j, body)]
     if named[0] is None and steered:
         raise ValueError(
-            f"not a differential drive: the wheel joint(s) {', '.join(steered)} hang from a moving joint (a "
-            "steering joint or a leg), not from the root's body; name the wheels in the scenario "
-            "(robot.left, robot.right) to drive them anyway"
+            f"not a differential drive: the wheel joint(s) {', '.join(steered)} hang from a turning joint (a "
+            "steering joint or a leg), not from the root's body or a suspension; name the wheels in the "
+            "scenario (robot.left, robot.right) to drive them anyway"
         )
     if named[0] is None:
         found.sort(key=lambda f: -float(f[2][1]))  # left (+Y) first
@@ -241,6 +307,7 @@ def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
         half_axle=float(half_axle),
         wheel_links=(left.child, right.child),
         signs=(signs[0], signs[1]),
+        casters=tuple(casters),
     )
 
 
