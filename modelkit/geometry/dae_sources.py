@@ -23,7 +23,7 @@ listed for the loader's notes.
 from __future__ import annotations
 
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
@@ -31,6 +31,18 @@ import numpy as np
 
 # pycollada's loaders are class attributes: one document at a time (a re-entrant lock: the patches nest)
 _PATCH = threading.RLock()
+
+
+@contextmanager
+def _patched(owner: Any, name: str, replacement: Callable[..., Any]) -> Iterator[None]:
+    """``owner.name`` is the static method ``replacement`` inside the block, one document at a time."""
+    with _PATCH:
+        original = getattr(owner, name)
+        setattr(owner, name, staticmethod(replacement))
+        try:
+            yield
+        finally:
+            setattr(owner, name, staticmethod(original))
 
 
 def _positions(mesh: Any, collada: Any) -> set[str]:
@@ -78,12 +90,8 @@ def positions_only() -> Iterator[None]:
         stub.data = np.zeros((numbers // len(params), len(stub.components)), dtype=np.float32)
         return stub
 
-    with _PATCH:
-        dae.FloatSource.load = staticmethod(load)
-        try:
-            yield
-        finally:
-            dae.FloatSource.load = staticmethod(original)
+    with _patched(dae.FloatSource, "load", load):
+        yield
 
 
 @contextmanager
@@ -104,9 +112,5 @@ def materials_optional(missing: list[str]) -> Iterator[None]:
             return scene.MaterialNode(node.get("symbol"), None, inputs, xmlnode=node)
         return original(collada, node)
 
-    with _PATCH:
-        scene.MaterialNode.load = staticmethod(load)
-        try:
-            yield
-        finally:
-            scene.MaterialNode.load = staticmethod(original)
+    with _patched(scene.MaterialNode, "load", load):
+        yield
