@@ -1799,7 +1799,7 @@ _TABLE: tuple[CodeInfo, ...] = (
         "warning",
         "MJCF: a free robot stands at home on a body so light that MuJoCo's default contact gives way under "
         "the robot's weight: MuJoCo softens a contact by the inverse mass it moves, and the robot's mass "
-        "times the body's `body_invweight0` is above 400 (the robots measured standing reach 178; "
+        "times the body's `body_invweight0` is above 400 (the robots measured standing reach 177; "
         "icub-models' iCubLisboa01, 10 g feet, 926, sinks 33 mm and falls). The source's masses are kept.",
     ),
     CodeInfo(
@@ -1815,16 +1815,17 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK885",
         "wheel-not-round",
         "warning",
-        "A free robot's wheel (a joint turning without end on a horizontal axis, its link on the ground) "
-        "collides as a shape whose reach from the axis changes as it turns by more than 10 % (Hello Robot "
-        "Stretch: a box around a round wheel, 50.8 to 71.8 mm): rolling lifts the robot and drops it, in "
-        "every simulator. Nothing is changed.",
+        "A free robot's wheel (a joint turning without end on a horizontal axis, its link on the ground, "
+        "its visual round) collides as a shape whose reach from the axis changes as it turns by more than "
+        "10 % (Hello Robot Stretch: a box around a round wheel, 50.8 to 71.8 mm): rolling lifts the robot "
+        "and drops it, in every simulator. Nothing is changed.",
     ),
     CodeInfo(
         "MK886",
         "chassis-on-ground",
         "warning",
-        "A free wheeled robot's chassis (the root link's collision shapes other than spheres) reaches the "
+        "A free wheeled robot's chassis (the root link's collision shapes other than those that roll: a "
+        "sphere, a cylinder or capsule on its side) reaches the "
         "ground its wheels stand on at q = 0: on a floor it rests there beside them and drags as they "
         "turn, in every simulator. Nothing is changed.",
     ),

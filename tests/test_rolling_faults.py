@@ -103,9 +103,10 @@ def axle_heights(path: Path) -> tuple[float, float]:
 
 
 def test_the_square_wheel_lifts_the_written_robot(tmp_path: Path) -> None:
-    """The user's step: the MJCF with the source's shapes (--wheel-collision cylinder keeps them) rolled
-    on a plane: the square wheels lift the axle by what MK885 says (20.7 mm; measured 20.9), the round
-    ones by nothing."""
+    """The user's step: the MJCF ``convert`` writes with its default options (the square wheels are no
+    wheels to it and keep their boxes; the round ones become spheres, MK826), rolled on a plane: the
+    square wheels lift the axle by what MK885 says (20.7 mm; measured 20.9), the round ones by
+    nothing."""
     from click.testing import CliRunner
 
     from modelkit.cli import main
@@ -113,8 +114,7 @@ def test_the_square_wheel_lifts_the_written_robot(tmp_path: Path) -> None:
     lifts = {}
     for shape in (SQUARE, ROUND):
         out = tmp_path / ("box" if shape == SQUARE else "round") / "r.xml"
-        result = CliRunner().invoke(main, ["convert", str(rover(tmp_path, shape, 0.1)), "-o", str(out),
-                                           "--wheel-collision", "cylinder"])
+        result = CliRunner().invoke(main, ["convert", str(rover(tmp_path, shape, 0.1)), "-o", str(out)])
         assert result.exit_code == 0, result.output
         low, high = axle_heights(out)
         lifts[shape] = high - low

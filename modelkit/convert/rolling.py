@@ -41,8 +41,7 @@ TILT = 0.05  # |world axis · z| below this: a horizontal axis (about 3°)
 
 def note_rolling_faults(robot: Robot, notes: NoteSink) -> None:
     """MK885 for each wheel that is not round, MK886 for a chassis on the wheels' ground."""
-    from modelkit.convert.tracks import roller_names
-    from modelkit.convert.wheels import GROUND_LEVEL, link_lows
+    from modelkit.convert.wheels import GROUND_LEVEL, endless_axles, link_lows
 
     if robot.root is None or robot.root_joint is not JointType.FLOATING:
         return
@@ -51,22 +50,13 @@ def note_rolling_faults(robot: Robot, notes: NoteSink) -> None:
     if not lows:
         return
     floor = min(lows.values())
-    rollers = roller_names(robot, "roller_links")
     links = {link.name: link for link in robot.links}
     wheels: list[str] = []
-    for joint in robot.joints:
-        link = links.get(joint.child)
-        pose = poses.get(joint.child)
-        if (joint.type is not JointType.REVOLUTE or joint.limits.position_limited or joint.mimic is not None
-                or link is None or pose is None or link.name in rollers or link.name not in lows
-                or lows[link.name] - floor > GROUND_LEVEL):
-            continue
-        axis = np.asarray(joint.axis, dtype=float)
-        norm = float(np.linalg.norm(axis))
-        if norm == 0.0 or abs(float(pose.rotation @ (axis / norm) @ np.array([0.0, 0.0, 1.0]))) > TILT:
-            continue
-        collided = _reach(link.collisions, axis / norm)
-        drawn = _reach(link.visuals, axis / norm)
+    for joint, link, _, axis in endless_axles(robot, poses, TILT):
+        if link.name not in lows or lows[link.name] - floor > GROUND_LEVEL:
+            continue  # off the ground
+        collided = _reach(link.collisions, axis)
+        drawn = _reach(link.visuals, axis)
         if not (_round(collided) or _round(drawn)):
             continue  # a leg on a joint without a range (pybullet_data's y-up Laikago), not a wheel
         wheels.append(link.name)

@@ -22,11 +22,12 @@ MuJoCo softens a contact in proportion to the inverse mass the contact moves (it
 regularisation is ``(1 − d) / d`` times the diagonal of the inverse inertia in contact space, which
 the compiler estimates per body as ``body_invweight0``). So under a robot's weight a body sinks in
 proportion to the robot's mass times that body's ``body_invweight0``: a dimensionless *load ratio*,
-1 for a rigid block resting on the floor. Measured with MuJoCo's default contact on the 128 free
+1 for a rigid block resting on the floor. Measured with MuJoCo's default contact on the 133 free
 robots of example-robot-data, pybullet_data, the shared corpus and icub-models 3.2.0 reset to
-``home`` on a plain floor (docs/convert.md): every robot that stands has a ratio of at most 178
-(HyQ's feet, 10 mm of sink; quadrupeds 40 to 180, humanoids 7 to 33); icub-models' iCubLisboa01,
-whose source gives each foot 10 g, has 926: its feet sink 33 mm and it falls within 2 s.
+``home`` on a plain floor for 2 s (``bench/bench_home_floor.py``, docs/convert.md): every robot that
+stands has a ratio of at most 177 (HyQ, 10.9 mm of sink; quadrupeds 31 to 137, humanoids 7.5 to 33);
+icub-models' iCubLisboa01, whose source gives each foot 10 g, has 926: its feet sink 33 mm and it
+falls at 1.1 s.
 """
 
 from __future__ import annotations
@@ -92,7 +93,7 @@ BELOW_TOLERANCE = 1e-3  # m: what a collision shape may reach below the base bef
 SUPPORT_LEVEL = 1e-3  # m: a body whose collision shapes reach this close to the lowest point stands there
 SOFT_LOAD_RATIO = 400.0
 """MK883: the load ratio above which a support body's contact is said to be too soft: more than twice the
-largest of the robots measured standing (178), less than half of the one that falls (926)."""
+largest of the robots measured standing (177), less than half of the one that falls (926)."""
 DEFAULT_SOLREF = (0.02, 1.0)
 DEFAULT_SOLIMP = (0.9, 0.95, 0.001, 0.5, 2.0)
 

@@ -35,6 +35,7 @@ Every replaced shape gets an MK826 note; the wheels found are recorded in
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -45,7 +46,7 @@ from modelkit.convert.notes import NoteSink
 from modelkit.convert.registry import TARGETS
 from modelkit.convert.tracks import roller_names
 from modelkit.geometry.extents import ROUNDNESS, Round, across, extent, round_about
-from modelkit.model import Cylinder, Ellipsoid, Geom, JointType, Mesh, Robot, Sphere
+from modelkit.model import Cylinder, Ellipsoid, Geom, Joint, JointType, Link, Mesh, Robot, Sphere
 from modelkit.spatial import Pose
 
 WHEELS_KEY = "wheels"
@@ -101,6 +102,29 @@ class Wheel:
     axis: np.ndarray  # unit, link frame
 
 
+def endless_axles(robot: Robot, poses: dict[str, Pose], tilt: float
+                  ) -> Iterator[tuple[Joint, Link, Pose, np.ndarray]]:
+    """(joint, child link, its pose, unit axis in the link frame) of each joint that could carry a wheel:
+    a revolute joint without a range, not a mimic follower, not a track roller ``convert.tracks``
+    wrote, its axis within ``tilt`` (|axis · z|) of horizontal at ``poses``. The wheel rules here and
+    :mod:`modelkit.convert.rolling` judge the shapes on them."""
+    rollers = roller_names(robot, "roller_links")
+    links = {link.name: link for link in robot.links}
+    z = np.array([0.0, 0.0, 1.0])
+    for joint in robot.joints:
+        link = links.get(joint.child)
+        pose = poses.get(joint.child)
+        if (joint.type is not JointType.REVOLUTE or joint.limits.position_limited or joint.mimic is not None
+                or link is None or pose is None or link.name in rollers):
+            continue
+        norm = float(np.linalg.norm(np.asarray(joint.axis, dtype=float)))
+        if norm == 0.0:
+            continue
+        axis = np.asarray(joint.axis, dtype=float) / norm
+        if abs(float((pose.rotation @ axis) @ z)) <= tilt:
+            yield joint, link, pose, axis
+
+
 def find_wheels(robot: Robot) -> dict[str, Wheel]:
     """Wheel link → its :class:`Wheel`."""
     if robot.root is None or robot.root_joint is JointType.FIXED:
@@ -109,22 +133,9 @@ def find_wheels(robot: Robot) -> dict[str, Wheel]:
     floor = _lowest(robot, poses)
     if floor is None:
         return {}
-    rollers = roller_names(robot, "roller_links")
-    links = {link.name: link for link in robot.links}
     z = np.array([0.0, 0.0, 1.0])
     out: dict[str, Wheel] = {}
-    for joint in robot.joints:
-        link = links.get(joint.child)
-        pose = poses.get(joint.child)
-        if (joint.type is not JointType.REVOLUTE or joint.limits.position_limited or joint.mimic is not None
-                or link is None or pose is None or link.name in rollers):
-            continue
-        axis = np.asarray(joint.axis, dtype=float)
-        if float(np.linalg.norm(axis)) == 0.0:
-            continue
-        axis = axis / float(np.linalg.norm(axis))
-        if abs(float((pose.rotation @ axis) @ z)) > HORIZONTAL:
-            continue
+    for joint, link, pose, axis in endless_axles(robot, poses, HORIZONTAL):
         best: Wheel | None = None
         for i, geom in enumerate(link.collisions):
             shape = round_about(geom, axis, PARALLEL)

@@ -295,7 +295,7 @@ class MjcfWriter:
             f"the robot ({first.robot_mass:.4g} kg) stands at home on {shown}: MuJoCo softens a contact "
             "by the inverse mass it moves, and this load ratio (the robot's mass times the body's "
             f"body_invweight0) is above {SOFT_LOAD_RATIO:.0f}, where the robots measured standing on a "
-            "default floor reach 178 at most (HyQ's feet, 10 mm deep); with MuJoCo's default contact the "
+            "default floor reach 177 at most (HyQ's feet, 10.9 mm deep); with MuJoCo's default contact the "
             "robot sinks into the floor and may fall (icub-models' iCubLisboa01, 10 g feet, load ratio "
             "926: 33 mm, falls within 2 s). The source's masses are kept; a body as heavy as the "
             "hardware's, or a stiffer solimp on its collision geoms (0.99 0.999), holds the robot",

@@ -29,6 +29,7 @@ Skip). Everything is measured in the root link's frame at q = 0:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 
@@ -60,21 +61,7 @@ def find_drive(robot: Robot, scenario: Scenario, prepared: Robot | None = None) 
     else:
         drive = _wheels(robot, scenario, frames)
     pan, tilt = _pan_tilt(robot, scenario, frames, {drive.left, drive.right})
-    return Drive(
-        kind=drive.kind,
-        left=drive.left,
-        right=drive.right,
-        radius=drive.radius,
-        half_axle=drive.half_axle,
-        wheel_links=drive.wheel_links,
-        signs=drive.signs,
-        pan=pan,
-        tilt=tilt,
-        rollers=drive.rollers,
-        roller_radius=drive.roller_radius,
-        track_offset_y=drive.track_offset_y,
-        casters=drive.casters,
-    )
+    return dataclasses.replace(drive, pan=pan, tilt=tilt)
 
 
 # ----------------------------------------------------------------------------------------------------
@@ -89,25 +76,27 @@ def _axis_in_root(joint: Joint, frames: dict[str, Pose]) -> np.ndarray:
     return np.asarray(frames[joint.child].rotation @ (axis / norm))
 
 
-def _joints_above(robot: Robot, joint: Joint, body: set[str] | list[str]) -> list[Joint]:
+def _joints_above(robot: Robot, joint: Joint, body: set[str]) -> list[Joint]:
     """The moving joints between the root's rigid body and ``joint``'s parent link, lowest first."""
     parent_of = {j.child: j for j in robot.joints}
     out: list[Joint] = []
     link = joint.parent
-    while link not in body and link in parent_of and len(out) <= len(robot.joints):
-        above = parent_of[link]
+    for _ in range(len(robot.joints)):  # a walk up a tree: at most one step per joint
+        above = parent_of.get(link)
+        if link in body or above is None:
+            break
         if above.type.moves:
             out.append(above)
         link = above.parent
     return out
 
 
-def _turned_above(robot: Robot, joint: Joint, body: set[str] | list[str]) -> bool:
+def _turned_above(robot: Robot, joint: Joint, body: set[str]) -> bool:
     """Whether a joint that turns (not a suspension's slide) lies between the root's body and ``joint``."""
     return any(j.type is not JointType.PRISMATIC for j in _joints_above(robot, joint, body))
 
 
-def _swivels(robot: Robot, joint: Joint, body: set[str] | list[str], frames: dict[str, Pose]) -> bool:
+def _swivels(robot: Robot, joint: Joint, body: set[str], frames: dict[str, Pose]) -> bool:
     """A caster wheel: it hangs from a joint turning without end about the vertical (TIAGo's four)."""
     return any(j.type is JointType.REVOLUTE and not j.limits.position_limited
                and _parallel(_axis_in_root(j, frames), (0.0, 0.0, 1.0))
@@ -249,7 +238,7 @@ def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
             shape = (scenario.wheel_radius, np.zeros(3))
         centre = frame.rotation @ shape[1] + frame.translation
         found.append((j, shape[0], centre))
-    body = root_body(robot)
+    body = set(root_body(robot))
     casters: list[str] = []
     if named[0] is None and len(found) > 2:  # caster wheels swivel about a vertical joint
         casters = [j.name for j, _, _ in found if _swivels(robot, j, body, frames)]
@@ -257,7 +246,7 @@ def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
     if named[0] is None and len(found) != 2:
         what = ", ".join(j.name for j, _, _ in found) or "none"
         if casters:
-            what += f"; caster wheels, which hang from a moving joint, left out: {', '.join(casters)}"
+            what += f"; caster wheels, which hang from a swivel joint, left out: {', '.join(casters)}"
         if unround:
             what += (f"; {', '.join(unround)} turn(s) about Y, but no collision shape of its link is round "
                      f"about the axis: a cylinder, a sphere or a mesh whose reach across the axis varies by "
