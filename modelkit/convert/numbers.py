@@ -187,12 +187,13 @@ def _as_written(angle: float) -> str:
     if angle:
         turned = angle - math.copysign(2.0 * math.pi, angle)
         short = _short(turned)
-        if short is not None and _digits(short) <= WRITTEN_DIGITS and _digits(fmt(turned)) < _digits(text):
+        if (short is not None and significant_digits(short) <= WRITTEN_DIGITS
+                and significant_digits(fmt(turned)) < significant_digits(text)):
             return fmt(turned)
     return text
 
 
-def _digits(number: str) -> int:
+def significant_digits(number: str) -> int:
     """Significant digits of a number's text (``-0.05236`` → 4)."""
     return len(number.split("e")[0].replace("-", "").replace(".", "").lstrip("0"))
 

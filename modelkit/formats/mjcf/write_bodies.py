@@ -18,7 +18,8 @@
 * Inertials: ``<inertial pos mass diaginertia>`` when the tensor is diagonal, else ``fullinertia="Ixx
   Iyy Izz Ixy Ixz Iyz"``, or ``quat`` and ``diaginertia`` (the principal axes and moments) when a
   product is under 1e-9 kg·m² and that form is clean, or the smallest moment is nearly zero
-  (:func:`_principal`); MuJoCo never recomputes them (``inertiafromgeom="false"``). A massless link on
+  (:func:`_principal`), or its numbers are plainer (a source's own ``quat``/``diaginertia``:
+  :mod:`.principal_text`); MuJoCo never recomputes them (``inertiafromgeom="false"``). A massless link on
   a fixed joint is a body without ``<inertial>`` (MK816). MuJoCo refuses a moving body whose weld
   group (the body and what is welded to it) has no mass or a singular inertia; such a body gets
   ``MIN_MASS`` kg and/or ``MIN_INERTIA`` kg·m² on each principal axis at its origin (MK816 / MK819,
@@ -48,6 +49,7 @@ from modelkit.convert.context import WriteContext
 from modelkit.convert.frames import frame_links
 from modelkit.convert.numbers import clean_inertia, fmt, fmt_direction, fmt_position, fmt_tensor, fmt_vec
 from modelkit.convert.servo_gains import home_position
+from modelkit.formats.mjcf.principal_text import principal_text
 from modelkit.formats.mjcf.site_frames import named_frames, own_sites, site_pose
 from modelkit.formats.mjcf.write_chains import Chain, ChainFinder, shifted
 from modelkit.formats.mjcf.write_devices import DeviceWriter
@@ -667,7 +669,12 @@ class BodyTree:
             el.set("quat", fmt_vec(quat_wxyz(axes)))
             el.set("diaginertia", fmt_tensor(moments, tensor))
         elif any(v != 0.0 for v in off):
-            el.set("fullinertia", fmt_tensor([tensor[0, 0], tensor[1, 1], tensor[2, 2], *off], tensor))
+            plain = principal_text(tensor, *principal_axes_near_link(tensor))
+            if plain is not None:
+                el.set("quat", plain[0])
+                el.set("diaginertia", plain[1])
+            else:
+                el.set("fullinertia", fmt_tensor([tensor[0, 0], tensor[1, 1], tensor[2, 2], *off], tensor))
         else:
             el.set("diaginertia", fmt_tensor([tensor[0, 0], tensor[1, 1], tensor[2, 2]], tensor))
 

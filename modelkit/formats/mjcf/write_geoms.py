@@ -50,7 +50,7 @@ from modelkit.convert.numbers import fmt, fmt_vec
 from modelkit.diagnostics import SourceLocation
 from modelkit.formats.mjcf.bodies import GEOM_CONTACT_DEFAULTS
 from modelkit.formats.mjcf.write_names import NameTable
-from modelkit.formats.mjcf.write_xml import Element, set_pose, sub
+from modelkit.formats.mjcf.write_xml import Element, set_pose, sub, use_fromto
 from modelkit.model import (
     Box,
     Capsule,
@@ -151,6 +151,8 @@ class GeomWriter:
         for key, value in shape.items():
             el.set(key, value)
         set_pose(el, geom.pose @ offset)
+        if isinstance(geom.geometry, Cylinder | Capsule) and shape["type"] != "sphere":
+            use_fromto(el, geom.pose @ offset, geom.geometry.length / 2.0)
         role = COLLISION if collision else VISUAL
         el.set("class", role)
         self.used.add(role)

@@ -7,8 +7,17 @@ import math
 import numpy as np
 from lxml import etree
 
-from modelkit.convert.numbers import SNAP, clean_rotation, fmt, fmt_position, fmt_rpy, fmt_vec
-from modelkit.spatial import Mat3, Pose, axis_angle, matrix_from_rpy
+from modelkit.convert.numbers import (
+    SNAP,
+    ZERO,
+    clean_rotation,
+    fmt,
+    fmt_position,
+    fmt_rpy,
+    fmt_vec,
+    significant_digits,
+)
+from modelkit.spatial import Mat3, Pose, axis_angle, matrix_from_quat_wxyz, matrix_from_rpy
 
 Element = etree._Element
 
@@ -46,7 +55,9 @@ def set_pose(el: Element, pose: Pose) -> None:
     ``quat``; ``zaxis`` when it is the shortest turn taking Z to a direction (``zaxis="0 1 0"``);
     ``euler``, URDF's roll-pitch-yaw (with ``<compiler eulerseq="XYZ">``, which the writer adds):
     ``rpy="1.57079 0 1.57079"`` stays ``euler="1.57079 0 1.57079"`` instead of a quaternion of
-    four 15-digit numbers."""
+    four 15-digit numbers. A quaternion as a source writes one (:func:`short_quat`, at most
+    :data:`SOURCE_DIGITS` digits) goes before them when they have a longer number: a source's
+    ``quat="0.996179 0 -0.0873386 0"`` stays that, not ``euler="0 -0.174899984293942 0"``."""
     position = fmt_position(pose.translation)
     if position != "0 0 0":
         el.set("pos", position)
@@ -58,7 +69,84 @@ def set_pose(el: Element, pose: Pose) -> None:
                 if text is not None:
                     texts[key] = text
             key = min(texts, key=lambda k: len(texts[k]))  # the shortest exact one; quat on a tie
+            if plainness(texts[key]) > SOURCE_DIGITS:
+                written = short_quat(pose.rotation)
+                if written is not None:
+                    key, texts[key] = "quat", written
             el.set(key, texts[key])
+
+
+# A number of at most this many significant digits is one a source wrote (MuJoCo saves six, exporters
+# up to nine); a longer one is arithmetic. Another form of a pose or an inertia replaces the writer's
+# usual one only when that has a longer number and the other has none.
+SOURCE_DIGITS = 9
+# How far from unit length a rounded quaternion may be: six digits put it within 1e-6 (each component
+# off by 5e-7 at most). A turn about Z by π/2 rounded to fewer digits (``0.7 0 0 0.7``, ``0.7071 0 0
+# 0.7071``) normalises to the same rotation too, but reads as an approximation of it.
+UNIT_QUAT = 2e-6
+
+
+def short_quat(rotation: Mat3, most: int = SOURCE_DIGITS) -> str | None:
+    """The rotation as a quaternion a source would write: the unit quaternion with every component
+    rounded to the fewest significant digits (the same count for all four, at most ``most``) that
+    give back the matrix to 1e-12 once MuJoCo has normalised them, and leave it within
+    :data:`UNIT_QUAT` of unit length; None when no count does. A quaternion a source printed to six
+    digits is not of unit length (``0.996179 0 -0.0873386 0``: 1 + 2e-7), so its normalised
+    components have 16 digits; rounded to six they are the source's text again."""
+    r = np.asarray(rotation, dtype=float)
+    q = [float(x) for x in quat_wxyz(r)]
+    for digits in range(1, most + 1):
+        rounded = [float(f"{x:.{digits}g}") for x in q]
+        norm = math.hypot(*rounded)
+        if abs(norm - 1.0) > UNIT_QUAT:
+            continue
+        # a quaternion within SNAP/8 gives a matrix within SNAP (each entry is quadratic in it)
+        if max(abs(a / norm - b) for a, b in zip(rounded, q, strict=True)) > SNAP / 8.0:
+            continue
+        if float(np.max(np.abs(matrix_from_quat_wxyz(rounded) - r))) <= SNAP:
+            return fmt_vec(rounded)
+    return None
+
+
+def plainness(text: str) -> int:
+    """The significant digits of the longest number in a text of numbers."""
+    return max(significant_digits(number) for number in text.split())
+
+
+ROTATION_KEYS = ("quat", "zaxis", "euler")
+
+
+def use_fromto(el: Element, pose: Pose, half_length: float) -> None:
+    """A capsule or cylinder ``el`` (``size="r h"`` and its pose already set) as MuJoCo's ``fromto``,
+    the two ends of its axis, when ``pos``, the rotation and the half-length have a number longer
+    than a source writes (:data:`SOURCE_DIGITS`) and the ends have none: a source's
+    ``fromto="0 0 -0.03 -0.06 0 -0.17"`` comes back so, not as ``size="0.055 0.0761577310586391"
+    pos="-0.03 0 -0.1" euler="0 0.404891786285083 0"``. Only when MuJoCo's reading of the ends (their
+    middle, half their distance, the shortest turn taking Z towards the first) gives the shape back:
+    the rotation to 1e-12, the centre and length to what a written position may differ by
+    (:data:`ZERO` of the metre)."""
+    rotation = np.asarray(pose.rotation, dtype=float)
+    centre = np.asarray(pose.translation, dtype=float)
+    axis = rotation[:, 2]
+    # MuJoCo turns the shape's Z towards the first end: from = centre + h·Z, to = centre − h·Z
+    ends = f"{fmt_position(centre + half_length * axis)} {fmt_position(centre - half_length * axis)}"
+    radius, half_text = el.get("size", "").split()
+    written = [el.get("pos", "0"), half_text, *(el.get(key) or "0" for key in ROTATION_KEYS)]
+    if max(plainness(text) for text in written) <= SOURCE_DIGITS or plainness(ends) > SOURCE_DIGITS:
+        return
+    values = np.array([float(v) for v in ends.split()])
+    start, end = values[:3], values[3:]
+    length = float(np.linalg.norm(end - start))
+    tolerance = ZERO * max(1.0, float(np.max(np.abs(values))))
+    if (length == 0.0 or abs(length / 2.0 - half_length) > tolerance
+            or float(np.max(np.abs((start + end) / 2.0 - centre))) > tolerance
+            or float(np.max(np.abs(z_turn([float(v) for v in start - end]) - rotation))) > SNAP):
+        return
+    for key in ("pos", *ROTATION_KEYS):
+        if key in el.attrib:
+            del el.attrib[key]
+    el.set("size", radius)
+    el.set("fromto", ends)
 
 
 def zaxis_text(rotation: Mat3) -> str | None:
