@@ -8,7 +8,10 @@ URDF's ``continuous`` knee) or on a welded base (an arm's ``continuous`` joints:
 servos its four), so the written model holds its home pose as MuJoCo Menagerie's arms and legs do; on a
 free base, a motor on any other joint without one (wheels, casters, endless spindles), whose zero control
 leaves it free as the source has it. A mobile robot's joints without a range are its wheels and casters
-(the lecture's smartcar has its wheels' masses off their axes: still motors). Before, a welded arm's
+(the lecture's smartcar has its wheels' masses off their axes: still motors), except those of an arm
+(:func:`mobile_arm_joints`: off the ground, so no wheel or caster, and turned by gravity at home), which get a servo
+as a welded arm's do: roboschool's Fetch has three continuous roll joints in its arm, and as motors
+its gripper fell 0.22 m in 2 s. Before, a welded arm's
 unranged joints that gravity does not turn (example-robot-data's Kinova: joint 1, vertical, and joint 6)
 were motors: free at zero control, joint 1 turned 0.0136 rad while joint 2 moved 0.5 rad.
 """
@@ -31,25 +34,49 @@ GRAVITY_FLOOR = 1e-9  # N·m or N: a gravity load at home below this is rounding
 ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # notes list kinds in this order
 
 
-def chosen_kind(joint: Joint, robot: Robot, choice: str, legs: Set[str]) -> ActuatorKind | None:
+def chosen_kind(joint: Joint, robot: Robot, choice: str, legs: Set[str],
+                arms: Set[str] = frozenset()) -> ActuatorKind | None:
     """The ``choice`` kind for a joint the source does not actuate (None: no actuator); ``legs`` are the
-    joints of the robot's legs (:func:`modelkit.convert.legs.leg_joints`)."""
+    joints of the robot's legs (:func:`modelkit.convert.legs.leg_joints`), ``arms`` the unranged joints
+    of a mobile robot's arms (:func:`mobile_arm_joints`)."""
     if joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
         return None
     if choice == "auto":
-        lower, upper = joint.limits.lower, joint.limits.upper
-        ranged = math.isfinite(lower) and math.isfinite(upper) and lower < upper
         welded = robot.root_joint is JointType.FIXED  # an arm; a mobile robot's are wheels, casters
-        held = ranged or joint.name in legs or welded
+        held = ranged(joint) or joint.name in legs or welded or joint.name in arms
         return ActuatorKind.POSITION if held else ActuatorKind.EFFORT
     return CHOICES.get(choice)
 
 
-def chosen_actuators(robot: Robot, choice: str, legs: Set[str], skip: Set[str]) -> list[Actuator]:
+def ranged(joint: Joint) -> bool:
+    """Whether the joint has a finite range of more than one value."""
+    lower, upper = joint.limits.lower, joint.limits.upper
+    return math.isfinite(lower) and math.isfinite(upper) and lower < upper
+
+
+def mobile_arm_joints(robot: Robot, turned: Callable[[Joint], bool]) -> frozenset[str]:
+    """On a free base, the hinges and slides without a range that belong to an arm: off the ground
+    (:func:`modelkit.convert.legs.off_ground_joints`: nothing below them reaches the floor, so no wheel
+    or caster) and turned by gravity at home (``turned``: :func:`turned_by_gravity`). Those ``auto``
+    servos, as on a welded base; a pan joint about a vertical axis and a spindle with its mass on its
+    axis stay motors. A link round about its roll axis is no wheel here: Fetch's forearm is a cylinder
+    about its own. Empty on a welded base."""
+    if robot.root_joint is not JointType.FLOATING:
+        return frozenset()
+    candidates = [joint for joint in robot.joints
+                  if joint.type in (JointType.REVOLUTE, JointType.PRISMATIC) and not ranged(joint)]
+    if not candidates:
+        return frozenset()
+    off_ground = off_ground_joints(robot)
+    return frozenset(joint.name for joint in candidates if joint.name in off_ground and turned(joint))
+
+
+def chosen_actuators(robot: Robot, choice: str, legs: Set[str], skip: Set[str],
+                     arms: Set[str] = frozenset()) -> list[Actuator]:
     """The ``choice`` actuator (:func:`chosen_kind`) of every joint not in ``skip`` that gets one."""
     out: list[Actuator] = []
     for joint in robot.joints:
-        kind = None if joint.name in skip else chosen_kind(joint, robot, choice, legs)
+        kind = None if joint.name in skip else chosen_kind(joint, robot, choice, legs, arms)
         if kind is not None:
             out.append(Actuator(joint=joint.name, kind=kind, source_kind=CHOSEN, source=joint.source))
     return out
@@ -63,7 +90,7 @@ def constrained_joints(robot: Robot) -> set[str]:
 
 
 def servoed_interfaces(robot: Robot, choice: str, source_actuators: str,
-                       legs: Set[str]) -> dict[int, Actuator]:
+                       legs: Set[str], arms: Set[str] = frozenset()) -> dict[int, Actuator]:
     """``--source-actuators auto``: the source's ROS effort interfaces (URDF ``EffortJointInterface``
     transmissions, ros2_control ``effort`` command interfaces) on joints to which the ``--actuators``
     choice gives a servo, keyed by the id of the source's actuator they replace.
@@ -85,7 +112,7 @@ def servoed_interfaces(robot: Robot, choice: str, source_actuators: str,
         if not actuator.ros_interface or actuator.kind is not ActuatorKind.EFFORT or joint is None \
                 or joint.name in constrained:
             continue
-        kind = chosen_kind(joint, robot, choice, legs)
+        kind = chosen_kind(joint, robot, choice, legs, arms)
         if kind is None or kind is ActuatorKind.EFFORT:
             continue  # --actuators motor or none, a wheel, or not a hinge or slide: the source's motor
         force = actuator.force_range
@@ -118,7 +145,7 @@ def servoed_message(servoed: list[Actuator], choice: str, label: Callable[[Actua
 
 
 def load_bearing_unactuated(robot: Robot, taken: Set[str], choice: str, legs: Set[str],
-                            sags: Callable[[Joint], bool]) -> list[Actuator]:
+                            sags: Callable[[Joint], bool], arms: Set[str] = frozenset()) -> list[Actuator]:
     """``--source-actuators auto``: the ``--actuators`` choice, where it gives a servo, on the joints
     that a source naming actuators for others leaves without one (not in ``taken``) and that carry the
     robot: a leg's joints, and the joints gravity turns at home (``sags``) on a welded base or, on a free
@@ -136,9 +163,9 @@ def load_bearing_unactuated(robot: Robot, taken: Set[str], choice: str, legs: Se
                 joint.type not in (JointType.REVOLUTE, JointType.PRISMATIC):
             continue
         held = welded or joint.name in off_ground
-        if joint.name not in legs and not (held and sags(joint)):
+        if joint.name not in legs and joint.name not in arms and not (held and sags(joint)):
             continue
-        kind = chosen_kind(joint, robot, choice, legs)
+        kind = chosen_kind(joint, robot, choice, legs, arms)
         if kind is ActuatorKind.POSITION or kind is ActuatorKind.VELOCITY:
             out.append(Actuator(joint=joint.name, kind=kind, source_kind=FILLED, source=joint.source))
     return out
@@ -164,4 +191,9 @@ def sags_at_home(joint: Joint, load: JointLoad, links: dict[str, Link]) -> bool:
     sags: its load is the robot's, which the floor carries."""
     if is_wheel(joint, links):
         return False
+    return turned_by_gravity(joint, load)
+
+
+def turned_by_gravity(joint: Joint, load: JointLoad) -> bool:
+    """Whether the joint's gravity load at home (``load``) exceeds its Coulomb friction."""
     return load.gravity > max(joint.friction, GRAVITY_FLOOR)

@@ -39,9 +39,11 @@ from modelkit.convert.actuator_choice import (
     counted,
     filled_message,
     load_bearing_unactuated,
+    mobile_arm_joints,
     sags_at_home,
     servoed_interfaces,
     servoed_message,
+    turned_by_gravity,
 )
 from modelkit.convert.context import WriteContext
 from modelkit.convert.legs import is_wheel, leg_joints, resting_on
@@ -84,6 +86,7 @@ class ActuatorWriter:
         self.any_position = False
         self.servos = 0  # position and velocity actuators written
         self._loads: dict[str, JointLoad] | None = None
+        self._arms: frozenset[str] | None = None
         self._legs: frozenset[str] | None = None  # the joints in a legged robot's legs, found once
         self._links: dict[str, Link] | None = None
         self._holding: dict[str, float] = {}  # joint → the most its position servo gives it (N·m or N)
@@ -109,7 +112,8 @@ class ActuatorWriter:
             or self.robot.extras.get("mjcf_actuators"))
         taken = {a.joint for a, _ in planned}
         if made_up:
-            chosen = chosen_actuators(self.robot, self.ctx.options.actuators, self._leg_joints(), taken)
+            chosen = chosen_actuators(self.robot, self.ctx.options.actuators, self._leg_joints(), taken,
+                                      self._arm_joints())
             planned += [(a, by_name.get(a.joint)) for a in chosen]
         else:
             filled = self._load_bearing_unactuated(taken)
@@ -147,7 +151,8 @@ class ActuatorWriter:
         if self.ctx.options.source_actuators != "auto" or self.robot.source_format == "mjcf":
             return []
         choice = self.ctx.options.actuators
-        out = load_bearing_unactuated(self.robot, taken, choice, self._leg_joints(), self.sags)
+        out = load_bearing_unactuated(self.robot, taken, choice, self._leg_joints(), self.sags,
+                                      self._arm_joints())
         if out:
             message = filled_message(out, self._leg_joints(), choice, f"<{ELEMENTS[out[0].kind]}>",
                                      "its home keyframe")
@@ -163,7 +168,7 @@ class ActuatorWriter:
     def _servoed_interfaces(self) -> dict[int, Actuator]:
         """:func:`modelkit.convert.actuator_choice.servoed_interfaces` (MK864)."""
         return servoed_interfaces(self.robot, self.ctx.options.actuators, self.ctx.options.source_actuators,
-                                  self._leg_joints())
+                                  self._leg_joints(), self._arm_joints())
 
     def _said_servoed(self, servoed: list[Actuator]) -> None:
         """MK864: the source's ROS effort interfaces written as the ``--actuators`` choice."""
@@ -269,10 +274,19 @@ class ActuatorWriter:
             self._legs = leg_joints(self.robot)
         return self._legs
 
+    def _arm_joints(self) -> frozenset[str]:
+        """The unranged joints of a mobile robot's arms (:func:`modelkit.convert.actuator_choice.
+        mobile_arm_joints`), found once."""
+        if self._arms is None:
+            self._arms = mobile_arm_joints(self.robot,
+                                           lambda joint: turned_by_gravity(joint, self.load(joint)))
+        return self._arms
+
     def _chosen_kind(self, joint: Joint) -> ActuatorKind | None:
         """The ``--actuators`` kind of a joint the source does not actuate (None: no actuator):
         :func:`modelkit.convert.actuator_choice.chosen_kind`."""
-        return chosen_kind(joint, self.robot, self.ctx.options.actuators, self._leg_joints())
+        return chosen_kind(joint, self.robot, self.ctx.options.actuators, self._leg_joints(),
+                           self._arm_joints())
 
     def sags(self, joint: Joint) -> bool:
         """Whether gravity turns the joint at home: its gravity load there exceeds its Coulomb friction

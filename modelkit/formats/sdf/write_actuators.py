@@ -34,9 +34,11 @@ from modelkit.convert.actuator_choice import (
     counted,
     filled_message,
     load_bearing_unactuated,
+    mobile_arm_joints,
     sags_at_home,
     servoed_interfaces,
     servoed_message,
+    turned_by_gravity,
 )
 from modelkit.convert.context import WriteContext
 from modelkit.convert.drive_plugin import find_drive
@@ -100,6 +102,7 @@ class ActuatorWriter:
         self.sources = source_plugins(robot)
         self._loads: dict[str, JointLoad] | None = None
         self._legs: frozenset[str] | None = None  # the joints in a legged robot's legs, found once
+        self._arms: frozenset[str] | None = None  # the unranged joints of a mobile robot's arms
 
     def write(self, model: Element) -> int:
         robot = self.robot
@@ -158,7 +161,8 @@ class ActuatorWriter:
         links = {link.name: link for link in robot.links}
         taken = {a.joint for a in robot.actuators}
         out = load_bearing_unactuated(robot, taken, options.actuators, legs,
-                                      lambda joint: sags_at_home(joint, self._load(joint.name), links))
+                                      lambda joint: sags_at_home(joint, self._load(joint.name), links),
+                                      self._arm_joints())
         if out:
             message = filled_message(out, legs, options.actuators, SYSTEM_FOR[out[0].kind], "its home pose")
             self.ctx.note("MK827", message, robot.source, "model/plugin")
@@ -170,13 +174,22 @@ class ActuatorWriter:
         robot, options = self.robot, self.ctx.options
         if not any(a.ros_interface and a.kind is ActuatorKind.EFFORT for a in robot.actuators):
             return {}
-        return servoed_interfaces(robot, options.actuators, options.source_actuators, self._leg_joints())
+        return servoed_interfaces(robot, options.actuators, options.source_actuators, self._leg_joints(),
+                                  self._arm_joints())
 
     def _leg_joints(self) -> frozenset[str]:
         """The joints of the robot's legs (:func:`modelkit.convert.legs.leg_joints`), found once."""
         if self._legs is None:
             self._legs = leg_joints(self.robot)
         return self._legs
+
+    def _arm_joints(self) -> frozenset[str]:
+        """The unranged joints of a mobile robot's arms (:func:`modelkit.convert.actuator_choice.
+        mobile_arm_joints`), found once."""
+        if self._arms is None:
+            self._arms = mobile_arm_joints(self.robot,
+                                           lambda joint: turned_by_gravity(joint, self._load(joint.name)))
+        return self._arms
 
     def _said_servoed(self, servoed: list[Actuator]) -> None:
         """MK864: the source's ROS effort interfaces written as position or velocity controllers."""
@@ -227,7 +240,7 @@ class ActuatorWriter:
         lost: list[str] = []
         written: Counter[ActuatorKind] = Counter()
         skipped = constrained_joints(robot) | driven
-        for actuator in chosen_actuators(robot, choice, self._leg_joints(), skipped):
+        for actuator in chosen_actuators(robot, choice, self._leg_joints(), skipped, self._arm_joints()):
             joint, target = by_name[actuator.joint], self.joints.get(actuator.joint)
             if target is None:
                 continue  # not written as a revolute or prismatic joint
