@@ -12,7 +12,8 @@ Per robot: whether the file has a key, how deep its collision shapes start insid
 deepest contact; 0 when none), how far the floor throws the base up within the first second, MuJoCo's
 warnings and the first non-finite state; the load ratio of the bodies it stands on after 0.3 s (the
 robot's mass times the body's ``body_invweight0``, the largest; MK883), whether ``convert`` said
-MK883, how deep it sinks and whether it falls (the base more than 10 cm lower) within 2 s. A file
+MK883, how deep it sinks, whether it falls (the base more than 10 cm lower) within 2 s, how far the
+base tilts (it tipped over beyond 0.15 rad) and whether ``convert`` said MK887 (it cannot stand). A file
 that does not convert or compile is counted, not fatal.
 
     python bench/bench_home_floor.py [--json out.json] [--source DIR] [--extra DIR ...]
@@ -37,6 +38,7 @@ CORPUS = ROOT.parent / "shared" / "corpus"
 THROWN = 0.01  # m: a base rising more than this in the second was thrown by the floor
 INSIDE = 1e-3  # m: a start deeper than this is inside the floor
 FELL = 0.1  # m: a base this much lower than it started has fallen
+TIPPED = 0.15  # rad: a base turned this much about a horizontal axis within 2 s has tipped over
 SETTLED = 0.3  # s: the bodies touching the floor then are the ones the robot stands on
 EXTRA: list[Path] = []  # --extra folders
 
@@ -86,6 +88,9 @@ def measure(path: Path) -> dict[str, Any] | None:
     floor = m.geom("floor").id
     deepest = min([float(c.dist) for c in d.contact[:d.ncon] if floor in tuple(c.geom)] or [0.0])
     start = highest = lowest = float(d.qpos[2])
+    up = np.zeros(9)
+    mujoco.mju_quat2Mat(up, d.qpos[3:7])
+    start_up, tilt = up.reshape(3, 3)[:, 2].copy(), 0.0
     unstable = None
     ratio, sunk = 0.0, 0.0
     mass = float(m.body_subtreemass[int(m.jnt_bodyid[0])])
@@ -100,6 +105,8 @@ def measure(path: Path) -> dict[str, Any] | None:
         if step < round(1.0 / m.opt.timestep):
             highest = max(highest, float(d.qpos[2]))
         lowest = min(lowest, float(d.qpos[2]))
+        mujoco.mju_quat2Mat(up, d.qpos[3:7])
+        tilt = max(tilt, float(np.arccos(np.clip(up.reshape(3, 3)[:, 2] @ start_up, -1.0, 1.0))))
         touching = [c for c in d.contact[:d.ncon] if floor in tuple(c.geom)]
         sunk = max([sunk, *(-float(c.dist) for c in touching)])
         if step == round(SETTLED / m.opt.timestep):
@@ -107,7 +114,7 @@ def measure(path: Path) -> dict[str, Any] | None:
             ratio = max([0.0, *(mass * float(m.body_invweight0[b][0]) for b in bodies)])
     return {"key": key >= 0, "start_height": start, "inside": max(0.0, -deepest), "thrown": highest - start,
             "warnings": warnings, "unstable_at": unstable, "load_ratio": ratio, "mk883": "MK883" in said,
-            "sunk": sunk, "fell": start - lowest > FELL}
+            "sunk": sunk, "fell": start - lowest > FELL, "tilt": tilt, "mk887": "MK887" in said}
 
 
 def _short(name: str) -> str:
@@ -149,6 +156,11 @@ def main(argv: list[str] | None = None) -> int:
           + str([f"{_short(n)} (load ratio {free[n]['load_ratio']:.0f})" for n in fell]))
     print(f"largest load ratio of a robot that stands: {max(standing, default=0.0):.0f}; "
           f"MK883 said for {len(said)}: {[_short(n) for n in said]}")
+    tipped = sorted(name for name, row in free.items() if row["tilt"] > TIPPED or row["fell"])
+    cannot = sorted(name for name, row in free.items() if row["mk887"])
+    print(f"tipped ({TIPPED:g} rad) or fell within 2 s: {len(tipped)} {[_short(n) for n in tipped]}")
+    print(f"MK887 said for {len(cannot)}: {[_short(n) for n in cannot]}; of them tipped or fell: "
+          f"{len(set(cannot) & set(tipped))}")
     if args.json:
         args.json.write_text(json.dumps(free, indent=1, sort_keys=True) + "\n")
     return 0

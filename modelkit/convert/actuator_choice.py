@@ -9,9 +9,9 @@ servos its four), so the written model holds its home pose as MuJoCo Menagerie's
 free base, a motor on any other joint without one (wheels, casters, endless spindles), whose zero control
 leaves it free as the source has it. A mobile robot's joints without a range are its wheels and casters
 (the lecture's smartcar has its wheels' masses off their axes: still motors), except those of an arm
-(:func:`mobile_arm_joints`: off the ground, so no wheel or caster, and turned by gravity at home), which get a servo
-as a welded arm's do: roboschool's Fetch has three continuous roll joints in its arm, and as motors
-its gripper fell 0.22 m in 2 s. Before, a welded arm's
+(:func:`mobile_arm_joints`: off the ground, so no wheel or caster, and turned by gravity at home),
+which get a servo as a welded arm's do: roboschool's Fetch has three continuous roll joints in its
+arm; as motors, its forearm roll turned 0.161 rad in 2 s. Before, a welded arm's
 unranged joints that gravity does not turn (example-robot-data's Kinova: joint 1, vertical, and joint 6)
 were motors: free at zero control, joint 1 turned 0.0136 rad while joint 2 moved 0.5 rad.
 """
@@ -22,6 +22,8 @@ import math
 from collections import Counter
 from collections.abc import Callable, Mapping, Set
 
+import numpy as np
+
 from modelkit.convert.legs import is_wheel, off_ground_joints
 from modelkit.convert.servo_gains import JointLoad
 from modelkit.model import Actuator, ActuatorKind, Joint, JointType, Link, Robot
@@ -31,6 +33,8 @@ CHOSEN = "--actuators"  # an Actuator's source_kind when the --actuators choice 
 SERVOED = "ROS effort interface, servoed"  # source_kind of a servo --source-actuators auto put there
 FILLED = "unactuated, load-bearing"  # source_kind of a servo on a joint the source left without (MK827)
 GRAVITY_FLOOR = 1e-9  # N·m or N: a gravity load at home below this is rounding (a vertical axis)
+ARM_LOAD = 1e-6  # of the robot's weight times its size: a smaller gravity load turns no arm joint
+STANDARD_GRAVITY = 9.81  # m/s²
 ORDER = (ActuatorKind.POSITION, ActuatorKind.VELOCITY, ActuatorKind.EFFORT)  # notes list kinds in this order
 
 
@@ -54,13 +58,15 @@ def ranged(joint: Joint) -> bool:
     return math.isfinite(lower) and math.isfinite(upper) and lower < upper
 
 
-def mobile_arm_joints(robot: Robot, turned: Callable[[Joint], bool]) -> frozenset[str]:
+def mobile_arm_joints(robot: Robot, load: Callable[[Joint], JointLoad]) -> frozenset[str]:
     """On a free base, the hinges and slides without a range that belong to an arm: off the ground
     (:func:`modelkit.convert.legs.off_ground_joints`: nothing below them reaches the floor, so no wheel
-    or caster) and turned by gravity at home (``turned``: :func:`turned_by_gravity`). Those ``auto``
-    servos, as on a welded base; a pan joint about a vertical axis and a spindle with its mass on its
-    axis stay motors. A link round about its roll axis is no wheel here: Fetch's forearm is a cylinder
-    about its own. Empty on a welded base."""
+    or caster) and turned by gravity at home: a gravity ``load`` above the joint's Coulomb friction and
+    above :data:`ARM_LOAD` of the robot's weight times its size (a massless sensor frame that a writer
+    gives a milligram turns nothing: the tutorial's tilt joint, 6e-7 N·m, stays a motor). Those
+    ``auto`` servos, as on a welded base; a pan joint about a vertical axis and a spindle with its mass
+    on its axis stay motors. A link round about its roll axis is no wheel here: Fetch's forearm is a
+    cylinder about its own. Empty on a welded base."""
     if robot.root_joint is not JointType.FLOATING:
         return frozenset()
     candidates = [joint for joint in robot.joints
@@ -68,7 +74,14 @@ def mobile_arm_joints(robot: Robot, turned: Callable[[Joint], bool]) -> frozense
     if not candidates:
         return frozenset()
     off_ground = off_ground_joints(robot)
-    return frozenset(joint.name for joint in candidates if joint.name in off_ground and turned(joint))
+    poses = robot.world_poses()
+    corners = [np.asarray(pose.translation, dtype=float) for pose in poses.values()]
+    size = float(np.linalg.norm(np.ptp(np.array(corners), axis=0))) if corners else 0.0
+    masses = [link.inertial.mass for link in robot.links if link.inertial is not None]
+    mass = sum(m for m in masses if math.isfinite(m) and m > 0.0)
+    least = ARM_LOAD * mass * STANDARD_GRAVITY * size
+    return frozenset(joint.name for joint in candidates if joint.name in off_ground
+                     and load(joint).gravity > max(joint.friction, GRAVITY_FLOOR, least))
 
 
 def chosen_actuators(robot: Robot, choice: str, legs: Set[str], skip: Set[str],
@@ -191,9 +204,4 @@ def sags_at_home(joint: Joint, load: JointLoad, links: dict[str, Link]) -> bool:
     sags: its load is the robot's, which the floor carries."""
     if is_wheel(joint, links):
         return False
-    return turned_by_gravity(joint, load)
-
-
-def turned_by_gravity(joint: Joint, load: JointLoad) -> bool:
-    """Whether the joint's gravity load at home (``load``) exceeds its Coulomb friction."""
     return load.gravity > max(joint.friction, GRAVITY_FLOOR)

@@ -74,6 +74,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     from modelkit.convert.merge import merge_fixed_joints
     from modelkit.convert.rolling import note_rolling_faults
     from modelkit.convert.spawn import note_spawn_height
+    from modelkit.convert.stance import note_tipping
     from modelkit.convert.tracks import approximate_tracks
     from modelkit.convert.wheels import approximate_wheels
     from modelkit.formats.mjcf.site_frames import sites_as_links
@@ -88,6 +89,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     out = copy.deepcopy(robot)
     settle_base(out, options.base, notes)
     note_rolling_faults(out, notes)
+    note_tipping(out, notes)
     if not target.tracks_native:
         approximate_tracks(out, notes)
     approximate_wheels(out, options.wheel_collision, target.name, notes)

@@ -43,7 +43,6 @@ from modelkit.convert.actuator_choice import (
     sags_at_home,
     servoed_interfaces,
     servoed_message,
-    turned_by_gravity,
 )
 from modelkit.convert.context import WriteContext
 from modelkit.convert.legs import is_wheel, leg_joints, resting_on
@@ -278,8 +277,7 @@ class ActuatorWriter:
         """The unranged joints of a mobile robot's arms (:func:`modelkit.convert.actuator_choice.
         mobile_arm_joints`), found once."""
         if self._arms is None:
-            self._arms = mobile_arm_joints(self.robot,
-                                           lambda joint: turned_by_gravity(joint, self.load(joint)))
+            self._arms = mobile_arm_joints(self.robot, self.load)
         return self._arms
 
     def _chosen_kind(self, joint: Joint) -> ActuatorKind | None:

@@ -38,7 +38,6 @@ from modelkit.convert.actuator_choice import (
     sags_at_home,
     servoed_interfaces,
     servoed_message,
-    turned_by_gravity,
 )
 from modelkit.convert.context import WriteContext
 from modelkit.convert.drive_plugin import find_drive
@@ -187,8 +186,7 @@ class ActuatorWriter:
         """The unranged joints of a mobile robot's arms (:func:`modelkit.convert.actuator_choice.
         mobile_arm_joints`), found once."""
         if self._arms is None:
-            self._arms = mobile_arm_joints(self.robot,
-                                           lambda joint: turned_by_gravity(joint, self._load(joint.name)))
+            self._arms = mobile_arm_joints(self.robot, lambda joint: self._load(joint.name))
         return self._arms
 
     def _said_servoed(self, servoed: list[Actuator]) -> None:
