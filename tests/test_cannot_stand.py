@@ -107,3 +107,16 @@ def test_a_prop_is_not_said(tmp_path: Path) -> None:
     pybullet_data = pytest.importorskip("pybullet_data")
     notes = write(load(Path(pybullet_data.getDataPath()) / "duck_vhacd.urdf"), tmp_path / "duck.xml")
     assert not [n for n in notes if n.code == "MK887"]
+
+
+def test_the_support_region_is_the_convex_hull() -> None:
+    """The hull (with its filter for many points: a mesh's flat sole) against SciPy's Qhull."""
+    from scipy.spatial import ConvexHull
+
+    from modelkit.convert.stance import _area, _hull
+
+    rng = np.random.default_rng(7)
+    grid = np.stack(np.meshgrid(np.linspace(0.0, 0.2, 300), np.linspace(0.0, 0.1, 300)), -1).reshape(-1, 2)
+    for points in (rng.uniform(-1.0, 1.0, (50, 2)), rng.normal(size=(20000, 2)), grid):
+        ours = _hull(points)
+        assert _area(ours) == pytest.approx(ConvexHull(points).volume, rel=1e-5)

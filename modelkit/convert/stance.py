@@ -161,6 +161,7 @@ def _hull(points: np.ndarray) -> np.ndarray:
     unique = np.unique(np.round(points, 6), axis=0)
     if len(unique) <= 2:
         return unique
+    unique = _outer(unique)
     ordered = sorted(map(tuple, unique))
 
     def cross(o: tuple[float, ...], a: tuple[float, ...], b: tuple[float, ...]) -> float:
@@ -180,6 +181,21 @@ def _hull(points: np.ndarray) -> np.ndarray:
     if len(hull) < 3:  # collinear: the two ends
         return np.array([ordered[0], ordered[-1]])
     return np.array(hull)
+
+
+def _outer(points: np.ndarray) -> np.ndarray:
+    """The points not strictly inside the octagon of the farthest points in eight directions (Akl and
+    Toussaint's filter): the hull's corners are among them. The monotone chain is plain Python, and a
+    flat-bottomed mesh puts every vertex of its sole on the floor."""
+    angles = np.arange(8) * (math.pi / 4.0)
+    reach = points @ np.stack([np.cos(angles), np.sin(angles)])
+    corners = points[np.argmax(reach, axis=0)]  # counter-clockwise, as their directions turn
+    keep = np.zeros(len(points), dtype=bool)
+    for a, b in zip(corners, np.roll(corners, -1, axis=0), strict=True):
+        if np.array_equal(a, b):
+            continue
+        keep |= (b[0] - a[0]) * (points[:, 1] - a[1]) - (b[1] - a[1]) * (points[:, 0] - a[0]) <= 0.0
+    return points[keep] if keep.any() else points
 
 
 def _area(hull: np.ndarray) -> float:
