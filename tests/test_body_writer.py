@@ -14,8 +14,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from click.testing import CliRunner
 
-from modelkit.api import validate
+from modelkit.api import load, validate
+from modelkit.cli import main
 from modelkit.convert.api import CONVERTIBLE_ERRORS, output_stem, write
 from modelkit.convert.compare import Difference, compare_robots
 from modelkit.convert.notes import ConversionNote, NoteSink
@@ -510,3 +512,45 @@ def test_massless_moving_chain_gets_a_tiny_mass(tmp_path: Path) -> None:
     assert back.errors == [] and back.robot is not None
     masses = {lk.name: lk.inertial.mass if lk.inertial else None for lk in back.robot.links}
     assert masses == {"palm": 0.5, "finger1": 1e-6, "finger2": 1e-6}
+
+
+DUSTY_URDF = """<robot name="dusty">
+  <link name="base">
+    <inertial><mass value="2"/><origin xyz="0.1 3.08087e-14 0"/>
+      <inertia ixx="0.0955703125" ixy="0" ixz="0" iyy="0.0955703125" iyz="-1.1552820390394e-17"
+               izz="0.001234375"/>
+    </inertial>
+  </link>
+  <link name="arm">
+    <inertial><mass value="0.5"/>
+      <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>
+    <visual><origin xyz="0 -5.54343e-12 4.45647e-12" rpy="1.57080000000002 1.53105e-11 0"/>
+      <geometry><box size="0.1 0.1 0.1"/></geometry></visual>
+  </link>
+  <joint name="shoulder" type="continuous">
+    <parent link="base"/><child link="arm"/>
+    <origin xyz="0 2.28232e-12 0.2" rpy="0 0 1.84768450970784e-13"/><axis xyz="6.12323399573677e-17 0 1"/>
+  </joint>
+</robot>
+"""
+
+
+def test_clean_numbers(tmp_path: Path) -> None:
+    """Issue 17 §5 for .body as for the other targets: CAD dust below 1e-10 of the model's size in a
+    position, an axis or a rotation and below 1e-12 of a tensor's largest entry is written as 0 (or the
+    key left out), and the file reads back as the source to 1e-9."""
+    source = tmp_path / "dusty.urdf"
+    source.write_text(DUSTY_URDF)
+    out = tmp_path / "out" / "dusty.body"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    text = out.read_text()
+    assert "e-1" not in text and "e-2" not in text, text
+    assert "inertia: [ 0.0955703125, 0, 0, 0, 0.0955703125, 0, 0, 0, 0.001234375 ]" in text
+    assert "joint_axis: [ 0, 0, 1 ]" in text
+    assert "translation: [ 0, 0, 0.2 ]" in text
+    want, got = load(source), load(out)
+    for name, pose in want.world_poses().items():
+        other = got.world_poses()[name]
+        assert np.allclose(pose.translation, other.translation, atol=1e-9)
+        assert np.allclose(pose.rotation, other.rotation, atol=1e-9)

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from modelkit.convert.context import WriteContext
+from modelkit.convert.numbers import clean_angle
 from modelkit.formats.body.devices import CORE_DEVICES, DEVICE_PARAMS, PLUGIN_DEVICES
 from modelkit.formats.body.write_yaml import Flow, axis_angle_of, deg, num, nums, put_pose
 from modelkit.model import CAMERA_KINDS, Device, DeviceKind
@@ -77,7 +78,7 @@ def _value(kind_of: str, value: Any) -> Any:
     if found is None:
         return Flow([num(0.0), num(0.0), num(1.0), num(0.0)])
     axis, angle = found
-    return Flow([*nums(axis, tidy=True), deg(angle)])
+    return Flow([*nums(axis, tidy=True), deg(clean_angle(angle))])
 
 
 def _differs(value: Any, default: Any) -> bool:

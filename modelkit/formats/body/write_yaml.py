@@ -21,7 +21,15 @@ from typing import Any
 import numpy as np
 import yaml
 
-from modelkit.convert.numbers import clean, fmt, fmt_inertia, fmt_length
+from modelkit.convert.numbers import (
+    ZERO,
+    clean_angle,
+    clean_inertia,
+    clean_length,
+    fmt,
+    fmt_inertia,
+    fmt_length,
+)
 from modelkit.spatial import Mat3
 
 NUM_TAG = "tag:modelkit,2024:number"
@@ -48,22 +56,31 @@ def num(value: float) -> Num:
 
 
 def nums(values: Iterable[float] | np.ndarray, tidy: bool = False) -> Flow:
-    """A flow list of numbers; ``tidy`` sets arithmetic dust below 1e-15 to 0 (poses and axes)."""
+    """A flow list of numbers; ``tidy`` (a direction: an axis) sets each component within 1e-10
+    (:data:`~modelkit.convert.numbers.ZERO`) of the vector's length to 0, as the other writers do
+    (``1.84768450970784e-13, -1, 1.84768450970784e-13`` → ``0, -1, 0``)."""
     flat = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel()
-    return Flow(num(clean(float(x)) if tidy else float(x)) for x in flat)
+    if tidy:
+        length = float(np.linalg.norm(flat)) if np.all(np.isfinite(flat)) else 0.0
+        flat = np.where(np.abs(flat) <= ZERO * length, 0.0, flat)
+    return Flow(num(float(x)) for x in flat)
 
 
 def lengths(values: Iterable[float] | np.ndarray) -> Flow:
-    """A flow list of lengths in metres: dust below 1e-15 set to 0, each written by ``fmt_length`` (a
-    shorter decimal within 1e-12 of the model's size, where the rest is arithmetic dust)."""
+    """A flow list of lengths in metres: dust below 1e-10 of the model's size set to 0
+    (``clean_length``: a CAD export's ``3.08087e-14``), each written by ``fmt_length`` (a shorter
+    decimal within 1e-12 of the model's size, where the rest is arithmetic dust)."""
     flat = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel()
-    return Flow(Num(fmt_length(clean(float(x)))) if math.isfinite(x) else num(x) for x in flat)
+    return Flow(Num(fmt_length(clean_length(float(x)))) if math.isfinite(x) else num(x) for x in flat)
 
 
-def tensor(values: np.ndarray) -> Flow:
-    """The 9 entries of an inertia tensor, each written by ``fmt_inertia`` (dust relative to the
-    tensor's largest entry)."""
+def tensor(values: np.ndarray, mass: float) -> Flow:
+    """The 9 entries of the inertia tensor of a link of ``mass``, cleaned by ``clean_inertia`` (a product
+    of 1e-17 beside moments of 0.1 kg·m² is 0) and each written by ``fmt_inertia`` (dust relative to
+    the tensor's largest entry)."""
     t = np.asarray(values, dtype=float)
+    if np.all(np.isfinite(t)):
+        t = clean_inertia(t, mass)
     return Flow(Num(fmt_inertia(float(x), t)) if math.isfinite(x) else num(x) for x in t.ravel())
 
 
@@ -107,13 +124,13 @@ def rotation_value(rotation: Mat3) -> Flow | None:
         return None
     axis, angle = found
     value = nums(axis, tidy=True)
-    value.append(deg(angle))
+    value.append(deg(clean_angle(angle)))
     return value
 
 
 def put_pose(node: dict[str, Any], rotation: Mat3, translation: np.ndarray) -> None:
     """``translation`` / ``rotation`` keys of a node, each omitted when it is the identity."""
-    t = np.asarray(translation, dtype=float)
+    t = np.asarray([clean_length(float(x)) for x in np.asarray(translation, dtype=float).ravel()])
     if np.any(t != 0.0):
         node["translation"] = lengths(t)
     r = rotation_value(rotation)

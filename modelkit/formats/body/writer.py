@@ -358,7 +358,7 @@ def _inertial(inertial: Inertial | None, node: dict[str, Any]) -> None:
         return
     node["mass"] = num(inertial.mass)
     node["center_of_mass"] = lengths(com)
-    node["inertia"] = tensor(inertia)
+    node["inertia"] = tensor(inertia, inertial.mass)
 
 
 def _extra_joints(robot: Robot, names: _Names, ctx: WriteContext) -> list[dict[str, Any]]:

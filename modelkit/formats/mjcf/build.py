@@ -461,9 +461,22 @@ def apply_joint_equalities(
     refs: dict[int, float],
     sink: DiagnosticSink,
     where: dict[int, SourceLocation],
+    actuated: frozenset[int] = frozenset(),
 ) -> None:
     """Joint-joint equalities become mimics: MuJoCo's ``q1 − ref1 = Σ cᵢ (q2 − ref2)ⁱ`` is the model's
-    ``q1 = m·q2 + o`` when only c₀ and c₁ are non-zero. Anything else is reported."""
+    ``q1 = m·q2 + o`` when only c₀ and c₁ are non-zero. Anything else is reported.
+
+    In MuJoCo both joints keep their freedom and the equality is a constraint between them, so an
+    actuator may sit on either; the model's mimic has a direction, and a follower carries no actuator
+    of its own (URDF, SDF and the writers' rule). When the source actuates ``joint1`` and not
+    ``joint2`` (``actuated``: MuJoCo joint ids with an actuator on the joint itself), the same linear
+    constraint is read the other way, ``q2 = (q1 − o) / m``, so that the actuator stays on the leader
+    (safety-gymnasium's racecar: its steering servo is on ``joint1``). Only where that makes no chain:
+    ``joint2`` follows nothing and leads no other joint."""
+    linear = [eq for eq in equalities if eq["type"] == "joint" and eq["active"]
+              and eq["obj2id"] is not None and eq["obj2id"] >= 0]
+    followed = [eq["obj2id"] for eq in linear]
+    followers = [eq["obj1id"] for eq in linear]
     for eq in equalities:
         if eq["type"] != "joint" or not eq["active"]:
             continue
@@ -491,7 +504,12 @@ def apply_joint_equalities(
             continue
         ref1, ref2 = refs.get(eq["obj1id"], 0.0), refs.get(eq["obj2id"], 0.0)
         multiplier = coef[1]
-        follower.mimic = Mimic(leader.name, multiplier, coef[0] + ref1 - multiplier * ref2, source=loc)
+        offset = coef[0] + ref1 - multiplier * ref2
+        if (multiplier != 0.0 and eq["obj1id"] in actuated and eq["obj2id"] not in actuated
+                and eq["obj2id"] not in followers and followed.count(eq["obj2id"]) == 1):
+            leader.mimic = Mimic(follower.name, 1.0 / multiplier, -offset / multiplier, source=loc)
+            continue
+        follower.mimic = Mimic(leader.name, multiplier, offset, source=loc)
 
 
 def quoted(name: str | None) -> str:

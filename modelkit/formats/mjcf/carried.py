@@ -46,8 +46,10 @@ def sites_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]
 
 
 def equalities_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]]:
-    """The equalities that are not a joint coupling the model holds as a mimic (the joint follows the
-    other, as the reader made it of the equality)."""
+    """The equalities that are not a joint coupling the model holds as a mimic (one joint follows the
+    other, as the reader made it of the equality: usually ``joint1`` follows ``joint2``, the other
+    way when the source actuates ``joint1``)."""
     followers = {(j.name, j.mimic.joint) for j in robot.joints if j.mimic is not None}
+    coupled = followers | {(leader, follower) for follower, leader in followers}
     return [e for e in value if not (isinstance(e, dict) and e.get("type") == "joint"
-                                     and (e.get("obj1"), e.get("obj2")) in followers)]
+                                     and (e.get("obj1"), e.get("obj2")) in coupled)]

@@ -178,7 +178,10 @@ class _MjcfReader:
         equalities = reader.equalities()
         where = self._item_locations(index, "equality", [e["name"] for e in equalities])
         refs = {j.index: j.ref for b in bodies for j in b.joints}
-        apply_joint_equalities(equalities, built.joints, refs, self.sink, where)
+        m = reader.m
+        on_joints = frozenset(int(m.actuator_trnid[a][0]) for a in range(int(m.nu))
+                              if int(m.actuator_trntype[a]) == int(mujoco.mjtTrn.mjTRN_JOINT))
+        apply_joint_equalities(equalities, built.joints, refs, self.sink, where, on_joints)
         _home_positions(reader.keyframes(), bodies, built.joints)
         tendons = reader.tendons()
         self._report_unsupported(equalities, tendons, index, where)

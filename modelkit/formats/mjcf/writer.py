@@ -416,13 +416,20 @@ class MjcfWriter:
                 )
                 continue
             source = self._source_equality(joint.name, mimic.joint)
+            first, second, offset, multiplier = follower[0], leader[0], mimic.offset, mimic.multiplier
+            named = joint.name
+            if source is not None and source.get("obj1") == mimic.joint and mimic.multiplier != 0.0:
+                # the reader read this equality the other way (its actuator is on joint1): the same
+                # constraint, written as the source wrote it
+                first, second, named = leader[0], follower[0], mimic.joint
+                offset, multiplier = -mimic.offset / mimic.multiplier, 1.0 / mimic.multiplier
             el = sub(
                 self.sections["equality"],
                 "joint",
-                name=self.names.claim("equality", str((source or {}).get("name") or f"{joint.name}_mimic")),
-                joint1=follower[0],
-                joint2=leader[0],
-                polycoef=f"{fmt(mimic.offset)} {fmt(mimic.multiplier)} 0 0 0",
+                name=self.names.claim("equality", str((source or {}).get("name") or f"{named}_mimic")),
+                joint1=first,
+                joint2=second,
+                polycoef=f"{fmt(offset)} {fmt(multiplier)} 0 0 0",
             )
             solver = (source or {}).get("solver") or {}
             for key, value in solver.items():
@@ -463,7 +470,8 @@ class MjcfWriter:
         """An MJCF source's joint equality the reader made this mimic of (its name and solver settings
         are written back; it counts as written, :attr:`written_equalities`)."""
         for eq in self.robot.extras.get("mjcf_equalities") or []:
-            if eq.get("type") == "joint" and (eq.get("obj1"), eq.get("obj2")) == (follower, leader):
+            if eq.get("type") == "joint" and (eq.get("obj1"), eq.get("obj2")) in ((follower, leader),
+                                                                                   (leader, follower)):
                 self.written_equalities.append(eq)
                 return dict(eq)
         return None
