@@ -484,6 +484,15 @@ def _run(report: VerifyReport, source: Path, out_dir: Path, engines: Sequence[st
     _layer4(report, robot, out_dir, engines, inject, chosen, given)
 
 
+def _too_stiff(robot: Robot, drive: Any, scenario: Any) -> str | None:
+    """:func:`~modelkit.verify.drive.reference.law_too_stiff` on the source's no-slip model (wheels)."""
+    from modelkit.verify.drive import reference
+
+    if drive.kind != "wheels":
+        return None
+    return reference.law_too_stiff(reference.planar_model(robot, drive), drive, scenario)
+
+
 def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence[str], inject: Sequence[str],
             chosen: Any, given: Mapping[str, tuple[Path, Renames]]) -> None:
     """Layer 4: the source driven by the seed's controllers in MuJoCo and PyBullet, on a floor;
@@ -501,7 +510,7 @@ def _layer4(report: VerifyReport, robot: Robot, out_dir: Path, engines: Sequence
         return
     chosen = chosen or scenarios.default_scenario(drive.kind, bool(drive.pan or drive.tilt))
     why = (vehicle.supported(robot, drive) or vehicle.drivable(robot, drive, chosen)
-           or vehicle.caster_drag(robot, drive))
+           or vehicle.caster_drag(robot, drive) or _too_stiff(robot, drive, chosen))
     if why is not None:
         report.skips.append(Skip(4, "all", f"layer 4 (driven scenarios) not run: {why}"))
         return

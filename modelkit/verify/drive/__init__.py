@@ -152,6 +152,11 @@ class Drive:
     roller_radius: float = 0.0
     track_offset_y: float = 0.0
     casters: tuple[str, ...] = ()  # caster wheel joints (round, about Y, on a swivel): not driven
+    heading: float = 0.0
+    """Forward in the root frame, as an angle about its Z: 0 when the axle is the root's Y (x forward,
+    REP-103), π/2 when the axle is the root's X (forward +Y: safety-gymnasium's car). Every planar
+    quantity of layer 4 (the engines' paths, the references' COM and root offset, "left" at +Y) is
+    in the drive frame, the root frame turned by ``heading``."""
 
     def as_dict(self) -> dict[str, Any]:
         """Plain data (for the report and for an engine's child process)."""
@@ -161,7 +166,7 @@ class Drive:
             "pan": self.pan, "tilt": self.tilt,
             "rollers": {k: list(v) for k, v in sorted(self.rollers.items())},
             "roller_radius": self.roller_radius, "track_offset_y": self.track_offset_y,
-            "casters": list(self.casters),
+            "casters": list(self.casters), "heading": self.heading,
         }
 
     @staticmethod
@@ -175,6 +180,7 @@ class Drive:
             roller_radius=float(data.get("roller_radius", 0.0)),
             track_offset_y=float(data.get("track_offset_y", 0.0)),
             casters=tuple(data.get("casters", ())),
+            heading=float(data.get("heading", 0.0)),
         )
 
 

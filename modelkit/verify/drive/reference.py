@@ -123,6 +123,13 @@ def _subtree(robot: Robot, joint_name: str) -> set[str]:
     return out
 
 
+def _drive_frame(heading: float) -> np.ndarray:
+    """The rotation taking root-frame vectors into the drive frame (the root frame turned by
+    ``heading`` about Z, :attr:`Drive.heading`)."""
+    c, s = math.cos(heading), math.sin(heading)
+    return np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]]) if heading else np.eye(3)
+
+
 def planar_model(robot: Robot, drive: Drive, friction: float | None = None) -> PlanarModel:
     """The no-slip model's parameters from ``robot``'s own links (the source, or for tracks the
     model with its track approximation), every link's inertial at q = 0 in the root frame.
@@ -161,7 +168,8 @@ def planar_model(robot: Robot, drive: Drive, friction: float | None = None) -> P
         masses.append((link.name, float(link.inertial.mass), c,
                        rotate_inertia(link.inertial.inertia, frame.rotation)))
     mass, centre, about_com = combine_mass_properties([(m, c, i) for _, m, c, i in masses])
-    com = np.asarray(centre) - p  # relative to the axle midpoint
+    turn = _drive_frame(drive.heading)
+    com = turn @ (np.asarray(centre) - p)  # relative to the axle midpoint, in the drive frame
     inertia = float(about_com[2, 2]) + mass * float(com[0] ** 2 + com[1] ** 2)  # yaw, about P
     spin = []
     spinning = (
@@ -191,7 +199,7 @@ def planar_model(robot: Robot, drive: Drive, friction: float | None = None) -> P
         tilt_inertia = _axis_inertia(
             by_link, _subtree(robot, drive.tilt), axis, frames[tilt.child].translation
         )
-    root = frames[str(robot.root)].translation
+    root = turn @ (frames[str(robot.root)].translation - p)  # the root origin relative to P
     servo_limit, servo_rollers = math.inf, (1, 1)
     if drive.kind == "tracks":
         servo_limit, servo_rollers = _servo_bound(robot, drive, mass, friction)
@@ -206,7 +214,7 @@ def planar_model(robot: Robot, drive: Drive, friction: float | None = None) -> P
         spin=(spin[0], spin[1]),
         radius=drive.radius,
         half_axle=drive.half_axle,
-        root_offset=(float(root[0] - p[0]), float(root[1] - p[1])),
+        root_offset=(float(root[0]), float(root[1])),
         pan_inertia=pan_inertia,
         tilt_inertia=tilt_inertia,
         notes=tuple(notes),
@@ -251,6 +259,38 @@ def _axis_inertia(
             d_perp = d - axis * float(axis @ d)
             total += float(axis @ i @ axis) + m * float(d_perp @ d_perp)
     return total
+
+
+def law_too_stiff(model: PlanarModel, drive: Drive, scenario: Scenario) -> str | None:
+    """Why the scenario's wheel law cannot drive this robot at its control period (None when it can).
+
+    The seed's ``u = kd (dq* − dq)`` is applied once per control period ``dt`` and held: in wheel
+    space the speeds move by ``dt·kd·I⁻¹`` of their error each period, where ``I`` is the robot's
+    inertia seen by the two wheels (``Jᵀ M J``, M the no-slip mass matrix over (v, w), J the wheels'
+    map to (v, w)). Above 1 for the lightest mode the speeds overshoot their targets at every period
+    and ring (diverge above 2), in the engines as in this reference: the driven comparison would grade
+    numerical ringing. The tutorial robots: 0.01. safety-gymnasium's car (a 20 g chassis of density
+    5 kg/m³, wheels of 5 cm): far above 1."""
+    if drive.kind != "wheels" or scenario.controller not in (None, "drive"):
+        return None
+    r, b = model.radius, model.half_axle
+    if r <= 0.0 or b <= 0.0:
+        return None
+    mass = np.array([[model.m_eff, model.coupling], [model.coupling, model.j_eff]])
+    to_body = np.array([[r / 2.0, r / 2.0], [-r / (2.0 * b), r / (2.0 * b)]])  # (dqL, dqR) → (v, w)
+    wheel_space = to_body.T @ mass @ to_body
+    eigen = np.linalg.eigvalsh(wheel_space)
+    lightest = float(eigen[0])
+    if not math.isfinite(lightest) or lightest <= 0.0:
+        return None
+    ratio = scenario.kd * scenario.dt / lightest
+    if ratio < 1.0:
+        return None
+    return (f"the drive law u = kd (dq* - dq), kd {scenario.kd:g}, applied every "
+            f"{scenario.dt * 1e3:g} ms, is too stiff for this robot: its wheels' lightest mode has an "
+            f"inertia of {lightest:.3g} kg·m², so each control period moves the wheel speeds by "
+            f"{ratio:.3g} times their error (above 1 they overshoot and ring, above 2 they diverge, in "
+            f"any engine); give a scenario kd below {lightest / scenario.dt:.3g}")
 
 
 # ----------------------------------------------------------------------------------------------------

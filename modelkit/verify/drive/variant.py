@@ -149,12 +149,13 @@ def yaw_of(rotations: Array) -> Array:
 
 
 def planar(source: str, profile: Profile, variant: str, t: Array, positions: Array, rotations: Array,
-           joints: dict[str, Array], wheels: tuple[str, str]) -> Trajectory:
+           joints: dict[str, Array], wheels: tuple[str, str], heading: float = 0.0) -> Trajectory:
     """A trajectory from raw samples of the root link frame (world positions (n, 3), rotations
-    (n, 3, 3)) and joint positions: x, y in the start pose's frame, yaw unwrapped relative to the
-    start, joint angles relative to the start."""
+    (n, 3, 3)) and joint positions: x, y in the start pose's drive frame (the root frame turned by
+    ``heading``, :attr:`Drive.heading`), yaw unwrapped relative to the start, joint angles relative to
+    the start."""
     yaw = np.unwrap(yaw_of(rotations))
-    c, s = math.cos(yaw[0]), math.sin(yaw[0])
+    c, s = math.cos(yaw[0] + heading), math.sin(yaw[0] + heading)
     dx, dy = positions[:, 0] - positions[0, 0], positions[:, 1] - positions[0, 1]
     rel = {name: q - q[0] for name, q in joints.items()}
     return Trajectory(source=source, profile=profile.name, variant=variant, t=t,

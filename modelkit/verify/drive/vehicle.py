@@ -203,10 +203,49 @@ def caster_drag(robot: Robot, drive: Drive) -> str | None:
             "reference after a 5 rad spin; 0.45 mrad with frictionless casters)")
 
 
+def _spinners(robot: Robot, frames: dict[str, Pose], direction: tuple[float, float, float]) -> list[Joint]:
+    """The unlimited revolute joints (not mimics) about ``direction`` (root frame) whose child link
+    has a collision round about the axis."""
+    links = {link.name: link for link in robot.links}
+    out = []
+    for j in robot.joints:
+        if (j.type is not JointType.REVOLUTE or j.limits.position_limited or j.mimic is not None
+                or j.child not in links):
+            continue
+        axis = _axis_in_root(j, frames)
+        if _parallel(axis, direction) and wheel_shape(links[j.child], frames[j.child].rotation.T @ axis):
+            out.append(j)
+    return out
+
+
+def _heading(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> float:
+    """:attr:`Drive.heading`: π/2 when the wheels turn about the root's X (the scenario's, else the
+    only round wheels found, at least two, with none about Y), else 0."""
+    x_axis = (1.0, 0.0, 0.0)
+    if scenario.left is not None:
+        joint = next((j for j in robot.joints if j.name == scenario.left), None)
+        if joint is None or joint.child not in frames:
+            return 0.0
+        return math.pi / 2 if _parallel(_axis_in_root(joint, frames), x_axis) else 0.0
+    if _spinners(robot, frames, (0.0, 1.0, 0.0)) or len(_spinners(robot, frames, x_axis)) < 2:
+        return 0.0
+    return math.pi / 2
+
+
+def _turned(frames: dict[str, Pose], heading: float) -> dict[str, Pose]:
+    """``frames`` (root frame) in the drive frame: the root frame turned by ``heading`` about Z."""
+    c, s = math.cos(heading), math.sin(heading)
+    turn = Pose(np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]]), np.zeros(3))
+    return {name: turn @ pose for name, pose in frames.items()}
+
+
 def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
     links = {link.name: link for link in robot.links}
     joints = {j.name: j for j in robot.joints}
     named = [scenario.left, scenario.right]
+    heading = _heading(robot, scenario, frames)
+    if heading:
+        frames = _turned(frames, heading)
     if any(n is not None for n in named):
         if None in named:
             raise ValueError("the scenario names only one wheel joint: give both robot.left and robot.right")
@@ -297,6 +336,7 @@ def _wheels(robot: Robot, scenario: Scenario, frames: dict[str, Pose]) -> Drive:
         wheel_links=(left.child, right.child),
         signs=(signs[0], signs[1]),
         casters=tuple(casters),
+        heading=heading,
     )
 
 

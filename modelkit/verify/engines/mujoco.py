@@ -1145,7 +1145,8 @@ class MujocoDriver:
         self.last_wall = time.perf_counter() - wall
         out = v.planar("mujoco", profile, "", np.arange(n) * every * dt, base[:, :3],
                        v.rotations_wxyz(base[:, 3:]),
-                       {name: qrec[:, i] for i, name in enumerate(self.recorded)}, v.wheel_joints(drive))
+                       {name: qrec[:, i] for i, name in enumerate(self.recorded)}, v.wheel_joints(drive),
+                       drive.heading)
         out.settings = dict(self.settings)
         out.support = support
         if laws is None and self._law_gain is not None:

@@ -672,7 +672,7 @@ class PyBulletDriver:
         times: Array = np.arange(len(base), dtype=np.float64) * (every * self.dt)
         out = v.planar("pybullet", profile, "", times, positions, rotations,
                        {name: q[:, i].copy() for i, name in enumerate(self.recorded)},
-                       v.wheel_joints(self.drive))
+                       v.wheel_joints(self.drive), self.drive.heading)
         out.settings = dict(self.settings)
         out.support = {str(k): float(f) for k, f in raw.get("support", {}).items()}
         if raw.get("law") == "per-step" and self.fast:
