@@ -9,6 +9,7 @@ from modelkit.checks import run_rules
 from modelkit.diagnostics import Diagnostic, Severity, sorted_diagnostics
 from modelkit.formats import read_model
 from modelkit.formats.common import ReadOptions
+from modelkit.formats.meshref import VISUAL_ONLY, collision_mesh_problem
 from modelkit.model import Robot
 from modelkit.textio import OpenedFile
 
@@ -91,9 +92,20 @@ def validate(
 
 
 def _for_target(d: Diagnostic, target: str) -> Diagnostic:
-    if d.code not in TARGET_REFUSALS[target] or d.severity is Severity.ERROR:
+    if d.severity is Severity.ERROR or not (d.code in TARGET_REFUSALS[target] or _mesh_refused(d, target)):
         return d
     return replace(d, severity=Severity.ERROR, message=f"{d.message} [an error for --target {target}]")
+
+
+def _mesh_refused(d: Diagnostic, target: str) -> bool:
+    """A mesh problem the target's loader refuses though the file's own loader does not look: a
+    collision mesh (MuJoCo's URDF import and PyBullet load it), and for PyBullet a visual mesh that
+    is not found (it refuses the file; MuJoCo's import discards visuals)."""
+    if target not in ("mjcf", "pybullet"):
+        return False
+    if collision_mesh_problem(d):
+        return True
+    return target == "pybullet" and d.code in ("MK500", "MK504") and d.message.endswith(VISUAL_ONLY)
 
 
 def load(path: str | Path, options: ReadOptions | None = None, fmt: str | None = None) -> Robot:

@@ -995,14 +995,20 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "A resource file does not exist (a warning when the mesh is visual-only). A warning also when an "
         "absolute path does not exist but the same path under the model's folder does: PyBullet reads it "
-        "there, Gazebo and other tools do not.",
+        "there, Gazebo and other tools do not. In URDF, xacro and SDF, whose own loaders (check_urdf, "
+        "libsdformat) never open meshes, a collision mesh's MK500, MK501, MK502, MK504 or MK506 is a "
+        "warning that says MuJoCo and PyBullet refuse the file: an error for `--target mjcf` and "
+        "`--target pybullet` (which also refuses a missing visual mesh), and `convert` exits 1.",
     ),
-    CodeInfo("MK501", "resource-load-failed", "error", "A resource file exists but cannot be loaded."),
+    CodeInfo("MK501", "resource-load-failed", "error",
+             "A resource file exists but cannot be loaded (a warning for a URDF or SDF collision mesh: "
+             "MK500)."),
     CodeInfo(
         "MK502",
         "resource-fragment-missing",
         "error",
-        "A resource `node` fragment does not exist in the file.",
+        "A resource `node` fragment does not exist in the file (a warning for a URDF or SDF collision mesh: "
+        "MK500).",
     ),
     CodeInfo(
         "MK503",
@@ -1019,10 +1025,12 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "A `package://` URI names a package that cannot be found. A warning when `NAME/REL` (or a bare "
         "`package://FILE`) lies beside the model file, where PyBullet looks (it strips `package://`): the "
-        "file is read, but ROS tools and Gazebo will not find it.",
+        "file is read, but ROS tools and Gazebo will not find it. A warning too for a URDF or SDF mesh, "
+        "which check_urdf and libsdformat never resolve (MK500 says when it is an error).",
     ),
     CodeInfo("MK505", "path-variable-undefined", "error", "A `${VAR}` path variable is not defined."),
-    CodeInfo("MK506", "resource-extension", "error", "A resource file type is not supported."),
+    CodeInfo("MK506", "resource-extension", "error",
+             "A resource file type is not supported (a warning for a URDF or SDF collision mesh: MK500)."),
     CodeInfo("MK507", "texture-unreadable", "warning", "A texture image cannot be found."),
     CodeInfo(
         "MK508",

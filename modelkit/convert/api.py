@@ -22,6 +22,7 @@ from modelkit.convert.output import OutputPlan, safe_file_name, target_problem
 from modelkit.convert.registry import TargetInfo, load_writer, target_for_path, target_info
 from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
 from modelkit.formats.common import ReadOptions
+from modelkit.formats.meshref import collision_mesh_problem
 from modelkit.model import Robot
 
 # Reader errors that do not stop a conversion: the writer deals with them and says so in a note
@@ -237,7 +238,10 @@ def convert(
                 )
             result.status = max(result.status, 1)
             continue
-        input_errors = input_errors or bool(checked.errors)
+        # a collision mesh the format's loader never opens (a warning for validate) is left out of the
+        # written robot, which then has no collision there: an input error for convert
+        input_errors = input_errors or bool(checked.errors) or any(
+            collision_mesh_problem(d) for d in checked.diagnostics)
         plan.inputs |= {p for r in robots for p in input_files(r, source)}
         names = _outputs_for(source, robots, out, target, folder_mode)
         if len(robots) > 1:

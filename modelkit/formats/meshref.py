@@ -14,12 +14,24 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from modelkit import rot3
-from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
+from modelkit.diagnostics import Diagnostic, DiagnosticSink, Severity, SourceLocation
 from modelkit.model import Mesh
 from modelkit.resources import Resolution, Resolver, found_report
 from modelkit.textio import UnreadableFile, check_regular
 
 MESH_FILE_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl", ".glb", ".gltf"})
+# A mesh file that is missing, names an unknown package, or cannot be loaded.
+MESH_PROBLEM_CODES = frozenset({"MK500", "MK501", "MK502", "MK504", "MK506"})
+COLLISION_MARK = " (a collision mesh: "
+VISUAL_ONLY = " (visual only)"
+
+
+def collision_mesh_problem(d: Diagnostic) -> bool:
+    """A problem with a collision mesh of a format whose own loader never opens meshes (URDF and its
+    xacro: check_urdf; SDF: libsdformat). The loader accepts the file, so ``validate`` warns; MuJoCo
+    and PyBullet refuse it, so it is an error for ``--target mjcf`` and ``--target pybullet``, and
+    ``convert`` exits 1 (the written robot has no collision there)."""
+    return d.code in MESH_PROBLEM_CODES and COLLISION_MARK in d.message
 
 
 def _symlink_loop(path: Path) -> bool:
@@ -52,6 +64,9 @@ class MeshChecker:
     # The simulator that fetches http(s) meshes as it loads the file (SDF: Gazebo, from Gazebo Fuel):
     # there such a mesh is an info (MK503); elsewhere a warning naming the consumers that cannot fetch it.
     web_fetched_by: str | None = None
+    # The format's own loader, when it never opens meshes (URDF: check_urdf; SDF: libsdformat): a
+    # collision mesh's problem is then a warning (:func:`collision_mesh_problem`), not an error.
+    unopened_by: str | None = None
     _loaded: dict[str, str | None] = field(default_factory=dict)
     _textures: set[str] = field(default_factory=set)
 
@@ -90,21 +105,28 @@ class MeshChecker:
     ) -> Mesh:
         """A :class:`Mesh` for ``uri``; unresolvable or unloadable files are reported at ``loc``.
 
-        A problem with a mesh used only for display is a warning; for collision it is an error.
+        A problem with a mesh used only for display is a warning; for collision it is an error, or a
+        warning that says who refuses the file where the format's own loader never opens meshes
+        (:attr:`unopened_by`).
         """
         resolution = self.resolution(uri, loc)
         severity = Severity.WARNING if visual_only else None
-        usage = " (visual only)" if visual_only else ""
+        usage = VISUAL_ONLY if visual_only else ""
+        if not visual_only and self.unopened_by:
+            severity = Severity.WARNING
+            usage = (f"{COLLISION_MARK}{self.unopened_by} never opens meshes and accepts the file; MuJoCo "
+                     "and PyBullet refuse it)")
         path = resolution.path
         if resolution.scheme in ("http", "https"):
             self._web_mesh(uri, loc)
         elif resolution.code is not None:
+            known = resolution.code in MESH_PROBLEM_CODES or visual_only
             self.sink.emit(
                 resolution.code,
-                (resolution.message or uri) + usage,
+                (resolution.message or uri) + (usage if known else ""),
                 loc,
                 hint=resolution.hint,
-                severity=severity,
+                severity=severity if known else None,
             )
         elif path is not None:
             report = found_report(resolution, uri)
@@ -118,7 +140,7 @@ class MeshChecker:
                 self.sink.emit(
                     "MK506",
                     f'resource "{uri}": {suffix or "no extension"} files are not supported '
-                    "(supported: .stl .obj .dae .wrl .glb .gltf)",
+                    f"(supported: .stl .obj .dae .wrl .glb .gltf){usage}",
                     loc,
                     severity=severity,
                 )
@@ -126,7 +148,9 @@ class MeshChecker:
                 problem = self._load(path, submesh)
                 if problem:
                     code, message = problem.split("\t", 1)
-                    self.sink.emit(code, f'resource "{uri}": {message}{usage}', loc, severity=severity)
+                    known = code in MESH_PROBLEM_CODES or visual_only
+                    self.sink.emit(code, f'resource "{uri}": {message}{usage if known else ""}', loc,
+                                   severity=severity if known else None)
         return Mesh(
             uri=uri,
             path=str(path) if path is not None else None,

@@ -118,6 +118,7 @@ class Context:
                 self.options.check_resources,
                 resolve=lambda uri, loc: self._file_resolution(uri, src, loc),
                 web_fetched_by="Gazebo",
+                unopened_by="libsdformat",
             )
             self._meshes[key] = checker
         return checker

@@ -88,7 +88,8 @@ def read_urdf_document(
     robot = Robot(name=root.get("name", ""), source_format="urdf", source=doc.loc(root))
     _header(ctx, root, robot)
     check_structure(ctx, root)
-    meshes = MeshChecker(options.resolver, base_dir, model_file, sink, options.check_resources)
+    meshes = MeshChecker(options.resolver, base_dir, model_file, sink, options.check_resources,
+                         unopened_by="check_urdf")
     materials = Materials(meshes)
     for element in ctx.children(root, "material"):
         materials.define(ctx, element)
