@@ -152,8 +152,11 @@ def test_validate_reports_a_broken_glb(tmp_path: Path) -> None:
     (tmp_path / "part.glb").write_bytes(b"glTF\x02\x00\x00\x00garbage")
     path = tmp_path / "g.urdf"
     path.write_text(URDF.format(mesh="part.glb"))
+    # check_urdf never opens meshes: a warning that says who refuses the file, an error for them
     result = CliRunner().invoke(main, ["validate", str(path)])
-    assert "MK501" in result.output and result.exit_code == 1, result.output
+    assert "warning MK501" in result.output and result.exit_code == 0, result.output
+    result = CliRunner().invoke(main, ["validate", "--target", "mjcf", str(path)])
+    assert "error MK501" in result.output and result.exit_code == 1, result.output
 
 
 def test_converted_outputs_load_in_their_consumers(glb_urdf: Path, tmp_path: Path) -> None:
