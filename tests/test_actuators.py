@@ -291,15 +291,17 @@ def test_auto_servos_ranged_joints_and_leaves_endless_ones_free(tmp_path: Path) 
 
 def test_made_up_gains_follow_the_rule(tmp_path: Path) -> None:
     """The pendulum's arm: 1 kg, COM 0.5 m from the axis, Ixx 0.0835417 → I = 0.3335417 kg·m² about the
-    joint; kp = I (2π·30)², kv = 2 I (2π·30)."""
+    joint; kp = I (2π·30)², kv = 2 I (2π·30), each rounded up to three significant digits."""
     path = tmp_path / "pendulum.body"
     path.write_text(PENDULUM_BODY)
     out, _ = convert(load(path), tmp_path / "out", "position")
     (el,) = actuator_elements(out)
     wn = 2 * np.pi * 30.0
     inertia = 0.0835417 + 1.0 * 0.5**2
-    assert float(el.get("kp")) == pytest.approx(inertia * wn**2, rel=1e-9)
-    assert float(el.get("kv")) == pytest.approx(2 * inertia * wn, rel=1e-9)
+    # the rule's numbers, rounded up to three significant digits: 11850.9 → 11900, 125.73 → 126
+    assert (el.get("kp"), el.get("kv")) == ("11900", "126")
+    assert inertia * wn**2 <= float(el.get("kp")) < inertia * wn**2 * 1.01
+    assert 2 * inertia * wn <= float(el.get("kv")) < 2 * inertia * wn * 1.01
     m = mujoco.MjModel.from_xml_path(str(out))
     d = mujoco.MjData(m)
     mujoco.mj_forward(m, d)
@@ -952,3 +954,18 @@ def test_tiago_holds_its_head_and_hand_on_a_plain_floor(tmp_path: Path) -> None:
               and not m.joint(j).name.startswith(("wheel", "caster"))}
     worst = max(turned, key=turned.__getitem__)
     assert turned[worst] < 0.02, f"{worst} turned {turned[worst]:.3f} rad"
+
+
+def test_made_up_gains_are_rounded_up_to_three_digits() -> None:
+    """A made-up gain is written as a person writes it, and never below the rule's value (the sag and
+    tipping bounds are lower bounds)."""
+    from modelkit.convert.servo_gains import rounded_up
+
+    assert rounded_up(155503.604519839) == 156000.0
+    assert rounded_up(6.46029817704328) == 6.47
+    assert rounded_up(6.47) == 6.47  # already three digits: itself, not 6.48
+    assert rounded_up(999.5) == 1000.0
+    assert rounded_up(0.00123456) == 0.00124
+    for value in (1e-7 / 3, 1.0 / 3, 12345.678, 9.999e5):
+        assert value <= rounded_up(value) < value * 1.01
+        assert len(f"{rounded_up(value):g}".replace(".", "").rstrip("0").lstrip("0").split("e")[0]) <= 3

@@ -25,6 +25,11 @@ tips over it (an inverted pendulum: ``(M / n) g h``), so a biped's ankles hold i
 A drive wheel also carries its share of the robot it pushes, ``(M / n) r²`` about its axis
 (:mod:`modelkit.convert.wheel_loads`), so a wheel's velocity servo tracks with the robot on it.
 A subtree without mass gets ``MIN_INERTIA`` so that every gain is positive.
+
+Every gain is then rounded up to :data:`GAIN_DIGITS` significant digits (:func:`rounded_up`): a made-up
+number is written as a person would write it (``kp="156000"``, not ``"155503.604519839"``), and
+rounding up keeps every lower bound above (the sag, the tipping margin, a wheel's share) while moving
+the servo's frequency by at most 0.5 %.
 """
 
 from __future__ import annotations
@@ -32,6 +37,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from decimal import ROUND_CEILING, Decimal
 
 import numpy as np
 
@@ -47,6 +53,7 @@ DAMPING_RATIO = 1.0
 MIN_INERTIA = 1e-6  # kg·m² or kg: the floor of a massless subtree's reflected inertia
 TIPPING_MARGIN = 4.0  # a leg servo's kp over the tipping stiffness it holds (legs.carried_loads)
 TIPPING_BANDWIDTH_HZ = 150.0  # its ceiling: ωn·dt = 1.9 at a 2 ms step, under the explicit limit of 2
+GAIN_DIGITS = 3  # significant digits of a made-up gain (rounded up: rounded_up)
 GRAVITY = np.array([0.0, 0.0, -9.81])  # m/s², in the root's frame
 
 
@@ -224,13 +231,25 @@ def natural_frequency_for(load: JointLoad) -> float:
     return wn
 
 
+def rounded_up(value: float, digits: int = GAIN_DIGITS) -> float:
+    """``value`` (positive, finite) rounded up to ``digits`` significant digits: 155503.6 → 156000,
+    6.4603 → 6.47; a value that already has no more digits is itself. Others are returned as given."""
+    if not (math.isfinite(value) and value > 0.0):
+        return value
+    exact = Decimal(repr(value))
+    step = Decimal(1).scaleb(exact.adjusted() - digits + 1)
+    return float(exact.quantize(step, rounding=ROUND_CEILING))
+
+
 def position_gains(load: JointLoad) -> tuple[float, float]:
-    """(kp, kv) of a critically damped position servo (module docstring)."""
+    """(kp, kv) of a critically damped position servo (module docstring), each rounded up to
+    :data:`GAIN_DIGITS` significant digits."""
     i = max(load.inertia, MIN_INERTIA)
     wn = natural_frequency_for(load)
-    return i * wn * wn, 2.0 * DAMPING_RATIO * i * wn
+    return rounded_up(i * wn * wn), rounded_up(2.0 * DAMPING_RATIO * i * wn)
 
 
 def velocity_gain(load: JointLoad) -> float:
-    """kv of a velocity servo at the stated bandwidth."""
-    return max(load.inertia, MIN_INERTIA) * natural_frequency()
+    """kv of a velocity servo at the stated bandwidth, rounded up to :data:`GAIN_DIGITS` significant
+    digits."""
+    return rounded_up(max(load.inertia, MIN_INERTIA) * natural_frequency())
