@@ -402,6 +402,80 @@ def _blank_declaration(data: bytes) -> bytes | None:
     return data[:start] + bytes(b if b in b"\r\n" else 32 for b in data[start:end]) + data[end:]
 
 
+_TAIL_COMMENT = re.compile(rb"<!--.*?-->", re.DOTALL)
+_TAIL_INSTRUCTION = re.compile(rb"<\?.*?\?>", re.DOTALL)
+_TAIL_END_TAG = re.compile(rb"</[^\s<>/]+\s*>")
+_TAIL_TAG = re.compile(rb"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<(/?)[^\s<>/!?]+(?:\s[^<>]*?)?(/?)>",
+                       re.DOTALL)
+_TAIL_BLANK = b" \t\r\n"
+
+
+def _blank_markup_after_root(data: bytes, line: int, col: int) -> bytes | None:
+    """TinyXML2 reads the root element and then every node after it, keeping none: end tags of any name
+    (PyFlyt's rocket ends with ``</robot>`` twice), whole elements, comments and processing instructions.
+    libxml2 stops at the first (``line``, ``col``: its position, in characters). That tail becomes
+    spaces, so every offset stays. None (the error stands) when the tail holds text outside any element
+    (MuJoCo, libsdformat and PyBullet refuse it) or markup that is not whole."""
+    if line < 1 or col < 1 or data.startswith(b"\xef\xbb\xbf"):
+        return None
+    lines = data.split(b"\n")
+    if line > len(lines):
+        return None
+    try:
+        before = lines[line - 1].decode("utf-8")[: col - 1].encode("utf-8")
+    except UnicodeDecodeError:
+        return None
+    start = sum(len(lines[k]) + 1 for k in range(line - 1)) + len(before)
+    if not _markup_only(data[start:]):
+        return None
+    return data[:start] + bytes(b if b in b"\r\n" else 32 for b in data[start:])
+
+
+def _markup_only(tail: bytes) -> bool:
+    """``tail`` is nothing but blanks, comments, processing instructions, end tags and whole elements."""
+    at = 0
+    while True:
+        while at < len(tail) and tail[at] in _TAIL_BLANK:
+            at += 1
+        if at == len(tail):
+            return True
+        for simple in (_TAIL_COMMENT, _TAIL_INSTRUCTION, _TAIL_END_TAG):
+            found = simple.match(tail, at)
+            if found:
+                at = found.end()
+                break
+        else:
+            end = _element_end(tail, at)
+            if end is None:
+                return False
+            at = end
+
+
+def _element_end(tail: bytes, at: int) -> int | None:
+    """Where the element starting at ``at`` ends, when it is whole and well formed (lxml parses it)."""
+    depth = 0
+    for found in _TAIL_TAG.finditer(tail, at):
+        if found.start() != at and depth == 0:
+            return None
+        text = found.group(0)
+        if text.startswith((b"<!", b"<?")):
+            continue
+        if found.group(1):
+            depth -= 1
+        elif not found.group(2):
+            depth += 1
+        if depth == 0:
+            try:
+                etree.fromstring(tail[at : found.end()], etree.XMLParser(resolve_entities=False,
+                                                                          no_network=True, load_dtd=False))
+            except (etree.XMLSyntaxError, ValueError):
+                return None
+            return found.end()
+        if depth < 0:
+            return None
+    return None
+
+
 _TINYXML2 = "libsdformat, urdfdom, MuJoCo and PyBullet (TinyXML2)"
 
 
@@ -414,7 +488,7 @@ def _declared_version(text: str) -> str:
 class _Leniency:
     """Something libxml2 refuses that TinyXML2 reads past: how to read past it, and what to say."""
 
-    repair: Callable[[bytes], bytes | None]
+    repair: Callable[[bytes, tuple[int, int]], bytes | None]  # (data, libxml2's line and column)
     say: Callable[[str], str]  # the document's text → the warning
     hint: str
     at_declaration: bool  # located at the XML declaration (else where libxml2 stopped)
@@ -424,25 +498,33 @@ _DECLARATION_HINT = 'start the file with <?xml version="1.0"?> or leave the decl
 #: libxml2's complaint → how TinyXML2 reads past it.
 _TINYXML2_LENIENCY = {
     "hyphen within comment": _Leniency(
-        _blank_comment_hyphens,
+        lambda data, _: _blank_comment_hyphens(data),
         lambda text: 'a comment contains "--", which XML forbids: libsdformat, urdfdom and MuJoCo (TinyXML2) '
         "accept it, strict XML tools (xacro, lxml, ROS launch) refuse it",
         'write "- -" or "-" inside comments',
         at_declaration=False,
     ),
     "Unsupported version": _Leniency(
-        _blank_declaration,
+        lambda data, _: _blank_declaration(data),
         lambda text: f'the XML declaration names version "{_declared_version(text)}", not 1.0; {_TINYXML2} '
         "ignore it, strict XML tools (lxml, so urdf_parser_py and yourdfpy) refuse it",
         _DECLARATION_HINT,
         at_declaration=True,
     ),
     "XML declaration allowed only at the start": _Leniency(
-        _blank_declaration,
+        lambda data, _: _blank_declaration(data),
         lambda text: f"the XML declaration is not at the start of the file; {_TINYXML2} ignore it, strict "
         "XML tools (lxml, so urdf_parser_py and yourdfpy, and xacro) refuse it",
         _DECLARATION_HINT,
         at_declaration=True,
+    ),
+    "Extra content at the end of the document": _Leniency(
+        lambda data, at: _blank_markup_after_root(data, *at),
+        lambda text: "the document goes on after its root element ends (an end tag, element, comment or "
+        f"processing instruction): {_TINYXML2} read the root element and ignore the rest, strict XML tools "
+        "(lxml, so urdf_parser_py and yourdfpy, and xacro) refuse the file",
+        "delete everything after the root element's end tag",
+        at_declaration=False,
     ),
 }
 
@@ -465,7 +547,7 @@ def _as_tinyxml2_reads(
             break
         applied.add(problem)
         leniency = _TINYXML2_LENIENCY[problem]
-        repaired = leniency.repair(data)
+        repaired = leniency.repair(data, (where.line or 0, where.col or 0))
         if repaired is None:
             break
         if leniency.at_declaration:

@@ -381,6 +381,65 @@ def test_xml_declaration_as_tinyxml2_reads_it(tmp_path: Path, head: str, line: i
     assert [d.code for d in validate(path).errors] == ["MK020"]  # a real malformation stays an error
 
 
+_MJCF_BALL = ('<mujoco model="m">\n'
+              '  <worldbody><body name="b"><freejoint/><geom size="0.1"/></body></worldbody>\n'
+              "</mujoco>")
+#: what follows the root element's end tag (each of them TinyXML2 reads past and libxml2 refuses), and the
+#: column of the line after the root where libxml2 stops (a comment there is XML)
+_AFTER_ROOT = {
+    "end tag again": ("\n</{root}>\n", 1),  # PyFlyt 0.29's rocket.urdf
+    "another end tag": ("\n</foo>\n", 1),
+    "a second root": ('\n<{root} name="b"><x/></{root}>\n', 1),
+    "an element and a comment": ("\n<!-- c --><junk a='1'/>\n", 11),
+}
+
+
+@pytest.mark.parametrize("tail", list(_AFTER_ROOT), ids=list(_AFTER_ROOT))
+@pytest.mark.parametrize("kind", ["urdf", "mjcf", "sdf"])
+def test_markup_after_the_root_element_is_a_warning_as_tinyxml2_reads_it(
+    tmp_path: Path, sdf_oracle: Path, kind: str, tail: str  # noqa: F811
+) -> None:
+    """TinyXML2 (urdfdom, MuJoCo, libsdformat, PyBullet) reads the root element and ignores end tags,
+    elements and comments after it; libxml2 refuses the file. PyFlyt's rocket ends with ``</robot>``
+    twice. The file's own loader accepts each, so validate warns where it goes on, and reads the robot."""
+    model, root, suffix = {"urdf": (_TRIANGLE_URDF, "robot", "urdf"), "mjcf": (_MJCF_BALL, "mujoco", "xml"),
+                           "sdf": (_BOX_MODEL.format(name="m"), "sdf", "sdf")}[kind]
+    path = tmp_path / f"m.{suffix}"
+    after, column = _AFTER_ROOT[tail]
+    text = model.rstrip("\n") + after.format(root=root)
+    path.write_text(text)
+    accepted, said = reference(kind, path, sdf_oracle, tmp_path)
+    assert accepted, said
+    v = validate(path)
+    assert v.errors == []
+    (d,) = [d for d in v.diagnostics if d.code == "MK020"]
+    assert d.severity.value == "warning" and "after its root element ends" in d.message
+    after_root = model.rstrip("\n").count("\n") + 2
+    assert d.location is not None and (d.location.line, d.location.col) == (after_root, column)
+    assert v.robot is not None and v.robot.name in ("r", "m")
+    if kind == "urdf":
+        import pybullet
+
+        client = pybullet.connect(pybullet.DIRECT)
+        try:
+            assert pybullet.loadURDF(str(path), physicsClientId=client) >= 0
+        finally:
+            pybullet.disconnect(client)
+
+
+@pytest.mark.parametrize("kind", ["mjcf", "sdf"])
+def test_text_after_the_root_element_stays_an_error(tmp_path: Path, sdf_oracle: Path, kind: str) -> None:  # noqa: F811
+    """Text outside any element after the root: MuJoCo and libsdformat refuse it (TinyXML2's
+    XML_ERROR_PARSING_TEXT), and so does validate; so do unfinished tags."""
+    model, suffix = {"mjcf": (_MJCF_BALL, "xml"), "sdf": (_BOX_MODEL.format(name="m"), "sdf")}[kind]
+    path = tmp_path / f"m.{suffix}"
+    for tail in ("\ngarbage\n", "\n<!-- c -->\n&amp;\n", "\n<x\n"):
+        path.write_text(model.rstrip("\n") + tail)
+        if tail != "\n<x\n":
+            assert reference(kind, path, sdf_oracle, tmp_path)[0] is False
+        assert [d.code for d in validate(path).errors] == ["MK020"], tail
+
+
 def test_an_undeclared_namespace_prefix_in_a_urdf_is_a_warning_as_tinyxml2_reads_it(tmp_path: Path) -> None:
     """airo-models' UR3e/UR5e URDFs carry Drake's ``drake:acceleration`` and
     ``<drake:collision_filter_group>`` without declaring ``xmlns:drake``: urdfdom reads them (TinyXML2

@@ -23,7 +23,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from modelkit.diagnostics import DiagnosticSink, SourceLocation, sorted_diagnostics
+from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation, sorted_diagnostics
 from modelkit.formats.common import ReadOptions, ReadResult
 from modelkit.formats.meshref import not_found
 from modelkit.formats.mjcf.actuators import OnJoint, read_actuators, tendon_actuators
@@ -78,7 +78,8 @@ class _MjcfReader:
             return []
         index = SourceIndex(doc, self.path.parent, self.sink, self.options.max_bytes)
         list(index.iter_all())  # reads the included files: their XML problems stop here too
-        if any(d.code in ("MK001", "MK020", "MK021", "MK002", "MK003") for d in self.sink.items):
+        if any(d.code in ("MK001", "MK020", "MK021", "MK002", "MK003") and d.severity is Severity.ERROR
+               for d in self.sink.items):  # not MK020's warnings: TinyXML2 (MuJoCo) reads those files
             return []
         if not check_asset_files(index, self.path.parent, self.sink, self.options.max_bytes):
             return []
