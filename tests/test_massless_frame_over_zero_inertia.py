@@ -86,3 +86,40 @@ def test_verify_passes_with_the_kept_tensor(source: Path, tmp_path: Path) -> Non
     assert [c for c in report.checks if not c.passed] == []
     assert {(c.layer, c.engine, c.quantity) for c in report.checks} >= {(1, "mujoco", "inertia"),
                                                                        (3, "mujoco", "mass-matrix")}
+
+
+# PyFlyt 0.29's fixed-wing drone: eight links welded to a free base, each a point mass (a mass with a zero
+# tensor). Spread over 2 m their group has an inertia, but MuJoCo adds the bodies' own moments and refused
+# the written file ("mass and inertia of moving bodies must be larger than mjMINVAL"; convert: MK877).
+POINT_MASSES = """<robot name="plane">
+  <link name="base_link"><inertial><mass value="0.3"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>
+    <collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision></link>
+""" + "".join(f"""  <link name="part{k}"><inertial><mass value="{mass}"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+  <joint name="fix{k}" type="fixed"><parent link="base_link"/><child link="part{k}"/>
+    <origin xyz="{xyz}"/></joint>
+""" for k, (mass, xyz) in enumerate([(0.1, "-1.1 0 0"), (0.05, "-1.1 0 0.15"), (0.2, "-0.5 0.95 0"),
+                                      (0.2, "-0.5 -0.95 0"), (1.0, "-0.45 0 0")])) + "</robot>\n"
+
+
+def test_a_free_group_of_point_masses_loads_in_mujoco_with_its_spread_inertia(tmp_path: Path) -> None:
+    source = tmp_path / "plane.urdf"
+    source.write_text(POINT_MASSES)
+    out = tmp_path / "out" / "plane.xml"
+    notes = write(load(source), out, force=True)
+    assert "MK877" not in {n.code for n in notes}
+    (lifted,) = [n for n in notes if n.code == "MK870"]
+    assert "base_link" in lifted.message and "point masses" in lifted.message
+    m = mujoco.MjModel.from_xml_path(str(out))  # refused before
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    # the group's inertia about its centre of mass is the point masses' spread, to the writer's 1e-9 kg·m²
+    model = pin.buildModelFromUrdf(str(source), pin.JointModelFreeFlyer())
+    data = model.createData()
+    expected = pin.crba(model, data, pin.neutral(model))
+    expected = np.triu(expected) + np.triu(expected, 1).T
+    full = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, full)
+    assert np.trace(expected[3:, 3:]) > 0.5  # the spread alone: 0.36, 0.49 and 0.85 kg·m² about the base
+    assert np.allclose(full, expected, rtol=0.0, atol=5e-9)

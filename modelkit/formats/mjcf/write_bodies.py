@@ -619,7 +619,7 @@ class BodyTree:
         com = np.asarray(inertial.com, dtype=float) if inertial is not None else np.zeros(3)
         tensor = clean_inertia(inertial.inertia, inertial.mass) if inertial is not None else np.zeros((3, 3))
         if moving:
-            group_mass, moments = self._weld_group(link)
+            group_mass, moments, own = self._weld_group(link)
             if group_mass < SINGULAR:
                 kept = bool(np.any(tensor != 0.0))  # a tensor the source gives without mass is kept
                 self.ctx.note(
@@ -633,15 +633,19 @@ class BodyTree:
                 mass, com = mass + MIN_MASS, com if mass > 0.0 else np.zeros(3)
                 self.lifted.add(link.name)
                 tensor = tensor + MIN_INERTIA * np.eye(3)
-            elif float(np.min(moments)) < (SINGULAR_DIAGONAL if _diagonal(tensor) or _principal_form(tensor)
-                                           else SINGULAR_FULL):
+            elif (singular := float(np.min(moments)) < (
+                    SINGULAR_DIAGONAL if _diagonal(tensor) or _principal_form(tensor) else SINGULAR_FULL)
+            ) or own < SINGULAR_DIAGONAL:
                 # a massless frame over welded links with mass but no inertia carries the fix itself
                 # (icub-models' iCub: a free base_link over root_link's 4.72 kg with a zero tensor)
                 frame = mass <= 0.0
+                why = ("its inertia (with what is welded to it) is singular" if singular else
+                       "neither it nor what is welded to it has an inertia of its own (point masses, whose "
+                       "spread alone gives the group its inertia)")
                 self.ctx.note(
                     "MK870",
-                    f"link {link.name} moves but its inertia (with what is welded to it) is "
-                    f"singular; MuJoCo refuses that, so {fmt(MIN_INERTIA)} kg·m² is added on each axis"
+                    f"link {link.name} moves but {why}; MuJoCo refuses that, so {fmt(MIN_INERTIA)} kg·m² is "
+                    "added on each axis"
                     + (f" (with {fmt(MIN_MASS)} kg, since the link itself has no mass)" if frame else ""),
                     link.loc("inertia"),
                     target,
@@ -698,9 +702,13 @@ class BodyTree:
         )
         return fixed
 
-    def _weld_group(self, link: Link) -> tuple[float, np.ndarray]:
-        """Mass and principal moments of ``link`` and every link welded to it (fixed joints down)."""
+    def _weld_group(self, link: Link) -> tuple[float, np.ndarray, float]:
+        """Mass and principal moments of ``link`` and every link welded to it (fixed joints down), and
+        the largest of their own smallest principal moments (0 when every one of them is a point mass:
+        MuJoCo adds the bodies' own moments without the spread of their centres and refuses such a group,
+        PyFlyt's fixed-wing's eight point masses)."""
         parts: list[tuple[float, np.ndarray, np.ndarray]] = []
+        own = 0.0
         stack: list[tuple[str, Pose]] = [(link.name, Pose())]
         while stack:
             name, pose = stack.pop()
@@ -716,8 +724,9 @@ class BodyTree:
                         rotate_inertia(inertial.inertia, pose.rotation),
                     )
                 )
+                own = max(own, float(np.min(principal_moments(np.asarray(inertial.inertia, dtype=float)))))
             for joint in self.children.get(name, []):
                 if joint.type not in MOVING:
                     stack.append((joint.child, pose @ joint.origin))
         mass, _, inertia = combine_mass_properties(parts)
-        return mass, principal_moments(inertia)
+        return mass, principal_moments(inertia), own
