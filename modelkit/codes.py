@@ -1059,7 +1059,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A URDF mesh is glTF (.glb/.gltf): rviz and gz-sim read it; MuJoCo cannot, PyBullet refuses the "
         "file.",
     ),
-    # (urdf materials and resources MK515-MK529) (sdf resources MK530-MK549)
+    CodeInfo(
+        "MK515",
+        "mesh-ply-consumers",
+        "warning",
+        "A URDF mesh is PLY: rviz and gz-sim read it (Assimp); MuJoCo cannot (\"no decoder found\"), "
+        "PyBullet refuses the file (\"invalid mesh filename extension\").",
+    ),
+    # (urdf materials and resources MK516-MK529) (sdf resources MK530-MK549)
     CodeInfo(
         "MK530",
         "sdf-include-invalid",

@@ -79,7 +79,7 @@ def test_import_does_not_load_parsers() -> None:
 
 
 def test_supported_extensions() -> None:
-    assert frozenset({".stl", ".obj", ".dae", ".wrl", ".glb", ".gltf"}) == SUPPORTED_EXTENSIONS
+    assert frozenset({".stl", ".obj", ".dae", ".wrl", ".glb", ".gltf", ".ply"}) == SUPPORTED_EXTENSIONS
 
 
 # ---- STL (GR001) -------------------------------------------------------------------------------

@@ -244,6 +244,22 @@ def gltf_meshes(robot: Robot) -> Iterator[Diagnostic]:
         )
 
 
+@rule("ply-meshes", "MK515")
+def ply_meshes(robot: Robot) -> Iterator[Diagnostic]:
+    """PLY meshes in a URDF (ManiSkill's SO-100 collides its jaws with them): rviz and gz-sim read them
+    through Assimp; MuJoCo has no decoder ("no decoder found for mesh file") and PyBullet refuses the
+    whole URDF ("invalid mesh filename extension '.ply'"), measured with MuJoCo 3.14 and PyBullet 3.2.7."""
+    for link, geom, uri in _urdf_meshes(robot, frozenset({".ply"})):
+        role = "collision" if geom in link.collisions else "visual"
+        yield diag(
+            "MK515",
+            f'{role} mesh "{uri}" is PLY, read by rviz and gz-sim (Assimp): MuJoCo cannot load it and '
+            "PyBullet refuses the whole URDF",
+            geom.source or link.loc("name"),
+            hint="`modelkit convert` writes it as STL/OBJ for every target",
+        )
+
+
 @rule("collada-for-mujoco", "MK512")
 def collada_for_mujoco(robot: Robot) -> Iterator[Diagnostic]:
     """COLLADA meshes in a URDF: MuJoCo cannot load them ("no decoder found for mesh file")."""

@@ -19,7 +19,9 @@ from modelkit.model import Mesh
 from modelkit.resources import Resolution, Resolver, found_report
 from modelkit.textio import UnreadableFile, check_regular
 
-MESH_FILE_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl", ".glb", ".gltf"})
+# what modelkit.geometry.meshfiles.load_mesh reads (its SUPPORTED_EXTENSIONS; a test keeps them equal,
+# this module does not import that one's numpy and parsers)
+MESH_FILE_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl", ".glb", ".gltf", ".ply"})
 # A mesh file that is missing, names an unknown package, or cannot be loaded.
 MESH_PROBLEM_CODES = frozenset({"MK500", "MK501", "MK502", "MK504", "MK506"})
 COLLISION_MARK = " (a collision mesh: "
@@ -140,7 +142,7 @@ class MeshChecker:
                 self.sink.emit(
                     "MK506",
                     f'resource "{uri}": {suffix or "no extension"} files are not supported '
-                    f"(supported: .stl .obj .dae .wrl .glb .gltf){usage}",
+                    f"(supported: {' '.join(sorted(MESH_FILE_EXTENSIONS))}){usage}",
                     loc,
                     severity=severity,
                 )

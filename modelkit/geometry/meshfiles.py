@@ -1,4 +1,4 @@
-"""Load mesh files (STL, OBJ, COLLADA, VRML97, glTF) into triangles, the way Choreonoid reads them.
+"""Load mesh files (STL, OBJ, COLLADA, VRML97, glTF, PLY) into triangles, the way Choreonoid reads them.
 
 One entry point, :func:`load_mesh`, returns every triangle of a file (or of one named part of it) in
 metres, in the file's root frame. The rules follow ``docs/body-format.md`` §3.6 / §4.9:
@@ -8,6 +8,9 @@ metres, in the file's root frame. The rules follow ``docs/body-format.md`` §3.6
   and COLLADA, **not** for VRML (as Choreonoid).
 * **COLLADA.** The root ``<asset><unit meter>`` is applied; ``<up_axis>`` is **ignored** (Choreonoid,
   RViz and Gazebo all ignore it; trimesh ignores ``<unit>`` as well, so it is not used for DAE).
+* **PLY** (binary or ASCII, as Blender and ManiSkill's SO-100 write it) is read with trimesh; metadata
+  applies as for STL. No target but rviz and gz-sim (Assimp) reads it, so ``convert`` writes it as
+  STL/OBJ for every target.
 * **Fragments** (VRML ``DEF`` names, COLLADA node ``name`` attributes): the first node with that name in a
   depth-first search is *detached*: the translations of its ancestors and its own translation are
   dropped, the accumulated linear part (rotation, scale) is kept.
@@ -44,7 +47,7 @@ __all__ = [
     "load_mesh",
 ]
 
-SUPPORTED_EXTENSIONS: frozenset[str] = frozenset({".stl", ".obj", ".dae", ".wrl", ".glb", ".gltf"})
+SUPPORTED_EXTENSIONS: frozenset[str] = frozenset({".stl", ".obj", ".dae", ".wrl", ".glb", ".gltf", ".ply"})
 
 #: Extensions Choreonoid reads through Assimp that modelkit does not read.
 _ASSIMP_ONLY_EXTENSIONS = frozenset({".blend", ".x", ".dxf"})
@@ -99,7 +102,7 @@ class LoadedMesh:
     mesh: TriangleMeshData  # all triangles of the file (or fragment), metres, file root frame
     parts: list[str]  # named nodes found (VRML DEF names / COLLADA node names), sorted
     unit_scale: float  # scale applied (COLLADA <unit meter> × metadata length unit)
-    source_format: str  # "stl" | "obj" | "dae" | "wrl" | "glb" | "gltf"
+    source_format: str  # "stl" | "obj" | "dae" | "wrl" | "glb" | "gltf" | "ply"
     notes: list[str] = field(default_factory=list)  # facts worth telling a user
     # The file's own colours (COLLADA, glTF): per face an index into ``palette`` (RGBA 0..1, None for a
     # face without a colour of its own); None when the file gives none
@@ -178,6 +181,8 @@ def _load_data(
                 return _finish(_load_stl(data, path.name), path.name, fragment, metadata)
             if ext == ".obj":
                 return _finish(_load_obj(data, path.name), path.name, fragment, metadata)
+            if ext == ".ply":
+                return _finish(_load_ply(data, path.name), path.name, fragment, metadata)
             if ext == ".dae":
                 return _load_dae(data, path.name, fragment, metadata)
             if ext in (".glb", ".gltf"):
@@ -809,8 +814,28 @@ def _metadata_transform(metadata: MeshMetadata | None, notes: list[str]) -> tupl
     return scale, rot
 
 
+def _load_ply(data: bytes, name: str) -> _Raw:
+    """PLY, binary or ASCII, with trimesh's reader (imported here: only a PLY file pays for it). A file
+    of points without faces (a point cloud) holds no triangles; a face index past the vertices is
+    refused, as trimesh's own mesh would fail on it later."""
+    from trimesh.exchange.ply import load_ply
+    from trimesh.geometry import triangulate_quads
+
+    if not data.startswith(b"ply"):
+        raise MeshLoadError("MK501", f"{name} is not a PLY file (it does not start with 'ply')")
+    loaded = load_ply(io.BytesIO(data), fix_texture=False, prefer_color=None, skip_materials=True)
+    vertices = np.asarray(loaded.get("vertices", np.zeros((0, 3))), dtype=np.float64).reshape(-1, 3)
+    polygons = loaded.get("faces")
+    if polygons is None or len(polygons) == 0:
+        return _Raw("ply", vertices, np.zeros((0, 3), dtype=np.int64))
+    faces = np.asarray(triangulate_quads(polygons), dtype=np.int64).reshape(-1, 3)  # quads, polygons fanned
+    if faces.size and (int(faces.min()) < 0 or int(faces.max()) >= len(vertices)):
+        raise MeshLoadError("MK501", f"{name}: a face names a vertex the file does not have")
+    return _Raw("ply", vertices, faces)
+
+
 def _finish(raw: _Raw, name: str, fragment: str | None, metadata: MeshMetadata | None) -> LoadedMesh:
-    """STL/OBJ: no named parts; apply metadata; check the numbers."""
+    """STL/OBJ/PLY: no named parts; apply metadata; check the numbers."""
     if fragment is not None:
         raise MeshLoadError(
             "MK502",
