@@ -182,6 +182,7 @@ class YourdfpyKinematics(_KinematicsOnly):
     def __init__(self, path: Path, root: str) -> None:
         import yourdfpy
 
+        _quiet_yourdfpy()
         self.urdf = yourdfpy.URDF.load(str(path), load_meshes=False, build_scene_graph=True,
                                        load_collision_meshes=False, build_collision_scene_graph=False)
         self.root = root
@@ -286,6 +287,38 @@ class YourdfpyError(EngineError):
     """yourdfpy refused the written URDF, or its child process failed."""
 
 
+class YourdfpyMimicChain(EngineError):
+    """The written URDF has a mimic of a mimic (ManiSkill's Inspire hand: the thumb's IP joint mimics its
+    MCP joint, which mimics CMC pitch, on purpose). urdfdom, MuJoCo, PyBullet and Pinocchio follow the
+    chain; yourdfpy 0.0.5x takes a leader that is itself a mimic as 0 ("this joint is not actuated - will
+    assume (0.0 + offset)"), so its poses are not the file's: verify skips it, the others grade."""
+
+    engine_limit = True  # verify reports a skip, not a failed load
+
+
+def mimic_chain(path: Path) -> tuple[str, str] | None:
+    """(follower, leader) of the first mimic whose leader mimics another joint in the URDF at ``path``,
+    or None (also when the file cannot be parsed: yourdfpy then says why)."""
+    from lxml import etree
+
+    try:
+        root = etree.parse(str(path), etree.XMLParser(resolve_entities=False, no_network=True,
+                                                       huge_tree=False)).getroot()
+    except (OSError, etree.XMLSyntaxError):
+        return None
+    leaders: dict[str, str] = {str(joint.get("name")): str(mimic.get("joint"))
+                               for joint in root.iterfind("joint") for mimic in joint.iterfind("mimic")}
+    return next(((follower, leader) for follower, leader in leaders.items() if leader in leaders), None)
+
+
+def _quiet_yourdfpy() -> None:
+    """yourdfpy logs a warning per configuration it is asked (hundreds per verify run) on stderr; what
+    matters of it is in the report."""
+    import logging
+
+    logging.getLogger("yourdfpy").setLevel(logging.ERROR)
+
+
 class _YourdfpyServer:
     """The child's side: yourdfpy imported at once, then one model loaded and its poses asked."""
 
@@ -362,6 +395,14 @@ def load_yourdfpy(model: Path | Robot, renames: Renames, *, root: str,
     started one, else in this process."""
     if isinstance(model, Robot):
         raise TypeError("yourdfpy reads the written URDF")
+    chain = mimic_chain(Path(model))
+    if chain is not None:
+        if worker is not None:
+            worker.close()
+        follower, leader = chain
+        raise YourdfpyMimicChain(
+            f"joint {follower} mimics {leader}, itself a mimic: yourdfpy takes {leader} as 0 there, so its "
+            "poses are not the file's (urdfdom, MuJoCo, PyBullet and Pinocchio follow the chain)")
     if worker is not None and worker.alive():
         return YourdfpyModel(Path(model), root, worker)
     return YourdfpyKinematics(Path(model), root)
