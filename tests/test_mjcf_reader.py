@@ -857,3 +857,32 @@ def test_uncompiled_fallback_keeps_full_and_rotated_inertias(tmp_path: Path) -> 
     assert b is not None and b.inertial is not None
     written = [[0.3, 0.01, -0.02], [0.01, 0.4, 0.03], [-0.02, 0.03, 0.5]]
     assert np.array_equal(b.inertial.inertia, written)
+
+
+def test_a_relative_path_reads_meshes_an_include_names_from_its_own_folder(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """genesis-world 1.4.5's franka_sim: ``assets/assets.xml`` names ``../meshes/collision/link0.stl``.
+    MuJoCo finds it from the model's absolute path, and not from a relative one with folders
+    (``x/franka_sim/bi-franka_panda.xml``: "Error opening file"), so validate, tree and convert
+    failed when the user typed such a path. The reader gives MuJoCo the absolute path."""
+    import struct
+
+    folder = tmp_path / "pkg" / "sim"
+    (folder / "assets").mkdir(parents=True)
+    (folder / "meshes").mkdir()
+    triangles = [((0, 0, 0), (1, 0, 0), (0, 1, 0)), ((0, 0, 0), (0, 1, 0), (0, 0, 1)),
+                 ((0, 0, 0), (0, 0, 1), (1, 0, 0)), ((1, 0, 0), (0, 0, 1), (0, 1, 0))]
+    stl = b"\0" * 80 + struct.pack("<I", len(triangles)) + b"".join(
+        struct.pack("<12fH", 0, 0, 0, *[c * 0.1 for v in t for c in v], 0) for t in triangles)
+    (folder / "meshes" / "part.stl").write_bytes(stl)
+    (folder / "assets" / "assets.xml").write_text(
+        '<mujocoinclude><asset><mesh name="part" file="../meshes/part.stl"/></asset></mujocoinclude>')
+    (folder / "robot.xml").write_text(
+        '<mujoco model="r"><include file="assets/assets.xml"/><compiler meshdir=""/><worldbody>'
+        '<body name="b"><joint type="hinge"/><geom type="mesh" mesh="part"/></body></worldbody></mujoco>')
+    monkeypatch.chdir(tmp_path)
+    relative = Path("pkg/sim/robot.xml")
+    v = validate(relative)
+    assert v.errors == [], [d.message for d in v.errors]
+    assert v.robot is not None and v.robot.name == "r"
+    assert all(d.location is None or not Path(d.location.file).is_absolute() for d in v.diagnostics)

@@ -64,7 +64,10 @@ def _import_mujoco() -> Any:
 
 class _MjcfReader:
     def __init__(self, path: Path, options: ReadOptions, display: str, sink: DiagnosticSink) -> None:
-        self.path = path
+        # MuJoCo is given the absolute path: from a relative one with folders
+        # (``a/b/robot.xml``) it opens an included file's ``../meshes/x.stl`` in the wrong folder
+        # (genesis-world's franka_sim: "Error opening file"), which from any absolute path it finds
+        self.path = Path(path).absolute()
         self.options = options
         self.display = display
         self.sink = sink
