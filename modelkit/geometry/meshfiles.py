@@ -175,8 +175,11 @@ def _load_data(
 ) -> LoadedMesh:
     """:func:`load_mesh` once the bytes are read: :class:`MeshLoadError` for anything that fails."""
     try:
-        # overflow/invalid values in hostile files end up as non-finite vertices, reported below
-        with np.errstate(all="ignore"):
+        # overflow/invalid values in hostile files end up as non-finite vertices, reported below; the
+        # parser libraries' own warnings (trimesh's texture statistics on an OBJ whose UVs are all NaN:
+        # pybullet's Panda as genesis-world ships it) are neither a finding nor something for stderr
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
             if ext == ".stl":
                 return _finish(_load_stl(data, path.name), path.name, fragment, metadata)
             if ext == ".obj":
