@@ -228,36 +228,32 @@ def _urdf_meshes(robot: Robot, suffixes: frozenset[str]) -> Iterator[tuple[Link,
             yield link, geom, uri
 
 
-@rule("gltf-meshes", "MK514")
-def gltf_meshes(robot: Robot) -> Iterator[Diagnostic]:
-    """glTF meshes in a URDF, for consumers that read glTF through Assimp (rviz, gz-sim): MuJoCo has no
-    decoder for them ("no decoder found for mesh file") and PyBullet refuses the whole URDF ("failed to
-    parse link"), measured with MuJoCo 3.14 and PyBullet 3.2.7 on dexmate's grippers."""
-    for link, geom, uri in _urdf_meshes(robot, GLTF_SUFFIXES):
+def _assimp_only(robot: Robot, code: str, kind: str, suffixes: frozenset[str]) -> Iterator[Diagnostic]:
+    """A URDF's meshes of a format only Assimp's consumers (rviz, gz-sim) read: MuJoCo has no decoder
+    ("no decoder found for mesh file") and PyBullet refuses the whole URDF; one finding per file."""
+    for link, geom, uri in _urdf_meshes(robot, suffixes):
         role = "collision" if geom in link.collisions else "visual"
         yield diag(
-            "MK514",
-            f'{role} mesh "{uri}" is glTF, read by rviz and gz-sim (Assimp): MuJoCo cannot load it and '
+            code,
+            f'{role} mesh "{uri}" is {kind}, read by rviz and gz-sim (Assimp): MuJoCo cannot load it and '
             "PyBullet refuses the whole URDF",
             geom.source or link.loc("name"),
             hint="`modelkit convert` writes it as STL/OBJ for every target",
         )
+
+
+@rule("gltf-meshes", "MK514")
+def gltf_meshes(robot: Robot) -> Iterator[Diagnostic]:
+    """glTF meshes in a URDF (PyBullet: "failed to parse link"), measured with MuJoCo 3.14 and PyBullet
+    3.2.7 on dexmate's grippers."""
+    return _assimp_only(robot, "MK514", "glTF", GLTF_SUFFIXES)
 
 
 @rule("ply-meshes", "MK515")
 def ply_meshes(robot: Robot) -> Iterator[Diagnostic]:
-    """PLY meshes in a URDF (ManiSkill's SO-100 collides its jaws with them): rviz and gz-sim read them
-    through Assimp; MuJoCo has no decoder ("no decoder found for mesh file") and PyBullet refuses the
-    whole URDF ("invalid mesh filename extension '.ply'"), measured with MuJoCo 3.14 and PyBullet 3.2.7."""
-    for link, geom, uri in _urdf_meshes(robot, frozenset({".ply"})):
-        role = "collision" if geom in link.collisions else "visual"
-        yield diag(
-            "MK515",
-            f'{role} mesh "{uri}" is PLY, read by rviz and gz-sim (Assimp): MuJoCo cannot load it and '
-            "PyBullet refuses the whole URDF",
-            geom.source or link.loc("name"),
-            hint="`modelkit convert` writes it as STL/OBJ for every target",
-        )
+    """PLY meshes in a URDF (ManiSkill's SO-100 collides its jaws with them; PyBullet: "invalid mesh
+    filename extension '.ply'"), measured with MuJoCo 3.14 and PyBullet 3.2.7."""
+    return _assimp_only(robot, "MK515", "PLY", frozenset({".ply"}))
 
 
 @rule("collada-for-mujoco", "MK512")
