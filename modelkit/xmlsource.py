@@ -402,7 +402,6 @@ def _blank_declaration(data: bytes) -> bytes | None:
     return data[:start] + bytes(b if b in b"\r\n" else 32 for b in data[start:end]) + data[end:]
 
 
-_TAIL_COMMENT = re.compile(rb"<!--.*?-->", re.DOTALL)
 _TAIL_INSTRUCTION = re.compile(rb"<\?.*?\?>", re.DOTALL)
 _TAIL_END_TAG = re.compile(rb"</[^\s<>/]+\s*>")
 _TAIL_TAG = re.compile(rb"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<(/?)[^\s<>/!?]+(?:\s[^<>]*?)?(/?)>",
@@ -439,7 +438,7 @@ def _markup_only(tail: bytes) -> bool:
             at += 1
         if at == len(tail):
             return True
-        for simple in (_TAIL_COMMENT, _TAIL_INSTRUCTION, _TAIL_END_TAG):
+        for simple in (_COMMENT, _TAIL_INSTRUCTION, _TAIL_END_TAG):  # _COMMENT: the comments' own pattern
             found = simple.match(tail, at)
             if found:
                 at = found.end()
