@@ -38,7 +38,8 @@ from modelkit.formats.registry import FORMAT_NAMES, TARGET_NAMES
 from modelkit.verify.engines.registry import DEFAULT_ENGINES  # data only: no numpy, no engine
 
 F = TypeVar("F", bound=Callable[..., Any])
-UNREADABLE_CODES = frozenset({"MK001", "MK002"})
+# MK899: modelkit failed on the input (a fault of its own): the file could not be checked either.
+UNREADABLE_CODES = frozenset({"MK001", "MK002", "MK899"})
 # Tree errors after which the tree can still be printed as check_urdf prints it: a joint named like a
 # link (legal URDF), a link with two parents under one root (check_urdf prints it twice).
 TREE_PRINTABLE_CODES = frozenset({"MK211", "MK220"})
@@ -198,7 +199,42 @@ def _no_mujoco_rendering() -> None:
     click.get_current_context().call_on_close(lambda: os.environ.pop("MUJOCO_GL", None))
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+def internal_error(exc: Exception, where: str) -> Diagnostic:
+    """MK899: ``exc`` escaped modelkit's own code on ``where`` (a bug, not a fault of the input), named
+    with the innermost place in modelkit's sources that raised it."""
+    import traceback
+
+    package = Path(__file__).resolve().parent
+    place = ""
+    for frame in reversed(traceback.extract_tb(exc.__traceback__)):
+        path = Path(frame.filename).resolve()
+        if path.is_relative_to(package):
+            place = f" (modelkit/{path.relative_to(package).as_posix()}:{frame.lineno})"
+            break
+    message = (f"modelkit failed on this input: {type(exc).__name__}: {exc}"[:600] + f"{place}; this is a "
+               "fault of modelkit, not of the file: please report it with the file (MODELKIT_DEBUG=1 shows "
+               "the traceback)")
+    return diag("MK899", message, SourceLocation(where))
+
+
+class _Commands(click.Group):
+    """The command group; an exception that escapes a command (a bug of modelkit's) becomes one MK899
+    line on stderr and exit 2 instead of a traceback, unless ``MODELKIT_DEBUG`` is set."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort):
+            raise
+        except Exception as exc:
+            if os.environ.get("MODELKIT_DEBUG"):
+                raise
+            command = ctx.invoked_subcommand or "modelkit"
+            click.echo(render_text(internal_error(exc, f"modelkit {command}")), err=True)
+            sys.exit(2)
+
+
+@click.group(cls=_Commands, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="modelkit")
 def main() -> None:
     """Validate, convert and verify robot model files (Choreonoid .body, URDF/xacro, SDF, MJCF)."""
@@ -229,7 +265,12 @@ def _validate_one(path: Path, options: Any, input_format: str | None, target: st
 
     mesh_cache.enable()
     with _collector_paused():
-        return list(validate_file(path, options, input_format, str(path), target).diagnostics)
+        try:
+            return list(validate_file(path, options, input_format, str(path), target).diagnostics)
+        except Exception as exc:  # a fault of modelkit's: this file is said, the others still checked
+            if os.environ.get("MODELKIT_DEBUG"):
+                raise
+            return [internal_error(exc, str(path))]
 
 
 def _validate_all(

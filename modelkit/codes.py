@@ -1903,6 +1903,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "The `--report` file is (or is a link to) a file the conversion writes; nothing is written.",
     ),
+    CodeInfo(
+        "MK899",
+        "internal-error",
+        "error",
+        "modelkit itself failed on this input: an exception it did not expect, which is a fault of "
+        "modelkit, not of the file. The message names the exception and the place in modelkit's code; "
+        "the command exits 2 (`validate` goes on with the other files). Please report it with the file; "
+        "`MODELKIT_DEBUG=1` prints the whole traceback.",
+    ),
     # -- MK9xx: verify scenario files (layer 4 command profiles, `verify --scenario`) ------------------
     CodeInfo("MK900", "scenario-wrong-type", "error", "A value in a scenario file has the wrong type."),
     CodeInfo("MK901", "scenario-unknown-key", "error", "A scenario file has a key the schema lacks."),
