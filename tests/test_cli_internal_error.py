@@ -48,7 +48,8 @@ def test_validate_says_the_fault_on_its_file_and_checks_the_others(tmp_path: Pat
     assert "Traceback" not in result.output
     assert checked == ["first.urdf", "second.urdf"]
     (line,) = [ln for ln in result.output.splitlines() if "MK899" in ln]
-    assert line.startswith(f"{first}: error MK899 modelkit failed on this input: TypeError: unsupported format")
+    head = f"{first}: error MK899 modelkit failed on this input: TypeError: unsupported format"
+    assert line.startswith(head)
     assert "(modelkit/cli.py:" in line  # the innermost frame in modelkit's sources (the fault is the test's)
     assert "please report it with the file" in line
     assert "1 error(s)" in result.output
