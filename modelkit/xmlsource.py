@@ -475,6 +475,32 @@ def _element_end(tail: bytes, at: int) -> int | None:
     return None
 
 
+# A start tag (quoted values may hold ">"), or markup whose text must stay as it is.
+_TAG_OR_OPAQUE = re.compile(rb"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>"
+                            rb"""|<[A-Za-z_:][^\s<>/"']*(?:[^<>"']|"[^"]*"|'[^']*')*>""", re.DOTALL)
+_GLUED_ATTRIBUTE = re.compile(rb"""(=\s*(?:"[^"]*"|'[^']*'))(?=[A-Za-z_:])""")
+
+
+def _space_between_attributes(data: bytes) -> bytes | None:
+    """TinyXML2 reads an attribute that follows the previous one's closing quote with no space between
+    (robotblockset's ``type="box"size="..."``); XML requires the space. One is put there in every start
+    tag (comments, CDATA and processing instructions untouched); no line changes, and locations are
+    found in the file's own text. None when there is nothing to mend."""
+    changed = False
+
+    def mend(found: re.Match[bytes]) -> bytes:
+        nonlocal changed
+        tag = found.group(0)
+        if tag.startswith((b"<!", b"<?")):
+            return tag
+        mended = _GLUED_ATTRIBUTE.sub(rb"\1 ", tag)
+        changed = changed or mended != tag
+        return mended
+
+    repaired = _TAG_OR_OPAQUE.sub(mend, data)
+    return repaired if changed else None
+
+
 _TINYXML2 = "libsdformat, urdfdom, MuJoCo and PyBullet (TinyXML2)"
 
 
@@ -516,6 +542,14 @@ _TINYXML2_LENIENCY = {
         "XML tools (lxml, so urdf_parser_py and yourdfpy, and xacro) refuse it",
         _DECLARATION_HINT,
         at_declaration=True,
+    ),
+    "attributes construct error": _Leniency(
+        lambda data, _: _space_between_attributes(data),
+        lambda text: "an attribute follows the previous attribute's closing quote without a space between "
+        f"them, which XML requires: {_TINYXML2} read it, strict XML tools (lxml, so urdf_parser_py and "
+        "yourdfpy, and xacro) refuse the file",
+        "put a space between the attributes",
+        at_declaration=False,
     ),
     "Extra content at the end of the document": _Leniency(
         lambda data, at: _blank_markup_after_root(data, *at),

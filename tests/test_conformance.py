@@ -552,6 +552,48 @@ _TRIANGLE_URDF = """<?xml version="1.0"?>
 """
 
 
+#: a model with two attributes glued to the previous one's closing quote (robotblockset's inspection cell:
+#: ``type="box"size="0.02 0.15 0.35"``), and where libxml2 stops: the first glued attribute
+_GLUED = {
+    "urdf": (_TRIANGLE_URDF.replace("/></joint>", '/>\n    <limit effort="1"velocity="2"/></joint>'),
+             "urdf", (8, 22)),
+    "mjcf": (_MJCF_BALL.replace('<geom size="0.1"/>', '<geom type="box"size="0.1 0.2 0.3"rgba="1 0 0 1"/>'),
+             "xml", (2, 57)),
+    "sdf": (_BOX_MODEL.format(name="m").replace('<collision name="c">', "<collision name='c'>").replace(
+        '<model name="m">', '<model name="m"><!-- a="1"b="2" -->').replace(
+        '<sdf version="1.7">', '<sdf version="1.7"xmlns:x="http://x">'), "sdf", (2, 19)),
+}
+
+
+@pytest.mark.parametrize("kind", list(_GLUED))
+def test_attributes_without_a_space_between_are_a_warning_as_tinyxml2_reads_them(
+    tmp_path: Path, sdf_oracle: Path, kind: str  # noqa: F811
+) -> None:
+    """TinyXML2 (urdfdom, MuJoCo, libsdformat, PyBullet) reads an attribute glued to the previous one's
+    closing quote; libxml2 refuses the file (\"attributes construct error\"). The file's own loader accepts
+    it, so validate warns at the first one and reads the attributes' values; a comment is left as written."""
+    text, suffix, at = _GLUED[kind]
+    path = tmp_path / f"m.{suffix}"
+    path.write_text(text)
+    accepted, said = reference(kind, path, sdf_oracle, tmp_path)
+    assert accepted, said
+    v = validate(path)
+    assert v.errors == []
+    (d,) = [d for d in v.diagnostics if d.code == "MK020"]
+    assert d.severity.value == "warning" and "without a space between them" in d.message
+    assert d.location is not None and (d.location.line, d.location.col) == at
+    robot = v.robot
+    assert robot is not None
+    if kind == "urdf":
+        (joint,) = robot.joints
+        assert (joint.limits.effort, joint.limits.velocity) == (1.0, 2.0)
+    if kind == "mjcf":
+        (geom,) = [c for link in robot.links for c in link.collisions]
+        assert tuple(geom.geometry.size) == pytest.approx((0.2, 0.4, 0.6))
+    path.write_text(text.replace("</", "<bad></", 1))
+    assert [d.code for d in validate(path).errors] == ["MK020"]  # a real malformation stays an error
+
+
 def test_impossible_inertia_is_an_error_only_for_consumers_that_refuse_it(tmp_path: Path) -> None:
     from click.testing import CliRunner
 
