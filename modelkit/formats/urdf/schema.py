@@ -169,7 +169,8 @@ def _foreign(ctx: Context, element: Element) -> None:
             f"<xacro:{qname.localname}> is a xacro instruction, which URDF parsers ignore: this file must be "
             "expanded by xacro first",
             ctx.loc(element),
-            hint="name the file .xacro (modelkit then expands it), or run xacro on it",
+            hint="pass --input-format xacro or name the file .xacro (modelkit then expands it), or run xacro "
+            "on it",
         )
 
 
