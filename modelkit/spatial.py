@@ -133,6 +133,14 @@ def matrix_from_quat_wxyz(quat: Sequence[float] | NDArray[np.float64]) -> Mat3:
     )
 
 
+# cos(pitch) below which roll and yaw may need to be found together (:func:`rpy_from_matrix`): above it
+# each atan2 is exact to 1e-13 rad. Below it they are, when their triple does not give the matrix back to
+# NEAR_LOCK_EXACT (the 1e-12 writers promise); a triple that does is kept as it is, so a source's own
+# ``rpy="0 -1.57079632679 -1.57079632679"`` (TIAGo's arm) is still written as it was given.
+NEAR_GIMBAL_LOCK = 1e-3
+NEAR_LOCK_EXACT = 1e-12
+
+
 def rpy_from_matrix(r: Mat3) -> Vec3:
     """URDF/SDF fixed-axis roll-pitch-yaw of R = Rz(yaw)·Ry(pitch)·Rx(roll), pitch in [-π/2, π/2].
 
@@ -145,10 +153,30 @@ def rpy_from_matrix(r: Mat3) -> Vec3:
     if cos_pitch > 1e-12:
         roll = math.atan2(float(r[2, 1]), float(r[2, 2]))
         yaw = math.atan2(float(r[1, 0]), float(r[0, 0]))
+        if (cos_pitch <= NEAR_GIMBAL_LOCK
+                and float(np.max(np.abs(matrix_from_rpy(roll, pitch, yaw) - r))) > NEAR_LOCK_EXACT):
+            roll, yaw = _near_lock(r, pitch, cos_pitch)
     else:  # gimbal lock: put everything into yaw
         roll = 0.0
         yaw = math.atan2(-float(r[0, 1]), float(r[1, 1]))
     return np.array([roll, pitch, yaw])
+
+
+def _near_lock(r: Mat3, pitch: float, cos_pitch: float) -> tuple[float, float]:
+    """Roll and yaw of ``r`` near the gimbal lock, together. There each is an atan2 of entries of size
+    cos(pitch), off by up to 1e-16/cos(pitch) (1.2e-9 rad for Menagerie-style B2 feet 7.3e-8 from the
+    lock, which then came back 4e-10 off), and only their difference is well determined. The yaw is
+    kept, or a multiple of π/4 when moving it there changes ``r`` below rounding (the B2 feet: 7.6e-10
+    from 0, which moves it by 5e-17), and the roll is what yaw and pitch leave:
+    Rx(roll) = (Rz(yaw)·Ry(pitch))ᵀ·R, so the triple gives ``r`` back to rounding."""
+    import numpy as np
+
+    yaw = math.atan2(float(r[1, 0]), float(r[0, 0]))
+    plain = round(yaw / (math.pi / 4)) * (math.pi / 4)
+    if abs(yaw - plain) * cos_pitch <= 1e-16:
+        yaw = plain
+    rest = matrix_from_rpy(0.0, pitch, yaw).T @ np.asarray(r, dtype=float)
+    return math.atan2(float(rest[2, 1]), float(rest[1, 1])), yaw
 
 
 def inertia_from_moments(ixx: float, ixy: float, ixz: float, iyy: float, iyz: float, izz: float) -> Mat3:

@@ -12,11 +12,12 @@ import numpy as np
 import pytest
 from lxml import etree
 
-from modelkit.api import validate
+from modelkit.api import load, validate
 from modelkit.convert.api import write
 from modelkit.convert.compare import compare_poses, compare_robots
 from modelkit.convert.notes import renames
 from modelkit.convert.numbers import clean_angle, clean_length, clean_rotation, fmt, fmt_text, length_scale
+from modelkit.convert.options import WriteOptions
 from modelkit.formats.mjcf.write_xml import euler_text, quat_wxyz, set_pose, z_turn, zaxis_text
 from modelkit.formats.urdf.massless import TINY_INERTIA
 from modelkit.spatial import Pose, matrix_from_rpy
@@ -438,3 +439,36 @@ def test_every_writer_drops_the_dust_of_small_values(target: str, tmp_path: Path
     back = validate(out).robot
     assert back is not None
     assert compare_poses(robot, back, renames(notes, "link"), tol=1e-9) == []
+
+
+def test_a_tensor_turned_by_a_short_pi_over_2_loses_its_product_dust(tmp_path: Path) -> None:
+    """gym-ignition's cart-pole turns its pole's inertia by ``rpy="1.57079632679 0 0"``: π/2 to 11
+    decimals, 4.9e-12 rad short. The turned tensor has a product of 5.1e-11 kg·m² beside moments of
+    10.4: 4.9e-12 of its largest, no measurement, and it was written (``fullinertia="...
+    5.10059809416233e-11"``).
+    Entries below 1e-10 of the tensor's largest are 0, as lengths and rotations below 1e-10 are; the
+    written file keeps the moments, and the read-back equals the source to 1e-10 of the tensor."""
+    from modelkit.convert.numbers import clean_inertia
+
+    a = 1.57079632679
+    turn = np.array([[1.0, 0.0, 0.0], [0.0, np.cos(a), -np.sin(a)], [0.0, np.sin(a), np.cos(a)]])
+    pole = turn @ np.diag([10.4166979167, 10.4166979167, 6.25e-05]) @ turn.T
+    assert 4e-11 < abs(pole[1, 2]) < 6e-11
+    cleaned = clean_inertia(pole, 10.0)
+    assert cleaned[1, 2] == cleaned[2, 1] == 0.0
+    assert np.max(np.abs(cleaned - pole)) <= 1e-10 * np.max(np.abs(pole))
+    source = tmp_path / "cartpole.urdf"
+    source.write_text("""<robot name="cartpole">
+  <link name="rail"><inertial><mass value="10"/>
+    <inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="pole"><inertial><origin rpy="1.57079632679 0 0" xyz="0 0 0.5"/><mass value="10"/>
+    <inertia ixx="10.4166979167" ixy="0" ixz="0" iyy="10.4166979167" iyz="0" izz="6.25e-05"/>
+  </inertial></link>
+  <joint name="hinge" type="continuous"><parent link="rail"/><child link="pole"/><axis xyz="1 0 0"/></joint>
+</robot>
+""")
+    for suffix in (".xml", ".urdf", ".sdf", ".body"):
+        out = tmp_path / f"out{suffix}"
+        notes = write(load(source), out, options=WriteOptions(), force=True)
+        assert not [n for n in notes if n.severity.value == "error"], suffix
+        assert not re.search(r"e-1\d", out.read_text()), suffix

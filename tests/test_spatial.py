@@ -57,6 +57,39 @@ def test_rpy_round_trips_through_rpy_from_matrix() -> None:
         assert np.allclose(rpy_from_matrix(matrix_from_rpy(*rpy)), rpy, atol=1e-12, rtol=0.0)
 
 
+@pytest.mark.parametrize("cos_pitch", [1e-4, 3.7e-8, 1e-10, 2e-12])
+def test_rpy_near_gimbal_lock_gives_the_matrix_back(cos_pitch: float) -> None:
+    """Near pitch ±π/2 roll and yaw are each atan2s of entries of size cos(pitch): apart, each was off
+    by up to 1e-16/cos(pitch), and the triple gave the matrix back only to 4e-10 at 7.3e-8 from the lock
+    (Menagerie-style Unitree B2 feet; verify saw the URDF's feet turned by 1.17e-9 rad). The roll is
+    found from what yaw and pitch leave when their two atan2s do not give the matrix back to 1e-12."""
+    rng = np.random.default_rng(3)
+    worst = 0.0
+    for sign in (1.0, -1.0):
+        for _ in range(200):
+            half = [0.5 * float(rng.uniform(-3.0, 3.0)), 0.5 * sign * math.acos(cos_pitch),
+                    0.5 * float(rng.uniform(-3.0, 3.0))]
+            c, s = np.cos(half), np.sin(half)  # quaternion of Rz(y)·Ry(p)·Rx(r), as sources have it
+            quat = (c[0] * c[1] * c[2] + s[0] * s[1] * s[2], s[0] * c[1] * c[2] - c[0] * s[1] * s[2],
+                    c[0] * s[1] * c[2] + s[0] * c[1] * s[2], c[0] * c[1] * s[2] - s[0] * s[1] * c[2])
+            r = matrix_from_quat_wxyz(quat)  # entries near 0 off by rounding of the O(1) terms
+            worst = max(worst, float(np.max(np.abs(matrix_from_rpy(*rpy_from_matrix(r)) - r))))
+    assert worst <= 1e-12  # what writers promise (the text's own rounding aside)
+
+
+def test_rpy_near_gimbal_lock_keeps_a_plain_yaw() -> None:
+    """The B2 foot's rotation 3.7e-8 rad from the lock: a yaw 7.6e-10 from 0 moves the matrix by 5e-17,
+    so it is 0 (the roll takes the rest), and URDF gets ``1.5707964 1.5707964 0``."""
+    from modelkit.convert.numbers import fmt_rpy
+
+    r = matrix_from_quat_wxyz((0.4999999633974483, 0.49999999999999867, 0.49999999999999867,
+                               -0.5000000366025518))
+    assert rpy_from_matrix(r)[2] in (0.0, math.pi, -math.pi)
+    text = fmt_rpy(r)
+    assert text == "1.5707964 1.5707964 0"
+    assert np.max(np.abs(matrix_from_rpy(*(float(v) for v in text.split())) - r)) <= 1e-15
+
+
 # -- quaternions -----------------------------------------------------------------------------
 
 

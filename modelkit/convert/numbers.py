@@ -18,7 +18,7 @@ multiple), :func:`fmt_direction` for axes (a component below 1e-10 of the length
 :func:`clean_length` for positions (below 1e-10 of the model's length scale is 0; the scale is set
 with :func:`length_scale` around a write, 1 m by default; :func:`fmt_position` writes a point so),
 and :func:`clean_inertia` for inertia tensors (a tensor below 1e-12 of the link's mass × the length
-scale² is 0, else its entries below 1e-12 of its largest). Zero is 1e-10 (:data:`ZERO`): a tenth of
+scale² is 0, else its entries below 1e-10 of its largest). Zero is 1e-10 (:data:`ZERO`): a tenth of
 a nanometre or of a nanoradian on a metre robot is no measurement, and a read-back still equals the
 model to 1e-9.
 """
@@ -264,7 +264,9 @@ def clean_inertia(tensor: np.ndarray, mass: float) -> np.ndarray:
     (:data:`SNAP`) of ``mass`` × the model's length scale² is float dust of a zero tensor, and is 0:
     iCub's ``ixz="1.35525e-20"`` on a link whose other five entries are 0 (written as it is, MuJoCo
     refuses it: a negative eigenvalue), Drake's cart-pole's 1e-20 on each axis. In any other tensor,
-    the entries below 1e-12 of its own largest are 0.
+    the entries below 1e-10 (:data:`ZERO`) of its own largest are 0, as lengths and rotations below 1e-10
+    are: gym-ignition's cart-pole turns its pole's tensor by ``rpy="1.57079632679 0 0"`` (π/2 to 11
+    decimals, 4.9e-12 rad short), which leaves a product of 5.1e-11 beside moments of 10.4 kg·m².
 
     Relative to the tensor itself, not to mass × size²: verify compares each tensor with the source's
     to 1e-9 of its own largest entry, and a small link's tensor is far below its mass × the robot's
@@ -277,7 +279,7 @@ def clean_inertia(tensor: np.ndarray, mass: float) -> np.ndarray:
         return t
     if own <= scale:
         return np.zeros_like(t)
-    cleaned: np.ndarray = np.where(np.abs(t) <= SNAP * own, 0.0, t)
+    cleaned: np.ndarray = np.where(np.abs(t) <= ZERO * own, 0.0, t)
     return cleaned
 
 
