@@ -894,6 +894,7 @@ def _without_armature(robot: Robot) -> Any:
 
     model = PinocchioModel(robot)
     model.model.armature[:] = 0.0
+    model.ball_armature.clear()  # a ball's a·JᵀJ too: URDF and SDF cannot hold it either
     model.settings["armature"] = "zeroed (the file's format cannot hold it)"
     return model
 
