@@ -969,3 +969,61 @@ def test_made_up_gains_are_rounded_up_to_three_digits() -> None:
     for value in (1e-7 / 3, 1.0 / 3, 12345.678, 9.999e5):
         assert value <= rounded_up(value) < value * 1.01
         assert len(f"{rounded_up(value):g}".replace(".", "").rstrip("0").lstrip("0").split("e")[0]) <= 3
+
+
+# A leg as robotblockset's Unitree B2 robot file has it: position servos kp 4000, kv 200 on light links,
+# MuJoCo's default Euler integrator and 2 ms step (its scene file sets implicitfast and 1 ms).
+LIGHT_LEG = """<mujoco model="leg">
+  <worldbody>
+    <body name="thigh" pos="0 0 1">
+      <joint name="hip" axis="0 1 0" range="-1 1"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03" mass="{mass}"/>
+      <body name="calf" pos="0 0 -0.3">
+        <joint name="knee" axis="0 1 0" range="-2 0"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.02" mass="{mass}"/>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <general joint="hip" biastype="affine" gainprm="4000" biasprm="0 -4000 -200"/>
+    <general joint="knee" biastype="affine" gainprm="4000" biasprm="0 -4000 -200"/>
+  </actuator>
+  <keyframe><key name="home" qpos="0.3 -0.6" ctrl="0.3 -0.6"/></keyframe>
+</mujoco>
+"""
+
+
+@pytest.mark.parametrize(("mass", "diverges"), [(0.3, True), (40.0, False)])
+def test_an_mjcf_source_s_servos_that_euler_cannot_take_get_implicitfast(tmp_path: Path, mass: float,
+                                                                          diverges: bool) -> None:
+    """An MJCF source's servos keep the integrator its author chose, unless Euler cannot take their
+    damping at the file's step (damping/inertia × dt over 2): the file alone then goes NaN in
+    milliseconds (the B2 robot file: 14 ms), and the written file gets implicitfast with MK825. A leg
+    heavy enough for Euler keeps MuJoCo's default."""
+    import mujoco
+    import numpy as np
+
+    source = tmp_path / "leg.xml"
+    source.write_text(LIGHT_LEG.format(mass=mass))
+
+    def hold(m: Any) -> tuple[bool, float]:
+        d = mujoco.MjData(m)
+        mujoco.mj_resetDataKeyframe(m, d, 0)
+        while d.time < 1.0 and not np.isnan(d.qpos).any():
+            mujoco.mj_step(m, d)
+        return bool(np.isnan(d.qpos).any() or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number), \
+            float(np.max(np.abs(d.qpos - m.key_qpos[0])))
+
+    assert hold(mujoco.MjModel.from_xml_path(str(source)))[0] is diverges  # the source itself
+    out = tmp_path / "out.xml"
+    notes = write(load(source), out, options=WriteOptions(), force=True)
+    said = [n.message for n in notes if n.code == "MK825"]
+    m = mujoco.MjModel.from_xml_path(str(out))
+    if diverges:
+        (message,) = said
+        assert "diverge under MuJoCo's default Euler integrator at its 0.002 s step" in message
+        assert m.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+        bad, off = hold(m)
+        assert not bad and off < 1e-2, off
+    else:
+        assert said == [] and m.opt.integrator == mujoco.mjtIntegrator.mjINT_EULER

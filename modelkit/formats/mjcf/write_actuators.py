@@ -84,6 +84,9 @@ class ActuatorWriter:
         self.made_up = False  # the actuators are the --actuators choice, not the source's
         self.any_position = False
         self.servos = 0  # position and velocity actuators written
+        # joint → (servo damping kv·gear², the joint's reflected inertia at home): what decides whether
+        # MuJoCo's explicit Euler integrator can take the servo's damping (:meth:`euler_rate`)
+        self.damping: dict[str, tuple[float, float]] = {}
         self._loads: dict[str, JointLoad] | None = None
         self._arms: frozenset[str] | None = None
         self._legs: frozenset[str] | None = None  # the joints in a legged robot's legs, found once
@@ -324,6 +327,13 @@ class ActuatorWriter:
             return "the joint follows another (mimic) or is locked"
         return None
 
+    def euler_rate(self) -> tuple[str, float, float, float] | None:
+        """The written servo whose damping Euler takes worst: (joint, damping, inertia, damping/inertia
+        in 1/s). Euler integrates a servo's damping explicitly, and it diverges when damping/inertia × the
+        timestep passes 2. None without damped servos or when a joint carries no inertia."""
+        rates = [(name, d, i, d / i) for name, (d, i) in self.damping.items() if i > 0.0]
+        return max(rates, key=lambda item: item[3]) if rates else None
+
     def load(self, joint: Joint) -> JointLoad:
         if self._loads is None:
             self._loads = joint_loads(self.as_written)
@@ -359,6 +369,9 @@ class ActuatorWriter:
             self.ctrl.append(home_q if kind is ActuatorKind.POSITION else 0.0)
             self.any_position = self.any_position or kind is ActuatorKind.POSITION
             self.servos += 1
+            kv = float(el.get("kv") or 0.0)
+            if kv > 0.0:
+                self.damping[joint.name] = (kv * actuator.gear ** 2, self.load(joint).inertia)
         force = actuator.force_range
         if force is None and limited and kind is not ActuatorKind.EFFORT:
             force = (-effort, effort)

@@ -80,6 +80,8 @@ SECTIONS = (
     "sensor", "keyframe",
 )
 SERVO_INTEGRATOR = "implicitfast"  # with position/velocity servos: kv taken implicitly (as Menagerie's arms)
+DEFAULT_TIMESTEP = 0.002  # s: MuJoCo's, when <option> names none
+EULER_DAMPING_LIMIT = 2.0  # damping/inertia × timestep past which explicit Euler's damping diverges
 MIMIC_SOLREF = "0.005 1"
 """A mimic's joint equality (not a track approximation's rollers, whose skid-steer tolerances were
 measured with MuJoCo's default coupling: docs/verify.md): time constant 5 ms (MuJoCo Menagerie's
@@ -565,3 +567,28 @@ class MjcfWriter:
                 self.robot.source,
                 "option",
             )
+        elif self.actuators.servos and option.get("integrator") is None:
+            self._euler_diverges(option)
+
+    def _euler_diverges(self, option: Element) -> None:
+        """An MJCF source's own servos under MuJoCo's default Euler integrator, when Euler cannot take
+        their damping at the file's timestep (damping/inertia × dt over 2: the file goes NaN within
+        milliseconds). A robot file written to be included by a scene that sets the integrator does so
+        (robotblockset's Unitree B2: kv 200 on 0.05 kg·m² calves at 2 ms; its scene sets implicitfast).
+        The written file stands alone, so it gets implicitfast, and MK825 says why."""
+        worst = self.actuators.euler_rate()
+        timestep = float(option.get("timestep") or DEFAULT_TIMESTEP)
+        if worst is None or worst[3] * timestep <= EULER_DAMPING_LIMIT:
+            return
+        joint, damping, inertia, rate = worst
+        option.set("integrator", SERVO_INTEGRATOR)
+        self.ctx.note(
+            "MK825",
+            f'<option integrator="{SERVO_INTEGRATOR}">: the source\'s servos diverge under MuJoCo\'s default '
+            f"Euler integrator at its {fmt(timestep)} s step (joint {joint}: damping {damping:.3g} on "
+            f"{inertia:.3g} kg·m² at home, damping/inertia × step = {rate * timestep:.3g}, over "
+            f"{fmt(EULER_DAMPING_LIMIT)}: the file alone goes NaN); a scene that includes it and sets its "
+            "own integrator keeps that",
+            self.robot.source,
+            "option",
+        )
