@@ -36,6 +36,7 @@ import mujoco
 import pytest
 
 from modelkit.api import Validation, validate
+from modelkit.diagnostics import Diagnostic
 from modelkit.formats.common import ReadOptions
 from modelkit.formats.xacro.reader import expand_xacro
 from modelkit.model import Mesh
@@ -381,6 +382,18 @@ def test_xml_declaration_as_tinyxml2_reads_it(tmp_path: Path, head: str, line: i
     assert [d.code for d in validate(path).errors] == ["MK020"]  # a real malformation stays an error
 
 
+def _read_past_as_tinyxml2(path: Path, kind: str, oracle: Path, said: str) -> tuple[Validation, Diagnostic]:
+    """The file's own loader accepts ``path``; validate reads it with no error and one MK020 warning that
+    says ``said`` (what TinyXML2 read past)."""
+    accepted, words = reference(kind, path, oracle, path.parent)
+    assert accepted, words
+    v = validate(path)
+    assert v.errors == []
+    (d,) = [d for d in v.diagnostics if d.code == "MK020"]
+    assert d.severity.value == "warning" and said in d.message
+    return v, d
+
+
 _MJCF_BALL = ('<mujoco model="m">\n'
               '  <worldbody><body name="b"><freejoint/><geom size="0.1"/></body></worldbody>\n'
               "</mujoco>")
@@ -408,12 +421,7 @@ def test_markup_after_the_root_element_is_a_warning_as_tinyxml2_reads_it(
     after, column = _AFTER_ROOT[tail]
     text = model.rstrip("\n") + after.format(root=root)
     path.write_text(text)
-    accepted, said = reference(kind, path, sdf_oracle, tmp_path)
-    assert accepted, said
-    v = validate(path)
-    assert v.errors == []
-    (d,) = [d for d in v.diagnostics if d.code == "MK020"]
-    assert d.severity.value == "warning" and "after its root element ends" in d.message
+    v, d = _read_past_as_tinyxml2(path, kind, sdf_oracle, "after its root element ends")
     after_root = model.rstrip("\n").count("\n") + 2
     assert d.location is not None and (d.location.line, d.location.col) == (after_root, column)
     assert v.robot is not None and v.robot.name in ("r", "m")
@@ -575,12 +583,7 @@ def test_attributes_without_a_space_between_are_a_warning_as_tinyxml2_reads_them
     text, suffix, at = _GLUED[kind]
     path = tmp_path / f"m.{suffix}"
     path.write_text(text)
-    accepted, said = reference(kind, path, sdf_oracle, tmp_path)
-    assert accepted, said
-    v = validate(path)
-    assert v.errors == []
-    (d,) = [d for d in v.diagnostics if d.code == "MK020"]
-    assert d.severity.value == "warning" and "without a space between them" in d.message
+    v, d = _read_past_as_tinyxml2(path, kind, sdf_oracle, "without a space between them")
     assert d.location is not None and (d.location.line, d.location.col) == at
     robot = v.robot
     assert robot is not None
