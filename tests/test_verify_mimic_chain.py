@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from modelkit.verify.api import verify
-from modelkit.verify.engines.reference import mimic_chain
+from modelkit.verify.engines.reference import mimic_chain, yourdfpy_limit
 
 pytest.importorskip("yourdfpy")
 pytest.importorskip("mujoco")
@@ -58,3 +58,39 @@ def test_verify_skips_yourdfpy_on_a_mimic_chain_and_passes(tmp_path: Path,
     graded = {(c.engine, c.quantity) for c in report.checks if c.layer == 2}
     assert {("mujoco", "pose-position"), ("pybullet", "pose-position")} <= graded
     assert "yourdfpy" not in capfd.readouterr().err
+
+
+PLANAR = ("<robot name=\"base\">\n<link name=\"footprint\"/>\n" + _LINK.format(name="chassis")
+          + _LINK.format(name="arm") + """
+  <joint name="base_joint" type="planar"><parent link="footprint"/><child link="chassis"/>
+    <axis xyz="0 0 1"/></joint>
+  <joint name="shoulder" type="revolute"><parent link="chassis"/><child link="arm"/><origin xyz="0.1 0 0.2"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+""")
+
+
+def test_a_planar_joint_is_a_yourdfpy_limit(tmp_path: Path) -> None:
+    """yourdfpy counts a planar joint as two coordinates and places its child at the joint's origin
+    whatever they are, which shifts every later joint's coordinate: roboplan's reachback (a planar
+    ``base_joint``) failed yourdfpy's layer 2 by 5 m. yourdfpy is skipped for such a file, saying why."""
+    path = tmp_path / "base.urdf"
+    path.write_text(PLANAR)
+    said = yourdfpy_limit(path)
+    assert said is not None and "joint base_joint is planar" in said
+    assert yourdfpy_limit(tmp_path / "missing.urdf") is None
+    path.write_text(PLANAR.replace('type="planar"', 'type="fixed"'))
+    assert yourdfpy_limit(path) is None
+    path.write_text(PLANAR.replace('type="planar"', 'type="floating"'))
+    assert "joint base_joint is floating" in str(yourdfpy_limit(path))
+    path.write_text(THUMB)
+    assert "ip mimics mcp, itself a mimic" in str(yourdfpy_limit(path))
+
+
+def test_verify_skips_yourdfpy_on_a_planar_joint(tmp_path: Path) -> None:
+    source = tmp_path / "base.urdf"
+    source.write_text(PLANAR)
+    report = verify(source, tmp_path / "verify", engines=("yourdfpy",), replay=False, driven=False)
+    (skip,) = [s for s in report.skips if s.engine == "yourdfpy"]
+    assert "joint base_joint is planar" in skip.reason
+    assert not [c for c in report.checks if c.engine == "yourdfpy"]

@@ -288,10 +288,11 @@ class YourdfpyError(EngineError):
 
 
 class YourdfpyMimicChain(EngineError):
-    """The written URDF has a mimic of a mimic (ManiSkill's Inspire hand: the thumb's IP joint mimics its
-    MCP joint, which mimics CMC pitch, on purpose). urdfdom, MuJoCo, PyBullet and Pinocchio follow the
-    chain; yourdfpy 0.0.5x takes a leader that is itself a mimic as 0 ("this joint is not actuated - will
-    assume (0.0 + offset)"), so its poses are not the file's: verify skips it, the others grade."""
+    """The written URDF has what yourdfpy does not move as the file says (:func:`yourdfpy_limit`): a
+    mimic of a mimic (ManiSkill's Inspire hand: the thumb's IP joint mimics its MCP joint, which mimics
+    CMC pitch, on purpose; urdfdom, MuJoCo, PyBullet and Pinocchio follow the chain, yourdfpy 0.0.5x takes
+    a leader that is itself a mimic as 0), or a planar or floating joint. verify skips it, the others
+    grade."""
 
     engine_limit = True  # verify reports a skip, not a failed load
 
@@ -299,16 +300,46 @@ class YourdfpyMimicChain(EngineError):
 def mimic_chain(path: Path) -> tuple[str, str] | None:
     """(follower, leader) of the first mimic whose leader mimics another joint in the URDF at ``path``,
     or None (also when the file cannot be parsed: yourdfpy then says why)."""
+    root = _urdf_root(path)
+    return None if root is None else _mimic_chain_in(root)
+
+
+def _urdf_root(path: Path) -> Any:
     from lxml import etree
 
     try:
-        root = etree.parse(str(path), etree.XMLParser(resolve_entities=False, no_network=True,
+        return etree.parse(str(path), etree.XMLParser(resolve_entities=False, no_network=True,
                                                        huge_tree=False)).getroot()
     except (OSError, etree.XMLSyntaxError):
         return None
+
+
+def _mimic_chain_in(root: Any) -> tuple[str, str] | None:
     leaders: dict[str, str] = {str(joint.get("name")): str(mimic.get("joint"))
                                for joint in root.iterfind("joint") for mimic in joint.iterfind("mimic")}
     return next(((follower, leader) for follower, leader in leaders.items() if leader in leaders), None)
+
+
+def yourdfpy_limit(path: Path) -> str | None:
+    """Why yourdfpy's poses of the URDF at ``path`` are not the file's, or None: a mimic of a mimic
+    (:class:`YourdfpyMimicChain`), or a planar or floating joint, which yourdfpy 0.0.5x counts as 2 or 6
+    coordinates and then places its child at the joint's origin whatever they are (its forward
+    kinematics: "this includes: floating, planar, fixed"), shifting every later joint's coordinate;
+    roboplan's reachback rides on a planar ``base_joint``."""
+    root = _urdf_root(path)
+    if root is None:
+        return None
+    chain = _mimic_chain_in(root)
+    if chain is not None:
+        follower, leader = chain
+        return (f"joint {follower} mimics {leader}, itself a mimic: yourdfpy takes {leader} as 0 there, so "
+                "its poses are not the file's (urdfdom, MuJoCo, PyBullet and Pinocchio follow the chain)")
+    unmoved = next((joint for joint in root.iterfind("joint") if joint.get("type") in ("planar", "floating")),
+                   None)
+    if unmoved is not None:
+        return (f"joint {unmoved.get('name')} is {unmoved.get('type')}: yourdfpy moves nothing with such a "
+                "joint's coordinates and counts them among the others', so its poses are not the file's")
+    return None
 
 
 def _quiet_yourdfpy() -> None:
@@ -395,14 +426,11 @@ def load_yourdfpy(model: Path | Robot, renames: Renames, *, root: str,
     started one, else in this process."""
     if isinstance(model, Robot):
         raise TypeError("yourdfpy reads the written URDF")
-    chain = mimic_chain(Path(model))
-    if chain is not None:
+    limit = yourdfpy_limit(Path(model))
+    if limit is not None:
         if worker is not None:
             worker.close()
-        follower, leader = chain
-        raise YourdfpyMimicChain(
-            f"joint {follower} mimics {leader}, itself a mimic: yourdfpy takes {leader} as 0 there, so its "
-            "poses are not the file's (urdfdom, MuJoCo, PyBullet and Pinocchio follow the chain)")
+        raise YourdfpyMimicChain(limit)
     if worker is not None and worker.alive():
         return YourdfpyModel(Path(model), root, worker)
     return YourdfpyKinematics(Path(model), root)
