@@ -437,18 +437,35 @@ class TooManyJoints(PyBulletError):
     engine_limit = True  # verify reports a skip, not a failed load
 
 
+class PlanarJoint(PyBulletError):
+    """The URDF has a planar joint, whose child PyBullet's URDF importer places by the child's centre of
+    mass instead of its link frame."""
+
+    engine_limit = True  # verify reports a skip, not a failed load
+
+
 def _check_size(model: Path) -> None:
+    """What PyBullet cannot hold as the file says, raised before it loads (each an engine limit): more
+    joints than it reports states for, or a planar joint. At zero coordinates PyBullet puts a planar
+    joint's child's centre of mass where the child's link frame belongs, so the child and everything
+    below it are off by that link's COM offset (Hello Robot's Stretch 4: 9.6 cm; a fixed joint in its
+    place is right)."""
     from lxml import etree
 
     try:
         root = etree.parse(str(model)).getroot()
     except (OSError, etree.XMLSyntaxError):
         return  # PyBullet's own load says what is wrong with the file
-    joints = sum(1 for _ in root.iterchildren("joint"))
-    if joints > MAX_MOVING_JOINTS:
-        raise TooManyJoints(f"{joints} joints: PyBullet reports the joint states of a body of at most "
+    joints = list(root.iterchildren("joint"))
+    if len(joints) > MAX_MOVING_JOINTS:
+        raise TooManyJoints(f"{len(joints)} joints: PyBullet reports the joint states of a body of at most "
                             f"{MAX_MOVING_JOINTS} joints, fixed ones included (getJointState fails for "
                             "every joint beyond that)")
+    planar = next((joint.get("name") for joint in joints if joint.get("type") == "planar"), None)
+    if planar is not None:
+        raise PlanarJoint(f"joint {planar} is planar: PyBullet's URDF importer places a planar joint's "
+                          "child by its centre of mass instead of its link frame, so the child and every "
+                          "link below it are off by that COM offset")
 
 
 def load(model: Path, renames: Renames, *, root: str, pose_path: str = "com-frame",
