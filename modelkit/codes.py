@@ -836,6 +836,15 @@ _TABLE: tuple[CodeInfo, ...] = (
         "coupling allows.",
     ),
     CodeInfo(
+        "MK327",
+        "planar-joint-pybullet",
+        "warning",
+        "A URDF planar joint's child has its centre of mass off its link frame: PyBullet's URDF importer "
+        "places that child by its centre of mass instead of its link frame, so the child and everything "
+        "below it sit off by that offset in PyBullet (urdfdom, MuJoCo and Drake follow the file). PyBullet "
+        "loads the file, so it stays a warning under `--target pybullet`.",
+    ),
+    CodeInfo(
         "MK340",
         "sdf-joint-type-unsupported",
         "warning",

@@ -64,3 +64,24 @@ def test_verify_reports_pybullet_not_run_on_a_planar_joint(tmp_path: Path) -> No
     (skip,) = [s for s in report.skips if s.engine == "pybullet"]
     assert "joint base_joint is planar" in skip.reason and "centre of mass" in skip.reason
     assert not [c for c in report.checks if c.engine == "pybullet"]
+
+
+def test_a_planar_child_whose_centre_of_mass_is_its_frame_is_graded(tmp_path: Path) -> None:
+    """PyBullet places such a child right (roboplan's reachback: a massless ``base_link``), so it is
+    graded, and validate's MK327 says nothing; with the offset, MK327 warns (also for ``--target
+    pybullet``: PyBullet loads the file, it does not refuse it)."""
+    from modelkit.api import validate
+
+    source = tmp_path / "planar.urdf"
+    source.write_text(PLANAR.replace('<origin xyz="0.01 0.02 0.1"/>', ""))
+    assert _link_frames(source)["body"] == pytest.approx((0.0, 0.0, 0.3), abs=1e-6)
+    assert not [d for d in validate(source).diagnostics if d.code == "MK327"]
+    report = verify(source, tmp_path / "verify", engines=("pybullet",), replay=False, driven=False)
+    assert [c for c in report.checks if c.engine == "pybullet" and c.layer == 2]
+    assert not [s for s in report.skips if s.engine == "pybullet" and "planar" in s.reason]
+    source.write_text(PLANAR)
+    (said,) = [d for d in validate(source).diagnostics if d.code == "MK327"]
+    assert said.severity.value == "warning" and "102 mm from its link frame" in said.message
+    assert said.location is not None and said.location.line == 8  # the joint's type
+    (targeted,) = [d for d in validate(source, target="pybullet").diagnostics if d.code == "MK327"]
+    assert targeted.severity.value == "warning"

@@ -256,6 +256,33 @@ def ply_meshes(robot: Robot) -> Iterator[Diagnostic]:
     return _assimp_only(robot, "MK515", "PLY", frozenset({".ply"}))
 
 
+@rule("planar-joint-pybullet", "MK327")
+def planar_joint_pybullet(robot: Robot) -> Iterator[Diagnostic]:
+    """A URDF planar joint whose child's centre of mass is off its link frame: PyBullet 3.2.7 puts that
+    centre of mass where the link frame belongs (measured; a fixed joint in the planar's place is
+    right). Hello Robot's Stretch 4 and roboplan's reachback ride on planar joints."""
+    if robot.source_format not in URDF_FORMATS:
+        return
+    links = {link.name: link for link in robot.links}
+    for joint in robot.joints:
+        child = links.get(joint.child)
+        if joint.type is not JointType.PLANAR or child is None or child.inertial is None:
+            continue
+        offset = math.hypot(*(float(v) for v in child.inertial.com))
+        if offset <= 1e-9:
+            continue
+        yield diag(
+            "MK327",
+            f'joint "{joint.name}" is planar and its child "{child.name}" has its centre of mass '
+            f"{offset * 1000:.3g} mm from its link frame: PyBullet places the child by its centre of "
+            f'mass, so "{child.name}" and every link below it sit {offset * 1000:.3g} mm off in PyBullet '
+            "(urdfdom, MuJoCo and Drake follow the file)",
+            joint.loc("type"),
+            hint="for PyBullet, make the planar joint's child a frame whose centre of mass is its origin "
+            "(a link of tiny mass, with the body on a fixed joint below it)",
+        )
+
+
 @rule("collada-for-mujoco", "MK512")
 def collada_for_mujoco(robot: Robot) -> Iterator[Diagnostic]:
     """COLLADA meshes in a URDF: MuJoCo cannot load them ("no decoder found for mesh file")."""

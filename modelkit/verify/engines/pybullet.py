@@ -446,10 +446,10 @@ class PlanarJoint(PyBulletError):
 
 def _check_size(model: Path) -> None:
     """What PyBullet cannot hold as the file says, raised before it loads (each an engine limit): more
-    joints than it reports states for, or a planar joint. At zero coordinates PyBullet puts a planar
-    joint's child's centre of mass where the child's link frame belongs, so the child and everything
-    below it are off by that link's COM offset (Hello Robot's Stretch 4: 9.6 cm; a fixed joint in its
-    place is right)."""
+    joints than it reports states for, or a planar joint whose child's centre of mass is off its link
+    frame. At zero coordinates PyBullet puts that centre of mass where the child's link frame belongs,
+    so the child and everything below it are off by the offset (Hello Robot's Stretch 4: 9.6 cm; a
+    fixed joint in its place is right, and so is a planar child whose COM is at its frame)."""
     from lxml import etree
 
     try:
@@ -461,11 +461,25 @@ def _check_size(model: Path) -> None:
         raise TooManyJoints(f"{len(joints)} joints: PyBullet reports the joint states of a body of at most "
                             f"{MAX_MOVING_JOINTS} joints, fixed ones included (getJointState fails for "
                             "every joint beyond that)")
-    planar = next((joint.get("name") for joint in joints if joint.get("type") == "planar"), None)
+    planar = next((j for j in joints if j.get("type") == "planar" and _com_off(root, j)), None)
     if planar is not None:
-        raise PlanarJoint(f"joint {planar} is planar: PyBullet's URDF importer places a planar joint's "
-                          "child by its centre of mass instead of its link frame, so the child and every "
-                          "link below it are off by that COM offset")
+        raise PlanarJoint(f"joint {planar.get('name')} is planar and its child's centre of mass is off its "
+                          "link frame: PyBullet's URDF importer places a planar joint's child by its centre "
+                          "of mass instead of its link frame, so the child and every link below it are off "
+                          "by that offset (validate's MK327)")
+
+
+def _com_off(root: Any, joint: Any) -> bool:
+    """Whether the URDF ``joint``'s child link has its inertial origin off its link frame."""
+    child = joint.find("child")
+    name = child.get("link") if child is not None else None
+    link = next((e for e in root.iterchildren("link") if e.get("name") == name), None)
+    origin = link.find("inertial/origin") if link is not None else None
+    try:
+        xyz = [float(v) for v in (origin.get("xyz") or "0 0 0").split()] if origin is not None else []
+    except ValueError:
+        return False
+    return any(abs(v) > 1e-9 for v in xyz)
 
 
 def load(model: Path, renames: Renames, *, root: str, pose_path: str = "com-frame",
