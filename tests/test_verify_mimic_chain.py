@@ -73,7 +73,7 @@ PLANAR = ("<robot name=\"base\">\n<link name=\"footprint\"/>\n" + _LINK.format(n
 def test_a_planar_joint_is_a_yourdfpy_limit(tmp_path: Path) -> None:
     """yourdfpy counts a planar joint as two coordinates and places its child at the joint's origin
     whatever they are, which shifts every later joint's coordinate: roboplan's reachback (a planar
-    ``base_joint``) failed yourdfpy's layer 2 by 5 m. yourdfpy is skipped for such a file, saying why."""
+    ``base_joint``) failed yourdfpy's layer 2 by 6.2 m. yourdfpy is skipped for such a file, saying why."""
     path = tmp_path / "base.urdf"
     path.write_text(PLANAR)
     said = yourdfpy_limit(path)
