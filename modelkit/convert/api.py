@@ -24,6 +24,7 @@ from modelkit.convert.registry import TargetInfo, load_writer, target_for_path, 
 from modelkit.diagnostics import Diagnostic, Severity, SourceLocation, diag
 from modelkit.formats.common import ReadOptions
 from modelkit.formats.meshref import collision_mesh_problem
+from modelkit.formats.urdf.schema import XACRO_INSTRUCTION
 from modelkit.model import Robot
 
 if TYPE_CHECKING:
@@ -193,7 +194,7 @@ def _nothing_to_convert(source: Path, checked: Validation) -> str:
         named = ", ".join(f'"{name}"' for name in frames[:5]) + (", ..." if len(frames) > 5 else "")
         message = (f"{source} holds no robot, only frames without mass, shape or joint ({named}): nothing "
                    "to convert")
-    if any(d.code == "MK123" and "xacro instruction" in d.message for d in checked.diagnostics):
+    if any(d.code == "MK123" and XACRO_INSTRUCTION in d.message for d in checked.diagnostics):
         message += "; its xacro instructions would make the robot: convert it with --input-format xacro"
     return message
 

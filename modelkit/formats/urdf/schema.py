@@ -149,6 +149,10 @@ def check_structure(ctx: Context, root: Element) -> None:
                 stack.append((child, child_tag))
 
 
+# MK123's words for a xacro element in a file read as URDF (convert's MK895 looks for them)
+XACRO_INSTRUCTION = "is a xacro instruction"
+
+
 def _foreign(ctx: Context, element: Element) -> None:
     """Comments and extension namespaces are fine; XInclude and xacro are not processed, so say so."""
     if not isinstance(element.tag, str):
@@ -166,7 +170,7 @@ def _foreign(ctx: Context, element: Element) -> None:
         ctx.xacro_reported = True
         ctx.emit(
             "MK123",
-            f"<xacro:{qname.localname}> is a xacro instruction, which URDF parsers ignore: this file must be "
+            f"<xacro:{qname.localname}> {XACRO_INSTRUCTION}, which URDF parsers ignore: this file must be "
             "expanded by xacro first",
             ctx.loc(element),
             hint="pass --input-format xacro or name the file .xacro (modelkit then expands it), or run xacro "
