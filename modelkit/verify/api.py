@@ -199,7 +199,7 @@ def _given_file(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Rena
     from modelkit.convert.api import render_model
     from modelkit.convert.notes import renames
     from modelkit.convert.output import OutputPlan
-    from modelkit.verify.layers import approximations
+    from modelkit.verify.layers import approximations, planar
 
     try:
         notes = render_model(robot, fmt, OutputPlan(out_dir / ".renames"), path.name, WriteOptions())
@@ -217,7 +217,8 @@ def _given_file(robot: Robot, fmt: str, path: Path, out_dir: Path) -> tuple[Rena
     _joints_by_child(robot, fmt, root, out, names["joint"])
     held = [note for note in notes if note.code in GIVEN_NOTES or any(
         set(chain.joints) <= names["joint"] and set(chain.links) <= names["link"]
-        for chain in approximations.ball_chains(fmt, [note]))]
+        for chain in approximations.ball_chains(fmt, [note])) or any(
+        set(chain.joints) <= names["joint"] for chain in planar.mjcf_chains(fmt, [note]))]
     held.extend(_merged_links(robot, fmt, path, out_dir, out, names["link"]))
     return out, held
 
@@ -536,7 +537,15 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
     """Layers 1–3 on the welded model; returns the source model as read and the MJCF and URDF the user
     gave, as the engines loaded them, with their renames (None when nothing ran)."""
     from modelkit.verify.engines.reference import SourceModel, dof_joints, source_static
-    from modelkit.verify.layers import approximations, coupled_armature, dynamics, kinematics, shapes, static
+    from modelkit.verify.layers import (
+        approximations,
+        coupled_armature,
+        dynamics,
+        kinematics,
+        planar,
+        shapes,
+        static,
+    )
 
     t0 = time.perf_counter()
     try:
@@ -610,6 +619,12 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
     chains_of = {eng.label: approximations.ball_chains(INPUTS.get(eng.label, "robot"),
                                                        written.get(INPUTS.get(eng.label, "robot"), []))
                  for eng in loaded}
+    # A planar joint is the MJCF writer's two slides and a hinge, or the SDF writer's free child (MK813).
+    planar_of = {eng.label: (planar.mjcf_chains(INPUTS.get(eng.label, "robot"),
+                                                written.get(INPUTS.get(eng.label, "robot"), [])),
+                             planar.sdf_floated(INPUTS.get(eng.label, "robot"),
+                                                written.get(INPUTS.get(eng.label, "robot"), [])))
+                 for eng in loaded}
     for eng in loaded:
         # An engine holding a documented approximation (MK816 tiny masses, PyBullet's 1 kg) is
         # compared with the source with that approximation applied; the report lists it.
@@ -627,12 +642,18 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         plates_entry = approximations.plates_skip(eng.label, plates)
         if plates_entry is not None:
             report.skips.append(plates_entry)
+        planar_chains, floated = planar_of[eng.label]
+        planar_entry = planar.skip(eng.label, planar_chains, floated)
+        if planar_entry is not None:
+            report.skips.append(planar_entry)
         held = approximations.applied_chains(models[eng.label], chains)
+        held = planar.applied_sdf(planar.applied_mjcf(held, planar_chains, maps.get(kind, {})), floated)
         if wheels is not None:
             held = approximations.applied_wheels(held, robot, wheels)
         held = approximations.applied_plates(held, plates)
         eng_static = (source_static(approximations.applied(held, approx[eng.label]))
-                      if approx[eng.label] or chains or wheels or plates or models[eng.label] is not reference
+                      if approx[eng.label] or chains or wheels or plates or planar_chains or floated
+                      or models[eng.label] is not reference
                       else src_static)
         # ... and so is one holding the URDF writer's ±1e16 for an infinite position bound (MK819).
         stand_ins = approximations.limits_for_engine(kind, reference)
@@ -683,8 +704,11 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
             # an engine holding each ball joint as the URDF writer's chain (MK813) is compared with the
             # source holding those chains, whose three joints are revolute degrees of freedom
             chains = chains_of[eng.label]
-            model = approximations.applied(approximations.applied_chains(models[eng.label], chains),
-                                           approx[eng.label])
+            planar_chains, floated = planar_of[eng.label]
+            held_planar = planar.applied_sdf(planar.applied_mjcf(
+                approximations.applied_chains(models[eng.label], chains), planar_chains, maps.get(
+                    INPUTS.get(eng.label, "robot"), {})), floated)
+            model = approximations.applied(held_planar, approx[eng.label])
             ref = (_without_armature(model) if dropped
                    else pin_ref if model is reference else _pinocchio(model))
             held_state = [(approximations.chain_configuration(q, chains), dq) for q, dq in state]
@@ -702,6 +726,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                     continue
             try:
                 last = {chain.joint: chain.joints[2] for chain in chains}
+                last.update({chain.joint: chain.joints[2] for chain in planar_chains})
                 report.checks.extend(_guarded(3, eng, lambda eng=eng, ref=ref, st=held_state, last=last,
                                               wb=with_balls: dynamics.layer3a(ref, eng, st, last, wb)))
                 report.engines[eng.label] = dict(eng.model.settings)  # a route layer 3a chose, said
@@ -710,8 +735,8 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                         f"joint armature (rotor inertia) of {', '.join(with_armature)} cannot be written in "
                         "URDF/SDF (MK820): the mass matrix is compared with the Pinocchio reference "
                         "without it")))
-            except NotImplementedError:
-                report.skips.append(dynamics.no_dynamics(eng))
+            except NotImplementedError as exc:
+                report.skips.append(dynamics.no_dynamics(eng, str(exc)))
         for label, armature in sorted(floors.items()):
             report.checks.extend(coupled_armature.rule_checks(label, reference, armature, pin_ref))
     t5 = time.perf_counter()
@@ -955,6 +980,17 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
         report.skips.append(Skip(3, "mujoco+pybullet", (
             f"layer 3b (replay) not run: PyBullet's file holds ball joint(s) {', '.join(unheld)} not as the "
             "URDF writer's chain of three joints (MK813), so the replay cannot drive them the same way")))
+        return
+    planes = [joint.name for joint in reference.joints
+              if joint.type in (JointType.PLANAR, JointType.FLOATING)]
+    if planes:
+        report.skips.append(Skip(3, "mujoco+pybullet", (
+            f"layer 3b (replay) not run: joint(s) {', '.join(planes)} let a part of the robot move in a "
+            "plane or in space, driven by nothing: the replay would compare how each engine moves that "
+            "base under the arm's reaction, through joints held differently (PyBullet's planar joint, "
+            "whose inverse dynamics it does not implement; the MJCF's two slides and a hinge; the SDF's "
+            "free body), which layer 3a does not check. Layers 1-3a compare each engine with the source "
+            "at that joint's zero")))
         return
     if chains and "mjcf" in maps:
         maps = _ball_chain_replay(reference, chains, maps, inertials, frames, report)

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -73,6 +74,9 @@ SINGULAR_FULL = 1e-13
 # kg·m²: a product of inertia under this is written in the tensor's principal form (_principal)
 UNREADABLE_PRODUCT = 1e-9
 WELL_APART = 1e-6  # relative: principal moments closer than this leave their axes to round-off
+PLANAR_NOTE = re.compile(r'planar joint "(?P<joint>.+)" written as two slides and a hinge '
+                         r'\("(?P<x>[^"]+)", "(?P<y>[^"]+)", "(?P<z>[^"]+)"\)$')
+"""The MK813 note of a planar joint (:meth:`BodyTree._planar`): verify reads the written joints back."""
 MOVING = (JointType.REVOLUTE, JointType.PRISMATIC, JointType.BALL, JointType.PLANAR, JointType.FLOATING)
 
 def _principal_form(tensor: np.ndarray) -> bool:
@@ -544,12 +548,7 @@ class BodyTree:
             el.set("pos", fmt_position(anchor))
 
     def _planar(self, body: Element, joint: Joint, body_name: str) -> None:
-        normal = np.asarray(joint.axis, dtype=float)
-        normal = normal / float(np.linalg.norm(normal))
-        helper = np.array([1.0, 0.0, 0.0]) if abs(normal[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        u = np.cross(helper, normal)
-        u = u / float(np.linalg.norm(u))
-        v = np.cross(normal, u)
+        u, v, normal = planar_axes(joint.axis)
         written = []
         for suffix, kind, axis in (("_tx", "slide", u), ("_ty", "slide", v), ("_rz", "hinge", normal)):
             target = f"body[{body_name}]/joint[{joint.name}{suffix}]"
@@ -560,7 +559,8 @@ class BodyTree:
         self.joint_names[joint.name] = written
         self.ctx.note(
             "MK813",
-            f"planar joint {joint.name} written as two slides and a hinge ({', '.join(written)})",
+            f'planar joint "{joint.name}" written as two slides and a hinge '
+            f'({", ".join(f"{chr(34)}{name}{chr(34)}" for name in written)})',
             joint.source,
             f"body[{body_name}]",
         )
@@ -730,3 +730,15 @@ class BodyTree:
                     stack.append((joint.child, pose @ joint.origin))
         mass, _, inertia = combine_mass_properties(parts)
         return mass, principal_moments(inertia), own
+
+
+def planar_axes(normal: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The two slide axes ``u``, ``v`` and the hinge axis ``n`` of a planar joint about ``normal``
+    (in the joint frame): ``u`` ⟂ ``n`` from the first of X, Y not near ``n``, ``v = n × u``, so
+    (u, v, n) is right-handed."""
+    n = np.asarray(normal, dtype=float)
+    n = n / float(np.linalg.norm(n))
+    helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = np.cross(helper, n)
+    u = u / float(np.linalg.norm(u))
+    return u, np.cross(n, u), n

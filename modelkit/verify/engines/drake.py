@@ -285,10 +285,7 @@ class DrakeModel:
             plant.get_joint(i) for i in plant.GetJointIndices(self._instance) if not self._is_base_weld(i)
         ]
         dofs = [j for j in self._joints if isinstance(j, RevoluteJoint | PrismaticJoint)]
-        dofs.sort(key=lambda j: j.position_start())
-        for j in dofs:
-            if j.position_start() != j.velocity_start():
-                raise DrakeLoadError(f"{path.name}: joint {j.name()!r}: position and velocity index differ")
+        dofs.sort(key=lambda j: j.velocity_start())  # a free body's quaternion shifts later positions
         self._dofs = dofs
         self._balls = [j for j in self._joints if isinstance(j, BallRpyJoint)]
         self.settings: dict[str, Any] = {

@@ -6,7 +6,9 @@ origin composed with the fixed joints above it; a fixed joint adds no Pinocchio 
 link's inertia is appended to the supporting joint at the composed placement. A ball joint is three
 revolute joints about its X, Y and Z through two massless bodies, turned by the configuration's
 ``NAME#x``... angles; their degrees of freedom are held at rest and left out of the mass matrix and
-bias (:meth:`PinocchioModel.dof_names`), which compare the revolute and prismatic ones. Every link gets a
+bias (:meth:`PinocchioModel.dof_names`), which compare the revolute and prismatic ones. A planar joint
+(two slides and a turn) and a floating joint in the tree (three slides, three turns) are held at rest
+the same way: the mass matrix and bias of the other joints do not depend on them there. Every link gets a
 body frame carrying its own inertia (read back by layer 1; ``addFrame(..., append_inertia=False)``
 so it is not counted twice). The root link is welded to the
 universe at the identity. Joint armature (rotor inertia) goes to ``model.armature``, which
@@ -84,7 +86,8 @@ class PinocchioModel:
         if robot.root is None:
             raise ValueError("the model has no root link")
         self.robot = robot
-        widths = {JointType.REVOLUTE: 1, JointType.PRISMATIC: 1, JointType.BALL: 3}
+        widths = {JointType.REVOLUTE: 1, JointType.PRISMATIC: 1, JointType.BALL: 3, JointType.PLANAR: 3,
+                  JointType.FLOATING: 6}
         dofs = sum(widths.get(j.type, 0) for j in robot.joints)
         if dofs > max_dofs():
             raise TooManyDofs(
@@ -101,7 +104,10 @@ class PinocchioModel:
         self._joint_types: dict[str, str] = {}
         self._joint_child: dict[str, str] = {}
         self._ball_pieces: set[str] = set()  # the three revolute joints holding each ball joint
+        self._held_pieces: set[str] = set()  # the single-axis joints holding a planar or floating joint
         self._balls: dict[str, str] = {}  # ball joint -> child link
+        # planar and floating joints in the tree: their pieces (held at rest, like a ball's) -> type
+        self._held: dict[str, tuple[str, str]] = {}  # joint -> (type, child link)
         # a ball joint's armature, per axis of the child's angular velocity (MuJoCo's ball dofs)
         self.ball_armature: dict[str, float] = {}
         root_frame = model.addFrame(pin.Frame(robot.root, 0, 0, pin.SE3.Identity(), pin.FrameType.BODY,
@@ -131,6 +137,10 @@ class PinocchioModel:
                 if joint.armature:  # mass_matrix_with_balls adds it
                     self.ball_armature[joint.name] = float(joint.armature)
                 self._balls[joint.name] = joint.child
+            elif joint.type in (JointType.PLANAR, JointType.FLOATING):
+                frame = self._carry(model, joint, self._add_held(model, joint, pjid, placement), parent_frame)
+                armature.extend([0.0] * widths[joint.type])
+                self._held[joint.name] = (joint.type.value, joint.child)
             elif joint.type in (JointType.FIXED, JointType.PSEUDO_CONTINUOUS_TRACK):
                 model.appendBodyToJoint(pjid, _inertia(robot, joint.child), placement)
                 self._support[joint.child] = (pjid, placement)
@@ -140,7 +150,8 @@ class PinocchioModel:
                                                  _inertia(robot, joint.child)), False)
             else:
                 raise UnsupportedJoint(f"joint {joint.name!r} is {joint.type.value}: the fixed-base "
-                                       "Pinocchio reference holds revolute, prismatic, ball and fixed joints")
+                                       "Pinocchio reference holds revolute, prismatic, ball, planar, "
+                                       "floating and fixed joints")
             self._joint_child[joint.name] = joint.child
             self._joint_types[joint.name] = ("fixed" if joint.type is JointType.PSEUDO_CONTINUOUS_TRACK
                                              else joint.type.value)
@@ -149,14 +160,18 @@ class PinocchioModel:
         self.model = model
         self.data = model.createData()
         self._all = [model.names[j] for j in range(1, model.njoints)]  # one q and one v each
-        self._visible = [i for i, name in enumerate(self._all) if name not in self._ball_pieces]
+        self._at_rest = self._ball_pieces | self._held_pieces
+        self._visible = [i for i, name in enumerate(self._all) if name not in self._at_rest]
+        self._with_balls = [i for i, name in enumerate(self._all) if name not in self._held_pieces]
         self._dofs = [self._all[i] for i in self._visible]
         self.settings: dict[str, Any] = {
             "version": pin.__version__,
             "built_from": "the in-memory source model (no file)",
             "joints": "JointModelRevoluteUnaligned / JointModelPrismaticUnaligned; fixed joints merged "
                       "into the supporting body, one BODY frame per link; a ball joint three revolute "
-                      "joints about X, Y, Z (massless between), at rest in the dynamics",
+                      "joints about X, Y, Z (massless between), at rest in the dynamics; a planar joint "
+                      "two prismatic joints and a revolute one, a floating joint in the tree three "
+                      "prismatic and three revolute ones, likewise",
             "base": "root link welded to the universe at the identity",
             "gravity": list(GRAVITY),
             "mass_matrix": "crba (upper triangle symmetrised), armature on the diagonal",
@@ -190,6 +205,31 @@ class PinocchioModel:
                 model.appendBodyToJoint(jid, pin.Inertia.Zero(), pin.SE3.Identity())
         return int(jid)
 
+    def _add_held(self, model: Any, joint: Joint, pjid: int, placement: Any) -> int:
+        """A planar joint (slides along two axes of its plane, a turn about its normal) or a floating
+        one (slides along X, Y, Z, turns about X, Y, Z) as single-axis joints through massless bodies;
+        returns the last. Like a ball's pieces, they are held at rest at zero and are not among
+        :meth:`dof_names`: the other engines hold these joints as one joint each, or as a chain of
+        their own (the MJCF's, compared through the source holding that chain)."""
+        from modelkit.formats.mjcf.write_bodies import planar_axes
+
+        if joint.type is JointType.PLANAR:
+            u, v, n = planar_axes(joint.axis)
+            pieces = [("#tx", False, u), ("#ty", False, v), ("#rz", True, n)]
+        else:
+            pieces = [(f"#t{key}", False, axis) for key, axis in zip("xyz", np.eye(3), strict=True)]
+            pieces += [(f"#r{key}", True, axis) for key, axis in zip("xyz", np.eye(3), strict=True)]
+        jid = pjid
+        inf = np.array([math.inf])
+        for i, (key, turns, axis) in enumerate(pieces):
+            jm = pin.JointModelRevoluteUnaligned(axis) if turns else pin.JointModelPrismaticUnaligned(axis)
+            jid = model.addJoint(jid, jm, placement, joint.name + key, inf, inf, -inf, inf)
+            placement = pin.SE3.Identity()
+            self._held_pieces.add(joint.name + key)
+            if i < len(pieces) - 1:
+                model.appendBodyToJoint(jid, pin.Inertia.Zero(), pin.SE3.Identity())
+        return int(jid)
+
     def dof_names(self) -> list[str]:
         return list(self._dofs)
 
@@ -209,6 +249,9 @@ class PinocchioModel:
             if frame.type == pin.FrameType.JOINT and frame.name in self._balls:
                 child = self._balls[frame.name]
                 facts.joints[frame.name] = JointFacts("ball", parent_of[child], child, np.zeros(3))
+            elif frame.type == pin.FrameType.JOINT and frame.name in self._held:
+                kind, child = self._held[frame.name]
+                facts.joints[frame.name] = JointFacts(kind, parent_of[child], child, np.zeros(3))
             elif frame.type == pin.FrameType.JOINT:
                 jid = m.getJointId(frame.name)
                 jm = m.joints[jid].extract()
@@ -238,8 +281,9 @@ class PinocchioModel:
         return full[np.ix_(self._visible, self._visible)]
 
     def dof_names_with_balls(self) -> list[str]:
-        """Every degree of freedom, a ball joint's three pieces (``NAME#x``...) included."""
-        return list(self._all)
+        """Every degree of freedom, a ball joint's three pieces (``NAME#x``...) included (a planar or
+        floating joint's left out)."""
+        return [self._all[i] for i in self._with_balls]
 
     def mass_matrix_with_balls(self, q: dict[str, float]) -> Array:
         """The mass matrix over :meth:`dof_names_with_balls`: a ball's pieces in the coordinates of
@@ -252,17 +296,18 @@ class PinocchioModel:
             pitch, yaw = (q.get(name + key, 0.0) for key in BALL_KEYS[1:])
             jacobian = np.array(ball_law.chain_jacobian(pitch, yaw), dtype=float).reshape(3, 3)
             full[first:first + 3, first:first + 3] += armature * jacobian.T @ jacobian
-        return full
+        return full[np.ix_(self._with_balls, self._with_balls)]
 
     def bias_with_balls(self, q: dict[str, float], dq: dict[str, float]) -> Array:
         """The bias over :meth:`dof_names_with_balls`, a ball's pieces at rest."""
-        hidden = self._ball_pieces
+        hidden = self._at_rest
         v = np.array([0.0 if n in hidden else dq.get(n, 0.0) for n in self._all], dtype=float)
-        return np.array(pin.rnea(self.model, self.data, self._q(q), v, np.zeros(self.model.nv)))
+        full = np.array(pin.rnea(self.model, self.data, self._q(q), v, np.zeros(self.model.nv)))
+        return full[self._with_balls]
 
     def bias(self, q: dict[str, float], dq: dict[str, float]) -> Array:
         """rnea with zero acceleration; a ball joint's pieces at rest (their velocity 0)."""
-        hidden = self._ball_pieces
+        hidden = self._at_rest
         v = np.array([0.0 if n in hidden else dq.get(n, 0.0) for n in self._all], dtype=float)
         full = np.array(pin.rnea(self.model, self.data, self._q(q), v, np.zeros(self.model.nv)))
         return full[self._visible]

@@ -347,6 +347,11 @@ class PyBulletModel:
         """After PyBullet's inverse dynamics refused a tensor it composed itself (``REFUSED_TENSOR``),
         the mass matrix and bias come from its forward dynamics, said in ``settings``; any other
         failure is the engine's finding and propagates."""
+        if PLANAR_REFUSED in str(exc):
+            raise NotImplementedError(
+                "PyBullet's inverse dynamics (calculateMassMatrix, calculateInverseDynamics) has no planar "
+                f"joint ({PLANAR_REFUSED!r}), and its forward dynamics would let the planar base move: no "
+                "mass matrix or bias from it") from exc
         found = REFUSED_TENSOR.search(str(exc))
         if found is None:
             raise exc
@@ -435,6 +440,9 @@ class TooManyJoints(PyBulletError):
     """The URDF has more joints than PyBullet reports states for."""
 
     engine_limit = True  # verify reports a skip, not a failed load
+
+
+PLANAR_REFUSED = "planar joints not implemented"  # btMultiBodyTreeCreator, PyBullet's inverse dynamics
 
 
 class PlanarJoint(PyBulletError):

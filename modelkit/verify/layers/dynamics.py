@@ -122,8 +122,9 @@ def layer3a(reference: EngineModel, eng: Loaded, samples: list[State],
     return checks
 
 
-def no_dynamics(eng: Loaded) -> Skip:
-    return Skip(3, eng.label, f"{eng.label} computes kinematics only: no mass matrix or bias forces")
+def no_dynamics(eng: Loaded, why: str = "") -> Skip:
+    """The skip of an engine that gives no mass matrix or bias (``why``: the engine's own reason)."""
+    return Skip(3, eng.label, why or f"{eng.label} computes kinematics only: no mass matrix or bias forces")
 
 
 def kinematic_only(robot: Robot) -> bool:

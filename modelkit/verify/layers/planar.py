@@ -1,0 +1,117 @@
+"""How the written files hold a planar joint, so that the layers compare each engine with that model.
+
+No target but URDF has a planar joint (MK813):
+
+* the MJCF writer writes it as two slides and a hinge in the child's body (``<joint>_tx``, ``_ty``,
+  ``_rz`` about the axes of ``formats.mjcf.write_bodies.planar_axes``); the MuJoCo adapter reads a
+  body with three joints as a chain of three links, the first two ``<body>__<joint>`` and massless
+  (the MJCF reader's rule), so :func:`applied_mjcf` gives the source the same chain;
+* the SDF writer leaves the child without a joint: it floats, placed at its initial pose. Drake
+  gives such a body its own free joint, so :func:`applied_sdf` makes the source's joint floating.
+
+Kinematically and dynamically both are the planar joint at its zero (layers 1 and 2 move the other
+joints); the report says so (:func:`skip`)."""
+
+from __future__ import annotations
+
+import copy
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from modelkit.convert.notes import ConversionNote
+from modelkit.model import Joint, JointLimits, JointType, Link, Robot
+from modelkit.spatial import Pose
+from modelkit.verify.engines.protocol import Skip
+
+Renames = dict[str, dict[str, str]]
+
+FLOATED_NOTE = re.compile(r'joint "(?P<joint>.+)" is planar: SDF has no such joint inside a model; ')
+"""The SDF writer's MK813 note for a planar joint whose child it writes without a joint."""
+
+
+@dataclass(frozen=True)
+class PlanarChain:
+    """A source planar joint as the MJCF writer wrote it: two slides and a hinge (written names)."""
+
+    joint: str  # source name
+    joints: tuple[str, str, str]  # the written slides along u and v, then the hinge about the normal
+
+
+def mjcf_chains(fmt: str, notes: Iterable[ConversionNote]) -> list[PlanarChain]:
+    """The MJCF writer's planar chains, read from its MK813 notes (none for another format)."""
+    if fmt != "mjcf":
+        return []
+    from modelkit.formats.mjcf.write_bodies import PLANAR_NOTE
+
+    out = []
+    for note in notes:
+        match = PLANAR_NOTE.match(note.message) if note.code == "MK813" else None
+        if match:
+            out.append(PlanarChain(match["joint"], (match["x"], match["y"], match["z"])))
+    return out
+
+
+def sdf_floated(fmt: str, notes: Iterable[ConversionNote]) -> list[str]:
+    """The source planar joints whose child the SDF writer left floating (none for another format)."""
+    if fmt != "sdf":
+        return []
+    return [match["joint"] for note in notes if note.code == "MK813"
+            for match in [FLOATED_NOTE.match(note.message)] if match]
+
+
+def applied_mjcf(robot: Robot, chains: list[PlanarChain], renames: Renames) -> Robot:
+    """A copy of ``robot`` whose planar joints are the MJCF's chains, as the MuJoCo adapter reads them:
+    a slide from the parent at the joint's origin to ``<body>__<x>``, a slide to ``<body>__<y>``,
+    a hinge (keeping the source joint's name) to the child, the two added links massless."""
+    if not chains:
+        return robot
+    from modelkit.formats.mjcf.write_bodies import planar_axes
+
+    out = copy.deepcopy(robot)
+    by_name = {joint.name: joint for joint in out.joints}
+    for chain in chains:
+        planar = by_name.get(chain.joint)
+        if planar is None or planar.type is not JointType.PLANAR:
+            continue
+        body = renames.get("link", {}).get(planar.child, planar.child)
+        links = [f"{body}__{chain.joints[0]}", f"{body}__{chain.joints[1]}"]
+        frames = [planar.parent, *links, planar.child]
+        kinds = (JointType.PRISMATIC, JointType.PRISMATIC, JointType.REVOLUTE)
+        added = [
+            Joint(chain.joint if i == 2 else chain.joints[i], kind, frames[i], frames[i + 1],
+                  origin=planar.origin if i == 0 else Pose(), axis=np.asarray(axis, dtype=float),
+                  limits=JointLimits(), damping=planar.damping, synthesised=i < 2, source=planar.source)
+            for i, (kind, axis) in enumerate(zip(kinds, planar_axes(planar.axis), strict=True))
+        ]
+        index = out.joints.index(planar)
+        out.joints[index:index + 1] = added
+        out.links.extend(Link(name, synthesised=True, source=planar.source) for name in links)
+    return out
+
+
+def applied_sdf(robot: Robot, floated: list[str]) -> Robot:
+    """A copy of ``robot`` whose planar joints the SDF left out are floating joints."""
+    if not floated:
+        return robot
+    out = copy.deepcopy(robot)
+    for joint in out.joints:
+        if joint.name in floated and joint.type is JointType.PLANAR:
+            joint.type = JointType.FLOATING
+    return out
+
+
+def skip(engine: str, chains: list[PlanarChain], floated: list[str]) -> Skip | None:
+    """The report's entry for an engine holding planar joints another way (never a silent pass)."""
+    if chains:
+        shown = "; ".join(f"{c.joint} as {', '.join(c.joints)}" for c in chains)
+        return Skip(1, engine, f"approximation: the MJCF writer writes {len(chains)} planar joint(s) as two "
+                    f"slides and a hinge in the child's body (MK813; MJCF has no planar joint): {shown}. "
+                    "Layer 1 compares this engine with the source holding these chains")
+    if floated:
+        return Skip(1, engine, f"approximation: the SDF writer leaves the child of planar joint(s) "
+                    f"{', '.join(floated)} free-floating (MK813; SDF has no planar joint). Layer 1 "
+                    "compares this engine with the source holding floating joints there")
+    return None
