@@ -20,17 +20,17 @@ TARGET_REFUSALS: dict[str, frozenset[str]] = {
     # MuJoCo: a zero principal moment, inertia violating A + B >= C; a moving link, no mass; URDF parts
     # its URDF import refuses (a shape without its size or file, an incomplete inertia or inertial, a
     # short rgba or mesh scale); a collision shape of size zero; a shape URDF does not have; a glTF or PLY
-    # mesh
+    # mesh; text after a URDF's root element
     "mjcf": frozenset(
         {"MK302", "MK303", "MK313", "MK143", "MK144", "MK145", "MK146", "MK420", "MK416", "MK412", "MK421",
-         "MK514", "MK515"}
+         "MK514", "MK515", "MK027"}
     ),
     "sdf": frozenset({"MK303", "MK211"}),  # libsdformat: the same, and links and joints sharing a name
     "urdf": frozenset(),
     # PyBullet: a URDF visual or collision without a shape, a shape without its size or file, an
     # inertial without mass value, inertia or a diagonal moment, a shape neither URDF nor PyBullet has, a
-    # visual's <material> without a name, a glTF or PLY mesh
-    "pybullet": frozenset({"MK122", "MK136", "MK143", "MK145", "MK412", "MK514", "MK515"}),
+    # visual's <material> without a name, a glTF or PLY mesh, text after the root element
+    "pybullet": frozenset({"MK122", "MK136", "MK143", "MK145", "MK412", "MK514", "MK515", "MK027"}),
 }
 TARGETS = tuple(TARGET_REFUSALS)
 

@@ -130,6 +130,13 @@ _TABLE: tuple[CodeInfo, ...] = (
         "One XML text, attribute value, name or comment is longer than 10,000,000 bytes (libxml2's limit, "
         "below `--max-bytes`); the document is refused unread.",
     ),
+    CodeInfo(
+        "MK027",
+        "xml-text-after-root",
+        "warning",
+        "Text follows a URDF's root element: urdfdom reads the root and ignores the rest; PyBullet refuses "
+        "the file, MuJoCo nearly always (an error under `--target mjcf` and `pybullet`).",
+    ),
     # -- MK1xx: schema and header ----------------------------------------------------------
     # MK100-MK119: .body schema and header; MK120-MK129: XML elements and attributes (all XML
     # formats); MK130-MK149: URDF; MK150-MK169: SDF; MK170-MK179: MJCF.

@@ -38,11 +38,12 @@ class Declared:
 
 
 def read_declaring_prefixes(path: Path, display: str, sink: DiagnosticSink, max_bytes: int,
-                            keep_blank_text: bool = True) -> Declared:
+                            keep_blank_text: bool = True, urdfdom: bool = False) -> Declared:
     """Read and parse ``path``; when lxml refuses it only for undeclared namespace prefixes, parse it
-    again with them declared. The caller says whether that deserves a note (URDF: yes)."""
+    again with them declared. The caller says whether that deserves a note (URDF: yes). ``urdfdom``:
+    read as urdfdom reads a URDF (``xmlsource.parse_xml_bytes``)."""
     first = DiagnosticSink()
-    doc = read_xml(path, first, max_bytes, display, keep_blank_text)
+    doc = read_xml(path, first, max_bytes, display, keep_blank_text, urdfdom=urdfdom)
     if doc is not None or not any(d.code == "MK020" and "Namespace prefix" in d.message for d in first.items):
         sink.extend(first.items)
         return Declared(doc)
@@ -57,7 +58,7 @@ def read_declaring_prefixes(path: Path, display: str, sink: DiagnosticSink, max_
         return Declared(None)
     repaired, prefixes, offset = declared
     second = DiagnosticSink()
-    doc = parse_xml_bytes(repaired.encode("utf-8"), display, second, path, keep_blank_text)
+    doc = parse_xml_bytes(repaired.encode("utf-8"), display, second, path, keep_blank_text, urdfdom=urdfdom)
     sink.extend(second.items)
     return Declared(doc, prefixes, location_at(text, display, offset) if doc is not None else None)
 

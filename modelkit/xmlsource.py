@@ -280,6 +280,7 @@ def parse_xml_bytes(
     path: Path | None = None,
     keep_blank_text: bool = True,
     positions: bool = True,
+    urdfdom: bool = False,
 ) -> XmlDocument | None:
     """Parse XML held in memory; problems become diagnostics and the result is None.
 
@@ -287,7 +288,8 @@ def parse_xml_bytes(
     without children): a third less memory for a large pretty-printed file, for readers that never
     write the document back. ``positions=False`` leaves out the index of start-tag positions, for a
     document whose every element is given an entry in ``origins`` (an xacro expansion): its locations
-    are those, and a location not found there is the element's line as lxml has it."""
+    are those, and a location not found there is the element's line as lxml has it. ``urdfdom``: the
+    document is a URDF, whose own loader also reads past text after the root element (MK027)."""
     text = decode_text(data, display, sink)
     if text is None:
         return None
@@ -334,7 +336,7 @@ def parse_xml_bytes(
                 hint="no robot model holds one value this long: is the file generated wrongly?",
             )
             return None
-        root = _as_tinyxml2_reads(data, parser, message, where, text, display, sink)
+        root = _as_tinyxml2_reads(data, parser, message, where, text, display, sink, urdfdom)
         if root is None:
             return None
     except ValueError as exc:  # e.g. an encoding declaration lxml cannot honour
@@ -409,12 +411,33 @@ _TAIL_TAG = re.compile(rb"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<(/?)[^\s<>/!
 _TAIL_BLANK = b" \t\r\n"
 
 
-def _blank_markup_after_root(data: bytes, line: int, col: int) -> bytes | None:
-    """TinyXML2 reads the root element and then every node after it, keeping none: end tags of any name
-    (PyFlyt's rocket ends with ``</robot>`` twice), whole elements, comments and processing instructions.
-    libxml2 stops at the first (``line``, ``col``: its position, in characters). That tail becomes
-    spaces, so every offset stays. None (the error stands) when the tail holds text outside any element
-    (MuJoCo, libsdformat and PyBullet refuse it) or markup that is not whole."""
+def _blank_markup_after_root(data: bytes, line: int, col: int, urdfdom: bool) -> bytes | None:
+    """TinyXML2 reads the root element and then the nodes after it, keeping none: whole elements,
+    comments and processing instructions, up to a stray end tag of any name (PyFlyt's rocket ends with
+    ``</robot>`` twice), where it stops and ignores the rest of the file. libxml2 stops at the first
+    (``line``, ``col``: its position, in characters). That tail becomes spaces, so every offset stays.
+    None (the error stands) when text outside any element comes before such an end tag (MuJoCo,
+    libsdformat and PyBullet refuse it) or markup is not whole; for a URDF (``urdfdom``) also when
+    urdfdom's TinyXML refuses the tail (:func:`_tinyxml1_reads`)."""
+    start = _tail_start(data, line, col)
+    if start is None or not _tinyxml2_reads(data[start:]) or (urdfdom and not _tinyxml1_reads(data[start:])):
+        return None
+    return _blanked(data, start)
+
+
+def _blank_text_after_root(data: bytes, line: int, col: int, urdfdom: bool) -> bytes | None:
+    """A URDF's tail that urdfdom's TinyXML (1) reads and TinyXML2 refuses: TinyXML reads the markup
+    after the root element as TinyXML2 does, stray end tags included, and stops quietly at the first
+    text outside any element, ignoring the rest of the file whatever it holds (check_urdf accepts
+    ``</robot>`` then ``garbage <b>``). That tail becomes spaces too."""
+    start = _tail_start(data, line, col)
+    if not urdfdom or start is None or not _tinyxml1_reads(data[start:]):
+        return None
+    return _blanked(data, start)
+
+
+def _tail_start(data: bytes, line: int, col: int) -> int | None:
+    """The byte offset of libxml2's (line, column), in characters; None where it cannot be placed."""
     if line < 1 or col < 1 or data.startswith(b"\xef\xbb\xbf"):
         return None
     lines = data.split(b"\n")
@@ -424,21 +447,43 @@ def _blank_markup_after_root(data: bytes, line: int, col: int) -> bytes | None:
         before = lines[line - 1].decode("utf-8")[: col - 1].encode("utf-8")
     except UnicodeDecodeError:
         return None
-    start = sum(len(lines[k]) + 1 for k in range(line - 1)) + len(before)
-    if not _markup_only(data[start:]):
-        return None
+    return sum(len(lines[k]) + 1 for k in range(line - 1)) + len(before)
+
+
+def _blanked(data: bytes, start: int) -> bytes:
     return data[:start] + bytes(b if b in b"\r\n" else 32 for b in data[start:])
 
 
-def _markup_only(tail: bytes) -> bool:
-    """``tail`` is nothing but blanks, comments, processing instructions, end tags and whole elements."""
+def _tinyxml2_reads(tail: bytes) -> bool:
+    """TinyXML2 reads ``tail`` (after the root element): blanks, comments, processing instructions and
+    whole elements, up to the end or to a stray end tag, where it stops (MuJoCo and PyBullet then load
+    ``</robot>`` followed by anything)."""
+    return _scan_tail(tail, end_tag_stops=True, text_stops=False)
+
+
+def _tinyxml1_reads(tail: bytes) -> bool:
+    """urdfdom's TinyXML (1) reads ``tail``: blanks, comments, processing instructions, stray end tags
+    and whole elements, up to the end or to text outside any element, where it stops (check_urdf loads
+    ``</robot>`` then ``garbage <b>``, and refuses ``</robot>`` then ``</x> <b>``)."""
+    return _scan_tail(tail, end_tag_stops=False, text_stops=True)
+
+
+def _scan_tail(tail: bytes, end_tag_stops: bool, text_stops: bool) -> bool:
     at = 0
     while True:
         while at < len(tail) and tail[at] in _TAIL_BLANK:
             at += 1
         if at == len(tail):
             return True
-        for simple in (_COMMENT, _TAIL_INSTRUCTION, _TAIL_END_TAG):  # _COMMENT: the comments' own pattern
+        if tail[at:at + 1] != b"<":
+            return text_stops
+        end_tag = _TAIL_END_TAG.match(tail, at)
+        if end_tag:
+            if end_tag_stops:
+                return True
+            at = end_tag.end()
+            continue
+        for simple in (_COMMENT, _TAIL_INSTRUCTION):  # _COMMENT: the comments' own pattern
             found = simple.match(tail, at)
             if found:
                 at = found.end()
@@ -513,38 +558,40 @@ def _declared_version(text: str) -> str:
 class _Leniency:
     """Something libxml2 refuses that TinyXML2 reads past: how to read past it, and what to say."""
 
-    repair: Callable[[bytes, tuple[int, int]], bytes | None]  # (data, libxml2's line and column)
+    # (data, libxml2's line and column, whether the document is a URDF: urdfdom reads it)
+    repair: Callable[[bytes, tuple[int, int], bool], bytes | None]
     say: Callable[[str], str]  # the document's text → the warning
     hint: str
     at_declaration: bool  # located at the XML declaration (else where libxml2 stopped)
+    code: str = "MK020"
 
 
 _DECLARATION_HINT = 'start the file with <?xml version="1.0"?> or leave the declaration out'
 #: libxml2's complaint → how TinyXML2 reads past it.
 _TINYXML2_LENIENCY = {
     "hyphen within comment": _Leniency(
-        lambda data, _: _blank_comment_hyphens(data),
+        lambda data, _, __: _blank_comment_hyphens(data),
         lambda text: 'a comment contains "--", which XML forbids: libsdformat, urdfdom and MuJoCo (TinyXML2) '
         "accept it, strict XML tools (xacro, lxml, ROS launch) refuse it",
         'write "- -" or "-" inside comments',
         at_declaration=False,
     ),
     "Unsupported version": _Leniency(
-        lambda data, _: _blank_declaration(data),
+        lambda data, _, __: _blank_declaration(data),
         lambda text: f'the XML declaration names version "{_declared_version(text)}", not 1.0; {_TINYXML2} '
         "ignore it, strict XML tools (lxml, so urdf_parser_py and yourdfpy) refuse it",
         _DECLARATION_HINT,
         at_declaration=True,
     ),
     "XML declaration allowed only at the start": _Leniency(
-        lambda data, _: _blank_declaration(data),
+        lambda data, _, __: _blank_declaration(data),
         lambda text: f"the XML declaration is not at the start of the file; {_TINYXML2} ignore it, strict "
         "XML tools (lxml, so urdf_parser_py and yourdfpy, and xacro) refuse it",
         _DECLARATION_HINT,
         at_declaration=True,
     ),
     "attributes construct error": _Leniency(
-        lambda data, _: _space_between_attributes(data),
+        lambda data, _, __: _space_between_attributes(data),
         lambda text: "an attribute follows the previous attribute's closing quote without a space between "
         f"them, which XML requires: {_TINYXML2} read it, strict XML tools (lxml, so urdf_parser_py and "
         "yourdfpy, and xacro) refuse the file",
@@ -552,12 +599,25 @@ _TINYXML2_LENIENCY = {
         at_declaration=False,
     ),
     "Extra content at the end of the document": _Leniency(
-        lambda data, at: _blank_markup_after_root(data, *at),
+        lambda data, at, urdfdom: _blank_markup_after_root(data, *at, urdfdom),
         lambda text: "the document goes on after its root element ends (an end tag, element, comment or "
         f"processing instruction): {_TINYXML2} read the root element and ignore the rest, strict XML tools "
         "(lxml, so urdf_parser_py and yourdfpy, and xacro) refuse the file",
         "delete everything after the root element's end tag",
         at_declaration=False,
+    ),
+}
+#: What urdfdom (TinyXML 1) reads past beyond TinyXML2: a URDF's own loader accepts it, PyBullet refuses
+#: it and MuJoCo nearly always (MK027 is an error under ``validate --target mjcf`` and ``pybullet``).
+_URDFDOM_LENIENCY = {
+    "Extra content at the end of the document": _Leniency(
+        lambda data, at, urdfdom: _blank_text_after_root(data, *at, urdfdom),
+        lambda text: "text follows the root element's end: urdfdom (TinyXML) reads the root element and "
+        "ignores the rest of the file; PyBullet (TinyXML2) refuses the file (XML_ERROR_PARSING_TEXT), so do "
+        "MuJoCo for all but a few such tails and strict XML tools (lxml, so xacro)",
+        "delete everything after the root element's end tag",
+        at_declaration=False,
+        code="MK027",
     ),
 }
 
@@ -570,9 +630,11 @@ def _as_tinyxml2_reads(
     text: str,
     display: str,
     sink: DiagnosticSink,
+    urdfdom: bool = False,
 ) -> etree._Element | None:
     """Parse ``data`` again past what libxml2 refuses and TinyXML2 (the reference loaders' parser)
-    accepts, each with a warning; every offset stays where it was. The error (MK020) when that fails."""
+    accepts, each with a warning; every offset stays where it was; ``urdfdom``: also past what urdfdom's
+    TinyXML accepts (a URDF's own loader). The error (MK020) when that fails."""
     applied: set[str] = set()
     while not data.startswith((b"\xff\xfe", b"\xfe\xff")):
         problem = next((p for p in _TINYXML2_LENIENCY if p in message and p not in applied), None)
@@ -580,14 +642,17 @@ def _as_tinyxml2_reads(
             break
         applied.add(problem)
         leniency = _TINYXML2_LENIENCY[problem]
-        repaired = leniency.repair(data, (where.line or 0, where.col or 0))
+        repaired = leniency.repair(data, (where.line or 0, where.col or 0), urdfdom)
+        if repaired is None and problem in _URDFDOM_LENIENCY:
+            leniency = _URDFDOM_LENIENCY[problem]
+            repaired = leniency.repair(data, (where.line or 0, where.col or 0), urdfdom)
         if repaired is None:
             break
         if leniency.at_declaration:
             declaration = _DECLARATION.match(data)
             at = declaration.start(3) if declaration else 0
             where = location_at(text, display, len(data[:at].decode("utf-8", "replace")))
-        sink.emit("MK020", leniency.say(text), where, hint=leniency.hint, severity=Severity.WARNING)
+        sink.emit(leniency.code, leniency.say(text), where, hint=leniency.hint, severity=Severity.WARNING)
         data = repaired
         try:
             return etree.fromstring(data, parser)
@@ -608,11 +673,13 @@ def read_xml(
     max_bytes: int = DEFAULT_MAX_BYTES,
     display: str | None = None,
     keep_blank_text: bool = True,
+    urdfdom: bool = False,
 ) -> XmlDocument | None:
-    """Read and parse an XML file with the checks every input gets: exists, size, encoding, syntax."""
+    """Read and parse an XML file with the checks every input gets: exists, size, encoding, syntax
+    (``urdfdom``: see :func:`parse_xml_bytes`)."""
     name = display or str(path)
     data = read_bytes(path, sink, max_bytes, name)
-    return None if data is None else parse_xml_bytes(data, name, sink, path, keep_blank_text)
+    return None if data is None else parse_xml_bytes(data, name, sink, path, keep_blank_text, urdfdom=urdfdom)
 
 
 def sniff_root_tag(path: Path, limit: int = 65536) -> str | None:

@@ -404,6 +404,7 @@ _AFTER_ROOT = {
     "another end tag": ("\n</foo>\n", 1),
     "a second root": ('\n<{root} name="b"><x/></{root}>\n', 1),
     "an element and a comment": ("\n<!-- c --><junk a='1'/>\n", 11),
+    "an end tag, then anything": ("\n</{root}>\ngarbage <b>\n", 1),  # TinyXML2 stops at the end tag
 }
 
 
@@ -433,6 +434,56 @@ def test_markup_after_the_root_element_is_a_warning_as_tinyxml2_reads_it(
             assert pybullet.loadURDF(str(path), physicsClientId=client) >= 0
         finally:
             pybullet.disconnect(client)
+
+
+#: text after a URDF's root element, before any stray end tag (TinyXML2 stops at one: _AFTER_ROOT)
+_TEXT_AFTER_ROOT = {
+    "text": "\ngarbage\n",
+    "text with markup characters": "\na < b & c\n",
+    "a comment then text": "\n<!-- c --> &amp; x\n",
+    "text then an open element": "\ntext <b>\n",
+}
+
+
+@pytest.mark.parametrize("tail", list(_TEXT_AFTER_ROOT), ids=list(_TEXT_AFTER_ROOT))
+def test_text_after_a_urdf_root_is_mk027_as_urdfdom_reads_it(tmp_path: Path, tail: str) -> None:
+    """urdfdom (TinyXML 1, check_urdf) stops at text after the root element and ignores the rest;
+    MuJoCo and PyBullet (TinyXML2) refuse the file. So it is a warning (MK027) and an error under their
+    targets."""
+    import pybullet
+
+    path = tmp_path / "m.urdf"
+    path.write_text(_TRIANGLE_URDF.rstrip("\n") + _TEXT_AFTER_ROOT[tail])
+    assert check_urdf_accepts(path)[0]
+    v = validate(path)
+    assert v.errors == [] and v.robot is not None and v.robot.name == "r"
+    (d,) = [d for d in v.diagnostics if d.code in ("MK020", "MK027")]
+    assert d.code == "MK027" and d.severity.value == "warning" and "urdfdom" in d.message
+    assert d.location is not None and d.location.line == _TRIANGLE_URDF.rstrip("\n").count("\n") + 2
+    with pytest.raises(ValueError, match="XML parse error"):
+        mujoco.MjModel.from_xml_path(str(path))
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        with pytest.raises(pybullet.error):
+            pybullet.loadURDF(str(path), physicsClientId=client)
+    finally:
+        pybullet.disconnect(client)
+    clean = tmp_path / "clean.urdf"
+    clean.write_text(_TRIANGLE_URDF)
+    for target in ("mjcf", "pybullet"):  # the clean file's errors (MK303) and MK027
+        before = sorted(d.code for d in validate(clean, target=target).errors)
+        assert sorted(d.code for d in validate(path, target=target).errors) == sorted([*before, "MK027"])
+    assert validate(path, target="urdf").errors == []
+
+
+@pytest.mark.parametrize("tail", ["\n<b> text\n", "\n</x> <b>\n"])
+def test_an_open_element_after_a_urdf_root_stays_an_error(tmp_path: Path, tail: str) -> None:
+    """An element left open before any text: urdfdom's TinyXML refuses it, also after a stray end tag
+    (where TinyXML2, which stops there, would read the file)."""
+    path = tmp_path / "m.urdf"
+    path.write_text(_TRIANGLE_URDF.rstrip("\n") + tail)
+    assert not check_urdf_accepts(path)[0]
+    assert [d.code for d in validate(path).errors] == ["MK020"]
 
 
 @pytest.mark.parametrize("kind", ["mjcf", "sdf"])

@@ -38,7 +38,8 @@ _KNOWN_NAMESPACES = {"drake": "http://drake.mit.edu", "xacro": "http://www.ros.o
 def read_urdf(path: Path, options: ReadOptions, display: str) -> ReadResult:
     """Read a URDF file into a :class:`Robot` (None when the file is not a readable URDF)."""
     sink = DiagnosticSink()
-    read = read_declaring_prefixes(path, display, sink, options.max_bytes, keep_blank_text=False)
+    read = read_declaring_prefixes(path, display, sink, options.max_bytes, keep_blank_text=False,
+                                   urdfdom=True)
     doc = read.doc  # never written back: whitespace between elements is dropped
     _said_prefixes(read, sink)
     robot = None
