@@ -1871,6 +1871,14 @@ _TABLE: tuple[CodeInfo, ...] = (
         "Nothing is changed.",
     ),
     CodeInfo(
+        "MK888",
+        "below-floor",
+        "warning",
+        "A welded robot's moving links reach below z = 0 where the written file starts it (the MJCF `home` "
+        "key; q = 0 elsewhere): a floor added at z = 0 cuts through them and pushes the arm off its pose "
+        "(a robot mounted overhead or on a wall). Nothing is changed.",
+    ),
+    CodeInfo(
         "MK890",
         "output-exists",
         "error",

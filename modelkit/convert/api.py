@@ -77,6 +77,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     has no sites (MK873), an SDF source's frames where it has no frames (MK874). The source model is
     never changed."""
     from modelkit.convert.base import settle_base
+    from modelkit.convert.floor import note_below_floor
     from modelkit.convert.merge import merge_fixed_joints
     from modelkit.convert.rolling import note_rolling_faults
     from modelkit.convert.spawn import note_spawn_height
@@ -96,6 +97,7 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     settle_base(out, options.base, notes)
     note_rolling_faults(out, notes)
     note_tipping(out, notes)
+    note_below_floor(out, target, notes)
     if not target.tracks_native:
         approximate_tracks(out, notes)
     approximate_wheels(out, options.wheel_collision, target.name, notes)
