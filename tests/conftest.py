@@ -163,3 +163,15 @@ def links_below(robot: Robot, tops: set[str]) -> set[str]:
                 out.add(joint.child)
                 changed = True
     return out
+
+
+def assert_pybullet_refuses(urdf: Path) -> None:
+    """PyBullet's ``loadURDF`` refuses the file (in a connection of its own)."""
+    import pybullet
+
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        with pytest.raises(pybullet.error):
+            pybullet.loadURDF(str(urdf), physicsClientId=client)
+    finally:
+        pybullet.disconnect(client)

@@ -43,7 +43,7 @@ from modelkit.model import Mesh
 from modelkit.resources import Resolver
 from modelkit.textio import read_head
 
-from .conftest import CORPUS, REPO, SAMPLES, require_tool
+from .conftest import CORPUS, REPO, SAMPLES, assert_pybullet_refuses, require_tool
 from .test_sdf_reader import sdf_oracle  # noqa: F401  (the compiled libsdformat checker, a fixture)
 
 KINDS = {".urdf": "urdf", ".xacro": "xacro", ".sdf": "sdf", ".world": "sdf", ".body": "body"}
@@ -450,8 +450,6 @@ def test_text_after_a_urdf_root_is_mk027_as_urdfdom_reads_it(tmp_path: Path, tai
     """urdfdom (TinyXML 1, check_urdf) stops at text after the root element and ignores the rest;
     MuJoCo and PyBullet (TinyXML2) refuse the file. So it is a warning (MK027) and an error under their
     targets."""
-    import pybullet
-
     path = tmp_path / "m.urdf"
     path.write_text(_TRIANGLE_URDF.rstrip("\n") + _TEXT_AFTER_ROOT[tail])
     assert check_urdf_accepts(path)[0]
@@ -462,12 +460,7 @@ def test_text_after_a_urdf_root_is_mk027_as_urdfdom_reads_it(tmp_path: Path, tai
     assert d.location is not None and d.location.line == _TRIANGLE_URDF.rstrip("\n").count("\n") + 2
     with pytest.raises(ValueError, match="XML parse error"):
         mujoco.MjModel.from_xml_path(str(path))
-    client = pybullet.connect(pybullet.DIRECT)
-    try:
-        with pytest.raises(pybullet.error):
-            pybullet.loadURDF(str(path), physicsClientId=client)
-    finally:
-        pybullet.disconnect(client)
+    assert_pybullet_refuses(path)
     clean = tmp_path / "clean.urdf"
     clean.write_text(_TRIANGLE_URDF)
     for target in ("mjcf", "pybullet"):  # the clean file's errors (MK303) and MK027

@@ -18,6 +18,7 @@ from click.testing import CliRunner
 
 from modelkit.cli import main
 from modelkit.geometry.meshfiles import MeshLoadError, load_mesh
+from tests.conftest import assert_pybullet_refuses
 from tests.test_sdf_reader import oracle_has_errors, sdf_oracle  # noqa: F401 (the fixture)
 
 # A node turned 90° about Z and moved: the box's triangles must be read where the node puts them.
@@ -126,12 +127,7 @@ def glb_urdf(tmp_path: Path) -> Path:
 
 def test_consumers_refuse_the_glb_urdf_itself(glb_urdf: Path) -> None:
     """What MK514 says, measured: PyBullet refuses the whole file, MuJoCo has no decoder."""
-    client = pybullet.connect(pybullet.DIRECT)
-    try:
-        with pytest.raises(pybullet.error):
-            pybullet.loadURDF(str(glb_urdf), physicsClientId=client)
-    finally:
-        pybullet.disconnect(client)
+    assert_pybullet_refuses(glb_urdf)
     with pytest.raises(ValueError, match="no decoder"):
         mujoco.MjModel.from_xml_path(str(glb_urdf))
 

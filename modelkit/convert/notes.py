@@ -7,6 +7,7 @@ target element it concerns. Writers add notes to a :class:`NoteSink`; the CLI pr
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -92,3 +93,9 @@ def renames(notes: Iterable[ConversionNote], kind: str = "link") -> dict[str, st
         if n.renamed is not None and n.renamed[0] == kind:
             out.setdefault(n.renamed[1], n.renamed[2])
     return out
+
+
+def note_matches(notes: Iterable[ConversionNote], code: str, pattern: re.Pattern[str]) -> list[re.Match[str]]:
+    """The matches of ``pattern`` at the start of the messages of the notes with ``code``: what a writer
+    said in words another module reads back (verify reads the MK813 chains a writer made)."""
+    return [found for note in notes if note.code == code for found in [pattern.match(note.message)] if found]

@@ -48,7 +48,7 @@ import numpy as np
 from lxml import etree
 
 from modelkit.convert.notes import ConversionNote
-from modelkit.model import BALL_KEYS, Box, Cylinder, Inertial, JointType, Mesh, Robot
+from modelkit.model import BALL_KEYS, Box, Cylinder, Inertial, Joint, JointType, Mesh, Robot
 from modelkit.spatial import Pose
 from modelkit.verify.engines.protocol import Skip, StaticFacts
 
@@ -518,15 +518,11 @@ def ball_chains(fmt: str, notes: Iterable[ConversionNote]) -> list[BallChain]:
     """The URDF writer's ball-joint chains, read from its MK813 notes (none for another format)."""
     if fmt != "urdf":
         return []
+    from modelkit.convert.notes import note_matches
     from modelkit.formats.urdf.write_joints import BALL_NOTE
 
-    out = []
-    for note in notes:
-        match = BALL_NOTE.match(note.message) if note.code == "MK813" else None
-        if match:
-            out.append(BallChain(match["joint"], (match["x"], match["y"], match["z"]),
-                                 (match["link_x"], match["link_y"])))
-    return out
+    return [BallChain(m["joint"], (m["x"], m["y"], m["z"]), (m["link_x"], m["link_y"]))
+            for m in note_matches(notes, "MK813", BALL_NOTE)]
 
 
 SENSOR_FRAME = re.compile(r'"(?P<frame>[^"]+)" on "(?P<parent>[^"]+)"'
@@ -609,29 +605,47 @@ def applied_chains(robot: Robot, chains: list[BallChain]) -> Robot:
     """A copy of ``robot`` whose ball joints are the written chains: the model as the URDF holds it.
     The first joint keeps the ball's origin, the last one keeps the source joint's name and child,
     the two added links have no mass (the writer's tiny inertial comes with :func:`applied`)."""
-    if not chains:
-        return robot
     from modelkit.formats.urdf.write_joints import BALL_AXES
-    from modelkit.model import Joint, JointLimits, Link
 
+    turns = [(JointType.REVOLUTE, axis) for _, axis in BALL_AXES]
+    by_joint = {chain.joint: chain for chain in chains}
+
+    def pieces(ball: Joint) -> ChainPieces | None:
+        chain = by_joint.get(ball.name)
+        return None if chain is None else ((chain.joints[0], chain.joints[1]), list(chain.links), turns)
+
+    return with_chains(robot, JointType.BALL, pieces) if chains else robot
+
+
+ChainPieces = tuple[tuple[str, str], list[str], list[tuple[JointType, Any]]]
+"""The first two joints' names, the two links between the three joints, each joint's type and axis."""
+
+
+def with_chains(robot: Robot, kind: JointType, pieces: Callable[[Joint], ChainPieces | None]) -> Robot:
+    """A copy of ``robot`` with each joint of type ``kind`` for which ``pieces`` gives a chain replaced
+    by that chain of three joints (:func:`in_chain`)."""
     out = copy.deepcopy(robot)
-    by_name = {joint.name: joint for joint in out.joints}
-    for chain in chains:
-        ball = by_name.get(chain.joint)
-        if ball is None or ball.type is not JointType.BALL:
-            continue
-        frames = [ball.parent, *chain.links, ball.child]
-        added = []
-        for i, (_, axis) in enumerate(BALL_AXES):
-            name = chain.joint if i == 2 else chain.joints[i]
-            added.append(Joint(name, JointType.REVOLUTE, frames[i], frames[i + 1],
-                               origin=ball.origin if i == 0 else Pose(), axis=np.asarray(axis, dtype=float),
-                               limits=JointLimits(), damping=ball.damping, synthesised=i < 2,
-                               source=ball.source))
-        index = out.joints.index(ball)
-        out.joints[index:index + 1] = added
-        out.links.extend(Link(name, synthesised=True, source=ball.source) for name in chain.links)
+    for joint in list(out.joints):
+        chain = pieces(joint) if joint.type is kind else None
+        if chain is not None:
+            in_chain(out, joint, *chain)
     return out
+
+
+def in_chain(robot: Robot, joint: Joint, first_two: tuple[str, str], links: Sequence[str],
+             pieces: Sequence[tuple[JointType, Any]]) -> None:
+    """Replace ``joint`` in ``robot`` by three single-axis joints (``pieces``: type and axis) through
+    ``links``, massless and added: the first keeps the joint's origin, the last its name and child."""
+    from modelkit.model import JointLimits, Link
+
+    frames = [joint.parent, *links, joint.child]
+    names = [*first_two, joint.name]
+    added = [Joint(names[i], kind, frames[i], frames[i + 1], origin=joint.origin if i == 0 else Pose(),
+                   axis=np.asarray(axis, dtype=float), limits=JointLimits(), damping=joint.damping,
+                   synthesised=i < 2, source=joint.source) for i, (kind, axis) in enumerate(pieces)]
+    index = robot.joints.index(joint)
+    robot.joints[index:index + 1] = added
+    robot.links.extend(Link(name, synthesised=True, source=joint.source) for name in links)
 
 
 def chain_configuration(q: dict[str, float], chains: list[BallChain]) -> dict[str, float]:

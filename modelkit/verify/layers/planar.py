@@ -19,12 +19,10 @@ import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-import numpy as np
-
-from modelkit.convert.notes import ConversionNote
-from modelkit.model import Joint, JointLimits, JointType, Link, Robot
-from modelkit.spatial import Pose
+from modelkit.convert.notes import ConversionNote, note_matches
+from modelkit.model import Joint, JointType, Robot
 from modelkit.verify.engines.protocol import Skip
+from modelkit.verify.layers.approximations import ChainPieces, with_chains
 
 Renames = dict[str, dict[str, str]]
 
@@ -46,50 +44,33 @@ def mjcf_chains(fmt: str, notes: Iterable[ConversionNote]) -> list[PlanarChain]:
         return []
     from modelkit.formats.mjcf.write_bodies import PLANAR_NOTE
 
-    out = []
-    for note in notes:
-        match = PLANAR_NOTE.match(note.message) if note.code == "MK813" else None
-        if match:
-            out.append(PlanarChain(match["joint"], (match["x"], match["y"], match["z"])))
-    return out
+    return [PlanarChain(match["joint"], (match["x"], match["y"], match["z"]))
+            for match in note_matches(notes, "MK813", PLANAR_NOTE)]
 
 
 def sdf_floated(fmt: str, notes: Iterable[ConversionNote]) -> list[str]:
     """The source planar joints whose child the SDF writer left floating (none for another format)."""
-    if fmt != "sdf":
-        return []
-    return [match["joint"] for note in notes if note.code == "MK813"
-            for match in [FLOATED_NOTE.match(note.message)] if match]
+    return [match["joint"] for match in note_matches(notes, "MK813", FLOATED_NOTE)] if fmt == "sdf" else []
 
 
 def applied_mjcf(robot: Robot, chains: list[PlanarChain], renames: Renames) -> Robot:
     """A copy of ``robot`` whose planar joints are the MJCF's chains, as the MuJoCo adapter reads them:
     a slide from the parent at the joint's origin to ``<body>__<x>``, a slide to ``<body>__<y>``,
     a hinge (keeping the source joint's name) to the child, the two added links massless."""
-    if not chains:
-        return robot
     from modelkit.formats.mjcf.write_bodies import planar_axes
 
-    out = copy.deepcopy(robot)
-    by_name = {joint.name: joint for joint in out.joints}
-    for chain in chains:
-        planar = by_name.get(chain.joint)
-        if planar is None or planar.type is not JointType.PLANAR:
-            continue
+    kinds = (JointType.PRISMATIC, JointType.PRISMATIC, JointType.REVOLUTE)
+    by_joint = {chain.joint: chain for chain in chains}
+
+    def pieces(planar: Joint) -> ChainPieces | None:
+        chain = by_joint.get(planar.name)
+        if chain is None:
+            return None
         body = renames.get("link", {}).get(planar.child, planar.child)
-        links = [f"{body}__{chain.joints[0]}", f"{body}__{chain.joints[1]}"]
-        frames = [planar.parent, *links, planar.child]
-        kinds = (JointType.PRISMATIC, JointType.PRISMATIC, JointType.REVOLUTE)
-        added = [
-            Joint(chain.joint if i == 2 else chain.joints[i], kind, frames[i], frames[i + 1],
-                  origin=planar.origin if i == 0 else Pose(), axis=np.asarray(axis, dtype=float),
-                  limits=JointLimits(), damping=planar.damping, synthesised=i < 2, source=planar.source)
-            for i, (kind, axis) in enumerate(zip(kinds, planar_axes(planar.axis), strict=True))
-        ]
-        index = out.joints.index(planar)
-        out.joints[index:index + 1] = added
-        out.links.extend(Link(name, synthesised=True, source=planar.source) for name in links)
-    return out
+        return ((chain.joints[0], chain.joints[1]), [f"{body}__{name}" for name in chain.joints[:2]],
+                list(zip(kinds, planar_axes(planar.axis), strict=True)))
+
+    return with_chains(robot, JointType.PLANAR, pieces) if chains else robot
 
 
 def applied_sdf(robot: Robot, floated: list[str]) -> Robot:
