@@ -526,7 +526,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK213",
         "non-root-free-joint",
         "warning",
-        "A non-root link has a free joint: its subtree floats separately (no URDF/MJCF equivalent).",
+        "A non-root link has a free (floating) joint: its subtree floats separately. MJCF allows a free "
+        "joint on a top-level body only and SDF none inside a model; in a URDF, PyBullet welds it and Drake "
+        "leaves the child free at the world origin, the joint's origin unread.",
     ),
     CodeInfo(
         "MK214",

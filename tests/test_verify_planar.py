@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from modelkit.api import validate
 from modelkit.model import JointType
 from modelkit.verify.api import verify
 from modelkit.verify.engines.pinocchio import PinocchioModel
@@ -138,3 +139,47 @@ def test_the_planar_axes_span_the_plane() -> None:
         assert abs(np.linalg.norm(u) - 1) < 1e-15 and abs(np.linalg.norm(v) - 1) < 1e-15
         assert max(abs(u @ n), abs(v @ n), abs(u @ v)) < 1e-15
         assert np.allclose(np.cross(u, v), n, atol=1e-15)
+
+
+LOOSE = """<robot name="loose">
+  <link name="base"><inertial><mass value="2"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+    <origin xyz="0 0 0.1"/><limit lower="-2" upper="2" effort="5" velocity="2"/></joint>
+  <link name="arm"><inertial><origin xyz="0 0 0.1"/><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.002" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="loose" type="floating"><parent link="base"/><child link="puck"/><origin xyz="0.5 0 0"/></joint>
+  <link name="puck"><inertial><mass value="0.5"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><sphere radius="0.05"/></geometry></collision></link>
+  <joint name="flap_hinge" type="revolute"><parent link="puck"/><child link="flap"/><axis xyz="1 0 0"/>
+    <limit lower="-2" upper="2" effort="5" velocity="2"/></joint>
+  <link name="flap"><inertial><origin xyz="0 0.05 0"/><mass value="0.2"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+</robot>
+"""
+
+
+def test_a_floating_joint_inside_the_tree_is_graded_where_the_engines_hold_it(tmp_path: Path) -> None:
+    """A URDF floating joint below the root: the MJCF writes its child as a top-level free body (MK813),
+    which MuJoCo's adapter now reports as a floating joint (before: "floating became fixed"); Drake's
+    URDF parser leaves the child free at the world origin, which the adapter sets where the file's joint
+    origin puts it (before: 0.5 m off in layer 2; its SDF failed to load); PyBullet welds the joint,
+    an engine limit said as a skip. The Pinocchio reference holds it at rest (before: skipped)."""
+    source = tmp_path / "loose.urdf"
+    source.write_text(LOOSE)
+    report = verify(source, tmp_path / "out", ENGINES, configurations=3, samples=3, driven=False)
+    assert report.failed == [], [c.detail for c in report.failed]
+    graded = {(c.layer, c.engine, c.quantity) for c in report.checks}
+    for engine in ("mujoco", "drake", "drake-urdf", "pinocchio"):
+        assert {(1, engine, "joint-type"), (2, engine, "pose-position")} <= graded, engine
+    for engine in ("mujoco", "drake", "drake-urdf"):
+        assert (3, engine, "mass-matrix") in graded, engine
+    assert "puck" in report.engines["drake-urdf"]["free_bodies"]
+    (pybullet,) = [s.reason for s in report.skips if s.engine == "pybullet"]
+    assert "welds it" in pybullet and pybullet.startswith("not run")
+    (said,) = [d.message for d in validate(source).diagnostics if d.code == "MK213"]
+    assert "PyBullet welds it" in said and 'Drake leaves "puck" free at the world origin' in said
+    moved = verify(source, tmp_path / "moved", ("mujoco", "drake-urdf"), inject=["com:flap:0.01"],
+                   configurations=2, samples=2, replay=False, driven=False)
+    assert {c.engine for c in moved.failed if c.quantity == "com"} == {"mujoco", "drake-urdf"}

@@ -210,10 +210,15 @@ def special_joints(robot: Robot) -> Iterator[Diagnostic]:
 
     for joint in robot.joints:
         if joint.type is JointType.FLOATING:
+            # measured with PyBullet 3.2.7 and Drake on a URDF floating joint below the root
+            consumers = (' (in this URDF: PyBullet welds it, "joint unsupported, creating a fixed joint '
+                         f'instead", and Drake leaves "{joint.child}" free at the world origin, the joint\'s '
+                         "origin unread; urdfdom and MuJoCo follow the file)"
+                         if robot.source_format in ("urdf", "xacro") else "")
             yield diag(
                 "MK213",
-                f'"{joint.child}" has a free joint below the root: its subtree floats as a separate '
-                "body (no URDF/MJCF equivalent)",
+                f'"{joint.child}" has a free joint below the root: its subtree floats as a separate body; '
+                f"MJCF allows a free joint on a top-level body only, SDF none inside a model{consumers}",
                 joint.loc("type"),
             )
         elif joint.type is JointType.PSEUDO_CONTINUOUS_TRACK:

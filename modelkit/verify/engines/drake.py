@@ -270,6 +270,7 @@ class DrakeModel:
             raise
         self.plant = plant
         self.context = plant.CreateDefaultContext()
+        placed = self._place_urdf_free_bodies() if not self._sdf else []
         self._root_body: RigidBody = root_body
         self._bodies: dict[str, RigidBody] = {
             plant.get_body(i).name(): plant.get_body(i) for i in plant.GetBodyIndices(self._instance)
@@ -305,10 +306,40 @@ class DrakeModel:
             "poses": "EvalBodyPoseInWorld, relative to the root",
             "mass_matrix": "CalcMassMatrix",
             "bias": "CalcBiasTerm - CalcGravityGeneralizedForces (MuJoCo qfrc_bias convention)",
+            **({"free_bodies": "Drake's URDF parser leaves the child of a floating joint a free body at "
+                               "the world origin (its warning); set where the file's joint origin puts "
+                               "it at q = 0: " + ", ".join(placed)} if placed else {}),
             "nq": int(plant.num_positions()),
             "nv": int(plant.num_velocities()),
             "parser_warnings": list(self.warnings),
         }
+
+    def _place_urdf_free_bodies(self) -> list[str]:
+        """Drake's URDF parser leaves the child of a ``floating`` joint as a free body at the world
+        origin ("not supported by MultibodyPlant. Leaving ... as a free body"), the joint's origin
+        unread. Each such body is set, as a user sets a free body's initial pose, where the file puts
+        it: its parent's pose at the default positions composed with the joint's origin."""
+        plant, placed = self.plant, []
+        for joint in etree.parse(str(self.path)).iterfind("./joint[@type='floating']"):
+            parent, child = joint.find("parent"), joint.find("child")
+            if parent is None or child is None:
+                continue
+            names = (str(parent.get("link")), str(child.get("link")))
+            if not all(plant.HasBodyNamed(name, self._instance) for name in names):
+                continue
+            body = plant.GetBodyByName(names[1], self._instance)
+            if not body.is_floating_base_body():
+                continue
+            origin = joint.find("origin")
+            xyz, rpy = (origin.get(key, "0 0 0") if origin is not None else "0 0 0" for key in ("xyz", "rpy"))
+            offset = RigidTransform(RollPitchYaw(_vec([float(v) for v in rpy.split()])),
+                                    _vec([float(v) for v in xyz.split()]))
+            parent = plant.EvalBodyPoseInWorld(self.context, plant.GetBodyByName(names[0], self._instance))
+            plant.SetDefaultFloatingBaseBodyPose(body, parent @ offset)
+            placed.append(names[1])
+        if placed:
+            self.context = plant.CreateDefaultContext()
+        return placed
 
     def _is_base_weld(self, index: JointIndex) -> bool:
         if self._world_root:

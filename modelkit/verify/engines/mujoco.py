@@ -212,6 +212,7 @@ class _Body:
     joints: tuple[int, ...]  # the chain's joints (hinge, slide, ball), in the body's order
     links: tuple[str, ...]  # the chain's links, one per joint (the body's own last); (name,) without joints
     offset: Array  # the body's link frame in the body frame (a translation)
+    free: bool = False  # a free joint of its own that the welding left: a floating subtree (MK813)
 
 
 class MujocoModel:
@@ -273,7 +274,8 @@ class MujocoModel:
         links = (*(f"{name}__{self._jname(j)}" for j in chain[:-1]), name)
         offset = np.array(m.jnt_pos[chain[-1]], dtype=float) if chain else np.zeros(3)
         parent = int(m.body_parentid[b])
-        return _Body(b, name, self._bname(parent) if parent > 0 else "world", chain, links, offset)
+        loose = any(int(m.jnt_type[j]) == free for j in range(start, start + count))
+        return _Body(b, name, self._bname(parent) if parent > 0 else "world", chain, links, offset, loose)
 
     def _frame_sites(self) -> dict[str, int]:
         """Named sites on a body whose name no link has and that nothing uses (a sensor, an equality, an
@@ -335,7 +337,10 @@ class MujocoModel:
             inertia = rot @ np.diag(m.body_inertia[b]) @ rot.T
             com = np.array(m.body_ipos[b], dtype=float) - body.offset
             facts.links[body.name] = LinkFacts(float(m.body_mass[b]), com, inertia)
-            if not body.joints and b != self._root_id:
+            if body.free and b != self._root_id:  # the MJCF writer's top-level body for a floating joint
+                facts.joints[f"floating:{body.name}"] = JointFacts("floating", body.parent, body.name,
+                                                                   np.zeros(3))
+            elif not body.joints and b != self._root_id:
                 facts.joints[f"fixed:{body.name}"] = JointFacts("fixed", body.parent, body.name, np.zeros(3))
             parent = body.parent
             for j, child in zip(body.joints, body.links if body.joints else (), strict=True):

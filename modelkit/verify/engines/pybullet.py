@@ -452,12 +452,19 @@ class PlanarJoint(PyBulletError):
     engine_limit = True  # verify reports a skip, not a failed load
 
 
+class FloatingJoint(PyBulletError):
+    """The URDF has a floating joint, which PyBullet's URDF importer welds."""
+
+    engine_limit = True  # verify reports a skip, not a failed load
+
+
 def _check_size(model: Path) -> None:
     """What PyBullet cannot hold as the file says, raised before it loads (each an engine limit): more
-    joints than it reports states for, or a planar joint whose child's centre of mass is off its link
-    frame. At zero coordinates PyBullet puts that centre of mass where the child's link frame belongs,
-    so the child and everything below it are off by the offset (Hello Robot's Stretch 4: 9.6 cm; a
-    fixed joint in its place is right, and so is a planar child whose COM is at its frame)."""
+    joints than it reports states for, a floating joint (PyBullet welds it), or a planar joint whose
+    child's centre of mass is off its link frame. At zero coordinates PyBullet puts that centre of mass
+    where the child's link frame belongs, so the child and everything below it are off by the offset
+    (Hello Robot's Stretch 4: 9.6 cm; a fixed joint in its place is right, and so is a planar child
+    whose COM is at its frame)."""
     from lxml import etree
 
     try:
@@ -469,6 +476,11 @@ def _check_size(model: Path) -> None:
         raise TooManyJoints(f"{len(joints)} joints: PyBullet reports the joint states of a body of at most "
                             f"{MAX_MOVING_JOINTS} joints, fixed ones included (getJointState fails for "
                             "every joint beyond that)")
+    floating = next((j for j in joints if j.get("type") == "floating"), None)
+    if floating is not None:
+        raise FloatingJoint(f"joint {floating.get('name')} is floating: PyBullet's URDF importer welds it "
+                            "(\"joint unsupported, creating a fixed joint instead\"), so its child does not "
+                            "move as the file says (validate's MK213)")
     planar = next((j for j in joints if j.get("type") == "planar" and _com_off(root, j)), None)
     if planar is not None:
         raise PlanarJoint(f"joint {planar.get('name')} is planar and its child's centre of mass is off its "
