@@ -620,11 +620,8 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                                                        written.get(INPUTS.get(eng.label, "robot"), []))
                  for eng in loaded}
     # A planar joint is the MJCF writer's two slides and a hinge, or the SDF writer's free child (MK813).
-    planar_of = {eng.label: (planar.mjcf_chains(INPUTS.get(eng.label, "robot"),
-                                                written.get(INPUTS.get(eng.label, "robot"), [])),
-                             planar.sdf_floated(INPUTS.get(eng.label, "robot"),
-                                                written.get(INPUTS.get(eng.label, "robot"), [])))
-                 for eng in loaded}
+    planar_of = {eng.label: planar.held_by(kind, written.get(kind, []))
+                 for eng in loaded for kind in [INPUTS.get(eng.label, "robot")]}
     for eng in loaded:
         # An engine holding a documented approximation (MK816 tiny masses, PyBullet's 1 kg) is
         # compared with the source with that approximation applied; the report lists it.
@@ -642,17 +639,16 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
         plates_entry = approximations.plates_skip(eng.label, plates)
         if plates_entry is not None:
             report.skips.append(plates_entry)
-        planar_chains, floated = planar_of[eng.label]
-        planar_entry = planar.skip(eng.label, planar_chains, floated)
+        planar_entry = planar.skip(eng.label, planar_of[eng.label])
         if planar_entry is not None:
             report.skips.append(planar_entry)
-        held = approximations.applied_chains(models[eng.label], chains)
-        held = planar.applied_sdf(planar.applied_mjcf(held, planar_chains, maps.get(kind, {})), floated)
+        held = planar_of[eng.label].applied(approximations.applied_chains(models[eng.label], chains),
+                                            maps.get(kind, {}))
         if wheels is not None:
             held = approximations.applied_wheels(held, robot, wheels)
         held = approximations.applied_plates(held, plates)
         eng_static = (source_static(approximations.applied(held, approx[eng.label]))
-                      if approx[eng.label] or chains or wheels or plates or planar_chains or floated
+                      if approx[eng.label] or chains or wheels or plates or planar_of[eng.label]
                       or models[eng.label] is not reference
                       else src_static)
         # ... and so is one holding the URDF writer's ±1e16 for an infinite position bound (MK819).
@@ -704,10 +700,9 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
             # an engine holding each ball joint as the URDF writer's chain (MK813) is compared with the
             # source holding those chains, whose three joints are revolute degrees of freedom
             chains = chains_of[eng.label]
-            planar_chains, floated = planar_of[eng.label]
-            held_planar = planar.applied_sdf(planar.applied_mjcf(
-                approximations.applied_chains(models[eng.label], chains), planar_chains, maps.get(
-                    INPUTS.get(eng.label, "robot"), {})), floated)
+            renames_of = maps.get(INPUTS.get(eng.label, "robot"), {})
+            chained = approximations.applied_chains(models[eng.label], chains)
+            held_planar = planar_of[eng.label].applied(chained, renames_of)
             model = approximations.applied(held_planar, approx[eng.label])
             ref = (_without_armature(model) if dropped
                    else pin_ref if model is reference else _pinocchio(model))
@@ -726,7 +721,7 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                     continue
             try:
                 last = {chain.joint: chain.joints[2] for chain in chains}
-                last.update({chain.joint: chain.joints[2] for chain in planar_chains})
+                last.update({chain.joint: chain.joints[2] for chain in planar_of[eng.label].chains})
                 report.checks.extend(_guarded(3, eng, lambda eng=eng, ref=ref, st=held_state, last=last,
                                               wb=with_balls: dynamics.layer3a(ref, eng, st, last, wb)))
                 report.engines[eng.label] = dict(eng.model.settings)  # a route layer 3a chose, said

@@ -31,6 +31,7 @@ sensors, lights and plugins by :mod:`write_devices`; the actuators as gz-sim joi
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 from lxml import etree
@@ -127,6 +128,10 @@ def as_written(m: Mat3) -> Mat3:
             out[i, j] = out[j, i] = float(fmt(0.5 * (m[i, j] + m[j, i])))
     return out
 
+
+UNJOINTED_NOTE = re.compile(r'joint "(?P<joint>.+)" is (?P<type>planar|floating): SDF has no such joint '
+                            r"inside a model; ")
+"""The MK813 note of a joint whose child is written without a joint (:meth:`_joint`): verify reads it."""
 
 class _ModelWriter:
     def __init__(self, robot: Robot, ctx: WriteContext) -> None:

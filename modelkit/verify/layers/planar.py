@@ -15,7 +15,6 @@ joints); the report says so (:func:`skip`)."""
 from __future__ import annotations
 
 import copy
-import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -26,16 +25,34 @@ from modelkit.verify.layers.approximations import ChainPieces, with_chains
 
 Renames = dict[str, dict[str, str]]
 
-FLOATED_NOTE = re.compile(r'joint "(?P<joint>.+)" is planar: SDF has no such joint inside a model; ')
-"""The SDF writer's MK813 note for a planar joint whose child it writes without a joint."""
-
-
 @dataclass(frozen=True)
 class PlanarChain:
     """A source planar joint as the MJCF writer wrote it: two slides and a hinge (written names)."""
 
     joint: str  # source name
     joints: tuple[str, str, str]  # the written slides along u and v, then the hinge about the normal
+
+
+@dataclass(frozen=True)
+class PlanarHeld:
+    """How one engine's file holds the source's planar joints: the MJCF's chains, or the source joints
+    whose child the SDF leaves floating (both empty for a URDF, which has planar joints)."""
+
+    chains: list[PlanarChain]
+    floated: list[str]
+
+    def applied(self, robot: Robot, renames: Renames) -> Robot:
+        """``robot`` as the file holds it (:func:`applied_mjcf`, :func:`applied_sdf`)."""
+        return applied_sdf(applied_mjcf(robot, self.chains, renames), self.floated)
+
+    def __bool__(self) -> bool:
+        return bool(self.chains or self.floated)
+
+
+def held_by(fmt: str, notes: Iterable[ConversionNote]) -> PlanarHeld:
+    """How a file of ``fmt`` holds the planar joints, read from its writer's MK813 notes."""
+    notes = list(notes)
+    return PlanarHeld(mjcf_chains(fmt, notes), sdf_floated(fmt, notes))
 
 
 def mjcf_chains(fmt: str, notes: Iterable[ConversionNote]) -> list[PlanarChain]:
@@ -50,7 +67,11 @@ def mjcf_chains(fmt: str, notes: Iterable[ConversionNote]) -> list[PlanarChain]:
 
 def sdf_floated(fmt: str, notes: Iterable[ConversionNote]) -> list[str]:
     """The source planar joints whose child the SDF writer left floating (none for another format)."""
-    return [match["joint"] for match in note_matches(notes, "MK813", FLOATED_NOTE)] if fmt == "sdf" else []
+    if fmt != "sdf":
+        return []
+    from modelkit.formats.sdf.writer import UNJOINTED_NOTE
+
+    return [m["joint"] for m in note_matches(notes, "MK813", UNJOINTED_NOTE) if m["type"] == "planar"]
 
 
 def applied_mjcf(robot: Robot, chains: list[PlanarChain], renames: Renames) -> Robot:
@@ -84,8 +105,9 @@ def applied_sdf(robot: Robot, floated: list[str]) -> Robot:
     return out
 
 
-def skip(engine: str, chains: list[PlanarChain], floated: list[str]) -> Skip | None:
+def skip(engine: str, held: PlanarHeld) -> Skip | None:
     """The report's entry for an engine holding planar joints another way (never a silent pass)."""
+    chains, floated = held.chains, held.floated
     if chains:
         shown = "; ".join(f"{c.joint} as {', '.join(c.joints)}" for c in chains)
         return Skip(1, engine, f"approximation: the MJCF writer writes {len(chains)} planar joint(s) as two "
