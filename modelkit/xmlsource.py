@@ -13,6 +13,7 @@ lxml parses; this module adds what the readers need on top of it:
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from array import array
 from bisect import bisect_right
@@ -411,29 +412,15 @@ _TAIL_TAG = re.compile(rb"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<(/?)[^\s<>/!
 _TAIL_BLANK = b" \t\r\n"
 
 
-def _blank_markup_after_root(data: bytes, line: int, col: int, urdfdom: bool) -> bytes | None:
-    """TinyXML2 reads the root element and then the nodes after it, keeping none: whole elements,
-    comments and processing instructions, up to a stray end tag of any name (PyFlyt's rocket ends with
-    ``</robot>`` twice), where it stops and ignores the rest of the file. libxml2 stops at the first
-    (``line``, ``col``: its position, in characters). That tail becomes spaces, so every offset stays.
-    None (the error stands) when text outside any element comes before such an end tag (MuJoCo,
-    libsdformat and PyBullet refuse it) or markup is not whole; for a URDF (``urdfdom``) also when
-    urdfdom's TinyXML refuses the tail (:func:`_tinyxml1_reads`)."""
+def _blank_tail(data: bytes, line: int, col: int, reads: Callable[[bytes], bool]) -> bytes | None:
+    """``data`` with what follows the root element blanked, when the parser behind ``reads`` reads that
+    tail (``_tinyxml2_reads``, ``_tinyxml1_reads``). libxml2 stops at its first node (``line``,
+    ``col``: its position, in characters). The tail becomes spaces, so every offset stays. None (the
+    error stands) when it cannot be placed or the parser refuses it."""
     start = _tail_start(data, line, col)
-    if start is None or not _tinyxml2_reads(data[start:]) or (urdfdom and not _tinyxml1_reads(data[start:])):
+    if start is None or not reads(data[start:]):
         return None
-    return _blanked(data, start)
-
-
-def _blank_text_after_root(data: bytes, line: int, col: int, urdfdom: bool) -> bytes | None:
-    """A URDF's tail that urdfdom's TinyXML (1) reads and TinyXML2 refuses: TinyXML reads the markup
-    after the root element as TinyXML2 does, stray end tags included, and stops quietly at the first
-    text outside any element, ignoring the rest of the file whatever it holds (check_urdf accepts
-    ``</robot>`` then ``garbage <b>``). That tail becomes spaces too."""
-    start = _tail_start(data, line, col)
-    if not urdfdom or start is None or not _tinyxml1_reads(data[start:]):
-        return None
-    return _blanked(data, start)
+    return data[:start] + bytes(b if b in b"\r\n" else 32 for b in data[start:])
 
 
 def _tail_start(data: bytes, line: int, col: int) -> int | None:
@@ -448,10 +435,6 @@ def _tail_start(data: bytes, line: int, col: int) -> int | None:
     except UnicodeDecodeError:
         return None
     return sum(len(lines[k]) + 1 for k in range(line - 1)) + len(before)
-
-
-def _blanked(data: bytes, start: int) -> bytes:
-    return data[:start] + bytes(b if b in b"\r\n" else 32 for b in data[start:])
 
 
 def _tinyxml2_reads(tail: bytes) -> bool:
@@ -558,48 +541,50 @@ def _declared_version(text: str) -> str:
 class _Leniency:
     """Something libxml2 refuses that TinyXML2 reads past: how to read past it, and what to say."""
 
-    # (data, libxml2's line and column, whether the document is a URDF: urdfdom reads it)
-    repair: Callable[[bytes, tuple[int, int], bool], bytes | None]
+    repair: Callable[[bytes, tuple[int, int]], bytes | None]  # (data, libxml2's line and column)
     say: Callable[[str], str]  # the document's text → the warning
     hint: str
     at_declaration: bool  # located at the XML declaration (else where libxml2 stopped)
     code: str = "MK020"
 
 
+_AFTER_ROOT = "Extra content at the end of the document"  # libxml2's complaint about a tail after the root
 _DECLARATION_HINT = 'start the file with <?xml version="1.0"?> or leave the declaration out'
 #: libxml2's complaint → how TinyXML2 reads past it.
 _TINYXML2_LENIENCY = {
     "hyphen within comment": _Leniency(
-        lambda data, _, __: _blank_comment_hyphens(data),
+        lambda data, _: _blank_comment_hyphens(data),
         lambda text: 'a comment contains "--", which XML forbids: libsdformat, urdfdom and MuJoCo (TinyXML2) '
         "accept it, strict XML tools (xacro, lxml, ROS launch) refuse it",
         'write "- -" or "-" inside comments',
         at_declaration=False,
     ),
     "Unsupported version": _Leniency(
-        lambda data, _, __: _blank_declaration(data),
+        lambda data, _: _blank_declaration(data),
         lambda text: f'the XML declaration names version "{_declared_version(text)}", not 1.0; {_TINYXML2} '
         "ignore it, strict XML tools (lxml, so urdf_parser_py and yourdfpy) refuse it",
         _DECLARATION_HINT,
         at_declaration=True,
     ),
     "XML declaration allowed only at the start": _Leniency(
-        lambda data, _, __: _blank_declaration(data),
+        lambda data, _: _blank_declaration(data),
         lambda text: f"the XML declaration is not at the start of the file; {_TINYXML2} ignore it, strict "
         "XML tools (lxml, so urdf_parser_py and yourdfpy, and xacro) refuse it",
         _DECLARATION_HINT,
         at_declaration=True,
     ),
     "attributes construct error": _Leniency(
-        lambda data, _, __: _space_between_attributes(data),
+        lambda data, _: _space_between_attributes(data),
         lambda text: "an attribute follows the previous attribute's closing quote without a space between "
         f"them, which XML requires: {_TINYXML2} read it, strict XML tools (lxml, so urdf_parser_py and "
         "yourdfpy, and xacro) refuse the file",
         "put a space between the attributes",
         at_declaration=False,
     ),
-    "Extra content at the end of the document": _Leniency(
-        lambda data, at, urdfdom: _blank_markup_after_root(data, *at, urdfdom),
+    _AFTER_ROOT: _Leniency(
+        # TinyXML2 reads whole elements, comments and processing instructions after the root, up to a
+        # stray end tag of any name (PyFlyt's rocket ends with `</robot>` twice), where it stops
+        lambda data, at: _blank_tail(data, *at, _tinyxml2_reads),
         lambda text: "the document goes on after its root element ends (an end tag, element, comment or "
         f"processing instruction): {_TINYXML2} read the root element and ignore the rest, strict XML tools "
         "(lxml, so urdf_parser_py and yourdfpy, and xacro) refuse the file",
@@ -607,17 +592,22 @@ _TINYXML2_LENIENCY = {
         at_declaration=False,
     ),
 }
-#: What urdfdom (TinyXML 1) reads past beyond TinyXML2: a URDF's own loader accepts it, PyBullet refuses
-#: it and MuJoCo nearly always (MK027 is an error under ``validate --target mjcf`` and ``pybullet``).
+#: A URDF's own loader is urdfdom (TinyXML 1): what follows its root element is read past when both
+#: parsers read it (MK020), or when urdfdom alone does (MK027: it stops quietly at text outside any
+#: element; PyBullet refuses it and MuJoCo nearly always, so it is an error under their targets).
 _URDFDOM_LENIENCY = {
-    "Extra content at the end of the document": _Leniency(
-        lambda data, at, urdfdom: _blank_text_after_root(data, *at, urdfdom),
-        lambda text: "text follows the root element's end: urdfdom (TinyXML) reads the root element and "
-        "ignores the rest of the file; PyBullet (TinyXML2) refuses the file (XML_ERROR_PARSING_TEXT), so do "
-        "MuJoCo for all but a few such tails and strict XML tools (lxml, so xacro)",
-        "delete everything after the root element's end tag",
-        at_declaration=False,
-        code="MK027",
+    _AFTER_ROOT: (
+        dataclasses.replace(_TINYXML2_LENIENCY[_AFTER_ROOT], repair=lambda data, at: _blank_tail(
+            data, *at, lambda tail: _tinyxml2_reads(tail) and _tinyxml1_reads(tail))),
+        _Leniency(
+            lambda data, at: _blank_tail(data, *at, _tinyxml1_reads),
+            lambda text: "text follows the root element's end: urdfdom (TinyXML) reads the root element and "
+            "ignores the rest of the file; PyBullet (TinyXML2) refuses the file (XML_ERROR_PARSING_TEXT), so "
+            "do MuJoCo for all but a few such tails and strict XML tools (lxml, so xacro)",
+            "delete everything after the root element's end tag",
+            at_declaration=False,
+            code="MK027",
+        ),
     ),
 }
 
@@ -641,11 +631,12 @@ def _as_tinyxml2_reads(
         if problem is None:
             break
         applied.add(problem)
-        leniency = _TINYXML2_LENIENCY[problem]
-        repaired = leniency.repair(data, (where.line or 0, where.col or 0), urdfdom)
-        if repaired is None and problem in _URDFDOM_LENIENCY:
-            leniency = _URDFDOM_LENIENCY[problem]
-            repaired = leniency.repair(data, (where.line or 0, where.col or 0), urdfdom)
+        repaired = None
+        candidates = _URDFDOM_LENIENCY.get(problem) if urdfdom else None
+        for leniency in candidates or (_TINYXML2_LENIENCY[problem],):
+            repaired = leniency.repair(data, (where.line or 0, where.col or 0))
+            if repaired is not None:
+                break
         if repaired is None:
             break
         if leniency.at_declaration:
