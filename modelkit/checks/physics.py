@@ -20,7 +20,7 @@ DEFAULTS_HINT = {
 }
 
 
-def _moving_links(robot: Robot) -> set[str]:
+def moving_links(robot: Robot) -> set[str]:
     """Links that move relative to the world: below a moving joint, or the floating root."""
     moving: set[str] = set()
     if robot.root is not None and robot.root_joint is JointType.FLOATING:
@@ -63,7 +63,7 @@ def mass(robot: Robot) -> Iterator[Diagnostic]:
     """Masses are positive where it matters; default mass properties are flagged."""
     if robot.masses_unknown:
         return  # e.g. MuJoCo could not compile the file: masses it would infer from geoms are unknown
-    moving = _moving_links(robot)
+    moving = moving_links(robot)
     merged = _merged_masses(robot)
     carried: dict[str, float] | None = None  # subtree masses, computed when first needed
     for link in robot.links:
@@ -207,7 +207,7 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
     ``.body``), links joined by fixed joints are judged as the one rigid body engines merge them into:
     a point mass on a sensor frame or a tool flange welded to an arm is not a finding.
     """
-    moving = _moving_links(robot)
+    moving = moving_links(robot)
     if robot.root is not None and robot.root_joint is None:
         # A root the format leaves open (a URDF root other than "world") floats in PyBullet and Gazebo
         # unless the loader is told to fix it: its inertia matters.

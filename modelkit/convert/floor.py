@@ -12,6 +12,7 @@ what is fixed to it) is left out: MuJoCo, PyBullet and Gazebo collide no static 
 
 from __future__ import annotations
 
+from modelkit.checks.physics import moving_links
 from modelkit.convert.notes import NoteSink
 from modelkit.convert.numbers import fmt
 from modelkit.convert.registry import TargetInfo
@@ -29,7 +30,7 @@ def note_below_floor(robot: Robot, target: TargetInfo, notes: NoteSink) -> None:
 
     if robot.root is None or robot.root_joint is JointType.FLOATING:
         return
-    moving = _moved_links(robot)
+    moving = moving_links(robot)  # the root is welded: the links below a moving joint
     if not moving:
         return
     start = "" if target.spawn else "home "  # a target that stands a robot itself has the `home` key
@@ -52,16 +53,3 @@ def note_below_floor(robot: Robot, target: TargetInfo, notes: NoteSink) -> None:
         "model",
     )
 
-
-def _moved_links(robot: Robot) -> set[str]:
-    """The links below at least one moving joint (the others are welded to the root)."""
-    children = robot.children_of()
-    moved: set[str] = set()
-    stack = [(joint, False) for joint in children.get(robot.root or "", [])]
-    while stack:
-        joint, below_moving = stack.pop()
-        moving = below_moving or joint.type.moves
-        if moving:
-            moved.add(joint.child)
-        stack.extend((below, moving) for below in children.get(joint.child, []))
-    return moved

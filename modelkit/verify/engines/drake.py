@@ -319,7 +319,10 @@ class DrakeModel:
         origin ("not supported by MultibodyPlant. Leaving ... as a free body"), the joint's origin
         unread. Each such body is set, as a user sets a free body's initial pose, where the file puts
         it: its parent's pose at the default positions composed with the joint's origin."""
-        plant, placed = self.plant, []
+        plant = self.plant
+        placed: list[str] = []
+        if not plant.GetFloatingBaseBodies():  # the root is welded: only a floating joint leaves one
+            return placed
         for joint in etree.parse(str(self.path)).iterfind("./joint[@type='floating']"):
             parent, child = joint.find("parent"), joint.find("child")
             if parent is None or child is None:
