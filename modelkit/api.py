@@ -9,7 +9,7 @@ from modelkit.checks import run_rules
 from modelkit.diagnostics import Diagnostic, Severity, sorted_diagnostics
 from modelkit.formats import read_model
 from modelkit.formats.common import ReadOptions
-from modelkit.formats.meshref import VISUAL_ONLY, collision_mesh_problem
+from modelkit.formats.meshref import VISUAL_ONLY, collision_mesh_problem, found_above_refused_by_mujoco
 from modelkit.model import Robot
 from modelkit.textio import OpenedFile
 
@@ -104,7 +104,7 @@ def _mesh_refused(d: Diagnostic, target: str) -> bool:
     is not found (it refuses the file; MuJoCo's import discards visuals)."""
     if target not in ("mjcf", "pybullet"):
         return False
-    if collision_mesh_problem(d):
+    if collision_mesh_problem(d) or (target == "mjcf" and found_above_refused_by_mujoco(d)):
         return True
     return target == "pybullet" and d.code in ("MK500", "MK504") and d.message.endswith(VISUAL_ONLY)
 

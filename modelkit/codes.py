@@ -1013,7 +1013,10 @@ _TABLE: tuple[CodeInfo, ...] = (
         "error",
         "A resource file does not exist (a warning when the mesh is visual-only). A warning also when an "
         "absolute path does not exist but the same path under the model's folder does: PyBullet reads it "
-        "there, Gazebo and other tools do not. In URDF, xacro and SDF, whose own loaders (check_urdf, "
+        "there, Gazebo and other tools do not. A warning too when a URDF or SDF mesh's relative path is not "
+        "beside the model but is under a folder above it: PyBullet looks there and reads it, and so does "
+        "modelkit; MuJoCo does not (an error for `--target mjcf` when it is a collision mesh). In URDF, "
+        "xacro and SDF, whose own loaders (check_urdf, "
         "libsdformat) never open meshes, a collision mesh's MK500, MK501, MK502, MK504 or MK506 is a "
         "warning that says MuJoCo and PyBullet refuse the file: an error for `--target mjcf` and "
         "`--target pybullet` (which also refuses a missing visual mesh), and `convert` exits 1.",

@@ -16,7 +16,9 @@ Search order for ``package://NAME/REL`` (see docs/resources.md):
 ``IGN_GAZEBO_RESOURCE_PATH``, ``SDF_PATH`` and ``GAZEBO_MODEL_PATH`` (:data:`MODEL_PATH_VARIABLES`); an SDF
 ``<include>`` looks a bare name or a relative path up there too when it is not beside the file.
 ``file://`` and plain paths are relative to the referring file's folder. An absolute path that does not
-exist, but does under the model's folder, is read there, as PyBullet reads it (a warning, MK500).
+exist, but does under the model's folder, is read there, as PyBullet reads it (a warning, MK500). A plain
+relative mesh path of a URDF or SDF file that is not beside the model is looked up in the folders above
+it, as PyBullet looks (:func:`in_folder_or_above`, used by :mod:`modelkit.formats.meshref`; MK500).
 """
 
 from __future__ import annotations
@@ -102,7 +104,7 @@ class Resolver:
         package, _, relative = rest.partition("/")
         root = self.find_package(package, model_file.parent)
         # PyBullet strips the scheme and looks the rest up beside the file: ``package://wheel.obj`` too.
-        beside = _without_package(model_file.parent, rest) if root is None else None
+        beside = in_folder_or_above(model_file.parent, rest) if root is None else None
         if beside is not None:
             if relative:
                 what = f'package "{package}" of "{uri}" cannot be found on the package paths'
@@ -221,11 +223,13 @@ def _absolute(uri: str, path: Path, base_dir: Path) -> Resolution:
     return Resolution(uri, written, "")
 
 
-def _without_package(folder: Path, rest: str) -> Path | None:
-    """``NAME/REL`` in the model's folder or the first folder above it that has the file, or None."""
+def in_folder_or_above(folder: Path, relative: str) -> Path | None:
+    """``relative`` in ``folder`` or the first folder above it that has the file, or None: how PyBullet
+    looks up a mesh it does not find beside the model (``package://NAME/REL`` with the scheme dropped, or
+    a plain relative path), from the model's folder up to the file system's root."""
     start = Path(os.path.realpath(folder))  # never raises on a symlink loop
     for candidate in (start, *start.parents):
-        path = _normal(candidate / rest)
+        path = _normal(candidate / relative)
         if path.is_file():
             return path
     return None

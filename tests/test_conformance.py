@@ -593,6 +593,51 @@ def test_absolute_path_found_under_the_model_folder_as_pybullet_looks(tmp_path: 
     _missing_collision_mesh(path, "MK500")
 
 
+@pytest.mark.parametrize("depth", [1, 2])
+def test_relative_mesh_path_found_above_the_model_folder_as_pybullet_looks(tmp_path: Path,
+                                                                          depth: int) -> None:
+    """``meshes/m.stl`` written in ``robot/urdf/r.urdf`` for ``robot/meshes/m.stl`` (differentiable-robot-
+    model's Panda and iiwa): PyBullet tries the path under every folder above the model's and loads it;
+    MuJoCo's URDF import does not, and refuses it. modelkit reads the mesh PyBullet reads, warns
+    (MK500, with the path to write), and makes it an error for ``--target mjcf`` only when it is a
+    collision mesh; ``convert`` copies it and the written MJCF loads."""
+    robot = tmp_path / "robot"
+    (robot / "meshes").mkdir(parents=True)
+    trimesh = pytest.importorskip("trimesh")
+    trimesh.creation.box((0.1, 0.1, 0.1)).export(robot / "meshes" / "m.stl")
+    folder = robot.joinpath(*["urdf"] * depth)
+    folder.mkdir(parents=True)
+    path = folder / "r.urdf"
+    shapes = '<geometry><mesh filename="meshes/m.stl"/></geometry>'
+    path.write_text(_urdf(_part(f"<visual>{shapes}</visual><collision>{shapes}</collision>")))
+    assert check_urdf_accepts(path)[0]
+    with pytest.raises(ValueError, match=r"meshes/m\.stl"):
+        mujoco.MjModel.from_xml_path(str(path))
+    command = [sys.executable, "-c", _PYBULLET_LOADS, str(path)]
+    loads = subprocess.run(command, capture_output=True, timeout=60)
+    assert loads.returncode == 0, loads.stderr[-400:]
+    v = validate(path)
+    assert v.errors == []
+    said = [d for d in v.diagnostics if d.code == "MK500"]
+    written = "../" * depth + "meshes/m.stl"
+    assert len(said) == 2 and all(d.severity.value == "warning" and f'reads "{written}"' in d.message
+                                  and written in (d.hint or "") for d in said), said
+    assert ["visual mesh" in d.message for d in said] == [True, False]
+    meshes = [g.geometry for link in v.robots[0].links for g in [*link.visuals, *link.collisions]]
+    assert [m.path for m in meshes if isinstance(m, Mesh)] == [str(robot / "meshes" / "m.stl")] * 2
+    assert validate(path, target="pybullet").errors == []
+    (refused,) = validate(path, target="mjcf").errors
+    assert refused.code == "MK500" and "visual mesh" not in refused.message
+    from modelkit.convert.api import write
+
+    write(v.robots[0], tmp_path / "out" / "r.xml", force=True)
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / "out" / "r.xml"))
+    assert model.nmesh == 1 and model.ngeom == 2
+    path.write_text(_urdf(_part(f"<collision>{shapes}</collision>")))
+    (robot / "meshes" / "m.stl").unlink()
+    _missing_collision_mesh(path, "MK500")  # found nowhere: PyBullet refuses it too
+
+
 _TRIANGLE_URDF = """<?xml version="1.0"?>
 <robot name="r">
   <link name="base"/>

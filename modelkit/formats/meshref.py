@@ -16,7 +16,7 @@ from pathlib import Path
 from modelkit import rot3
 from modelkit.diagnostics import Diagnostic, DiagnosticSink, Severity, SourceLocation
 from modelkit.model import Mesh
-from modelkit.resources import Resolution, Resolver, found_report
+from modelkit.resources import Resolution, Resolver, found_report, in_folder_or_above
 from modelkit.textio import UnreadableFile, check_regular
 
 # what modelkit.geometry.meshfiles.load_mesh reads (its SUPPORTED_EXTENSIONS; a test keeps them equal,
@@ -26,6 +26,11 @@ MESH_FILE_EXTENSIONS = frozenset({".stl", ".obj", ".dae", ".wrl", ".glb", ".gltf
 MESH_PROBLEM_CODES = frozenset({"MK500", "MK501", "MK502", "MK504", "MK506"})
 COLLISION_MARK = " (a collision mesh: "
 VISUAL_ONLY = " (visual only)"
+# A mesh found only by PyBullet's walk up the folders (:meth:`MeshChecker.found_above`): PyBullet loads
+# the file, MuJoCo's URDF import does not find the collision mesh.
+FOUND_ABOVE = "PyBullet looks in the folders above the model's and reads "
+COLLISION_FOUND_ABOVE = "; MuJoCo, Gazebo and ROS tools do not look there, so MuJoCo refuses the file"
+VISUAL_FOUND_ABOVE = "; MuJoCo, Gazebo and ROS tools do not look there (a visual mesh)"
 
 
 def collision_mesh_problem(d: Diagnostic) -> bool:
@@ -34,6 +39,11 @@ def collision_mesh_problem(d: Diagnostic) -> bool:
     and PyBullet refuse it, so it is an error for ``--target mjcf`` and ``--target pybullet``, and
     ``convert`` exits 1 (the written robot has no collision there)."""
     return d.code in MESH_PROBLEM_CODES and COLLISION_MARK in d.message
+
+
+def found_above_refused_by_mujoco(d: Diagnostic) -> bool:
+    """A collision mesh that only PyBullet's folder walk finds: MuJoCo's URDF import refuses the file."""
+    return d.code == "MK500" and FOUND_ABOVE in d.message and COLLISION_FOUND_ABOVE in d.message
 
 
 def _symlink_loop(path: Path) -> bool:
@@ -119,6 +129,17 @@ class MeshChecker:
             usage = (f"{COLLISION_MARK}{self.unopened_by} never opens meshes and accepts the file; MuJoCo "
                      "and PyBullet refuse it)")
         path = resolution.path
+        above = self.found_above(uri, resolution)
+        if above is not None:
+            self.sink.emit(
+                "MK500",
+                f'resource "{uri}" not found at {path}; {FOUND_ABOVE}"{self._relative(above)}", as modelkit '
+                "does" + (VISUAL_FOUND_ABOVE if visual_only else COLLISION_FOUND_ABOVE),
+                loc,
+                hint=f'write the path relative to the model file: "{self._relative(above)}"',
+                severity=Severity.WARNING,
+            )
+            path = above
         if resolution.scheme in ("http", "https"):
             self._web_mesh(uri, loc)
         elif resolution.code is not None:
@@ -159,6 +180,23 @@ class MeshChecker:
             fragment=submesh,
             scale=rot3.vec3(scale),
         )
+
+    def found_above(self, uri: str, resolution: Resolution) -> Path | None:
+        """A plain relative path that is not beside the model, found as PyBullet finds it: the same path
+        under the first folder above the model's that has it (``meshes/link0.stl`` of a URDF in
+        ``robot/urdf/`` read from ``robot/meshes/link0.stl``; differentiable-robot-model's Panda and
+        iiwa). None when the path is found, is absolute, has a scheme or there is no model file."""
+        text = uri.strip()
+        path = resolution.path
+        if (resolution.code is not None or resolution.scheme or path is None or self.model_file is None
+                or text.startswith("${") or Path(text).is_absolute() or path.exists()):
+            return None
+        folder = Path(os.path.realpath(self.model_file.parent))
+        return in_folder_or_above(folder.parent, text) if folder.parent != folder else None
+
+    def _relative(self, path: Path) -> str:
+        folder = self.model_file.parent if self.model_file is not None else self.base_dir
+        return Path(os.path.relpath(path, os.path.realpath(folder))).as_posix()
 
     def _web_mesh(self, uri: str, loc: SourceLocation) -> None:
         """MK503 for a mesh on a web server: the format's loader never opens meshes, so it accepts it."""
