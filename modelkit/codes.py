@@ -134,8 +134,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK027",
         "xml-text-after-root",
         "warning",
-        "Text follows a URDF's root element: urdfdom reads the root and ignores the rest; PyBullet refuses "
-        "the file, MuJoCo nearly always (an error under `--target mjcf` and `pybullet`).",
+        "Text, or a comment never closed, follows a URDF's root element: urdfdom reads the root and ignores "
+        "the rest; PyBullet refuses the file, MuJoCo nearly always (an error under `--target mjcf` and "
+        "`pybullet`).",
     ),
     # -- MK1xx: schema and header ----------------------------------------------------------
     # MK100-MK119: .body schema and header; MK120-MK129: XML elements and attributes (all XML

@@ -262,6 +262,10 @@ def _index_positions(doc: XmlDocument) -> None:
     doc._line_offsets.extend(m.end() for m in re.finditer(r"\n", text))
     starts = [m.start() for m in _START_TAG.finditer(mask_markup(text))]
     elements = [e for e in doc.root.iter() if isinstance(e.tag, str)]
+    if len(elements) < len(starts) and elements and (
+        doc._position(starts[len(elements) - 1])[0] == elements[-1].sourceline
+    ):  # the extra ones follow the root (a tail read past, MK020/MK027): no element of the tree
+        del starts[len(elements):]
     if len(starts) != len(elements):  # cannot pair them safely: fall back to lxml's lines
         return
     doc._starts = dict(zip(elements, starts, strict=True))
@@ -437,6 +441,21 @@ def _tail_start(data: bytes, line: int, col: int) -> int | None:
     return sum(len(lines[k]) + 1 for k in range(line - 1)) + len(before)
 
 
+def _blank_open_comment(data: bytes) -> bytes | None:
+    """``data`` with a comment that is never closed blanked to the end, when it follows a whole root
+    element (what is before it parses alone); None otherwise (inside the root it is an error for
+    urdfdom too: the root's end tag is missing)."""
+    start = data.rfind(b"<!--")
+    if start < 0 or b"-->" in data[start + 4 :]:
+        return None
+    try:
+        parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False)
+        etree.fromstring(data[:start], parser)
+    except (etree.XMLSyntaxError, ValueError):
+        return None
+    return data[:start] + bytes(b if b in b"\r\n" else 32 for b in data[start:])
+
+
 def _tinyxml2_reads(tail: bytes) -> bool:
     """TinyXML2 reads ``tail`` (after the root element): blanks, comments, processing instructions and
     whole elements, up to the end or to a stray end tag, where it stops (MuJoCo and PyBullet then load
@@ -447,11 +466,12 @@ def _tinyxml2_reads(tail: bytes) -> bool:
 def _tinyxml1_reads(tail: bytes) -> bool:
     """urdfdom's TinyXML (1) reads ``tail``: blanks, comments, processing instructions, stray end tags
     and whole elements, up to the end or to text outside any element, where it stops (check_urdf loads
-    ``</robot>`` then ``garbage <b>``, and refuses ``</robot>`` then ``</x> <b>``)."""
-    return _scan_tail(tail, end_tag_stops=False, text_stops=True)
+    ``</robot>`` then ``garbage <b>``, and refuses ``</robot>`` then ``</x> <b>``), or to a comment that
+    is never closed, which it reads to the end of the file without an error."""
+    return _scan_tail(tail, end_tag_stops=False, text_stops=True, open_comment_ends=True)
 
 
-def _scan_tail(tail: bytes, end_tag_stops: bool, text_stops: bool) -> bool:
+def _scan_tail(tail: bytes, end_tag_stops: bool, text_stops: bool, open_comment_ends: bool = False) -> bool:
     at = 0
     while True:
         while at < len(tail) and tail[at] in _TAIL_BLANK:
@@ -472,6 +492,8 @@ def _scan_tail(tail: bytes, end_tag_stops: bool, text_stops: bool) -> bool:
                 at = found.end()
                 break
         else:
+            if open_comment_ends and tail.startswith(b"<!--", at):
+                return True  # never closed (a closed one matched _COMMENT)
             end = _element_end(tail, at)
             if end is None:
                 return False
@@ -544,8 +566,15 @@ class _Leniency:
     repair: Callable[[bytes, tuple[int, int]], bytes | None]  # (data, libxml2's line and column)
     say: Callable[[str], str]  # the document's text → the warning
     hint: str
-    at_declaration: bool  # located at the XML declaration (else where libxml2 stopped)
+    # where to place the warning (a byte offset in the data before the repair); None: where libxml2 stopped
+    locate: Callable[[bytes], int] | None
     code: str = "MK020"
+
+
+def _declaration_at(data: bytes) -> int:
+    """The offset of the XML declaration's version (0 without a declaration)."""
+    declaration = _DECLARATION.match(data)
+    return declaration.start(3) if declaration else 0
 
 
 _AFTER_ROOT = "Extra content at the end of the document"  # libxml2's complaint about a tail after the root
@@ -557,21 +586,21 @@ _TINYXML2_LENIENCY = {
         lambda text: 'a comment contains "--", which XML forbids: libsdformat, urdfdom and MuJoCo (TinyXML2) '
         "accept it, strict XML tools (xacro, lxml, ROS launch) refuse it",
         'write "- -" or "-" inside comments',
-        at_declaration=False,
+        locate=None,
     ),
     "Unsupported version": _Leniency(
         lambda data, _: _blank_declaration(data),
         lambda text: f'the XML declaration names version "{_declared_version(text)}", not 1.0; {_TINYXML2} '
         "ignore it, strict XML tools (lxml, so urdf_parser_py and yourdfpy) refuse it",
         _DECLARATION_HINT,
-        at_declaration=True,
+        locate=_declaration_at,
     ),
     "XML declaration allowed only at the start": _Leniency(
         lambda data, _: _blank_declaration(data),
         lambda text: f"the XML declaration is not at the start of the file; {_TINYXML2} ignore it, strict "
         "XML tools (lxml, so urdf_parser_py and yourdfpy, and xacro) refuse it",
         _DECLARATION_HINT,
-        at_declaration=True,
+        locate=_declaration_at,
     ),
     "attributes construct error": _Leniency(
         lambda data, _: _space_between_attributes(data),
@@ -579,7 +608,7 @@ _TINYXML2_LENIENCY = {
         f"them, which XML requires: {_TINYXML2} read it, strict XML tools (lxml, so urdf_parser_py and "
         "yourdfpy, and xacro) refuse the file",
         "put a space between the attributes",
-        at_declaration=False,
+        locate=None,
     ),
     _AFTER_ROOT: _Leniency(
         # TinyXML2 reads whole elements, comments and processing instructions after the root, up to a
@@ -589,7 +618,7 @@ _TINYXML2_LENIENCY = {
         f"processing instruction): {_TINYXML2} read the root element and ignore the rest, strict XML tools "
         "(lxml, so urdf_parser_py and yourdfpy, and xacro) refuse the file",
         "delete everything after the root element's end tag",
-        at_declaration=False,
+        locate=None,
     ),
 }
 #: A URDF's own loader is urdfdom (TinyXML 1): what follows its root element is read past when both
@@ -601,11 +630,23 @@ _URDFDOM_LENIENCY = {
             data, *at, lambda tail: _tinyxml2_reads(tail) and _tinyxml1_reads(tail))),
         _Leniency(
             lambda data, at: _blank_tail(data, *at, _tinyxml1_reads),
-            lambda text: "text follows the root element's end: urdfdom (TinyXML) reads the root element and "
-            "ignores the rest of the file; PyBullet (TinyXML2) refuses the file (XML_ERROR_PARSING_TEXT), so "
-            "do MuJoCo for all but a few such tails and strict XML tools (lxml, so xacro)",
+            lambda text: "text, or a comment never closed, follows the root element's end: urdfdom (TinyXML) "
+            "reads the root element and ignores the rest of the file; PyBullet (TinyXML2) refuses the file "
+            "(XML_ERROR_PARSING_TEXT or _COMMENT), so do MuJoCo for all but a few such tails and strict XML "
+            "tools (lxml, so xacro)",
             "delete everything after the root element's end tag",
-            at_declaration=False,
+            locate=None,
+            code="MK027",
+        ),
+    ),
+    "Comment not terminated": (
+        _Leniency(
+            lambda data, _: _blank_open_comment(data),
+            lambda text: "a comment after the root element is never closed: urdfdom (TinyXML) reads the root "
+            "element and ignores the rest of the file; PyBullet and MuJoCo (TinyXML2: "
+            "XML_ERROR_PARSING_COMMENT) and strict XML tools (lxml, so xacro) refuse the file",
+            'close the comment with "-->" or delete it',
+            locate=lambda data: data.rfind(b"<!--"),
             code="MK027",
         ),
     ),
@@ -627,7 +668,8 @@ def _as_tinyxml2_reads(
     TinyXML accepts (a URDF's own loader). The error (MK020) when that fails."""
     applied: set[str] = set()
     while not data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        problem = next((p for p in _TINYXML2_LENIENCY if p in message and p not in applied), None)
+        known = (*_TINYXML2_LENIENCY, *(_URDFDOM_LENIENCY if urdfdom else ()))
+        problem = next((p for p in known if p in message and p not in applied), None)
         if problem is None:
             break
         applied.add(problem)
@@ -639,9 +681,8 @@ def _as_tinyxml2_reads(
                 break
         if repaired is None:
             break
-        if leniency.at_declaration:
-            declaration = _DECLARATION.match(data)
-            at = declaration.start(3) if declaration else 0
+        if leniency.locate is not None:
+            at = leniency.locate(data)
             where = location_at(text, display, len(data[:at].decode("utf-8", "replace")))
         sink.emit(leniency.code, leniency.say(text), where, hint=leniency.hint, severity=Severity.WARNING)
         data = repaired

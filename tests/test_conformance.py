@@ -442,6 +442,8 @@ _TEXT_AFTER_ROOT = {
     "text with markup characters": "\na < b & c\n",
     "a comment then text": "\n<!-- c --> &amp; x\n",
     "text then an open element": "\ntext <b>\n",
+    "a comment never closed": "\n<!-- never closed\n",
+    "an element then a comment never closed": "\n<x/>\n<!-- never closed",
 }
 
 
@@ -458,15 +460,27 @@ def test_text_after_a_urdf_root_is_mk027_as_urdfdom_reads_it(tmp_path: Path, tai
     (d,) = [d for d in v.diagnostics if d.code in ("MK020", "MK027")]
     assert d.code == "MK027" and d.severity.value == "warning" and "urdfdom" in d.message
     assert d.location is not None and d.location.line == _TRIANGLE_URDF.rstrip("\n").count("\n") + 2
+    clean = tmp_path / "clean.urdf"
+    clean.write_text(_TRIANGLE_URDF)
+    located = [(d.code, d.location.line, d.location.col) for d in validate(clean).diagnostics if d.location]
+    assert [(d.code, d.location.line, d.location.col) for d in v.diagnostics
+            if d.location and d.code != "MK027"] == located  # every element where it is, columns too
     with pytest.raises(ValueError, match="XML parse error"):
         mujoco.MjModel.from_xml_path(str(path))
     assert_pybullet_refuses(path)
-    clean = tmp_path / "clean.urdf"
-    clean.write_text(_TRIANGLE_URDF)
     for target in ("mjcf", "pybullet"):  # the clean file's errors (MK303) and MK027
         before = sorted(d.code for d in validate(clean, target=target).errors)
         assert sorted(d.code for d in validate(path, target=target).errors) == sorted([*before, "MK027"])
     assert validate(path, target="urdf").errors == []
+
+
+def test_a_comment_never_closed_inside_a_urdf_root_stays_an_error(tmp_path: Path) -> None:
+    """urdfdom's TinyXML reads a comment never closed to the end of the file: inside the root element
+    its end tag is then missing, and check_urdf refuses the file, as validate does."""
+    path = tmp_path / "m.urdf"
+    path.write_text(_TRIANGLE_URDF.replace("</robot>", "<!-- never closed\n</robot>"))
+    assert not check_urdf_accepts(path)[0]
+    assert [d.code for d in validate(path).diagnostics if d.code in ("MK020", "MK027")] == ["MK020"]
 
 
 @pytest.mark.parametrize("tail", ["\n<b> text\n", "\n</x> <b>\n"])
