@@ -297,6 +297,24 @@ def test_a_biped_rooted_at_its_torso_stands_on_legs_below_a_waist(tmp_path: Path
     robot = validate(path).robot
     assert robot is not None and decide(robot).kind is JointType.FIXED
 
+@pytest.mark.parametrize(("segment", "kind"), [("finger", JointType.FIXED), ("leg", JointType.FLOATING)])
+def test_limbs_resting_on_fingertips_are_a_hand_not_legs(tmp_path: Path, segment: str,
+                                                          kind: JointType) -> None:
+    """TriFinger (differentiable-robot-model's ``trifinger_edu.urdf``): three fingers hang from its frame
+    to the table's level at q = 0, and the URDF leaves the root open; the same tree with its links named
+    as legs is a tripod, and floats."""
+    limbs = [joint for k, (x, y) in enumerate(((0.1, 0.0), (-0.05, 0.09), (-0.05, -0.09)))
+             for joint in _limb("frame", [f"{segment}_{part}_{k}" for part in ("upper", "middle", "tip")],
+                                f"{x} {y} -0.05", "0 0 -0.16")]
+    path = tmp_path / "platform.urdf"
+    path.write_text(_tree_urdf("frame", limbs))
+    robot = validate(path).robot
+    assert robot is not None
+    decision = decide(robot)
+    assert decision.kind is kind, decision.reason
+    assert ("named as fingers" in decision.reason) is (segment == "finger"), decision.reason
+
+
 def test_an_upper_body_whose_arms_hang_below_its_pelvis_stays_welded() -> None:
     """Alex (example-robot-data): its arms part after three spine joints, at shoulders 0.43 m above the
     pelvis (the root), and reach lower than the pelvis: hands, not feet."""

@@ -21,7 +21,9 @@ with a fixed joint, or no ``world`` link; .body: ``jointType: fixed|free``).
   - legs: at least two branches whose shapes touch the lowest level through two or more moving
     joints each, parting from each other with at least two moving joints on each side (two legs from
     the root; or from a waist, each then with at least as many joints as the waist and starting below
-    the root's frame): floating;
+    the root's frame): floating; unless every such branch ends in a link named as a finger
+    (``finger``, ``thumb``): a hand or a platform resting on its fingertips (TriFinger, whose
+    fingers hang from its frame to the table's level at q = 0) is welded;
   - legs that do not reach the ground at q = 0 (folded or sideways, as some quadrupeds are modelled):
     four or more limbs of two or more moving joints in a row hanging from the root's rigid body (four
     legs, or two legs and two arms; an arm has one, a dual-arm torso two or three) that start around
@@ -39,6 +41,7 @@ collision shape) at q = 0, and "touches" means within 2 % of the robot's height 
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,6 +53,8 @@ from modelkit.model import WORLD_LINK, Cylinder, Geom, Joint, JointType, Robot, 
 from modelkit.spatial import Pose
 
 BASE_CHOICES = ("auto", "fixed", "floating")
+# The name of a link that ends a finger: limbs resting on such links are a hand's, not legs (TriFinger)
+_FINGER = re.compile("finger|thumb", re.IGNORECASE)
 LIMBS = 4  # limbs of ≥ 2 moving joints from the root's body that make a robot legged (4 legs, or 2 + 2 arms)
 _UP = np.array([0.0, 0.0, 1.0])
 
@@ -221,6 +226,11 @@ def decide(robot: Robot) -> BaseDecision:
         return _by_limbs(robot, poses, limbs, "the root's own body rests on the ground (an arm or a fixture"
                          + (f"; {raised} limb(s) point up, as a hand's fingers do" if raised else "") + ")")
     feet = _feet(paths, sorted(touching), _below_root(robot, poses))
+    if len(feet) >= 2 and all(_FINGER.search(name) for name in feet):
+        shown = ", ".join(f'"{name}"' for name in feet[:6])
+        return BaseDecision(JointType.FIXED, f"its {len(feet)} limbs that touch the ground end in links "
+                            f"named as fingers ({shown}): a hand or a manipulation platform resting on its "
+                            "fingertips, not a legged robot")
     if len(feet) >= 2:
         shown = ", ".join(f'"{name}"' for name in feet[:6])
         return BaseDecision(JointType.FLOATING, f"it stands on {len(feet)} legs (feet {shown} touch the "
