@@ -129,11 +129,14 @@ class MjGeom:
     friction: V3 = (1.0, 0.005, 0.0001)  # sliding, torsional, rolling (MuJoCo's defaults)
     condim: int = 3
     contact: dict[str, str] = field(default_factory=dict)  # solref, solimp... where not MuJoCo's default
+    paired: bool = False  # named by an explicit <contact><pair>
 
     @property
     def visual_only(self) -> bool:
-        """MuJoCo collides a geom only when its contype or conaffinity is non-zero."""
-        return self.contype == 0 and self.conaffinity == 0
+        """MuJoCo collides a geom when its contype or conaffinity is non-zero, or when a ``<pair>`` names
+        it (MJX models such as jaxterity's G1 keep ``contype="0" conaffinity="0"`` on every geom and
+        collide the feet with the floor and each other by pairs alone)."""
+        return self.contype == 0 and self.conaffinity == 0 and not self.paired
 
 
 @dataclass

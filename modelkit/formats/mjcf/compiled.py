@@ -70,6 +70,17 @@ class CompiledModel:
         self.m = model
         self.spec = spec
         self.model_dir = model_dir
+        self._paired: frozenset[int] | None = None
+
+    @property
+    def paired(self) -> frozenset[int]:
+        """The geoms an explicit ``<contact><pair>`` names: MuJoCo collides them through the pair
+        whatever their ``contype`` and ``conaffinity``."""
+        if self._paired is None:
+            m = self.m
+            self._paired = frozenset(int(g) for k in range(int(m.npair))
+                                     for g in (m.pair_geom1[k], m.pair_geom2[k]))
+        return self._paired
 
     def name(self, kind: str, index: int) -> str | None:
         obj = getattr(self.mj.mjtObj, f"mjOBJ_{kind.upper()}")
@@ -168,6 +179,7 @@ class CompiledModel:
             friction=rot3.vec3(m.geom_friction[g]),
             condim=int(m.geom_condim[g]),
             contact=contact_attributes(m, g),
+            paired=g in self.paired,
         )
         mesh = int(m.geom_dataid[g])
         if kind == "mesh" and mesh >= 0:

@@ -361,7 +361,8 @@ class MujocoModel:
         return facts
 
     def shapes(self) -> dict[str, list[ShapeFacts]]:
-        """Collision geoms (``contype | conaffinity`` non-zero) per link, in the link frame.
+        """Collision geoms (``contype | conaffinity`` non-zero, or named by a ``<pair>``) per link, in the
+        link frame.
 
         ``geom_size`` holds half sizes (box half edges, cylinder/capsule radius and half length).
         A mesh geom's compiled frame is moved to the mesh's centroid and principal axes
@@ -377,9 +378,10 @@ class MujocoModel:
             out.update({link: [] for link in body.links})
             shift[body.index] = Pose(np.eye(3), -body.offset)
             owner[body.index] = body.name
+        paired = {int(g) for k in range(m.npair) for g in (m.pair_geom1[k], m.pair_geom2[k])}
         for g in range(m.ngeom):
             b = int(m.geom_bodyid[g])
-            collides = bool(int(m.geom_contype[g]) | int(m.geom_conaffinity[g]))
+            collides = bool(int(m.geom_contype[g]) | int(m.geom_conaffinity[g])) or g in paired
             if (b == 0 and not self._world_is_root) or not collides:
                 continue
             kind = _GEOMS.get(int(m.geom_type[g]), f"type-{int(m.geom_type[g])}")

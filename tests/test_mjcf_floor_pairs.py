@@ -1,0 +1,102 @@
+"""Geoms that collide through ``<contact><pair>`` alone (issue 17: outputs a user can use as is).
+
+MJX models (jaxterity's G1, ``zoo/unitree_g1/g1_walk.xml``) give every geom ``contype="0"
+conaffinity="0"`` and collide the feet with the floor, and with each other, by explicit pairs. Such a
+geom is a collision shape: MuJoCo collides it through the pair. Until 2026-12-03 the reader took it for a
+visual, so the URDF and SDF outputs had no collision at all and the robot fell through any floor. The
+floor is the source's world, which a robot file does not hold, so its pairs are left out (MK851); the
+MJCF writer then lets the paired geom collide with any default floor, with the pair's contact values.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import pytest
+from click.testing import CliRunner
+
+from modelkit.api import validate
+from modelkit.cli import main
+
+_BLOCK = """<mujoco model="block">
+  <default><geom contype="0" conaffinity="0" condim="1"/></default>
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 0.01"/>
+    <body name="base" pos="0 0 0.2">
+      <freejoint/>
+      <inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/>
+      <geom name="shell" type="sphere" size="0.05" rgba="1 0 0 1"/>
+      <geom name="foot" type="box" size="0.1 0.1 0.02" pos="0 0 -0.1"/>
+    </body>
+  </worldbody>
+  <contact>
+    <pair name="foot_floor" geom1="foot" geom2="floor" condim="3" friction="0.6 0.6"/>
+  </contact>
+</mujoco>
+"""
+
+
+@pytest.fixture
+def source(tmp_path: Path) -> Path:
+    path = tmp_path / "block.xml"
+    path.write_text(_BLOCK)
+    return path
+
+
+def _settled_height(model_file: Path, add_floor: bool) -> float:
+    """The foot's lowest point after 1 s from 0.2 m up (on a default floor when ``add_floor``)."""
+    spec = mujoco.MjSpec.from_file(str(model_file))
+    if add_floor:
+        spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 0.05])
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    while data.time < 1.0:
+        mujoco.mj_step(model, data)
+    foot = model.geom("foot").id
+    return float(data.geom_xpos[foot][2] - model.geom_size[foot][2])
+
+
+def test_a_paired_geom_is_a_collision_shape(source: Path) -> None:
+    v = validate(source)
+    assert v.errors == [] and v.robot is not None
+    (link,) = v.robot.links
+    assert [g.name for g in link.collisions] == ["foot"]  # the shell collides with nothing: a visual
+    assert "shell" in [g.name for g in link.visuals]
+
+
+def test_the_urdf_keeps_the_paired_geom_as_collision(source: Path, tmp_path: Path) -> None:
+    target = tmp_path / "out" / "block.urdf"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(target)])
+    assert result.exit_code == 0, result.output
+    assert target.read_text().count("<collision") == 1
+
+
+def test_the_mjcf_foot_lands_on_the_users_floor_as_on_the_sources(source: Path, tmp_path: Path) -> None:
+    """The source on its own floor and the written MJCF on a default one land alike; the pair with
+    the source's floor is said (MK851) with what the geom now carries."""
+    target = tmp_path / "out" / "block.xml"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(target)])
+    assert result.exit_code == 0, result.output
+    (note,) = [line for line in result.output.splitlines() if "MK851" in line]
+    assert "'floor' is not in the written file" in note and "collides with any floor" in note, note
+    assert "condim, friction" in note
+    foot = next(line for line in target.read_text().splitlines() if 'name="foot"' in line)
+    assert 'contype="1" conaffinity="0"' in foot and 'condim="3"' in foot, foot
+    assert 'friction="0.6 0.005 0.0001"' in foot, foot
+    assert abs(_settled_height(source, add_floor=False)) < 0.005  # the source stands on its floor
+    assert abs(_settled_height(target, add_floor=True)) < 0.005  # ours on the user's
+    shell = next(line for line in target.read_text().splitlines() if 'name="shell"' in line)
+    assert 'class="visual"' in shell  # what collided with nothing still does not
+
+
+def test_a_geom_that_already_touches_a_default_floor_is_left_as_it_is(tmp_path: Path) -> None:
+    path = tmp_path / "block.xml"
+    path.write_text(_BLOCK.replace('<geom name="foot"', '<geom name="foot" contype="1"'))
+    target = tmp_path / "out" / "block.xml"
+    result = CliRunner().invoke(main, ["convert", str(path), "-o", str(target)])
+    assert result.exit_code == 0, result.output
+    (note,) = [line for line in result.output.splitlines() if "MK851" in line]
+    assert "collides with any floor" not in note
+    foot = next(line for line in target.read_text().splitlines() if 'name="foot"' in line)
+    assert "friction" not in foot and 'condim="1"' in foot, foot
