@@ -90,6 +90,9 @@ def test_mjcf_rotations_take_the_shortest_exact_text() -> None:
     # matrix's own triple is (−π, 1.57079632678979, −π) and its zaxis "1 0 -5.10341196725696e-12" was
     # written; the source's triple is the other one of the two, and the shortest
     assert written(matrix_from_rpy(0.0, 1.5707963268, 0.0)) == {"euler": "0 1.5707963268 0"}
+    # differentiable-robot-model's Allegro hand writes π as 3.1415926518 (1.8e-9 short): its quaternion
+    # "8.95e-10 1 0 0" is shorter, and a number a reader sees as noise; the source's text is exact too
+    assert written(matrix_from_rpy(3.1415926518, 0.0, 0.0)) == {"euler": "3.1415926518 0 0"}
     for rotation in (matrix_from_rpy(0.3, -1.2, 2.9), matrix_from_rpy(math.pi, 0.0, 0.0)):
         assert np.allclose(z_turn([0.0, 0.0, -1.0]) @ np.eye(3), matrix_from_rpy(math.pi, 0.0, 0.0))
         assert written(rotation)  # never the identity for a turn

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 from lxml import etree
@@ -57,7 +58,8 @@ def set_pose(el: Element, pose: Pose) -> None:
     ``rpy="1.57079 0 1.57079"`` stays ``euler="1.57079 0 1.57079"`` instead of a quaternion of
     four 15-digit numbers. A quaternion as a source writes one (:func:`short_quat`, at most
     :data:`SOURCE_DIGITS` digits) goes before them when they have a longer number: a source's
-    ``quat="0.996179 0 -0.0873386 0"`` stays that, not ``euler="0 -0.174899984293942 0"``."""
+    ``quat="0.996179 0 -0.0873386 0"`` stays that, not ``euler="0 -0.174899984293942 0"``. A text
+    with a tiny number (:func:`tiny_number`) is written only when every other one has one too."""
     position = fmt_position(pose.translation)
     if position != "0 0 0":
         el.set("pos", position)
@@ -68,12 +70,23 @@ def set_pose(el: Element, pose: Pose) -> None:
             for key, text in (("zaxis", zaxis_text(pose.rotation)), ("euler", euler_text(pose.rotation))):
                 if text is not None:
                     texts[key] = text
-            key = min(texts, key=lambda k: len(texts[k]))  # the shortest exact one; quat on a tie
+            # the shortest exact one (quat on a tie) among those without a tiny number, if any has none
+            key = min(texts, key=lambda k: (tiny_number(texts[k]), len(texts[k])))
             if plainness(texts[key]) > SOURCE_DIGITS:
                 written = short_quat(pose.rotation)
-                if written is not None:
+                if written is not None and (tiny_number(texts[key]) or not tiny_number(written)):
                     key, texts[key] = "quat", written
             el.set(key, texts[key])
+
+
+_TINY = re.compile(r"\de-")
+
+
+def tiny_number(text: str) -> bool:
+    """Whether ``text`` holds a number written with a negative exponent (``8.95e-10``). Allegro's
+    ``rpy="3.1415926518 0 0"`` is ``quat="8.95e-10 1 0 0"``, four characters shorter than its
+    ``euler="3.1415926518 0 0"``, which is the source's own text and is written instead."""
+    return _TINY.search(text) is not None
 
 
 # A number of at most this many significant digits is one a source wrote (MuJoCo saves six, exporters
