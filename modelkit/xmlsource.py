@@ -441,12 +441,24 @@ def _tail_start(data: bytes, line: int, col: int) -> int | None:
     return sum(len(lines[k]) + 1 for k in range(line - 1)) + len(before)
 
 
+def _open_comment_start(data: bytes) -> int:
+    """Where the comment that is never closed starts (the first ``<!--`` without a ``-->`` after it,
+    comments being read in turn), or -1."""
+    at = data.find(b"<!--")
+    while at >= 0:
+        end = data.find(b"-->", at + 4)
+        if end < 0:
+            return at
+        at = data.find(b"<!--", end + 3)
+    return -1
+
+
 def _blank_open_comment(data: bytes) -> bytes | None:
     """``data`` with a comment that is never closed blanked to the end, when it follows a whole root
     element (what is before it parses alone); None otherwise (inside the root it is an error for
     urdfdom too: the root's end tag is missing)."""
-    start = data.rfind(b"<!--")
-    if start < 0 or b"-->" in data[start + 4 :]:
+    start = _open_comment_start(data)
+    if start < 0:
         return None
     try:
         parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False)
@@ -646,7 +658,7 @@ _URDFDOM_LENIENCY = {
             "element and ignores the rest of the file; PyBullet and MuJoCo (TinyXML2: "
             "XML_ERROR_PARSING_COMMENT) and strict XML tools (lxml, so xacro) refuse the file",
             'close the comment with "-->" or delete it',
-            locate=lambda data: data.rfind(b"<!--"),
+            locate=_open_comment_start,
             code="MK027",
         ),
     ),
