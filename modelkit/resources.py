@@ -174,7 +174,7 @@ class Resolver:
             return None
         for entry in self.model_path():
             candidate = entry / relative
-            if candidate.exists():
+            if exists(candidate):
                 return _normal(candidate)
         return None
 
@@ -207,9 +207,9 @@ def _absolute(uri: str, path: Path, base_dir: Path) -> Resolution:
     """An absolute path; when it does not exist but the same path under the model's folder does, that
     file, as PyBullet reads it (``/meshes/link_0.stl`` in pybullet's KUKA SDF files)."""
     written = _normal(path)
-    if not written.exists():
+    if not exists(written):
         beside = _normal(base_dir / str(path).lstrip("/\\"))
-        if beside.is_file():
+        if is_file(beside):
             return Resolution(
                 uri,
                 beside,
@@ -230,9 +230,26 @@ def in_folder_or_above(folder: Path, relative: str) -> Path | None:
     start = Path(os.path.realpath(folder))  # never raises on a symlink loop
     for candidate in (start, *start.parents):
         path = _normal(candidate / relative)
-        if path.is_file():
+        if is_file(path):
             return path
     return None
+
+
+def exists(path: Path) -> bool:
+    """``path.exists()``, False for a name the file system cannot even look up (longer than its limit:
+    ENAMETOOLONG, which ``Path.exists`` raises): no such file."""
+    try:
+        return path.exists()
+    except OSError:
+        return False
+
+
+def is_file(path: Path) -> bool:
+    """``path.is_file()``, False where :func:`exists` is."""
+    try:
+        return path.is_file()
+    except OSError:
+        return False
 
 
 def _split_paths(value: str) -> list[Path]:

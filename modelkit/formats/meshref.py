@@ -16,7 +16,7 @@ from pathlib import Path
 from modelkit import rot3
 from modelkit.diagnostics import Diagnostic, DiagnosticSink, Severity, SourceLocation
 from modelkit.model import Mesh
-from modelkit.resources import Resolution, Resolver, found_report, in_folder_or_above
+from modelkit.resources import Resolution, Resolver, exists, found_report, in_folder_or_above
 from modelkit.textio import UnreadableFile, check_regular
 
 # what modelkit.geometry.meshfiles.load_mesh reads (its SUPPORTED_EXTENSIONS; a test keeps them equal,
@@ -98,7 +98,7 @@ class MeshChecker:
         if path is not None and _symlink_loop(path):
             self.sink.emit("MK001", f'texture "{uri}": cannot read file: a symlink loop', loc)
             return
-        if path is None or not path.exists():
+        if path is None or not exists(path):
             why = resolution.message or f"not found at {path}"
             self.sink.emit("MK507", f'texture "{uri}" cannot be found ({why})', loc, hint=resolution.hint)
             return
@@ -157,7 +157,7 @@ class MeshChecker:
                 code, message, hint, warning = report
                 self.sink.emit(code, message, loc, hint=hint, severity=Severity.WARNING if warning else None)
             suffix = path.suffix.lower()
-            if not path.exists():
+            if not exists(path):
                 self.sink.emit("MK500", not_found(uri, path, usage), loc, severity=severity)
             elif suffix not in MESH_FILE_EXTENSIONS:
                 self.sink.emit(
@@ -189,7 +189,7 @@ class MeshChecker:
         text = uri.strip()
         path = resolution.path
         if (resolution.code is not None or resolution.scheme or path is None or self.model_file is None
-                or text.startswith("${") or Path(text).is_absolute() or path.exists()):
+                or text.startswith("${") or Path(text).is_absolute() or exists(path)):
             return None
         folder = Path(os.path.realpath(self.model_file.parent))
         return in_folder_or_above(folder.parent, text) if folder.parent != folder else None

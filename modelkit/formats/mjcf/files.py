@@ -8,6 +8,7 @@ the model; a file that does not exist is left to MuJoCo, which reports it.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from modelkit.diagnostics import DiagnosticSink
@@ -49,7 +50,7 @@ def check_asset_files(index: SourceIndex, model_dir: Path, sink: DiagnosticSink,
             if not written:
                 continue
             for candidate in _candidates(model_dir, written, folders, folder):
-                if not (candidate.exists() or candidate.is_symlink()):
+                if not os.path.lexists(candidate):  # a file or a symbolic link; False for a name too long
                     continue
                 try:
                     check_regular(candidate, max_bytes)

@@ -1,0 +1,35 @@
+"""A mesh named by a path longer than the file system can look up (ENAMETOOLONG, issue 18 §2): a
+coded MK500 in every format, never MK899 (modelkit failing on the input) or a traceback. Before
+2026-12-03 ``Path.exists`` raised on such a name in every reader (MK899)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from modelkit.api import validate
+
+NAME = "a" * 5000 + ".stl"  # one component over NAME_MAX (255)
+DEEP = "/".join(["b" * 200] * 30) + ".stl"  # every component allowed, the whole over PATH_MAX (4096)
+
+MODELS = {
+    "urdf": '<robot name="r"><link name="a"><collision><geometry><mesh filename="{uri}"/></geometry>'
+            "</collision></link></robot>",
+    "sdf": '<sdf version="1.7"><model name="m"><link name="a"><collision name="c"><geometry><mesh>'
+           "<uri>{uri}</uri></mesh></geometry></collision></link></model></sdf>",
+    "xml": '<mujoco><asset><mesh name="m" file="{uri}"/></asset><worldbody><body><freejoint/>'
+           '<geom type="mesh" mesh="m"/></body></worldbody></mujoco>',
+    "body": "format: ChoreonoidBody\nformat_version: 2.0\nname: r\nroot_link: a\nlinks:\n  - name: a\n"
+            "    joint_type: free\n    mass: 1\n    inertia: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n    elements:\n"
+            "      - type: Resource\n        uri: {uri}\n",
+}
+
+
+@pytest.mark.parametrize("uri", [NAME, DEEP], ids=["long-name", "long-path"])
+@pytest.mark.parametrize("suffix", list(MODELS))
+def test_a_mesh_path_too_long_to_look_up_is_not_found(tmp_path: Path, suffix: str, uri: str) -> None:
+    path = tmp_path / f"m.{suffix}"
+    path.write_text(MODELS[suffix].format(uri=uri))
+    codes = [d.code for d in validate(path).diagnostics]
+    assert "MK899" not in codes and "MK500" in codes, codes
