@@ -252,6 +252,14 @@ def is_file(path: Path) -> bool:
         return False
 
 
+def is_dir(path: Path) -> bool:
+    """``path.is_dir()``, False where :func:`exists` is."""
+    try:
+        return path.is_dir()
+    except OSError:
+        return False
+
+
 def _split_paths(value: str) -> list[Path]:
     return [Path(p) for p in value.split(os.pathsep) if p]
 

@@ -33,3 +33,26 @@ def test_a_mesh_path_too_long_to_look_up_is_not_found(tmp_path: Path, suffix: st
     path.write_text(MODELS[suffix].format(uri=uri))
     codes = [d.code for d in validate(path).diagnostics]
     assert "MK899" not in codes and "MK500" in codes, codes
+
+
+INCLUDES = {
+    "sdf": ('<sdf version="1.7"><world name="w"><include><uri>{uri}</uri></include></world></sdf>', "MK500"),
+    "xml": ('<mujoco><include file="{uri}.xml"/><worldbody/></mujoco>', "MK170"),
+    "xacro": ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+              '<xacro:include filename="{uri}.xacro"/><link name="a"/></robot>', "MK705"),
+    "urdf": ('<robot name="r"><material name="m"><texture filename="{uri}.png"/></material><link name="a"/>'
+             "</robot>", "MK507"),
+}
+
+
+@pytest.mark.parametrize("uri", [NAME, DEEP], ids=["long-name", "long-path"])
+@pytest.mark.parametrize("suffix", list(INCLUDES))
+def test_an_include_or_texture_too_long_to_look_up_is_not_found(tmp_path: Path, suffix: str,
+                                                                 uri: str) -> None:
+    """The same for an included file (SDF ``<include>``, MJCF ``<include>``, ``xacro:include``) and a
+    texture: each format's own "cannot be found" code."""
+    model, code = INCLUDES[suffix]
+    path = tmp_path / f"m.{suffix}"
+    path.write_text(model.format(uri=uri))
+    codes = [d.code for d in validate(path).diagnostics]
+    assert "MK899" not in codes and code in codes, codes
