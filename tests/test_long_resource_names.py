@@ -56,3 +56,13 @@ def test_an_include_or_texture_too_long_to_look_up_is_not_found(tmp_path: Path, 
     path.write_text(model.format(uri=uri))
     codes = [d.code for d in validate(path).diagnostics]
     assert "MK899" not in codes and code in codes, codes
+
+
+def test_a_materials_file_too_long_to_look_up_cannot_be_read(tmp_path: Path) -> None:
+    """``--materials`` naming such a path: the same two errors as a materials file that does not exist."""
+    from modelkit.formats.common import ReadOptions
+
+    body = Path(__file__).resolve().parents[1] / "samples" / "choreonoid_ros2_mobile_robot_tutorial" / "model"
+    options = ReadOptions(materials_path=tmp_path / NAME.replace(".stl", ".yaml"))
+    codes = [d.code for d in validate(body / "mobile_robot_pantilt.body", options).errors]
+    assert "MK899" not in codes and "MK511" in codes, codes
