@@ -100,3 +100,26 @@ def test_a_geom_that_already_touches_a_default_floor_is_left_as_it_is(tmp_path: 
     assert "collides with any floor" not in note
     foot = next(line for line in target.read_text().splitlines() if 'name="foot"' in line)
     assert "friction" not in foot and 'condim="1"' in foot, foot
+
+
+def test_verify_counts_geoms_that_collide_by_pairs_alone(tmp_path: Path) -> None:
+    """Two pads that touch each other only by a ``<pair>`` (contype 0, no floor): the source model and
+    the written MJCF both have them as collision shapes, and layer 1 compares them (before, MuJoCo's
+    adapter left them out and the shape sets differed)."""
+    from modelkit.verify.api import verify
+
+    path = tmp_path / "pads.xml"
+    path.write_text(_BLOCK.replace(
+        '<geom name="foot" type="box" size="0.1 0.1 0.02" pos="0 0 -0.1"/>',
+        '<geom name="foot" type="box" size="0.1 0.1 0.02" pos="0 0 -0.1"/>\n'
+        '      <body name="pad" pos="0.3 0 0"><joint type="hinge" axis="0 1 0"/>\n'
+        '        <inertial pos="0 0 0" mass="0.1" diaginertia="0.001 0.001 0.001"/>\n'
+        '        <geom name="pad" type="box" size="0.05 0.05 0.02"/></body>').replace(
+        '<pair name="foot_floor" geom1="foot" geom2="floor" condim="3" friction="0.6 0.6"/>',
+        '<pair name="foot_pad" geom1="foot" geom2="pad"/>'))
+    report = verify(path, None, ("mujoco", "pinocchio"), configurations=5, samples=3, replay=False,
+                    driven=False)
+    assert report.errors == []
+    assert list(report.failed) == []
+    shapes = [c for c in report.checks if c.engine == "mujoco" and c.quantity == "shape-set"]
+    assert shapes and all(c.passed for c in shapes)
