@@ -48,7 +48,8 @@ def note_tipping(robot: Robot, notes: NoteSink) -> None:
     if not any(joint.type.moves for joint in robot.joints):
         return  # a prop (pybullet_data's duck and teddy bear rock a degree or two on their curved bottoms)
     poses = robot.world_poses({joint.name: home_position(joint) for joint in robot.joints})
-    points, links = _resting(robot, poses)
+    clouds = _clouds(robot, poses)
+    points, links = _resting(clouds)
     centre = _centre_of_mass(robot, poses)
     if points is None or centre is None:
         return
@@ -63,18 +64,25 @@ def note_tipping(robot: Robot, notes: NoteSink) -> None:
         what = ("its ground contacts at home span only " + ("a line" if len(hull) == 2 else "a point")
                 + f", {away} from below its centre of mass")
     shown = ", ".join(links[:4]) + (" ..." if len(links) > 4 else "")
+    falls = "it tips over on a floor before a controller can act"
+    if len(hull) == 2:
+        caught = _caught(clouds, set(links), hull, centre)
+        if caught is not None:
+            angle, by = caught
+            falls = (f"on a floor it pitches {fmt(round(math.degrees(angle), 1))}° about that line onto "
+                     f"the collision shape of {by} before a controller can act")
     notes.note(
         "MK887",
         f"the robot cannot stand on its own: {what} (the collision shapes of {shown}, seen from above); "
-        "it tips over on a floor before a controller can act. A caster, a support or a foot the source "
-        "lacks, or a home pose over the feet, is what it needs",
+        f"{falls}. A caster, a support or a foot the source lacks, or a home pose over the feet, is what "
+        "it needs",
         robot.source,
         "model",
     )
 
 
-def _resting(robot: Robot, poses: dict[str, Pose]) -> tuple[np.ndarray | None, list[str]]:
-    """The horizontal positions of the collision points within the ground band, and their links."""
+def _clouds(robot: Robot, poses: dict[str, Pose]) -> list[tuple[str, np.ndarray]]:
+    """Each collision shape's points that include its lowest ones, in the world, with its link."""
     clouds: list[tuple[str, np.ndarray]] = []
     for link in robot.links:
         pose = poses.get(link.name)
@@ -85,6 +93,11 @@ def _resting(robot: Robot, poses: dict[str, Pose]) -> tuple[np.ndarray | None, l
             cloud = _points(geom, rotation.T @ -_UP)
             if cloud is not None and len(cloud):
                 clouds.append((link.name, cloud @ rotation.T + np.asarray(pose.translation, dtype=float)))
+    return clouds
+
+
+def _resting(clouds: list[tuple[str, np.ndarray]]) -> tuple[np.ndarray | None, list[str]]:
+    """The horizontal positions of the collision points within the ground band, and their links."""
     if not clouds:
         return None, []
     every = np.concatenate([cloud for _, cloud in clouds])
@@ -102,6 +115,37 @@ def _resting(robot: Robot, poses: dict[str, Pose]) -> tuple[np.ndarray | None, l
             resting.append(cloud[cloud[:, 2] <= low + CONTACT_BAND, :2])
             names.append(name)
     return np.concatenate(resting), names
+
+
+def _caught(clouds: list[tuple[str, np.ndarray]], resting: set[str], line: np.ndarray,
+            centre: np.ndarray) -> tuple[float, str] | None:
+    """When the robot rests on a line (two wheels) with its centre of mass to one side: the angle it
+    turns about that line, towards its centre of mass, before another link's collision shape meets
+    the floor, and that link (None when none lies on that side). A point at height h above the floor
+    and s out from the line on that side meets it after atan2(h, s). The resting links turn about
+    their own joints (wheels roll) and are left out. roboschool's Fetch: its chassis, 9.7 mm above the
+    floor, catches it after a few degrees."""
+    a, b = np.asarray(line[0], dtype=float), np.asarray(line[1], dtype=float)
+    along = (b - a) / float(np.linalg.norm(b - a))
+    offset = np.asarray(centre[:2], dtype=float) - a
+    side = offset - float(offset @ along) * along
+    if not float(np.linalg.norm(side)) > 0.0:
+        return None
+    side = side / float(np.linalg.norm(side))
+    floor = min(float(cloud[:, 2].min()) for name, cloud in clouds if name in resting)
+    best: tuple[float, str] | None = None
+    for name, cloud in clouds:
+        if name in resting:
+            continue
+        out = (cloud[:, :2] - a) @ side
+        ahead = out > 0.0
+        if not ahead.any():
+            continue
+        angles = np.arctan2(np.maximum(cloud[ahead, 2] - floor, 0.0), out[ahead])
+        angle = float(angles.min())
+        if best is None or angle < best[0]:
+            best = (angle, name)
+    return best
 
 
 def _points(geom: Geom, down: np.ndarray) -> np.ndarray | None:
