@@ -1873,8 +1873,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A free robot cannot stand on a floor at its home pose: its centre of mass lies more than 5 mm "
         "outside the region its ground contacts span seen from above (the links whose collision shapes "
         "come within 2 % of its height of its lowest point), or off the line or point they span (two "
-        "wheels without a caster). It tips over in every simulator before a controller can act. "
-        "Nothing is changed.",
+        "wheels without a caster). It tips over in every simulator before a controller can act; over a "
+        "line, the note says how far it pitches and onto which link's collision shape. Nothing is changed.",
     ),
     CodeInfo(
         "MK888",
