@@ -15,6 +15,8 @@ Search order for ``package://NAME/REL`` (see docs/resources.md):
 ``model://NAME/REL`` looks in the ``--resource-path`` folders, then ``GZ_SIM_RESOURCE_PATH``,
 ``IGN_GAZEBO_RESOURCE_PATH``, ``SDF_PATH`` and ``GAZEBO_MODEL_PATH`` (:data:`MODEL_PATH_VARIABLES`); an SDF
 ``<include>`` looks a bare name or a relative path up there too when it is not beside the file.
+Files are looked up with ``os.path.exists``/``isfile``/``isdir``, which return False where ``Path``'s
+raise (a name the file system cannot look up, ENAMETOOLONG); the readers do the same.
 ``file://`` and plain paths are relative to the referring file's folder. An absolute path that does not
 exist, but does under the model's folder, is read there, as PyBullet reads it (a warning, MK500). A plain
 relative mesh path of a URDF or SDF file that is not beside the model is looked up in the folders above
@@ -174,7 +176,7 @@ class Resolver:
             return None
         for entry in self.model_path():
             candidate = entry / relative
-            if exists(candidate):
+            if os.path.exists(candidate):
                 return _normal(candidate)
         return None
 
@@ -207,9 +209,9 @@ def _absolute(uri: str, path: Path, base_dir: Path) -> Resolution:
     """An absolute path; when it does not exist but the same path under the model's folder does, that
     file, as PyBullet reads it (``/meshes/link_0.stl`` in pybullet's KUKA SDF files)."""
     written = _normal(path)
-    if not exists(written):
+    if not os.path.exists(written):
         beside = _normal(base_dir / str(path).lstrip("/\\"))
-        if is_file(beside):
+        if os.path.isfile(beside):
             return Resolution(
                 uri,
                 beside,
@@ -230,34 +232,9 @@ def in_folder_or_above(folder: Path, relative: str) -> Path | None:
     start = Path(os.path.realpath(folder))  # never raises on a symlink loop
     for candidate in (start, *start.parents):
         path = _normal(candidate / relative)
-        if is_file(path):
+        if os.path.isfile(path):
             return path
     return None
-
-
-def exists(path: Path) -> bool:
-    """``path.exists()``, False for a name the file system cannot even look up (longer than its limit:
-    ENAMETOOLONG, which ``Path.exists`` raises): no such file."""
-    try:
-        return path.exists()
-    except OSError:
-        return False
-
-
-def is_file(path: Path) -> bool:
-    """``path.is_file()``, False where :func:`exists` is."""
-    try:
-        return path.is_file()
-    except OSError:
-        return False
-
-
-def is_dir(path: Path) -> bool:
-    """``path.is_dir()``, False where :func:`exists` is."""
-    try:
-        return path.is_dir()
-    except OSError:
-        return False
 
 
 def _split_paths(value: str) -> list[Path]:

@@ -16,7 +16,7 @@ from pathlib import Path
 from modelkit import rot3
 from modelkit.diagnostics import Diagnostic, DiagnosticSink, Severity, SourceLocation
 from modelkit.model import Mesh
-from modelkit.resources import Resolution, Resolver, exists, found_report, in_folder_or_above
+from modelkit.resources import Resolution, Resolver, found_report, in_folder_or_above
 from modelkit.textio import UnreadableFile, check_regular
 
 # what modelkit.geometry.meshfiles.load_mesh reads (its SUPPORTED_EXTENSIONS; a test keeps them equal,
@@ -98,7 +98,7 @@ class MeshChecker:
         if path is not None and _symlink_loop(path):
             self.sink.emit("MK001", f'texture "{uri}": cannot read file: a symlink loop', loc)
             return
-        if path is None or not exists(path):
+        if path is None or not os.path.exists(path):
             why = resolution.message or f"not found at {path}"
             self.sink.emit("MK507", f'texture "{uri}" cannot be found ({why})', loc, hint=resolution.hint)
             return
@@ -131,12 +131,13 @@ class MeshChecker:
         path = resolution.path
         above = self.found_above(uri, resolution)
         if above is not None:
+            relative = self._relative(above)
             self.sink.emit(
                 "MK500",
-                f'resource "{uri}" not found at {path}; {FOUND_ABOVE}"{self._relative(above)}", as modelkit '
-                "does" + (VISUAL_FOUND_ABOVE if visual_only else COLLISION_FOUND_ABOVE),
+                f'resource "{uri}" not found at {path}; {FOUND_ABOVE}"{relative}", as modelkit does'
+                + (VISUAL_FOUND_ABOVE if visual_only else COLLISION_FOUND_ABOVE),
                 loc,
-                hint=f'write the path relative to the model file: "{self._relative(above)}"',
+                hint=f'write the path relative to the model file: "{relative}"',
                 severity=Severity.WARNING,
             )
             path = above
@@ -157,7 +158,7 @@ class MeshChecker:
                 code, message, hint, warning = report
                 self.sink.emit(code, message, loc, hint=hint, severity=Severity.WARNING if warning else None)
             suffix = path.suffix.lower()
-            if not exists(path):
+            if not os.path.exists(path):
                 self.sink.emit("MK500", not_found(uri, path, usage), loc, severity=severity)
             elif suffix not in MESH_FILE_EXTENSIONS:
                 self.sink.emit(
@@ -189,7 +190,7 @@ class MeshChecker:
         text = uri.strip()
         path = resolution.path
         if (resolution.code is not None or resolution.scheme or path is None or self.model_file is None
-                or text.startswith("${") or Path(text).is_absolute() or exists(path)):
+                or text.startswith("${") or Path(text).is_absolute() or os.path.exists(path)):
             return None
         folder = Path(os.path.realpath(self.model_file.parent))
         return in_folder_or_above(folder.parent, text) if folder.parent != folder else None

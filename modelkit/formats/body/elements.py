@@ -9,6 +9,7 @@ the model's Z-axis primitives here (the only place where that rotation is applie
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -32,7 +33,7 @@ from modelkit.model import (
     TriangleMeshData,
     VisualMaterial,
 )
-from modelkit.resources import Resolver, exists, found_report
+from modelkit.resources import Resolver, found_report
 from modelkit.rot3 import peek
 from modelkit.spatial import Pose
 from modelkit.yamltree import YamlDocument, YMap, YNode, YScalar, YSeq, parse_yaml, read_text
@@ -630,7 +631,7 @@ def _add_mesh_file(
             code, message, hint, warning = report
             severity_of_note = Severity.WARNING if warning else None
             ctx.sink.emit(code, message, uri_node.loc, hint=hint, severity=severity_of_note)
-        if not exists(path):
+        if not os.path.exists(path):
             ctx.sink.emit(
                 "MK500", f'resource "{uri}" not found at {path}{usage}', uri_node.loc, severity=severity
             )

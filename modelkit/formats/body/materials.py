@@ -6,13 +6,13 @@ The default table is Choreonoid's own ``share/default/materials.yaml`` (shipped 
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
 from modelkit.formats.body.values import number, scalar_text
-from modelkit.resources import exists
 from modelkit.textio import real_path
 from modelkit.yamltree import YMap, YScalar, YSeq, parse_yaml, read_text
 
@@ -51,7 +51,7 @@ _CACHE: dict[str, MaterialTable] = {}
 def load_materials(path: Path | None, sink: DiagnosticSink) -> MaterialTable:
     """Read a materials file; problems go to ``sink`` (MK511) and give an empty table."""
     target = path or DEFAULT_MATERIALS
-    key = str(real_path(target)) if exists(target) else str(target)
+    key = str(real_path(target)) if os.path.exists(target) else str(target)
     if key in _CACHE:
         return _CACHE[key]
     table = MaterialTable(str(target))

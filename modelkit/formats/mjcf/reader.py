@@ -20,6 +20,7 @@ or the file does not compile.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -39,7 +40,6 @@ from modelkit.formats.mjcf.source import SourceIndex, TreeShape, locate, pair
 from modelkit.formats.mjcf.transmissions import transmission_sites
 from modelkit.formats.mjcf.uncompiled import SpecReader
 from modelkit.model import Actuator, ActuatorKind, Joint, Robot
-from modelkit.resources import exists
 from modelkit.xmlsource import read_xml
 
 MUJOCO_DEFAULT_NAME = "MuJoCo Model"
@@ -417,7 +417,7 @@ class _MjcfReader:
             if not written:
                 continue
             path = mesh_path(self.path.parent, str(spec.meshdir or ""), written)
-            if not exists(path):
+            if not os.path.exists(path):
                 placed = by_file.get(written)
                 loc = placed.loc("file") if placed is not None else index.top().loc()
                 self.sink.emit("MK500", not_found(written, path), loc)

@@ -9,6 +9,7 @@ disagree) an object points at its nearest located ancestor instead.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,7 +17,6 @@ from pathlib import Path
 from lxml.etree import _Element as Element
 
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
-from modelkit.resources import exists
 from modelkit.textio import real_path
 from modelkit.xmlsource import XmlDocument, read_xml
 
@@ -83,7 +83,7 @@ class SourceIndex:
         candidates = [self.base_dir / name]
         if placed.doc.path is not None:
             candidates.append(placed.doc.path.parent / name)
-        path = next((p for p in candidates if exists(p)), candidates[0])
+        path = next((p for p in candidates if os.path.exists(p)), candidates[0])
         key = real_path(path)
         owner = self._owner.setdefault(key, placed.el)
         if owner is not placed.el:
@@ -91,7 +91,7 @@ class SourceIndex:
         if key not in self._included:
             display = str(Path(self.main.display).parent / name)
             self._included[key] = (
-                read_xml(path, self.sink, self.max_bytes, display) if exists(path) else None
+                read_xml(path, self.sink, self.max_bytes, display) if os.path.exists(path) else None
             )
         return self._included[key]
 

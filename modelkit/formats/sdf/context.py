@@ -22,7 +22,7 @@ from modelkit.formats.meshref import MeshChecker
 from modelkit.formats.sdf.document import MAX_VERSION, SdfDocument, load_document, parse_version
 from modelkit.formats.sdf.spec import check_elements
 from modelkit.model import Mesh
-from modelkit.resources import Resolution, exists, is_dir, is_file
+from modelkit.resources import Resolution
 from modelkit.xmlsource import read_xml
 
 
@@ -82,7 +82,7 @@ class Context:
             return None
         relative = model_file.is_absolute() is False
         for folder in Path(os.path.abspath(model_file)).parents:
-            if is_dir(folder / name):
+            if os.path.isdir(folder / name):
                 found = folder / rest
                 if relative:
                     found = Path(os.path.relpath(found))
@@ -155,13 +155,13 @@ class Context:
             )
             return None
         path = resolution.path
-        if not exists(path) and resolution.scheme in ("", "file"):
+        if not os.path.exists(path) and resolution.scheme in ("", "file"):
             # libsdformat's findFile: a bare name or relative path not beside the file is looked up on
             # the model path (SDF_PATH, GZ_SIM_RESOURCE_PATH, ...), as Gazebo does.
             text = uri.strip()
             relative = text[len("file://") :] if text.lower().startswith("file://") else text
             path = self.options.resolver.find_on_model_path(relative.rstrip("/")) or path
-        if not exists(path):
+        if not os.path.exists(path):
             self.sink.emit(
                 "MK500",
                 f'included model "{uri.strip()}" not found at {path} nor on the model path',
@@ -170,17 +170,17 @@ class Context:
                 "SDF_PATH / GZ_SIM_RESOURCE_PATH",
             )
             return None
-        if is_dir(path):
+        if os.path.isdir(path):
             return self._model_folder(uri, path, loc)
         return path
 
     def _model_folder(self, uri: str, folder: Path, loc: SourceLocation) -> Path | None:
         config = folder / "model.config"
-        if not is_file(config) and is_file(folder / "manifest.xml"):
+        if not os.path.isfile(config) and os.path.isfile(folder / "manifest.xml"):
             config = folder / "manifest.xml"  # the older name, which libsdformat still reads
-        if not is_file(config):
+        if not os.path.isfile(config):
             fallback = folder / "model.sdf"
-            if is_file(fallback):
+            if os.path.isfile(fallback):
                 # libsdformat 12 refuses the include ("Unable to resolve uri[...] to model path [...] since
                 # it does not contain a model.config file"); the model is still read to check it
                 self.sink.emit(
@@ -213,7 +213,7 @@ class Context:
         usable = [c for c in choices if c[0] is not None and c[0] <= MAX_VERSION]
         version_name = max(usable, key=lambda c: c[0] or (0, 0))[1] if usable else choices[0][1]
         target = folder / version_name
-        if not is_file(target):
+        if not os.path.isfile(target):
             self.sink.emit(
                 "MK530",
                 f'included model "{uri}": {config} names "{version_name}", which does not exist',

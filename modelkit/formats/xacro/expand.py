@@ -55,7 +55,6 @@ from modelkit.formats.xacro.legacy import (
 from modelkit.formats.xacro.origins import OriginMap, dom_elements
 from modelkit.formats.xacro.pretty import pretty_xml
 from modelkit.formats.xacro.text import evaluator as split_once_eval_text
-from modelkit.resources import exists, is_dir
 from modelkit.textio import UnreadableFile, decode_text, read_regular, real_path
 from modelkit.xmlsource import XmlDocument, read_xml
 
@@ -164,9 +163,9 @@ class _Run:
         """xacro's ``parse`` of a file: our checks, origins and legacy rewriting, then a minidom tree."""
         xacro = self.xacro
         path = Path(filename)
-        if not exists(path) or is_dir(path):
+        if not os.path.exists(path) or os.path.isdir(path):
             xacro.filestack.pop()  # as xacro does: the missing file is not "the current file"
-            code = errno.EISDIR if is_dir(path) else errno.ENOENT
+            code = errno.EISDIR if os.path.isdir(path) else errno.ENOENT
             error = OSError(code, os.strerror(code), filename)
             raise xacro.XacroException(f"{error.strerror}: {filename}", exc=error)
         self.sandbox.check(path)

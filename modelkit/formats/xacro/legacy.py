@@ -25,7 +25,6 @@ from lxml.etree import _Element as Element
 
 from modelkit.formats.common import ReadOptions
 from modelkit.formats.xacro.origins import Origin, attributes, source_elements, tag_name
-from modelkit.resources import is_file
 from modelkit.xmlsource import XmlDocument
 
 # Legacy directive → the attribute it must carry to be taken for one (an `<include>` without
@@ -212,7 +211,7 @@ def scan_file_set(
         for element in _include_elements(doc):
             for target in resolve_spec(element.get("filename", ""), path, args, options, top):
                 key = file_key(target)
-                if key in files.docs or not is_file(target):
+                if key in files.docs or not os.path.isfile(target):
                     continue
                 included = load(target)
                 if included is not None:
