@@ -19,11 +19,12 @@ from modelkit.textio import OpenedFile
 TARGET_REFUSALS: dict[str, frozenset[str]] = {
     # MuJoCo: a zero principal moment, inertia violating A + B >= C; a moving link, no mass; URDF parts
     # its URDF import refuses (a shape without its size or file, an incomplete inertia or inertial, a
-    # short rgba or mesh scale); a collision shape of size zero; a shape URDF does not have; a glTF or PLY
-    # mesh; text after a URDF's root element
+    # short rgba or mesh scale, a word where an inertial, collision or colour number should be); a
+    # collision shape of size zero; a shape URDF does not have; a glTF or PLY mesh; text after a URDF's
+    # root element
     "mjcf": frozenset(
-        {"MK302", "MK303", "MK313", "MK143", "MK144", "MK145", "MK146", "MK420", "MK416", "MK412", "MK421",
-         "MK514", "MK515", "MK027"}
+        {"MK302", "MK303", "MK313", "MK143", "MK144", "MK145", "MK146", "MK127", "MK129", "MK420", "MK416",
+         "MK412", "MK421", "MK514", "MK515", "MK027"}
     ),
     "sdf": frozenset({"MK303", "MK211"}),  # libsdformat: the same, and links and joints sharing a name
     "urdf": frozenset(),

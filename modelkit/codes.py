@@ -349,6 +349,44 @@ _TABLE: tuple[CodeInfo, ...] = (
         "for another variant of the robot) are not used; one warning counts them and names the first.",
     ),
     CodeInfo(
+        "MK127",
+        "urdf-link-not-a-number",
+        "warning",
+        "A word where a number of a URDF link's `<inertial>` or `<collision>` should be (a mass, an inertia "
+        "moment, an origin, a shape's size: `MASS`, `1,5`); modelkit leaves that inertial or collision "
+        "out. Reference: urdfdom logs an error, keeps what it read of the link before it (an inertial's "
+        "mass, with "
+        "an all-zero inertia), drops the link's later visuals and collisions, and loads the robot; PyBullet "
+        "reads the text with C's `atof` (`MASS` is 0, `1,5` is 1); MuJoCo refuses the file (an error under "
+        "`--target mjcf`).",
+    ),
+    CodeInfo(
+        "MK116",
+        "urdf-visual-not-a-number",
+        "warning",
+        "A word where a number of a URDF `<visual>` should be (its origin, its shape's size); modelkit "
+        "leaves the visual out. Reference: urdfdom logs an error, drops it and the link's later visuals and "
+        "collisions, and loads the robot; PyBullet reads the text with C's `atof`; MuJoCo's URDF import "
+        "discards visuals.",
+    ),
+    CodeInfo(
+        "MK128",
+        "urdf-contact-not-a-number",
+        "warning",
+        "A friction of PyBullet's URDF `<contact>` that is not a number; modelkit leaves it out. PyBullet "
+        "reads the text with C's `atof` (a word is 0: the link slides); urdfdom and MuJoCo ignore "
+        "`<contact>`.",
+    ),
+    CodeInfo(
+        "MK129",
+        "urdf-color-not-a-number",
+        "warning",
+        "The `rgba` of a URDF `<material>` holds a word where a number should be; modelkit keeps the "
+        "material without a colour. Reference: urdfdom logs an error, drops the colour and loads the file; "
+        "PyBullet reads four parts with C's `atof` (with another count it keeps 0 0 0 0); MuJoCo refuses "
+        "the file (an error under `--target mjcf`).",
+    ),
+    CodeInfo(
         "MK149",
         "srdf-joint-value-unusable",
         "warning",

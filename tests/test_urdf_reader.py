@@ -371,7 +371,7 @@ def test_broken_parts_are_left_out_and_the_rest_is_read(tmp_path: Path) -> None:
     assert link.inertial is None
     assert [type(g.geometry) for g in link.visuals] == [Sphere]
     assert [type(g.geometry) for g in link.collisions] == [Box]
-    assert [d.split(" ")[0] for d in diags] == ["MK121", "MK143", "MK122"]
+    assert [d.split(" ")[0] for d in diags] == ["MK127", "MK143", "MK122"]
 
 
 def test_gazebo_blocks_sensors_and_transmissions(tmp_path: Path) -> None:

@@ -15,7 +15,7 @@ from lxml.etree import _Element as Element
 from modelkit import rot3
 from modelkit.diagnostics import Severity, did_you_mean
 from modelkit.formats.meshref import MeshChecker
-from modelkit.formats.urdf.values import Context, number, origin, vector
+from modelkit.formats.urdf.values import Context, Tolerated, number, origin, vector
 from modelkit.model import (
     Box,
     Capsule,
@@ -55,7 +55,9 @@ class Materials:
                 found = True  # urdfdom keeps the material (black); modelkit keeps it without a colour
             elif color.get("rgba") is None:
                 ctx.emit("MK120", "<color> has no `rgba` attribute", ctx.loc(color))
-            elif rgba is not None:
+            elif rgba is None:
+                found = True  # reported (MK129, MK121): the material is kept, without a colour
+            else:
                 found = True
                 if any(v < 0.0 or v > 1.0 for v in rgba):
                     ctx.emit(
@@ -139,13 +141,20 @@ class Materials:
 
 _SHORT_RGBA: list[float] = []  # the colour of an rgba that does not hold four numbers (MK146)
 
+COLOUR_WORD = Tolerated(
+    "MK129",
+    "modelkit keeps the material without a colour; urdfdom logs an error, drops the colour and loads the "
+    "file; PyBullet reads each of four parts with C's atof (a word is 0) or, with another count, says "
+    "\"has no rgba\" and keeps 0 0 0 0; MuJoCo refuses the file",
+)
+
 
 def _rgba(ctx: Context, color: Element, name: str | None) -> list[float] | None:
     """The four numbers of ``rgba``; :data:`_SHORT_RGBA` (reported, MK146) when it holds another count."""
     text = color.get("rgba")
     numbers = parse_numbers(text)
     if numbers is None or len(numbers) == 4:
-        return vector(ctx, color, "rgba", f'material "{name}" color', count=4)
+        return vector(ctx, color, "rgba", f'material "{name}" color', count=4, tolerated=COLOUR_WORD)
     ctx.emit(
         "MK146",
         f'material "{name}": `rgba="{text}"` holds {len(numbers)} numbers, not 4; urdfdom silently makes the '
@@ -205,6 +214,12 @@ def contact_parameters(contact: Element) -> dict[str, str]:
 PYBULLET_LATERAL_DEFAULT = 0.5
 """PyBullet's lateral friction of a link whose ``<contact>`` does not give one."""
 
+CONTACT_WORD = Tolerated(
+    "MK128",
+    "modelkit leaves it out; PyBullet reads the text as {atof} (C's atof); urdfdom and MuJoCo ignore "
+    "<contact> and load the file",
+)
+
 
 def contact_friction(ctx: Context, contact: Element, link: str) -> SurfaceFriction | None:
     """PyBullet's ``<contact>`` of a link: its lateral, spinning and rolling friction hold for all the
@@ -215,7 +230,7 @@ def contact_friction(ctx: Context, contact: Element, link: str) -> SurfaceFricti
         child = ctx.first(contact, tag)
         if child is None:
             continue
-        value = number(ctx, child, "value", f'{tag} of link "{link}"', required=True)
+        value = number(ctx, child, "value", f'{tag} of link "{link}"', required=True, tolerated=CONTACT_WORD)
         if value is not None and value < 0.0:
             ctx.emit("MK121", f'{tag} of link "{link}": `value="{child.get("value")}"` is negative',
                      ctx.loc(child, "value"))
@@ -237,7 +252,7 @@ def read_inertial(ctx: Context, element: Element, link: str) -> Inertial | None:
     None (with the faults reported) when any part is missing or malformed, as urdfdom drops it.
     """
     origin_el = ctx.first(element, "origin")
-    pose = origin(ctx, origin_el, f'inertial of link "{link}"')
+    pose = origin(ctx, origin_el, f'inertial of link "{link}"', tolerated=INERTIAL_WORD)
     mass_el = ctx.first(element, "mass")
     inertia_el = ctx.first(element, "inertia")
     for name, child in (("mass", mass_el), ("inertia", inertia_el)):
@@ -247,7 +262,8 @@ def read_inertial(ctx: Context, element: Element, link: str) -> Inertial | None:
         _unreadable_inertial(ctx, mass_el, link, "has a <mass> without `value`")
         mass = None
     else:
-        mass = None if mass_el is None else number(ctx, mass_el, "value", f'mass of link "{link}"')
+        mass = None if mass_el is None else number(ctx, mass_el, "value", f'mass of link "{link}"',
+                                                    tolerated=INERTIAL_WORD)
     tensor = None if inertia_el is None else _inertia(ctx, inertia_el, link)
     if pose is None or mass is None or tensor is None or mass_el is None or inertia_el is None:
         return None
@@ -264,10 +280,15 @@ def read_inertial(ctx: Context, element: Element, link: str) -> Inertial | None:
     return inertial
 
 
-# What urdfdom does with a link whose <inertial> it cannot read (MK144, MK145).
+# What urdfdom does with a link whose <inertial> it cannot read (MK144, MK145, MK127).
 URDFDOM_INERTIAL = (
     "urdfdom (check_urdf, libsdformat's URDF conversion) logs an error, keeps the mass it read with an "
     "all-zero inertia, drops every visual and collision of the link, and loads the robot"
+)
+INERTIAL_WORD = Tolerated(
+    "MK127",
+    f"modelkit leaves the inertial out; {URDFDOM_INERTIAL}; PyBullet reads the text as {{atof}} (C's atof) "
+    "and loads the file; MuJoCo refuses it",
 )
 
 
@@ -294,7 +315,8 @@ def _inertia(ctx: Context, element: Element, link: str) -> rot3.M3 | None:
             ctx.loc(element),
             hint=" ".join(f'{k}="0"' for k in missing) + " (all six of ixx, ixy, ixz, iyy, iyz, izz)",
         )
-    values = [number(ctx, element, k, f'inertia of link "{link}"', default=0.0) for k in INERTIA_KEYS]
+    values = [number(ctx, element, k, f'inertia of link "{link}"', default=0.0, tolerated=INERTIAL_WORD)
+              for k in INERTIA_KEYS]
     if any(v is None for v in values):
         return None
     return rot3.inertia_from_moments(*(float(v or 0.0) for v in values))
@@ -324,12 +346,29 @@ NO_SHAPE_CONSUMERS = (
 )
 
 
+# A word where a shape's number should be (MK116, MK127): urdfdom logs it and loads the file.
+VISUAL_WORD = Tolerated(
+    "MK116",
+    f"modelkit leaves the visual out; {URDFDOM_DROPS_SHAPE}; PyBullet reads the text as {{atof}} (C's atof); "
+    "MuJoCo's URDF import discards visuals",
+)
+COLLISION_WORD = Tolerated(
+    "MK127",
+    f"modelkit leaves the collision out; {URDFDOM_DROPS_SHAPE}; PyBullet reads the text as {{atof}} (C's "
+    "atof) and loads the file; MuJoCo refuses it",
+)
+
+
+def _shape_word(visual_only: bool) -> Tolerated:
+    return VISUAL_WORD if visual_only else COLLISION_WORD
+
+
 def _read_geom(
     ctx: Context, element: Element, link: str, meshes: MeshChecker, visual_only: bool
 ) -> Geom | None:
     kind = "visual" if visual_only else "collision"
     what = f'{kind} of link "{link}"'
-    pose = origin(ctx, ctx.first(element, "origin"), what)
+    pose = origin(ctx, ctx.first(element, "origin"), what, tolerated=_shape_word(visual_only))
     geometry_el = ctx.first(element, "geometry")
     if geometry_el is None:
         ctx.emit(
@@ -365,7 +404,7 @@ def read_geometry(
         if shape.get("size") is None:
             _unreadable_shape(ctx, shape, what, "`size`")
             return None
-        size = vector(ctx, shape, "size", f"box of the {what}")
+        size = vector(ctx, shape, "size", f"box of the {what}", tolerated=_shape_word(visual_only))
         if size is None:
             return None
         if any(s <= 0.0 for s in size):
@@ -378,8 +417,8 @@ def read_geometry(
         if missing:
             _unreadable_shape(ctx, shape, what, " and ".join(f"`{k}`" for k in missing))
             return None
-        radius = number(ctx, shape, "radius", f"{tag} of the {what}")
-        length = number(ctx, shape, "length", f"{tag} of the {what}")
+        radius = number(ctx, shape, "radius", f"{tag} of the {what}", tolerated=_shape_word(visual_only))
+        length = number(ctx, shape, "length", f"{tag} of the {what}", tolerated=_shape_word(visual_only))
         if radius is None or length is None:
             return None
         if radius <= 0.0:
@@ -391,7 +430,7 @@ def read_geometry(
         if shape.get("radius") is None:
             _unreadable_shape(ctx, shape, what, "`radius`")
             return None
-        radius = number(ctx, shape, "radius", f"sphere of the {what}")
+        radius = number(ctx, shape, "radius", f"sphere of the {what}", tolerated=_shape_word(visual_only))
         if radius is None:
             return None
         if radius <= 0.0:

@@ -7,6 +7,7 @@ the caller can carry on with a default. Number syntax is urdfdom's (see :mod:`mo
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 
 from lxml import etree
@@ -92,6 +93,30 @@ class Context:
         self.newer_features.append((feature, needs, loc))
 
 
+@dataclass(frozen=True)
+class Tolerated:
+    """A place where urdfdom logs a number it cannot read and loads the file all the same (check_urdf
+    exits 0): such a number is reported with ``code`` (a warning; an error only under the ``validate
+    --target`` that refuses it) instead of MK121, and ``consequence`` says what each consumer does.
+    ``{atof}`` in it is replaced by what PyBullet reads (C's ``atof`` of the text)."""
+
+    code: str
+    consequence: str
+
+    def message(self, what: str, text: str) -> str:
+        return f"{what}; " + self.consequence.replace("{atof}", f"{c_atof(text):g}")
+
+
+_ATOF_PREFIX = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)")
+
+
+def c_atof(text: str) -> float:
+    """What C's ``atof`` makes of ``text`` (PyBullet's URDF reader): its longest leading decimal
+    number, 0 when it starts with none ("1,5" is 1, "MASS" is 0)."""
+    match = _ATOF_PREFIX.match(text)
+    return float(match.group(1)) if match else 0.0
+
+
 def number(
     ctx: Context,
     element: Element,
@@ -99,8 +124,10 @@ def number(
     what: str,
     default: float | None = None,
     required: bool = False,
+    tolerated: Tolerated | None = None,
 ) -> float | None:
-    """The attribute as a number; a missing required one or a malformed one is reported (None back)."""
+    """The attribute as a number; a missing required one or a malformed one is reported (None back;
+    ``tolerated``: where urdfdom loads the file all the same, see :class:`Tolerated`)."""
     text = element.get(attribute)
     if text is None:
         if required:
@@ -112,11 +139,11 @@ def number(
         return default
     value = parse_number(text)
     if value is None:
-        ctx.emit(
-            "MK121",
-            f'{what}: `{attribute}="{text}"` is not a number',
-            ctx.loc(element, attribute),
-        )
+        said = f'{what}: `{attribute}="{text}"` is not a number'
+        if tolerated is not None:
+            ctx.emit(tolerated.code, tolerated.message(said, text), ctx.loc(element, attribute))
+        else:
+            ctx.emit("MK121", said, ctx.loc(element, attribute))
         return None
     if not math.isfinite(value):
         ctx.emit("MK121", f'{what}: `{attribute}="{text}"` is not finite', ctx.loc(element, attribute))
@@ -124,8 +151,10 @@ def number(
     return value
 
 
-def vector(ctx: Context, element: Element, attribute: str, what: str, count: int = 3) -> list[float] | None:
-    """The attribute as exactly ``count`` blank-separated numbers; None (reported) otherwise."""
+def vector(ctx: Context, element: Element, attribute: str, what: str, count: int = 3,
+           tolerated: Tolerated | None = None) -> list[float] | None:
+    """The attribute as exactly ``count`` blank-separated numbers; None (reported) otherwise
+    (``tolerated``: a word where a number should be, where urdfdom loads the file all the same)."""
     text = element.get(attribute)
     if text is None:
         return None
@@ -133,7 +162,11 @@ def vector(ctx: Context, element: Element, attribute: str, what: str, count: int
     if values is None:
         bad = next((item for item in text.split() if parse_number(item) is None), text)
         where = ctx.loc(element, attribute)
-        ctx.emit("MK121", f'{what}: `{attribute}="{text}"`: "{bad}" is not a number', where)
+        said = f'{what}: `{attribute}="{text}"`: "{bad}" is not a number'
+        if tolerated is not None:
+            ctx.emit(tolerated.code, tolerated.message(said, bad), where)
+        else:
+            ctx.emit("MK121", said, where)
         return None
     if len(values) != count:
         ctx.emit(
@@ -149,16 +182,18 @@ def vector(ctx: Context, element: Element, attribute: str, what: str, count: int
     return values
 
 
-def origin(ctx: Context, element: Element | None, what: str) -> Pose | None:
+def origin(ctx: Context, element: Element | None, what: str, tolerated: Tolerated | None = None
+           ) -> Pose | None:
     """The pose of an ``<origin xyz rpy quat_xyzw>`` element (identity when absent).
 
     None when the origin is malformed (already reported); callers fall back to identity.
+    ``tolerated``: a word where a number should be, where urdfdom loads the file all the same.
     """
     if element is None:
         return Pose()
     ok = True
     pose = Pose()
-    xyz = vector(ctx, element, "xyz", f"{what} origin")
+    xyz = vector(ctx, element, "xyz", f"{what} origin", tolerated=tolerated)
     if xyz is not None:
         pose.translation = rot3.vec3(xyz)
     elif element.get("xyz") is not None:
@@ -174,14 +209,14 @@ def origin(ctx: Context, element: Element | None, what: str) -> Pose | None:
         )
         return None
     if has_rpy:
-        rpy = vector(ctx, element, "rpy", f"{what} origin")
+        rpy = vector(ctx, element, "rpy", f"{what} origin", tolerated=tolerated)
         if rpy is None:
             ok = False
         else:
             pose.rotation = rot3.from_rpy(*rpy)
     elif has_quat:
         ctx.uses_feature("`quat_xyzw`", "1.1", ctx.loc(element, "quat_xyzw"))
-        quat = vector(ctx, element, "quat_xyzw", f"{what} origin", count=4)
+        quat = vector(ctx, element, "quat_xyzw", f"{what} origin", count=4, tolerated=tolerated)
         if quat is None:
             ok = False
         else:
