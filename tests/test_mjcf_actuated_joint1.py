@@ -101,3 +101,80 @@ def test_urdf_puts_the_transmission_on_the_leader(tmp_path: Path) -> None:
     actuated = {j.get("name") for j in tree.iter("joint") if j.getparent().tag == "transmission"}
     actuated |= {j.get("name") for j in tree.findall("ros2_control/joint")}
     assert "left_steer" in actuated and "right_steer" not in actuated, etree.tostring(tree).decode()[-1500:]
+
+
+# Reachy 2's gripper (sai-mujoco): the servo is on the finger joint, which the equalities make follow
+# the proximal joint, which in turn follows the distal joint and a copy of itself; the distal joint
+# follows its own copy. Five joints, four linear equalities, no loop, one actuated joint.
+GRIPPER = """<mujoco model="gripper">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="palm">
+      <geom type="box" size="0.05 0.05 0.02" mass="0.5"/>
+      {bodies}
+    </body>
+  </worldbody>
+  <equality>
+    <joint joint1="finger" joint2="proximal" polycoef="0.554 -0.4689 0 0 0"/>
+    <joint joint1="proximal" joint2="distal" polycoef="0 -1 0 0 0"/>
+    <joint joint1="proximal" joint2="proximal_copy" polycoef="0 1 0 0 0"/>
+    <joint joint1="distal" joint2="distal_copy" polycoef="0 1 0 0 0"/>
+  </equality>
+  <actuator>
+    <position name="grip" joint="finger" kp="2" ctrlrange="0.3 0.8"/>
+  </actuator>
+</mujoco>
+"""
+GRIPPER_JOINTS = ("finger", "proximal", "distal", "proximal_copy", "distal_copy")
+
+
+def _gripper(tmp_path: Path) -> Path:
+    bodies = "\n      ".join(
+        f'<body name="{name}_link" pos="0 {0.02 * i:g} 0.03"><joint name="{name}" axis="1 0 0" '
+        f'range="-3 3" damping="0.05" armature="0.001"/><geom type="capsule" size="0.005 0.02" contype="0" '
+        f'conaffinity="0" '
+        f'mass="0.01"/></body>'
+        for i, name in enumerate(GRIPPER_JOINTS))
+    path = tmp_path / "gripper.xml"
+    path.write_text(GRIPPER.format(bodies=bodies))
+    return path
+
+
+def test_a_group_of_coupled_joints_is_read_from_its_actuated_joint(tmp_path: Path) -> None:
+    mimics = _mimics(_gripper(tmp_path))
+    # proximal = (finger − 0.554) / −0.4689; distal = −proximal; the copies as their joints
+    m, o = 1.0 / -0.4689, 0.554 / 0.4689
+    want = {"proximal": (m, o), "distal": (-m, -o), "proximal_copy": (m, o), "distal_copy": (-m, -o)}
+    assert set(mimics) == set(want)
+    for name, (mult, off) in want.items():
+        leader, got_m, got_o = mimics[name]
+        assert leader == "finger" and got_m == pytest.approx(mult, rel=1e-12) and got_o == pytest.approx(off)
+
+
+def _gripper_settled(xml: Path, target: float) -> np.ndarray:
+    m = mujoco.MjModel.from_xml_path(str(xml))
+    d = mujoco.MjData(m)
+    d.ctrl[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "grip")] = target
+    for _ in range(int(3.0 / m.opt.timestep)):
+        mujoco.mj_step(m, d)
+    return np.array([d.qpos[m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)]]
+                     for name in GRIPPER_JOINTS])
+
+
+def test_the_written_gripper_closes_as_the_source_on_every_target(tmp_path: Path) -> None:
+    source = _gripper(tmp_path)
+    out = tmp_path / "out" / "gripper.xml"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "MK842" not in result.output and "MK808" not in result.output  # the servo kept, nothing lost
+    assert [a.get("joint") for a in etree.parse(str(out)).find("actuator")] == ["finger"]
+    got, want = _gripper_settled(out, 0.6), _gripper_settled(source, 0.6)
+    assert abs(want[0] - 0.6) < 0.01 and np.max(np.abs(got - want)) < 1e-3, (got, want)
+    urdf = tmp_path / "out" / "gripper.urdf"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(urdf)])
+    assert result.exit_code == 0 and "MK842" not in result.output, result.output
+    tree = etree.parse(str(urdf))
+    assert {m.getparent().get("name"): m.get("joint") for m in tree.iter("mimic")} == {
+        name: "finger" for name in GRIPPER_JOINTS[1:]}
+    actuated = {j.get("name") for j in tree.iter("joint") if j.getparent().tag == "transmission"}
+    assert actuated == {"finger"}

@@ -472,13 +472,22 @@ def apply_joint_equalities(
     ``joint2`` (``actuated``: MuJoCo joint ids with an actuator on the joint itself), the same linear
     constraint is read the other way, ``q2 = (q1 − o) / m``, so that the actuator stays on the leader
     (safety-gymnasium's racecar: its steering servo is on ``joint1``). Only where that makes no chain:
-    ``joint2`` follows nothing and leads no other joint."""
+    ``joint2`` follows nothing and leads no other joint.
+
+    A larger group of joints tied by linear equalities, without a loop, with one actuated joint that
+    the equalities make follow another, is read from that joint: every other joint of the group follows
+    it directly, the linear maps along the way composed (:func:`_rooted_at_the_actuator`; Reachy 2's
+    gripper, whose servo is on the finger joint that the equalities tie to a proximal joint, which ties
+    the distal joint and two copies)."""
     linear = [eq for eq in equalities if eq["type"] == "joint" and eq["active"]
               and eq["obj2id"] is not None and eq["obj2id"] >= 0]
     followed = [eq["obj2id"] for eq in linear]
     followers = [eq["obj1id"] for eq in linear]
+    rooted, covered = _rooted_at_the_actuator(linear, joints, refs, actuated)
+    for joint_id, (root, multiplier, offset, index) in sorted(rooted.items()):
+        joints[joint_id].mimic = Mimic(joints[root].name, multiplier, offset, source=where.get(index))
     for eq in equalities:
-        if eq["type"] != "joint" or not eq["active"]:
+        if eq["type"] != "joint" or not eq["active"] or eq["index"] in covered:
             continue
         follower, leader = joints.get(eq["obj1id"]), joints.get(eq["obj2id"])
         loc = where.get(eq["index"])
@@ -510,6 +519,61 @@ def apply_joint_equalities(
             leader.mimic = Mimic(follower.name, 1.0 / multiplier, -offset / multiplier, source=loc)
             continue
         follower.mimic = Mimic(leader.name, multiplier, offset, source=loc)
+
+
+def _is_linear(eq: dict[str, Any]) -> bool:
+    return not any(abs(c) > 0.0 for c in eq["data"][2:5]) and eq["data"][1] != 0.0
+
+
+def _rooted_at_the_actuator(linear: list[dict[str, Any]], joints: dict[int, Joint], refs: dict[int, float],
+                            actuated: frozenset[int]
+                            ) -> tuple[dict[int, tuple[int, float, float, int]], set[int]]:
+    """The groups of joints tied by linear equalities that are read from their one actuated joint
+    (:func:`apply_joint_equalities`): ``joint → (actuated joint, m, o, equality index)`` with
+    ``q = m·q_actuated + o``, and the indices of the equalities this covers. A group qualifies when its
+    equalities make no loop, exactly one of its joints is actuated, and an equality makes that joint
+    follow another (otherwise the equalities are read as written)."""
+    # joint → (neighbour, m, o, equality index) with q_neighbour = m·q + o
+    steps: dict[int, list[tuple[int, float, float, int]]] = {}
+    edges = [eq for eq in linear if eq["obj1id"] in joints and eq["obj2id"] in joints and _is_linear(eq)]
+    for eq in edges:
+        one, two = eq["obj1id"], eq["obj2id"]
+        coef = eq["data"]
+        multiplier = coef[1]
+        offset = coef[0] + refs.get(one, 0.0) - multiplier * refs.get(two, 0.0)  # q1 = m·q2 + o
+        steps.setdefault(two, []).append((one, multiplier, offset, eq["index"]))
+        steps.setdefault(one, []).append((two, 1.0 / multiplier, -offset / multiplier, eq["index"]))
+    rooted: dict[int, tuple[int, float, float, int]] = {}
+    covered: set[int] = set()
+    seen: set[int] = set()
+    for start in sorted(steps):
+        if start in seen:
+            continue
+        group, order = {start}, [start]
+        for joint_id in order:
+            for neighbour, *_ in steps[joint_id]:
+                if neighbour not in group:
+                    group.add(neighbour)
+                    order.append(neighbour)
+        seen |= group
+        indices = {index for j in group for *_, index in steps[j]}
+        drivers = sorted(group & actuated)
+        if len(indices) != len(group) - 1 or len(drivers) != 1:
+            continue  # a loop, or no actuated joint or several: the equalities as written
+        root = drivers[0]
+        if not any(eq["obj1id"] == root for eq in edges if eq["index"] in indices):
+            continue  # the actuated joint leads already
+        maps: dict[int, tuple[float, float]] = {root: (1.0, 0.0)}
+        queue = [root]
+        for joint_id in queue:
+            m0, o0 = maps[joint_id]
+            for neighbour, m, o, index in steps[joint_id]:
+                if neighbour not in maps:
+                    maps[neighbour] = (m * m0, m * o0 + o)
+                    rooted[neighbour] = (root, m * m0, m * o0 + o, index)
+                    queue.append(neighbour)
+        covered |= indices
+    return rooted, covered
 
 
 def quoted(name: str | None) -> str:

@@ -48,8 +48,21 @@ def sites_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]
 def equalities_left(value: list[dict[str, Any]], robot: Robot) -> list[dict[str, Any]]:
     """The equalities that are not a joint coupling the model holds as a mimic (one joint follows the
     other, as the reader made it of the equality: usually ``joint1`` follows ``joint2``, the other
-    way when the source actuates ``joint1``)."""
-    followers = {(j.name, j.mimic.joint) for j in robot.joints if j.mimic is not None}
-    coupled = followers | {(leader, follower) for follower, leader in followers}
-    return [e for e in value if not (isinstance(e, dict) and e.get("type") == "joint"
-                                     and (e.get("obj1"), e.get("obj2")) in coupled)]
+    way when the source actuates ``joint1``), nor a linear one between two joints that follow the same
+    joint (:func:`held_by_mimics`)."""
+    leads = {j.name: j.mimic.joint for j in robot.joints if j.mimic is not None}
+    return [e for e in value if not (isinstance(e, dict) and held_by_mimics(e, leads))]
+
+
+def held_by_mimics(equality: dict[str, Any], leads: dict[str, str]) -> bool:
+    """Whether the mimics ``leads`` (follower → leader) hold this source equality: a joint equality
+    between a follower and its leader, or a linear one between two joints that follow the same joint (a
+    group the MJCF reader read from its actuated joint, whose composed mimics imply it)."""
+    if equality.get("type") != "joint":
+        return False
+    one, two = equality.get("obj1"), equality.get("obj2")
+    if leads.get(str(one)) == two or leads.get(str(two)) == one:
+        return True
+    data = equality.get("data") or []
+    linear = len(data) >= 5 and not any(abs(float(c)) > 0.0 for c in data[2:5])
+    return linear and str(one) in leads and leads[str(one)] == leads.get(str(two), two)

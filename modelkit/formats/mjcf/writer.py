@@ -59,6 +59,7 @@ from modelkit.convert.self_contact import SOFT_LOAD_RATIO, BelowBase, Lowest, to
 from modelkit.convert.servo_gains import with_written_masses
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.convert.tracks import roller_names
+from modelkit.formats.mjcf.carried import held_by_mimics
 from modelkit.formats.mjcf.coupling_armature import floor_coupled_armature
 from modelkit.formats.mjcf.write_actuators import ActuatorWriter
 from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, MIN_MASS, BodyTree
@@ -107,6 +108,7 @@ class MjcfWriter:
         self.names = NameTable(ctx)
         self._refusal_explained = False  # a note already says why MuJoCo refuses the file (MK872)
         self.written_equalities: list[dict[str, Any]] = []  # an MJCF source's, written back
+        self.written_mimics: dict[str, str] = {}  # follower → leader, the mimics written as equalities
         self.stiff_mimics = 0  # mimics written with MIMIC_SOLREF (MK869)
         self.root = etree.Element("mujoco", model=robot.name)
         self.sections = {tag: sub(self.root, tag) for tag in SECTIONS}
@@ -199,7 +201,7 @@ class MjcfWriter:
         lost.update(own.write_sensors())
         written = {id(eq) for eq in self.written_equalities + transmissions.equalities}
         lost["mjcf_equalities"] = [eq for eq in self.robot.extras.get("mjcf_equalities") or []
-                                   if id(eq) not in written]
+                                   if id(eq) not in written and not held_by_mimics(eq, self.written_mimics)]
         return lost
 
     def _surface_note(self) -> None:
@@ -440,6 +442,7 @@ class MjcfWriter:
                 el.set("solref", MIMIC_SOLREF)
                 self.stiff_mimics += 1
             couplings.append((follower[0], leader[0], mimic.multiplier, mimic.offset))
+            self.written_mimics[joint.name] = mimic.joint
         self._home_coupled(couplings)
 
     def _home_coupled(self, couplings: list[tuple[str, str, float, float]]) -> None:
