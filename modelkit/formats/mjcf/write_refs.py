@@ -63,5 +63,13 @@ class WrittenObjects:
         offset = [float(x) for x in link.extras.get("mjcf_body_offset") or (0.0, 0.0, 0.0)]
         return (Pose(translation=offset).inverse() @ self.tree.frame(name)).is_identity()
 
+    def source_frame(self, name: str) -> Pose | None:
+        """The MuJoCo source body's frame of link ``name`` in its written body (None: not written)."""
+        link = self.robot.link(name)
+        if link is None or name not in self.tree.bodies:
+            return None
+        offset = [float(x) for x in link.extras.get("mjcf_body_offset") or (0.0, 0.0, 0.0)]
+        return self.tree.frame(name) @ Pose(translation=offset).inverse()
+
     def body(self, link: str) -> str | None:
         return self.tree.body_name.get(link) if link in self.tree.bodies else None

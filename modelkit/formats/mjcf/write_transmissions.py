@@ -25,6 +25,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from modelkit.convert.actuator_choice import CHOSEN, FILLED, SERVOED
 from modelkit.convert.context import WriteContext
 from modelkit.convert.numbers import fmt, fmt_vec
@@ -59,6 +61,8 @@ class TransmissionWriter:
         for eq in self.robot.extras.get("mjcf_equalities") or []:
             if eq.get("type") == "tendon":
                 self._tendon_equality(eq)
+            elif eq.get("type") in ("connect", "weld"):
+                self._frame_equality(eq)
         if not self.actuators.set_aside:
             self._generals()
         return {"mjcf_tendons": lost}
@@ -84,6 +88,49 @@ class TransmissionWriter:
         if second is not None:
             el.set("tendon2", second)
         el.set("polycoef", fmt_vec(rebased([float(x) for x in eq["data"][:5]], shift1, shift2)))
+        if not eq.get("active", True):
+            el.set("active", "false")
+        for key, value in (eq.get("solver") or {}).items():
+            el.set(key, str(value))
+        self.equalities.append(eq)
+
+    def _frame_equality(self, eq: dict[str, Any]) -> None:
+        """A connect or weld equality between two bodies (or a body and the world) or two sites, when
+        they are written where the source has them: a closed loop the model does not hold (Menagerie's
+        Robotiq 2F-85 ties each follower to its coupler), written back with MuJoCo's compiled data.
+        connect: ``anchor`` in body1's frame; weld: ``anchor``, ``relpose`` and ``torquescale``."""
+        objtype = str(eq.get("objtype"))
+        if objtype not in ("body", "xbody", "site"):
+            return
+        # a weld's relative pose holds only between bodies written at their source frames; a connect's
+        # anchor is moved into the written body's frame
+        kind = "site" if objtype == "site" else "xbody" if eq["type"] == "weld" else "body"
+        first = self.refs.object(kind, str(eq.get("obj1")))
+        second = self.refs.object(kind, str(eq.get("obj2"))) if eq.get("obj2") else None
+        if first is None or (eq.get("obj2") and second is None) or (kind == "site" and second is None):
+            return
+        data = [float(x) for x in eq["data"]]
+        if kind == "body":
+            frame = self.refs.source_frame(str(eq.get("obj1")))
+            if frame is None:
+                return
+            data[0:3] = [float(x) for x in frame.rotation @ np.asarray(data[0:3]) + frame.translation]
+        el = sub(self.equality, str(eq["type"]))
+        if eq.get("name"):
+            wanted = str(eq["name"])
+            el.set("name", self.names.claim("equality", wanted, None, f"equality/{eq['type']}[{wanted}]"))
+        if kind == "site":
+            el.set("site1", first)
+            el.set("site2", str(second))
+        else:
+            el.set("body1", first)
+            if second is not None:
+                el.set("body2", second)
+            el.set("anchor", fmt_vec(data[0:3]))
+            if eq["type"] == "weld":
+                el.set("relpose", fmt_vec(data[3:10]))
+        if eq["type"] == "weld" and data[10] != 1.0:
+            el.set("torquescale", fmt(data[10]))
         if not eq.get("active", True):
             el.set("active", "false")
         for key, value in (eq.get("solver") or {}).items():
