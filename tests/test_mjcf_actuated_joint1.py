@@ -62,14 +62,16 @@ def test_the_actuated_joint1_leads(tmp_path: Path) -> None:
     assert _mimics(_source(tmp_path, "left_steer", "0.1 2")) == {"right_steer": ("left_steer", 0.5, -0.05)}
 
 
-def _settled(xml: Path, target: float) -> np.ndarray:
+def _settled(xml: Path, target: float, actuator: str = "steer",
+             joints: tuple[str, ...] = ("left_steer", "right_steer")) -> np.ndarray:
+    """The joints' positions after 3 s with ``actuator``'s control at ``target``."""
     m = mujoco.MjModel.from_xml_path(str(xml))
     d = mujoco.MjData(m)
-    d.ctrl[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "steer")] = target
+    d.ctrl[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)] = target
     for _ in range(int(3.0 / m.opt.timestep)):
         mujoco.mj_step(m, d)
     return np.array([d.qpos[m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)]]
-                     for name in ("left_steer", "right_steer")])
+                     for name in joints])
 
 
 @pytest.mark.parametrize("coef", ["0 1", "0.1 2"])
@@ -151,16 +153,6 @@ def test_a_group_of_coupled_joints_is_read_from_its_actuated_joint(tmp_path: Pat
         assert leader == "finger" and got_m == pytest.approx(mult, rel=1e-12) and got_o == pytest.approx(off)
 
 
-def _gripper_settled(xml: Path, target: float) -> np.ndarray:
-    m = mujoco.MjModel.from_xml_path(str(xml))
-    d = mujoco.MjData(m)
-    d.ctrl[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "grip")] = target
-    for _ in range(int(3.0 / m.opt.timestep)):
-        mujoco.mj_step(m, d)
-    return np.array([d.qpos[m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)]]
-                     for name in GRIPPER_JOINTS])
-
-
 def test_the_written_gripper_closes_as_the_source_on_every_target(tmp_path: Path) -> None:
     source = _gripper(tmp_path)
     out = tmp_path / "out" / "gripper.xml"
@@ -168,7 +160,7 @@ def test_the_written_gripper_closes_as_the_source_on_every_target(tmp_path: Path
     assert result.exit_code == 0, result.output
     assert "MK842" not in result.output and "MK808" not in result.output  # the servo kept, nothing lost
     assert [a.get("joint") for a in etree.parse(str(out)).find("actuator")] == ["finger"]
-    got, want = _gripper_settled(out, 0.6), _gripper_settled(source, 0.6)
+    got, want = _settled(out, 0.6, "grip", GRIPPER_JOINTS), _settled(source, 0.6, "grip", GRIPPER_JOINTS)
     assert abs(want[0] - 0.6) < 0.01 and np.max(np.abs(got - want)) < 1e-3, (got, want)
     urdf = tmp_path / "out" / "gripper.urdf"
     result = CliRunner().invoke(main, ["convert", str(source), "-o", str(urdf)])
