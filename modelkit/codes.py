@@ -353,21 +353,21 @@ _TABLE: tuple[CodeInfo, ...] = (
         "urdf-link-not-a-number",
         "warning",
         "A word where a number of a URDF link's `<inertial>` or `<collision>` should be (a mass, an inertia "
-        "moment, an origin, a shape's size: `MASS`, `1,5`); modelkit leaves that inertial or collision "
-        "out. Reference: urdfdom logs an error, keeps what it read of the link before it (an inertial's "
-        "mass, with "
-        "an all-zero inertia), drops the link's later visuals and collisions, and loads the robot; PyBullet "
-        "reads the text with C's `atof` (`MASS` is 0, `1,5` is 1); MuJoCo refuses the file (an error under "
+        "moment, an origin, a shape's size or a mesh's scale: `MASS`, `1,5`); modelkit leaves that "
+        "inertial or collision out. Reference: urdfdom logs an error, keeps what it read of the link before "
+        "it (an inertial's mass, with an all-zero inertia), drops the link's later visuals and collisions, "
+        "and loads the robot; PyBullet reads the text with C's `atof` (`MASS` is 0, `1,5` is 1); MuJoCo "
+        "refuses the file (an error under "
         "`--target mjcf`).",
     ),
     CodeInfo(
         "MK116",
         "urdf-visual-not-a-number",
         "warning",
-        "A word where a number of a URDF `<visual>` should be (its origin, its shape's size); modelkit "
-        "leaves the visual out. Reference: urdfdom logs an error, drops it and the link's later visuals and "
-        "collisions, and loads the robot; PyBullet reads the text with C's `atof`; MuJoCo's URDF import "
-        "discards visuals.",
+        "A word where a number of a URDF `<visual>` should be (its origin, its shape's size or scale); "
+        "modelkit leaves the visual out. Reference: urdfdom logs an error, drops it and the link's later "
+        "visuals and collisions, and loads the robot; PyBullet reads the text with C's `atof`; MuJoCo's "
+        "URDF import discards visuals.",
     ),
     CodeInfo(
         "MK128",

@@ -12,6 +12,7 @@ ignores ``<contact>`` and visuals.
 
 from __future__ import annotations
 
+import struct
 import subprocess
 from pathlib import Path
 
@@ -25,6 +26,7 @@ from .conftest import require_tool
 
 BOX = '<geometry><box size="0.1 0.1 0.1"/></geometry>'
 INERTIA = '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>'
+SCALED = '<geometry><mesh filename="{mesh}" scale="1 s 1"/></geometry>'  # {mesh}: a file _write makes
 
 
 def _robot(inertial: str = "", contact: str = "", rgba: str = "1 0 0 1", visual: str = BOX,
@@ -66,15 +68,21 @@ CASES = {
     "visual-radius-word": ("MK116", _robot(visual='<geometry><cylinder radius="r" length="1"/></geometry>'),
                            "r", "visual radius"),
     "visual-origin-word": ("MK116", _robot(visual=f'<origin xyz="0 0 q"/>{BOX}'), "q", "visual z"),
+    "visual-scale-word": ("MK116", _robot(visual=SCALED), "s", "visual scale y"),
+    "collision-scale-word": ("MK127", _robot(collision=SCALED), "s", "collision size y"),
     "colour-word": ("MK129", _robot(rgba="VISUALCOLOR 1"), "VISUALCOLOR", "rgba"),
     "colour-four-words": ("MK129", _robot(rgba="red 0 0 1"), "red", "rgba"),
 }
 REFUSED_BY_MUJOCO = {"MK127", "MK129"}
+MESH = "tri.stl"  # one triangle, beside the file
 
 
 def _write(tmp_path: Path, text: str) -> Path:
+    mesh = tmp_path / MESH
+    triangle = struct.pack("<12fH", 0, 0, 1, 0, 0, 0, 0.1, 0, 0, 0, 0.1, 0, 0)
+    mesh.write_bytes(b"\0" * 80 + struct.pack("<I", 1) + triangle)
     path = tmp_path / "robot.urdf"
-    path.write_text(text)
+    path.write_text(text.replace("{mesh}", str(mesh)))
     return path
 
 
@@ -89,6 +97,7 @@ def _pybullet_reading(path: Path, quantity: str) -> float | tuple[float, ...]:
         visual = p.getVisualShapeData(body, physicsClientId=client)[-1]
         collision = p.getCollisionShapeData(body, 0, physicsClientId=client)[0]
         shapes = {"rgba": tuple(visual[7]), "visual radius": visual[3][1], "visual z": visual[5][2],
+                  "visual scale y": visual[3][1],
                   "collision size y": collision[3][1], "collision z": collision[5][2]}
         if quantity in shapes:
             return shapes[quantity]
@@ -148,3 +157,4 @@ def test_a_robot_level_material_whose_colour_is_a_word_is_kept_without_a_colour(
 def test_c_atof_reads_the_leading_number_as_c_does() -> None:
     assert [c_atof(t) for t in ("MASS", "1,5", " 2.5e1kg", "-.5", "+3.", "e5", "", ".")] == [
         0.0, 1.0, 25.0, -0.5, 3.0, 0.0, 0.0, 0.0]
+

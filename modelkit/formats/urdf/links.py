@@ -529,7 +529,7 @@ def _mesh(ctx: Context, shape: Element, what: str, meshes: MeshChecker, visual_o
         if numbers and len(numbers) != 3 and all(math.isfinite(v) for v in numbers):
             scale = _scale_as_pybullet_reads_it(ctx, shape, what, text, numbers)
         else:
-            values = vector(ctx, shape, "scale", f"mesh of the {what}")
+            values = vector(ctx, shape, "scale", f"mesh of the {what}", tolerated=_shape_word(visual_only))
             if values is None:
                 return None
             scale = (values[0], values[1], values[2])
