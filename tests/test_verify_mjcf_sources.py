@@ -311,3 +311,42 @@ def test_mujoco_warnings_are_collected_and_instability_fails(tmp_path: Path,
     (check,) = engine_warnings(report, "mujoco", sim.runtime_warnings, "replay_warnings", "the replay")
     assert (check.quantity, check.passed) == ("stability", False) and "QACC" in check.detail
     assert report.engines["mujoco"]["replay_warnings"]
+
+
+# A two-link arm whose bodies MuJoCo holds up against gravity (trossen-arm-sim's WXAI follower: every
+# body gravcomp="1", every joint actuatorgravcomp). No URDF holds it, so PyBullet's arm falls: the
+# replay leaves MuJoCo's gravity compensation out too (it failed by 0.13 rad at 0.22 s before).
+GRAVCOMP_ARM = """<mujoco model="held">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="base" gravcomp="1">
+      <geom type="cylinder" size="0.03 0.03" mass="1"/>
+      <body name="upper" pos="0 0 0.05" gravcomp="1">
+        <joint name="shoulder" axis="0 1 0" range="-2 2" actuatorgravcomp="true"/>
+        <geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.02" mass="0.5"/>
+        <body name="fore" pos="0.2 0 0" gravcomp="1">
+          <joint name="elbow" axis="0 1 0" range="-2 2" actuatorgravcomp="true"/>
+          <geom type="capsule" fromto="0 0 0 0.15 0 0.02" size="0.015" mass="0.3"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <motor name="shoulder" joint="shoulder" ctrlrange="-5 5"/>
+    <motor name="elbow" joint="elbow" ctrlrange="-5 5"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def test_the_replay_leaves_mujocos_gravity_compensation_out_and_says_so(tmp_path: Path) -> None:
+    engines = _installed(("mujoco", "pybullet", "pinocchio"))
+    if engines != ["mujoco", "pybullet", "pinocchio"]:
+        pytest.skip("needs MuJoCo, PyBullet and Pinocchio")
+    source = tmp_path / "held.xml"
+    source.write_text(GRAVCOMP_ARM)
+    report = verify(source, None, tuple(engines), configurations=2, samples=2, driven=False)
+    assert report.failed == [], [(c.engine, c.quantity, c.where, c.error) for c in report.failed]
+    assert [c for c in report.checks if c.quantity == "replay" and c.engine == "pybullet"]
+    (entry,) = [s for s in report.skips if "passive terms" in s.reason]
+    assert "body gravity compensation of 3 bodies (base 1, fore 1, upper 1)" in entry.reason

@@ -887,19 +887,24 @@ def _frame_placements(held: Robot, inertials: Mapping[str, Any], renames: Rename
 
 
 def _left_out(sims: list[Any], maps: dict[str, Renames]) -> list[str]:
-    """What the MuJoCo simulator zeroed for the replay (damping, friction loss, stiffness; armature is
-    said by its own entry), per quantity, with the joints by source name and their values."""
+    """What the MuJoCo simulator zeroed for the replay (damping, friction loss, stiffness, a tendon's
+    passive terms, a body's gravity compensation; armature is said by its own entry), per quantity,
+    with the joints, tendons or bodies by source name and their values."""
     back = {w: src for src, w in maps.get("mjcf", {}).get("joint", {}).items()}
+    back_links = {w: src for src, w in maps.get("mjcf", {}).get("link", {}).items()}
     out = []
     for sim in sims:
-        for quantity, joints in sorted(getattr(sim, "left_out", {}).items()):
+        for quantity, objects in sorted(getattr(sim, "left_out", {}).items()):
             if quantity == "armature":
                 continue
-            names = sorted(back.get(j, j) for j in joints)
-            values = {back.get(j, j): v for j, v in joints.items()}
+            kind = quantity.split(" ", 1)[0] if quantity.startswith(("tendon ", "body ")) else "joint"
+            names_back = back_links if kind == "body" else back
+            names = sorted(names_back.get(o, o) for o in objects)
+            values = {names_back.get(o, o): v for o, v in objects.items()}
             shown = ", ".join(f"{n} {values[n]:g}" for n in names[:8]) + (
                 f" and {len(names) - 8} more" if len(names) > 8 else "")
-            out.append(f"joint {quantity} of {len(names)} joint(s) ({shown})")
+            what = quantity if kind != "joint" else f"joint {quantity}"
+            out.append(f"{what} of {len(names)} {'bodies' if kind == 'body' else kind + '(s)'} ({shown})")
     return out
 
 
@@ -1038,7 +1043,8 @@ def _replay(reference: Robot, files: dict[str, Path], maps: dict[str, Renames], 
     if left_out:
         report.skips.append(Skip(3, "mujoco+pybullet", (
             "replay without the joints' passive terms (it tests inertial data; PyBullet's worker zeroes "
-            "all damping, its 0.04 default and the URDF's <dynamics damping>): MuJoCo's "
+            "all damping, its 0.04 default and the URDF's <dynamics damping>; a URDF holds no gravity "
+            "compensation): MuJoCo's "
             + "; ".join(left_out) + " zeroed on the compiled model")))
     if with_armature:
         report.skips.append(Skip(3, "mujoco+pybullet", (

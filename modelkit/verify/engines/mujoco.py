@@ -652,7 +652,7 @@ class MujocoSimulator:
                          "passive_joint_terms": ("dof_damping, dof_frictionloss and jnt_stiffness zeroed"
                                                  + ("" if armature else ", dof_armature zeroed")
                                                  + "; tendon stiffness, damping, friction loss and armature "
-                                                   "zeroed"),
+                                                   "zeroed; body_gravcomp zeroed"),
                          "left_out": {k: dict(sorted(v.items())) for k, v in sorted(self.left_out.items())},
                          "inertials_replaced": {k: list(v) for k, v in sorted((inertials or {}).items())},
                          "torques": ("the PD law as affine actuators (gain kp, bias 0, -kp, -kd; the file's "
@@ -691,6 +691,13 @@ class MujocoSimulator:
                     name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_TENDON, t) or f"tendon {t}"
                     left_out.setdefault(f"tendon {quantity}", {})[name] = value
             values[...] = 0.0
+        # An MJCF source's gravity compensation (body gravcomp) is MuJoCo's alone: no URDF holds it
+        # (MK808), so PyBullet's arm falls under gravity where MuJoCo's would float
+        for b in range(m.nbody):
+            if m.body_gravcomp[b]:
+                name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) or f"body {b}"
+                left_out.setdefault("body gravity compensation", {})[name] = float(m.body_gravcomp[b])
+        m.body_gravcomp[:] = 0.0
         return left_out
 
     def dof_names(self) -> list[str]:
