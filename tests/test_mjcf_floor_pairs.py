@@ -123,3 +123,71 @@ def test_verify_counts_geoms_that_collide_by_pairs_alone(tmp_path: Path) -> None
     assert list(report.failed) == []
     shapes = [c for c in report.checks if c.engine == "mujoco" and c.quantity == "shape-set"]
     assert shapes and all(c.passed for c in shapes)
+
+
+# MuJoCo Menagerie's Apptronik Apollo: no geom collides and no pair is in the robot file; its scene
+# pairs the soles with its floor. Menagerie keeps collision shapes in geom group 3 (visuals in 2).
+_SCENE_PAIRED = """<mujoco model="walker">
+  <default>
+    <geom contype="0" conaffinity="0"/>
+    <default class="visual"><geom group="2"/></default>
+    <default class="collision"><geom group="3" rgba="0 1 0 0.4"/></default>
+  </default>
+  <worldbody>
+    <body name="pelvis" pos="0 0 0.3">
+      <freejoint/>
+      <inertial pos="0 0 0" mass="2" diaginertia="0.02 0.02 0.02"/>
+      <geom class="visual" type="sphere" size="0.08"/>
+      <geom class="collision" type="capsule" size="0.06 0.05"/>
+      <body name="shin" pos="0 0 -0.15">
+        <joint name="knee" axis="0 1 0" range="-1 1"/>
+        <inertial pos="0 0 -0.05" mass="0.5" diaginertia="0.002 0.002 0.001"/>
+        <geom class="visual" type="cylinder" size="0.03 0.05" pos="0 0 -0.05"/>
+        <geom name="sole" class="collision" type="box" size="0.08 0.04 0.01" pos="0 0 -0.11"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_a_file_that_collides_nothing_itself_keeps_its_group_3_geoms_as_collisions(tmp_path: Path) -> None:
+    """Every output has the two collision shapes; the MJCF keeps them colliding nothing, as the source
+    (its scene pairs them); the URDF stands on PyBullet's plane instead of falling through it."""
+    import pybullet as p
+    import pybullet_data
+
+    source = tmp_path / "walker.xml"
+    source.write_text(_SCENE_PAIRED)
+    robot = validate(source).robot
+    assert robot is not None
+    assert {link.name: len(link.collisions) for link in robot.links} == {"pelvis": 1, "shin": 1}
+    assert all(len(link.visuals) >= 1 for link in robot.links)
+    urdf = tmp_path / "out" / "walker.urdf"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(urdf)])
+    assert result.exit_code == 0, result.output
+    client = p.connect(p.DIRECT)
+    try:
+        p.setGravity(0, 0, -9.81, physicsClientId=client)
+        p.loadURDF(str(Path(pybullet_data.getDataPath()) / "plane.urdf"), physicsClientId=client)
+        body = p.loadURDF(str(urdf), [0, 0, 0.3], physicsClientId=client)
+        for _ in range(480):
+            p.stepSimulation(physicsClientId=client)
+        assert p.getBasePositionAndOrientation(body, physicsClientId=client)[0][2] > 0.1
+    finally:
+        p.disconnect(client)
+    xml = tmp_path / "out" / "walker.xml"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(xml)])
+    assert result.exit_code == 0, result.output
+    m = mujoco.MjModel.from_xml_path(str(xml))
+    assert not any(m.geom_contype) and not any(m.geom_conaffinity) and m.npair == 0  # as the source
+    assert sum(int(g) == 3 for g in m.geom_group) == 2
+
+
+def test_group_3_geoms_that_collide_nothing_stay_visuals_where_the_file_collides(tmp_path: Path) -> None:
+    text = _SCENE_PAIRED.replace('<geom name="sole" class="collision"', '<geom name="sole" contype="1"')
+    source = tmp_path / "walker.xml"
+    source.write_text(text)
+    robot = validate(source).robot
+    assert robot is not None
+    assert {link.name: len(link.collisions) for link in robot.links} == {"pelvis": 0, "shin": 1}

@@ -130,13 +130,16 @@ class MjGeom:
     condim: int = 3
     contact: dict[str, str] = field(default_factory=dict)  # solref, solimp... where not MuJoCo's default
     paired: bool = False  # named by an explicit <contact><pair>
+    collision_group: bool = False  # in group 3 of a file that collides nothing itself (its scene does)
 
     @property
     def visual_only(self) -> bool:
         """MuJoCo collides a geom when its contype or conaffinity is non-zero, or when a ``<pair>`` names
         it (MJX models such as jaxterity's G1 keep ``contype="0" conaffinity="0"`` on every geom and
-        collide the feet with the floor and each other by pairs alone)."""
-        return self.contype == 0 and self.conaffinity == 0 and not self.paired
+        collide the feet with the floor and each other by pairs alone). In a file that collides
+        nothing itself, the geoms of collision group 3 are its collision shapes: the scene that
+        includes it pairs them (``CompiledModel.collisions_elsewhere``)."""
+        return self.contype == 0 and self.conaffinity == 0 and not self.paired and not self.collision_group
 
 
 @dataclass

@@ -62,6 +62,18 @@ def enum_word(enum_value: Any, prefix: str) -> str:
     return name[len(prefix) :].lower() if name.startswith(prefix) else name.lower()
 
 
+MENAGERIE_COLLISION_GROUP = 3
+"""The geom group MuJoCo Menagerie's models put their collision shapes in (visuals in group 2)."""
+
+
+def collides_nothing(m: Any) -> bool:
+    """Whether a compiled model collides nothing itself: every geom has ``contype`` and ``conaffinity``
+    0 and no ``<pair>`` names one, as MuJoCo Menagerie's Apptronik Apollo, whose scene file pairs the
+    soles with its floor. Its geoms in :data:`MENAGERIE_COLLISION_GROUP` are then its collision shapes."""
+    return (int(m.npair) == 0 and not any(int(x) for x in m.geom_contype)
+            and not any(int(x) for x in m.geom_conaffinity))
+
+
 class CompiledModel:
     """Reads one ``MjModel`` (with the ``MjSpec`` it came from, for mesh file names)."""
 
@@ -71,6 +83,7 @@ class CompiledModel:
         self.spec = spec
         self.model_dir = model_dir
         self._paired: frozenset[int] | None = None
+        self._collisions_elsewhere: bool | None = None
 
     @property
     def paired(self) -> frozenset[int]:
@@ -81,6 +94,13 @@ class CompiledModel:
             self._paired = frozenset(int(g) for k in range(int(m.npair))
                                      for g in (m.pair_geom1[k], m.pair_geom2[k]))
         return self._paired
+
+    @property
+    def collisions_elsewhere(self) -> bool:
+        """:func:`collides_nothing`: the file's collisions are in the scene that includes it."""
+        if self._collisions_elsewhere is None:
+            self._collisions_elsewhere = collides_nothing(self.m)
+        return self._collisions_elsewhere
 
     def name(self, kind: str, index: int) -> str | None:
         obj = getattr(self.mj.mjtObj, f"mjOBJ_{kind.upper()}")
@@ -180,6 +200,7 @@ class CompiledModel:
             condim=int(m.geom_condim[g]),
             contact=contact_attributes(m, g),
             paired=g in self.paired,
+            collision_group=self.collisions_elsewhere and int(m.geom_group[g]) == MENAGERIE_COLLISION_GROUP,
         )
         mesh = int(m.geom_dataid[g])
         if kind == "mesh" and mesh >= 0:

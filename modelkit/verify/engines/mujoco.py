@@ -26,6 +26,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from modelkit.formats.mjcf.compiled import MENAGERIE_COLLISION_GROUP, collides_nothing
 from modelkit.formats.mjcf.quiet import collected_warnings
 from modelkit.model import BALL_KEYS, Robot
 from modelkit.spatial import Pose, axis_angle, matrix_from_quat_wxyz
@@ -361,8 +362,8 @@ class MujocoModel:
         return facts
 
     def shapes(self) -> dict[str, list[ShapeFacts]]:
-        """Collision geoms (``contype | conaffinity`` non-zero, or named by a ``<pair>``) per link, in the
-        link frame.
+        """Collision geoms (``contype | conaffinity`` non-zero, or named by a ``<pair>``; in a file that
+        collides nothing itself, those of group 3) per link, in the link frame.
 
         ``geom_size`` holds half sizes (box half edges, cylinder/capsule radius and half length).
         A mesh geom's compiled frame is moved to the mesh's centroid and principal axes
@@ -379,9 +380,11 @@ class MujocoModel:
             shift[body.index] = Pose(np.eye(3), -body.offset)
             owner[body.index] = body.name
         paired = {int(g) for k in range(m.npair) for g in (m.pair_geom1[k], m.pair_geom2[k])}
+        grouped = collides_nothing(m)  # the collisions are the scene's: group 3 holds the shapes
         for g in range(m.ngeom):
             b = int(m.geom_bodyid[g])
-            collides = bool(int(m.geom_contype[g]) | int(m.geom_conaffinity[g])) or g in paired
+            collides = (bool(int(m.geom_contype[g]) | int(m.geom_conaffinity[g])) or g in paired
+                        or (grouped and int(m.geom_group[g]) == MENAGERIE_COLLISION_GROUP))
             if (b == 0 and not self._world_is_root) or not collides:
                 continue
             kind = _GEOMS.get(int(m.geom_type[g]), f"type-{int(m.geom_type[g])}")
