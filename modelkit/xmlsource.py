@@ -633,6 +633,16 @@ _TINYXML2_LENIENCY = {
         locate=None,
     ),
 }
+#: A comment after a URDF's root element that is never closed: urdfdom alone reads past it (MK027).
+_OPEN_COMMENT = _Leniency(
+    lambda data, _: _blank_open_comment(data),
+    lambda text: "a comment after the root element is never closed: urdfdom (TinyXML) reads the root "
+    "element and ignores the rest of the file; PyBullet and MuJoCo (TinyXML2: "
+    "XML_ERROR_PARSING_COMMENT) and strict XML tools (lxml, so xacro) refuse the file",
+    'close the comment with "-->" or delete it',
+    locate=_open_comment_start,
+    code="MK027",
+)
 #: A URDF's own loader is urdfdom (TinyXML 1): what follows its root element is read past when both
 #: parsers read it (MK020), or when urdfdom alone does (MK027: it stops quietly at text outside any
 #: element; PyBullet refuses it and MuJoCo nearly always, so it is an error under their targets).
@@ -651,17 +661,10 @@ _URDFDOM_LENIENCY = {
             code="MK027",
         ),
     ),
-    "Comment not terminated": (
-        _Leniency(
-            lambda data, _: _blank_open_comment(data),
-            lambda text: "a comment after the root element is never closed: urdfdom (TinyXML) reads the root "
-            "element and ignores the rest of the file; PyBullet and MuJoCo (TinyXML2: "
-            "XML_ERROR_PARSING_COMMENT) and strict XML tools (lxml, so xacro) refuse the file",
-            'close the comment with "-->" or delete it',
-            locate=_open_comment_start,
-            code="MK027",
-        ),
-    ),
+    "Comment not terminated": (_OPEN_COMMENT,),
+    # `<!-- a <!-- b` at the end: libxml2 first meets the "--" of the inner `<!--`; the comment is never
+    # closed, and urdfdom ignores it whole
+    "hyphen within comment": (_OPEN_COMMENT, _TINYXML2_LENIENCY["hyphen within comment"]),
 }
 
 

@@ -444,6 +444,7 @@ _TEXT_AFTER_ROOT = {
     "text then an open element": "\ntext <b>\n",
     "a comment never closed": "\n<!-- never closed\n",
     "an element then a comment never closed": "\n<x/>\n<!-- never closed",
+    "a comment never closed holding another's start": "\n<!-- a <!-- b\n",
 }
 
 
@@ -481,6 +482,9 @@ def test_a_comment_never_closed_inside_a_urdf_root_stays_an_error(tmp_path: Path
     path.write_text(_TRIANGLE_URDF.replace("</robot>", "<!-- never closed\n</robot>"))
     assert not check_urdf_accepts(path)[0]
     assert [d.code for d in validate(path).diagnostics if d.code in ("MK020", "MK027")] == ["MK020"]
+    path.write_text(_TRIANGLE_URDF.replace("</robot>", "<!-- a -- b\n</robot>"))  # "--" in it
+    assert not check_urdf_accepts(path)[0]
+    assert [d.severity.value for d in validate(path).diagnostics if d.code == "MK020"][-1] == "error"
 
 
 @pytest.mark.parametrize("tail", ["\n<b> text\n", "\n</x> <b>\n"])
