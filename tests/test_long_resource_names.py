@@ -66,3 +66,38 @@ def test_a_materials_file_too_long_to_look_up_cannot_be_read(tmp_path: Path) -> 
     options = ReadOptions(materials_path=tmp_path / NAME.replace(".stl", ".yaml"))
     codes = [d.code for d in validate(body / "mobile_robot_pantilt.body", options).errors]
     assert "MK899" not in codes and "MK511" in codes, codes
+
+
+_BODY = ("format: ChoreonoidBody\nformat_version: 2.0\nname: r\nroot_link: a\nlinks:\n  - name: a\n"
+         "    joint_type: free\n    mass: 1\n    inertia: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n")
+BODY_FILES = {
+    "sub-body": (_BODY + "  - type: SubBody\n    uri: {uri}.body\n    parent: a\n", "MK216"),
+    "yaml-resource": (_BODY + "    elements:\n      - type: Resource\n        uri: {uri}.yaml\n", "MK500"),
+    "texture": (_BODY + "    elements:\n      - type: Shape\n"
+                "        geometry: {{ type: Box, size: [1, 1, 1] }}\n"
+                "        appearance: {{ texture: {{ uri: {uri}.png }} }}\n", "MK507"),
+}
+
+
+@pytest.mark.parametrize("uri", [NAME, DEEP], ids=["long-name", "long-path"])
+@pytest.mark.parametrize("kind", list(BODY_FILES))
+def test_a_body_file_resource_too_long_to_look_up_is_not_found(tmp_path: Path, kind: str,
+                                                               uri: str) -> None:
+    """A ``.body`` SubBody, YAML resource or texture (``Path.exists`` and ``is_file`` raised on these
+    until 2026-12-04: MK899)."""
+    model, code = BODY_FILES[kind]
+    path = tmp_path / "m.body"
+    path.write_text(model.format(uri=uri.removesuffix(".stl")))
+    codes = [d.code for d in validate(path).diagnostics]
+    assert "MK899" not in codes and code in codes, codes
+
+
+@pytest.mark.parametrize("uri", [NAME, DEEP], ids=["long-name", "long-path"])
+def test_a_load_yaml_file_too_long_to_look_up_is_not_found(tmp_path: Path, uri: str) -> None:
+    path = tmp_path / "m.xacro"
+    path.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                    f'<xacro:property name="p" value="${{xacro.load_yaml(\'{uri}.yaml\')}}"/>'
+                    '<link name="a"><inertial><mass value="${p[\'m\']}"/>'
+                    '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>')
+    codes = [d.code for d in validate(path).diagnostics]
+    assert "MK899" not in codes and "MK705" in codes, codes

@@ -304,7 +304,7 @@ def _material(shape: YMap, ctx: WalkContext) -> VisualMaterial | None:
         uri = v.scalar_text(uri_node)
         if uri is not None and uri_node is not None:
             res = ctx.resolver.resolve(uri, ctx.base_dir, ctx.path)
-            if res.path is None or not res.path.is_file():
+            if res.path is None or not os.path.isfile(res.path):  # False for a name too long to look up
                 ctx.sink.emit(
                     "MK507",
                     f'texture "{uri}" cannot be found'
@@ -725,7 +725,7 @@ def _add_yaml_resource(
     path = resolution.path
     key = str(path)
     if key not in ctx.yaml_cache:
-        if not path.exists():
+        if not os.path.exists(path):  # False for a name too long to look up, as for a missing file
             ctx.sink.emit("MK500", f'YAML resource "{uri}" not found at {path}', uri_node.loc)
             ctx.yaml_cache[key] = None
         else:

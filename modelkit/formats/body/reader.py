@@ -8,6 +8,7 @@ shared docs) is the specification; section numbers below refer to it.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -555,7 +556,7 @@ class _BodyReader:
                 uri_node.loc,
             )
             return []
-        if not path.exists():
+        if not os.path.exists(path):  # False for a name too long to look up, as for a missing file
             self.sink.emit(
                 "MK216",
                 f'SubBody "{uri}" cannot be loaded: not found at {path}; {SUBBODY_DROPPED}',
