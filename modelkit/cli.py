@@ -742,7 +742,7 @@ def _verify(sources: tuple[Path, ...], output: Path | None, names: tuple[str, ..
     from modelkit.interrupt import check
     from modelkit.safewrite import UnsafeOutput
 
-    if len(sources) == 1 and not sources[0].is_dir() and cluster is None:
+    if len(sources) == 1 and not os.path.isdir(sources[0]) and cluster is None:
         from modelkit.verify.api import verify as run_verify
         from modelkit.verify.many import progress_wanted, save
         from modelkit.verify.report import render_table

@@ -146,13 +146,14 @@ class Resolver:
     def _search_package(self, package: str, start: Path) -> Path | None:
         if package in self.package_paths:
             return self.package_paths[package]
+        # os.path.isdir, not Path.is_dir: False for a package name too long to look up (ENAMETOOLONG)
         for entry in _split_paths(self.environ.get("ROS_PACKAGE_PATH", "")):
-            if (entry / package).is_dir():
+            if os.path.isdir(entry / package):
                 return entry / package
-            if entry.name == package and entry.is_dir():
+            if entry.name == package and os.path.isdir(entry):
                 return entry
         for entry in _split_paths(self.environ.get("AMENT_PREFIX_PATH", "")):
-            if (entry / "share" / package).is_dir():
+            if os.path.isdir(entry / "share" / package):
                 return entry / "share" / package
         folder = Path(os.path.realpath(start))  # never raises on a symlink loop
         for candidate in (folder, *folder.parents):

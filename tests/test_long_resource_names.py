@@ -101,3 +101,32 @@ def test_a_load_yaml_file_too_long_to_look_up_is_not_found(tmp_path: Path, uri: 
                     '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>')
     codes = [d.code for d in validate(path).diagnostics]
     assert "MK899" not in codes and "MK705" in codes, codes
+
+
+def test_a_package_name_too_long_to_look_up_on_the_package_path_is_not_found(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path))
+    path = tmp_path / "m.urdf"
+    path.write_text(MODELS["urdf"].format(uri=f"package://{'p' * 300}/m.stl"))
+    codes = [d.code for d in validate(path).diagnostics]
+    assert "MK899" not in codes and "MK504" in codes, codes
+
+
+def test_convert_and_verify_given_names_too_long_say_so(tmp_path: Path) -> None:
+    """``convert -o`` a name the file system cannot create: the write fails with MK894 and nothing is
+    left; ``verify`` of a model (or ``--urdf``) named so: "no such file", exit 2. Both were MK899."""
+    from click.testing import CliRunner
+
+    from modelkit.cli import main
+
+    source = tmp_path / "m.urdf"
+    source.write_text('<robot name="r"><link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" '
+                      'ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>')
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(tmp_path / ("o" * 300 + ".xml"))])
+    assert result.exit_code == 2 and "MK894" in result.output and "MK899" not in result.output, result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.urdf"]
+    too_long = [str(tmp_path / ("v" * 300 + ".urdf"))], [str(source), "--urdf", str(tmp_path / ("u" * 300))]
+    for args in too_long:
+        result = CliRunner().invoke(main, ["verify", *args])
+        assert result.exit_code == 2 and "no such file" in result.output, result.output
+        assert "MK899" not in result.output

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -236,7 +237,7 @@ def convert(
     options = options or WriteOptions()
     out = Path(output)
     by_suffix = target_for_path(out)
-    folder_mode = by_suffix is None or len(inputs) > 1 or out.is_dir()
+    folder_mode = by_suffix is None or len(inputs) > 1 or os.path.isdir(out)  # False for a name too long
     target = target_info(to) if to else by_suffix
     if target is None:
         result.diagnostics.append(diag("MK892", f"cannot tell the target format of {out}: name a file "

@@ -152,7 +152,7 @@ class _Commit:
     def _mkdirs(self, folder: Path) -> None:
         missing = []
         probe = folder
-        while not probe.exists() and probe != probe.parent:
+        while not os.path.exists(probe) and probe != probe.parent:
             missing.append(probe)
             probe = probe.parent
         for path in reversed(missing):

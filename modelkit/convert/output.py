@@ -10,6 +10,7 @@ when any file fails nothing of the conversion is left behind.
 from __future__ import annotations
 
 import hashlib
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -115,9 +116,11 @@ def target_problem(path: Path, data: bytes, what: str, force: bool,
     ident = identity(path)
     if ident is not None and ident in protected:
         return diag("MK891", f"{path} is an input of this conversion; it is not overwritten", where)
-    if path.is_symlink() or (path.exists() and not path.is_file()):
+    # os.path's tests, not pathlib's: they are False for a name too long to look up (ENAMETOOLONG),
+    # which the commit then reports as a write that failed (MK894)
+    if os.path.islink(path) or (os.path.exists(path) and not os.path.isfile(path)):
         return diag("MK892", f"{path} exists and is not a regular file", where)
-    if path.exists() and not force:
+    if os.path.exists(path) and not force:
         if what in ("mesh", "texture") and path.read_bytes() == data:
             return None
         return diag("MK890", f"{path} exists; use --force to replace it", where)

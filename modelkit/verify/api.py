@@ -59,6 +59,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import importlib
+import os
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -151,7 +152,7 @@ def _convert(welded: Robot, out_dir: Path, given: dict[str, Path | None], report
     for fmt in ("mjcf", "urdf", "sdf"):
         user = given.get(fmt)
         if user is not None:
-            if not user.exists():
+            if not os.path.exists(user):  # False for a name too long to look up
                 raise VerifyError(f"--{fmt} {user}: no such file")
             files[fmt] = user
             maps[fmt], held = _given_file(welded, fmt, user, out_dir)

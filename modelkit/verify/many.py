@@ -102,7 +102,7 @@ def expand_inputs(paths: Sequence[Path]) -> list[Path]:
     out: list[Path] = []
     seen: set[Path] = set()
     for path in paths:
-        if path.is_dir():
+        if os.path.isdir(path):  # False for a name too long to look up: then "no such file" as given
             found = sorted(p for p in path.iterdir() if p.is_file() and detect_format(p) is not None)
         else:
             found = [path]

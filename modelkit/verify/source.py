@@ -8,6 +8,7 @@ re-reads the source when it is given a report alone).
 from __future__ import annotations
 
 import copy
+import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -48,7 +49,7 @@ def read_robot(source: Path, reading: Mapping[str, Any] | None = None) -> Robot:
     from modelkit.api import validate
     from modelkit.convert.api import CONVERTIBLE_ERRORS, UNREADABLE
 
-    if not source.exists():
+    if not os.path.exists(source):  # False for a name too long to look up, as for a missing file
         raise VerifyError(f"{source}: no such file")
     options, fmt = read_options(reading)
     checked = validate(source, options, fmt)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib.util
 import math
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -104,7 +105,7 @@ def shape_facts(geom: Geom) -> ShapeFacts | None:
     if isinstance(g, Ellipsoid):
         return ShapeFacts("ellipsoid", np.asarray(g.radii, dtype=float), pose)
     if isinstance(g, Mesh):
-        missing = g.data is None and (g.path is None or not Path(g.path).is_file())
+        missing = g.data is None and (g.path is None or not os.path.isfile(g.path))
         return ShapeFacts("missing-mesh" if missing else "mesh", np.asarray(g.scale, dtype=float), pose)
     return None  # pragma: no cover - the model has no other geometry
 

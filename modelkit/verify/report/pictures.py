@@ -206,7 +206,7 @@ def _mesh_file(g: Mesh) -> tuple[Array, NDArray[np.int64]] | str:
     scale = np.ones(3)
     if g.data is not None:
         return np.asarray(g.data.vertices, dtype=float) * scale, np.asarray(g.data.faces, dtype=np.int64)
-    if g.path is None or not Path(g.path).is_file():
+    if g.path is None or not os.path.isfile(g.path):
         return f"mesh {g.uri or g.path or '(no uri)'} not found"
     from modelkit.geometry.meshfiles import MeshLoadError, MeshMetadata, load_mesh
 
