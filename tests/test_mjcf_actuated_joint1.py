@@ -117,10 +117,10 @@ GRIPPER = """<mujoco model="gripper">
     </body>
   </worldbody>
   <equality>
-    <joint joint1="finger" joint2="proximal" polycoef="0.554 -0.4689 0 0 0"/>
-    <joint joint1="proximal" joint2="distal" polycoef="0 -1 0 0 0"/>
-    <joint joint1="proximal" joint2="proximal_copy" polycoef="0 1 0 0 0"/>
-    <joint joint1="distal" joint2="distal_copy" polycoef="0 1 0 0 0"/>
+    <joint joint1="finger" joint2="proximal" polycoef="0.554 -0.4689 0 0 0" {solver}/>
+    <joint joint1="proximal" joint2="distal" polycoef="0 -1 0 0 0" {solver}/>
+    <joint joint1="proximal" joint2="proximal_copy" polycoef="0 1 0 0 0" {solver}/>
+    <joint joint1="distal" joint2="distal_copy" polycoef="0 1 0 0 0" {solver}/>
   </equality>
   <actuator>
     <position name="grip" joint="finger" kp="2" ctrlrange="0.3 0.8"/>
@@ -128,6 +128,7 @@ GRIPPER = """<mujoco model="gripper">
 </mujoco>
 """
 GRIPPER_JOINTS = ("finger", "proximal", "distal", "proximal_copy", "distal_copy")
+GRIPPER_SOLVER = 'solref="0.005 1" solimp="0.95 0.99 0.001"'
 
 
 def _gripper(tmp_path: Path) -> Path:
@@ -138,7 +139,7 @@ def _gripper(tmp_path: Path) -> Path:
         f'mass="0.01"/></body>'
         for i, name in enumerate(GRIPPER_JOINTS))
     path = tmp_path / "gripper.xml"
-    path.write_text(GRIPPER.format(bodies=bodies))
+    path.write_text(GRIPPER.format(bodies=bodies, solver=GRIPPER_SOLVER))
     return path
 
 
@@ -159,7 +160,11 @@ def test_the_written_gripper_closes_as_the_source_on_every_target(tmp_path: Path
     result = CliRunner().invoke(main, ["convert", str(source), "-o", str(out)])
     assert result.exit_code == 0, result.output
     assert "MK842" not in result.output and "MK808" not in result.output  # the servo kept, nothing lost
-    assert [a.get("joint") for a in etree.parse(str(out)).find("actuator")] == ["finger"]
+    written = etree.parse(str(out))
+    assert [a.get("joint") for a in written.find("actuator")] == ["finger"]
+    # every coupling, the composed ones too, as soft as the source's equalities
+    assert {(e.get("solref"), e.get("solimp")) for e in written.findall("equality/joint")} == {
+        ("0.005 1", "0.95 0.99 0.001 0.5 2")}
     got, want = _settled(out, 0.6, "grip", GRIPPER_JOINTS), _settled(source, 0.6, "grip", GRIPPER_JOINTS)
     assert abs(want[0] - 0.6) < 0.01 and np.max(np.abs(got - want)) < 1e-3, (got, want)
     urdf = tmp_path / "out" / "gripper.urdf"

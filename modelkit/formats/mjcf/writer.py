@@ -435,10 +435,13 @@ class MjcfWriter:
                 joint2=second,
                 polycoef=f"{fmt(offset)} {fmt(multiplier)} 0 0 0",
             )
-            solver = (source or {}).get("solver") or {}
+            # a mimic the reader composed along a group of the source's equalities (no equality of its
+            # own) keeps their solver settings: the source's coupling was as soft as they are
+            group = self._group_equality(joint.name) if source is None else None
+            solver = (source or group or {}).get("solver") or {}
             for key, value in solver.items():
                 el.set(key, str(value))
-            if source is None and joint.name not in rollers:  # rigid in the source: stiff here
+            if source is None and group is None and joint.name not in rollers:  # rigid in the source
                 el.set("solref", MIMIC_SOLREF)
                 self.stiff_mimics += 1
             couplings.append((follower[0], leader[0], mimic.multiplier, mimic.offset))
@@ -478,6 +481,16 @@ class MjcfWriter:
             if eq.get("type") == "joint" and (eq.get("obj1"), eq.get("obj2")) in ((follower, leader),
                                                                                    (leader, follower)):
                 self.written_equalities.append(eq)
+                return dict(eq)
+        return None
+
+    def _group_equality(self, follower: str) -> dict[str, Any] | None:
+        """An MJCF source's linear joint equality that names ``follower`` (the first), for a mimic the
+        reader composed along several of them (it does not count as written)."""
+        for eq in self.robot.extras.get("mjcf_equalities") or []:
+            data = eq.get("data") or []
+            if (eq.get("type") == "joint" and follower in (eq.get("obj1"), eq.get("obj2"))
+                    and len(data) >= 5 and not any(abs(float(c)) > 0.0 for c in data[2:5])):
                 return dict(eq)
         return None
 
