@@ -26,6 +26,7 @@ from typing import Any
 from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
 from modelkit.formats.mjcf.bodies import MjBody, MjGeom, MjJoint, MjSite, translation
+from modelkit.formats.mjcf.carried import is_linear
 from modelkit.formats.mjcf.source import Locator
 from modelkit.model import (
     WORLD_LINK,
@@ -522,7 +523,8 @@ def apply_joint_equalities(
 
 
 def _is_linear(eq: dict[str, Any]) -> bool:
-    return not any(abs(c) > 0.0 for c in eq["data"][2:5]) and eq["data"][1] != 0.0
+    """Linear and invertible: only c₀ and a non-zero c₁."""
+    return is_linear(eq) and eq["data"][1] != 0.0
 
 
 def _rooted_at_the_actuator(linear: list[dict[str, Any]], joints: dict[int, Joint], refs: dict[int, float],

@@ -63,6 +63,10 @@ def held_by_mimics(equality: dict[str, Any], leads: dict[str, str]) -> bool:
     one, two = equality.get("obj1"), equality.get("obj2")
     if leads.get(str(one)) == two or leads.get(str(two)) == one:
         return True
+    return is_linear(equality) and str(one) in leads and leads[str(one)] == leads.get(str(two), two)
+
+
+def is_linear(equality: dict[str, Any]) -> bool:
+    """Whether a joint equality's polynomial has only its constant and linear terms."""
     data = equality.get("data") or []
-    linear = len(data) >= 5 and not any(abs(float(c)) > 0.0 for c in data[2:5])
-    return linear and str(one) in leads and leads[str(one)] == leads.get(str(two), two)
+    return len(data) >= 5 and not any(abs(float(c)) > 0.0 for c in data[2:5])

@@ -59,7 +59,7 @@ from modelkit.convert.self_contact import SOFT_LOAD_RATIO, BelowBase, Lowest, to
 from modelkit.convert.servo_gains import with_written_masses
 from modelkit.convert.simulator import CONTACT, mujoco_contact, mujoco_options
 from modelkit.convert.tracks import roller_names
-from modelkit.formats.mjcf.carried import held_by_mimics
+from modelkit.formats.mjcf.carried import held_by_mimics, is_linear
 from modelkit.formats.mjcf.coupling_armature import floor_coupled_armature
 from modelkit.formats.mjcf.write_actuators import ActuatorWriter
 from modelkit.formats.mjcf.write_bodies import MIN_INERTIA, MIN_MASS, BodyTree
@@ -488,9 +488,7 @@ class MjcfWriter:
         """An MJCF source's linear joint equality that names ``follower`` (the first), for a mimic the
         reader composed along several of them (it does not count as written)."""
         for eq in self.robot.extras.get("mjcf_equalities") or []:
-            data = eq.get("data") or []
-            if (eq.get("type") == "joint" and follower in (eq.get("obj1"), eq.get("obj2"))
-                    and len(data) >= 5 and not any(abs(float(c)) > 0.0 for c in data[2:5])):
+            if eq.get("type") == "joint" and follower in (eq.get("obj1"), eq.get("obj2")) and is_linear(eq):
                 return dict(eq)
         return None
 
