@@ -16,7 +16,12 @@ from modelkit.convert.merge import merge_fixed_joints
 from modelkit.convert.notes import NoteSink
 from modelkit.convert.options import WriteOptions
 from modelkit.convert.registry import target_info
-from modelkit.convert.tracks import approximate_tracks, assembly_mass_properties
+from modelkit.convert.tracks import (
+    MAX_ROLLERS,
+    ROLLER_CLEARANCE,
+    approximate_tracks,
+    assembly_mass_properties,
+)
 from modelkit.geometry.extents import support
 from modelkit.model import (
     Box,
@@ -499,3 +504,34 @@ def test_a_short_track_gets_two_overlapping_rollers_and_says_so() -> None:
     entry = robot.extras["tracks"]["track_joint"]
     assert len(entry["rollers"]) == 2 and entry["overlap"] is True
     assert "the rollers overlap" in notes.items[0].message
+
+
+@pytest.mark.parametrize("length", [1.0e6, 1.0e30])
+def test_an_absurdly_long_track_gets_at_most_max_rollers_and_says_so(length: float) -> None:
+    """A track whose extent is absurd for its height (a semantic fuzz mutant: an Extrusion point at
+    3.5e38 m) once asked for ~1e38 rollers and ran the machine out of memory."""
+    robot = _box_track_robot([0.0, 1.0, 0.0], np.eye(3))
+    track = robot.link("track")
+    assert track is not None
+    for geom in [*track.collisions, *track.visuals]:
+        geom.geometry = Box(np.array([length, 0.1, 0.2]))
+    notes = NoteSink()
+    approximate_tracks(robot, notes)
+    entry = robot.extras["tracks"]["track_joint"]
+    assert len(entry["rollers"]) == MAX_ROLLERS
+    assert entry["overlap"] is False
+    assert f"longer than {MAX_ROLLERS} rollers of its height cover" in notes.items[0].message
+
+
+def test_a_track_that_fits_max_rollers_gets_them_all_without_gaps_note() -> None:
+    robot = _box_track_robot([0.0, 1.0, 0.0], np.eye(3))
+    track = robot.link("track")
+    assert track is not None
+    r = 0.1  # the box's height 0.2 / 2
+    fits = 2 * r + (MAX_ROLLERS - 1) * 2 * r * (1 + ROLLER_CLEARANCE)  # exactly MAX_ROLLERS rollers
+    for geom in [*track.collisions, *track.visuals]:
+        geom.geometry = Box(np.array([fits, 0.1, 0.2]))
+    notes = NoteSink()
+    approximate_tracks(robot, notes)
+    assert len(robot.extras["tracks"]["track_joint"]["rollers"]) == MAX_ROLLERS
+    assert "longer than" not in notes.items[0].message

@@ -93,6 +93,11 @@ TRACK_MASS_FRACTION = 0.5
 ROLLER_CLEARANCE = 0.02
 """Minimum gap between neighbouring rollers, as a fraction of the roller diameter."""
 
+MAX_ROLLERS = 64
+"""At most this many rollers per track. A real track is a few roller diameters long (the tutorial's: 2
+rollers); a track whose extent is absurd for its height (an Extrusion point at 1e38 m) would otherwise
+ask for billions of rollers. Past the cap the rollers are spread evenly with gaps, and the note says so."""
+
 TRACKS_KEY = "tracks"
 """``Robot.extras`` key of the per-track record."""
 
@@ -214,13 +219,19 @@ def split_mass(track: Inertial, roller_centres: list[Vec3], roller_inertia: Mat3
 # ---- the pass ----------------------------------------------------------------------------------
 
 
-def roller_count(shape: TrackShape) -> int:
+def rollers_that_fit(shape: TrackShape) -> int:
     """As many rollers as fit end to end without touching (at least 2); see the module docstring."""
     r = shape.radius
     span = shape.length - 2.0 * r
     if span <= 0.0:
         return 2
-    return max(2, 1 + math.floor(span / (2.0 * r * (1.0 + ROLLER_CLEARANCE)) + 1e-9))
+    fit = span / (2.0 * r * (1.0 + ROLLER_CLEARANCE)) + 1e-9
+    return max(2, 1 + math.floor(fit)) if fit < MAX_ROLLERS else MAX_ROLLERS + 1
+
+
+def roller_count(shape: TrackShape) -> int:
+    """:func:`rollers_that_fit`, at most :data:`MAX_ROLLERS`."""
+    return min(rollers_that_fit(shape), MAX_ROLLERS)
 
 
 def _rotation_z_to(axis: Vec3, forward: Vec3) -> Mat3:
@@ -320,6 +331,10 @@ def _approximate(robot: Robot, joint: Joint, link: Link, notes: NoteSink) -> Non
         "mujoco_impratio": TRACK_IMPRATIO,
     }
     message = _message(joint, link, shape, joint_names, spacing, roller_mass, exact, overlap, material)
+    if rollers_that_fit(shape) > MAX_ROLLERS:
+        message += (f"; the track is longer than {MAX_ROLLERS} rollers of its height cover (length "
+                    f"{shape.length:.6g} m for a height of {2 * r:.6g} m), so its {MAX_ROLLERS} rollers "
+                    f"are spread with gaps of {spacing - 2 * r:.6g} m between them")
     notes.note("MK809", message, source, target)
 
 
