@@ -448,6 +448,15 @@ class Robot:
                 return link
         return None
 
+    @property
+    def free_links_float(self) -> bool:
+        """Whether the links of ``free_link_poses`` float as separate bodies (SDF: a model that is not
+        static) rather than stay fixed in the world (a static model: its root welded without a world
+        joint of its own)."""
+        static = (self.root_joint is JointType.FIXED and "sdf_world_joint" not in self.extras
+                  and self.root != WORLD_LINK)
+        return not static
+
     def children_of(self) -> dict[str, list[Joint]]:
         """Parent link name → the joints that hang from it, in document order (a new dict each call)."""
         out: dict[str, list[Joint]] = {}

@@ -1642,3 +1642,41 @@ def test_asymmetric_body_inertia_is_a_warning_and_converts_its_upper_triangle(tm
     result = CliRunner().invoke(main, ["convert", "-o", str(out), str(source)])
     assert result.exit_code == 0, result.output
     assert 'ixx="0.021" ixy="0.005" ixz="0" iyy="0.021" iyz="0" izz="0.0005"' in out.read_text()
+
+
+_BAD_INERTIA = (
+    '<link name="{0}"><inertial><mass>12.3</mass><inertia><ixx>0.205</ixx><iyy>0.17425</iyy>'
+    "<izz>0.05125</izz><iyz>-0.5</iyz></inertia></inertial></link>"
+)
+
+
+@pytest.mark.parametrize("case", ["free_link", "static_model", "world_joint_child_elsewhere"])
+def test_a_negative_moment_on_any_sdf_link_is_an_error_as_libsdformat_refuses_it(
+    case: str, tmp_path: Path, sdf_oracle: Path  # noqa: F811
+) -> None:
+    """A semantic fuzz mutant of sdformat_urdf's joint_revolute.sdf: the joint's parent turned to `world`
+    left `link_1` unconnected (it floats, MK201) with a negative principal moment. validate called the link
+    static and warned; libsdformat refuses the file, and the .body convert wrote was refused by modelkit's
+    own reader (a free link with that inertia)."""
+    static = "<static>true</static>" if case == "static_model" else ""
+    joint = ('<joint name="j" type="revolute"><parent>world</parent><child>b</child><axis><xyz>1 0 0</xyz>'
+             "</axis></joint>")
+    body = f'<model name="m">{static}{_BAD_INERTIA.format("a")}{_LINK.format("b")}{joint}</model>'
+    path = tmp_path / "m.sdf"
+    path.write_text(_sdf("1.7", body))
+    assert not _libsdformat_accepts(sdf_oracle, path)
+    found = [d for d in validate(path).diagnostics if d.code == "MK302"]
+    assert [d.severity.value for d in found] == ["error"], found
+    if case == "static_model":
+        assert "libsdformat refuses the whole file" in found[0].message
+
+
+def test_a_negative_moment_on_a_welded_urdf_link_stays_a_warning(tmp_path: Path) -> None:
+    """urdfdom and PyBullet load it, and no engine simulates a link welded to the world."""
+    path = tmp_path / "r.urdf"
+    path.write_text(_urdf(
+        '<link name="world"/><joint name="w" type="fixed"><parent link="world"/><child link="a"/></joint>'
+        '<link name="a"><inertial><mass value="12.3"/><inertia ixx="0.205" iyy="0.17425" izz="0.05125" '
+        'ixy="0" ixz="0" iyz="-0.5"/></inertial></link>'))
+    found = [d for d in validate(path).diagnostics if d.code == "MK302"]
+    assert found and {d.severity.value for d in found} == {"warning"}, found

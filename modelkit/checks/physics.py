@@ -21,12 +21,15 @@ DEFAULTS_HINT = {
 
 
 def moving_links(robot: Robot) -> set[str]:
-    """Links that move relative to the world: below a moving joint, or the floating root."""
+    """Links that move relative to the world: below a moving joint, the floating root, or a link no joint
+    connects to the tree that floats as a separate body (SDF, MK201), with what hangs from it."""
     moving: set[str] = set()
     if robot.root is not None and robot.root_joint is JointType.FLOATING:
         moving.add(robot.root)
     children = robot.children_of()
     stack = [(robot.root, robot.root in moving)] if robot.root else []
+    if robot.free_links_float:
+        stack += [(name, True) for name in robot.free_link_poses]
     seen: set[str] = set()
     while stack:
         name, moves = stack.pop()
@@ -268,6 +271,11 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
         yield from _judge_inertia(robot, what, total, tensor, _body_loc(links, members), severity, static)
 
 
+# Source formats whose own loader refuses a negative principal moment on any link, moving or not.
+NEGATIVE_MOMENT_REFUSED_BY = {
+    "sdf": 'libsdformat refuses the whole file ("A link named ... has invalid inertia")',
+}
+
 # Source formats whose loader does not judge a welded link's inertia on its own: there links welded by fixed
 # joints are judged as one body. MuJoCo judges only bodies with joints (and refuses the file itself, MK170,
 # where such a body alone is too light); libsdformat refuses a bad inertia on any SDF link.
@@ -295,6 +303,10 @@ def _judge_inertia(
     listed = ", ".join(f"{m:.6g}" for m in moments)
     if moments[0] < -zero:  # indefinite: a negative moment
         said = f"{what}: the inertia is not positive definite (principal moments {listed}){static}"
+        if static and robot.source_format in NEGATIVE_MOMENT_REFUSED_BY:  # libsdformat: any link
+            said = f"{what}: the inertia is not positive definite (principal moments {listed}); the link " \
+                   f"does not move, but {NEGATIVE_MOMENT_REFUSED_BY[robot.source_format]}"
+            severity = None
         yield diag("MK302", said, where, severity=severity)
         return
     if moments[0] <= zero:  # no finite acceleration about that axis

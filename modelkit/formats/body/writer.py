@@ -154,8 +154,7 @@ def _unconnected(robot: Robot, order: list[Link], ctx: WriteContext) -> list[tup
     unconnected link has no pose to write and is left out (MK822)."""
     written = {id(lk) for lk in order}
     free_poses = robot.free_link_poses
-    static = (robot.root_joint is JointType.FIXED and "sdf_world_joint" not in robot.extras
-              and robot.root != WORLD_LINK)
+    static = not robot.free_links_float
     out = []
     for link in robot.links:
         if id(link) in written or robot.root is None:
