@@ -54,7 +54,7 @@ from modelkit.formats.body.write_yaml import (
     rotation_value,
     tensor,
 )
-from modelkit.model import WORLD_LINK, Inertial, Joint, JointType, Link, Robot
+from modelkit.model import Inertial, Joint, JointType, Link, Robot
 
 JOINT_WORDS = {
     JointType.FIXED: "fixed",
