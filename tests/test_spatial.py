@@ -181,3 +181,13 @@ def test_rotate_inertia_of_principal_moments_by_a_quaternion() -> None:
     assert np.allclose(tensor, np.diag([2.0, 1.0, 3.0]), atol=1e-15)
     s = math.sqrt(0.5)
     assert np.allclose(rotate_inertia(np.diag([1.0, 2.0, 3.0]), matrix_from_quat_wxyz((s, 0, 0, s))), tensor)
+
+
+def test_the_identity_test_of_the_bounds_rule_takes_numpy_poses() -> None:
+    """A pose computed with numpy (a re-parented SDF joint) holds arrays: comparing them with a tuple once
+    raised "The truth value of an array ... is ambiguous" inside validate."""
+    from modelkit.checks.bounds import _is_identity
+
+    assert _is_identity(Pose(np.eye(3), np.zeros(3)))
+    assert not _is_identity(Pose(np.eye(3), np.array([0.0, 0.0, 1.0])))
+    assert _is_identity(Pose())

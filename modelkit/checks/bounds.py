@@ -125,7 +125,7 @@ def geom_box(geom: Geom, frame: Pose | None = None) -> Aabb | None:
 
 def _is_identity(frame: Pose) -> bool:
     """Whether ``frame`` is exactly the identity (the pose of a body's own top link)."""
-    return rot3.peek(frame, "translation") == rot3.ZERO3 and frame.rotation_tuple == rot3.IDENTITY
+    return frame.translation_tuple == rot3.ZERO3 and frame.rotation_tuple == rot3.IDENTITY
 
 
 def union(boxes: list[Aabb]) -> Aabb:
