@@ -772,8 +772,11 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK307",
         "joint-range-reversed",
         "error",
-        "A joint range has its lower bound above its upper bound. Reference: in URDF a warning (urdfdom, "
-        "libsdformat's URDF conversion, PyBullet and MuJoCo load it).",
+        "A joint range has its lower bound above its upper bound: no position is within it. An error in "
+        "MJCF (MuJoCo refuses it: \"range[0] should be smaller than range[1]\"); a warning in URDF "
+        "(urdfdom, libsdformat's URDF conversion, PyBullet and MuJoCo load it), SDF (libsdformat loads it) "
+        "and `.body` (Choreonoid's loader sets the range as written). The MJCF writer leaves such a joint "
+        "unlimited (MK824); the other writers keep the range as it is.",
     ),
     CodeInfo("MK308", "rotation-axis-zero", "error", "A rotation axis is the zero vector."),
     CodeInfo(

@@ -1680,3 +1680,28 @@ def test_a_negative_moment_on_a_welded_urdf_link_stays_a_warning(tmp_path: Path)
         'ixy="0" ixz="0" iyz="-0.5"/></inertial></link>'))
     found = [d for d in validate(path).diagnostics if d.code == "MK302"]
     assert found and {d.severity.value for d in found} == {"warning"}, found
+
+
+def test_a_reversed_sdf_joint_range_is_a_warning_as_libsdformat_loads_it(tmp_path: Path,
+                                                                         sdf_oracle: Path) -> None:  # noqa: F811
+    """The SDF convert wrote from a URDF with lower 1 > upper -1 (a semantic fuzz mutant): libsdformat
+    says "Valid.", and validate called the written file an error."""
+    joint = ('<joint name="j" type="revolute"><parent>a</parent><child>b</child><axis><xyz>0 0 1</xyz>'
+             "<limit><lower>1</lower><upper>-1</upper></limit></axis></joint>")
+    path = tmp_path / "m.sdf"
+    path.write_text(_sdf("1.9", f'<model name="m">{_LINK.format("a")}{_LINK.format("b")}{joint}</model>'))
+    assert _libsdformat_accepts(sdf_oracle, path)
+    found = [d for d in validate(path).diagnostics if d.code == "MK307"]
+    assert [d.severity.value for d in found] == ["warning"], found
+    assert "libsdformat" in found[0].message
+    assert not [d for d in validate(path).diagnostics if d.severity.value == "error"]
+
+
+def test_a_reversed_mjcf_joint_range_stays_an_error_as_mujoco_refuses_it(tmp_path: Path) -> None:
+    path = tmp_path / "m.xml"
+    path.write_text('<mujoco><worldbody><body><joint name="j" range="1 -1" limited="true"/>'
+                    '<geom size="0.1"/></body></worldbody></mujoco>')
+    with pytest.raises(ValueError, match="range"):
+        mujoco.MjModel.from_xml_path(str(path))
+    found = [d for d in validate(path).diagnostics if d.code == "MK307"]
+    assert [d.severity.value for d in found] == ["error"], found

@@ -358,21 +358,29 @@ def _body_loc(links: dict[str, Link], members: list[tuple[str, Pose]]) -> Source
     return inertial.sources.get("inertia", _mass_loc(heaviest)) if inertial else heaviest.source
 
 
+# The formats whose own loader takes a joint range with its lower limit above its upper (MK307: a
+# warning there), and who loads it. MuJoCo refuses it ("range[0] should be smaller than range[1]").
+REVERSED_RANGE_LOADED_BY = {
+    "urdf": "urdfdom, libsdformat's URDF conversion, PyBullet and MuJoCo load it",
+    "sdf": "libsdformat and its checker `gz sdf -k` load it",
+    "body": "Choreonoid's body loader takes it and sets the range as written",
+}
+
+
 @rule("joint-ranges", "MK307", "MK315")
 def joint_ranges(robot: Robot) -> Iterator[Diagnostic]:
     """Joint position and velocity ranges are ordered."""
     for joint in robot.joints:
         limits = joint.limits
         if limits.lower > limits.upper:
-            urdf = robot.source_format == "urdf"  # urdfdom, libsdformat, PyBullet and MuJoCo load it
+            loaded_by = REVERSED_RANGE_LOADED_BY.get(robot.source_format or "")
             yield diag(
                 "MK307",
                 f'joint "{joint.name}": lower limit {limits.lower:.6g} is above upper limit '
                 f"{limits.upper:.6g}"
-                + ("; no position is within the limits (urdfdom, libsdformat's URDF conversion, PyBullet "
-                   "and MuJoCo load it)" if urdf else ""),
+                + (f"; no position is within the limits ({loaded_by})" if loaded_by else ""),
                 joint.loc("range"),
-                severity=Severity.WARNING if urdf else None,
+                severity=Severity.WARNING if loaded_by else None,
             )
         if limits.velocity_lower > limits.velocity_upper:
             yield diag(
