@@ -1115,7 +1115,9 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK513",
         "color-out-of-range",
         "warning",
-        "A URDF colour `rgba` has values outside 0..1 (they are clamped).",
+        "A colour has values outside 0..1 (they are clamped): a URDF `rgba` (urdfdom rejects the colour), "
+        "a `.body` material's colour, intensity or transparency (Choreonoid loads it; libsdformat refuses "
+        "such a colour in the SDF it would become, urdfdom drops it).",
     ),
     CodeInfo(
         "MK514",

@@ -281,6 +281,30 @@ def split_affine(affine: Affine) -> tuple[Pose | None, rot3.V3]:
     return Pose(rot3.transpose((c0, c1, c2)), offset), scale
 
 
+def _fraction(material: YMap, keys: tuple[str, ...], read: Any, ctx: WalkContext) -> Any:
+    """A colour (three numbers) or an intensity or transparency (one) of a ``material``, each number
+    clamped to 0..1 with MK513 when it is outside: Choreonoid loads it, but the model holds fractions,
+    and libsdformat refuses such a colour (urdfdom drops it)."""
+    node = material.get(*keys)
+    value = read(node)
+    if value is None or node is None:
+        return value
+    numbers = [float(x) for x in value] if isinstance(value, tuple | list) else [float(value)]
+    if all(0.0 <= x <= 1.0 for x in numbers):
+        return value
+    shown = " ".join(f"{x:g}" for x in numbers)
+    key = next((k for k in keys if k in material), keys[-1])
+    ctx.sink.emit(
+        "MK513",
+        f"material `{key}` {shown} has values outside 0..1 (Choreonoid loads it; libsdformat refuses such a "
+        "colour and urdfdom drops it; modelkit clamps it)",
+        node.loc,
+        hint="colours, intensities and transparency are fractions: 255 is written 1",
+    )
+    clamped = [min(max(x, 0.0), 1.0) for x in numbers]
+    return tuple(clamped) if len(clamped) > 1 else clamped[0]
+
+
 def _material(shape: YMap, ctx: WalkContext) -> VisualMaterial | None:
     appearance = shape.get("appearance")
     if not isinstance(appearance, YMap):
@@ -288,11 +312,11 @@ def _material(shape: YMap, ctx: WalkContext) -> VisualMaterial | None:
     m = appearance.get("material")
     result = VisualMaterial()
     if isinstance(m, YMap):
-        result.diffuse = v.vector3(m.get("diffuse", "diffuseColor"))
-        result.ambient = v.number(m.get("ambient", "ambientIntensity"))
-        result.specular = v.vector3(m.get("specular", "specularColor"))
-        result.emissive = v.vector3(m.get("emissive", "emissiveColor"))
-        result.transparency = v.get_number(m, "transparency", default=0.0) or 0.0
+        result.diffuse = _fraction(m, ("diffuse", "diffuseColor"), v.vector3, ctx)
+        result.ambient = _fraction(m, ("ambient", "ambientIntensity"), v.number, ctx)
+        result.specular = _fraction(m, ("specular", "specularColor"), v.vector3, ctx)
+        result.emissive = _fraction(m, ("emissive", "emissiveColor"), v.vector3, ctx)
+        result.transparency = _fraction(m, ("transparency",), v.number, ctx) or 0.0
         exponent = v.number(m.get("specular_exponent"))
         shininess = v.number(m.get("shininess"))
         if exponent is None and shininess is not None:

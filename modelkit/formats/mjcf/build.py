@@ -397,10 +397,21 @@ class RobotBuilder:
             return None
         material = None
         if mg.rgba is not None:
-            r, g, b, a = mg.rgba
-            diffuse = (float(r), float(g), float(b))
-            material = VisualMaterial(name=mg.material, diffuse=diffuse, transparency=1.0 - a)
-            _look(material, mg.look, diffuse)
+            rgba = [float(x) for x in mg.rgba]
+            clamped = [min(max(x, 0.0), 1.0) for x in rgba]
+            diffuse = (clamped[0], clamped[1], clamped[2])
+            material = VisualMaterial(name=mg.material, diffuse=diffuse, transparency=1.0 - clamped[3])
+            beyond = _look(material, mg.look, diffuse)
+            if clamped != rgba or beyond:
+                shown = " ".join(f"{x:g}" for x in rgba)
+                self.sink.emit(
+                    "MK513",
+                    f"geom{quoted(mg.name)}: " + (f"rgba {shown}" if clamped != rgba else beyond)
+                    + " has values outside 0..1 (MuJoCo loads it; libsdformat refuses such a colour and "
+                    "urdfdom drops it; modelkit clamps it)",
+                    where,
+                    hint="colours are fractions: 255 is written 1",
+                )
             texture = mg.look.get("texture_not_held")
             if texture is not None and mg.material not in self.textures_said:
                 self.textures_said.add(str(mg.material))
@@ -603,17 +614,26 @@ def surface_friction(mg: MjGeom) -> SurfaceFriction | None:
     return None if acting == MUJOCO_DEFAULT_FRICTION else acting
 
 
-def _look(material: VisualMaterial, look: dict[str, Any], diffuse: tuple[float, float, float]) -> None:
+def _look(material: VisualMaterial, look: dict[str, Any], diffuse: tuple[float, float, float]) -> str:
     """A MuJoCo material's specular, shininess, emission and colour texture in the model's terms:
     specular colour (s, s, s), Phong exponent 127·shininess + 1 (Choreonoid's rule), emissive colour
-    emission × the colour, the texture's file."""
+    emission × the colour, the texture's file. Colours are clamped to 0..1 (an emission above 1 is
+    brighter than white); returns what was clamped ("" when nothing was)."""
+    beyond = []
     if "specular" in look:
         s = float(look["specular"])
-        material.specular = (s, s, s)
+        material.specular = (min(max(s, 0.0), 1.0),) * 3
+        if not 0.0 <= s <= 1.0:
+            beyond.append(f"specular {s:g}")
     if "shininess" in look:
         material.specular_exponent = 127.0 * float(look["shininess"]) + 1.0
     if "emission" in look:
         e = float(look["emission"])
-        material.emissive = (e * diffuse[0], e * diffuse[1], e * diffuse[2])
+        emissive = [e * c for c in diffuse]
+        material.emissive = (min(max(emissive[0], 0.0), 1.0), min(max(emissive[1], 0.0), 1.0),
+                             min(max(emissive[2], 0.0), 1.0))
+        if any(not 0.0 <= c <= 1.0 for c in emissive):
+            beyond.append(f"emission {e:g} × colour")
     if "texture" in look:
         material.texture = str(look["texture"])
+    return ", ".join(beyond)
