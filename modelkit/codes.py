@@ -181,8 +181,10 @@ _TABLE: tuple[CodeInfo, ...] = (
         "MK120",
         "xml-attribute-missing",
         "error",
-        "A required XML attribute is missing. Reference: a URDF `<texture>` without `filename` is a warning "
-        "(urdfdom and PyBullet ignore the element and load the file).",
+        "A required XML attribute is missing. In SDF, every attribute SDFormat's description requires "
+        "(a `<plugin>`'s `filename` and `name`, a `<light>`'s `name` and `type`, a `<noise>`'s or "
+        "`<shader>`'s `type`...): libsdformat refuses the file. Reference: a URDF `<texture>` without "
+        "`filename` is a warning (urdfdom and PyBullet ignore the element and load the file).",
     ),
     CodeInfo(
         "MK121",

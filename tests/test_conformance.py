@@ -1705,3 +1705,35 @@ def test_a_reversed_mjcf_joint_range_stays_an_error_as_mujoco_refuses_it(tmp_pat
         mujoco.MjModel.from_xml_path(str(path))
     found = [d for d in validate(path).diagnostics if d.code == "MK307"]
     assert [d.severity.value for d in found] == ["error"], found
+
+
+@pytest.mark.parametrize(("fragment", "tag", "attribute"), [
+    ('<sensor name="s" type="imu"><plugin name="p"/></sensor>', "plugin", "filename"),
+    ('<sensor name="s" type="imu"><plugin filename="libp.so"/></sensor>', "plugin", "name"),
+    ('<light name="l"><diffuse>1 1 1 1</diffuse></light>', "light", "type"),
+    ('<visual name="v"><geometry><box><size>1 1 1</size></box></geometry><material><shader/></material>'
+     "</visual>", "shader", "type"),
+    ('<sensor name="s" type="imu"><imu><angular_velocity><x><noise/></x></angular_velocity></imu></sensor>',
+     "noise", "type"),
+])
+def test_a_missing_required_sdf_attribute_is_an_error_as_libsdformat_refuses_it(
+    fragment: str, tag: str, attribute: str, tmp_path: Path, sdf_oracle: Path  # noqa: F811
+) -> None:
+    """A semantic fuzz mutant of the lecture's unicycle: a `<plugin>` without `filename` passed validate
+    and convert wrote an SDF libsdformat refused ("Required attribute[filename] in element[plugin] is not
+    specified in SDF")."""
+    path = tmp_path / "m.sdf"
+    path.write_text(_sdf("1.9", f'<model name="m"><link name="a">{fragment}</link></model>'))
+    assert not _libsdformat_accepts(sdf_oracle, path)
+    found = [d for d in validate(path).diagnostics if d.code == "MK120" and d.severity.value == "error"]
+    assert [d.message.split(";")[0] for d in found] == [f"<{tag}> has no {attribute} attribute"], found
+
+
+def test_required_sdf_attributes_present_are_not_said(tmp_path: Path, sdf_oracle: Path) -> None:  # noqa: F811
+    path = tmp_path / "m.sdf"
+    path.write_text(_sdf("1.9", '<model name="m"><link name="a"><sensor name="s" type="imu">'
+                                '<plugin name="p" filename="libp.so"/></sensor>'
+                                '<light name="l" type="point"><diffuse>1 1 1 1</diffuse></light>'
+                                "</link></model>"))
+    assert _libsdformat_accepts(sdf_oracle, path)
+    assert not [d for d in validate(path).diagnostics if d.code == "MK120"]
