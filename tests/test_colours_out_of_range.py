@@ -36,8 +36,8 @@ links:
 
 MJCF = ('<mujoco model="m"><asset><material name="bright" emission="3"/></asset><worldbody>'
         '<body name="a"><freejoint/><geom name="g" size="0.1" rgba="-0.5 2 0.5 1.5"/>'
-        '<body name="b" pos="1 0 0"><joint name="j" type="hinge"/><geom name="h" size="0.1" material="bright"/>'
-        "</body></body></worldbody></mujoco>")
+        '<body name="b" pos="1 0 0"><joint name="j" type="hinge"/>'
+        '<geom name="h" size="0.1" material="bright"/></body></body></worldbody></mujoco>')
 
 
 def _convert(source: Path, output: Path) -> None:
@@ -80,3 +80,14 @@ def test_colours_within_0_1_are_not_said(tmp_path: Path) -> None:
     source.write_text(BODY.replace("[-0.5, 2.0, 0.5]", "[0.5, 1.0, 0.0]").replace("[3, 0, 0]", "[1, 0, 0]")
                       .replace("[0, -1, 0]", "[0, 0, 0]").replace("transparency: -0.5", "transparency: 0.25"))
     assert not [d for d in validate(source).diagnostics if d.code == "MK513"]
+
+
+def test_a_colour_component_too_small_for_a_float_is_written_0_in_sdf(tmp_path: Path,
+                                                                       sdf_oracle: Path) -> None:  # noqa: F811
+    """libsdformat reads colours as 32-bit floats and refused `<ambient>1e-300 0 0 1</ambient>` ("Out of
+    range"); a semantic fuzz mutant of Choreonoid's SpringModel.body wrote it."""
+    source = tmp_path / "c.body"
+    source.write_text(BODY.replace("[-0.5, 2.0, 0.5]", "[1.0e-300, 0.5, 1.0e-39]"))
+    _convert(source, tmp_path / "sdf" / "c.sdf")
+    assert _libsdformat_accepts(sdf_oracle, tmp_path / "sdf" / "c.sdf")
+    assert "<diffuse>0 0.5 0 1</diffuse>" in (tmp_path / "sdf" / "c.sdf").read_text()

@@ -45,11 +45,17 @@ def add_pose(parent: Element, pose: Pose, relative_to: str | None = None, always
         el.set("relative_to", relative_to)
 
 
+FLOAT32_SMALLEST_NORMAL = 1.1754943508222875e-38
+
+
 def rgba(values: Any, alpha: float = 1.0) -> str:
+    """A colour's text. libsdformat reads colour components as 32-bit floats (``std::stof``), which
+    refuses a value too small for one ("Out of range. Unable to set value [1e-300]"): such a component
+    is written 0, the colour it stands for."""
     v = [float(x) for x in values]
     if len(v) == 3:
         v.append(alpha)
-    return fmt_vec(v)
+    return fmt_vec([0.0 if abs(x) < FLOAT32_SMALLEST_NORMAL else x for x in v])
 
 
 def data_to_element(parent: Element, tag: str, data: Any) -> Element:
