@@ -58,6 +58,12 @@ def _elements(root: etree._Element) -> list[etree._Element]:
     return [e for e in root.iter() if isinstance(e.tag, str)]
 
 
+def _pick(root: etree._Element, rng: random.Random, tag: str) -> etree._Element | None:
+    """One of the ``tag`` elements, chosen with ``rng``; None when there is none."""
+    found = [e for e in _elements(root) if e.tag == tag]
+    return rng.choice(found) if found else None
+
+
 def _xml_number(root: etree._Element, rng: random.Random, kind: str) -> str | None:
     spots: list[tuple[etree._Element, str | None]] = []
     for e in _elements(root):
@@ -94,10 +100,9 @@ def _xml_joint_type(root: etree._Element, rng: random.Random, kind: str) -> str 
 
 def _xml_shape(root: etree._Element, rng: random.Random, kind: str) -> str | None:
     if kind == "mjcf":
-        geoms = [e for e in _elements(root) if e.tag == "geom"]
-        if not geoms:
+        geom = _pick(root, rng, "geom")
+        if geom is None:
             return None
-        geom = rng.choice(geoms)
         old = geom.get("type", "sphere")
         new = rng.choice([t for t in MJCF_SHAPES if t != old])
         geom.set("type", new)
@@ -152,27 +157,24 @@ def _xml_duplicate(root: etree._Element, rng: random.Random, kind: str) -> str |
 
 def _xml_limits(root: etree._Element, rng: random.Random, kind: str) -> str | None:
     if kind == "urdf":
-        limits = [e for e in _elements(root) if e.tag == "limit"]
-        if not limits:
+        limit = _pick(root, rng, "limit")
+        if limit is None:
             return None
-        limit = rng.choice(limits)
         lower, upper = rng.choice([("1", "-1"), ("0", "0"), ("-1e9", "1e9"), ("3", "3.1"), ("-7", "7")])
         limit.set("lower", lower)
         limit.set("upper", upper)
         return f"limit lower {lower} upper {upper}"
     if kind == "mjcf":
-        joints = [e for e in _elements(root) if e.tag == "joint"]
-        if not joints:
+        joint = _pick(root, rng, "joint")
+        if joint is None:
             return None
-        joint = rng.choice(joints)
         value = rng.choice(["1 -1", "0 0", "-1e9 1e9", "-400 400"])
         joint.set("range", value)
         joint.set("limited", rng.choice(["true", "auto"]))
         return f"joint {joint.get('name')!r} range {value}"
-    limits = [e for e in _elements(root) if e.tag == "limit"]
-    if not limits:
+    limit = _pick(root, rng, "limit")
+    if limit is None:
         return None
-    limit = rng.choice(limits)
     lower, upper = rng.choice([("1", "-1"), ("0", "0"), ("-1e16", "1e16")])
     for tag, value in (("lower", lower), ("upper", upper)):
         found = limit.find(tag)
@@ -183,29 +185,18 @@ def _xml_limits(root: etree._Element, rng: random.Random, kind: str) -> str | No
 
 
 def _xml_reparent(root: etree._Element, rng: random.Random, kind: str) -> str | None:
-    if kind == "urdf":
-        joints = [e for e in _elements(root) if e.tag == "joint"]
-        links = [e.get("name") for e in _elements(root) if e.tag == "link" and e.get("name")]
-        if not joints or not links:
+    if kind in ("urdf", "sdf"):
+        links = [str(e.get("name")) for e in _elements(root) if e.tag == "link" and e.get("name")]
+        joint = _pick(root, rng, "joint") if links else None
+        parent = joint.find("parent") if joint is not None else None
+        if joint is None or parent is None:
             return None
-        joint = rng.choice(joints)
-        parent = joint.find("parent")
-        if parent is None:
-            return None
-        new = rng.choice(links)
-        parent.set("link", new or "")
+        new = rng.choice(links if kind == "urdf" else [*links, "world"])
+        if kind == "urdf":
+            parent.set("link", new)
+        else:
+            parent.text = new
         return f"joint {joint.get('name')!r} parent -> {new!r}"
-    if kind == "sdf":
-        joints = [e for e in _elements(root) if e.tag == "joint"]
-        links = [e.get("name") for e in _elements(root) if e.tag == "link" and e.get("name")]
-        if not joints or not links:
-            return None
-        joint = rng.choice(joints)
-        parent = joint.find("parent")
-        if parent is None:
-            return None
-        parent.text = rng.choice([*links, "world"])
-        return f"joint {joint.get('name')!r} parent -> {parent.text!r}"
     bodies = [e for e in _elements(root) if e.tag == "body"]
     if len(bodies) < 2:
         return None
