@@ -304,8 +304,8 @@ def _judge_inertia(
     if moments[0] < -zero:  # indefinite: a negative moment
         said = f"{what}: the inertia is not positive definite (principal moments {listed}){static}"
         if static and robot.source_format in NEGATIVE_MOMENT_REFUSED_BY:  # libsdformat: any link
-            said = f"{what}: the inertia is not positive definite (principal moments {listed}); the link " \
-                   f"does not move, but {NEGATIVE_MOMENT_REFUSED_BY[robot.source_format]}"
+            said = (f"{what}: the inertia is not positive definite (principal moments {listed}); the link "
+                    f"does not move, but {NEGATIVE_MOMENT_REFUSED_BY[robot.source_format]}")
             severity = None
         yield diag("MK302", said, where, severity=severity)
         return
