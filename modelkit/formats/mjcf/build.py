@@ -94,6 +94,7 @@ class RobotBuilder:
         self.sink = sink
         self.model_name = model_name
         self.textures_said: set[str] = set()  # materials whose texture MK178 named
+        self.bright_said: set[str] = set()  # materials whose colours MK513 named (once per material)
         self.names = Names()
         self.link_name: dict[int, str] = {}
         self.joint_name: dict[int, str] = {}
@@ -402,6 +403,9 @@ class RobotBuilder:
             diffuse = (clamped[0], clamped[1], clamped[2])
             material = VisualMaterial(name=mg.material, diffuse=diffuse, transparency=1.0 - clamped[3])
             beyond = _look(material, mg.look, diffuse)
+            if beyond and clamped == rgba and f"{mg.material}:{beyond}" in self.bright_said:
+                beyond = ""  # the material's own values, said at its first geom
+            self.bright_said.add(f"{mg.material}:{beyond}")
             if clamped != rgba or beyond:
                 shown = " ".join(f"{x:g}" for x in rgba)
                 self.sink.emit(
