@@ -30,8 +30,9 @@ EXCEPTIONS: dict[tuple[str, str], str] = {
         "copied by the SDF writer)",
     ("formats/urdf/write_gazebo.py", "sdf_plugins"): "an SDF model's plugins are written as <gazebo> blocks",
     ("formats/urdf/writer.py", "sdf_plugins"): "the same: written, so no MK808 note",
-    ("formats/body/writer.py", "sdf_world_joint"):
-        "a model fixed without a world joint is a static SDF model: its free links are written fixed",
+    ("model.py", "sdf_world_joint"):
+        "Robot.free_links_float: a model fixed without a world joint is a static SDF model, whose free links "
+        "stay fixed (the .body writer and the inertia rule ask it)",
     ("formats/body/writer.py", "gazebo"): "URDF extension blocks are noted as not carried over",
     ("formats/body/writer.py", "transmissions"): "the same",
     ("formats/body/writer.py", "ros2_control"): "the same",
