@@ -19,6 +19,7 @@ from modelkit.diagnostics import DiagnosticSink, Severity, SourceLocation
 from modelkit.formats.body import devices as dev
 from modelkit.formats.body import values as v
 from modelkit.formats.body.values import IDENTITY_AFFINE, Affine
+from modelkit.formats.fractions import clamped_fractions
 from modelkit.model import (
     Box,
     Capsule,
@@ -290,7 +291,8 @@ def _fraction(material: YMap, keys: tuple[str, ...], read: Any, ctx: WalkContext
     if value is None or node is None:
         return value
     numbers = [float(x) for x in value] if isinstance(value, tuple | list) else [float(value)]
-    if all(0.0 <= x <= 1.0 for x in numbers):
+    clamped, outside = clamped_fractions(numbers)
+    if not outside:
         return value
     shown = " ".join(f"{x:g}" for x in numbers)
     key = next((k for k in keys if k in material), keys[-1])
@@ -301,8 +303,7 @@ def _fraction(material: YMap, keys: tuple[str, ...], read: Any, ctx: WalkContext
         node.loc,
         hint="colours, intensities and transparency are fractions: 255 is written 1",
     )
-    clamped = [min(max(x, 0.0), 1.0) for x in numbers]
-    return tuple(clamped) if len(clamped) > 1 else clamped[0]
+    return clamped if len(clamped) > 1 else clamped[0]
 
 
 def _material(shape: YMap, ctx: WalkContext) -> VisualMaterial | None:

@@ -25,6 +25,7 @@ from typing import Any
 
 from modelkit import rot3
 from modelkit.diagnostics import DiagnosticSink, SourceLocation
+from modelkit.formats.fractions import clamped_fractions
 from modelkit.formats.mjcf.bodies import MjBody, MjGeom, MjJoint, MjSite, translation
 from modelkit.formats.mjcf.carried import is_linear
 from modelkit.formats.mjcf.source import Locator
@@ -399,18 +400,18 @@ class RobotBuilder:
         material = None
         if mg.rgba is not None:
             rgba = [float(x) for x in mg.rgba]
-            clamped = [min(max(x, 0.0), 1.0) for x in rgba]
+            clamped, rgba_outside = clamped_fractions(rgba)
             diffuse = (clamped[0], clamped[1], clamped[2])
             material = VisualMaterial(name=mg.material, diffuse=diffuse, transparency=1.0 - clamped[3])
             beyond = _look(material, mg.look, diffuse)
-            if beyond and clamped == rgba and f"{mg.material}:{beyond}" in self.bright_said:
+            if beyond and not rgba_outside and f"{mg.material}:{beyond}" in self.bright_said:
                 beyond = ""  # the material's own values, said at its first geom
             self.bright_said.add(f"{mg.material}:{beyond}")
-            if clamped != rgba or beyond:
+            if rgba_outside or beyond:
                 shown = " ".join(f"{x:g}" for x in rgba)
                 self.sink.emit(
                     "MK513",
-                    f"geom{quoted(mg.name)}: " + (f"rgba {shown}" if clamped != rgba else beyond)
+                    f"geom{quoted(mg.name)}: " + (f"rgba {shown}" if rgba_outside else beyond)
                     + " has values outside 0..1 (MuJoCo loads it; libsdformat refuses such a colour and "
                     "urdfdom drops it; modelkit clamps it)",
                     where,
@@ -626,17 +627,17 @@ def _look(material: VisualMaterial, look: dict[str, Any], diffuse: tuple[float, 
     beyond = []
     if "specular" in look:
         s = float(look["specular"])
-        material.specular = (min(max(s, 0.0), 1.0),) * 3
-        if not 0.0 <= s <= 1.0:
+        (clamped_s,), outside = clamped_fractions((s,))
+        material.specular = (clamped_s,) * 3
+        if outside:
             beyond.append(f"specular {s:g}")
     if "shininess" in look:
         material.specular_exponent = 127.0 * float(look["shininess"]) + 1.0
     if "emission" in look:
         e = float(look["emission"])
-        emissive = [e * c for c in diffuse]
-        material.emissive = (min(max(emissive[0], 0.0), 1.0), min(max(emissive[1], 0.0), 1.0),
-                             min(max(emissive[2], 0.0), 1.0))
-        if any(not 0.0 <= c <= 1.0 for c in emissive):
+        emissive, outside = clamped_fractions(e * c for c in diffuse)
+        material.emissive = (emissive[0], emissive[1], emissive[2])
+        if outside:
             beyond.append(f"emission {e:g} × colour")
     if "texture" in look:
         material.texture = str(look["texture"])

@@ -14,6 +14,7 @@ from lxml.etree import _Element as Element
 
 from modelkit import rot3
 from modelkit.diagnostics import Severity, did_you_mean
+from modelkit.formats.fractions import clamped_fractions
 from modelkit.formats.meshref import MeshChecker
 from modelkit.formats.urdf.values import Context, Tolerated, number, origin, vector
 from modelkit.model import (
@@ -59,7 +60,8 @@ class Materials:
                 found = True  # reported (MK129, MK121): the material is kept, without a colour
             else:
                 found = True
-                if any(v < 0.0 or v > 1.0 for v in rgba):
+                clamped, outside = clamped_fractions(rgba)
+                if outside:
                     ctx.emit(
                         "MK513",
                         f'material "{name}": rgba "{color.get("rgba")}" has values outside 0..1 '
@@ -67,8 +69,8 @@ class Materials:
                         ctx.loc(color, "rgba"),
                         hint="colours are fractions: 255 is written 1",
                     )
-                material.diffuse = tuple(min(max(v, 0.0), 1.0) for v in rgba[:3])
-                material.transparency = 1.0 - min(max(rgba[3], 0.0), 1.0)
+                material.diffuse = clamped[:3]
+                material.transparency = 1.0 - clamped[3]
         texture = ctx.first(element, "texture")
         if texture is not None:
             filename = texture.get("filename")
