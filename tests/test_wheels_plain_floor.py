@@ -20,6 +20,7 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from lxml import etree
 
 from modelkit.cli import main
 from tests.plain_floor_support import Pose2, drive_mujoco, drive_pybullet, ideal
@@ -101,3 +102,33 @@ def test_wheel_collision_cylinder_keeps_the_cylinder(tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     assert 'type="cylinder" size="0.076 0.015"' in target.read_text()
     assert "MK826" not in result.output
+
+
+TYRE_END = "            diffuseColor: [ 0.2, 0.2, 0.2 ]\n  -\n    name: RightWheel"
+
+
+@pytest.mark.parametrize("suffix", ["xml", "urdf"])
+def test_a_tyre_given_twice_rolls_as_one(tmp_path: Path, suffix: str) -> None:
+    """The primitive robot with its left tyre given twice (the same cylinder, a copy-paste a semantic-fuzz
+    mutant made): ``convert`` made a sphere of the first and kept the second cylinder, whose rim contacts
+    scrubbed, so in MuJoCo the spin turned about the left wheel (its effective radius 40.9 mm of 76) and
+    verify's layer 4 failed 13 checks. Every collision that rolls now gets the sphere, and the spin is
+    the unicycle's."""
+    text = (MODELS / "mobile_robot_primitive.body").read_text()
+    assert text.count(TYRE_END) == 1
+    source = tmp_path / "twice.body"
+    source.write_text(text.replace(TYRE_END, TYRE_END.replace("\n  -", "\n      - *TireShape\n  -", 1)))
+    target = tmp_path / f"robot.{suffix}"
+    result = CliRunner().invoke(main, ["convert", str(source), "-o", str(target)])
+    assert result.exit_code == 0, result.output
+    said = [line for line in result.output.splitlines() if "MK826 wheel LeftWheel" in line]
+    assert len(said) == 2 and all("of the 2 that roll on the floor" in line for line in said), result.output
+    tree = etree.parse(str(target))
+    if suffix == "xml":
+        shapes = [g.get("type") for g in tree.iterfind(".//body[@name='LeftWheel']/geom[@class='collision']")]
+    else:
+        shapes = [g.tag for g in tree.iterfind("link[@name='LeftWheel']/collision/geometry/*")]
+    assert shapes == ["sphere", "sphere"], shapes
+    v, w = PROFILES["spin"]
+    drive = drive_mujoco if suffix == "xml" else drive_pybullet
+    _check(drive(target, v, w, RADIUS, HALF_AXLE), "spin")

@@ -35,6 +35,7 @@ Every replaced shape gets an MK826 note; the wheels found are recorded in
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -97,9 +98,12 @@ class Wheel:
     about the joint axis (link frame)."""
 
     joint: str
-    index: int
+    index: int  # the largest collision that rolls
     round: Round
     axis: np.ndarray  # unit, link frame
+    rolling: tuple[tuple[int, Round], ...] = ()
+    """Every collision of the link that rolls on the floor (index, its roundness), the largest
+    included: each gets the wheel's collision shape (a tyre given twice, a twin tyre)."""
 
 
 def endless_axles(robot: Robot, poses: dict[str, Pose], tilt: float
@@ -137,6 +141,7 @@ def find_wheels(robot: Robot) -> dict[str, Wheel]:
     out: dict[str, Wheel] = {}
     for joint, link, pose, axis in endless_axles(robot, poses, HORIZONTAL):
         best: Wheel | None = None
+        rolling: list[tuple[int, Round]] = []
         for i, geom in enumerate(link.collisions):
             shape = round_about(geom, axis, PARALLEL)
             if shape is None or shape.radius <= 0.0:
@@ -148,23 +153,26 @@ def find_wheels(robot: Robot) -> dict[str, Wheel]:
             reach = extent([geom], pose.rotation.T @ z)
             if reach is None or abs(float(pose.translation[2]) + reach[0] - floor) > GROUND_LEVEL:
                 continue
+            rolling.append((i, shape))
             if best is None or shape.radius > best.round.radius:
                 best = Wheel(joint.name, i, shape, axis)
         if best is not None:
-            out[link.name] = best
+            out[link.name] = dataclasses.replace(best, rolling=tuple(rolling))
     return out
 
 
-def wheel_proxy(geom: Geom, wheel: Wheel, shape: str) -> tuple[Geom, str]:
-    """The ``shape`` ("sphere" or "ellipsoid") written for a wheel's collision cylinder or round mesh,
-    and its words."""
-    radius, centre = wheel.round.radius, wheel.round.centre
+def wheel_proxy(geom: Geom, wheel: Wheel, shape: str, roundness: Round | None = None) -> tuple[Geom, str]:
+    """The ``shape`` ("sphere" or "ellipsoid") written for a wheel's collision cylinder or round mesh
+    ``geom`` (``roundness``: that collision's, one of ``wheel.rolling``; the largest's by default), and
+    its words."""
+    shaped = wheel.round if roundness is None else roundness
+    radius, centre = shaped.radius, shaped.centre
     if shape == "sphere":
         new = Geom(Sphere(radius), Pose(translation=np.array(centre, dtype=float)),
                    name=geom.name, material=geom.material, source=geom.source)
         where = "the cylinder's centre" if isinstance(geom.geometry, Cylinder) else "the mesh's centre"
         return new, f"a sphere of radius {radius:g} m at {where}"
-    radii = (radius, radius, 0.5 * wheel.round.width)
+    radii = (radius, radius, 0.5 * shaped.width)
     if isinstance(geom.geometry, Cylinder):
         frame, words = geom.pose, "the cylinder's frame"
     else:  # the ellipsoid's z along the wheel's axis, at the mesh's centre
@@ -186,18 +194,20 @@ def approximate_wheels(robot: Robot, choice: str, target: str, notes: NoteSink) 
     if shape == "cylinder":
         return
     links = {link.name: link for link in robot.links}
-    for name, wheel in sorted(wheels.items()):
+    for name, wheel, index, roundness in rolling_shapes(wheels):
         link = links[name]
-        geom = link.collisions[wheel.index]
+        geom = link.collisions[index]
         g = geom.geometry
         if isinstance(g, Cylinder):
             was = f"its collision cylinder (radius {g.radius:g} m, width {g.length:g} m)"
         elif isinstance(g, Mesh):
             was = (f"its collision mesh {mesh_name(g)} (round about the joint axis: radius "
-                   f"{wheel.round.radius:.6g} m, width {wheel.round.width:.6g} m)")
+                   f"{roundness.radius:.6g} m, width {roundness.width:.6g} m)")
         else:  # already a sphere: nothing to replace
             continue
-        link.collisions[wheel.index], what = wheel_proxy(geom, wheel, shape)
+        if len(wheel.rolling) > 1:
+            was = f"{was}, collision {index} of the {len(wheel.rolling)} that roll on the floor,"
+        link.collisions[index], what = wheel_proxy(geom, wheel, shape, roundness)
         notes.note(
             "MK826",
             f"wheel {name} (joint {wheel.joint}): {was} "
@@ -207,8 +217,15 @@ def approximate_wheels(robot: Robot, choice: str, target: str, notes: NoteSink) 
             "contacts, a sphere touches the floor at one point under the hub in both; --wheel-collision "
             "cylinder keeps the source's shape",
             geom.source or link.source,
-            f"link[{name}]/collision[{wheel.index}]",
+            f"link[{name}]/collision[{index}]",
         )
+
+
+def rolling_shapes(wheels: dict[str, Wheel]) -> Iterator[tuple[str, Wheel, int, Round]]:
+    """(link, wheel, collision index, roundness) of every collision that rolls, wheels by name."""
+    for name, wheel in sorted(wheels.items()):
+        for index, roundness in wheel.rolling or ((wheel.index, wheel.round),):
+            yield name, wheel, index, roundness
 
 
 def mesh_name(mesh: Mesh) -> str:

@@ -448,13 +448,24 @@ def skip(engine: str, approx: dict[str, Approximated]) -> Skip | None:
 
 @dataclass(frozen=True)
 class LimitStandIn:
-    """A source joint with an infinite position bound, written with a finite stand-in."""
+    """A source joint whose position bounds the engine holds otherwise, as documented: an infinite
+    bound written with a finite stand-in, or a reversed range held as no limit."""
 
     joint: str  # source name
     lower: float  # what the file (and the engine reading it) holds
     upper: float
     code: str
-    by: str
+    what: str  # the report's phrase, "{n}" standing for the number of joints
+
+
+FINITE_STAND_IN = ("the URDF writer writes the infinite position bounds of {n} joint(s) as ±1e16 (MK819: "
+                   "URDF has no unlimited prismatic joint)")
+REVERSED_UNLIMITED = {
+    "mjcf": ("MK824", "the MJCF writer writes the reversed range (MK307) of {n} joint(s) unlimited (MK824: "
+                      "MuJoCo refuses a range whose lower limit is above its upper)"),
+    "pybullet": ("MK307", "PyBullet holds the reversed range (MK307) of {n} joint(s), which the URDF keeps "
+                          "as the source has it, as no limit (it enforces a range only when lower <= upper)"),
+}
 
 
 def urdf_limits(source: Robot) -> dict[str, LimitStandIn]:
@@ -471,13 +482,30 @@ def urdf_limits(source: Robot) -> dict[str, LimitStandIn]:
                 continue
             out[joint.name] = LimitStandIn(joint.name, lo if math.isfinite(lo) else -SYNTHESISED_POSITION,
                                            hi if math.isfinite(hi) else SYNTHESISED_POSITION, "MK819",
-                                           "the URDF writer")
+                                           FINITE_STAND_IN)
     return out
 
 
-def limits_for_engine(fmt: str, source: Robot) -> dict[str, LimitStandIn]:
-    """The finite stand-ins an engine reading the written ``fmt`` file holds, by source joint."""
-    return urdf_limits(source) if fmt == "urdf" else {}
+def reversed_unlimited(source: Robot, holder: str) -> dict[str, LimitStandIn]:
+    """The source's reversed ranges (MK307) that ``holder`` (a key of :data:`REVERSED_UNLIMITED`) holds
+    as no limit."""
+    code, what = REVERSED_UNLIMITED[holder]
+    return {joint.name: LimitStandIn(joint.name, -math.inf, math.inf, code, what)
+            for joint in source.joints if joint.limits.lower > joint.limits.upper}
+
+
+def limits_for_engine(fmt: str, source: Robot, engine: str = "") -> dict[str, LimitStandIn]:
+    """The bounds an engine reading the written ``fmt`` file holds in place of the source's, by source
+    joint: the URDF writer's finite stand-ins, and a reversed range where the MJCF writer or PyBullet
+    takes it as no limit."""
+    if fmt == "mjcf":
+        return reversed_unlimited(source, "mjcf")
+    if fmt != "urdf":
+        return {}
+    out = urdf_limits(source)
+    if engine == "pybullet":
+        out.update(reversed_unlimited(source, "pybullet"))
+    return out
 
 
 def applied_limits(facts: StaticFacts, stand_ins: dict[str, LimitStandIn]) -> StaticFacts:
@@ -495,13 +523,14 @@ def limits_skip(engine: str, stand_ins: dict[str, LimitStandIn]) -> Skip | None:
     """The report's entry for an engine's limit stand-ins (never a silent pass)."""
     if not stand_ins:
         return None
-    names = sorted(stand_ins)
-    shown = ", ".join(f"{n} [{stand_ins[n].lower:g}, {stand_ins[n].upper:g}]" for n in names[:8]) + (
-        f" and {len(names) - 8} more" if len(names) > 8 else "")
-    first = stand_ins[names[0]]
-    return Skip(1, engine, f"approximation: {first.by} writes the infinite position bounds of {len(names)} "
-                f"joint(s) as ±1e16 ({first.code}: URDF has no unlimited prismatic joint): {shown}. Layer 1 "
-                "checks this engine holds exactly these bounds")
+    parts = []
+    for what in sorted({s.what for s in stand_ins.values()}):
+        names = sorted(n for n, s in stand_ins.items() if s.what == what)
+        shown = ", ".join(f"{n} [{stand_ins[n].lower:g}, {stand_ins[n].upper:g}]" for n in names[:8]) + (
+            f" and {len(names) - 8} more" if len(names) > 8 else "")
+        parts.append(f"{what.format(n=len(names))}: {shown}")
+    return Skip(1, engine, f"approximation: {'; '.join(parts)}. Layer 1 checks this engine holds exactly "
+                "these bounds")
 
 
 @dataclass(frozen=True)
@@ -711,17 +740,18 @@ def applied_wheels(robot: Robot, source: Robot, proxy: WheelProxy) -> Robot:
     """``robot`` (the reference) with the wheels' cylinders and round meshes of ``source`` replaced by
     ``proxy``'s shape,
     as ``convert`` writes them."""
-    from modelkit.convert.wheels import find_wheels, wheel_proxy
+    from modelkit.convert.wheels import find_wheels, rolling_shapes, wheel_proxy
 
     wheels = find_wheels(source)
     out = copy.deepcopy(robot)
-    for link in out.links:
-        if link.name not in proxy.links or link.name not in wheels:
+    links = {link.name: link for link in out.links}
+    for name, wheel, index, roundness in rolling_shapes(wheels):
+        if name not in proxy.links or name not in links:
             continue
-        index = wheels[link.name].index
+        link = links[name]
         geom = link.collisions[index]
         if isinstance(geom.geometry, Cylinder | Mesh):
-            link.collisions[index] = wheel_proxy(geom, wheels[link.name], proxy.shape)[0]
+            link.collisions[index] = wheel_proxy(geom, wheel, proxy.shape, roundness)[0]
     return out
 
 
