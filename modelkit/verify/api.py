@@ -346,13 +346,17 @@ def _load_engines(names: Sequence[str], reference: Robot, files: dict[str, Path]
         extra = {"worker": warm[name]} if warm and name in warm else {}
         try:
             model = load(model_in, renames, root=root, **extra)
+        except ImportError as exc:  # an engine whose adapter imports its library only when it loads
+            report.skips.append(Skip(0, name, f"not installed ({exc})"))
+            continue
         except Exception as exc:
             if getattr(type(exc), "engine_limit", False):  # e.g. Pinocchio's Data, cubic in the joints
                 report.skips.append(Skip(0, name, f"not run: {exc}"))
                 continue
-            loop_skip = _loop_refusal(name, reference, kind, files, exc)
-            if loop_skip is not None:
-                report.skips.append(loop_skip)
+            source_skip = (_loop_refusal(name, reference, kind, files, exc)
+                           or _reversed_range_refusal(name, reference, kind, files, exc))
+            if source_skip is not None:
+                report.skips.append(source_skip)
                 continue
             what = "the source model" if kind == "robot" else f"the written {kind.upper()} {files[kind].name}"
             why = str(exc)
@@ -372,7 +376,7 @@ def _loop_refusal(name: str, reference: Robot, kind: str, files: dict[str, Path]
     """A Skip (all layers, this engine) when an engine that models a tree of joints only refused the
     written file because the source's closed loops (``robot.loops``, written as extra joints, MK811)
     make its joints form a loop; None for any other failure (that stays a failed ``load`` check).
-    Only Drake raises this (``engine_drake.DrakeLoopError``); it is recognised by its ``loop_refusal`` flag
+    Only Drake raises this (``drake_child.DrakeLoopError``); it is recognised by its ``loop_refusal`` flag
     so that this module imports no engine."""
     if not reference.loops or not getattr(type(exc), "loop_refusal", False):
         return None
@@ -382,6 +386,27 @@ def _loop_refusal(name: str, reference: Robot, kind: str, files: dict[str, Path]
         f"not verified (layers 1, 2 and 3): the source has {len(reference.loops)} closed-loop joint(s), "
         f"{joints}, which the written {kind.upper()} {files[kind].name} keeps as extra joint(s) (MK811); "
         f"{limitation}. Drake said: {exc}"))
+
+
+def _reversed_range_refusal(name: str, reference: Robot, kind: str, files: dict[str, Path], exc: Exception
+                            ) -> Skip | None:
+    """A Skip (all layers, this engine) when Drake aborted on a reversed joint range the source itself
+    holds (MK307: urdfdom, libsdformat and Choreonoid load such a file, MuJoCo refuses it), so that the
+    written file is faithful and the engine cannot read it; None otherwise (a reversed range the
+    conversion made stays a failed ``load`` check). Recognised by the ``reversed_range_refusal`` flag
+    (``drake_child.DrakeReversedRange``)."""
+    if not getattr(type(exc), "reversed_range_refusal", False):
+        return None
+    reversed_ranges = [joint for joint in reference.joints if joint.limits.lower > joint.limits.upper]
+    if not reversed_ranges:
+        return None
+    joints = ", ".join(f"{joint.name} [{joint.limits.lower:g}, {joint.limits.upper:g}]"
+                       for joint in reversed_ranges)
+    limitation = str(getattr(type(exc), "limitation", ""))
+    return Skip(0, name, (
+        f"not verified (layers 1, 2 and 3): the source's joint range(s) {joints} are reversed (MK307), and "
+        f"the written {kind.upper()} {files[kind].name} keeps them as the source has them; {limitation}. "
+        f"Drake said: {' '.join(str(exc).split())}"))
 
 
 def verify(
@@ -652,8 +677,9 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
                       if approx[eng.label] or chains or wheels or plates or planar_of[eng.label]
                       or models[eng.label] is not reference
                       else src_static)
-        # ... and so is one holding the URDF writer's ±1e16 for an infinite position bound (MK819).
-        stand_ins = approximations.limits_for_engine(kind, reference)
+        # ... and so is one holding the URDF writer's ±1e16 for an infinite position bound (MK819), or a
+        # reversed range as no limit (MK824 in MJCF; PyBullet).
+        stand_ins = approximations.limits_for_engine(kind, reference, eng.label)
         eng_static = approximations.applied_limits(eng_static, stand_ins)
         limits_entry = approximations.limits_skip(eng.label, stand_ins)
         if limits_entry is not None:

@@ -72,6 +72,13 @@ from pydrake.multibody.tree import (
 from modelkit.model import BALL_KEYS, Robot
 from modelkit.spatial import Pose
 from modelkit.verify.engines import ball_law
+from modelkit.verify.engines.child import serve
+from modelkit.verify.engines.drake_child import (
+    LOOP_MESSAGE,
+    REVERSED_RANGE_REFUSAL,
+    DrakeLoadError,
+    DrakeLoopError,
+)
 from modelkit.verify.engines.protocol import Array, JointFacts, LinkFacts, StaticFacts
 
 Renames = dict[str, dict[str, str]]
@@ -103,25 +110,6 @@ def _unrotated_weld(joint: Any) -> bool:
     child = joint.frame_on_child().GetFixedPoseInBodyFrame().rotation().matrix()
     rotation = parent @ joint.X_FM().rotation().matrix() @ child.T
     return bool(np.abs(rotation - np.eye(3)).max() <= 1e-12)
-
-
-class DrakeLoadError(RuntimeError):
-    """Drake could not load the file, or the file does not hold the expected single model/root."""
-
-
-LOOP_MESSAGE = "form one or more loops"  # Drake's Finalize() message when the joints form a loop
-LOOP_LIMITATION = ("Drake's MultibodyPlant models a tree of joints only: it refuses a file whose joints "
-                   "form a loop (it asks for the loop joint to be replaced by a constraint, "
-                   "https://drake.mit.edu/troubleshooting.html#mbp-loops-in-graph)")
-
-
-class DrakeLoopError(DrakeLoadError):
-    """Drake refused the file because its bodies and joints form a loop (a closed-loop joint written as
-    an extra joint, MK811): a limitation of ``MultibodyPlant``, not a defect of the file (the verifier
-    reports it as a skip when the source has loops, see ``modelkit.verify.api``)."""
-
-    loop_refusal = True
-    limitation = LOOP_LIMITATION
 
 
 def _version() -> str:
@@ -485,3 +473,34 @@ def load_urdf(model: Path | Robot, renames: Renames, *, root: str) -> DrakeModel
     if isinstance(model, Robot):
         raise TypeError("the Drake adapter reads a written SDF or URDF file")
     return DrakeModel(Path(model), root, "drake-urdf")
+
+
+class _ChildServer:
+    """The child's side of :mod:`.drake_child`: this module (pydrake) imported at once, the head start;
+    then one file loaded and asked."""
+
+    def __init__(self) -> None:
+        self.model: DrakeModel | None = None
+
+    def load(self, path: str, root: str, engine: str) -> dict[str, Any]:
+        """The model's facts that do not depend on a configuration, or ``{"refused": (type, message)}``
+        when Drake refuses the file with an exception (re-raised as that type in the parent)."""
+        try:
+            self.model = DrakeModel(Path(path), root, engine)
+        except DrakeLoadError as exc:
+            kind = "DrakeReversedRange" if REVERSED_RANGE_REFUSAL in str(exc) else type(exc).__name__
+            return {"refused": (kind, str(exc))}
+        except RuntimeError as exc:  # Drake's parser and Finalize() raise RuntimeError
+            return {"refused": ("DrakeLoadError", f"{type(exc).__name__}: {exc}")}
+        model = self.model
+        return {"settings": model.settings, "warnings": list(model.warnings), "dofs": model.dof_names(),
+                "dofs_with_balls": model.dof_names_with_balls(), "static": model.static()}
+
+    def call(self, method: str, args: tuple[Any, ...]) -> Any:
+        assert self.model is not None, "load first"
+        return getattr(self.model, method)(*args)
+
+
+def serve_child() -> int:
+    """The child's entry point (:data:`.drake_child.DRAKE_CHILD`; :func:`.child.serve`)."""
+    return serve(_ChildServer)

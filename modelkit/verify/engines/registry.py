@@ -11,14 +11,17 @@ ENGINES: dict[str, str] = {
     "pinocchio": "modelkit.verify.engines.pinocchio:load",
     "mujoco": "modelkit.verify.engines.mujoco:load",
     "pybullet": "modelkit.verify.engines.pybullet:load",
-    "drake": "modelkit.verify.engines.drake:load",
-    "drake-urdf": "modelkit.verify.engines.drake:load_urdf",
+    "drake": "modelkit.verify.engines.drake_child:load",
+    "drake-urdf": "modelkit.verify.engines.drake_child:load_urdf",
     "yourdfpy": "modelkit.verify.engines.reference:load_yourdfpy",
 }
 DEFAULT_ENGINES = ("mujoco", "pybullet", "pinocchio", "drake", "drake-urdf", "yourdfpy")
 # Engines whose child process starts when verify starts (it imports its library while verify reads and
 # converts); the loader takes it as ``worker=``. The function returns None when the engine is missing.
-PRESTART: dict[str, str] = {"yourdfpy": "modelkit.verify.engines.reference:start_yourdfpy"}
+# Drake runs in a child whether or not it started ahead: an abort in its C++ must not end verify.
+PRESTART: dict[str, str] = {"yourdfpy": "modelkit.verify.engines.reference:start_yourdfpy",
+                            "drake": "modelkit.verify.engines.drake_child:start_drake",
+                            "drake-urdf": "modelkit.verify.engines.drake_child:start_drake"}
 
 # Which written file each engine reads ("robot" = the in-memory source model).
 INPUTS: dict[str, str] = {
