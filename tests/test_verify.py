@@ -254,3 +254,17 @@ def test_one_model_shows_progress_on_a_terminal_only(tmp_path: Path) -> None:
     assert "verify: " not in quiet and "PASS" in quiet
     piped = _cli(*args)  # not a terminal
     assert "verify: " not in piped.stdout + piped.stderr and piped.returncode == 0
+
+
+def test_a_check_whose_error_is_nan_fails_and_is_printed() -> None:
+    """An engine that blew up gives NaN errors (a fuzz mutant's 3.5e38 kg wheel in PyBullet's layer 4):
+    the check fails, and the table and report.json say so (the table raised ValueError, MK899)."""
+    from modelkit.verify.engines.protocol import Check
+    from modelkit.verify.report import VerifyReport, render_table
+
+    report = VerifyReport("x.body")
+    report.checks.append(Check(4, "pybullet", "noslip-position", "straight", float("nan"), 0.015, "path"))
+    assert not report.checks[0].passed and report.exit_code == 1
+    table = render_table(report)
+    assert "nan" in table and "FAIL" in table
+    assert json.loads(report_json(report))["checks"][0]["error"] is None

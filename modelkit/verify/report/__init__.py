@@ -111,8 +111,8 @@ def report_json(report: VerifyReport) -> str:
 
 
 def _fmt(x: float) -> str:
-    if math.isinf(x):
-        return "inf"
+    if math.isinf(x) or math.isnan(x):
+        return str(x)
     if x == 0:
         return "0"
     if x == int(x) and abs(x) < 1e6:
