@@ -174,6 +174,11 @@ def test_inertia_dust_is_written_as_zero(tmp_path: Path) -> None:
         dust = tail.copy()
         dust[0, 1] = dust[1, 0] = 5e-19  # 7e-13 of the tensor's largest: dust
         assert clean_inertia(dust, 0.01)[0, 1] == 0.0 and clean_inertia(dust, 0.01)[1, 2] == 2.26e-15
+        # a written tensor is no dust whatever the mass beside it (a fuzz mutant: 3.5e38 kg, whose
+        # 1e-12 of m·L² zeroed the wheel's 0.0023 kg·m², and MuJoCo refused the MJCF)
+        wheel = np.diag([0.0012, 0.0023, 0.0012])
+        assert (clean_inertia(wheel, 3.5e38) == wheel).all()
+        assert not clean_inertia(np.diag([1e-20, 1e-20, 1e-20]), 3.5e38).any()
     source = tmp_path / "ankle.urdf"
     source.write_text("""<robot name="ankle">
   <link name="shin"><inertial><mass value="1"/>

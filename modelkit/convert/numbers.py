@@ -38,6 +38,9 @@ SNAP = 1e-12  # relative: what a written number may differ from the model's
 # (iCub's ``pos="0 2.28232e-12 ..."``), and ten of them in a chain still within the 1e-9 m a
 # read-back and verify compare poses to.
 ZERO = 1e-10
+# kg·m²: the most a tensor of dust can hold, whatever its link's mass: a milligram a millimetre from
+# its axis. A larger value is one someone wrote or measured (:func:`clean_inertia`).
+INERTIA_DUST = 1e-12
 _LENGTH_SCALE: contextvars.ContextVar[float] = contextvars.ContextVar("length_scale", default=1.0)
 _EXACT_ROTATION_VALUES = (0.0, 1.0, 0.5, math.sqrt(0.5))
 
@@ -271,13 +274,17 @@ def clean_inertia(tensor: np.ndarray, mass: float) -> np.ndarray:
     Relative to the tensor itself, not to mass × size²: verify compares each tensor with the source's
     to 1e-9 of its own largest entry, and a small link's tensor is far below its mass × the robot's
     size² (dm_control's dog: a tail vertebra's products of 3e-15 beside moments of 7e-7 kg·m², zeroed
-    at 1e-12 of m·L², were 4e-9 of the tensor)."""
+    at 1e-12 of m·L², were 4e-9 of the tensor).
+
+    Never a tensor above :data:`INERTIA_DUST`: a semantic-fuzz mutant gave the tutorial's wheel a mass of
+    3.5e38 kg beside its written 0.0023 kg·m², which 1e-12 of m·L² zeroed, and MuJoCo refused the MJCF
+    ("mass and inertia of moving bodies must be larger than mjMINVAL")."""
     t = np.asarray(tensor, dtype=float)
     scale = SNAP * abs(float(mass)) * _LENGTH_SCALE.get() ** 2
     own = float(np.max(np.abs(t))) if t.size else 0.0
     if not (math.isfinite(scale) and math.isfinite(own)) or scale <= 0.0:
         return t
-    if own <= scale:
+    if own <= min(scale, INERTIA_DUST):
         return np.zeros_like(t)
     cleaned: np.ndarray = np.where(np.abs(t) <= ZERO * own, 0.0, t)
     return cleaned
