@@ -378,3 +378,40 @@ def test_icub_stands_on_legs_not_wheels() -> None:
     assert robot is not None
     decision = decide(robot)
     assert decision.kind is JointType.FLOATING and "legs" in decision.reason, decision.reason
+
+
+COPTER = """<robot name="copter">
+  <link name="body"><inertial><mass value="1.4"/><inertia ixx="0.05" iyy="0.05" izz="0.24" ixy="0" ixz="0"
+    iyz="0"/></inertial><collision><geometry><box size="0.3 0.3 0.17"/></geometry></collision></link>
+  ROTORS
+</robot>"""
+ROTOR = """<link name="rotor_{i}"><inertial><mass value="0.005"/>
+    <inertia ixx="1e-5" iyy="1e-5" izz="2e-5" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><cylinder length="{thickness}" radius="0.14"/></geometry></collision></link>
+  <joint name="rotor_{i}_joint" type="{kind}"><parent link="body"/><child link="rotor_{i}"/>
+    <origin xyz="{x} {y} 0.1"/><axis xyz="0 0 1"/>{limit}</joint>"""
+
+
+@pytest.mark.parametrize(("kind", "thickness", "floats"),
+                         [("continuous", 0.005, True), ("revolute", 0.005, False),
+                          ("continuous", 0.2, False)],
+                         ids=["rotors", "limited", "thick"])
+def test_a_multirotor_flies(tmp_path: Path, kind: str, thickness: float, floats: bool) -> None:
+    """bullet-safety-gym's quadcopter (a box body resting on the ground, four propeller discs 5 mm thick on
+    continuous joints about vertical axes) was welded, as an arm on its base is. Discs turning without end
+    about vertical axes, clear of the ground, make it fly; a limited joint or a thick drum (a turntable)
+    does not."""
+    limit = '<limit lower="-1" upper="1" effort="1" velocity="1"/>' if kind == "revolute" else ""
+    corners = [(0.2, 0.2), (-0.2, 0.2), (-0.2, -0.2), (0.2, -0.2)]
+    rotors = "\n  ".join(ROTOR.format(i=i, x=x, y=y, kind=kind, limit=limit, thickness=thickness)
+                         for i, (x, y) in enumerate(corners))
+    path = tmp_path / "copter.urdf"
+    path.write_text(COPTER.replace("ROTORS", rotors))
+    robot = validate(path).robot
+    assert robot is not None
+    decision = decide(robot)
+    assert (decision.kind is JointType.FLOATING) is floats, decision.reason
+    assert ("flies on 4 rotors" in decision.reason) is floats, decision.reason
+    if floats:
+        _convert(path, tmp_path / "copter.xml")
+        assert _drop(tmp_path / "copter.xml") > 1.0  # free: it falls without thrust, as a copter does

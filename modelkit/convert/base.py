@@ -16,6 +16,10 @@ with a fixed joint, or no ``world`` link; .body: ``jointType: fixed|free``).
     extents across the axis are equal within 10 % and centred on it): floating, also when a shape of
     the root's own body touches too (a caster ball or skid fixed to the base, as on most
     differential-drive robots: the tutorial's robot written to URDF came back welded);
+  - rotors: at least two revolute joints without a range about a vertical axis, each turning a leaf
+    link clear of the ground whose shapes are round about the axis and flat along it (at most half
+    their radius thick: propeller discs): floating, a multirotor flies (bullet-safety-gym's quadcopter
+    was welded by the next rule, its body box resting on the ground);
   - otherwise a robot whose root's own rigid body (the root and what is fixed to it) touches the
     lowest level rests on its base: welded (arms, fixtures);
   - legs: at least two branches whose shapes touch the lowest level through two or more moving
@@ -222,6 +226,11 @@ def decide(robot: Robot) -> BaseDecision:
         caster = " beside a caster of the root's own body" if on_base else ""
         return BaseDecision(JointType.FLOATING, f"it drives on wheels (joint(s) {shown}: a round shape "
                             f"on a horizontal axis touching the ground{caster})")
+    rotors = _rotors(robot, poses, touching, use_collisions)
+    if len(rotors) >= 2:
+        shown = ", ".join(f'"{j.name}"' for j in rotors[:8]) + (" ..." if len(rotors) > 8 else "")
+        return BaseDecision(JointType.FLOATING, f"it flies on {len(rotors)} rotors (joint(s) {shown}: a flat "
+                            "round shape turning without end about a vertical axis, clear of the ground)")
     if on_base:
         return _by_limbs(robot, poses, limbs, "the root's own body rests on the ground (an arm or a fixture"
                          + (f"; {raised} limb(s) point up, as a hand's fingers do" if raised else "") + ")")
@@ -354,6 +363,46 @@ def _wheels(robot: Robot, poses: dict[str, Pose], touching: set[str], use_collis
         if any(_round_about(geom, axis) for geom in geoms):
             out.append(joint)
     return out
+
+
+ROTOR_FLATNESS = 0.5  # a rotor's shapes are at most this much of their radius thick along the axis
+
+
+def _rotors(robot: Robot, poses: dict[str, Pose], touching: set[str], use_collisions: bool) -> list[Joint]:
+    """A multirotor's rotors: revolute joints without a range about a vertical axis whose child is a leaf
+    (no joint below it moves) clear of the ground, with a shape round about the axis and flat along it
+    (a propeller's disc: bullet-safety-gym's quadcopter, 0.005 m thick, 0.14 m in radius). A turntable
+    or a wrist turning without end has a thick or non-round link, or links below it that move."""
+    out: list[Joint] = []
+    links = {link.name: link for link in robot.links}
+    children = robot.children_of()
+    for joint in robot.joints:
+        if (joint.type is not JointType.REVOLUTE or joint.limits.position_limited or joint.mimic is not None
+                or joint.child in touching or joint.child not in poses
+                or any(j.type.moves for j in children.get(joint.child, []))):
+            continue
+        axis = np.asarray(joint.axis, dtype=float)
+        norm = float(np.linalg.norm(axis))
+        if norm == 0.0:
+            continue
+        axis = axis / norm  # in the child frame
+        if abs(float((poses[joint.child].rotation @ axis)[2])) < 1.0 - 1e-6:
+            continue
+        geoms = links[joint.child].collisions if use_collisions else links[joint.child].visuals
+        if geoms and all(_round_about(geom, axis) and _flat_along(geom, axis) for geom in geoms):
+            out.append(joint)
+    return out
+
+
+def _flat_along(geom: Geom, axis: np.ndarray) -> bool:
+    """Whether the shape is at most :data:`ROTOR_FLATNESS` of its reach across ``axis`` thick along it."""
+    along = extent([geom], axis)
+    side = np.cross(axis, _UP if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0]))
+    across_span = extent([geom], side / np.linalg.norm(side))
+    if along is None or across_span is None:
+        return False
+    radius = (across_span[1] - across_span[0]) / 2
+    return bool(radius > 0.0 and along[1] - along[0] <= ROTOR_FLATNESS * radius)
 
 
 def _round_about(geom: Geom, axis: np.ndarray) -> bool:
