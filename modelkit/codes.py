@@ -720,7 +720,8 @@ _TABLE: tuple[CodeInfo, ...] = (
         "A 9-element inertia matrix is not symmetric: an off-diagonal pair differs by more than 1e-4 of "
         "the largest diagonal moment (less is rounding, ignored). Reference: only .body has 9 elements; "
         "Choreonoid loads the file and uses the matrix as given (no rigid body has such a matrix), so a "
-        "warning; formats of six numbers get its upper triangle (xy, xz, yz) from `convert`.",
+        "warning; formats of six numbers get its upper triangle (xy, xz, yz) from `convert`, which is then "
+        "judged as any inertia is (MK302, MK303).",
     ),
     CodeInfo(
         "MK302",

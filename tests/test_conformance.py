@@ -43,7 +43,7 @@ from modelkit.model import Mesh
 from modelkit.resources import Resolver
 from modelkit.textio import read_head
 
-from .conftest import CORPUS, REPO, SAMPLES, assert_pybullet_refuses, require_tool
+from .conftest import CORPUS, REPO, SAMPLES, TUTORIAL, assert_pybullet_refuses, require_tool
 from .test_sdf_reader import sdf_oracle  # noqa: F401  (the compiled libsdformat checker, a fixture)
 
 KINDS = {".urdf": "urdf", ".xacro": "xacro", ".sdf": "sdf", ".world": "sdf", ".body": "body"}
@@ -1637,11 +1637,34 @@ def test_asymmetric_body_inertia_is_a_warning_and_converts_its_upper_triangle(tm
 
     source = REPO / "tests" / "broken_body" / "inertia_asymmetric.body"  # arm: xy 0.005, yx 0
     v = validate(source)
-    assert v.errors == [] and _codes(v, "warning") == ["MK301"]
+    # its upper triangle (principal moments 0.016, 0.026, 0.0005) breaks the triangle inequality: MK303
+    assert v.errors == [] and _codes(v, "warning") == ["MK301", "MK303"]
     out = tmp_path / "p.urdf"
     result = CliRunner().invoke(main, ["convert", "-o", str(out), str(source)])
     assert result.exit_code == 0, result.output
     assert 'ixx="0.021" ixy="0.005" ixz="0" iyy="0.021" iyz="0" izz="0.0005"' in out.read_text()
+
+
+def test_an_asymmetric_body_inertia_is_judged_as_the_upper_triangle_convert_writes(tmp_path: Path) -> None:
+    """A semantic-fuzz mutant of the tutorial's mobile_robot.body: its left wheel's iyz (row-major index 5)
+    set to 3.5e38, zy left 0. validate warned MK301 and stopped judging the link; convert wrote the upper
+    triangle, a tensor with principal moments ±3.5e38, and MuJoCo refused the MJCF ("inertia must satisfy
+    A + B >= C"). The written tensor is now judged: MK302, an error (the wheel moves)."""
+    text = (TUTORIAL / "mobile_robot_primitive.body").read_text()
+    wheel = """    inertia: [ 0.0012, 0,      0,
+               0,      0.0023, 0,
+               0,      0,      0.0012 ]
+    material: Tire"""
+    assert text.count(wheel) == 2
+    source = tmp_path / "wheel.body"
+    source.write_text(text.replace(wheel, wheel.replace("0.0023, 0,", "0.0023, 0.05,"), 1))
+    v = validate(source)
+    assert _codes(v, "warning") == ["MK301"]
+    (error,) = v.errors
+    assert error.code == "MK302" and '"LeftWheel" (its upper triangle, which convert writes)' in error.message
+    # a small asymmetry whose upper triangle is a physical tensor stays a warning only
+    source.write_text(text.replace(wheel, wheel.replace("0.0023, 0,", "0.0023, 0.0001,"), 1))
+    assert validate(source).errors == []
 
 
 _BAD_INERTIA = (

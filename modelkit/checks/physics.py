@@ -248,10 +248,15 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
                 where,
                 hint="give the same value to each off-diagonal pair (row-major: xy = yx, xz = zx, yz = zy)",
             )
-            continue
+            # judged further as what every target gets: convert writes the upper triangle
+            tensor = rot3.inertia_from_moments(tensor[0][0], tensor[0][1], tensor[0][2], tensor[1][1],
+                                               tensor[1][2], tensor[2][2])
+            upper = " (its upper triangle, which convert writes)"
+        else:
+            upper = ""
         head = merged_into.get(link.name)
         if head is None:
-            what = f'link "{link.name}"'
+            what = f'link "{link.name}"{upper}'
             yield from _judge_inertia(robot, what, inertial.mass, tensor, where, severity, static)
         else:
             yield from _negative_moment_in_body(link, tensor, head, where)
