@@ -886,3 +886,29 @@ def test_a_relative_path_reads_meshes_an_include_names_from_its_own_folder(
     assert v.errors == [], [d.message for d in v.errors]
     assert v.robot is not None and v.robot.name == "r"
     assert all(d.location is None or not Path(d.location.file).is_absolute() for d in v.diagnostics)
+
+
+def test_a_body_gets_a_look_only_from_the_colliding_geoms_mujoco_draws(tmp_path: Path) -> None:
+    """A body without a visual-only geom gets copies of its colliding geoms as its look, as MuJoCo draws
+    it: geoms of groups 0-2 that are not fully transparent. A body whose colliders are hidden (group 3, as
+    Menagerie keeps collisions) looked like nothing in the source; it got a visible copy of them, so
+    MJCF -> MJCF wrote each such geom twice and drew what the source hid."""
+    path = tmp_path / "looks.xml"
+    path.write_text("""<mujoco><worldbody><body name="base"><freejoint/>
+      <geom name="hidden" type="box" size=".1 .1 .1" group="3" mass="1"/>
+      <body name="leg" pos="0 0 -.2"><joint name="j" axis="0 1 0"/>
+        <geom name="drawn" type="capsule" size=".02" fromto="0 0 0 0 0 -.2" mass=".2"/>
+        <geom name="clear" type="sphere" size=".03" rgba="1 0 0 0" mass=".1"/></body>
+    </body></worldbody></mujoco>""")
+    robot = validate(path).robot
+    assert robot is not None
+    links = {link.name: link for link in robot.links}
+    assert [g.name for g in links["base"].collisions] == ["hidden"] and links["base"].visuals == []
+    assert [g.name for g in links["leg"].collisions] == ["drawn", "clear"]
+    assert [g.name for g in links["leg"].visuals] == ["drawn"]
+    out = tmp_path / "out.xml"
+    result = CliRunner().invoke(main, ["convert", str(path), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    model = mujoco.MjModel.from_xml_path(str(out))
+    base = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "base")
+    assert int(model.body_geomnum[base]) == 1  # the hidden box, once

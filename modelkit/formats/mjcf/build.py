@@ -59,6 +59,16 @@ JOINT_TYPES = {
 }
 
 
+DRAWN_GROUPS = 3  # MuJoCo's viewer draws geom groups 0, 1 and 2 unless told otherwise (mjvOption.geomgroup)
+
+
+def drawn(mg: MjGeom) -> bool:
+    """Whether MuJoCo draws the geom by default: a group below :data:`DRAWN_GROUPS` and a colour that is
+    not fully transparent. A body whose colliding geoms are all hidden (Menagerie's group 3) has no look
+    of its own, and gets no visual copy of them."""
+    return mg.group < DRAWN_GROUPS and (mg.rgba is None or mg.rgba[3] > 0.0)
+
+
 @dataclass
 class Names:
     """Deterministic, unique names for links and joints (generated names never shadow real ones)."""
@@ -371,6 +381,7 @@ class RobotBuilder:
     def _geoms(self, link: Link, body: MjBody, back: Pose) -> None:
         visuals: list[Geom] = []
         collisions: list[Geom] = []
+        shown: list[Geom] = []  # the collisions MuJoCo draws: a body's look when it has no visual geom
         for mg in body.geoms:
             geom = self.geom(mg, back)
             if geom is None:
@@ -379,7 +390,9 @@ class RobotBuilder:
                 entry = {"collision": len(collisions), "name": mg.name, **mg.contact}
                 link.extras.setdefault("mjcf_contact", []).append(entry)
             (visuals if mg.visual_only else collisions).append(geom)
-        link.visuals = visuals if visuals else [self._copy(g) for g in collisions]
+            if not mg.visual_only and drawn(mg):
+                shown.append(geom)
+        link.visuals = visuals if visuals else [self._copy(g) for g in shown]
         link.collisions = collisions
 
     @staticmethod
