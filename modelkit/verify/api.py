@@ -390,9 +390,9 @@ def _loop_refusal(name: str, reference: Robot, kind: str, files: dict[str, Path]
 
 def _reversed_range_refusal(name: str, reference: Robot, kind: str, files: dict[str, Path], exc: Exception
                             ) -> Skip | None:
-    """A Skip (all layers, this engine) when Drake aborted on a reversed joint range the source itself
-    holds (MK307: urdfdom, libsdformat and Choreonoid load such a file, MuJoCo refuses it), so that the
-    written file is faithful and the engine cannot read it; None otherwise (a reversed range the
+    """A Skip (all layers, this engine) when Drake refused or aborted on a reversed joint range the source
+    itself holds (MK307: urdfdom, libsdformat and Choreonoid load such a file, MuJoCo refuses it), so that
+    the written file is faithful and the engine cannot read it; None otherwise (a reversed range the
     conversion made stays a failed ``load`` check). Recognised by the ``reversed_range_refusal`` flag
     (``drake_child.DrakeReversedRange``)."""
     if not getattr(type(exc), "reversed_range_refusal", False):
