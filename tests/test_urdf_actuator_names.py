@@ -78,3 +78,23 @@ def test_a_transmission_of_a_joint_the_robot_lacks_is_left_out(tmp_path: Path) -
     assert "MK808" in result.output and '"gone_trans" left out' in result.output
     assert _drake_loads(out) is None
     assert out.read_text().count("<transmission") == 2
+
+
+def test_a_transmission_of_a_joint_of_several_coordinates_is_left_out(tmp_path: Path) -> None:
+    """A semantic-fuzz mutant of ros-industrial's UR5 turned ``shoulder_pan_joint`` planar (another, the
+    wrist floating) and kept its transmission: check_urdf loads the written URDF, Drake refused it ("this
+    joint has 3 degrees of freedom, and MultibodyPlant currently only supports actuators for single
+    degree-of-freedom joints"; for the floating wrist: "Transmission specifies joint ... which does not
+    exist"). convert leaves such a transmission out (MK808) and keeps the others."""
+    for kind in ("planar", "floating"):
+        source = tmp_path / f"{kind}.urdf"
+        text = SOURCE.replace('name="motor3"', 'name="motor4"', 1)
+        text = text.replace('<joint name="joint3" type="revolute">', f'<joint name="joint3" type="{kind}">')
+        source.write_text(text)
+        assert _drake_loads(source) is not None
+        out = tmp_path / "out" / f"{kind}.urdf"
+        result = CliRunner().invoke(main, ["convert", str(source), "-o", str(out)])
+        assert result.exit_code == 0, result.output
+        assert f"\"joint3_trans\" left out: it drives joint(s) 'joint3' ({kind})" in result.output, result.output
+        assert _drake_loads(out) is None
+        assert out.read_text().count("<transmission") == 1

@@ -27,7 +27,7 @@ from modelkit.formats.sdf.gazebo_blocks import joint_block, link_block, model_bl
 from modelkit.formats.urdf.write_actuators import rename_motor, unique_motor, write_transmissions
 from modelkit.formats.urdf.write_frames import SensorFrames
 from modelkit.formats.urdf.write_names import NameTable
-from modelkit.model import Device, DeviceKind, Link, Robot, SurfaceFriction
+from modelkit.model import Device, DeviceKind, JointType, Link, Robot, SurfaceFriction
 from modelkit.spatial import Pose
 
 # Gazebo reads the SDF inside a URDF's <gazebo> blocks; sensors are written as SDF 1.6 describes them
@@ -249,6 +249,10 @@ def _drive_plugin(robot_el: Element, robot: Robot, gazebo: str, names: NameTable
         etree.SubElement(plugin, tag).text = text
 
 
+# The joints a transmission can drive: one coordinate each (a planar, floating or ball joint has more)
+ONE_COORDINATE = frozenset({JointType.REVOLUTE, JointType.PRISMATIC})
+
+
 def _transmissions(robot_el: Element, robot: Robot, names: NameTable, ctx: WriteContext) -> None:
     motors: set[str] = set()
     for entry in robot.extras.get("transmissions", []) or []:
@@ -271,6 +275,20 @@ def _transmissions(robot_el: Element, robot: Robot, names: NameTable, ctx: Write
                 f'<transmission> "{block.get("name", "")}" left out: it drives joint(s) '
                 f'{", ".join(repr(m) for m in missing)}, which the robot does not have (validate: MK139); '
                 "Drake refuses a URDF whose transmission names no joint",
+                source if isinstance(source, SourceLocation) else None,
+                "transmission",
+            )
+            continue
+        types = {joint.name: joint.type for joint in robot.joints}
+        driven = [str(joint.get("name", "")) for joint in block.iter("joint")]
+        several = [f"{name!r} ({types[name].value})" for name in driven if types[name] not in ONE_COORDINATE]
+        if several:  # Drake refuses the file: "only supports actuators for single degree-of-freedom joints"
+            source = entry.get("source")
+            ctx.note(
+                "MK808",
+                f'<transmission> "{block.get("name", "")}" left out: it drives joint(s) '
+                f"{', '.join(several)}, which have more than one coordinate; a transmission drives one, "
+                "and Drake refuses a URDF whose transmission names such a joint",
                 source if isinstance(source, SourceLocation) else None,
                 "transmission",
             )
