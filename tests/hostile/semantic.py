@@ -310,7 +310,7 @@ def kind_of(path: Path) -> str:
     suffix = path.suffix.lower()
     if suffix == ".body":
         return "body"
-    if suffix == ".urdf":
+    if suffix in (".urdf", ".xacro"):  # a xacro source mutated as the URDF it expands to
         return "urdf"
     if suffix in (".sdf", ".world"):
         return "sdf"
