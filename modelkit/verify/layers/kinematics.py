@@ -56,19 +56,31 @@ def _with_mimics(robot: Robot, q: dict[str, float]) -> dict[str, float]:
 
 
 def layer2(reference: EngineModel, eng: Loaded, configs: list[dict[str, float]],
-           chain_joints: Mapping[str, str] | None = None) -> list[Check]:
+           chain_joints: Mapping[str, str] | None = None, detached: Mapping[str, str] | None = None
+           ) -> list[Check]:
     """Link poses relative to the root link, source FK vs the engine, over every configuration.
 
     A ball joint turns by its three angles (``BALL_KEYS``) in an engine that holds it as a ball joint
     (MuJoCo, Drake's SDF), or as the URDF writer's chain of three joints (``chain_joints``: ``NAME#x``...
     → the written joint); an engine that holds it neither way compares with it at zero (said in the
-    check's detail)."""
+    check's detail).
+
+    ``detached`` (link → the head of its subtree, :func:`approximations.detached_subtrees`): the links
+    of a subtree that hangs by a floating joint, which the engine holds as a free body left where it
+    is at q = 0 (MK813): each is compared where the source puts it when its head stays at its pose at
+    q = 0 and the joints inside the subtree move."""
     position, rotation = Worst(), Worst()
     chain_joints = dict(chain_joints or {})
+    detached = dict(detached or {})
     held = _ball_keys_held(eng, configs, chain_joints)
+    at_rest = reference.link_poses({}) if detached else {}
     for i, q in enumerate(configs):
         q = {k: v for k, v in q.items() if k not in held}
         ref = reference.link_poses(q)
+        moved = dict(ref)  # the heads as the source moves them, before any is put back at rest
+        for link, head in detached.items():
+            if link in ref and head in moved:
+                ref[link] = at_rest[head] @ moved[head].inverse() @ moved[link]
         qe = engine_q({k: v for k, v in q.items() if k not in chain_joints}, eng)
         qe.update({chain_joints[k]: v for k, v in q.items() if k in chain_joints})
         got: dict[str, Pose] = eng.model.link_poses(qe)
@@ -84,6 +96,10 @@ def layer2(reference: EngineModel, eng: Loaded, configs: list[dict[str, float]],
             if rotation.beats(da):
                 rotation.see(da, name, f"configuration {i}: orientation differs by {da:.3g} rad")
     n = f"{len(configs)} configurations, every link"
+    if detached:
+        heads = sorted(set(detached.values()))
+        n += (f"; the subtree(s) of {', '.join(heads)} (hanging by a floating joint) held where the engine "
+              "holds them, a free body at its pose at q = 0 (MK813)")
     if held:
         balls = sorted({k.rpartition("#")[0] for k in held})
         n += ("; ball joint(s) held at zero, which the engine holds neither as a ball nor as a chain: "
