@@ -274,6 +274,9 @@ class Link:
         return self.sources.get(attribute, self.source)
 
 
+NO_LIMIT = 1e16  # rad or m: SDFormat's default joint bound before 1.10, meaning "no limit"
+
+
 @dataclass(eq=False)
 class JointLimits:
     lower: float = -math.inf
@@ -286,6 +289,12 @@ class JointLimits:
     @property
     def position_limited(self) -> bool:
         return math.isfinite(self.lower) or math.isfinite(self.upper)
+
+    @property
+    def endless(self) -> bool:
+        """No position bound, or bounds at SDFormat's "no limit" (±1e16 or beyond), which a URDF made from
+        an SDF keeps as numbers (example-robot-data's iris: rotors limited to ±1e16)."""
+        return self.lower <= -NO_LIMIT and self.upper >= NO_LIMIT
 
 
 @dataclass(eq=False)

@@ -415,3 +415,14 @@ def test_a_multirotor_flies(tmp_path: Path, kind: str, thickness: float, floats:
     if floats:
         _convert(path, tmp_path / "copter.xml")
         assert _drop(tmp_path / "copter.xml") > 1.0  # free: it falls without thrust, as a copter does
+
+
+def test_rotors_limited_at_sdformats_no_limit_turn_without_end() -> None:
+    """example-robot-data's iris (a URDF made from an SDF) keeps SDFormat's "no limit" as numbers: its four
+    rotors are revolute joints limited to ±1e16 rad. They turn without end as a continuous joint does,
+    so the quadrotor flies; it was welded as an arm is."""
+    robot = validate(example_robot("iris_description/robots/iris.urdf")).robot
+    assert robot is not None
+    assert all(j.limits.lower == -1e16 for j in robot.joints if "rotor" in j.name)
+    decision = decide(robot)
+    assert decision.kind is JointType.FLOATING and "flies on 4 rotors" in decision.reason, decision.reason

@@ -347,7 +347,7 @@ def _wheels(robot: Robot, poses: dict[str, Pose], touching: set[str], use_collis
     out: list[Joint] = []
     links = {link.name: link for link in robot.links}
     for joint in robot.joints:
-        if (joint.type is not JointType.REVOLUTE or joint.limits.position_limited
+        if (joint.type is not JointType.REVOLUTE or not joint.limits.endless
                 or joint.child not in touching or joint.child not in poses):
             continue  # a wheel turns without end, as the writers' wheels (convert.wheels, legs.is_wheel) do
         link = links[joint.child]
@@ -377,7 +377,7 @@ def _rotors(robot: Robot, poses: dict[str, Pose], touching: set[str], use_collis
     links = {link.name: link for link in robot.links}
     children = robot.children_of()
     for joint in robot.joints:
-        if (joint.type is not JointType.REVOLUTE or joint.limits.position_limited or joint.mimic is not None
+        if (joint.type is not JointType.REVOLUTE or not joint.limits.endless or joint.mimic is not None
                 or joint.child in touching or joint.child not in poses
                 or any(j.type.moves for j in children.get(joint.child, []))):
             continue

@@ -118,7 +118,7 @@ def endless_axles(robot: Robot, poses: dict[str, Pose], tilt: float
     for joint in robot.joints:
         link = links.get(joint.child)
         pose = poses.get(joint.child)
-        if (joint.type is not JointType.REVOLUTE or joint.limits.position_limited or joint.mimic is not None
+        if (joint.type is not JointType.REVOLUTE or not joint.limits.endless or joint.mimic is not None
                 or link is None or pose is None or link.name in rollers):
             continue
         norm = float(np.linalg.norm(np.asarray(joint.axis, dtype=float)))
