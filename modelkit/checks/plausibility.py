@@ -156,6 +156,34 @@ def collision_shape_differs(robot: Robot) -> Iterator[Diagnostic]:
             )
 
 
+def _shape_key(geom: Geom) -> tuple[object, ...]:
+    """What makes two shapes the same, triangles in memory compared by content."""
+    g = geom.geometry
+    if not isinstance(g, Mesh):
+        return (repr(g),)
+    data = None if g.data is None else (g.data.vertices.tobytes(), g.data.faces.tobytes())
+    return ("mesh", g.uri, g.path, g.fragment, tuple(float(v) for v in g.scale), g.generator, data)
+
+
+@rule("collision-repeated", "MK411")
+def collision_repeated(robot: Robot) -> Iterator[Diagnostic]:
+    """A link's collision repeats another of the link exactly: the same geometry at the same pose."""
+    for link in robot.links:
+        seen: dict[tuple[object, ...], int] = {}
+        for index, geom in enumerate(link.collisions):
+            key = (_shape_key(geom), geom.pose.translation_tuple, geom.pose.rotation_tuple)
+            first = seen.setdefault(key, index)
+            if first != index:
+                yield diag(
+                    "MK411",
+                    f'link "{link.name}": collision {index} repeats collision {first} (the same '
+                    f"{_kind(geom)} at the same pose); engines make a contact for each, so the contact there "
+                    "is stiffer than one shape's",
+                    geom.source or link.loc("name"),
+                    hint="give the shape once",
+                )
+
+
 @rule("inertia-implausible", "MK316")
 def inertia_implausible(robot: Robot) -> Iterator[Diagnostic]:
     """A rigid body's radius of gyration is far larger than its shapes: no mass inside them has that inertia.
