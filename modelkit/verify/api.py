@@ -691,14 +691,16 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
     report.checks[:] = _explain_invalid_inertia(reference, loaded, report.checks)
     t3 = time.perf_counter()
     configs = kinematics.configurations(reference, configurations, seed)
-    # a subtree hanging by a floating joint inside the tree, which some engines hold as a free body (MK813)
-    subtrees = approximations.detached_subtrees(reference)
-    detached_in = {label for label in approximations.DETACHED_BY if subtrees}
+    # a subtree hanging by a floating (planar) joint inside the tree, which some engines hold as a free
+    # body (MK813)
+    subtrees = {label: approximations.detached_subtrees(reference, detaching.kinds)
+                for label, detaching in approximations.DETACHED_BY.items()}
+    detached_in = {label for label, links in subtrees.items() if links}
     for eng in loaded:
         chain_joints = {c.joint + key: written_joint for c in chains_of[eng.label]
                         for key, written_joint in zip(BALL_KEYS, c.joints, strict=True)}
         fk = src if models[eng.label] is reference else SourceModel(models[eng.label])
-        held_free = subtrees if eng.label in detached_in else {}
+        held_free = subtrees.get(eng.label, {})
         report.checks.extend(_guarded(2, eng, lambda eng=eng, cj=chain_joints, fk=fk, hf=held_free:
                                       kinematics.layer2(fk, eng, configs, cj, hf)))
     t4 = time.perf_counter()
@@ -728,11 +730,13 @@ def _layers_1_to_3(report: VerifyReport, source: Path, out_dir: Path, engines: S
             if eng.label == "pinocchio":
                 continue
             if eng.label in detached_in:
-                heads = ", ".join(sorted(set(subtrees.values())))
+                detaching = approximations.DETACHED_BY[eng.label]
+                heads = ", ".join(sorted(set(subtrees[eng.label].values())))
+                kinds = " or ".join(sorted(kind.value for kind in detaching.kinds))
                 report.skips.append(Skip(3, eng.label, (
-                    f"not compared: the subtree(s) of {heads} hang by a floating joint, and "
-                    f"{approximations.DETACHED_BY[eng.label]}; its mass matrix over the other joints then "
-                    "leaves the subtree out, which the reference's chain carries")))
+                    f"not compared: the subtree(s) of {heads} hang by a {kinds} joint, and {detaching.why}; "
+                    "its mass matrix over the other joints then leaves the subtree out, which the "
+                    "reference's chain carries")))
                 continue
             dropped = bool(with_armature) and INPUTS.get(eng.label) in ("urdf", "sdf")
             # an engine holding each ball joint as the URDF writer's chain (MK813) is compared with the

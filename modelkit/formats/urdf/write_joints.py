@@ -105,9 +105,9 @@ def _limit_element(
         )
 
 
-def _dynamics(parent: Element, joint: Joint) -> None:
-    if joint.damping != 0.0 or joint.friction != 0.0:
-        etree.SubElement(parent, "dynamics", damping=fmt(joint.damping), friction=fmt(joint.friction))
+def _dynamics(parent: Element, damping: float, friction: float) -> None:
+    if damping != 0.0 or friction != 0.0:
+        etree.SubElement(parent, "dynamics", damping=fmt(damping), friction=fmt(friction))
 
 
 def _dropped_values(joint: Joint, dropped: list[str]) -> None:
@@ -177,7 +177,14 @@ def joint_elements(
         if narrowed:
             dropped.append("velocity range")
     _extras(el, joint)
-    _dynamics(el, joint)
+    if word == "planar" and (joint.damping != 0.0 or joint.friction != 0.0):
+        # a planar joint's <dynamics>: urdfdom reads one damping number and refuses three; Drake's parser
+        # wants three (x, y, θ) and refuses one or none ("Expected 3 values for attribute damping got 1")
+        dropped.append(f"damping {fmt(joint.damping)} and friction {fmt(joint.friction)} of a planar joint "
+                       "(its <dynamics>: urdfdom reads one damping number, Drake's parser three; no form "
+                       "loads in both)")
+    else:
+        _dynamics(el, joint.damping, joint.friction)
     if joint.mimic is not None and joint.mimic.joint not in names.joint_map:
         ctx.note(
             "MK812",
@@ -233,7 +240,7 @@ def _ball(
         etree.SubElement(el, "parent", link=links[i])
         etree.SubElement(el, "child", link=links[i + 1])
         etree.SubElement(el, "axis", xyz=fmt_direction(axis))
-        _dynamics(el, joint)
+        _dynamics(el, joint.damping, joint.friction)
         out.append(el)
     extra_links.extend(Link(link, source=joint.source) for link in links[1:3])
     ctx.note(

@@ -533,43 +533,54 @@ def limits_skip(engine: str, stand_ins: dict[str, LimitStandIn]) -> Skip | None:
                 "these bounds")
 
 
-# The engines that hold a subtree hanging by a floating joint inside the tree as a free body at its pose
-# at q = 0, and why (PyBullet welds such a joint and yourdfpy does not move it: neither is run).
+@dataclass(frozen=True)
+class Detaching:
+    """The joints whose child an engine holds as a free body left where it is at q = 0, and why."""
+
+    kinds: frozenset[JointType]
+    why: str
+
+
+# The engines that hold a subtree hanging by a floating (or planar) joint inside the tree as a free body at
+# its pose at q = 0 (PyBullet welds a floating joint and yourdfpy does not move one: neither is run).
 DETACHED_BY = {
-    "mujoco": "the MJCF writer makes it a top-level body with <freejoint/> (MK813: MuJoCo allows a free "
-              "joint on a top-level body only)",
-    "drake": "the SDF writer leaves its head link without a joint, free-floating (MK813: SDF has no "
-             "floating joint inside a model)",
-    "drake-urdf": "Drake's URDF parser leaves the child of a floating joint a free body",
+    "mujoco": Detaching(frozenset({JointType.FLOATING}), "the MJCF writer makes it a top-level body with "
+                        "<freejoint/> (MK813: MuJoCo allows a free joint on a top-level body only)"),
+    "drake": Detaching(frozenset({JointType.FLOATING, JointType.PLANAR}), "the SDF writer leaves its head "
+                       "link without a joint, free-floating (MK813: SDF has no floating or planar joint "
+                       "inside a model)"),
+    "drake-urdf": Detaching(frozenset({JointType.FLOATING}), "Drake's URDF parser leaves the child of a "
+                            "floating joint a free body"),
 }
 
 
-def detached_subtrees(source: Robot) -> dict[str, str]:
-    """Link → the head of its subtree, for every link below a floating joint inside the tree whose parent
-    a joint moves (the head: that joint's child; a link below two such joints belongs to the nearer).
-    A floating joint on the root's rigid body leaves its subtree where the source has it either way."""
+def detached_subtrees(source: Robot, kinds: frozenset[JointType] = frozenset({JointType.FLOATING})
+                      ) -> dict[str, str]:
+    """Link → the head of its subtree, for every link below a joint of ``kinds`` inside the tree whose
+    parent another joint moves (the head: that joint's child; a link below two such joints belongs to the
+    nearer). Such a joint on the root's rigid body leaves its subtree where the source has it either way."""
     children = source.children_of()
     up = {joint.child: joint for joint in source.joints}
 
-    def carried(link: str) -> bool:  # a hinge, slide, ball or planar joint moves ``link``
+    def carried(link: str) -> bool:  # a joint not of ``kinds`` moves ``link``
         seen: set[str] = set()
         while link in up and link not in seen:
             seen.add(link)
             joint = up[link]
-            if joint.type.moves and joint.type is not JointType.FLOATING:
+            if joint.type.moves and joint.type not in kinds:
                 return True
             link = joint.parent
         return False
 
     out: dict[str, str] = {}
     for joint in source.joints:
-        if joint.type is not JointType.FLOATING or not carried(joint.parent):
+        if joint.type not in kinds or not carried(joint.parent):
             continue
         stack = [joint.child]
         while stack:
             link = stack.pop()
             out[link] = joint.child
-            stack.extend(j.child for j in children.get(link, []) if j.type is not JointType.FLOATING)
+            stack.extend(j.child for j in children.get(link, []) if j.type not in kinds)
     return out
 
 

@@ -98,8 +98,8 @@ def layer2(reference: EngineModel, eng: Loaded, configs: list[dict[str, float]],
     n = f"{len(configs)} configurations, every link"
     if detached:
         heads = sorted(set(detached.values()))
-        n += (f"; the subtree(s) of {', '.join(heads)} (hanging by a floating joint) held where the engine "
-              "holds them, a free body at its pose at q = 0 (MK813)")
+        n += (f"; the subtree(s) of {', '.join(heads)} (hanging by a floating or planar joint) held where "
+              "the engine holds them, a free body at its pose at q = 0 (MK813)")
     if held:
         balls = sorted({k.rpartition("#")[0] for k in held})
         n += ("; ball joint(s) held at zero, which the engine holds neither as a ball nor as a chain: "
