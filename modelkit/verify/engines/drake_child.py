@@ -30,7 +30,9 @@ from modelkit.verify.engines.protocol import Array, EngineError, StaticFacts
 Renames = dict[str, dict[str, str]]
 DRAKE_CHILD = ("import sys; from modelkit.verify.engines.drake import serve_child; "
                "sys.exit(serve_child())")
-LOAD_TIMEOUT = 120.0  # seconds: Drake parses every mesh of a large model (ARMAR-4: 89 MB)
+# seconds: Drake parses every mesh of the file (ARMAR-4: 89 MB of them); in verify's own process the
+# load had no bound, so this one is wide: it only stops a parse that would never end
+LOAD_TIMEOUT = 600.0
 
 # What Drake's Joint constructor asserts before it aborts, and why: a reversed range in the written
 # file, which the source holds (MK307) when the conversion copied it.
