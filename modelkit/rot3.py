@@ -159,6 +159,27 @@ def inertia_from_moments(ixx: float, ixy: float, ixz: float, iyy: float, iyz: fl
             (float(ixz), float(iyz), float(izz)))
 
 
+# An inertia matrix is asymmetric (validate's MK301) when an off-diagonal pair differs by more than this
+# fraction of its largest diagonal moment; smaller differences are the source's rounding.
+ASYMMETRY_TOLERANCE = 1e-4
+
+
+def inertia_skew(m: M3) -> float:
+    """The largest difference of an off-diagonal pair."""
+    return max(abs(m[i][j] - m[j][i]) for i in range(3) for j in range(3))
+
+
+def is_asymmetric(m: M3) -> bool:
+    """Whether ``m`` is an asymmetric inertia matrix (:data:`ASYMMETRY_TOLERANCE`), not rounding."""
+    return inertia_skew(m) > ASYMMETRY_TOLERANCE * max(abs(m[i][i]) for i in range(3))
+
+
+def upper_symmetric(m: M3) -> M3:
+    """The symmetric matrix of ``m``'s upper triangle (row-major xy, xz, yz): what every six-number format
+    gets of a ``.body`` file's asymmetric nine-number inertia (MK301)."""
+    return inertia_from_moments(m[0][0], m[0][1], m[0][2], m[1][1], m[1][2], m[2][2])
+
+
 def rotate_inertia(inertia: M3, rotation: M3) -> M3:
     """R·I·Rᵀ."""
     return matmul(matmul(rotation, inertia), transpose(rotation))

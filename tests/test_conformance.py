@@ -1760,3 +1760,40 @@ def test_required_sdf_attributes_present_are_not_said(tmp_path: Path, sdf_oracle
                                 "</link></model>"))
     assert _libsdformat_accepts(sdf_oracle, path)
     assert not [d for d in validate(path).diagnostics if d.code == "MK120"]
+
+
+def test_every_six_number_target_gets_the_same_upper_triangle(tmp_path: Path) -> None:
+    """An asymmetric nine-number .body inertia (MK301): the URDF writer wrote its upper triangle, the SDF
+    and MJCF writers the average of the two halves, so one source gave two robots (a semantic-fuzz
+    mutant of PA10 failed verify: each engine held another tensor, and Pinocchio refused the source's).
+    ``convert`` now gives every six-number target the upper triangle; verify compares with it and says
+    so; .body keeps the nine numbers as Choreonoid uses them."""
+    from click.testing import CliRunner
+
+    import modelkit
+    from modelkit.cli import main
+    from modelkit.verify.api import verify
+
+    text = (TUTORIAL / "mobile_robot_primitive.body").read_text()
+    wheel = """    inertia: [ 0.0012, 0,      0,
+               0,      0.0023, 0,
+               0,      0,      0.0012 ]
+    material: Tire"""
+    source = tmp_path / "wheel.body"
+    source.write_text(text.replace(wheel, wheel.replace("0.0023, 0,", "0.0023, 0.0001,"), 1))
+    assert _codes(validate(source), "warning") == ["MK301"]
+    held = {}
+    for suffix in ("urdf", "sdf", "xml", "body"):
+        out = tmp_path / f"out.{suffix}"
+        result = CliRunner().invoke(main, ["convert", str(source), "-o", str(out)])
+        assert result.exit_code == 0, result.output
+        (link,) = [link for link in modelkit.load(out).links if link.name == "LeftWheel"]
+        assert link.inertial is not None
+        held[suffix] = [[round(float(x), 12) for x in row] for row in link.inertial.inertia]
+    upper = [[0.0012, 0.0, 0.0], [0.0, 0.0023, 0.0001], [0.0, 0.0001, 0.0012]]
+    assert held["urdf"] == held["sdf"] == held["xml"] == upper, held
+    assert held["body"] == [[0.0012, 0.0, 0.0], [0.0, 0.0023, 0.0001], [0.0, 0.0, 0.0012]]
+    report = verify(source, tmp_path / "v", ("mujoco", "pinocchio", "drake"), configurations=2, samples=1,
+                    replay=False, driven=False)
+    assert report.failed == [], [c.detail for c in report.failed]
+    assert any("LeftWheel is not symmetric (MK301" in s.reason for s in report.skips)

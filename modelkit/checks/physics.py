@@ -159,9 +159,6 @@ def _no_mass_information(robot: Robot, link: Link) -> Diagnostic:
     return diag("MK313", f'link "{link.name}" moves but has no mass', link.loc("name"))
 
 
-# MK301: an inertia matrix is asymmetric when an off-diagonal pair differs by more than this fraction of
-# the largest diagonal moment (smaller differences are rounding in the source and are ignored).
-ASYMMETRY_TOLERANCE = 1e-4
 # What a loader does with an asymmetric 9-element inertia (MK301, a warning: Choreonoid loads the file).
 ASYMMETRIC_INERTIA_CONSUMERS = (
     "Choreonoid uses the matrix as given, which no rigid body has; convert writes its upper triangle"
@@ -239,8 +236,8 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
         # harmless, so the finding is a warning there.
         severity = None if link.name in moving else Severity.WARNING
         static = "" if link.name in moving else " (the link does not move, so simulators ignore it)"
-        skew = max(abs(tensor[i][j] - tensor[j][i]) for i in range(3) for j in range(3))
-        if skew > ASYMMETRY_TOLERANCE * max(abs(tensor[i][i]) for i in range(3)):
+        if rot3.is_asymmetric(tensor):
+            skew = rot3.inertia_skew(tensor)
             yield diag(
                 "MK301",
                 f'link "{link.name}": the inertia matrix is not symmetric (off-diagonal pairs differ by up '
@@ -249,8 +246,7 @@ def inertia(robot: Robot) -> Iterator[Diagnostic]:
                 hint="give the same value to each off-diagonal pair (row-major: xy = yx, xz = zx, yz = zy)",
             )
             # judged further as what every target gets: convert writes the upper triangle
-            tensor = rot3.inertia_from_moments(tensor[0][0], tensor[0][1], tensor[0][2], tensor[1][1],
-                                               tensor[1][2], tensor[2][2])
+            tensor = rot3.upper_symmetric(tensor)
             upper = " (its upper triangle, which convert writes)"
         else:
             upper = ""

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from modelkit import rot3
 from modelkit.convert.commit import CommitRefused, Entry, identity
 from modelkit.convert.context import WriteContext
 from modelkit.convert.extras_notes import note_foreign_extras
@@ -95,6 +96,8 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
                    f"not written: {target.name} has no exclusion of one link pair (MJCF's <contact><exclude> "
                    "has)", robot.collision_exclusions[0].source, "collision")
     out = copy.deepcopy(robot)
+    if target.name != "body":
+        upper_triangle_inertias(out)
     settle_base(out, options.base, notes)
     note_rolling_faults(out, notes)
     note_tipping(out, notes)
@@ -110,6 +113,22 @@ def prepare(robot: Robot, target: TargetInfo, options: WriteOptions, notes: Note
     if options.merge_fixed:
         merge_fixed_joints(out, notes)
     return out
+
+
+def upper_triangle_inertias(robot: Robot) -> list[str]:
+    """Give each link whose inertia matrix is asymmetric (a ``.body`` file's nine numbers, validate's
+    MK301) the symmetric matrix of its upper triangle, in place: the one rule every six-number target
+    follows (the URDF, SDF and MJCF writers wrote the upper triangle, the average and the average).
+    Returns the links changed. ``.body`` keeps the nine numbers as Choreonoid uses them."""
+    changed = []
+    for link in robot.links:
+        if link.inertial is None:
+            continue
+        tensor = rot3.mat3(rot3.peek(link.inertial, "inertia"))
+        if rot3.all_finite(tensor) and rot3.is_asymmetric(tensor):
+            link.inertial.inertia = rot3.upper_symmetric(tensor)
+            changed.append(link.name)
+    return changed
 
 
 def _check_mass_properties(robot: Robot) -> None:
