@@ -157,12 +157,21 @@ def collision_shape_differs(robot: Robot) -> Iterator[Diagnostic]:
 
 
 def _shape_key(geom: Geom) -> tuple[object, ...]:
-    """What makes two shapes the same, triangles in memory compared by content."""
+    """What makes two shapes the same, triangles in memory compared by content. Read from the stored
+    values (:func:`_plain`): an array field's getter would import numpy, which validate does not."""
     g = geom.geometry
     if not isinstance(g, Mesh):
-        return (repr(g),)
+        return (type(g).__name__, *(_plain(value) for _, value in sorted(vars(g).items())))
     data = None if g.data is None else (g.data.vertices.tobytes(), g.data.faces.tobytes())
-    return ("mesh", g.uri, g.path, g.fragment, tuple(float(v) for v in g.scale), g.generator, data)
+    return ("mesh", g.uri, g.path, g.fragment, _plain(rot3.peek(g, "scale")), g.generator, data)
+
+
+def _plain(value: object) -> object:
+    """A stored number, vector or matrix as nested tuples of floats (a numpy array by its ``tolist``)."""
+    listed = value.tolist() if hasattr(value, "tolist") else value
+    if isinstance(listed, (list, tuple)):
+        return tuple(_plain(item) for item in listed)
+    return float(listed) if isinstance(listed, (int, float)) else repr(listed)
 
 
 @rule("collision-repeated", "MK411")
