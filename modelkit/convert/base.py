@@ -52,7 +52,7 @@ import numpy as np
 
 from modelkit.convert.moving_paths import MovingPaths
 from modelkit.convert.notes import NoteSink
-from modelkit.geometry.extents import extent
+from modelkit.geometry.extents import across, extent
 from modelkit.model import WORLD_LINK, Cylinder, Geom, Joint, JointType, Robot, Sphere
 from modelkit.spatial import Pose
 
@@ -397,8 +397,7 @@ def _rotors(robot: Robot, poses: dict[str, Pose], touching: set[str], use_collis
 def _flat_along(geom: Geom, axis: np.ndarray) -> bool:
     """Whether the shape is at most :data:`ROTOR_FLATNESS` of its reach across ``axis`` thick along it."""
     along = extent([geom], axis)
-    side = np.cross(axis, _UP if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0]))
-    across_span = extent([geom], side / np.linalg.norm(side))
+    across_span = extent([geom], across(axis)[0])
     if along is None or across_span is None:
         return False
     radius = (across_span[1] - across_span[0]) / 2
